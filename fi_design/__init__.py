@@ -1,0 +1,60 @@
+"""fi_design: design guideline, simulation and reports for friction isolators.
+
+A friction isolator is a compliant flexure joint between an actuated stage and
+the cart of a rolling or sliding bearing, with stroke limiters. Near standstill
+the controller feels the smooth flexure instead of the friction discontinuity,
+and friction-induced hunting disappears. This package implements the four-step
+design guideline of the paper (friction gap, crossover, drive stiffness, PID
+gains), confirms it with a nonlinear LuGre simulation, and renders sign-off
+reports.
+
+The public API (imported lazily, so ``import fi_design`` stays fast):
+
+- :func:`load_spec` -- read and validate a YAML spec or a mapping;
+- :func:`design` -- the four guideline steps and the simulated confirmation;
+- :func:`simulate` -- one nonlinear simulation;
+- :func:`sweep`, :func:`robustness` -- parameter studies;
+- :func:`load_measurement`, :func:`reconcile` -- compare with measured data;
+- :func:`render_report` -- HTML or PDF report.
+
+All values are SI floats; units are stated in the docstrings.
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from importlib.metadata import PackageNotFoundError, version as _version
+
+try:
+    __version__ = _version("fi_design")
+except PackageNotFoundError:  # running from a source tree without install
+    __version__ = "0.0.0+unknown"
+
+_API = {
+    "load_spec": "fi_design.specfile",
+    "Spec": "fi_design.spec",
+    "design": "fi_design.guideline",
+    "DesignResult": "fi_design.guideline",
+    "simulate": "fi_design.simulate",
+    "SimulationResult": "fi_design.simulate",
+    "sweep": "fi_design.sweep",
+    "robustness": "fi_design.sweep",
+    "load_measurement": "fi_design.measured",
+    "reconcile": "fi_design.reconcile",
+    "render_report": "fi_design.report",
+    "FiDesignError": "fi_design.errors",
+    "SpecError": "fi_design.errors",
+    "DataError": "fi_design.errors",
+}
+
+__all__ = sorted(_API) + ["__version__"]
+
+
+def __getattr__(name: str):
+    if name in _API:
+        return getattr(import_module(_API[name]), name)
+    raise AttributeError(f"module 'fi_design' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return __all__

@@ -1,0 +1,5 @@
+"""``python -m fi_design``: the command-line interface."""
+
+from fi_design.cli import main
+
+main()

@@ -1,0 +1,182 @@
+"""The catalogue of physical effects the model can carry (DESIGN.md section 5).
+
+Effects are data. Each :class:`Effect` has a stable name, a one-line physical
+description and its :class:`Parameter` entries (unit, fitting bounds, neutral
+value). The simulation kernel implements every effect once, with a neutral
+default; an effect only sets kernel parameters (``Parameter.kernel_field``),
+so adding one to a spec never changes the compiled code.
+
+Effects compose with ``+`` into an :class:`EffectSet`, which refuses two
+effects that set the same kernel parameter (like lmfit's composite models
+refuse colliding parameter names).
+
+A spec lists applied effects under ``effects:`` as ``{type: NAME, PARAM: value,
+...}``; see :func:`fi_design.spec.Spec`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One parameter of an effect.
+
+    Attributes
+    ----------
+    name : str
+        Key in the spec's effect entry and in result dictionaries.
+    unit : str
+        SI unit (``"1"`` for a plain fraction, ``"rad"`` for phases).
+    description : str
+        What it is, in one line.
+    kernel_field : str
+        Name of the :class:`fi_design.plant.PlantParameters` field it sets.
+    bounds : tuple of float
+        Search range for the reconciliation fit, SI. When ``relative`` is true,
+        factors applied to the nominal value instead.
+    neutral : float or None
+        The value that leaves the model unchanged; ``None`` means "the nominal
+        spec value" (for effects that correct a spec parameter).
+    relative : bool
+        Whether ``bounds`` are factors on the nominal value.
+    log : bool
+        Whether a fit should search this parameter on a logarithmic scale.
+    periodic : bool
+        Whether the parameter is a phase (wraps at 2 pi, searched on a grid).
+    required : bool
+        Whether a spec entry must give it (optional ones take ``neutral``).
+    """
+
+    name: str
+    unit: str
+    description: str
+    kernel_field: str
+    bounds: tuple[float, float]
+    neutral: float | None = 0.0
+    relative: bool = False
+    log: bool = False
+    periodic: bool = False
+    required: bool = True
+
+
+@dataclass(frozen=True)
+class Effect:
+    """A named physical effect: parameters and how it enters the model.
+
+    Attributes
+    ----------
+    name : str
+        Stable name from DESIGN.md section 5.
+    description : str
+        How the effect enters the equations, one line.
+    parameters : tuple of Parameter
+        Its parameters.
+    """
+
+    name: str
+    description: str
+    parameters: tuple[Parameter, ...]
+
+    @property
+    def kernel_fields(self) -> tuple[str, ...]:
+        """Kernel parameters this effect sets."""
+        return tuple(p.kernel_field for p in self.parameters)
+
+    def parameter(self, name: str) -> Parameter:
+        """Return the parameter called ``name`` (KeyError if absent)."""
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def __add__(self, other: "Effect | EffectSet") -> "EffectSet":
+        return EffectSet((self,)) + other
+
+
+@dataclass(frozen=True)
+class EffectSet:
+    """Several effects applied together; no two may set the same kernel field."""
+
+    effects: tuple[Effect, ...] = field(default_factory=tuple)
+
+    def __post_init__(self) -> None:
+        seen: dict[str, str] = {}
+        for eff in self.effects:
+            for f in eff.kernel_fields:
+                if f in seen:
+                    raise ValueError(f"effects '{seen[f]}' and '{eff.name}' both set '{f}'")
+                seen[f] = eff.name
+
+    def __add__(self, other: "Effect | EffectSet") -> "EffectSet":
+        more = other.effects if isinstance(other, EffectSet) else (other,)
+        return EffectSet(self.effects + tuple(more))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Names of the effects, in order."""
+        return tuple(e.name for e in self.effects)
+
+
+_TWO_PI = 2.0 * math.pi
+
+CATALOGUE: dict[str, Effect] = {e.name: e for e in (
+    Effect("viscous_friction", "the bearing's viscous coefficient sigma2 differs from nominal", (
+        Parameter("viscous", "N*s/m", "true viscous friction coefficient sigma2", "sigma2",
+                  (0.0, 500.0), neutral=None),)),
+    Effect("stribeck_velocity", "the Stribeck velocity vs differs from nominal", (
+        Parameter("stribeck_velocity", "m/s", "true Stribeck velocity vs", "vs",
+                  (1e-5, 0.1), neutral=None, log=True),)),
+    Effect("position_dependent_friction",
+           "Fs and Fc scaled by 1 + a sin(2 pi x2 / wavelength + phase) along the rail", (
+        Parameter("amplitude", "1", "relative amplitude a of the friction variation", "pdf_amplitude",
+                  (0.0, 0.9)),
+        Parameter("wavelength", "m", "spatial period of the variation", "pdf_wavelength",
+                  (2e-4, 0.05), neutral=1.0, log=True),
+        Parameter("phase", "rad", "phase of the variation at x2 = 0", "pdf_phase",
+                  (-math.pi, math.pi), periodic=True, required=False),)),
+    Effect("force_ripple", "extra force A sin(2 pi x1 / pitch + phase) on the stage (motor cogging)", (
+        Parameter("amplitude", "N", "ripple force amplitude A", "ripple_amplitude", (0.0, 10.0)),
+        Parameter("pitch", "m", "spatial period of the ripple", "ripple_pitch",
+                  (2e-4, 0.05), neutral=1.0, log=True),
+        Parameter("phase", "rad", "phase of the ripple at x1 = 0", "ripple_phase",
+                  (-math.pi, math.pi), periodic=True, required=False),)),
+    Effect("cable_force", "extra force -k_c (x1 - x1(0)) - F0 on the stage (cable slab)", (
+        Parameter("stiffness", "N/m", "cable stiffness k_c", "cable_stiffness", (-500.0, 500.0)),
+        Parameter("preload", "N", "constant cable force F0", "cable_preload", (-10.0, 10.0),
+                  required=False),)),
+    Effect("time_delay", "the actuator force u is applied `delay` later", (
+        Parameter("delay", "s", "extra loop delay", "delay", (0.0, 0.02)),)),
+    Effect("quantization", "the controller sees round(x1 / q) q", (
+        Parameter("resolution", "m", "position quantization step q", "quantization",
+                  (1e-8, 1e-4), log=True),)),
+    Effect("force_saturation", "the actuator force is clipped to +-limit", (
+        Parameter("limit", "N", "actuator force limit", "force_limit", (0.1, 1000.0),
+                  neutral=math.inf, log=True),)),
+    Effect("mass_error", "the true stage and cart masses differ from nominal", (
+        Parameter("stage_mass", "kg", "true stage mass m1", "m1", (0.5, 2.0), neutral=None,
+                  relative=True, required=False),
+        Parameter("cart_mass", "kg", "true cart mass m2", "m2", (0.5, 2.0), neutral=None,
+                  relative=True, required=False),)),
+    Effect("joint_damping", "the joint damping c of the isolator differs from nominal", (
+        Parameter("damping", "N*s/m", "true joint damping c", "c", (0.0, 200.0), neutral=None),)),
+)}
+
+#: Stable effect names, in catalogue order.
+EFFECT_NAMES: tuple[str, ...] = tuple(CATALOGUE)
+
+
+def get(name: str) -> Effect:
+    """Return the catalogue entry ``name``.
+
+    Raises
+    ------
+    KeyError
+        With the list of known names, when ``name`` is not in the catalogue.
+    """
+    try:
+        return CATALOGUE[name]
+    except KeyError:
+        raise KeyError(f"unknown effect {name!r}; known: {', '.join(EFFECT_NAMES)}") from None

@@ -1,0 +1,112 @@
+"""Result values shared by the analyses: checks and the one path to JSON.
+
+Results are frozen dataclasses with a docstring per field (unit and shape).
+Array fields use ``eq=False`` dataclasses and are copied and made read-only by
+:func:`frozen_array`. :func:`to_jsonable` turns any result into plain JSON
+data: dataclasses to dicts, arrays to lists, infinities and NaN to ``None``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+
+class Status(str, enum.Enum):
+    """Outcome of a check."""
+
+    PASS = "PASS"
+    FAIL = "FAIL"
+    WARN = "WARN"
+    INFO = "INFO"
+
+
+@dataclass(frozen=True)
+class Check:
+    """One guideline check: data, not prose.
+
+    Attributes
+    ----------
+    name : str
+        Short identifier, e.g. ``"friction_gap"``.
+    passed : bool or None
+        True if the requirement holds, False if not, None for warnings and
+        information that have no pass/fail meaning.
+    value : float or None
+        The computed quantity, in ``unit``.
+    limit : float or None
+        The requirement it is compared with, in ``unit``.
+    unit : str
+        Unit of ``value`` and ``limit`` (``"N"``, ``"Hz"``, ``"deg"``, ``"-"``).
+    message : str
+        One sentence a reviewer can read.
+    step : str
+        Where the check comes from: a guideline step or paper section.
+    status : Status
+        PASS, FAIL, WARN or INFO; derived from ``passed`` unless given.
+    """
+
+    name: str
+    passed: bool | None
+    value: float | None
+    limit: float | None
+    unit: str
+    message: str
+    step: str = ""
+    status: Status | None = None
+
+    def __post_init__(self) -> None:
+        if self.status is None:
+            st = Status.INFO if self.passed is None else (Status.PASS if self.passed else Status.FAIL)
+            object.__setattr__(self, "status", st)
+
+
+def frozen_array(values, dtype=float) -> np.ndarray:
+    """Copy ``values`` into a new read-only array."""
+    arr = np.array(values, dtype=dtype, copy=True)
+    arr.flags.writeable = False
+    return arr
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert a result (dataclasses, arrays, enums, floats) to plain JSON data.
+
+    Infinite and NaN floats become ``None`` (JSON has no infinity); numpy
+    scalars become Python numbers; tuples become lists.
+    """
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        if hasattr(obj, "to_dict"):
+            return obj.to_dict()
+        return dataclass_dict(obj)
+    if isinstance(obj, enum.Enum):
+        return obj.value
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return [to_jsonable(v) for v in obj.tolist()]
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        x = float(obj)
+        return x if math.isfinite(x) else None
+    if hasattr(obj, "model_dump"):  # pydantic spec sections
+        return to_jsonable(obj.model_dump())
+    return obj
+
+
+def dataclass_dict(obj: Any) -> dict:
+    """Field-by-field :func:`to_jsonable` of a dataclass.
+
+    A result's own ``to_dict`` builds on this (calling :func:`to_jsonable` on
+    itself would recurse). Fields declared with ``repr=False`` are left out.
+    """
+    return {f.name: to_jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj) if f.repr}

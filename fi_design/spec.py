@@ -1,0 +1,500 @@
+"""The design spec: validated, immutable, in SI.
+
+A spec mirrors the YAML file key for key (DESIGN.md section 3), so one dotted
+path (``friction.static``, ``isolator.stroke``) names a quantity in the file, in
+error messages, in ``fi-design sweep --x PATH=...`` and in JSON. Every physical
+field accepts an SI number or a string with units; after validation it holds an
+SI float (frequencies in Hz, phase margins in degrees, gain margins in dB).
+
+Defaults live here and only here: the ``Field`` defaults below, plus four that
+depend on other values, computed by the functions at the end of this module
+(:func:`bristle_damping`, :func:`joint_damping`, :func:`limiter_damping`,
+:func:`proposed_stiffness`). ``fi-design schema`` prints them all.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal, Union
+
+from pydantic import (BaseModel, BeforeValidator, ConfigDict, Discriminator, Field, PrivateAttr,
+                      Tag, WithJsonSchema, create_model, model_validator)
+
+from . import effects as _effects
+from .reference import jerk_profile_times
+from .units import to_si
+
+# --------------------------------------------------------------------------- quantities
+
+
+def _parser(unit: str):
+    def parse(value: Any) -> Any:
+        if value is None:
+            return None
+        return to_si(value, unit)
+
+    return parse
+
+
+def Q(unit: str, **schema: Any):
+    """A float field holding a quantity converted to ``unit`` (SI, Hz, deg or dB)."""
+    shown = {"deg": "degree", "dB": "decibel", "1": "dimensionless"}.get(unit, unit)
+    json = {"anyOf": [{"type": "number"}, {"type": "string"}], "x-unit": shown} \
+        if unit not in ("deg", "dB") else {"type": "string", "x-unit": shown}
+    json.update(schema)
+    return Annotated[float, BeforeValidator(_parser(unit)), WithJsonSchema(json)]
+
+
+def OptQ(unit: str):
+    """Like :func:`Q` but ``null`` allowed."""
+    shown = {"deg": "degree", "dB": "decibel", "1": "dimensionless"}.get(unit, unit)
+    json = {"anyOf": [{"type": "number"}, {"type": "string"}, {"type": "null"}], "x-unit": shown}
+    return Annotated[Union[float, None], BeforeValidator(_parser(unit)), WithJsonSchema(json)]
+
+
+class StrictModel(BaseModel):
+    """Base of every spec section: unknown keys are errors, values immutable and finite."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False,
+                              str_strip_whitespace=True)
+
+
+# --------------------------------------------------------------------------- sections
+
+
+class Body(StrictModel):
+    """A rigid body."""
+
+    mass: Q("kg") = Field(gt=0, description="Mass [kg].")
+
+
+class Friction(StrictModel):
+    """Friction of the bearing, acting on the cart (LuGre, Canudas de Wit et al. 1995)."""
+
+    model: Literal["lugre", "switch"] = Field(
+        "lugre", description="Friction model: 'lugre' (default) or 'switch' (Karnopp-type "
+                             "stick-slip cross-check).")
+    static: Q("N") = Field(gt=0, description="Static friction force Fs [N].")
+    coulomb: Q("N") = Field(gt=0, description="Coulomb (sliding) friction force Fc [N].")
+    stribeck_velocity: Q("m/s") = Field(gt=0, description="Stribeck velocity vs [m/s].")
+    viscous: Q("N*s/m") = Field(0.0, ge=0, description="Viscous friction coefficient sigma2 "
+                                                        "[N s/m]. Default 0.")
+    bristle_stiffness: Q("N/m") = Field(1e6, gt=0, description="Bristle (presliding) stiffness "
+                                                               "sigma0 [N/m]. Default 1e6 N/m.")
+    bristle_damping: OptQ("N*s/m") = Field(
+        None, ge=0, description="Bristle damping sigma1 [N s/m]. Default sqrt(sigma0 (m1 + m2)): "
+                                "damping ratio 0.5 of the whole moving mass on the bristles.")
+
+    @model_validator(mode="after")
+    def _static_above_coulomb(self) -> "Friction":
+        if self.static < self.coulomb:
+            raise ValueError(f"static friction Fs = {self.static:g} N must be at least the "
+                             f"Coulomb friction Fc = {self.coulomb:g} N")
+        return self
+
+
+class Limiter(StrictModel):
+    """Compliant stroke limiter (end stop) of the joint."""
+
+    stiffness: Q("N/m") = Field(1e6, gt=0, description="Contact stiffness k_stop [N/m]. "
+                                                       "Default 1e6 N/m.")
+    damping: OptQ("N*s/m") = Field(None, ge=0, description="Contact damping c_stop [N s/m]. "
+                                                           "Default 2 * 0.2 * sqrt(k_stop m1).")
+
+
+class ParasiticMode(StrictModel):
+    """A parasitic resonance of the flexure, added to the linear limit cases."""
+
+    name: str = Field("mode", description="Label used in reports.")
+    frequency: Q("Hz") = Field(gt=0, description="Resonance frequency [Hz].")
+    damping_ratio: float = Field(0.01, ge=0, lt=1, description="Modal damping ratio [-]. "
+                                                               "Default 0.01.")
+    collocated: bool = Field(False, description="True: an antiresonance precedes the resonance "
+                                                "(phase returns); false: the resonance adds a "
+                                                "180 degree phase drop.")
+    antiresonance: OptQ("Hz") = Field(None, gt=0, description="Antiresonance of a collocated "
+                                                              "mode [Hz]. Default frequency / "
+                                                              "sqrt(2).")
+
+    @model_validator(mode="after")
+    def _anti_below(self) -> "ParasiticMode":
+        if self.antiresonance is not None and self.antiresonance >= self.frequency:
+            raise ValueError("antiresonance must lie below the resonance frequency")
+        return self
+
+
+class Material(StrictModel):
+    """Flexure material."""
+
+    youngs_modulus: Q("Pa") = Field(gt=0, description="Young's modulus E [Pa].")
+    allowed_stress: Q("Pa") = Field(gt=0, description="Allowed bending stress [Pa] (fatigue "
+                                                      "limit with safety).")
+    density: Q("kg/m**3") = Field(gt=0, description="Density [kg/m^3].")
+
+
+Bounds = tuple[Q("m"), Q("m")]
+
+
+class Flexure(StrictModel):
+    """Parallel leaf-spring guide to size in step 3."""
+
+    material: Material
+    leaves: int = Field(2, ge=2, le=8, description="Number of parallel leaves. Default 2.")
+    length: Bounds = Field((5e-3, 100e-3), description="Leaf length range [m]. Default "
+                                                       "5 mm to 100 mm.")
+    width: Bounds = Field((2e-3, 50e-3), description="Leaf width range [m]. Default 2 mm to 50 mm.")
+    thickness: Bounds = Field((0.05e-3, 2e-3), description="Leaf thickness range [m]. Default "
+                                                           "0.05 mm to 2 mm.")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "Flexure":
+        for name in ("length", "width", "thickness"):
+            lo, hi = getattr(self, name)
+            if not 0 < lo <= hi:
+                raise ValueError(f"{name} must be [min, max] with 0 < min <= max")
+        return self
+
+
+class Isolator(StrictModel):
+    """The friction isolator: a compliant joint between stage and cart, with limiters."""
+
+    stiffness: OptQ("N/m") = Field(None, gt=0, description="Drive stiffness k [N/m]. Omit to let "
+                                                           "step 3 propose one (k_max / 2).")
+    stroke: Q("m") = Field(gt=0, description="One-sided stroke s before the limiter engages [m].")
+    damping: OptQ("N*s/m") = Field(None, ge=0, description="Joint damping c [N s/m]. Default "
+                                                           "damping ratio 0.05 of the joint mode: "
+                                                           "2 * 0.05 * sqrt(k m1 m2 / (m1 + m2)).")
+    limiter: Limiter = Field(default_factory=Limiter)
+    parasitic_modes: tuple[ParasiticMode, ...] = Field((), description="Parasitic resonances of "
+                                                                        "the flexure.")
+    flexure: Flexure | None = Field(None, description="Optional: size a parallel leaf-spring "
+                                                      "guide that realises the stiffness.")
+
+
+class Controller(StrictModel):
+    """PID controller tuned from the crossover (DESIGN.md section 2, paper section 2.2)."""
+
+    crossover: Q("Hz") = Field(gt=0, description="Desired crossover frequency fc [Hz].")
+    derivative_ratio: float = Field(3.0, gt=1, description="wd = wc / ratio and wt = ratio * wc. "
+                                                           "Default 3.")
+    integrator_ratio: float = Field(10.0, gt=1, description="wi = wc / ratio. Default 10.")
+    tuning_mass: Literal["total", "stage"] = Field(
+        "total", description="Mass the gains are tuned on: 'total' (m1 + m2, default) or 'stage'.")
+    sample_rate: OptQ("Hz") = Field(None, gt=0, description="Sample rate of a discrete controller "
+                                                            "[Hz]; null for continuous time.")
+    delay: Q("s") = Field(0.0, ge=0, description="Computational delay [s]. Default 0.")
+    pade_order: int = Field(3, ge=1, le=10, description="Order of the Pade approximation of the "
+                                                        "delay in the linear analysis. Default 3.")
+
+
+class Move(StrictModel):
+    """A point-to-point move with a trapezoidal (or jerk-limited) velocity profile."""
+
+    distance: Q("m") = Field(description="Signed travel [m].")
+    velocity: Q("m/s") = Field(gt=0, description="Maximum velocity [m/s].")
+    acceleration: Q("m/s**2") = Field(gt=0, description="Maximum acceleration [m/s^2].")
+    jerk: OptQ("m/s**3") = Field(None, gt=0, description="Maximum jerk [m/s^3]; null for a "
+                                                         "trapezoidal velocity.")
+    start: OptQ("s") = Field(None, ge=0, description="Start time [s]; null: right after the "
+                                                     "previous move.")
+
+    @model_validator(mode="after")
+    def _nonzero(self) -> "Move":
+        if self.distance == 0:
+            raise ValueError("distance must not be zero")
+        return self
+
+
+class Motion(StrictModel):
+    """Reference motion: moves run one after another, then hold."""
+
+    moves: tuple[Move, ...] = Field(min_length=1, description="The moves.")
+    duration: Q("s") = Field(20.0, gt=0, description="Simulated time [s]. Default 20 s.")
+
+    @model_validator(mode="after")
+    def _in_order(self) -> "Motion":
+        t = 0.0
+        for i, mv in enumerate(self.moves):
+            if mv.start is not None and mv.start < t - 1e-12:
+                raise ValueError(f"moves[{i}] starts at {mv.start:g} s, before moves[{i - 1}] ends "
+                                 f"at {t:.4g} s")
+            t = (mv.start if mv.start is not None else t) + move_duration(mv)
+        return self
+
+
+class Hunting(StrictModel):
+    """Settings of the hunting metric (paper section 2.3)."""
+
+    window_start: Q("s") = Field(10.0, ge=0, description="Start of the counting window [s]. "
+                                                         "Default 10 s.")
+    window_length: Q("s") = Field(10.0, gt=0, description="Length of the window [s]. "
+                                                          "Default 10 s.")
+    min_distance: Q("s") = Field(0.5, gt=0, description="Minimum time between peaks [s]. "
+                                                        "Default 0.5 s.")
+    min_height: Q("m") = Field(1e-4, gt=0, description="Minimum peak height of x1 - r [m]. "
+                                                       "Default 0.1 mm.")
+    settle_band: Q("m") = Field(1e-5, gt=0, description="Error band for 'settled' and the "
+                                                        "settling time [m]. Default 10 um.")
+
+
+class Requirements(StrictModel):
+    """Design requirements and metric settings."""
+
+    friction_gap: Q("N") = Field(1.0, gt=0, description="Fs - Fc above which hunting is a risk "
+                                                        "[N]. Default 1 N (paper).")
+    parasitic_separation: float = Field(3.0, ge=1, description="Parasitic modes must lie above "
+                                                               "this times the crossover. "
+                                                               "Default 3.")
+    phase_margin: Q("deg") = Field(30.0, ge=0, lt=180, description="Minimum phase margin "
+                                                                  "[deg]. Default 30 deg.")
+    gain_margin: Q("dB") = Field(6.0, ge=0, description="Minimum gain margin [dB]. Default 6 dB.")
+    modulus_margin: float | None = Field(None, gt=0, le=1, description="Minimum modulus margin "
+                                                                       "min|1 + L| [-]; null: "
+                                                                       "not required.")
+    stiffness_safety: float = Field(1.0, ge=1, description="k_max = Fs / (safety * stroke). "
+                                                           "Default 1 (the paper's rule).")
+    hunting: Hunting = Field(default_factory=Hunting)
+
+
+class Measurement(StrictModel):
+    """What the sensors add (for reconciliation); estimated from data when absent."""
+
+    position_noise: OptQ("m") = Field(None, ge=0, description="Position noise std [m].")
+    deflection_noise: OptQ("m") = Field(None, ge=0, description="Deflection noise std [m].")
+    force_noise: OptQ("N") = Field(None, ge=0, description="Force noise std [N].")
+
+
+class CrossoverScan(StrictModel):
+    """Grid of the scan for the lowest hunting-free crossover."""
+
+    start: Q("Hz") = Field(1.0, gt=0, description="Lowest crossover scanned [Hz]. Default 1 Hz.")
+    stop: Q("Hz") = Field(30.0, gt=0, description="Highest crossover scanned [Hz]. "
+                                                  "Default 30 Hz.")
+    step: Q("Hz") = Field(0.5, gt=0, description="Scan resolution [Hz]. Default 0.5 Hz.")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "CrossoverScan":
+        if self.stop <= self.start:
+            raise ValueError("stop must be above start")
+        return self
+
+
+class Simulation(StrictModel):
+    """Settings of the nonlinear simulation."""
+
+    tolerance: float = Field(1e-6, gt=1e-12, lt=1e-2, description="Relative tolerance of the "
+                                                                  "adaptive integrator. "
+                                                                  "Default 1e-6.")
+    output_rate: Q("Hz") = Field(1000.0, gt=0, description="Sample rate of the output traces "
+                                                           "[Hz]. Default 1 kHz.")
+    max_steps: int = Field(2_000_000, ge=1000, description="Step budget per simulation.")
+    crossover_scan: CrossoverScan = Field(default_factory=CrossoverScan)
+
+
+class ReportInfo(StrictModel):
+    """Title block of the sign-off report."""
+
+    document_id: str = Field("FI-0001", description="Document id.")
+    revision: str = Field("A", description="Revision.")
+    status: str = Field("draft", description="Status (draft unless given).")
+    author: str | None = Field(None, description="Prepared by.")
+    map: bool = Field(False, description="Add a crossover x stroke map around the design point.")
+
+
+# --------------------------------------------------------------------------- effects
+
+
+def _effect_model(effect: _effects.Effect):
+    fields: dict[str, Any] = {"type": (Literal[effect.name], Field(description=effect.description))}
+    for p in effect.parameters:
+        kind = p.unit
+        if p.required:
+            fields[p.name] = (Q(kind), Field(description=f"{p.description} [{p.unit}]."))
+        else:
+            fields[p.name] = (OptQ(kind), Field(None, description=f"{p.description} [{p.unit}]. "
+                                                                  "Optional."))
+    model = create_model("Effect_" + effect.name, __base__=StrictModel, **fields)
+    model.__doc__ = effect.description
+    return model
+
+
+EFFECT_MODELS = {name: _effect_model(e) for name, e in _effects.CATALOGUE.items()}
+
+
+def _effect_tag(value: Any) -> str | None:
+    if isinstance(value, dict):
+        return value.get("type")
+    return getattr(value, "type", None)
+
+
+EffectEntry = Annotated[
+    Union[tuple(Annotated[m, Tag(n)] for n, m in EFFECT_MODELS.items())],
+    Discriminator(_effect_tag, custom_error_type="unknown_effect",
+                  custom_error_message="unknown effect type; known: " +
+                  ", ".join(_effects.EFFECT_NAMES)),
+]
+
+
+# --------------------------------------------------------------------------- the spec
+
+
+class Spec(StrictModel):
+    """A friction-isolator design spec (DESIGN.md section 3), values in SI."""
+
+    name: str = Field("Unnamed stage", description="Project or stage name.")
+    stage: Body = Field(description="The actuated stage (m1, carries the sensor).")
+    cart: Body = Field(description="The bearing cart (m2, friction acts on it).")
+    friction: Friction
+    isolator: Isolator | None = Field(None, description="Omit for a stage without isolator.")
+    controller: Controller
+    motion: Motion
+    requirements: Requirements = Field(default_factory=Requirements)
+    measurement: Measurement | None = None
+    effects: tuple[EffectEntry, ...] = Field((), description="Effects added to the model "
+                                                             "(DESIGN.md section 5).")
+    report: ReportInfo = Field(default_factory=ReportInfo)
+    simulation: Simulation = Field(default_factory=Simulation)
+
+    #: Where the spec was read from (set by fi_design.specfile.load_spec).
+    _origin: Any = PrivateAttr(default=None)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "Spec":
+        h = self.requirements.hunting
+        end = h.window_start + h.window_length
+        if end > self.motion.duration * (1 + 1e-9):
+            raise ValueError(f"the hunting window ends at {end:g} s, after motion.duration = "
+                             f"{self.motion.duration:g} s")
+        names = [e.type for e in self.effects]
+        dupes = sorted({n for n in names if names.count(n) > 1})
+        if dupes:
+            raise ValueError(f"effect listed twice: {', '.join(dupes)}")
+        if "joint_damping" in names and self.isolator is None:
+            raise ValueError("effect joint_damping needs an isolator")
+        return self
+
+    # convenience views, all SI
+    @property
+    def has_isolator(self) -> bool:
+        """Whether the spec describes a stage with a friction isolator."""
+        return self.isolator is not None
+
+    @property
+    def total_mass(self) -> float:
+        """m1 + m2 [kg]."""
+        return self.stage.mass + self.cart.mass
+
+
+# --------------------------------------------------------------------------- derived defaults
+
+
+def bristle_damping(spec: Spec) -> float:
+    """Bristle damping sigma1 [N s/m]: the given value, else sqrt(sigma0 (m1 + m2))."""
+    f = spec.friction
+    if f.bristle_damping is not None:
+        return f.bristle_damping
+    return math.sqrt(f.bristle_stiffness * spec.total_mass)
+
+
+def limiter_damping(spec: Spec) -> float:
+    """Limiter contact damping c_stop [N s/m]: given, else 2 * 0.2 * sqrt(k_stop m1)."""
+    lim = spec.isolator.limiter if spec.isolator else Limiter()
+    if lim.damping is not None:
+        return lim.damping
+    return 2.0 * 0.2 * math.sqrt(lim.stiffness * spec.stage.mass)
+
+
+def stiffness_limit(spec: Spec, stroke: float | None = None) -> float:
+    """Maximum drive stiffness k_max = Fs / (safety * stroke) [N/m] (guideline step 3)."""
+    s = stroke if stroke is not None else spec.isolator.stroke
+    return spec.friction.static / (spec.requirements.stiffness_safety * s)
+
+
+def proposed_stiffness(spec: Spec, stroke: float | None = None) -> float:
+    """Drive stiffness proposed when the spec gives none [N/m]: k_max / 2.
+
+    Half the maximum keeps the flexure force at full stroke at Fs / 2, leaving
+    room for friction scatter along the rail, while the joint stays stiff
+    enough to push the cart at Coulomb friction within the stroke as long as
+    Fc < Fs / 2.
+    """
+    return 0.5 * stiffness_limit(spec, stroke)
+
+
+def drive_stiffness(spec: Spec) -> float:
+    """The joint stiffness k used for analysis [N/m]: given, else :func:`proposed_stiffness`."""
+    iso = spec.isolator
+    if iso is None:
+        raise ValueError("spec has no isolator")
+    return iso.stiffness if iso.stiffness is not None else proposed_stiffness(spec)
+
+
+def joint_damping(spec: Spec, stiffness: float | None = None) -> float:
+    """Joint damping c [N s/m]: given, else 2 * 0.05 * sqrt(k m1 m2 / (m1 + m2))."""
+    iso = spec.isolator
+    if iso is None:
+        raise ValueError("spec has no isolator")
+    if iso.damping is not None:
+        return iso.damping
+    k = stiffness if stiffness is not None else drive_stiffness(spec)
+    m1, m2 = spec.stage.mass, spec.cart.mass
+    return 2.0 * 0.05 * math.sqrt(k * m1 * m2 / (m1 + m2))
+
+
+def antiresonance(mode: ParasiticMode) -> float:
+    """Antiresonance of a collocated parasitic mode [Hz]: given, else frequency / sqrt(2)."""
+    return mode.antiresonance if mode.antiresonance is not None else mode.frequency / math.sqrt(2.0)
+
+
+# --------------------------------------------------------------------------- warnings
+
+
+def warnings_for(spec: Spec) -> list[tuple[str, str]]:
+    """Suspicious but legal input, as ``(path, message)`` pairs.
+
+    Checks the LuGre dissipativity condition sigma1 < sigma2 Fc / (Fs - Fc), a
+    hunting window that starts before the last move ends, a stroke smaller than
+    the presliding range and effects with neutral values.
+    """
+    out: list[tuple[str, str]] = []
+    f = spec.friction
+    gap = f.static - f.coulomb
+    if f.model == "lugre" and gap > 0:
+        s1 = bristle_damping(spec)
+        bound = f.viscous * f.coulomb / gap
+        if s1 >= bound:
+            out.append(("friction.bristle_damping",
+                        f"sigma1 = {s1:.4g} N s/m exceeds sigma2 Fc / (Fs - Fc) = {bound:.4g} N s/m: "
+                        "the LuGre model is not guaranteed dissipative (Barabanov and Ortega); "
+                        "common in practice, but watch for unphysical presliding oscillation"))
+    if spec.isolator is not None:
+        presl = f.static / f.bristle_stiffness
+        if spec.isolator.stroke < 5 * presl:
+            out.append(("isolator.stroke",
+                        f"stroke {spec.isolator.stroke * 1e3:.3g} mm is within 5x the presliding "
+                        f"range Fs/sigma0 = {presl * 1e6:.3g} um: the joint can hardly isolate"))
+    t_end = _motion_end(spec)
+    if t_end > spec.requirements.hunting.window_start:
+        out.append(("requirements.hunting.window_start",
+                    f"the last move ends at {t_end:.3g} s, inside the hunting window that starts at "
+                    f"{spec.requirements.hunting.window_start:g} s"))
+    return out
+
+
+def _motion_end(spec: Spec) -> float:
+    t = 0.0
+    for mv in spec.motion.moves:
+        t0 = mv.start if mv.start is not None else t
+        t = t0 + move_duration(mv)
+    return t
+
+
+def move_duration(mv: Move) -> float:
+    """Duration of one move [s] (trapezoidal, or jerk-limited when ``jerk`` is set)."""
+    d, v, a, j = abs(mv.distance), mv.velocity, mv.acceleration, mv.jerk
+    if j is None:
+        if v * v / a >= d:  # triangular
+            return 2.0 * math.sqrt(d / a)
+        return d / v + v / a
+    tj, ta, tv = jerk_profile_times(d, v, a, j)
+    return 4 * tj + 2 * ta + tv

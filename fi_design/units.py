@@ -1,0 +1,151 @@
+"""The unit boundary: strings with units in, SI floats out.
+
+pint is used here and nowhere else. Inside the package every physical value is
+an SI float; the spec file may give a bare number (read as SI) or a string such
+as ``"0.3 mm"``, ``"2 N/mm"`` or ``"5 Hz"``.
+
+Three kinds of quantity need care:
+
+- Frequencies are stored in Hz. pint treats the radian as dimensionless, so
+  ``"62.8 rad/s"`` would silently convert to 62.8 Hz. Here any angle unit in a
+  frequency (rad/s, deg/s, rpm, cycles/s) is converted through rad/s and divided
+  by 2 pi, so ``"62.83 rad/s"`` is 10 Hz.
+- Angles (phase margins) are stored in degrees and must carry a unit: a bare
+  30 could be degrees or radians.
+- Gain ratios given in decibels (``"6 dB"``) are stored in dB; a bare number is
+  refused for the same reason.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from functools import lru_cache
+
+from .errors import UnitError
+
+#: Target units understood by :func:`to_si`, with the dimension users see in messages.
+KNOWN_UNITS = {
+    "1": "dimensionless",
+    "kg": "mass",
+    "m": "length",
+    "s": "time",
+    "N": "force",
+    "N/m": "stiffness (force per length)",
+    "N*s/m": "damping (force per velocity)",
+    "m/s": "velocity",
+    "m/s**2": "acceleration",
+    "m/s**3": "jerk",
+    "Hz": "frequency",
+    "Pa": "pressure or stress",
+    "kg/m**3": "density",
+    "rad": "angle",
+    "deg": "angle",
+    "dB": "gain in decibels",
+}
+
+_DB = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*dB\s*$")
+
+
+@lru_cache(maxsize=1)
+def registry():
+    """Return the shared pint UnitRegistry (created on first use, about 0.2 s)."""
+    import pint
+
+    return pint.UnitRegistry()
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _finite(x: float, path: str | None, text) -> float:
+    if not math.isfinite(x):
+        raise UnitError(f"value {text!r} is not a finite number", path=path)
+    return float(x)
+
+
+def to_si(value, unit: str, path: str | None = None) -> float:
+    """Convert a spec value to an SI float (or Hz, deg, dB for those kinds).
+
+    Parameters
+    ----------
+    value : float, int or str
+        A bare number (taken as already in ``unit``) or a string with units.
+    unit : str
+        Target unit, one of :data:`KNOWN_UNITS`.
+    path : str, optional
+        Dotted spec path, used in error messages.
+
+    Returns
+    -------
+    float
+        The value in ``unit``.
+
+    Raises
+    ------
+    UnitError
+        Unparsable text, wrong dimension, not finite, or a bare number where a
+        unit is required (angles, decibels).
+    """
+    if unit not in KNOWN_UNITS:  # programming error, not user input
+        raise ValueError(f"unknown target unit {unit!r}")
+    if _is_number(value):
+        if unit in ("deg", "rad"):
+            raise UnitError(f"a bare number is ambiguous for an angle; write e.g. '{value} deg'",
+                            path=path)
+        if unit == "dB":
+            raise UnitError(f"a bare number is ambiguous for a gain; write e.g. '{value} dB'",
+                            path=path)
+        return _finite(float(value), path, value)
+    if not isinstance(value, str):
+        raise UnitError(f"expected a number or a string with units, got {type(value).__name__}",
+                        path=path)
+    text = value.strip()
+    if not text:
+        raise UnitError("empty value", path=path)
+    if unit == "dB":
+        m = _DB.match(text)
+        if not m:
+            raise UnitError(f"cannot read {value!r} as a gain in dB (write e.g. '6 dB')", path=path)
+        return _finite(float(m.group(1)), path, value)
+    return _finite(_convert(text, unit, path), path, value)
+
+
+def _convert(text: str, unit: str, path: str | None) -> float:
+    import pint
+
+    ureg = registry()
+    try:
+        q = ureg.Quantity(text)
+    except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError,
+            AssertionError, KeyError, ZeroDivisionError) as exc:
+        raise UnitError(f"cannot read {text!r} as a quantity in {unit} ({exc})", path=path) from None
+    if unit == "1":
+        if not q.dimensionless:
+            raise UnitError(f"{text!r} has units of {q.dimensionality}, expected a plain number",
+                            path=path)
+        return float(q.to("dimensionless").magnitude)
+    if unit == "Hz" and _has_angle(q):
+        try:
+            return float(q.to("rad/s").magnitude) / (2.0 * math.pi)
+        except pint.errors.DimensionalityError:
+            pass
+    if unit in ("deg", "rad") and q.unitless:
+        raise UnitError(f"{text!r} has no unit; write e.g. '{text} deg'", path=path)
+    try:
+        return float(q.to(unit).magnitude)
+    except pint.errors.DimensionalityError:
+        raise UnitError(f"{text!r} is not a {KNOWN_UNITS[unit]} (expected units convertible to {unit},"
+                        f" got {q.dimensionality})", path=path) from None
+
+
+def _has_angle(q) -> bool:
+    """True if the quantity's units contain an angle (radian, degree, revolution, ...)."""
+    ureg = registry()
+    for name in q.unit_items() if hasattr(q, "unit_items") else q._units.items():
+        uname = name[0]
+        _, root = ureg.get_root_units(uname)
+        if "radian" in str(root):
+            return True
+    return False
