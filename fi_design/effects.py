@@ -48,6 +48,9 @@ class Parameter:
         Whether the parameter is a phase (wraps at 2 pi, searched on a grid).
     required : bool
         Whether a spec entry must give it (optional ones take ``neutral``).
+    combine : str
+        ``"set"``: the value replaces the kernel parameter; ``"add"``: it adds
+        to the nominal one (an extra delay on top of the controller's).
     """
 
     name: str
@@ -60,6 +63,7 @@ class Parameter:
     log: bool = False
     periodic: bool = False
     required: bool = True
+    combine: str = "set"
 
 
 @dataclass(frozen=True)
@@ -148,7 +152,7 @@ CATALOGUE: dict[str, Effect] = {e.name: e for e in (
         Parameter("preload", "N", "constant cable force F0", "cable_preload", (-10.0, 10.0),
                   required=False),)),
     Effect("time_delay", "the actuator force u is applied `delay` later", (
-        Parameter("delay", "s", "extra loop delay", "delay", (0.0, 0.02)),)),
+        Parameter("delay", "s", "extra loop delay", "delay", (0.0, 0.02), combine="add"),)),
     Effect("quantization", "the controller sees round(x1 / q) q", (
         Parameter("resolution", "m", "position quantization step q", "quantization",
                   (1e-8, 1e-4), log=True),)),

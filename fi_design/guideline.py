@@ -1,0 +1,811 @@
+"""The four-step design guideline (paper section 4) and its result.
+
+Each step is a function of the spec returning a frozen result that carries its
+checks (:class:`~fi_design.results.Check`):
+
+1. :func:`step1_friction_gap` -- is ``Fs - Fc`` above ``requirements.friction_gap``?
+   Then stick-slip, and with an integrator hunting, is a risk.
+2. :func:`step2_crossover` -- the desired crossover against the achievable one
+   (the highest crossover at which all linear limit cases keep the required
+   margins and the parasitic modes stay ``parasitic_separation`` times above
+   it), with the margins of each limit case at the desired crossover.
+3. :func:`step3_stiffness` -- ``k_max = Fs / (stiffness_safety * stroke)``, the
+   chosen stiffness (given, or proposed as ``k_max / 2``) checked against it;
+   :func:`step3_flexure` sizes a leaf-spring guide when the spec asks for one.
+4. :func:`step4_pid` -- the PID gains from the tuning mass and the crossover.
+
+:func:`design` runs the four steps and returns a :class:`DesignResult`, whose
+``to_dict()`` is the JSON contract of ``fi-design SPEC.yaml --json``. Without
+an isolator in the spec, :func:`isolator_advice` says whether one looks needed
+and which stroke and stiffness to start from.
+
+The nonlinear confirmation is not part of this module: a simulation result is
+attached with ``design(spec, simulation=...)`` or
+:meth:`DesignResult.with_simulation`, and appears in JSON under ``simulation``
+only when set.
+
+The linear analysis (python-control) is imported inside the step functions,
+so importing this module stays fast.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Mapping
+
+from .flexure import FlexureResult, size_flexure
+from .pid import PidGains, tune_pid
+from .results import Check, Status, dataclass_dict, to_jsonable
+from .spec import Spec, drive_stiffness, proposed_stiffness, stiffness_limit, warnings_for
+
+__all__ = [
+    "SUGGESTED_STROKE", "FrictionGapResult", "ModeSeparation", "CrossoverResult",
+    "StiffnessResult", "PidResult", "IsolatorAdvice", "DesignResult", "step1_friction_gap",
+    "step2_crossover", "step3_stiffness", "step3_flexure", "step4_pid", "isolator_advice",
+    "design",
+]
+
+log = logging.getLogger(__name__)
+
+#: Stroke suggested for a first isolator design [m]: the paper's 0.3 mm.
+SUGGESTED_STROKE = 0.3e-3
+
+
+def _g(x: float | None, digits: int = 4) -> str:
+    """``digits`` significant digits; plain (no exponent) from 1e4 to 1e6."""
+    if x is None:
+        return "-"
+    if 1e4 <= abs(x) < 1e6:
+        return f"{x:.0f}"
+    return f"{x:.{digits}g}"
+
+
+# --------------------------------------------------------------------------- step 1
+
+
+@dataclass(frozen=True)
+class FrictionGapResult:
+    """Step 1: the gap between static and Coulomb friction.
+
+    Attributes
+    ----------
+    static : float
+        Static friction Fs [N].
+    coulomb : float
+        Coulomb friction Fc [N].
+    gap : float
+        Fs - Fc [N].
+    threshold : float
+        ``requirements.friction_gap`` [N]: above it hunting is a risk.
+    hunting_risk : bool
+        ``gap >= threshold``.
+    checks : tuple of Check
+        The step's checks (also in :attr:`DesignResult.checks`).
+    """
+
+    static: float
+    coulomb: float
+    gap: float
+    threshold: float
+    hunting_risk: bool
+    checks: tuple[Check, ...] = field(default=(), repr=False)
+
+    def to_dict(self) -> dict:
+        """Plain JSON data (checks are listed once, in the design's ``checks``)."""
+        return dataclass_dict(self)
+
+
+def step1_friction_gap(spec: Spec) -> FrictionGapResult:
+    """Guideline step 1: compare Fs - Fc with ``requirements.friction_gap``.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+
+    Returns
+    -------
+    FrictionGapResult
+        The gap [N], the threshold [N] and whether hunting is a risk. The
+        check is PASS below the threshold and WARN (a risk, not a design
+        error) at or above it.
+    """
+    f = spec.friction
+    gap = f.static - f.coulomb
+    thr = spec.requirements.friction_gap
+    risk = gap >= thr
+    if risk:
+        msg = (f"Fs - Fc = {gap:.3g} N is at or above the {thr:.3g} N threshold: stick-slip "
+               "can make an integrating controller hunt")
+    else:
+        msg = (f"Fs - Fc = {gap:.3g} N is below the {thr:.3g} N threshold: stick-slip, and so "
+               "hunting, is unlikely")
+    check = Check("friction_gap", not risk, gap, thr, "N", msg, step="1 friction gap",
+                  status=Status.WARN if risk else Status.PASS)
+    return FrictionGapResult(static=f.static, coulomb=f.coulomb, gap=gap, threshold=thr,
+                             hunting_risk=risk, checks=(check,))
+
+
+# --------------------------------------------------------------------------- step 2
+
+
+@dataclass(frozen=True)
+class ModeSeparation:
+    """A parasitic mode against the crossover.
+
+    Attributes
+    ----------
+    name : str
+        The mode's label.
+    frequency : float
+        Its frequency [Hz].
+    required : float
+        ``parasitic_separation`` x desired crossover [Hz].
+    collocated : bool
+        Collocated (antiresonance first) or not.
+    passed : bool
+        ``frequency >= required``.
+    """
+
+    name: str
+    frequency: float
+    required: float
+    collocated: bool
+    passed: bool
+
+
+@dataclass(frozen=True)
+class CrossoverResult:
+    """Step 2: desired and achievable crossover, margins per limit case.
+
+    Attributes
+    ----------
+    desired : float
+        ``controller.crossover`` [Hz].
+    achievable : float or None
+        Highest crossover meeting all requirements [Hz]; None if none does.
+    limited_by : str
+        What limits the achievable crossover, in words.
+    limit_kind : str
+        ``margin``, ``mode``, ``scan_limit`` or ``infeasible``
+        (see :class:`fi_design.linear.AchievableCrossover`).
+    limiting_case : str or None
+        Case name when a margin limits.
+    feasible_ranges : tuple of tuple of float
+        Feasible crossover stretches of the scan [Hz].
+    delay : float
+        Loop delay in the linear analysis [s] (computational plus half a
+        sample period).
+    stiffness : float or None
+        Joint stiffness the cases use [N/m]; None without isolator.
+    cases : tuple of fi_design.linear.CaseMargins
+        Margins of each limit case with the PID tuned at the desired crossover.
+    parasitic_modes : tuple of ModeSeparation
+        Each parasitic mode against ``parasitic_separation`` x desired crossover.
+    checks : tuple of Check
+        The step's checks.
+    """
+
+    desired: float
+    achievable: float | None
+    limited_by: str
+    limit_kind: str
+    limiting_case: str | None
+    feasible_ranges: tuple[tuple[float, float], ...]
+    delay: float
+    stiffness: float | None
+    cases: tuple[Any, ...]
+    parasitic_modes: tuple[ModeSeparation, ...]
+    checks: tuple[Check, ...] = field(default=(), repr=False)
+
+    def to_dict(self) -> dict:
+        """Plain JSON data."""
+        return dataclass_dict(self)
+
+
+def step2_crossover(spec: Spec) -> CrossoverResult:
+    """Guideline step 2: desired versus achievable crossover.
+
+    The limit cases use the spec's joint stiffness (the proposed one when the
+    spec gives none, as step 3 would choose).
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+
+    Returns
+    -------
+    CrossoverResult
+        Achievable crossover and its limit, per-case margins at the desired
+        crossover, the parasitic separation, and the checks: one reachability
+        check, phase and gain margin (and modulus margin if required) per case,
+        one separation check per parasitic mode.
+    """
+    from . import linear
+
+    req = spec.requirements
+    fc = spec.controller.crossover
+    cases = linear.limit_cases(spec)
+    at = linear.analyse(spec, fc, cases=cases)
+    ach = linear.achievable_crossover(spec)
+    step = "2 crossover"
+    checks: list[Check] = []
+    reach = ach.frequency is not None and fc <= ach.frequency * (1 + 1e-9)
+    if ach.frequency is None:
+        msg = f"no crossover is achievable: {ach.limited_by}"
+    elif reach:
+        msg = (f"the desired crossover {fc:.4g} Hz is at or below the achievable "
+               f"{ach.frequency:.4g} Hz (limited by {ach.limited_by})")
+    else:
+        msg = (f"the desired crossover {fc:.4g} Hz is above the achievable {ach.frequency:.4g} Hz "
+               f"(limited by {ach.limited_by})")
+    checks.append(Check("crossover_achievable", reach, fc, ach.frequency, "Hz", msg, step=step))
+
+    for c in at.cases:
+        where = f"case {linear.CASE_NUMBERS[c.name]} ({c.description})"
+        at_f = f" at {c.crossover:.3g} Hz" if c.crossover is not None else ""
+        if c.stable:
+            msg = f"{where}: phase margin {c.phase_margin_deg:.3g} deg{at_f}"
+        else:
+            msg = f"{where}: the closed loop is unstable"
+        checks.append(Check(f"phase_margin.{c.name}", c.stable and
+                            c.phase_margin_deg >= req.phase_margin, c.phase_margin_deg,
+                            req.phase_margin, "deg", msg, step=step))
+        gm = c.gain_margin_db
+        if math.isinf(gm):
+            msg = f"{where}: the phase never crosses -180 deg, unlimited gain margin"
+        elif gm < 0:
+            msg = (f"{where}: gain margin {gm:.3g} dB (a lower margin: the loop goes unstable "
+                   f"if the gain falls {abs(gm):.3g} dB)")
+        else:
+            msg = f"{where}: gain margin {gm:.3g} dB"
+        checks.append(Check(f"gain_margin.{c.name}", c.stable and abs(gm) >= req.gain_margin,
+                            abs(gm), req.gain_margin, "dB", msg, step=step))
+        if req.modulus_margin is not None:
+            checks.append(Check(f"modulus_margin.{c.name}",
+                                c.stable and c.modulus_margin >= req.modulus_margin,
+                                c.modulus_margin, req.modulus_margin, "-",
+                                f"{where}: modulus margin min|1 + L| = {c.modulus_margin:.3g}",
+                                step=step))
+
+    modes = []
+    sep = req.parasitic_separation
+    for m in (spec.isolator.parasitic_modes if spec.isolator is not None else ()):
+        need = sep * fc
+        ok = m.frequency >= need
+        modes.append(ModeSeparation(m.name, m.frequency, need, m.collocated, ok))
+        checks.append(Check(
+            f"parasitic_separation.{m.name}", ok, m.frequency, need, "Hz",
+            f"parasitic mode '{m.name}' at {m.frequency:.4g} Hz "
+            + ("lies above" if ok else "lies below")
+            + f" {sep:g} x the desired crossover ({need:.4g} Hz)", step=step))
+
+    return CrossoverResult(
+        desired=fc, achievable=ach.frequency, limited_by=ach.limited_by, limit_kind=ach.kind,
+        limiting_case=ach.case, feasible_ranges=ach.feasible_ranges, delay=at.delay,
+        stiffness=at.stiffness, cases=at.cases, parasitic_modes=tuple(modes),
+        checks=tuple(checks))
+
+
+# --------------------------------------------------------------------------- step 3
+
+
+@dataclass(frozen=True)
+class StiffnessResult:
+    """Step 3: the maximum and the chosen drive stiffness.
+
+    Attributes
+    ----------
+    maximum : float
+        k_max = Fs / (stiffness_safety x stroke) [N/m].
+    chosen : float
+        The spec's stiffness, else the proposed k_max / 2 [N/m]. Without an
+        isolator: the stiffness suggested to start from.
+    source : str
+        Where ``chosen`` comes from, in words.
+    stroke : float
+        One-sided stroke [m] (the suggested one without isolator).
+    static : float
+        Static friction Fs [N].
+    safety : float
+        ``requirements.stiffness_safety`` [-].
+    force_at_stroke : float
+        Flexure force at full stroke, chosen x stroke [N]; stays below Fs.
+    suggested : bool
+        True when the spec has no isolator and the values are a suggestion.
+    checks : tuple of Check
+        The step's checks.
+    """
+
+    maximum: float
+    chosen: float
+    source: str
+    stroke: float
+    static: float
+    safety: float
+    force_at_stroke: float
+    suggested: bool
+    checks: tuple[Check, ...] = field(default=(), repr=False)
+
+    def to_dict(self) -> dict:
+        """Plain JSON data."""
+        return dataclass_dict(self)
+
+
+def step3_stiffness(spec: Spec) -> StiffnessResult:
+    """Guideline step 3: maximum drive stiffness from static friction and stroke.
+
+    ``k_max = Fs / (stiffness_safety * stroke)``: at full stroke the flexure must
+    push the cart with less than static friction, or the joint cannot keep the
+    cart still while the stage settles. Lower is better for hunting; the
+    flexure's parasitic frequencies bound how low (step 3 flexure sizing).
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec. Without an isolator the suggested stroke
+        (:data:`SUGGESTED_STROKE`) is used and the result is a suggestion.
+
+    Returns
+    -------
+    StiffnessResult
+        k_max, the chosen stiffness and why, with a check chosen <= k_max.
+    """
+    Fs = spec.friction.static
+    safety = spec.requirements.stiffness_safety
+    step = "3 drive stiffness"
+    if spec.isolator is None:
+        s = SUGGESTED_STROKE
+        kmax = stiffness_limit(spec, s)
+        k = proposed_stiffness(spec, s)
+        msg = (f"no isolator in the spec; for a {s * 1e3:.3g} mm stroke k_max = {_g(kmax)} N/m, "
+               f"start from k = {_g(k)} N/m (k_max / 2)")
+        check = Check("drive_stiffness", None, k, kmax, "N/m", msg, step=step)
+        return StiffnessResult(maximum=kmax, chosen=k, source="suggested: k_max / 2 for the "
+                               "paper's 0.3 mm stroke (no isolator in the spec)", stroke=s,
+                               static=Fs, safety=safety, force_at_stroke=k * s, suggested=True,
+                               checks=(check,))
+    s = spec.isolator.stroke
+    kmax = stiffness_limit(spec, s)
+    k = drive_stiffness(spec)
+    if spec.isolator.stiffness is not None:
+        source = "given in the spec (isolator.stiffness)"
+    else:
+        source = ("proposed: k_max / 2, so the flexure force at full stroke is Fs / 2, leaving "
+                  "room for friction scatter")
+    ok = k <= kmax * (1 + 1e-12)
+    msg = (f"k = {_g(k)} N/m ({source.split(':')[0].split(' (')[0]}) "
+           + ("is at or below" if ok else "exceeds")
+           + f" k_max = Fs / {'stroke' if safety == 1 else f'({safety:g} x stroke)'} = "
+           f"{_g(kmax)} N/m; flexure force at full "
+           f"stroke {k * s:.3g} N against Fs = {Fs:.3g} N")
+    check = Check("drive_stiffness", ok, k, kmax, "N/m", msg, step=step)
+    return StiffnessResult(maximum=kmax, chosen=k, source=source, stroke=s, static=Fs,
+                           safety=safety, force_at_stroke=k * s, suggested=False,
+                           checks=(check,))
+
+
+def step3_flexure(spec: Spec, stiffness: StiffnessResult | None = None) -> FlexureResult | None:
+    """Guideline step 3, second half: size the leaf-spring guide of ``isolator.flexure``.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+    stiffness : StiffnessResult, optional
+        Step 3's stiffness result (computed when omitted).
+
+    Returns
+    -------
+    FlexureResult or None
+        None when the spec has no ``isolator.flexure`` section. The required
+        parasitic frequency is ``parasitic_separation`` x the desired crossover.
+    """
+    if spec.isolator is None or spec.isolator.flexure is None:
+        return None
+    st = stiffness if stiffness is not None else step3_stiffness(spec)
+    return size_flexure(spec.isolator.flexure, target_stiffness=st.chosen,
+                        maximum_stiffness=st.maximum, stroke=st.stroke,
+                        stage_mass=spec.stage.mass,
+                        required_frequency=spec.requirements.parasitic_separation
+                        * spec.controller.crossover)
+
+
+def _flexure_checks(fx: FlexureResult | None) -> tuple[Check, ...]:
+    if fx is None:
+        return ()
+    step = "3 flexure"
+    if not fx.feasible:
+        return (Check("flexure", False, None, None, "-",
+                      f"no {fx.leaves}-leaf guide within the bounds fits: {fx.reason}",
+                      step=step),)
+    dims = (f"{fx.leaves} leaves L x b x t = {fx.length * 1e3:.3g} x {fx.width * 1e3:.3g} x "
+            f"{fx.thickness * 1e3:.3g} mm")
+    return (
+        Check("flexure.stiffness", fx.drive_stiffness <= fx.maximum_stiffness * (1 + 1e-9),
+              fx.drive_stiffness, fx.maximum_stiffness, "N/m",
+              f"{dims}: drive stiffness {_g(fx.drive_stiffness)} N/m (target "
+              f"{_g(fx.target_stiffness)} N/m, k_max {_g(fx.maximum_stiffness)} N/m)", step=step),
+        Check("flexure.stress", fx.stress <= fx.allowed_stress, fx.stress, fx.allowed_stress,
+              "Pa", f"bending stress at full stroke {fx.stress / 1e6:.3g} MPa, allowed "
+              f"{fx.allowed_stress / 1e6:.4g} MPa (margin x{fx.stress_margin:.3g})", step=step),
+        Check("flexure.support_frequency", fx.support_frequency >= fx.required_frequency,
+              fx.support_frequency, fx.required_frequency, "Hz",
+              f"support-direction frequency {fx.support_frequency:.4g} Hz with the stage "
+              f"mass, required {fx.required_frequency:.4g} Hz", step=step),
+        Check("flexure.bending_frequency", fx.bending_frequency >= fx.required_frequency,
+              fx.bending_frequency, fx.required_frequency, "Hz",
+              f"leaf bending resonance {fx.bending_frequency:.4g} Hz (clamped-guided, "
+              f"conservative), required {fx.required_frequency:.4g} Hz", step=step),
+    )
+
+
+# --------------------------------------------------------------------------- step 4
+
+
+@dataclass(frozen=True)
+class PidResult:
+    """Step 4: the PID gains.
+
+    Attributes
+    ----------
+    gains : fi_design.pid.PidGains
+        The gains (JSON: flattened into the ``pid`` object).
+    tuning_rule : str
+        ``total`` (m1 + m2, the paper's choice) or ``stage`` (m1).
+    derivative_ratio : float
+        wd = wc / ratio, wt = ratio x wc [-].
+    integrator_ratio : float
+        wi = wc / ratio [-].
+    checks : tuple of Check
+        The step's checks.
+    """
+
+    gains: PidGains
+    tuning_rule: str
+    derivative_ratio: float
+    integrator_ratio: float
+    checks: tuple[Check, ...] = field(default=(), repr=False)
+
+    def to_dict(self) -> dict:
+        """Flat JSON: the gains' fields plus the rule and ratios."""
+        return {**self.gains.to_dict(), "tuning_rule": self.tuning_rule,
+                "derivative_ratio": self.derivative_ratio,
+                "integrator_ratio": self.integrator_ratio}
+
+
+def step4_pid(spec: Spec) -> PidResult:
+    """Guideline step 4: PID gains from the moving mass and the desired crossover.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+
+    Returns
+    -------
+    PidResult
+        The gains (:func:`fi_design.pid.tune_pid`) and an informational check;
+        tuning on the stage mass alone gives a WARN (the paper found the
+        maximum moving mass best).
+    """
+    ctl = spec.controller
+    g = tune_pid(spec)
+    step = "4 PID"
+    msg = (f"tuned at {g.crossover:.4g} Hz on {g.tuning_mass:.4g} kg: kp = {g.kp:.4g} N/m, "
+           f"ki = {g.ki:.4g} N/(m s), kd = {g.kd:.4g} N s/m, wt = {g.wt:.4g} rad/s")
+    checks = [Check("pid", None, g.kp, None, "N/m", msg, step=step)]
+    if ctl.tuning_mass == "stage" and spec.isolator is not None:
+        checks.append(Check(
+            "pid.tuning_mass", None, g.tuning_mass, spec.total_mass, "kg",
+            "tuned on the stage mass alone: with the limiter engaged the loop sees m1 + m2 and "
+            "crosses over lower (the paper tunes on the maximum moving mass)", step=step,
+            status=Status.WARN))
+    return PidResult(gains=g, tuning_rule=ctl.tuning_mass, derivative_ratio=ctl.derivative_ratio,
+                     integrator_ratio=ctl.integrator_ratio, checks=tuple(checks))
+
+
+# --------------------------------------------------------------------------- no isolator
+
+
+@dataclass(frozen=True)
+class IsolatorAdvice:
+    """Whether a stage without isolator looks like it needs one.
+
+    Attributes
+    ----------
+    needed : bool or None
+        True: an isolator is recommended; False: not needed; None: it depends
+        on whether a higher crossover removes hunting (simulate to decide).
+    reason : str
+        Why, in words.
+    stroke : float
+        Stroke to start from [m] (the paper's 0.3 mm).
+    stiffness : float
+        Stiffness to start from, Fs / (2 x safety x stroke) [N/m].
+    maximum_stiffness : float
+        k_max for that stroke [N/m].
+    """
+
+    needed: bool | None
+    reason: str
+    stroke: float
+    stiffness: float
+    maximum_stiffness: float
+
+
+def isolator_advice(spec: Spec, gap: FrictionGapResult, crossover: CrossoverResult,
+                    ) -> IsolatorAdvice:
+    """For a stage without isolator: does one look needed, and where to start.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec (no isolator section).
+    gap : FrictionGapResult
+        Step 1.
+    crossover : CrossoverResult
+        Step 2.
+
+    Returns
+    -------
+    IsolatorAdvice
+        Needed when the friction gap is a hunting risk and the reachable
+        crossover is limited; not needed below the gap threshold; undecided
+        when the linear model sets no crossover limit within the scan.
+    """
+    s = SUGGESTED_STROKE
+    k = proposed_stiffness(spec, s)
+    kmax = stiffness_limit(spec, s)
+    start = (f"start from a {s * 1e3:.3g} mm stroke (the paper's) and k = {_g(k)} N/m "
+             f"(Fs / (2 x stroke); k_max = {_g(kmax)} N/m)")
+    if not gap.hunting_risk:
+        return IsolatorAdvice(False, f"the friction gap {gap.gap:.3g} N is below the "
+                              f"{gap.threshold:.3g} N threshold: an isolator is not needed",
+                              s, k, kmax)
+    if crossover.limit_kind == "scan_limit":
+        return IsolatorAdvice(None, (
+            f"the friction gap {gap.gap:.3g} N is a hunting risk, but the linear model limits "
+            f"the crossover nowhere up to {_g(crossover.achievable)} Hz: a high enough crossover "
+            "may avoid hunting without an isolator (the paper needed about 3x the isolated "
+            "crossover); add the loop delay to the spec and simulate to decide; for an "
+            f"isolator, {start}"), s, k, kmax)
+    return IsolatorAdvice(True, (
+        f"the friction gap {gap.gap:.3g} N is a hunting risk and the crossover is limited to "
+        f"{_g(crossover.achievable)} Hz ({crossover.limited_by}): an isolator is recommended; "
+        f"{start}"), s, k, kmax)
+
+
+# --------------------------------------------------------------------------- the design
+
+
+@dataclass(frozen=True)
+class DesignResult:
+    """The four guideline steps for one spec.
+
+    Attributes
+    ----------
+    spec : fi_design.spec.Spec
+        The spec that produced the result (not in JSON; see ``spec_sha256``).
+    friction_gap : FrictionGapResult
+        Step 1.
+    crossover : CrossoverResult
+        Step 2.
+    stiffness : StiffnessResult
+        Step 3 (a suggestion without isolator).
+    flexure : fi_design.flexure.FlexureResult or None
+        Step 3 leaf-spring sizing; None without ``isolator.flexure``.
+    pid : PidResult
+        Step 4.
+    isolator_advice : IsolatorAdvice or None
+        Only for a spec without isolator.
+    checks : tuple of Check
+        All checks of the four steps, in step order.
+    warnings : tuple of (str, str)
+        ``(path, message)`` of suspicious spec values
+        (:func:`fi_design.spec.warnings_for`).
+    conclusion : str
+        One paragraph in plain words.
+    fi_design_version : str
+        Version of fi_design that computed it.
+    spec_sha256 : str
+        SHA-256 of the spec file (of the spec's JSON when not read from a file).
+    simulation : object or None
+        The nonlinear confirmation, when attached (:meth:`with_simulation`);
+        emitted in JSON only when set.
+    """
+
+    spec: Spec = field(repr=False)
+    friction_gap: FrictionGapResult
+    crossover: CrossoverResult
+    stiffness: StiffnessResult
+    flexure: FlexureResult | None
+    pid: PidResult
+    isolator_advice: IsolatorAdvice | None
+    checks: tuple[Check, ...]
+    warnings: tuple[tuple[str, str], ...]
+    conclusion: str
+    fi_design_version: str
+    spec_sha256: str
+    simulation: Any = None
+
+    @property
+    def passed(self) -> bool:
+        """No check failed (warnings and information do not count)."""
+        return not any(c.status == Status.FAIL for c in self.checks)
+
+    @property
+    def failed_checks(self) -> tuple[Check, ...]:
+        """The checks with status FAIL."""
+        return tuple(c for c in self.checks if c.status == Status.FAIL)
+
+    def with_simulation(self, simulation: Any, conclusion: str | None = None) -> "DesignResult":
+        """A copy with the nonlinear confirmation attached.
+
+        Parameters
+        ----------
+        simulation : object
+            The simulation's result (anything :func:`fi_design.results.to_jsonable`
+            can serialise, e.g. a frozen dataclass with ``to_dict``).
+        conclusion : str, optional
+            A conclusion that includes the simulation's verdict; default keeps
+            the linear one.
+        """
+        return replace(self, simulation=simulation,
+                       conclusion=self.conclusion if conclusion is None else conclusion)
+
+    def to_dict(self) -> dict:
+        """The JSON contract: SI values, infinite margins as null.
+
+        Keys: ``name``, ``passed``, ``friction_gap``, ``crossover``, ``stiffness``,
+        ``flexure``, ``pid``, ``isolator_advice``, ``checks``, ``warnings``,
+        ``conclusion``, ``fi_design_version``, ``spec_sha256`` and, when set,
+        ``simulation``.
+        """
+        out = {
+            "name": self.spec.name,
+            "passed": self.passed,
+            "friction_gap": self.friction_gap.to_dict(),
+            "crossover": self.crossover.to_dict(),
+            "stiffness": self.stiffness.to_dict(),
+            "flexure": None if self.flexure is None else self.flexure.to_dict(),
+            "pid": self.pid.to_dict(),
+            "isolator_advice": to_jsonable(self.isolator_advice),
+            "checks": [to_jsonable(c) for c in self.checks],
+            "warnings": [{"path": p, "message": m} for p, m in self.warnings],
+            "conclusion": self.conclusion,
+            "fi_design_version": self.fi_design_version,
+            "spec_sha256": self.spec_sha256,
+        }
+        if self.simulation is not None:
+            out["simulation"] = to_jsonable(self.simulation)
+        return out
+
+
+def _sha256(spec: Spec) -> str:
+    from .specfile import origin
+
+    org = origin(spec)
+    if org is not None:
+        return org.sha256
+    return hashlib.sha256(spec.model_dump_json().encode()).hexdigest()
+
+
+def design(spec: Spec | str | Path | Mapping[str, Any], *, simulation: Any = None,
+           ) -> DesignResult:
+    """Run the four guideline steps on a spec.
+
+    Parameters
+    ----------
+    spec : Spec, path or mapping
+        A validated spec, or a YAML path or mapping for
+        :func:`fi_design.specfile.load_spec`.
+    simulation : object, optional
+        A nonlinear confirmation to attach (see :meth:`DesignResult.with_simulation`).
+
+    Returns
+    -------
+    DesignResult
+        Steps 1 to 4, all checks, warnings and a conclusion.
+
+    Raises
+    ------
+    fi_design.errors.SpecError
+        When ``spec`` is a path or mapping that does not validate.
+
+    """
+    from . import __version__
+
+    if not isinstance(spec, Spec):
+        from .specfile import load_spec
+
+        spec = load_spec(spec)
+    gap = step1_friction_gap(spec)
+    xo = step2_crossover(spec)
+    st = step3_stiffness(spec)
+    fx = step3_flexure(spec, st)
+    pid = step4_pid(spec)
+    advice = isolator_advice(spec, gap, xo) if spec.isolator is None else None
+    checks = gap.checks + xo.checks + st.checks + _flexure_checks(fx) + pid.checks
+    result = DesignResult(
+        spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,
+        isolator_advice=advice, checks=checks, warnings=tuple(warnings_for(spec)),
+        conclusion=_conclusion(spec, gap, xo, st, fx, pid, advice, checks),
+        fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None)
+    log.info("design of %r: %d checks, %d failed", spec.name, len(checks),
+             len(result.failed_checks))
+    return result if simulation is None else result.with_simulation(simulation)
+
+
+def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: StiffnessResult,
+                fx: FlexureResult | None, pid: PidResult, advice: IsolatorAdvice | None,
+                checks: tuple[Check, ...]) -> str:
+    from .linear import CASE_NUMBERS
+
+    parts = []
+    if gap.hunting_risk:
+        parts.append(f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, at or above "
+                     f"the {gap.threshold:.3g} N threshold, so stick-slip can make the "
+                     "integrating controller hunt.")
+    else:
+        parts.append(f"Static friction exceeds Coulomb friction by only {gap.gap:.3g} N, below "
+                     f"the {gap.threshold:.3g} N threshold, so hunting is unlikely"
+                     + (" and the isolator may not be needed." if spec.isolator is not None
+                        else "."))
+    n = len(xo.cases)
+    bad = [c for c in xo.cases if not c.passed]
+    pms = [c.phase_margin_deg for c in xo.cases]
+    gms = [abs(c.gain_margin_db) for c in xo.cases]
+    margins = (f"phase margins of at least {min(pms):.3g} deg and gain margins of at least "
+               f"{min(gms):.3g} dB" if all(math.isfinite(x) for x in gms)
+               else f"phase margins of at least {min(pms):.3g} deg")
+    if xo.achievable is None:
+        ach = f"no crossover meets the requirements ({xo.limited_by})"
+    elif xo.limit_kind == "scan_limit":
+        ach = (f"the linear model limits the crossover nowhere up to the scan limit of "
+               f"{xo.achievable:.4g} Hz")
+    else:
+        ach = f"the achievable crossover is {xo.achievable:.3g} Hz, limited by {xo.limited_by}"
+    if not bad:
+        every = "both" if n == 2 else f"all {n}"
+        parts.append(f"At the desired crossover of {xo.desired:.3g} Hz {every} linear limit "
+                     f"cases are stable with {margins}; {ach}.")
+    else:
+        which = ", ".join(f"case {CASE_NUMBERS[c.name]} ({c.description}: "
+                          f"{', '.join(c.failed)})" for c in bad)
+        parts.append(f"At the desired crossover of {xo.desired:.3g} Hz the margins fail in "
+                     f"{which}; {ach}.")
+    if spec.isolator is not None:
+        ok = st.chosen <= st.maximum * (1 + 1e-12)
+        parts.append(f"The drive stiffness of {_g(st.chosen)} N/m is "
+                     + ("within" if ok else "above")
+                     + f" the maximum of {_g(st.maximum)} N/m, so the flexure pushes the cart "
+                     f"with {st.force_at_stroke:.3g} N at full stroke against {st.static:.3g} N "
+                     "of static friction.")
+        if fx is not None:
+            if fx.feasible:
+                parts.append(
+                    f"A {fx.leaves}-leaf spring guide (L x b x t = {fx.length * 1e3:.3g} x "
+                    f"{fx.width * 1e3:.3g} x {fx.thickness * 1e3:.3g} mm) realises it with a "
+                    f"stress margin of {fx.stress_margin:.3g} and parasitic frequencies of "
+                    f"{fx.bending_frequency:.4g} Hz (leaf) and {fx.support_frequency:.4g} Hz "
+                    f"(support), above the {fx.required_frequency:.4g} Hz required.")
+            else:
+                parts.append(f"No leaf-spring guide within the given bounds fits ({fx.reason}).")
+    elif advice is not None:
+        parts.append(advice.reason[0].upper() + advice.reason[1:] + ".")
+    g = pid.gains
+    parts.append(f"The PID tuned on {g.tuning_mass:.3g} kg has kp = {g.kp:.4g} N/m, "
+                 f"ki = {g.ki:.4g} N/(m s) and kd = {g.kd:.4g} N s/m.")
+    failed = [c.name for c in checks if c.status == Status.FAIL]
+    if failed:
+        parts.append(f"{len(failed)} check(s) fail ({', '.join(failed)}): revise the design "
+                     "before the nonlinear confirmation.")
+    else:
+        parts.append("No check fails; the nonlinear simulation should confirm the verdict.")
+    return " ".join(parts)

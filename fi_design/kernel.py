@@ -1,0 +1,987 @@
+"""The fast integrator: RODAS4 with events, compiled with numba.
+
+Method (Hairer and Wanner, *Solving ODEs II*, section IV.7): RODAS4, a
+six-stage, L-stable, stiffly accurate Rosenbrock method of order 4 with an
+embedded order-3 error estimate and a continuous extension of order 3 for
+dense output. It uses the analytic Jacobian of :mod:`fi_design.plant`
+(one LU decomposition per step, six back-substitutions) and the explicit time
+derivative of the right-hand side, which the reference motion makes
+non-autonomous.
+
+Why this method: breakaway of the light cart is a locally unstable fast
+transient (real eigenvalues up to about +1.7e3 1/s) next to stiff bristle and
+limiter dynamics (down to -1e5 1/s). Explicit or fixed-step methods must use a
+step near 1e-4 s everywhere; the adaptive Rosenbrock method resolves the
+transients and takes long steps while the stage rests.
+
+Discontinuities are never stepped over:
+
+- *Time events*: steps land exactly on the reference breakpoints (where the
+  acceleration jumps), on the sample instants of a discrete controller and on
+  the instants its delayed output is applied.
+- *State events*: the right-hand side is evaluated with frozen modes (sliding
+  direction of the cart, limiter contact, quantization level, switch-model
+  stick flag), so it is smooth within a step. When a trial step ends in a
+  different mode, the crossing is located on the dense output (Illinois
+  method), the step is redone to end there and the mode switches. Guards
+  stop grazing contacts and creep velocities that touch zero from forcing
+  ever-shorter steps: a crossing located at the very start of a step switches
+  the mode without stepping, and a run of such switches falls back to the
+  modes the state implies.
+- *Delay*: the applied force u(t - delay) comes from a history of the
+  controller output (cubic Hermite between accepted steps); steps are capped
+  at the delay so every stage only needs the past.
+
+Failures (step budget exhausted, step-size underflow, NaN, divergence,
+history overflow) end the run with a status code and the time reached; the
+caller reports them, never silent garbage.
+"""
+
+from __future__ import annotations
+
+import os
+
+# Cache compiled code next to the package; fall back to a user cache directory
+# when the package folder is read-only (e.g. a system-wide install).
+_HERE = os.path.dirname(os.path.abspath(__file__))
+if "NUMBA_CACHE_DIR" not in os.environ and not os.access(os.path.join(_HERE, "__pycache__")
+                                                         if os.path.isdir(os.path.join(_HERE, "__pycache__"))
+                                                         else _HERE, os.W_OK):
+    try:
+        from platformdirs import user_cache_dir
+
+        os.environ["NUMBA_CACHE_DIR"] = os.path.join(user_cache_dir("fi_design"), "numba")
+    except ImportError:  # pragma: no cover - platformdirs is a dependency
+        os.environ["NUMBA_CACHE_DIR"] = os.path.join(os.path.expanduser("~"), ".cache",
+                                                     "fi_design", "numba")
+
+import math  # noqa: E402
+
+import numpy as np  # noqa: E402
+from numba import njit  # noqa: E402
+
+from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, P_AD11, P_AD12,  # noqa: E402
+                    P_AD21, P_AD22, P_BD1, P_BD2, P_CD1, P_CD2, P_DD, P_DELAY, P_FS, P_ISO,
+                    P_KD, P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_WT, actuator,
+                    drive_force, jacobian, measured_position, natural_modes, rhs)
+
+# Status codes of :func:`integrate`.
+OK = 0
+TOO_MANY_STEPS = 1
+STEP_UNDERFLOW = 2
+NOT_FINITE = 3
+DIVERGED = 4
+HISTORY_OVERFLOW = 5
+SINGULAR = 6
+
+STATUS_TEXT = {
+    OK: "ok",
+    TOO_MANY_STEPS: "step budget exhausted",
+    STEP_UNDERFLOW: "step size underflow",
+    NOT_FINITE: "state became NaN or infinite",
+    DIVERGED: "solution diverged",
+    HISTORY_OVERFLOW: "delay history overflow",
+    SINGULAR: "singular iteration matrix",
+}
+
+# Layout of the statistics array returned by :func:`integrate`.
+ST_STEPS, ST_REJECTED, ST_EVENTS, ST_T, ST_H, ST_OUT, ST_ZERO_EVENTS, ST_LIMIT_EVENTS = range(8)
+N_STATS = 8
+
+# Event kinds.
+EV_NONE, EV_SIGN, EV_LIMIT, EV_LEVEL, EV_UNSTICK, EV_STOP = 0, 1, 2, 3, 4, 5
+
+HIST = 8192  # delay history ring size
+FIFO = 256  # pending discrete outputs (delay / sample period < FIFO)
+
+# RODAS4 coefficients (Hairer and Wanner, rodas.f, METH = 1).
+GAMMA = 0.25
+C2, C3, C4 = 0.386, 0.21, 0.63
+D1, D2, D3, D4 = 0.25, -0.1043, 0.1035, -0.3620000000000023e-01
+A21 = 0.1544000000000000e+01
+A31, A32 = 0.9466785280815826e+00, 0.2557011698983284e+00
+A41, A42, A43 = 0.3314825187068521e+01, 0.2896124015972201e+01, 0.9986419139977817e+00
+A51, A52, A53, A54 = (0.1221224509226641e+01, 0.6019134481288629e+01, 0.1253708332932087e+02,
+                      -0.6878860361058950e+00)
+C21 = -0.5668800000000000e+01
+C31, C32 = -0.2430093356833875e+01, -0.2063599157091915e+00
+C41, C42, C43 = -0.1073529058151375e+00, -0.9594562251023355e+01, -0.2047028614809616e+02
+C51, C52, C53, C54 = (0.7496443313967647e+01, -0.1024680431464352e+02, -0.3399990352819905e+02,
+                      0.1170890893206160e+02)
+C61, C62, C63, C64, C65 = (0.8083246795921522e+01, -0.7981132988064893e+01,
+                           -0.3152159432874371e+02, 0.1631930543123136e+02,
+                           -0.6058818238834054e+01)
+DD21, DD22, DD23, DD24, DD25 = (0.1012623508344586e+02, -0.7487995877610167e+01,
+                                -0.3480091861555747e+02, -0.7992771707568823e+01,
+                                0.1025137723295662e+01)
+DD31, DD32, DD33, DD34, DD35 = (-0.6762803392801253e+00, 0.6087714651680015e+01,
+                                0.1643084320892478e+02, 0.2476722511418386e+02,
+                                -0.6594389125716872e+01)
+
+SAFE = 0.9
+FAC_MIN = 0.2  # hnew / h >= 0.2
+FAC_MAX = 6.0  # hnew / h <= 6
+
+
+# --------------------------------------------------------------------------- small helpers
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def reference_at(t, breaks, coeffs, k):
+    """Reference position, velocity, acceleration at ``t`` and the segment index.
+
+    ``k`` is a hint (the last segment used); the search walks from there.
+    """
+    nseg = coeffs.shape[0]
+    if t >= breaks[nseg]:
+        k = nseg - 1
+        tau = breaks[nseg] - breaks[k]
+        c0, c1, c2, c3 = coeffs[k, 0], coeffs[k, 1], coeffs[k, 2], coeffs[k, 3]
+        return c0 + tau * (c1 + tau * (c2 + tau * c3)), 0.0, 0.0, k
+    if t <= breaks[0]:
+        return coeffs[0, 0], 0.0, 0.0, 0
+    while k < nseg - 1 and t >= breaks[k + 1]:
+        k += 1
+    while k > 0 and t < breaks[k]:
+        k -= 1
+    tau = t - breaks[k]
+    c0, c1, c2, c3 = coeffs[k, 0], coeffs[k, 1], coeffs[k, 2], coeffs[k, 3]
+    r = c0 + tau * (c1 + tau * (c2 + tau * c3))
+    rd = c1 + tau * (2.0 * c2 + 3.0 * tau * c3)
+    rdd = 2.0 * c2 + 6.0 * tau * c3
+    return r, rd, rdd, k
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def lu_factor(A, piv):
+    """In-place LU decomposition with partial pivoting; returns False if singular."""
+    n = A.shape[0]
+    for k in range(n):
+        m = k
+        big = abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > big:
+                big = abs(A[i, k])
+                m = i
+        piv[k] = m
+        if big == 0.0:
+            return False
+        if m != k:
+            for j in range(n):
+                tmp = A[k, j]
+                A[k, j] = A[m, j]
+                A[m, j] = tmp
+        inv = 1.0 / A[k, k]
+        for i in range(k + 1, n):
+            A[i, k] *= inv
+            lik = A[i, k]
+            if lik != 0.0:
+                for j in range(k + 1, n):
+                    A[i, j] -= lik * A[k, j]
+    return True
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def lu_solve(A, piv, b):
+    """Solve in place with the factors of :func:`lu_factor`."""
+    n = A.shape[0]
+    for k in range(n):
+        m = piv[k]
+        if m != k:
+            tmp = b[k]
+            b[k] = b[m]
+            b[m] = tmp
+    for i in range(n):
+        s = b[i]
+        for j in range(i):
+            s -= A[i, j] * b[j]
+        b[i] = s
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, n):
+            s -= A[i, j] * b[j]
+        b[i] = s / A[i, i]
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def struct_factor(J, sigma, M, piv, w):
+    """Factor E = sigma I - J using the plant's structure.
+
+    The last three states (bristle z, integrator I, controller output u) are
+    "leaves": z depends only on the mechanical core, I on x1, u on x1, v1, I
+    and itself, and the core sees only z and u. Eliminating them leaves a
+    Schur complement on the core (4 x 4 isolated, 2 x 2 rigid), factored with
+    partial pivoting. ``w`` (shape (3, nc) + 3) keeps the elimination
+    coefficients for :func:`struct_solve`. Returns False if singular.
+    """
+    n = J.shape[0]
+    nc = n - 3
+    iz = nc
+    ii = nc + 1
+    iu = nc + 2
+    dI = 1.0 / sigma
+    du = 1.0 / (sigma - J[iu, iu])
+    dz = 1.0 / (sigma - J[iz, iz])
+    w[3, 0] = dI
+    w[3, 1] = du
+    w[3, 2] = dz
+    for c in range(nc):
+        cI = J[ii, c] * dI
+        w[0, c] = cI
+        w[1, c] = (J[iu, c] + J[iu, ii] * cI) * du
+        w[2, c] = J[iz, c] * dz
+    for i in range(nc):
+        for c in range(nc):
+            v = -J[i, c] - J[i, iu] * w[1, c] - J[i, iz] * w[2, c]
+            if i == c:
+                v += sigma
+            M[i, c] = v
+    return lu_factor(M, piv)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def struct_solve(J, M, piv, w, b, tmp):
+    """Solve (sigma I - J) x = b in place with the factors of :func:`struct_factor`."""
+    n = J.shape[0]
+    nc = n - 3
+    iz = nc
+    ii = nc + 1
+    iu = nc + 2
+    gI = b[ii] * w[3, 0]
+    gu = (b[iu] + J[iu, ii] * gI) * w[3, 1]
+    gz = b[iz] * w[3, 2]
+    for i in range(nc):
+        tmp[i] = b[i] + J[i, iu] * gu + J[i, iz] * gz
+    # forward and back substitution on the core
+    for k in range(nc):
+        m = piv[k]
+        if m != k:
+            t = tmp[k]
+            tmp[k] = tmp[m]
+            tmp[m] = t
+    for i in range(nc):
+        s = tmp[i]
+        for j in range(i):
+            s -= M[i, j] * tmp[j]
+        tmp[i] = s
+    for i in range(nc - 1, -1, -1):
+        s = tmp[i]
+        for j in range(i + 1, nc):
+            s -= M[i, j] * tmp[j]
+        tmp[i] = s / M[i, i]
+    yI = gI
+    yu = gu
+    yz = gz
+    for c in range(nc):
+        x = tmp[c]
+        b[c] = x
+        yI += w[0, c] * x
+        yu += w[1, c] * x
+        yz += w[2, c] * x
+    b[ii] = yI
+    b[iu] = yu
+    b[iz] = yz
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def dense(y0, y1, k2, k3, theta, out):
+    """RODAS4 continuous extension at ``theta`` in [0, 1] into ``out``."""
+    s1 = 1.0 - theta
+    for i in range(y0.shape[0]):
+        out[i] = y0[i] * s1 + theta * (y1[i] + s1 * (k2[i] + theta * k3[i]))
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def dense_component(y0, y1, k2, k3, theta, i):
+    """One component of :func:`dense`."""
+    s1 = 1.0 - theta
+    return y0[i] * s1 + theta * (y1[i] + s1 * (k2[i] + theta * k3[i]))
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def history_at(tq, ht, hu, hdu, hur, hdur, head, count):
+    """Delayed controller output u(tq) and its rate from the history ring.
+
+    Each entry i holds the time ``ht``, the value and rate arriving from the
+    left (``hu``, ``hdu``) and leaving to the right (``hur``, ``hdur``), which
+    differ only where u jumps. Returns ``(u, du, ok)``; ``ok`` is False when
+    ``tq`` is older than the oldest entry.
+    """
+    if count == 0 or tq <= 0.0:
+        return 0.0, 0.0, True
+    newest = (head - 1) % HIST
+    if tq >= ht[newest]:
+        return hur[newest], hdur[newest], True
+    oldest = (head - count) % HIST
+    if tq < ht[oldest]:
+        return 0.0, 0.0, False
+    lo = 0
+    hi = count - 1  # logical indices; entry lo <= tq < entry hi
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if ht[(head - count + mid) % HIST] <= tq:
+            lo = mid
+        else:
+            hi = mid
+    a = (head - count + lo) % HIST
+    b = (head - count + hi) % HIST
+    h = ht[b] - ht[a]
+    if h <= 0.0:
+        return hur[b], hdur[b], True
+    s = (tq - ht[a]) / h
+    u0 = hur[a]
+    u1 = hu[b]
+    m0 = hdur[a] * h
+    m1 = hdu[b] * h
+    s2 = s * s
+    s3 = s2 * s
+    u = (2 * s3 - 3 * s2 + 1) * u0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * u1 + (s3 - s2) * m1
+    du = ((6 * s2 - 6 * s) * u0 + (3 * s2 - 4 * s + 1) * m0 + (-6 * s2 + 6 * s) * u1
+          + (3 * s2 - 2 * s) * m1) / h
+    return u, du, True
+
+
+# --------------------------------------------------------------------------- events
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _limit_mode(d, s):
+    if d > s:
+        return 1
+    if d < -s:
+        return -1
+    return 0
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _root(g0, g1, y0, y1, k2, k3, kind, idx, idx2, offset, p, fa, fa_state, ybuf):
+    """Locate the zero of a switching function on the dense output, theta in [0, 1].
+
+    kind 0: y[idx] - offset; kind 1: y[idx] - y[idx2] - offset;
+    kind 2: |drive force| - offset (switch model breakaway).
+    """
+    a, b = 0.0, 1.0
+    ga, gb = g0, g1
+    side = 0
+    theta = 1.0
+    for _ in range(60):
+        theta = (a * gb - b * ga) / (gb - ga)
+        if not (theta > a and theta < b):
+            theta = 0.5 * (a + b)
+        if kind == 0:
+            g = dense_component(y0, y1, k2, k3, theta, idx) - offset
+        elif kind == 1:
+            g = (dense_component(y0, y1, k2, k3, theta, idx)
+                 - dense_component(y0, y1, k2, k3, theta, idx2) - offset)
+        else:
+            dense(y0, y1, k2, k3, theta, ybuf)
+            g = abs(drive_force(ybuf, p, fa, fa_state)) - offset
+        if g == 0.0:
+            return theta
+        if (g > 0.0) == (gb > 0.0):
+            b = theta
+            gb = g
+            if side == 1:
+                ga *= 0.5
+            side = 1
+        else:
+            a = theta
+            ga = g
+            if side == -1:
+                gb *= 0.5
+            side = -1
+        if b - a < 1e-12:
+            break
+    return b
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def find_event(y0, y1, k2, k3, p, modes, iv2, fa, fa_state, ybuf, skip):
+    """Earliest mode change within a trial step.
+
+    Returns ``(kind, theta)``: the event kind (``EV_*``) and where it happens
+    as a fraction of the step. ``skip`` is an event kind to ignore (the one
+    the step was shortened to reach).
+    """
+    best = EV_NONE
+    tbest = 2.0
+    iso = p[P_ISO] != 0.0
+    sw = p[P_SWITCH] != 0.0
+    sgn = modes[MODE_SIGN]
+    # sliding direction (LuGre |v|) or switch-model velocity reversal
+    stuck = sw and modes[MODE_STICK] == 1
+    if not stuck and skip != EV_SIGN:
+        v0 = y0[iv2] * sgn
+        v1 = y1[iv2] * sgn
+        if v1 < 0.0:
+            th = 0.0 if v0 < 0.0 else _root(v0, v1, y0, y1, k2, k3, 0, iv2, 0, 0.0, p, fa, fa_state, ybuf)
+            if th < tbest:
+                tbest = th
+                best = EV_SIGN
+    if sw and stuck and skip != EV_UNSTICK:
+        Fs = p[P_FS]
+        g1 = abs(drive_force(y1, p, fa, fa_state)) - Fs
+        if g1 > 0.0:
+            g0 = abs(drive_force(y0, p, fa, fa_state)) - Fs
+            th = 0.0 if g0 > 0.0 else _root(g0, g1, y0, y1, k2, k3, 2, 0, 0, Fs, p, fa, fa_state, ybuf)
+            if th < tbest:
+                tbest = th
+                best = EV_UNSTICK
+    if iso and skip != EV_LIMIT:
+        s = p[P_S]
+        lim = modes[MODE_LIMIT]
+        d1 = y1[0] - y1[2]
+        l1 = _limit_mode(d1, s)
+        if l1 != lim:
+            d0 = y0[0] - y0[2]
+            # boundary crossed first when leaving `lim` towards l1
+            if lim == 1 or (lim == 0 and l1 == 1):
+                off = s
+            else:
+                off = -s
+            g0 = d0 - off
+            g1 = d1 - off
+            if _limit_mode(d0, s) != lim or g0 == 0.0 or (g0 > 0.0) == (g1 > 0.0):
+                th = 0.0
+            else:
+                th = _root(g0, g1, y0, y1, k2, k3, 1, 0, 2, off, p, fa, fa_state, ybuf)
+            if th < tbest:
+                tbest = th
+                best = EV_LIMIT
+    q = p[P_QUANT]
+    if q > 0.0 and p[P_TS] == 0.0 and skip != EV_LEVEL:
+        lev = modes[MODE_LEVEL]
+        l1 = int(math.floor(y1[0] / q + 0.5))
+        if l1 != lev:
+            off = (lev + 0.5) * q if l1 > lev else (lev - 0.5) * q
+            g0 = y0[0] - off
+            g1 = y1[0] - off
+            l0 = int(math.floor(y0[0] / q + 0.5))
+            if l0 != lev or g0 == 0.0 or (g0 > 0.0) == (g1 > 0.0):
+                th = 0.0
+            else:
+                th = _root(g0, g1, y0, y1, k2, k3, 0, 0, 0, off, p, fa, fa_state, ybuf)
+            if th < tbest:
+                tbest = th
+                best = EV_LEVEL
+    return best, tbest
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def apply_event(kind, y, p, modes, iv2, iu, fa, fa_state, y_trial):
+    """Switch the mode for event ``kind`` at the current state (jumps included).
+
+    ``y_trial`` is the end of the trial step that detected the event: it tells
+    the direction of limiter and quantization crossings. Returns the jump of
+    the controller output u [N] (quantization with a continuous controller).
+    """
+    du = 0.0
+    if kind == EV_SIGN:
+        if p[P_SWITCH] != 0.0:
+            y[iv2] = 0.0
+            F = drive_force(y, p, fa, fa_state)
+            if abs(F) <= p[P_FS]:
+                modes[MODE_STICK] = 1
+            else:
+                modes[MODE_SIGN] = 1 if F > 0.0 else -1
+        else:
+            modes[MODE_SIGN] = -modes[MODE_SIGN]
+    elif kind == EV_UNSTICK:
+        F = drive_force(y, p, fa, fa_state)
+        modes[MODE_STICK] = 0
+        modes[MODE_SIGN] = 1 if F > 0.0 else -1
+    elif kind == EV_LIMIT:
+        s = p[P_S]
+        lim = modes[MODE_LIMIT]
+        target = _limit_mode(y_trial[0] - y_trial[2], s)
+        if lim == 0:
+            modes[MODE_LIMIT] = target
+        else:
+            modes[MODE_LIMIT] = 0
+    elif kind == EV_LEVEL:
+        q = p[P_QUANT]
+        lev = modes[MODE_LEVEL]
+        l1 = int(math.floor(y_trial[0] / q + 0.5))
+        step = 1 if l1 > lev else -1
+        modes[MODE_LEVEL] = lev + step
+        du = -p[P_WT] * p[P_KD] * q * step
+        y[iu] += du
+    return du
+
+
+# --------------------------------------------------------------------------- the integrator
+
+
+@njit(cache=True, error_model="numpy")
+def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_steps, x_bound,
+              out_y, out_r, out_fa, stats):
+    """Integrate the plant from ``y0`` at t = 0 to ``t_end``.
+
+    Parameters
+    ----------
+    p : ndarray, float64
+        Plant parameters (:class:`fi_design.plant.PlantParameters`).
+    y0 : ndarray, float64, shape (n,)
+        Initial state (7 isolated, 5 rigid).
+    breaks, coeffs : ndarray
+        Reference as a piecewise cubic (:class:`fi_design.reference.Reference`).
+    land : bool
+        Land steps on the reference breaks.
+    t_end : float
+        Final time [s].
+    t_out : ndarray, shape (m,)
+        Increasing output times [s] within [0, t_end].
+    rtol : float
+        Relative tolerance.
+    atol : ndarray, shape (n,)
+        Absolute tolerance per state component (state units).
+    h_max : float
+        Largest step [s].
+    max_steps : int
+        Step budget (accepted and rejected).
+    x_bound : float
+        |x1| beyond which the solution counts as diverged [m].
+    out_y : ndarray, shape (m, n)
+        Output: states at ``t_out``.
+    out_r : ndarray, shape (m,)
+        Output: reference at ``t_out`` [m].
+    out_fa : ndarray, shape (m,)
+        Output: applied actuator force at ``t_out`` [N] (after delay and
+        saturation).
+    stats : ndarray, shape (N_STATS,)
+        Output: counters (``ST_*``).
+
+    Returns
+    -------
+    int
+        Status code (``OK`` or a failure code, see ``STATUS_TEXT``).
+    """
+    n = y0.shape[0]
+    iso = p[P_ISO] != 0.0
+    iv2 = 3 if iso else 1
+    ii = n - 2
+    iu = n - 1
+    Ts = p[P_TS]
+    delay = p[P_DELAY]
+    discrete = Ts > 0.0
+    fa_state = (not discrete) and delay == 0.0
+    cont_delay = (not discrete) and delay > 0.0
+    if cont_delay and h_max > delay:
+        h_max = delay
+    sw = p[P_SWITCH] != 0.0
+
+    y = y0.copy()
+    ynew = np.empty(n)
+    ytmp = np.empty(n)
+    ybuf = np.empty(n)
+    yev = np.empty(n)
+    f0 = np.empty(n)
+    fs = np.empty(n)
+    ft = np.zeros(n)
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    k6 = np.empty(n)
+    cd2 = np.empty(n)
+    cd3 = np.empty(n)
+    J = np.empty((n, n))
+    M = np.empty((n - 3, n - 3))
+    piv = np.empty(n - 3, dtype=np.int64)
+    w = np.empty((4, n - 3 if n - 3 > 3 else 3))
+    tmp = np.empty(n)
+    modes = np.zeros(4, dtype=np.int64)
+    modes[MODE_SIGN] = 1
+    natural_modes(y, p, modes)
+    if sw:
+        modes[MODE_STICK] = 1 if y[iv2] == 0.0 else 0
+
+    # delay history (continuous controller)
+    ht = np.zeros(HIST)
+    hu = np.zeros(HIST)
+    hdu = np.zeros(HIST)
+    hur = np.zeros(HIST)
+    hdur = np.zeros(HIST)
+    head = 0
+    count = 0
+    jump_pending = False
+    jump_u = 0.0
+    jump_du = 0.0
+    # discrete controller
+    qd1 = 0.0
+    qd2 = 0.0
+    k_sample = 0
+    t_sample = 0.0 if discrete else math.inf
+    fa_hold = 0.0
+    fifo_t = np.zeros(FIFO)
+    fifo_u = np.zeros(FIFO)
+    f_head = 0
+    f_count = 0
+
+    for i in range(N_STATS):
+        stats[i] = 0.0
+    m_out = t_out.shape[0]
+    i_out = 0
+    kref = 0
+    t = 0.0
+    h = min(1e-5, h_max)
+    h_acc = h
+    err_acc = 1.0
+    reject = False
+    n_steps = 0
+    n_rej = 0
+    n_events = 0
+    n_zero = 0
+    zero_run = 0
+    suppress = False
+    status = OK
+    nb = breaks.shape[0]
+    ib = 0
+    while ib < nb and breaks[ib] <= 0.0:
+        ib += 1
+
+    while True:
+        # ---------------------------------------------------- time events at t
+        if discrete and t >= t_sample - 1e-12 * max(1.0, t):
+            r_s, _, _, kref = reference_at(t, breaks, coeffs, kref)
+            lev = int(math.floor(y[0] / p[P_QUANT] + 0.5)) if p[P_QUANT] > 0.0 else 0
+            e_k = r_s - measured_position(y[0], p, lev)
+            u_k = p[P_CD1] * qd1 + p[P_CD2] * qd2 + p[P_DD] * e_k
+            n1 = p[P_AD11] * qd1 + p[P_AD12] * qd2 + p[P_BD1] * e_k
+            n2 = p[P_AD21] * qd1 + p[P_AD22] * qd2 + p[P_BD2] * e_k
+            qd1 = n1
+            qd2 = n2
+            y[iu] = u_k
+            y[ii] = qd1
+            if delay == 0.0:
+                fa_hold = u_k
+            else:
+                if f_count == FIFO:
+                    status = HISTORY_OVERFLOW
+                    break
+                fifo_t[(f_head + f_count) % FIFO] = t + delay
+                fifo_u[(f_head + f_count) % FIFO] = u_k
+                f_count += 1
+            k_sample += 1
+            t_sample = k_sample * Ts
+        while f_count > 0 and t >= fifo_t[f_head] - 1e-12 * max(1.0, t):
+            fa_hold = fifo_u[f_head]
+            f_head = (f_head + 1) % FIFO
+            f_count -= 1
+        if sw and modes[MODE_STICK] == 1:
+            fa_now = fa_hold
+            if cont_delay:
+                fa_now, _, _ = history_at(t - delay, ht, hu, hdu, hur, hdur, head, count)
+            F = drive_force(y, p, fa_now, fa_state)
+            if abs(F) > p[P_FS]:
+                modes[MODE_STICK] = 0
+                modes[MODE_SIGN] = 1 if F > 0.0 else -1
+                n_events += 1
+
+        # ---------------------------------------------------- outputs at t
+        while i_out < m_out and t_out[i_out] <= t + 1e-12 * max(1.0, t):
+            for j in range(n):
+                out_y[i_out, j] = y[j]
+            rr, _, _, kref = reference_at(t_out[i_out], breaks, coeffs, kref)
+            out_r[i_out] = rr
+            if fa_state:
+                fa_o = y[iu]
+            elif cont_delay:
+                fa_o, _, _ = history_at(t_out[i_out] - delay, ht, hu, hdu, hur, hdur, head, count)
+            else:
+                fa_o = fa_hold
+            out_fa[i_out], _ = actuator(fa_o, p)
+            i_out += 1
+
+        if t >= t_end * (1.0 - 1e-14):
+            break
+        if n_steps + n_rej >= max_steps:
+            status = TOO_MANY_STEPS
+            break
+
+        # ---------------------------------------------------- next landing time
+        t_land = t_end
+        if land:
+            while ib < nb and breaks[ib] <= t + 1e-12 * max(1.0, t):
+                ib += 1
+            if ib < nb and breaks[ib] < t_land:
+                t_land = breaks[ib]
+        if discrete and t_sample < t_land:
+            t_land = t_sample
+        if f_count > 0 and fifo_t[f_head] < t_land:
+            t_land = fifo_t[f_head]
+
+        # ---------------------------------------------------- f, J, f_t at (t, y)
+        r0, rd0, rdd0, kref = reference_at(t, breaks, coeffs, kref)
+        fa0 = fa_hold
+        dfa0 = 0.0
+        if cont_delay:
+            fa0, dfa0, ok = history_at(t - delay, ht, hu, hdu, hur, hdur, head, count)
+            if not ok:
+                status = HISTORY_OVERFLOW
+                break
+        rhs(t, y, p, modes, r0, rd0, fa0, fa_state, f0)
+        jacobian(t, y, p, modes, r0, rd0, fa0, fa_state, J)
+        for j in range(n):
+            ft[j] = 0.0
+        if not discrete:
+            ft[ii] = p[P_KI] * rd0
+            ft[iu] = p[P_WT] * (p[P_KP] * rd0 + p[P_KD] * rdd0)
+        if cont_delay:
+            _, dsat = actuator(fa0, p)
+            m_acc = p[P_M1] if iso else p[P_M1] + p[P_M2]
+            ft[1] = dsat * dfa0 / m_acc
+            # record the controller output for the delayed force
+            newest = (head - 1) % HIST
+            if count > 0 and t == ht[newest]:
+                hur[newest] = y[iu]
+                hdur[newest] = f0[iu]
+            else:
+                if count == HIST:
+                    count -= 1
+                ht[head] = t
+                hur[head] = y[iu]
+                hdur[head] = f0[iu]
+                if jump_pending:
+                    hu[head] = jump_u
+                    hdu[head] = jump_du
+                else:
+                    hu[head] = y[iu]
+                    hdu[head] = f0[iu]
+                head = (head + 1) % HIST
+                count += 1
+            jump_pending = False
+
+        # ---------------------------------------------------- step attempts
+        pending = EV_NONE
+        n_nan = 0
+        restart = False
+        while True:
+            landing = False
+            if h > h_max:
+                h = h_max
+            if t + h >= t_land - 1e-12 * max(1.0, t_land):
+                h = t_land - t
+                landing = True
+            if h < 1e-14 * max(1.0, t):
+                status = STEP_UNDERFLOW
+                break
+            if n_steps + n_rej >= max_steps:
+                status = TOO_MANY_STEPS
+                break
+            if not struct_factor(J, 1.0 / (h * GAMMA), M, piv, w):
+                h *= 0.5
+                n_rej += 1
+                continue
+            # stage 1
+            for j in range(n):
+                k1[j] = f0[j] + h * D1 * ft[j]
+            struct_solve(J, M, piv, w, k1, tmp)
+            # stage 2
+            for j in range(n):
+                ytmp[j] = y[j] + A21 * k1[j]
+            ts = t + C2 * h
+            rs, rds, _, kref = reference_at(ts, breaks, coeffs, kref)
+            fas = fa_hold
+            if cont_delay:
+                fas, _, _ = history_at(ts - delay, ht, hu, hdu, hur, hdur, head, count)
+            rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
+            for j in range(n):
+                k2[j] = fs[j] + C21 / h * k1[j] + h * D2 * ft[j]
+            struct_solve(J, M, piv, w, k2, tmp)
+            # stage 3
+            for j in range(n):
+                ytmp[j] = y[j] + A31 * k1[j] + A32 * k2[j]
+            ts = t + C3 * h
+            rs, rds, _, kref = reference_at(ts, breaks, coeffs, kref)
+            if cont_delay:
+                fas, _, _ = history_at(ts - delay, ht, hu, hdu, hur, hdur, head, count)
+            rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
+            for j in range(n):
+                k3[j] = fs[j] + (C31 * k1[j] + C32 * k2[j]) / h + h * D3 * ft[j]
+            struct_solve(J, M, piv, w, k3, tmp)
+            # stage 4
+            for j in range(n):
+                ytmp[j] = y[j] + A41 * k1[j] + A42 * k2[j] + A43 * k3[j]
+            ts = t + C4 * h
+            rs, rds, _, kref = reference_at(ts, breaks, coeffs, kref)
+            if cont_delay:
+                fas, _, _ = history_at(ts - delay, ht, hu, hdu, hur, hdur, head, count)
+            rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
+            for j in range(n):
+                k4[j] = fs[j] + (C41 * k1[j] + C42 * k2[j] + C43 * k3[j]) / h + h * D4 * ft[j]
+            struct_solve(J, M, piv, w, k4, tmp)
+            # stage 5
+            for j in range(n):
+                ytmp[j] = y[j] + A51 * k1[j] + A52 * k2[j] + A53 * k3[j] + A54 * k4[j]
+            ts = t + h
+            rs, rds, _, kref = reference_at(ts, breaks, coeffs, kref)
+            if cont_delay:
+                fas, _, _ = history_at(ts - delay, ht, hu, hdu, hur, hdur, head, count)
+            rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
+            for j in range(n):
+                k5[j] = fs[j] + (C51 * k1[j] + C52 * k2[j] + C53 * k3[j] + C54 * k4[j]) / h
+            struct_solve(J, M, piv, w, k5, tmp)
+            # stage 6 (embedded solution + correction)
+            for j in range(n):
+                ytmp[j] += k5[j]
+            rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
+            for j in range(n):
+                k6[j] = fs[j] + (C61 * k1[j] + C62 * k2[j] + C63 * k3[j] + C64 * k4[j]
+                                 + C65 * k5[j]) / h
+            struct_solve(J, M, piv, w, k6, tmp)
+            err = 0.0
+            for j in range(n):
+                ynew[j] = ytmp[j] + k6[j]
+                sk = atol[j] + rtol * max(abs(y[j]), abs(ynew[j]))
+                err += (k6[j] / sk) ** 2
+            err = math.sqrt(err / n)
+            if not (err == err) or err == math.inf:
+                n_nan += 1
+                n_rej += 1
+                if n_nan > 30:
+                    status = NOT_FINITE
+                    break
+                h *= 0.25
+                reject = True
+                continue
+            fac = max(1.0 / FAC_MAX, min(1.0 / FAC_MIN, math.sqrt(math.sqrt(err)) / SAFE))
+            h_new = h / fac
+            if err > 1.0:
+                n_rej += 1
+                reject = True
+                h = h_new
+                pending = EV_NONE
+                continue
+            # dense output coefficients
+            for j in range(n):
+                cd2[j] = DD21 * k1[j] + DD22 * k2[j] + DD23 * k3[j] + DD24 * k4[j] + DD25 * k5[j]
+                cd3[j] = DD31 * k1[j] + DD32 * k2[j] + DD33 * k3[j] + DD34 * k4[j] + DD35 * k5[j]
+            # state events
+            if not suppress:
+                kind, theta = find_event(y, ynew, cd2, cd3, p, modes, iv2, fa0, fa_state, ybuf,
+                                         pending)
+                if kind != EV_NONE:
+                    if theta * h < 1e-12 * max(1.0, t) or theta <= 0.0:
+                        # crossing at the start of the step: switch now, no step
+                        for j in range(n):
+                            ybuf[j] = ynew[j]
+                        du = apply_event(kind, y, p, modes, iv2, iu, fa0, fa_state, ybuf)
+                        if du != 0.0 and cont_delay:
+                            jump_pending = True
+                            jump_u = y[iu] - du
+                            jump_du = f0[iu]
+                        n_events += 1
+                        n_zero += 1
+                        zero_run += 1
+                        if zero_run > 8:
+                            natural_modes(y, p, modes)
+                            suppress = True
+                            zero_run = 0
+                        restart = True
+                        break
+                    # redo the step so that it ends at the crossing
+                    for j in range(n):
+                        yev[j] = ynew[j]  # keep the trial end (direction of the crossing)
+                    pending = kind
+                    h = theta * h
+                    t_land = t + h
+                    continue
+            # ------------------------------------------------ accept
+            n_steps += 1
+            t_new = t_land if landing else t + h
+            # outputs inside (t, t_new]
+            while i_out < m_out and t_out[i_out] <= t_new + 1e-12 * max(1.0, t_new):
+                th = (t_out[i_out] - t) / h
+                if th > 1.0:
+                    th = 1.0
+                dense(y, ynew, cd2, cd3, th, ybuf)
+                for j in range(n):
+                    out_y[i_out, j] = ybuf[j]
+                rr, _, _, kref = reference_at(t_out[i_out], breaks, coeffs, kref)
+                out_r[i_out] = rr
+                if fa_state:
+                    fa_o = ybuf[iu]
+                elif cont_delay:
+                    fa_o, _, _ = history_at(t_out[i_out] - delay, ht, hu, hdu, hur, hdur, head,
+                                            count)
+                else:
+                    fa_o = fa_hold
+                out_fa[i_out], _ = actuator(fa_o, p)
+                i_out += 1
+            # predictive step control (Gustafsson)
+            if n_steps > 1:
+                facg = (h_acc / h) * math.sqrt(math.sqrt(err * err / err_acc)) / SAFE
+                facg = max(1.0 / FAC_MAX, min(1.0 / FAC_MIN, facg))
+                fac = max(fac, facg)
+                h_new = h / fac
+            h_acc = h
+            err_acc = max(1e-2, err)
+            if reject:
+                h_new = min(h_new, h)
+            reject = False
+            for j in range(n):
+                y[j] = ynew[j]
+            t = t_new
+            suppress = False
+            if pending != EV_NONE:
+                # the step ended at a located crossing: switch the mode
+                if pending == EV_LIMIT:
+                    stats[ST_LIMIT_EVENTS] += 1.0
+                u_before = y[iu]
+                du_before = 0.0
+                if cont_delay and pending == EV_LEVEL:
+                    r_e, rd_e, _, kref = reference_at(t, breaks, coeffs, kref)
+                    rhs(t, y, p, modes, r_e, rd_e, 0.0, True, fs)
+                    du_before = fs[iu]
+                du = apply_event(pending, y, p, modes, iv2, iu, fa0, fa_state, yev)
+                if du != 0.0 and cont_delay:
+                    jump_pending = True
+                    jump_u = u_before
+                    jump_du = du_before
+                n_events += 1
+                zero_run = 0
+                # after an event the old step size may be far too large
+                h_new = min(h_new, max(h_acc, 1e-6))
+            h = h_new
+            if abs(y[0]) > x_bound or not (y[0] == y[0]):
+                status = DIVERGED if y[0] == y[0] else NOT_FINITE
+            break
+        if status != OK:
+            break
+        if restart:
+            continue
+
+    stats[ST_STEPS] = n_steps
+    stats[ST_REJECTED] = n_rej
+    stats[ST_EVENTS] = n_events
+    stats[ST_T] = t
+    stats[ST_H] = h
+    stats[ST_OUT] = i_out
+    stats[ST_ZERO_EVENTS] = n_zero
+    return status
+
+
+def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
+        max_steps=2_000_000, x_bound=10.0):
+    """Allocate outputs and call :func:`integrate`.
+
+    Returns ``(status, out_y, out_r, out_fa, stats)`` as numpy arrays; see
+    :func:`integrate` for the meaning. This thin wrapper is the kernel's only
+    Python-level entry point; :mod:`fi_design.simulate` wraps it in a result.
+    """
+    p = np.ascontiguousarray(params, dtype=np.float64)
+    y = np.ascontiguousarray(y0, dtype=np.float64)
+    t_out = np.ascontiguousarray(t_out, dtype=np.float64)
+    n = y.shape[0]
+    m = t_out.shape[0]
+    out_y = np.full((m, n), np.nan)
+    out_r = np.full(m, np.nan)
+    out_fa = np.full(m, np.nan)
+    stats = np.zeros(N_STATS)
+    status = integrate(p, y, np.ascontiguousarray(breaks, dtype=np.float64),
+                       np.ascontiguousarray(coeffs, dtype=np.float64), bool(land), float(t_end),
+                       t_out, float(rtol), np.ascontiguousarray(atol, dtype=np.float64),
+                       float(h_max), int(max_steps), float(x_bound), out_y, out_r, out_fa, stats)
+    return int(status), out_y, out_r, out_fa, stats

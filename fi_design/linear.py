@@ -1,0 +1,862 @@
+"""The four linear limit cases and their loop margins (guideline step 2).
+
+Near standstill the friction isolator's plant switches between four linear
+limit cases (DESIGN.md section 2, paper Figure 2), from actuator force u [N]
+to stage position x1 [m]:
+
+====================  =====================================================================
+name                  model
+====================  =====================================================================
+``sliding_free``      1: cart sliding, joint free: stage m1 on the joint (k, c) to the cart
+                      m2, the cart damped by the viscous friction sigma2
+``stuck_free``        2: cart stuck, joint free: as 1, the cart held by the presliding
+                      bristles (spring sigma0, damper sigma1 + sigma2)
+``sliding_limited``   3: cart sliding, limiter engaged: rigid m1 + m2 damped by sigma2
+``stuck_limited``     4: cart stuck, limiter engaged: rigid m1 + m2 on the bristles
+====================  =====================================================================
+
+Without an isolator the stage is one rigid mass m1 + m2: cases ``sliding``
+(damped by sigma2) and ``stuck`` (on the bristles). The limiter is taken as
+rigid in cases 3 and 4 (its contact stiffness is far above the joint's).
+
+Sliding linearises LuGre at a speed well above the Stribeck velocity, where the
+friction slope is sigma2; sticking linearises it at rest, where ``dz/dt = v``
+and the friction force is ``sigma0 x2 + (sigma1 + sigma2) v2``.
+
+Parasitic flexure modes (``spec.isolator.parasitic_modes``) multiply every
+isolated case: a non-collocated mode by ``wr^2 / (s^2 + 2 zeta wr s + wr^2)``;
+a collocated one also by ``(s^2 + 2 zeta wa s + wa^2) / wa^2``, its
+antiresonance ``wa`` below ``wr`` (:func:`fi_design.spec.antiresonance`).
+
+The controller is the PID of :mod:`fi_design.pid`. The computational delay
+``controller.delay``, plus half a sample period for the zero-order hold when
+``controller.sample_rate`` is set, enters as a Pade approximation of order
+``controller.pade_order``; otherwise the controller is analysed in continuous
+time.
+
+Margins (:class:`CaseMargins`) come from :func:`control.stability_margins`
+with ``returnall=True``; closed-loop stability from the roots of
+``den + num`` of the loop. To keep the polynomial root finding well
+conditioned, every loop is evaluated with the Laplace variable scaled by the
+tuned crossover ``wc`` (``s = wc s'``); frequencies are scaled back before they
+are reported. :func:`achievable_crossover` retunes the PID over a log scan of
+crossovers and refines the highest feasible one by bisection.
+
+``import control`` takes one to three seconds: callers import this module
+lazily, where they use it.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, replace
+from typing import Any, Sequence
+
+import control
+import numpy as np
+
+from .pid import PidGains, tune_pid
+from .results import dataclass_dict, frozen_array
+from .spec import (Spec, antiresonance, bristle_damping, drive_stiffness, joint_damping)
+
+__all__ = [
+    "ISOLATED_CASES", "RIGID_CASES", "CASE_DESCRIPTIONS", "CASE_NUMBERS", "SCAN_LIMIT",
+    "SCAN_START",
+    "LimitCase", "CaseMargins", "LoopAnalysis", "AchievableCrossover",
+    "limit_cases", "mode_factor", "delay_time", "delay_polynomials", "controller_polynomials",
+    "controller_tf", "delay_tf", "loop_polynomials", "loop_transfer_function", "sensitivity",
+    "complementary_sensitivity", "loop_margins", "analyse", "achievable_crossover",
+]
+
+log = logging.getLogger(__name__)
+
+#: Names of the four limit cases of an isolated stage, in the paper's order.
+ISOLATED_CASES = ("sliding_free", "stuck_free", "sliding_limited", "stuck_limited")
+#: Names of the two limit cases of a stage without isolator.
+RIGID_CASES = ("sliding", "stuck")
+#: One line per case, for tables and messages.
+CASE_DESCRIPTIONS = {
+    "sliding_free": "cart sliding, joint free",
+    "stuck_free": "cart stuck, joint free",
+    "sliding_limited": "cart sliding, limiter engaged",
+    "stuck_limited": "cart stuck, limiter engaged",
+    "sliding": "cart sliding (no isolator)",
+    "stuck": "cart stuck (no isolator)",
+}
+
+#: Number of each case in the paper's order (Figure 2).
+CASE_NUMBERS = {**{n: i for i, n in enumerate(ISOLATED_CASES, 1)},
+                **{n: i for i, n in enumerate(RIGID_CASES, 1)}}
+
+#: Highest crossover the achievable-crossover scan looks at [Hz].
+SCAN_LIMIT = 1000.0
+#: Lowest crossover of the scan [Hz] (lower still when the desired crossover is low).
+SCAN_START = 0.1
+#: Scan points per decade before bisection.
+SCAN_POINTS_PER_DECADE = 10
+
+
+# --------------------------------------------------------------------------- plants
+
+
+@dataclass(frozen=True, eq=False)
+class LimitCase:
+    """One linear limit case: the plant from actuator force u [N] to stage position x1 [m].
+
+    Attributes
+    ----------
+    name : str
+        ``sliding_free``, ``stuck_free``, ``sliding_limited``, ``stuck_limited``
+        (isolated) or ``sliding``, ``stuck`` (no isolator).
+    number : int
+        1 to 4 in the paper's order (Figure 2); 1 and 2 without isolator.
+    description : str
+        The case in words.
+    num : numpy.ndarray
+        Numerator of P(s) = x1/u, descending powers of s [rad/s], parasitic
+        modes included; read-only, shape (n,).
+    den : numpy.ndarray
+        Denominator of P(s), same convention; read-only.
+    plant : control.StateSpace
+        The same plant as a state-space model. Physical states first
+        (isolated: x1, x2, v1, v2 [m, m/s]; rigid: x, v), then the states of
+        the parasitic-mode filters.
+    """
+
+    name: str
+    number: int
+    description: str
+    num: np.ndarray
+    den: np.ndarray
+    plant: Any
+
+    def __call__(self, s):
+        """Evaluate P(s) [m/N] at complex ``s`` [rad/s] (scalar or array)."""
+        return np.polyval(self.num, s) / np.polyval(self.den, s)
+
+
+def _rigid(mass: float, damping: float, stiffness: float):
+    A = np.array([[0.0, 1.0], [-stiffness / mass, -damping / mass]])
+    B = np.array([[0.0], [1.0 / mass]])
+    return control.ss(A, B, np.array([[1.0, 0.0]]), 0.0), [1.0], [mass, damping, stiffness]
+
+
+def _two_mass(m1: float, m2: float, k: float, c: float, cart_stiffness: float,
+              cart_damping: float):
+    """Stage m1 on the joint (k, c) to cart m2; the cart on (cart_stiffness, cart_damping)."""
+    A = np.array([
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+        [-k / m1, k / m1, -c / m1, c / m1],
+        [k / m2, -(k + cart_stiffness) / m2, c / m2, -(c + cart_damping) / m2],
+    ])
+    B = np.array([[0.0], [0.0], [1.0 / m1], [0.0]])
+    C = np.array([[1.0, 0.0, 0.0, 0.0]])
+    sys = control.ss(A, B, C, 0.0)
+    # P = (m2 s^2 + (c + cd) s + k + kc) / det, expanded by hand so that the
+    # cancelling terms (k^2, 2 c k) never meet in floating point.
+    kc, cd = cart_stiffness, cart_damping
+    num = [m2, c + cd, k + kc]
+    den = [m1 * m2, m1 * (c + cd) + m2 * c, m1 * (k + kc) + m2 * k + c * cd,
+           c * kc + k * cd, k * kc]
+    return sys, num, den
+
+
+def mode_factor(mode) -> tuple[np.ndarray, np.ndarray]:
+    """Numerator and denominator of one parasitic mode's factor (unit DC gain).
+
+    Parameters
+    ----------
+    mode : fi_design.spec.ParasiticMode
+        Frequency [Hz], damping ratio [-], collocated or not.
+
+    Returns
+    -------
+    num, den : numpy.ndarray
+        Descending powers of s [rad/s]: ``wr^2 / (s^2 + 2 zeta wr s + wr^2)``,
+        times ``(s^2 + 2 zeta wa s + wa^2) / wa^2`` when collocated.
+    """
+    wr = 2.0 * math.pi * mode.frequency
+    z = mode.damping_ratio
+    den = np.array([1.0, 2.0 * z * wr, wr * wr])
+    num = np.array([wr * wr])
+    if mode.collocated:
+        wa = 2.0 * math.pi * antiresonance(mode)
+        num = (wr * wr / (wa * wa)) * np.array([1.0, 2.0 * z * wa, wa * wa])
+    return num, den
+
+
+def limit_cases(spec: Spec, stiffness: float | None = None) -> tuple[LimitCase, ...]:
+    """The linear limit cases of a spec.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+    stiffness : float, optional
+        Joint drive stiffness k [N/m]; default :func:`fi_design.spec.drive_stiffness`
+        (the given value, else the proposed one). Ignored without isolator.
+
+    Returns
+    -------
+    tuple of LimitCase
+        Four cases for an isolated stage (:data:`ISOLATED_CASES`), two without
+        isolator (:data:`RIGID_CASES`).
+    """
+    f = spec.friction
+    m1, m2, M = spec.stage.mass, spec.cart.mass, spec.total_mass
+    s0, s1, s2 = f.bristle_stiffness, bristle_damping(spec), f.viscous
+    if spec.isolator is None:
+        raw = {"sliding": _rigid(M, s2, 0.0), "stuck": _rigid(M, s1 + s2, s0)}
+        modes = ()
+    else:
+        k = drive_stiffness(spec) if stiffness is None else float(stiffness)
+        c = joint_damping(spec, k)
+        raw = {
+            "sliding_free": _two_mass(m1, m2, k, c, 0.0, s2),
+            "stuck_free": _two_mass(m1, m2, k, c, s0, s1 + s2),
+            "sliding_limited": _rigid(M, s2, 0.0),
+            "stuck_limited": _rigid(M, s1 + s2, s0),
+        }
+        modes = spec.isolator.parasitic_modes
+    factors = [mode_factor(m) for m in modes]
+    out = []
+    for i, (name, (sys, num, den)) in enumerate(raw.items(), start=1):
+        num, den = np.asarray(num, float), np.asarray(den, float)
+        for fn, fd in factors:
+            num, den = np.polymul(num, fn), np.polymul(den, fd)
+            sys = control.series(sys, control.ss(control.tf(fn, fd)))
+        out.append(LimitCase(name=name, number=i, description=CASE_DESCRIPTIONS[name],
+                             num=frozen_array(num), den=frozen_array(den), plant=sys))
+    return tuple(out)
+
+
+def _case(spec: Spec, case, stiffness: float | None) -> LimitCase:
+    if isinstance(case, LimitCase):
+        return case
+    for c in limit_cases(spec, stiffness):
+        if c.name == case or c.number == case:
+            return c
+    names = ", ".join(c.name for c in limit_cases(spec, stiffness))
+    raise ValueError(f"unknown limit case {case!r}; this spec has: {names}")
+
+
+# --------------------------------------------------------------------------- controller, delay
+
+
+def delay_time(spec: Spec) -> float:
+    """Loop delay of the linear analysis.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+
+    Returns
+    -------
+    float
+        ``controller.delay`` plus half a sample period (zero-order hold) when
+        ``controller.sample_rate`` is set [s].
+    """
+    ctl = spec.controller
+    t = ctl.delay
+    if ctl.sample_rate is not None:
+        t += 0.5 / ctl.sample_rate
+    return t
+
+
+def delay_polynomials(spec: Spec) -> tuple[np.ndarray, np.ndarray]:
+    """Pade approximation of :func:`delay_time` (order ``controller.pade_order``).
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+
+    Returns
+    -------
+    num, den : numpy.ndarray
+        Descending powers of s [rad/s]; ``([1.], [1.])`` without delay.
+    """
+    t = delay_time(spec)
+    if t <= 0.0:
+        return np.array([1.0]), np.array([1.0])
+    num, den = control.pade(t, spec.controller.pade_order)
+    return np.asarray(num, float), np.asarray(den, float)
+
+
+def controller_polynomials(gains: PidGains) -> tuple[np.ndarray, np.ndarray]:
+    """C(s) = ks (1 + wi/s)(1 + s/wd)/(1 + s/wt) as numerator and denominator.
+
+    Parameters
+    ----------
+    gains : PidGains
+        The PID (:func:`fi_design.pid.tune_pid`).
+
+    Returns
+    -------
+    num, den : numpy.ndarray
+        Descending powers of s [rad/s], C in N/m:
+        ``ks wt (s + wi)(s + wd) / (wd s (s + wt))``.
+    """
+    g = gains
+    num = (g.ks * g.wt / g.wd) * np.polymul([1.0, g.wi], [1.0, g.wd])
+    den = np.array([1.0, g.wt, 0.0])
+    return num, den
+
+
+def controller_tf(gains: PidGains):
+    """The PID as a transfer function.
+
+    Parameters
+    ----------
+    gains : PidGains
+        The PID.
+
+    Returns
+    -------
+    control.TransferFunction
+        C(s) [N/m], s in rad/s.
+    """
+    return control.tf(*controller_polynomials(gains))
+
+
+def delay_tf(spec: Spec):
+    """The Pade delay model as a transfer function.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+
+    Returns
+    -------
+    control.TransferFunction
+        The all-pass approximation of :func:`delay_time`; 1 without delay.
+    """
+    return control.tf(*delay_polynomials(spec))
+
+
+def loop_polynomials(spec: Spec, case, crossover: float | None = None,
+                     stiffness: float | None = None,
+                     gains: PidGains | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Numerator and denominator of the loop L = C D P of one case.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+    case : str, int or LimitCase
+        Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
+    crossover : float, optional
+        Crossover the PID is tuned for [Hz]; default the spec's.
+    stiffness : float, optional
+        Joint drive stiffness [N/m]; default the spec's.
+    gains : PidGains, optional
+        Use these gains instead of tuning (``crossover`` is then ignored).
+
+    Returns
+    -------
+    num, den : numpy.ndarray
+        Descending powers of s [rad/s]; L is dimensionless.
+    """
+    lc = _case(spec, case, stiffness)
+    g = tune_pid(spec, crossover) if gains is None else gains
+    cn, cd = controller_polynomials(g)
+    dn, dd = delay_polynomials(spec)
+    return (np.polymul(np.polymul(cn, dn), lc.num), np.polymul(np.polymul(cd, dd), lc.den))
+
+
+def loop_transfer_function(spec: Spec, case, crossover: float | None = None,
+                           stiffness: float | None = None, gains: PidGains | None = None):
+    """Loop transfer function L(s) = C(s) D(s) P(s) of one limit case.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+    case : str, int or LimitCase
+        Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
+    crossover : float, optional
+        Crossover the PID is tuned for [Hz]; default the spec's.
+    stiffness : float, optional
+        Joint drive stiffness [N/m]; default the spec's.
+    gains : PidGains, optional
+        Use these gains instead of tuning (``crossover`` is then ignored).
+
+    Returns
+    -------
+    control.TransferFunction
+        Dimensionless L(s), s in rad/s.
+    """
+    return control.tf(*loop_polynomials(spec, case, crossover, stiffness, gains))
+
+
+def sensitivity(spec: Spec, case, crossover: float | None = None,
+                stiffness: float | None = None, gains: PidGains | None = None):
+    """Sensitivity S = 1 / (1 + L) of one limit case.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+    case : str, int or LimitCase
+        Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
+    crossover : float, optional
+        Crossover the PID is tuned for [Hz]; default the spec's.
+    stiffness : float, optional
+        Joint drive stiffness [N/m]; default the spec's.
+    gains : PidGains, optional
+        Use these gains instead of tuning (``crossover`` is then ignored).
+
+    Returns
+    -------
+    control.TransferFunction
+        S(s), dimensionless; ``1 / max|S|`` is the modulus margin.
+    """
+    num, den = loop_polynomials(spec, case, crossover, stiffness, gains)
+    return control.tf(den, np.polyadd(den, num))
+
+
+def complementary_sensitivity(spec: Spec, case, crossover: float | None = None,
+                              stiffness: float | None = None, gains: PidGains | None = None):
+    """Complementary sensitivity T = L / (1 + L) of one limit case.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+    case : str, int or LimitCase
+        Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
+    crossover : float, optional
+        Crossover the PID is tuned for [Hz]; default the spec's.
+    stiffness : float, optional
+        Joint drive stiffness [N/m]; default the spec's.
+    gains : PidGains, optional
+        Use these gains instead of tuning (``crossover`` is then ignored).
+
+    Returns
+    -------
+    control.TransferFunction
+        T(s), dimensionless: the closed loop from reference to x1.
+    """
+    num, den = loop_polynomials(spec, case, crossover, stiffness, gains)
+    return control.tf(num, np.polyadd(den, num))
+
+
+# --------------------------------------------------------------------------- margins
+
+
+@dataclass(frozen=True)
+class CaseMargins:
+    """Loop margins of one limit case at one tuned crossover.
+
+    Attributes
+    ----------
+    name : str
+        Case name (see :data:`ISOLATED_CASES`).
+    description : str
+        The case in words.
+    crossover : float or None
+        Gain crossover [Hz] with the worst phase margin (the loop may cross
+        0 dB several times; ``crossovers`` lists all). None without crossing.
+    phase_margin_deg : float
+        Worst phase margin over the crossings [deg]: the phase distance of
+        L(j w) from -180 deg, ``|wrap(angle L + 180)|``. Negative when the
+        closed loop is unstable. ``inf`` without a crossing.
+    gain_margin_db : float
+        Gain margin [dB] at the phase crossover nearest to 0 dB, signed:
+        positive, the gain may rise by this much; negative, the loop goes
+        unstable when the gain falls by this much (a conditionally stable
+        loop: the integrator on an undamped mass starts the phase below
+        -180 deg). ``inf`` without a phase crossover (``None`` in JSON).
+    modulus_margin : float
+        Smallest distance of L(j w) from -1, min |1 + L| = 1 / max |S| [-].
+    delay_margin : float
+        Smallest extra loop delay that makes the loop unstable [s]: over the
+        crossings, the phase lag left to -180 deg [rad] divided by the
+        crossing frequency [rad/s]. 0 when the closed loop is unstable.
+    stable : bool
+        All closed-loop poles (roots of den + num of L) in the open left half-plane.
+    crossovers : tuple of float
+        All gain crossovers [Hz], ascending.
+    passed : bool
+        Stable, and phase, gain and (if required) modulus margins meet the
+        spec's requirements.
+    failed : tuple of str
+        The requirements not met: ``stability``, ``phase margin``,
+        ``gain margin``, ``modulus margin``.
+    """
+
+    name: str
+    description: str
+    crossover: float | None
+    phase_margin_deg: float
+    gain_margin_db: float
+    modulus_margin: float
+    delay_margin: float
+    stable: bool
+    crossovers: tuple[float, ...] = ()
+    passed: bool = True
+    failed: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict:
+        """Plain JSON data; infinite margins become null."""
+        return dataclass_dict(self)
+
+
+def _scaled(p: np.ndarray, w0: float) -> np.ndarray:
+    """Coefficients of p(w0 s') in s' (descending powers)."""
+    n = len(p) - 1
+    return np.asarray(p, float) * w0 ** np.arange(n, -1, -1, dtype=float)
+
+
+def loop_margins(num: Sequence[float], den: Sequence[float], scale: float = 1.0,
+                 name: str = "", description: str = "") -> CaseMargins:
+    """Margins and closed-loop stability of a loop L = num/den.
+
+    Parameters
+    ----------
+    num, den : array_like
+        Loop numerator and denominator, descending powers of s [rad/s].
+    scale : float, optional
+        Frequency [rad/s] the Laplace variable is scaled by before the
+        polynomial root finding (the crossover is a good choice). Results are
+        reported unscaled.
+    name, description : str, optional
+        Labels copied into the result.
+
+    Returns
+    -------
+    CaseMargins
+        The margins; ``passed`` is left True (see :func:`analyse`).
+    """
+    ns, ds = _scaled(num, scale), _scaled(den, scale)
+    lead = ds[np.nonzero(ds)[0][0]]
+    ns, ds = ns / lead, ds / lead
+    sys = control.tf(ns, ds)
+    gm, pm, sm, _wpc, wgc, _wms = control.stability_margins(sys, returnall=True)
+    gm, pm, sm, wgc = (np.atleast_1d(np.asarray(a, float)) for a in (gm, pm, sm, wgc))
+
+    char = np.polyadd(ds, ns)
+    char = char[np.nonzero(char)[0][0]:]
+    poles = np.roots(char)
+    stable = bool(poles.size == 0 or np.all(poles.real < 0.0))
+
+    if wgc.size:
+        dist = np.abs(pm)
+        i = int(np.argmin(dist))
+        crossover = float(wgc[i] * scale / (2.0 * math.pi))
+        phase = float(dist[i]) if stable else -float(dist[i])
+        lag = np.radians(np.mod(pm, 360.0))
+        delay = float(np.min(lag / (wgc * scale))) if stable else 0.0
+        crossings = tuple(float(w * scale / (2.0 * math.pi)) for w in wgc)
+    else:
+        crossover, phase, delay, crossings = None, math.inf, math.inf if stable else 0.0, ()
+    finite = gm[np.isfinite(gm) & (gm > 0)]
+    if finite.size:
+        db = 20.0 * np.log10(finite)
+        gain = float(db[int(np.argmin(np.abs(db)))])
+    else:
+        gain = math.inf
+    modulus = float(min(np.min(sm), 1.0)) if sm.size else 1.0
+    return CaseMargins(name=name, description=description, crossover=crossover,
+                       phase_margin_deg=phase, gain_margin_db=gain, modulus_margin=modulus,
+                       delay_margin=delay, stable=stable, crossovers=crossings)
+
+
+def _judge(m: CaseMargins, spec: Spec) -> CaseMargins:
+    req = spec.requirements
+    failed = []
+    if not m.stable:
+        failed.append("stability")
+    if m.phase_margin_deg < req.phase_margin:
+        failed.append("phase margin")
+    if abs(m.gain_margin_db) < req.gain_margin:
+        failed.append("gain margin")
+    if req.modulus_margin is not None and m.modulus_margin < req.modulus_margin:
+        failed.append("modulus margin")
+    return replace(m, passed=not failed, failed=tuple(failed))
+
+
+@dataclass(frozen=True)
+class LoopAnalysis:
+    """Margins of every limit case at one tuned crossover.
+
+    Attributes
+    ----------
+    crossover : float
+        Crossover the PID is tuned for [Hz].
+    stiffness : float or None
+        Joint drive stiffness used [N/m]; None without isolator.
+    delay : float
+        Loop delay modelled [s] (Pade approximation).
+    gains : PidGains
+        The PID.
+    cases : tuple of CaseMargins
+        One per limit case, in the paper's order.
+    passed : bool
+        All cases meet the margin requirements.
+    """
+
+    crossover: float
+    stiffness: float | None
+    delay: float
+    gains: PidGains
+    cases: tuple[CaseMargins, ...]
+    passed: bool
+
+    def to_dict(self) -> dict:
+        """Plain JSON data."""
+        return dataclass_dict(self)
+
+
+def analyse(spec: Spec, crossover: float | None = None, stiffness: float | None = None,
+            cases: Sequence[LimitCase] | None = None) -> LoopAnalysis:
+    """Margins of all limit cases for the PID tuned at ``crossover``.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec (plant, controller rule, delay, requirements).
+    crossover : float, optional
+        Tuned crossover [Hz]; default ``spec.controller.crossover``.
+    stiffness : float, optional
+        Joint drive stiffness [N/m]; default the spec's.
+    cases : sequence of LimitCase, optional
+        Precomputed :func:`limit_cases` (saves rebuilding them in a loop).
+
+    Returns
+    -------
+    LoopAnalysis
+        Per-case margins judged against ``spec.requirements``.
+    """
+    fc = spec.controller.crossover if crossover is None else float(crossover)
+    lcs = limit_cases(spec, stiffness) if cases is None else tuple(cases)
+    g = tune_pid(spec, fc)
+    cn, cd = controller_polynomials(g)
+    dn, dd = delay_polynomials(spec)
+    ln, ld = np.polymul(cn, dn), np.polymul(cd, dd)
+    out = []
+    for lc in lcs:
+        m = loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den), scale=g.wc,
+                         name=lc.name, description=lc.description)
+        out.append(_judge(m, spec))
+    k = None
+    if spec.isolator is not None:
+        k = drive_stiffness(spec) if stiffness is None else float(stiffness)
+    return LoopAnalysis(crossover=fc, stiffness=k, delay=delay_time(spec), gains=g,
+                        cases=tuple(out), passed=all(c.passed for c in out))
+
+
+# --------------------------------------------------------------------------- achievable crossover
+
+
+@dataclass(frozen=True)
+class AchievableCrossover:
+    """The highest crossover at which every limit case meets the requirements.
+
+    Attributes
+    ----------
+    frequency : float or None
+        Achievable crossover [Hz] (to the bisection tolerance); None when no
+        scanned crossover is feasible.
+    limited_by : str
+        What limits it, in words: the case and margin, the parasitic mode,
+        or ``nothing up to the scan limit ...``.
+    kind : str
+        ``margin`` (a loop margin or stability of a case), ``mode`` (parasitic
+        separation), ``scan_limit`` (nothing found up to the top of the scan)
+        or ``infeasible`` (no scanned crossover works).
+    case : str or None
+        Name of the limiting case (``kind == "margin"``).
+    criterion : str or None
+        The failing requirement: ``stability``, ``phase margin``,
+        ``gain margin``, ``modulus margin`` or ``parasitic separation``.
+    scan_start, scan_stop : float
+        Range of the scan [Hz].
+    feasible_ranges : tuple of tuple of float
+        Feasible stretches of the scan grid, ``(low, high)`` [Hz], at grid
+        resolution (the top one refined). Several stretches mean that a lower
+        crossover can fail where a higher one passes.
+    evaluations : int
+        Crossovers evaluated.
+    """
+
+    frequency: float | None
+    limited_by: str
+    kind: str
+    case: str | None
+    criterion: str | None
+    scan_start: float
+    scan_stop: float
+    feasible_ranges: tuple[tuple[float, float], ...]
+    evaluations: int
+
+    def to_dict(self) -> dict:
+        """Plain JSON data."""
+        return dataclass_dict(self)
+
+
+def _units(criterion: str) -> str:
+    return {"phase margin": "deg", "gain margin": "dB", "modulus margin": ""}.get(criterion, "")
+
+
+def achievable_crossover(spec: Spec, stiffness: float | None = None,
+                         start: float | None = None, stop: float | None = None,
+                         rtol: float = 1e-3) -> AchievableCrossover:
+    """The highest crossover at which all limit cases meet the requirements.
+
+    At each crossover the PID is retuned by the spec's rule; a crossover is
+    feasible when every case is stable and meets ``requirements.phase_margin``,
+    ``requirements.gain_margin`` and ``requirements.modulus_margin`` (if set),
+    and every parasitic mode lies at or above ``requirements.parasitic_separation``
+    times the crossover. A log scan (:data:`SCAN_POINTS_PER_DECADE`) finds the
+    highest feasible grid point; bisection refines the boundary above it.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+    stiffness : float, optional
+        Joint drive stiffness [N/m]; default the spec's.
+    start : float, optional
+        Lowest crossover scanned [Hz]; default the smaller of :data:`SCAN_START`
+        and a tenth of the desired crossover.
+    stop : float, optional
+        Scan limit [Hz]; default :data:`SCAN_LIMIT`, capped at the Nyquist
+        frequency of a sampled controller. The parasitic separation caps the
+        scan further.
+    rtol : float, optional
+        Relative tolerance of the bisection [-]. Default 1e-3.
+
+    Returns
+    -------
+    AchievableCrossover
+        The frequency and what limits it.
+    """
+    lcs = limit_cases(spec, stiffness)
+    req = spec.requirements
+    sep = req.parasitic_separation
+    modes = spec.isolator.parasitic_modes if spec.isolator is not None else ()
+    ctl = spec.controller
+    f_lo = min(SCAN_START, ctl.crossover / 10.0) if start is None else float(start)
+    scan_limit = SCAN_LIMIT if stop is None else float(stop)
+    if ctl.sample_rate is not None:
+        scan_limit = min(scan_limit, 0.5 * ctl.sample_rate)
+    mode_limit, low_mode = math.inf, None
+    for m in modes:
+        if m.frequency / sep < mode_limit:
+            mode_limit, low_mode = m.frequency / sep, m
+    f_hi = min(scan_limit, mode_limit)
+    if f_hi <= f_lo:
+        f_lo = f_hi / 10.0
+    n = max(2, int(math.ceil(SCAN_POINTS_PER_DECADE * math.log10(f_hi / f_lo))) + 1)
+    grid = np.geomspace(f_lo, f_hi, n)
+    count = 0
+
+    def failures(fc: float, first_only: bool) -> list[CaseMargins]:
+        nonlocal count
+        count += 1
+        res = analyse(spec, fc, stiffness, cases=lcs).cases if not first_only else \
+            _analyse_until_fail(spec, fc, lcs)
+        return [c for c in res if not c.passed]
+
+    ok = np.array([not failures(float(f), True) for f in grid])
+    ranges = _ranges(grid, ok)
+
+    if ok[-1]:
+        if f_hi == mode_limit:
+            return AchievableCrossover(
+                frequency=float(f_hi),
+                limited_by=(f"parasitic mode '{low_mode.name}' at {low_mode.frequency:.4g} Hz, "
+                            f"which must lie above {sep:g} x the crossover"),
+                kind="mode", case=None, criterion="parasitic separation", scan_start=f_lo,
+                scan_stop=f_hi, feasible_ranges=ranges, evaluations=count)
+        return AchievableCrossover(
+            frequency=float(f_hi), limited_by=f"nothing up to the scan limit {f_hi:.4g} Hz",
+            kind="scan_limit", case=None, criterion=None, scan_start=f_lo, scan_stop=f_hi,
+            feasible_ranges=ranges, evaluations=count)
+    if not ok.any():
+        bad = failures(float(grid[0]), False)[0]
+        return AchievableCrossover(
+            frequency=None,
+            limited_by=(f"no crossover from {f_lo:.3g} Hz to {f_hi:.4g} Hz meets the "
+                        f"requirements; at {f_lo:.3g} Hz it is {_describe(bad, spec)}"),
+            kind="infeasible", case=bad.name, criterion=bad.failed[0], scan_start=f_lo,
+            scan_stop=f_hi, feasible_ranges=(), evaluations=count)
+
+    i = int(np.nonzero(ok)[0][-1])
+    a, b = float(grid[i]), float(grid[i + 1])
+    while b / a > 1.0 + rtol:
+        mid = math.sqrt(a * b)
+        if failures(mid, True):
+            b = mid
+        else:
+            a = mid
+    bad = failures(b, False)[0]
+    ranges = ranges[:-1] + ((ranges[-1][0], a),)
+    log.debug("achievable crossover %.4g Hz after %d evaluations", a, count)
+    return AchievableCrossover(
+        frequency=a, limited_by=_describe(bad, spec, above=a), kind="margin",
+        case=bad.name, criterion=bad.failed[0], scan_start=f_lo, scan_stop=f_hi,
+        feasible_ranges=ranges, evaluations=count)
+
+
+def _analyse_until_fail(spec: Spec, fc: float, lcs: Sequence[LimitCase]) -> list[CaseMargins]:
+    """Like :func:`analyse` but stops at the first failing case (for the scan)."""
+    g = tune_pid(spec, fc)
+    cn, cd = controller_polynomials(g)
+    dn, dd = delay_polynomials(spec)
+    ln, ld = np.polymul(cn, dn), np.polymul(cd, dd)
+    out = []
+    for lc in lcs:
+        m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den), scale=g.wc,
+                                name=lc.name, description=lc.description), spec)
+        out.append(m)
+        if not m.passed:
+            break
+    return out
+
+
+def _describe(m: CaseMargins, spec: Spec, above: float | None = None) -> str:
+    """What fails in a case, in words.
+
+    With ``above``: ``the gain margin of case 4 (cart stuck, limiter engaged)
+    falls below 6 dB above 11.8 Hz``; without: ``the gain margin of case 4
+    (...) is 5.2 dB, below the 6 dB required``.
+    """
+    req = spec.requirements
+    where = f"case {CASE_NUMBERS[m.name]} ({m.description})"
+    crit = m.failed[0]
+    if crit == "stability":
+        if above is not None:
+            return f"the stability of {where}: its closed loop turns unstable above {above:.4g} Hz"
+        return f"the stability of {where}: its closed loop is unstable"
+    value, limit = {
+        "phase margin": (m.phase_margin_deg, req.phase_margin),
+        "gain margin": (abs(m.gain_margin_db), req.gain_margin),
+        "modulus margin": (m.modulus_margin, req.modulus_margin),
+    }[crit]
+    unit = _units(crit)
+    unit = f" {unit}" if unit else ""
+    if above is not None:
+        return f"the {crit} of {where}, which falls below {limit:g}{unit} above {above:.4g} Hz"
+    return f"the {crit} of {where}, {value:.3g}{unit}, below the {limit:g}{unit} required"
+
+
+def _ranges(grid: np.ndarray, ok: np.ndarray) -> tuple[tuple[float, float], ...]:
+    out = []
+    start = None
+    for f, good in zip(grid, ok):
+        if good and start is None:
+            start = float(f)
+        if good:
+            end = float(f)
+        if not good and start is not None:
+            out.append((start, end))
+            start = None
+    if start is not None:
+        out.append((start, end))
+    return tuple(out)

@@ -1,0 +1,173 @@
+"""Hunting metrics, computed from simulated or measured traces only.
+
+The paper's metric (section 2.3): count the peaks of the position error
+x1 - r in a window after the expected settling time ([10 s, 20 s) by
+default), with a minimum distance between peaks (0.5 s) and a minimum peak
+height (0.1 mm); one peak per hunting cycle.
+
+The count alone is blind in two ways, and the verdict here is not:
+
+- a stage stuck far from its target shows no peaks: verdict ``stuck``;
+- a cycle slower than the window, or a slow creep, shows none either:
+  verdict ``undetermined`` ("too slow to judge in this window").
+
+Only a stage whose error stays inside the settle band at the end of the
+window is ``settled``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .results import dataclass_dict, frozen_array
+
+VERDICTS = ("settled", "hunting", "stuck", "undetermined")
+
+
+@dataclass(frozen=True, eq=False)
+class HuntingMetrics:
+    """Hunting metric and settling figures of one trace.
+
+    Attributes
+    ----------
+    hunting_cycles : int
+        Peaks of x1 - r counted in the window (the paper's metric).
+    peak_times : ndarray, shape (hunting_cycles,)
+        Times of the counted peaks [s].
+    peak_heights : ndarray, shape (hunting_cycles,)
+        Error at the counted peaks [m].
+    amplitude : float
+        Peak-to-peak error in the window [m].
+    period : float or None
+        Mean time between counted peaks [s]; None with fewer than two.
+    settled : bool
+        Whether |x1 - r| stays within the settle band over the last quarter of
+        the window.
+    settling_time : float or None
+        Time after the end of the motion until |x1 - r| stays within the
+        settle band to the end of the trace [s]; None if it never does.
+    final_error : float
+        x1 - r at the last sample [m].
+    verdict : str
+        ``settled``, ``hunting``, ``stuck`` or ``undetermined``.
+    reason : str
+        Why, in one sentence.
+    window : tuple of float
+        The counting window (start, end) [s].
+    settle_band : float
+        The band used for ``settled`` and the settling time [m].
+    """
+
+    hunting_cycles: int
+    peak_times: np.ndarray
+    peak_heights: np.ndarray
+    amplitude: float
+    period: float | None
+    settled: bool
+    settling_time: float | None
+    final_error: float
+    verdict: str
+    reason: str
+    window: tuple[float, float]
+    settle_band: float
+
+    def to_dict(self) -> dict:
+        """Plain JSON data (SI)."""
+        return dataclass_dict(self)
+
+
+def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_length: float = 10.0,
+                    min_distance: float = 0.5, min_height: float = 1e-4,
+                    settle_band: float = 1e-5, motion_end: float = 0.0,
+                    success: bool = True, failure: str = "") -> HuntingMetrics:
+    """Evaluate the hunting metric and the verdict on a trace.
+
+    Parameters
+    ----------
+    time_s : array_like, shape (n,)
+        Sample times [s], increasing (uniform sampling expected by the
+        paper's metric; the peak distance is converted with the median step).
+    error_m : array_like, shape (n,)
+        Position error x1 - r [m].
+    window_start, window_length : float
+        Counting window [s].
+    min_distance : float
+        Minimum time between counted peaks [s].
+    min_height : float
+        Minimum peak height of x1 - r [m].
+    settle_band : float
+        Band for ``settled`` and the settling time [m].
+    motion_end : float
+        End of the last move [s]; the settling time counts from here.
+    success : bool
+        Whether the trace is complete; an incomplete one is ``undetermined``.
+    failure : str
+        Why the trace is incomplete (used in ``reason``).
+
+    Returns
+    -------
+    HuntingMetrics
+    """
+    from scipy.signal import find_peaks
+
+    t = np.asarray(time_s, dtype=float)
+    e = np.asarray(error_m, dtype=float)
+    w0, w1 = window_start, window_start + window_length
+    inside = (t >= w0) & (t < w1) & np.isfinite(e)
+    tw, ew = t[inside], e[inside]
+    if len(tw) > 1:
+        dt = float(np.median(np.diff(tw)))
+        distance = max(1, int(round(min_distance / dt)))
+        idx, _ = find_peaks(ew, height=min_height, distance=distance)
+    else:
+        idx = np.zeros(0, dtype=int)
+    peaks_t, peaks_h = tw[idx], ew[idx]
+    cycles = int(len(idx))
+    amplitude = float(np.ptp(ew)) if len(ew) else float("nan")
+    period = float(np.mean(np.diff(peaks_t))) if cycles >= 2 else None
+    finite = np.isfinite(e)
+    final_error = float(e[finite][-1]) if finite.any() else float("nan")
+
+    tail = inside & (t >= w1 - window_length / 4.0)
+    settled = bool(success and tail.any() and np.all(np.abs(e[tail]) <= settle_band))
+    settling_time = _settling_time(t, e, settle_band, motion_end) if success else None
+
+    if not success:
+        verdict, reason = "undetermined", f"the simulation did not complete: {failure}"
+    elif len(ew) < 2:
+        verdict, reason = "undetermined", "the trace does not cover the counting window"
+    elif cycles > 0:
+        verdict = "hunting"
+        reason = (f"{cycles} peak(s) of at least {min_height * 1e3:g} mm in "
+                  f"[{w0:g} s, {w1:g} s)" + (f", period {period:.3g} s" if period else ""))
+    elif settled:
+        verdict = "settled"
+        reason = f"|x1 - r| stays within {settle_band * 1e6:g} um at the end of the window"
+    elif np.ptp(ew) <= settle_band:
+        verdict = "stuck"
+        reason = (f"the stage rests {abs(final_error) * 1e6:.3g} um from its target: no peaks, "
+                  "but not settled either (the integrator has not broken it loose in the window)")
+    else:
+        verdict = "undetermined"
+        reason = (f"no peaks counted, but the error still moves by {np.ptp(ew) * 1e6:.3g} um in "
+                  "the window: a cycle or creep too slow to judge in this window")
+    return HuntingMetrics(
+        hunting_cycles=cycles, peak_times=frozen_array(peaks_t), peak_heights=frozen_array(peaks_h),
+        amplitude=amplitude, period=period, settled=settled, settling_time=settling_time,
+        final_error=final_error, verdict=verdict, reason=reason, window=(w0, w1),
+        settle_band=settle_band)
+
+
+def _settling_time(t: np.ndarray, e: np.ndarray, band: float, start: float) -> float | None:
+    after = t >= start
+    if not after.any():
+        return None
+    outside = np.nonzero(after & ~(np.abs(e) <= band))[0]
+    if len(outside) == 0:
+        return 0.0
+    last = outside[-1]
+    if last == len(t) - 1:
+        return None
+    return float(t[last + 1] - start)

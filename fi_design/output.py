@@ -1,0 +1,207 @@
+"""Output files: checked before the work starts, written atomically.
+
+Every command that writes a file (JSON, report, CSV, a fixed spec) does two
+things with it:
+
+1. :func:`check_output` before any long computation, so a run never spends a
+   minute and then fails on a path it could have refused at once. It refuses
+   an existing file without ``force``, the spec itself (even with ``force``, and
+   also when reached through a symlink or a hard link), a wrong extension, a
+   directory and a missing parent directory.
+2. :func:`write_atomic` (or :func:`atomic_path` for writers that want a file
+   name) to write it: the data goes to a temporary file in the same directory,
+   is flushed to disk and moved into place with :func:`os.replace`. A failure
+   leaves the old file untouched and no temporary file behind; a reader never
+   sees half a file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+
+from .errors import OutputError
+
+
+def check_output(path: str | os.PathLike, *, force: bool = False,
+                 protect: Iterable[str | os.PathLike | None] = (),
+                 extensions: Iterable[str] = ()) -> Path:
+    """Refuse an output path before the work starts.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file the command is asked to write.
+    force : bool, optional
+        Allow overwriting an existing file. Default False.
+    protect : iterable of path, optional
+        Files that must never be overwritten, even with ``force`` (the spec,
+        the measured data, another output of the same run). ``None`` entries
+        are ignored. Compared by resolved path and, for existing files, with
+        :func:`os.path.samefile` (which also catches hard links).
+    extensions : iterable of str, optional
+        Allowed suffixes, e.g. ``(".json",)`` or ``(".html", ".pdf")``;
+        compared case-insensitively. Empty: any suffix.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    OutputError
+        The path is refused; the message says why and what to do.
+    """
+    out = Path(path)
+    exts = tuple(e.lower() if e.startswith(".") else "." + e.lower() for e in extensions)
+    for other in protect:
+        if other is None:
+            continue
+        if _same_file(out, Path(other)):
+            raise OutputError(f"{out}: refusing to overwrite the input file {other} "
+                              "(not even with --force); choose another output name")
+    if exts and out.suffix.lower() not in exts:
+        want = " or ".join(exts)
+        raise OutputError(f"{out}: output file name must end with {want}")
+    if out.is_dir():
+        raise OutputError(f"{out}: is a directory; give a file name")
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.exists():
+        raise OutputError(f"{out}: directory {parent} does not exist")
+    if not parent.is_dir():
+        raise OutputError(f"{out}: {parent} is not a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f"{out}: directory {parent} is not writable")
+    if out.exists() or out.is_symlink():
+        if not force:
+            raise OutputError(f"{out}: file exists; use --force to overwrite it")
+        if out.exists() and not out.is_file():
+            raise OutputError(f"{out}: exists and is not a regular file")
+    return out
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        if os.path.realpath(a) == os.path.realpath(b):
+            return True
+    except (OSError, ValueError):
+        pass
+    try:
+        return a.exists() and b.exists() and os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
+    """Give a temporary file name that becomes ``path`` when the block succeeds.
+
+    For writers that want a file name (weasyprint's ``write_pdf``,
+    ``Figure.savefig``, ``csv``). The temporary file lies in the same directory
+    as ``path`` (so the final :func:`os.replace` is atomic), is fsynced, gets
+    the permissions a new file would get (or those of the file it replaces),
+    and is removed if the block raises.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The final file name.
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary file to write (it exists, empty).
+
+    Raises
+    ------
+    OutputError
+        The temporary file cannot be created or moved into place.
+    """
+    out = Path(path)
+    parent = out.parent if str(out.parent) else Path(".")
+    try:
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp", dir=parent)
+    except OSError as exc:
+        raise OutputError(f"{out}: cannot create a file in {parent} ({exc.strerror})") from None
+    os.close(fd)
+    tmp = Path(tmp_name)
+    try:
+        yield tmp
+        _fsync_file(tmp)
+        os.chmod(tmp, _mode_for(out))
+        os.replace(tmp, out)
+    except OSError as exc:
+        _remove(tmp)
+        raise OutputError(f"{out}: cannot write ({exc.strerror or exc})") from None
+    except BaseException:
+        _remove(tmp)
+        raise
+    _fsync_dir(parent)
+
+
+def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:
+    """Write ``data`` to ``path`` atomically.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to write; check it first with :func:`check_output`.
+    data : str or bytes
+        The content; text is written as UTF-8.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    OutputError
+        The file cannot be written; the old file (if any) is untouched and no
+        temporary file is left behind.
+    """
+    payload = data.encode("utf-8") if isinstance(data, str) else bytes(data)
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            fh.write(payload)
+    return Path(path)
+
+
+def _fsync_file(path: Path) -> None:
+    with open(path, "rb+") as fh:
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
+def _fsync_dir(directory: Path) -> None:
+    """Make the rename durable (POSIX); harmless where directories cannot be opened."""
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _mode_for(out: Path) -> int:
+    """Permissions of the file being replaced, else 0o666 minus the umask."""
+    try:
+        return out.stat().st_mode & 0o7777
+    except OSError:
+        pass
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+def _remove(path: Path) -> None:
+    with contextlib.suppress(OSError):
+        path.unlink()

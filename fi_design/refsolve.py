@@ -1,0 +1,248 @@
+"""Reference solution with scipy's solve_ivp on the same equations.
+
+A deliberately plain path for tests and benchmarks: the right-hand side and
+Jacobian are those of :mod:`fi_design.plant`; mode changes (sliding direction,
+limiter contact, quantization level, switch-model sticking) are located by
+solve_ivp's own event finder and handled by the Python code below, written
+independently of the kernel's event logic; time events (reference
+breakpoints, controller samples, delayed outputs) split the integration.
+A continuous delay is integrated by the method of steps: chunks no longer
+than the delay, each reading the applied force from the dense output of the
+chunks before it.
+
+Slow by design (Python-level calls), exact to tight tolerances.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+
+import numpy as np
+
+from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, PlantParameters, actuator,
+                    drive_force, jacobian, natural_modes, rhs)
+from .reference import Reference
+
+
+class _History:
+    """Controller output u(t) from the dense outputs of finished chunks."""
+
+    def __init__(self, iu: int) -> None:
+        self.starts: list[float] = []
+        self.pieces: list = []
+        self.iu = iu
+
+    def add(self, t0: float, sol) -> None:
+        self.starts.append(t0)
+        self.pieces.append(sol)
+
+    def __call__(self, t: float) -> float:
+        if t <= 0.0 or not self.pieces:
+            return 0.0
+        k = max(bisect.bisect_right(self.starts, t) - 1, 0)
+        return float(self.pieces[k](t)[self.iu])
+
+
+def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t_out,
+                    rtol: float, atol, x_bound: float, method: str = "Radau"):
+    """Integrate with solve_ivp; same outputs as :func:`fi_design.kernel.run`.
+
+    Returns ``(code, out_y, out_r, out_fa, n_steps, n_rejected, n_events,
+    t_reached, status)``: code 0 on success, 3 on a solver failure, 4 on
+    divergence.
+    """
+    from scipy.integrate import solve_ivp
+
+    p = params.to_array()
+    n = len(y0)
+    iso = bool(params.isolated)
+    iv2 = 3 if iso else 1
+    ii, iu = n - 2, n - 1
+    Ts = params.sample_period
+    delay = params.delay
+    discrete = Ts > 0
+    fa_state = (not discrete) and delay == 0
+    cont_delay = (not discrete) and delay > 0
+    sw = bool(params.switch_model)
+    q = params.quantization
+    s = params.s
+
+    t_out = np.asarray(t_out, dtype=float)
+    out_y = np.full((len(t_out), n), np.nan)
+    out_r = np.full(len(t_out), np.nan)
+    out_fa = np.full(len(t_out), np.nan)
+
+    y = np.array(y0, dtype=float)
+    modes = np.zeros(4, dtype=np.int64)
+    modes[MODE_SIGN] = 1
+    natural_modes(y, p, modes)
+    if sw:
+        modes[MODE_STICK] = 1 if y[iv2] == 0.0 else 0
+    hist = _History(iu)
+    fa_hold = 0.0
+    qd = np.zeros(2)
+    fifo: list[tuple[float, float]] = []
+    k_sample = 0
+    t = 0.0
+    n_steps = n_rej = n_ev = 0
+    breaks = list(ref.breaks) if ref.land else []
+
+    def fa_at(tt: float, yy) -> float:
+        if fa_state:
+            return yy[iu]
+        if cont_delay:
+            return hist(tt - delay)
+        return fa_hold
+
+    def fun(tt, yy):
+        r, rd = float(ref(tt)), float(ref(tt, 1))
+        f = np.empty(n)
+        rhs(tt, yy, p, modes, r, rd, fa_at(tt, yy) if not fa_state else 0.0, fa_state, f)
+        return f
+
+    def jac(tt, yy):
+        r, rd = float(ref(tt)), float(ref(tt, 1))
+        J = np.empty((n, n))
+        jacobian(tt, yy, p, modes, r, rd, fa_at(tt, yy) if not fa_state else 0.0, fa_state, J)
+        return J
+
+    def events():
+        evs = []
+        sgn = modes[MODE_SIGN]
+        stuck = sw and modes[MODE_STICK] == 1
+        if not stuck:
+            evs.append(("sign", lambda tt, yy: sgn * yy[iv2], -1))
+        if sw and stuck:
+            evs.append(("unstick", lambda tt, yy: abs(drive_force(yy, p, fa_at(tt, yy), fa_state))
+                        - params.Fs, 1))
+        if iso:
+            lim = modes[MODE_LIMIT]
+            if lim == 0:
+                evs.append(("limit+", lambda tt, yy: yy[0] - yy[2] - s, 1))
+                evs.append(("limit-", lambda tt, yy: yy[0] - yy[2] + s, -1))
+            elif lim > 0:
+                evs.append(("limit0", lambda tt, yy: yy[0] - yy[2] - s, -1))
+            else:
+                evs.append(("limit0", lambda tt, yy: yy[0] - yy[2] + s, 1))
+        if q > 0 and not discrete:
+            lev = modes[MODE_LEVEL]
+            evs.append(("level+", lambda tt, yy: yy[0] - (lev + 0.5) * q, 1))
+            evs.append(("level-", lambda tt, yy: yy[0] - (lev - 0.5) * q, -1))
+        funcs = []
+        for name, g, direction in evs:
+            g.terminal = True
+            g.direction = direction
+            funcs.append(g)
+        return [e[0] for e in evs], funcs
+
+    def write_outputs(t0, t1, sol, fa_piece):
+        lo = bisect.bisect_left(t_out, t0 - 1e-12)
+        hi = bisect.bisect_right(t_out, t1 + 1e-12)
+        for i in range(lo, hi):
+            if not np.isnan(out_r[i]):
+                continue
+            tt = t_out[i]
+            yy = sol(tt) if sol is not None else y
+            out_y[i] = yy
+            out_r[i] = float(ref(tt))
+            if fa_state:
+                fa = yy[iu]
+            elif cont_delay:
+                fa = hist(tt - delay)
+            else:
+                fa = fa_piece
+            out_fa[i] = actuator(fa, p)[0]
+
+    status = "ok"
+    code = 0
+    while t < t_end - 1e-12:
+        # time events at t
+        if discrete and t >= k_sample * Ts - 1e-12:
+            lev = math.floor(y[0] / q + 0.5) if q > 0 else 0
+            xm = lev * q if q > 0 else y[0]
+            e_k = float(ref(t)) - xm
+            u_k = params.cd1 * qd[0] + params.cd2 * qd[1] + params.dd * e_k
+            qd = np.array([params.ad11 * qd[0] + params.ad12 * qd[1] + params.bd1 * e_k,
+                           params.ad21 * qd[0] + params.ad22 * qd[1] + params.bd2 * e_k])
+            y[iu] = u_k
+            y[ii] = qd[0]
+            if delay == 0:
+                fa_hold = u_k
+            else:
+                fifo.append((t + delay, u_k))
+            k_sample += 1
+        while fifo and t >= fifo[0][0] - 1e-12:
+            fa_hold = fifo.pop(0)[1]
+        if sw and modes[MODE_STICK] == 1:
+            F = drive_force(y, p, fa_at(t, y), fa_state)
+            if abs(F) > params.Fs:
+                modes[MODE_STICK] = 0
+                modes[MODE_SIGN] = 1 if F > 0 else -1
+        write_outputs(t, t, None, fa_hold)
+        # next time event
+        t_next = t_end
+        k = bisect.bisect_right(breaks, t + 1e-12)
+        if k < len(breaks):
+            t_next = min(t_next, breaks[k])
+        if discrete:
+            t_next = min(t_next, k_sample * Ts)
+        if fifo:
+            t_next = min(t_next, fifo[0][0])
+        if cont_delay:
+            t_next = min(t_next, t + delay)
+        names, funcs = events()
+        sol = solve_ivp(fun, (t, t_next), y, method=method, rtol=rtol, atol=atol, jac=jac,
+                        events=funcs, dense_output=True)
+        n_steps += len(sol.t) - 1
+        if sol.status == -1:
+            code, status = 3, "solver failure: " + sol.message
+            break
+        t1 = float(sol.t[-1])
+        if cont_delay:
+            hist.add(t, sol.sol)
+        write_outputs(t, t1, sol.sol, fa_hold)
+        y = sol.y[:, -1].copy()
+        if sol.status == 1:  # an event
+            for name, te, ye in zip(names, sol.t_events, sol.y_events):
+                if len(te):
+                    y = ye[0].copy()
+                    t1 = float(te[0])
+                    _switch(name, y, p, modes, params, iv2, iu, fa_at(t1, y), fa_state, cont_delay,
+                            hist, t1)
+                    n_ev += 1
+                    break
+        t = t1
+        if abs(y[0]) > x_bound or not np.all(np.isfinite(y)):
+            code, status = 4, "solution diverged"
+            break
+    return code, out_y, out_r, out_fa, n_steps, n_rej, n_ev, t, status
+
+
+def _switch(name, y, p, modes, params, iv2, iu, fa, fa_state, cont_delay, hist, t) -> None:
+    """Mode change at an event located by solve_ivp."""
+    if name == "sign":
+        if params.switch_model:
+            y[iv2] = 0.0
+            F = drive_force(y, p, fa, fa_state)
+            if abs(F) <= params.Fs:
+                modes[MODE_STICK] = 1
+            else:
+                modes[MODE_SIGN] = 1 if F > 0 else -1
+        else:
+            modes[MODE_SIGN] = -modes[MODE_SIGN]
+    elif name == "unstick":
+        F = drive_force(y, p, fa, fa_state)
+        modes[MODE_STICK] = 0
+        modes[MODE_SIGN] = 1 if F > 0 else -1
+    elif name == "limit+":
+        modes[MODE_LIMIT] = 1
+    elif name == "limit-":
+        modes[MODE_LIMIT] = -1
+    elif name == "limit0":
+        modes[MODE_LIMIT] = 0
+    elif name in ("level+", "level-"):
+        step = 1 if name == "level+" else -1
+        modes[MODE_LEVEL] += step
+        if params.sample_period == 0:
+            y[iu] += -params.wt * params.kd * params.quantization * step

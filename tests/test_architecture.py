@@ -1,0 +1,58 @@
+"""Architecture: the import-linter contracts hold, and the light paths stay light."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from conftest import ROOT
+
+#: Libraries that take a second or more to import; never needed for --help or `import fi_design`.
+HEAVY = ("control", "scipy", "matplotlib", "numba")
+
+
+def test_import_linter_contracts():
+    """`lint-imports` with the contracts in pyproject.toml (layers one way, physics library-free)."""
+    code = ("import sys; from importlinter.cli import lint_imports; "
+            "sys.exit(lint_imports(no_cache=True, no_logo=True))")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                       timeout=120)
+    assert p.returncode == 0, p.stdout + p.stderr
+
+
+def _loaded_after(code: str) -> set[str]:
+    probe = (f"import sys, json\n{code}\n"
+             "print(json.dumps(sorted({m.split('.')[0] for m in sys.modules})), file=sys.stderr)")
+    p = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=60,
+                       cwd=ROOT)
+    assert p.returncode == 0, p.stderr
+    return set(json.loads(p.stderr.strip().splitlines()[-1]))
+
+
+def test_import_fi_design_is_light():
+    loaded = _loaded_after("import fi_design; fi_design.__version__; dir(fi_design)")
+    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
+    assert "pydantic" not in loaded and "numpy" not in loaded
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["--version"], ["schema", "--help"],
+                                  ["design", "--help"], ["init", "--help"]])
+def test_cli_help_is_light(argv):
+    code = ("sys.argv = ['fi-design'] + " + repr(argv) + "\n"
+            "from fi_design.cli import main\n"
+            "import contextlib, io\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    try:\n"
+            "        main()\n"
+            "    except SystemExit as e:\n"
+            "        assert e.code in (0, None), e.code\n")
+    loaded = _loaded_after(code)
+    assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
+
+
+def test_cli_module_imports_no_library_at_top_level():
+    loaded = _loaded_after("import fi_design.cli")
+    assert not loaded & (set(HEAVY) | {"pydantic", "numpy", "pint", "rich"}), sorted(loaded)

@@ -1,0 +1,267 @@
+"""The command line through typer's CliRunner, plus the installed entry point."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import pytest
+from typer.testing import CliRunner
+
+from fi_design import __version__
+from fi_design.cli import app
+
+from conftest import BIN, ROOT
+
+runner = CliRunner()
+
+#: The JSON contract of `fi-design SPEC --json` (DESIGN.md section 6 and the guideline).
+CONTRACT = {
+    "friction_gap": ("gap", "threshold", "hunting_risk"),
+    "pid": ("kp", "ki", "kd", "wt", "tuning_mass"),
+    "crossover": ("desired", "achievable", "limited_by", "cases"),
+    "stiffness": ("maximum", "chosen"),
+}
+TOP_KEYS = ("flexure", "checks", "fi_design_version", "spec_sha256")
+
+
+@pytest.fixture(scope="module")
+def design_run(tmp_path_factory, paper_spec_path):
+    """One default-command run on the paper spec with --json (shared: the design takes a while)."""
+    out = tmp_path_factory.mktemp("design") / "result.json"
+    result = runner.invoke(app, [str(paper_spec_path), "--json", str(out)])
+    return result, out
+
+
+def test_default_command_prints_summary(design_run):
+    result, _ = design_run
+    assert result.exit_code == 0, result.output
+    out = result.stdout
+    for word in ("Checks", "PID gains", "kp [N/m]", "Conclusion"):
+        assert word in out
+    assert any(s in out for s in ("PASS", "FAIL", "WARN", "INFO"))
+    assert "Traceback" not in result.output
+
+
+def test_json_contract(design_run, paper_spec_path):
+    result, out = design_run
+    assert result.exit_code == 0, result.output
+    data = json.loads(out.read_text())
+    for section, keys in CONTRACT.items():
+        assert section in data, section
+        for key in keys:
+            assert key in data[section], f"{section}.{key}"
+    for key in TOP_KEYS:
+        assert key in data, key
+    assert isinstance(data["crossover"]["cases"], list)
+    assert data["fi_design_version"] == __version__
+    import hashlib
+
+    assert data["spec_sha256"] == hashlib.sha256(paper_spec_path.read_bytes()).hexdigest()
+    for check in data["checks"]:
+        assert {"name", "passed", "value", "limit", "unit", "message", "status"} <= set(check)
+    # no temporary files left next to the output
+    assert sorted(p.name for p in out.parent.iterdir()) == ["result.json"]
+
+
+def test_options_before_spec_and_explicit_command(tmp_path, paper_spec_path, monkeypatch):
+    calls = []
+    _fake_design(monkeypatch, calls)
+    out = tmp_path / "a.json"
+    r = runner.invoke(app, ["--json", str(out), str(paper_spec_path)])
+    assert r.exit_code == 0, r.output
+    assert out.exists()
+    r = runner.invoke(app, ["design", str(paper_spec_path)])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(app, ["--debug", str(paper_spec_path)])
+    assert r.exit_code == 0, r.output
+    assert len(calls) == 3
+
+
+def test_refuses_existing_output_without_force(tmp_path, paper_spec_path, monkeypatch):
+    calls = []
+    _fake_design(monkeypatch, calls)
+    out = tmp_path / "out.json"
+    out.write_text("old")
+    r = runner.invoke(app, [str(paper_spec_path), "--json", str(out)])
+    assert r.exit_code == 2
+    assert "exists" in r.stderr and "--force" in r.stderr
+    assert out.read_text() == "old"
+    assert calls == [], "the output must be refused before the work starts"
+    r = runner.invoke(app, [str(paper_spec_path), "--json", str(out), "--force"])
+    assert r.exit_code == 0, r.output
+    assert json.loads(out.read_text())["fi_design_version"] == __version__
+
+
+def test_refuses_spec_as_output_even_with_force(tmp_path, paper_spec_path):
+    spec = tmp_path / "spec.json"  # YAML is read whatever the suffix
+    shutil.copy(paper_spec_path, spec)
+    before = spec.read_bytes()
+    hard = tmp_path / "hard.json"
+    os.link(spec, hard)
+    soft = tmp_path / "soft.json"
+    soft.symlink_to(spec)
+    for target in (spec, hard, soft):
+        r = runner.invoke(app, [str(spec), "--json", str(target), "--force"])
+        assert r.exit_code == 2, (target, r.output)
+        assert "refusing to overwrite the input" in r.stderr
+    r = runner.invoke(app, [str(paper_spec_path), "--json", str(paper_spec_path), "--force"])
+    assert r.exit_code == 2
+    assert spec.read_bytes() == before
+
+
+def test_wrong_extension_and_missing_directory(tmp_path, paper_spec_path):
+    r = runner.invoke(app, [str(paper_spec_path), "--json", str(tmp_path / "out.txt")])
+    assert r.exit_code == 2 and ".json" in r.stderr
+    r = runner.invoke(app, [str(paper_spec_path), "--json", str(tmp_path / "nope" / "o.json")])
+    assert r.exit_code == 2 and "does not exist" in r.stderr
+
+
+def test_internal_error_exit_1_without_traceback(paper_spec_path, monkeypatch):
+    import fi_design.guideline
+
+    def boom(spec):
+        raise RuntimeError("kaboom")
+
+    monkeypatch.setattr(fi_design.guideline, "design", boom)
+    monkeypatch.delenv("FI_DESIGN_DEBUG", raising=False)
+    r = runner.invoke(app, [str(paper_spec_path)])
+    assert r.exit_code == 1
+    assert "internal error: RuntimeError: kaboom" in r.stderr
+    assert "--debug" in r.stderr and "FI_DESIGN_DEBUG" in r.stderr
+    assert "Traceback" not in r.output
+    r = runner.invoke(app, [str(paper_spec_path), "--debug"])
+    assert r.exit_code == 1
+    assert "Traceback" in r.stderr
+    r = runner.invoke(app, [str(paper_spec_path)], env={"FI_DESIGN_DEBUG": "1"})
+    assert r.exit_code == 1
+    assert "Traceback" in r.stderr
+
+
+def test_schema_prints_json_schema():
+    r = runner.invoke(app, ["schema"])
+    assert r.exit_code == 0, r.output
+    schema = json.loads(r.stdout)
+    assert schema["type"] == "object"
+    assert schema["additionalProperties"] is False
+    for key in ("stage", "cart", "friction", "controller", "motion"):
+        assert key in schema["required"]
+    assert {"isolator", "requirements", "effects"} <= set(schema["properties"])
+    for name, sub in schema["$defs"].items():  # every reference resolves
+        assert sub.get("type") == "object", name
+    refs = [p for p in _walk_refs(schema)]
+    assert refs and all(r.split("/")[-1] in schema["$defs"] for r in refs)
+
+
+def test_schema_markdown():
+    r = runner.invoke(app, ["schema", "--markdown"])
+    assert r.exit_code == 0
+    assert "| `friction.static` | N | required |" in r.stdout
+
+
+def test_init_writes_a_spec_that_loads(tmp_path, monkeypatch):
+    from fi_design import load_spec
+
+    monkeypatch.chdir(tmp_path)
+    r = runner.invoke(app, ["init"])
+    assert r.exit_code == 0, r.output
+    spec = load_spec(tmp_path / "bearing.yaml")
+    assert spec.has_isolator
+    r = runner.invoke(app, ["init", "other.yml"])
+    assert r.exit_code == 0, r.output
+    assert load_spec(tmp_path / "other.yml").friction.static == 4.0
+
+
+def test_init_refuses_to_overwrite(tmp_path):
+    path = tmp_path / "mine.yaml"
+    path.write_text("name: mine\n")
+    r = runner.invoke(app, ["init", str(path)])
+    assert r.exit_code == 2
+    assert "exists" in r.stderr
+    assert path.read_text() == "name: mine\n"
+    r = runner.invoke(app, ["init", str(path), "--force"])
+    assert r.exit_code == 0
+    assert "friction" in path.read_text()
+    r = runner.invoke(app, ["init", str(tmp_path / "x.json")])
+    assert r.exit_code == 2 and ".yaml" in r.stderr
+
+
+def test_version_and_help():
+    r = runner.invoke(app, ["--version"])
+    assert r.exit_code == 0 and r.stdout.strip() == f"fi-design {__version__}"
+    r = runner.invoke(app, ["--help"])
+    assert r.exit_code == 0
+    for name in ("design", "schema", "init"):
+        assert name in r.stdout
+    r = runner.invoke(app, [])
+    assert "Usage" in r.output
+
+
+def test_mistyped_command_gets_a_hint():
+    r = runner.invoke(app, ["shcema"])
+    assert r.exit_code == 2
+    assert "did you mean 'fi-design schema'" in r.stderr
+
+
+def test_installed_entry_point(tmp_path, paper_spec_path):
+    exe = BIN / "fi-design"
+    assert exe.exists(), f"{exe}: the package is not installed (pip install -e .)"
+    out = tmp_path / "r.json"
+    p = subprocess.run([str(exe), str(paper_spec_path), "--json", str(out)],
+                       capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "Conclusion" in p.stdout
+    assert json.loads(out.read_text())["spec_sha256"]
+    p = subprocess.run([str(exe), str(tmp_path / "missing.yaml")], capture_output=True,
+                       text=True, timeout=60)
+    assert p.returncode == 2
+    assert "no such file" in p.stderr and "Traceback" not in p.stderr
+
+
+def test_python_dash_m(tmp_path):
+    p = subprocess.run([sys.executable, "-m", "fi_design", "--version"], capture_output=True,
+                       text=True, timeout=60, cwd=ROOT)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() == f"fi-design {__version__}"
+    p = subprocess.run([sys.executable, "-m", "fi_design", "init", str(tmp_path / "b.yaml")],
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "b.yaml").exists()
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _walk_refs(node):
+    if isinstance(node, dict):
+        for k, v in node.items():
+            if k == "$ref":
+                yield v
+            else:
+                yield from _walk_refs(v)
+    elif isinstance(node, list):
+        for v in node:
+            yield from _walk_refs(v)
+
+
+class _FakeResult:
+    checks = ()
+    conclusion = "fake"
+    warnings = ()
+
+    def to_dict(self):
+        return {"fi_design_version": __version__}
+
+
+def _fake_design(monkeypatch, calls):
+    """Replace the (slow) design by a stub: these tests are about the CLI plumbing."""
+    import fi_design.guideline
+
+    def fake(spec):
+        calls.append(spec)
+        return _FakeResult()
+
+    monkeypatch.setattr(fi_design.guideline, "design", fake)

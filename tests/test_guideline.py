@@ -1,0 +1,234 @@
+"""The four guideline steps, the design result and its JSON contract."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import hashlib
+import json
+import math
+
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import fi_design
+from fi_design import guideline as gl
+from fi_design.results import Check, Status
+from fi_design.specfile import load_spec, origin
+
+
+def variant(spec, **paths):
+    """A copy of ``spec``'s YAML mapping with dotted paths replaced (None removes)."""
+    raw = copy.deepcopy(origin(spec).raw)
+    for path, value in paths.items():
+        node = raw
+        *head, last = path.split(".")
+        for key in head:
+            node = node.setdefault(key, {})
+        if value is None:
+            node.pop(last, None)
+        else:
+            node[last] = value
+    return load_spec(raw)
+
+
+@pytest.fixture(scope="module")
+def paper_design(paper_spec):
+    return gl.design(paper_spec)
+
+
+# --------------------------------------------------------------------------- JSON contract
+
+NUM = (int, float)
+
+
+def test_json_contract_for_the_paper_setup(paper_design, paper_spec):
+    d = json.loads(json.dumps(paper_design.to_dict(), allow_nan=False))
+    gap = d["friction_gap"]
+    assert gap["gap"] == pytest.approx(3.0) and gap["threshold"] == 1.0
+    assert gap["hunting_risk"] is True
+    for key in ("kp", "ki", "kd", "wt", "tuning_mass"):
+        assert isinstance(d["pid"][key], float) and d["pid"][key] > 0, key
+    assert d["pid"]["tuning_mass"] == 2.0
+    xo = d["crossover"]
+    assert xo["desired"] == 8.0 and isinstance(xo["achievable"], float)
+    assert isinstance(xo["limited_by"], str) and xo["limited_by"]
+    assert len(xo["cases"]) == 4
+    for case in xo["cases"]:
+        assert isinstance(case["name"], str)
+        assert isinstance(case["crossover"], float)
+        assert isinstance(case["phase_margin_deg"], float)
+        assert case["gain_margin_db"] is None or isinstance(case["gain_margin_db"], float)
+        assert isinstance(case["modulus_margin"], float)
+        assert isinstance(case["delay_margin"], float)
+        assert isinstance(case["stable"], bool)
+    assert [c["name"] for c in xo["cases"]] == ["sliding_free", "stuck_free",
+                                                 "sliding_limited", "stuck_limited"]
+    assert d["stiffness"]["maximum"] == pytest.approx(4.0 / 0.3e-3)
+    assert d["stiffness"]["chosen"] == 6667.0
+    fl = d["flexure"]
+    assert fl["feasible"] is True
+    for key in ("length", "width", "thickness", "stress", "stress_margin", "support_frequency",
+                "bending_frequency", "drive_stiffness"):
+        assert isinstance(fl[key], float), key
+    assert d["checks"]
+    for c in d["checks"]:
+        assert set(c) >= {"name", "passed", "value", "limit", "unit", "message", "status",
+                          "step"}
+        assert c["status"] in {"PASS", "FAIL", "WARN", "INFO"}
+        assert c["passed"] in (True, False, None)
+        assert c["value"] is None or isinstance(c["value"], NUM)
+    assert isinstance(d["warnings"], list)
+    for w in d["warnings"]:
+        assert set(w) == {"path", "message"}
+    assert d["fi_design_version"] == fi_design.__version__
+    assert d["spec_sha256"] == origin(paper_spec).sha256
+    assert len(d["spec_sha256"]) == 64
+    assert isinstance(d["conclusion"], str) and len(d["conclusion"]) > 100
+    assert "simulation" not in d
+
+
+def test_paper_verdict(paper_design):
+    r = paper_design
+    assert r.passed and not r.failed_checks
+    names = [c.name for c in r.checks]
+    assert names[0] == "friction_gap" and "crossover_achievable" in names
+    assert {f"phase_margin.{n}" for n in ("sliding_free", "stuck_free", "sliding_limited",
+                                          "stuck_limited")} <= set(names)
+    assert "parasitic_separation.stage tilt" in names and "drive_stiffness" in names
+    assert {"flexure.stiffness", "flexure.stress", "flexure.support_frequency",
+            "flexure.bending_frequency", "pid"} <= set(names)
+    gap = next(c for c in r.checks if c.name == "friction_gap")
+    assert gap.status == Status.WARN and gap.passed is False
+    assert r.crossover.desired <= r.crossover.achievable < 150.0 / 3
+    assert "8 Hz" in r.conclusion and "3 N" in r.conclusion
+
+
+# --------------------------------------------------------------------------- steps
+
+
+def test_step1_small_gap(paper_spec):
+    spec = variant(paper_spec, **{"friction.static": "1.5 N", "friction.coulomb": "1.2 N"})
+    s1 = gl.step1_friction_gap(spec)
+    assert s1.gap == pytest.approx(0.3) and not s1.hunting_risk
+    assert s1.checks[0].status == Status.PASS
+    assert "isolator may not be needed" in gl.design(spec).conclusion
+
+
+def test_step3_proposes_half_of_k_max_when_stiffness_is_missing(paper_spec):
+    spec = variant(paper_spec, **{"isolator.stiffness": None, "isolator.damping": None})
+    s3 = gl.step3_stiffness(spec)
+    assert s3.maximum == pytest.approx(4.0 / 0.3e-3)
+    assert s3.chosen == pytest.approx(s3.maximum / 2) and "proposed" in s3.source
+    assert s3.force_at_stroke == pytest.approx(2.0)
+    assert s3.checks[0].passed
+
+
+def test_step3_fails_above_k_max(paper_spec):
+    spec = variant(paper_spec, **{"isolator.stiffness": "20 N/mm"})
+    r = gl.design(spec)
+    check = next(c for c in r.checks if c.name == "drive_stiffness")
+    assert check.status == Status.FAIL and "exceeds" in check.message
+    assert not r.passed and "drive_stiffness" in r.conclusion
+
+
+
+def with_friction_and_stroke(spec, fs, stroke, safety):
+    """The spec with Fs, stroke and safety replaced (model_copy: no YAML, no pint, fast)."""
+    return spec.model_copy(update={
+        "friction": spec.friction.model_copy(update={"static": fs}),
+        "isolator": spec.isolator.model_copy(update={"stroke": stroke}),
+        "requirements": spec.requirements.model_copy(update={"stiffness_safety": safety}),
+    })
+
+
+@settings(max_examples=100, deadline=None)
+@given(fs=st.floats(1.0, 200.0), stroke=st.floats(0.02e-3, 5e-3), factor=st.floats(1.0, 5.0),
+       safety=st.floats(1.0, 3.0))
+def test_k_max_scales_as_static_friction_over_stroke(paper_spec, fs, stroke, factor, safety):
+    def kmax(f, s):
+        return gl.step3_stiffness(with_friction_and_stroke(paper_spec, f, s, safety)).maximum
+    k = kmax(fs, stroke)
+    assert k == pytest.approx(fs / (safety * stroke), rel=1e-12)
+    assert kmax(fs * factor, stroke) == pytest.approx(factor * k, rel=1e-12)
+    assert kmax(fs, stroke * factor) == pytest.approx(k / factor, rel=1e-12)
+    # the flexure force at full stroke never exceeds static friction
+    st3 = gl.step3_stiffness(with_friction_and_stroke(paper_spec, fs, stroke, safety))
+    assert st3.maximum * stroke <= fs * (1 + 1e-12)
+
+
+def test_infeasible_flexure_is_a_failed_check(paper_spec):
+    spec = variant(paper_spec, **{"isolator.flexure.thickness": ["0.8 mm", "1 mm"],
+                                  "isolator.flexure.length": ["10 mm", "15 mm"]})
+    r = gl.design(spec)
+    assert r.flexure is not None and not r.flexure.feasible
+    check = next(c for c in r.checks if c.name == "flexure")
+    assert check.status == Status.FAIL and r.flexure.reason in check.message
+    assert r.to_dict()["flexure"]["reason"].startswith(("stress", "stiffness"))
+
+
+def test_no_flexure_section_gives_null(paper_spec):
+    r = gl.design(variant(paper_spec, **{"isolator.flexure": None}))
+    assert r.flexure is None and r.to_dict()["flexure"] is None
+    assert not any(c.name.startswith("flexure") for c in r.checks)
+
+
+def test_desired_crossover_above_achievable_fails(paper_spec):
+    spec = variant(paper_spec, **{"controller.crossover": "60 Hz"})
+    r = gl.design(spec)
+    names = {c.name for c in r.failed_checks}
+    assert "crossover_achievable" in names and "parasitic_separation.stage tilt" in names
+    assert r.crossover.achievable < 60.0
+
+
+# --------------------------------------------------------------------------- no isolator
+
+
+def test_without_isolator_advises_on_the_need(paper_spec):
+    spec = variant(paper_spec, isolator=None, **{"controller.delay": "2 ms"})
+    r = gl.design(spec)
+    assert len(r.crossover.cases) == 2 and r.flexure is None
+    adv = r.isolator_advice
+    assert adv.needed is True and adv.stroke == 0.3e-3
+    assert adv.stiffness == pytest.approx(4.0 / (2 * 0.3e-3))
+    assert "recommended" in adv.reason and "0.3 mm" in adv.reason
+    assert r.stiffness.suggested and r.stiffness.chosen == pytest.approx(adv.stiffness)
+    d = r.to_dict()
+    assert d["isolator_advice"]["needed"] is True and len(d["crossover"]["cases"]) == 2
+
+    ideal = gl.design(variant(paper_spec, isolator=None))
+    assert ideal.isolator_advice.needed is None       # no crossover limit in the linear model
+    small = gl.design(variant(paper_spec, isolator=None, **{"friction.static": "1.5 N"}))
+    assert small.isolator_advice.needed is False
+
+
+# --------------------------------------------------------------------------- simulation, hashes
+
+
+def test_simulation_is_attached_only_when_given(paper_spec, paper_design):
+    @dataclasses.dataclass(frozen=True)
+    class FakeSimulation:
+        hunting_cycles: int
+
+    with_sim = paper_design.with_simulation(FakeSimulation(0), conclusion="confirmed")
+    assert with_sim.to_dict()["simulation"] == {"hunting_cycles": 0}
+    assert with_sim.conclusion == "confirmed" and paper_design.simulation is None
+    assert gl.design(paper_spec, simulation=FakeSimulation(3)).to_dict()["simulation"] == \
+        {"hunting_cycles": 3}
+
+
+def test_spec_hash_without_origin(paper_spec):
+    spec = paper_spec.model_copy()
+    spec._origin = None                    # as if built in code, not read by load_spec
+    assert origin(spec) is None and origin(paper_spec) is not None
+    r = gl.design(spec)
+    assert r.spec_sha256 == hashlib.sha256(spec.model_dump_json().encode()).hexdigest()
+    assert gl.design(origin(paper_spec).raw).crossover.achievable == \
+        pytest.approx(gl.design(paper_spec).crossover.achievable)
+
+
+def test_results_are_frozen(paper_design):
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        paper_design.conclusion = "x"
+    assert all(isinstance(c, Check) for c in paper_design.checks)
+    assert math.isfinite(paper_design.crossover.achievable)

@@ -1,0 +1,305 @@
+"""The four linear limit cases and their margins against hand derivations."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import control
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from fi_design import linear
+from fi_design.specfile import load_spec, origin
+
+W = np.geomspace(0.05, 5e3, 9)            # test frequencies [rad/s]...
+S = 1j * np.concatenate([W, [2 * math.pi * 150.0, 2 * math.pi * 10.3]])  # ...near modes too
+
+
+def variant(spec, **paths):
+    """A copy of ``spec``'s YAML mapping with dotted paths replaced, validated again."""
+    raw = copy.deepcopy(origin(spec).raw)
+    for path, value in paths.items():
+        node = raw
+        *head, last = path.split(".")
+        for key in head:
+            node = node.setdefault(key, {})
+        if value is None:
+            node.pop(last, None)
+        else:
+            node[last] = value
+    return load_spec(raw)
+
+
+# --------------------------------------------------------------------------- hand derivations
+# Paper setup: m1 = 1.6 kg, m2 = 0.4 kg, k = 6667 N/m, c = 4.62 N s/m, sigma0 = 1e6 N/m,
+# sigma1 = 1414 N s/m, sigma2 = 20 N s/m; mode 150 Hz, zeta 0.02, non-collocated.
+m1, m2, k, c, s0, s1, s2 = 1.6, 0.4, 6667.0, 4.62, 1e6, 1414.0, 20.0
+M = m1 + m2
+
+
+def two_mass(s, cart_k, cart_c, c=c):
+    """x1/u from
+        m1 s^2 x1 = u - (c s + k)(x1 - x2)
+        m2 s^2 x2 = (c s + k)(x1 - x2) - (cart_c s + cart_k) x2
+    => x2 = (c s + k) x1 / (m2 s^2 + (c + cart_c) s + k + cart_k), so
+       x1/u = D2 / (D1 D2 - (c s + k)^2),
+    with D1 = m1 s^2 + c s + k and D2 = m2 s^2 + (c + cart_c) s + k + cart_k.
+    """
+    d1 = m1 * s ** 2 + c * s + k
+    d2 = m2 * s ** 2 + (c + cart_c) * s + k + cart_k
+    return d2 / (d1 * d2 - (c * s + k) ** 2)
+
+
+def hand_cases(c=c):
+    """The four plants u -> x1 of DESIGN.md section 2 with joint damping c."""
+    return {
+        "sliding_free": lambda s: two_mass(s, 0.0, s2, c),              # cart: sigma2 only
+        "stuck_free": lambda s: two_mass(s, s0, s1 + s2, c),            # cart on the bristles
+        "sliding_limited": lambda s: 1.0 / (M * s ** 2 + s2 * s),       # rigid, sigma2
+        "stuck_limited": lambda s: 1.0 / (M * s ** 2 + (s1 + s2) * s + s0),  # rigid, bristles
+    }
+
+
+HAND = hand_cases()
+
+
+def mode(s, f=150.0, z=0.02):
+    wr = 2 * math.pi * f
+    return wr ** 2 / (s ** 2 + 2 * z * wr * s + wr ** 2)
+
+
+def pid(s, fc=8.0, m=M):
+    wc = 2 * math.pi * fc
+    ks, wd, wt, wi = m * wc ** 2 / 3, wc / 3, 3 * wc, wc / 10
+    return ks * (1 + wi / s) * (1 + s / wd) / (1 + s / wt)
+
+
+def ss_response(sys, s):
+    return np.array([complex(np.squeeze(sys(x))) for x in s])
+
+
+# --------------------------------------------------------------------------- plants
+
+
+def test_paper_cases_equal_hand_derived_transfer_functions(paper_spec):
+    cases = linear.limit_cases(paper_spec)
+    assert [c.name for c in cases] == list(linear.ISOLATED_CASES)
+    assert [c.number for c in cases] == [1, 2, 3, 4]
+    for case in cases:
+        want = HAND[case.name](S) * mode(S)
+        np.testing.assert_allclose(case(S), want, rtol=1e-9, err_msg=case.name)
+        np.testing.assert_allclose(ss_response(case.plant, S), want, rtol=1e-9, err_msg=case.name)
+
+
+def test_collocated_mode_and_default_damping(paper_spec):
+    spec = variant(paper_spec, **{
+        "isolator.damping": None,                         # default: zeta 0.05 of the joint mode
+        "isolator.parasitic_modes": [
+            {"name": "a", "frequency": "90 Hz", "damping_ratio": 0.03, "collocated": True},
+            {"name": "b", "frequency": "400 Hz", "damping_ratio": 0.01, "collocated": True,
+             "antiresonance": "250 Hz"}]})
+    hand = hand_cases(2 * 0.05 * math.sqrt(k * m1 * m2 / M))   # joint_damping default
+    wa = 2 * math.pi * 90 / math.sqrt(2)                        # default antiresonance f / sqrt 2
+    fa = mode(S, 90, 0.03) * (S ** 2 + 2 * 0.03 * wa * S + wa ** 2) / wa ** 2
+    wa2 = 2 * math.pi * 250
+    fb = mode(S, 400, 0.01) * (S ** 2 + 2 * 0.01 * wa2 * S + wa2 ** 2) / wa2 ** 2
+    for case in linear.limit_cases(spec):
+        want = hand[case.name](S) * fa * fb
+        np.testing.assert_allclose(case(S), want, rtol=1e-9, err_msg=case.name)
+        np.testing.assert_allclose(ss_response(case.plant, S), want, rtol=1e-9)
+
+
+def test_no_isolator_is_one_rigid_mass(paper_spec):
+    spec = variant(paper_spec, isolator=None)
+    cases = linear.limit_cases(spec)
+    assert [x.name for x in cases] == ["sliding", "stuck"]
+    for case, hand in zip(cases, (HAND["sliding_limited"], HAND["stuck_limited"])):
+        np.testing.assert_allclose(case(S), hand(S), rtol=1e-9)
+        np.testing.assert_allclose(ss_response(case.plant, S), hand(S), rtol=1e-9)
+
+
+def test_controller_and_loop(paper_spec):
+    g = linear.tune_pid(paper_spec)
+    np.testing.assert_allclose(ss_response(linear.controller_tf(g), S), pid(S), rtol=1e-9)
+    lp = linear.loop_transfer_function(paper_spec, "stuck_free")
+    np.testing.assert_allclose(ss_response(lp, S), pid(S) * HAND["stuck_free"](S) * mode(S),
+                               rtol=1e-9)
+    sens = linear.sensitivity(paper_spec, 2)
+    np.testing.assert_allclose(ss_response(sens, S), 1 / (1 + ss_response(lp, S)), rtol=1e-9)
+    comp = linear.complementary_sensitivity(paper_spec, 2)
+    np.testing.assert_allclose(ss_response(comp, S) + ss_response(sens, S), 1.0, rtol=1e-9)
+    with pytest.raises(ValueError, match="unknown limit case"):
+        linear.loop_transfer_function(paper_spec, "floating")
+
+
+def test_delay_is_a_pade_of_delay_plus_half_a_sample(paper_spec):
+    spec = variant(paper_spec, **{"controller.delay": "0.2 ms", "controller.sample_rate": "5 kHz",
+                                  "controller.pade_order": 4})
+    assert linear.delay_time(spec) == pytest.approx(0.2e-3 + 0.5 / 5000, rel=1e-12)
+    num, den = linear.delay_polynomials(spec)
+    assert len(den) == 5
+    w = np.geomspace(1, 2000, 5)
+    resp = np.polyval(num, 1j * w) / np.polyval(den, 1j * w)
+    np.testing.assert_allclose(np.abs(resp), 1.0, rtol=1e-9)          # all-pass
+    np.testing.assert_allclose(resp, np.exp(-1j * w * 0.3e-3), atol=1e-6)
+    assert linear.delay_time(paper_spec) == 0.0
+
+
+# --------------------------------------------------------------------------- margins
+
+
+def hand_phase_margins(cases=HAND):
+    """Worst phase margin and its crossover per case, from the hand-derived L(j w).
+
+    L(j w) = C(j w) P(j w) mode(j w); all crossings |L| = 1 on a dense grid from
+    1e-5 to 1e5 rad/s, refined with brentq on log|L|; the phase margin at a
+    crossing is the phase distance from -180 deg, |wrap(angle L + 180)|.
+    """
+    out = {}
+    w = np.geomspace(1e-5, 1e5, 20001)
+    for name, plant in cases.items():
+        def loop(x, plant=plant):
+            s = 1j * x
+            return pid(s) * plant(s) * mode(s)
+        g = np.log(np.abs(loop(w)))
+        found = []
+        for j in np.nonzero(np.diff(np.sign(g)))[0]:
+            x = brentq(lambda v: np.log(abs(loop(v))), w[j], w[j + 1], xtol=1e-13, rtol=1e-14)
+            pm = abs((np.angle(loop(x), deg=True) + 360.0) % 360.0 - 180.0)
+            found.append((pm, x / (2 * math.pi)))
+        out[name] = min(found)
+    return out
+
+
+#: The hand calculation's result for the paper setup (deg, Hz), recorded for the report.
+PAPER_PHASE_MARGINS = {"sliding_free": (62.451, 7.914), "stuck_free": (47.306, 15.425),
+                       "sliding_limited": (58.601, 7.921), "stuck_limited": (90.122, 0.0013475)}
+
+
+def test_paper_phase_margins_agree_with_a_hand_calculation(paper_spec):
+    hand = hand_phase_margins()
+    result = linear.analyse(paper_spec)
+    assert result.passed and result.crossover == 8.0 and result.stiffness == 6667.0
+    for case in result.cases:
+        pm, fx = hand[case.name]
+        assert case.phase_margin_deg == pytest.approx(pm, abs=0.01), case.name
+        assert case.crossover == pytest.approx(fx, rel=1e-6), case.name
+        want_pm, want_fx = PAPER_PHASE_MARGINS[case.name]
+        assert pm == pytest.approx(want_pm, abs=1e-3) and fx == pytest.approx(want_fx, rel=1e-3)
+        assert case.stable
+    # case 2 crosses three times: the integrator (0.21 Hz), before and after the joint resonance
+    stuck_free = result.cases[1]
+    assert len(stuck_free.crossovers) == 3 and stuck_free.crossover == stuck_free.crossovers[2]
+
+
+def test_modulus_gain_and_delay_margin_consistent(paper_spec):
+    result = linear.analyse(paper_spec)
+    w = np.geomspace(1e-3, 1e4, 200001)
+    for case in result.cases:
+        plant = HAND[case.name]
+        loop = pid(1j * w) * plant(1j * w) * mode(1j * w)
+        assert case.modulus_margin == pytest.approx(min(np.min(np.abs(1 + loop)), 1.0),
+                                                    rel=1e-4)
+        # gain margin: |L| at the phase crossover nearest 0 dB
+        ang = np.angle(loop)
+        cross = np.nonzero((np.diff(np.sign(ang)) != 0) & (np.real(loop[:-1]) < 0))[0]
+        if cross.size:
+            db = -20 * np.log10(np.abs(loop[cross]))
+            assert case.gain_margin_db == pytest.approx(db[np.argmin(np.abs(db))], abs=0.01)
+        # delay margin: the smallest lag-to-(-180 deg) over crossing frequency, and the exact
+        # delay e^{-j w tau} of that size puts L on -1 at its crossing
+        def loop_at(f, plant=plant):
+            s = 2j * math.pi * f
+            return pid(s) * plant(s) * mode(s)
+        taus = [math.radians((np.angle(loop_at(f), deg=True) + 180.0) % 360.0) / (2 * math.pi * f)
+                for f in case.crossovers]
+        assert case.delay_margin == pytest.approx(min(taus), rel=1e-6)
+        f = case.crossovers[int(np.argmin(taus))]
+        assert loop_at(f) * np.exp(-2j * math.pi * f * case.delay_margin) == \
+            pytest.approx(-1.0, abs=1e-6)
+
+
+def test_unstable_loop_is_reported(paper_spec):
+    spec = variant(paper_spec, **{"controller.delay": "10 ms"})
+    result = linear.analyse(spec, crossover=30.0)
+    bad = [x for x in result.cases if not x.stable]
+    assert bad and not result.passed
+    for case in bad:
+        assert case.phase_margin_deg < 0 and case.delay_margin == 0.0
+        assert "stability" in case.failed
+        poles = control.feedback(
+            linear.loop_transfer_function(spec, case.name, 30.0), 1).poles()
+        assert np.max(poles.real) > 0
+
+
+def test_infinite_gain_margin_is_null_in_json(paper_spec):
+    spec = variant(paper_spec, isolator=None)
+    sliding = linear.analyse(spec).cases[0]
+    assert math.isinf(sliding.gain_margin_db)
+    assert sliding.to_dict()["gain_margin_db"] is None
+
+
+# --------------------------------------------------------------------------- achievable crossover
+
+
+def test_paper_achievable_crossover_and_its_boundary(paper_spec):
+    ach = linear.achievable_crossover(paper_spec)
+    assert ach.kind == "margin" and ach.case == "stuck_limited" and ach.criterion == "gain margin"
+    assert "gain margin of case 4 (cart stuck, limiter engaged)" in ach.limited_by
+    assert 8.0 < ach.frequency < 150.0 / 3
+    assert linear.analyse(paper_spec, ach.frequency * 0.998).passed
+    assert not linear.analyse(paper_spec, ach.frequency * 1.003).passed
+
+
+def test_nothing_limits_an_ideal_loop(paper_spec):
+    spec = variant(paper_spec, **{"isolator.parasitic_modes": []})
+    ach = linear.achievable_crossover(spec)
+    assert ach.kind == "scan_limit" and ach.frequency == linear.SCAN_LIMIT
+    assert ach.limited_by == "nothing up to the scan limit 1000 Hz"
+
+
+def test_a_delay_lowers_the_achievable_crossover(paper_spec):
+    base = {"isolator.parasitic_modes": []}
+    found = []
+    for delay in ("0 s", "1 ms", "3 ms"):
+        spec = variant(paper_spec, **base, **{"controller.delay": delay})
+        ach = linear.achievable_crossover(spec)
+        found.append(ach.frequency)
+        if delay != "0 s":
+            assert ach.kind == "margin"
+    assert found == sorted(found, reverse=True) and len(set(found)) == 3
+    # a rigid mass: the delay eats phase w tau, so the limit scales roughly as 1 / tau
+    # (the viscous damping and the bristle resonance bend it a little)
+    rigid = [linear.achievable_crossover(variant(paper_spec, isolator=None,
+                                                 **{"controller.delay": d})).frequency
+             for d in ("1 ms", "2 ms")]
+    assert 0.45 < rigid[1] / rigid[0] < 0.6
+
+
+def test_sampling_adds_half_a_period(paper_spec):
+    spec = variant(paper_spec, isolator=None, **{"controller.sample_rate": "1 kHz"})
+    ach = linear.achievable_crossover(spec)
+    same = variant(paper_spec, isolator=None, **{"controller.delay": "0.5 ms"})
+    assert ach.frequency == pytest.approx(linear.achievable_crossover(same).frequency, rel=2e-3)
+    assert ach.scan_stop <= 500.0
+
+
+@pytest.mark.parametrize("freq, collocated", [(30.0, False), (45.0, True), (60.0, False)])
+def test_a_parasitic_mode_caps_the_crossover(paper_spec, freq, collocated):
+    spec = variant(paper_spec, **{"isolator.parasitic_modes": [
+        {"name": "tilt", "frequency": freq, "damping_ratio": 0.05, "collocated": collocated}]})
+    ach = linear.achievable_crossover(spec)
+    sep = spec.requirements.parasitic_separation
+    assert ach.frequency <= freq / sep * (1 + 1e-12)
+    if ach.kind == "mode":
+        assert ach.frequency == pytest.approx(freq / sep) and "'tilt' at" in ach.limited_by
+
+
+def test_nothing_feasible_is_said(paper_spec):
+    spec = variant(paper_spec, isolator=None, **{"controller.delay": "2 s",
+                                                 "requirements.phase_margin": "80 deg"})
+    ach = linear.achievable_crossover(spec)
+    assert ach.frequency is None and ach.kind == "infeasible"
+    assert ach.limited_by.startswith("no crossover from")

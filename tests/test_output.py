@@ -1,0 +1,128 @@
+"""Output paths: refused early, written atomically."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from fi_design.errors import FiDesignError, OutputError
+from fi_design.output import atomic_path, check_output, write_atomic
+
+
+def test_new_file_accepted(tmp_path):
+    assert check_output(tmp_path / "a.json", extensions=(".json",)) == tmp_path / "a.json"
+
+
+def test_existing_file_needs_force(tmp_path):
+    out = tmp_path / "a.json"
+    out.write_text("x")
+    with pytest.raises(OutputError, match="--force"):
+        check_output(out)
+    assert check_output(out, force=True) == out
+
+
+def test_protected_file_refused_even_with_force(tmp_path):
+    spec = tmp_path / "spec.yaml"
+    spec.write_text("name: x\n")
+    hard = tmp_path / "hard.yaml"
+    os.link(spec, hard)
+    soft = tmp_path / "soft.yaml"
+    soft.symlink_to(spec)
+    sub = tmp_path / "sub"
+    sub.mkdir()
+    for path in (spec, hard, soft, sub / ".." / "spec.yaml"):
+        with pytest.raises(OutputError, match="input file"):
+            check_output(path, force=True, protect=(spec, None))
+
+
+def test_extension_directory_parent(tmp_path):
+    with pytest.raises(OutputError, match=r"\.html or \.pdf"):
+        check_output(tmp_path / "r.txt", extensions=(".html", "pdf"))
+    assert check_output(tmp_path / "R.HTML", extensions=(".html",))
+    with pytest.raises(OutputError, match="does not exist"):
+        check_output(tmp_path / "missing" / "r.json")
+    (tmp_path / "d.json").mkdir()
+    with pytest.raises(OutputError, match="is a directory"):
+        check_output(tmp_path / "d.json", force=True)
+    (tmp_path / "file").write_text("")
+    with pytest.raises(OutputError, match="not a directory"):
+        check_output(tmp_path / "file" / "r.json")
+
+
+def test_output_error_is_fi_design_error():
+    assert issubclass(OutputError, FiDesignError) and issubclass(OutputError, OSError)
+
+
+def test_write_atomic_text_and_bytes(tmp_path):
+    out = tmp_path / "a.txt"
+    write_atomic(out, "héllo\n")
+    assert out.read_text(encoding="utf-8") == "héllo\n"
+    write_atomic(out, b"\x00\x01")
+    assert out.read_bytes() == b"\x00\x01"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt"]
+
+
+def test_write_atomic_keeps_mode_of_replaced_file(tmp_path):
+    out = tmp_path / "a.txt"
+    out.write_text("old")
+    out.chmod(0o640)
+    write_atomic(out, "new")
+    assert out.stat().st_mode & 0o777 == 0o640
+
+
+def test_new_file_gets_umask_permissions(tmp_path):
+    out = tmp_path / "n.txt"
+    old = os.umask(0o022)
+    try:
+        write_atomic(out, "x")
+    finally:
+        os.umask(old)
+    assert out.stat().st_mode & 0o777 == 0o644
+
+
+def test_failure_leaves_old_file_and_no_temporary(tmp_path):
+    out = tmp_path / "a.json"
+    out.write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_path(out) as tmp:
+            tmp.write_text("half")
+            raise RuntimeError("writer failed")
+    assert out.read_text() == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]
+
+
+def test_unwritable_directory(tmp_path, monkeypatch):
+    # simulated: the tests may run as root, who can write anywhere
+    import tempfile
+
+    monkeypatch.setattr(os, "access", lambda path, mode: False)
+    with pytest.raises(OutputError, match="not writable"):
+        check_output(tmp_path / "a.json")
+
+    def denied(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "mkstemp", denied)
+    with pytest.raises(OutputError, match="Permission denied"):
+        write_atomic(tmp_path / "a.json", "x")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_replace_failure_leaves_no_temporary(tmp_path, monkeypatch):
+    out = tmp_path / "a.json"
+    out.write_text("old")
+
+    def fail(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "replace", fail)
+    with pytest.raises(OutputError, match="No space left"):
+        write_atomic(out, "new")
+    assert out.read_text() == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]
+
+
+def test_missing_directory_on_write(tmp_path):
+    with pytest.raises(OutputError, match="cannot create"):
+        write_atomic(tmp_path / "nope" / "a.json", "x")
