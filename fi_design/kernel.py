@@ -60,6 +60,7 @@ import math  # noqa: E402
 import numpy as np  # noqa: E402
 from numba import njit  # noqa: E402
 
+from .plant import A1, A2, I1, b1, f8, i8  # noqa: E402  (numba signature types)
 from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, P_AD11, P_AD12,  # noqa: E402
                     P_AD21, P_AD22, P_BD1, P_BD2, P_CD1, P_CD2, P_DD, P_DELAY, P_FS, P_ISO,
                     P_KD, P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_WT, actuator,
@@ -126,7 +127,7 @@ FAC_MAX = 6.0  # hnew / h <= 6
 # --------------------------------------------------------------------------- small helpers
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, A1, A2, i8), cache=True, error_model="numpy", _nrt=False)
 def reference_at(t, breaks, coeffs, k):
     """Reference position, velocity, acceleration at ``t`` and the segment index.
 
@@ -152,7 +153,7 @@ def reference_at(t, breaks, coeffs, k):
     return r, rd, rdd, k
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((A2, I1), cache=True, error_model="numpy", _nrt=False)
 def lu_factor(A, piv):
     """In-place LU decomposition with partial pivoting; returns False if singular."""
     n = A.shape[0]
@@ -181,29 +182,7 @@ def lu_factor(A, piv):
     return True
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
-def lu_solve(A, piv, b):
-    """Solve in place with the factors of :func:`lu_factor`."""
-    n = A.shape[0]
-    for k in range(n):
-        m = piv[k]
-        if m != k:
-            tmp = b[k]
-            b[k] = b[m]
-            b[m] = tmp
-    for i in range(n):
-        s = b[i]
-        for j in range(i):
-            s -= A[i, j] * b[j]
-        b[i] = s
-    for i in range(n - 1, -1, -1):
-        s = b[i]
-        for j in range(i + 1, n):
-            s -= A[i, j] * b[j]
-        b[i] = s / A[i, i]
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((A2, f8, A2, I1, A2), cache=True, error_model="numpy", _nrt=False)
 def struct_factor(J, sigma, M, piv, w):
     """Factor E = sigma I - J using the plant's structure.
 
@@ -239,7 +218,7 @@ def struct_factor(J, sigma, M, piv, w):
     return lu_factor(M, piv)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((A2, A2, I1, A2, A1, A1), cache=True, error_model="numpy", _nrt=False)
 def struct_solve(J, M, piv, w, b, tmp):
     """Solve (sigma I - J) x = b in place with the factors of :func:`struct_factor`."""
     n = J.shape[0]
@@ -283,7 +262,7 @@ def struct_solve(J, M, piv, w, b, tmp):
     b[iz] = yz
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((A1, A1, A1, A1, f8, A1), cache=True, error_model="numpy", _nrt=False)
 def dense(y0, y1, k2, k3, theta, out):
     """RODAS4 continuous extension at ``theta`` in [0, 1] into ``out``."""
     s1 = 1.0 - theta
@@ -291,14 +270,14 @@ def dense(y0, y1, k2, k3, theta, out):
         out[i] = y0[i] * s1 + theta * (y1[i] + s1 * (k2[i] + theta * k3[i]))
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((A1, A1, A1, A1, f8, i8), cache=True, error_model="numpy", _nrt=False)
 def dense_component(y0, y1, k2, k3, theta, i):
     """One component of :func:`dense`."""
     s1 = 1.0 - theta
     return y0[i] * s1 + theta * (y1[i] + s1 * (k2[i] + theta * k3[i]))
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, A1, A1, A1, A1, A1, i8, i8), cache=True, error_model="numpy", _nrt=False)
 def history_at(tq, ht, hu, hdu, hur, hdur, head, count):
     """Delayed controller output u(tq) and its rate from the history ring.
 
@@ -344,7 +323,7 @@ def history_at(tq, ht, hu, hdu, hur, hdur, head, count):
 # --------------------------------------------------------------------------- events
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, f8), cache=True, error_model="numpy", _nrt=False)
 def _limit_mode(d, s):
     if d > s:
         return 1
@@ -353,7 +332,7 @@ def _limit_mode(d, s):
     return 0
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, f8, A1, A1, A1, A1, i8, i8, i8, f8, A1, f8, b1, A1), cache=True, error_model="numpy", _nrt=False)
 def _root(g0, g1, y0, y1, k2, k3, kind, idx, idx2, offset, p, fa, fa_state, ybuf):
     """Locate the zero of a switching function on the dense output, theta in [0, 1].
 
@@ -395,7 +374,7 @@ def _root(g0, g1, y0, y1, k2, k3, kind, idx, idx2, offset, p, fa, fa_state, ybuf
     return b
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((A1, A1, A1, A1, A1, I1, i8, f8, b1, A1, i8), cache=True, error_model="numpy", _nrt=False)
 def find_event(y0, y1, k2, k3, p, modes, iv2, fa, fa_state, ybuf, skip):
     """Earliest mode change within a trial step.
 
@@ -467,7 +446,7 @@ def find_event(y0, y1, k2, k3, p, modes, iv2, fa, fa_state, ybuf, skip):
     return best, tbest
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((i8, A1, A1, I1, i8, i8, f8, b1, A1), cache=True, error_model="numpy", _nrt=False)
 def apply_event(kind, y, p, modes, iv2, iu, fa, fa_state, y_trial):
     """Switch the mode for event ``kind`` at the current state (jumps included).
 
@@ -512,7 +491,7 @@ def apply_event(kind, y, p, modes, iv2, iu, fa, fa_state, y_trial):
 # --------------------------------------------------------------------------- the integrator
 
 
-@njit(cache=True, error_model="numpy")
+@njit((A1, A1, A1, A2, b1, f8, A1, f8, A1, f8, i8, f8, A2, A1, A1, A1), cache=True, error_model="numpy")
 def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_steps, x_bound,
               out_y, out_r, out_fa, stats):
     """Integrate the plant from ``y0`` at t = 0 to ``t_end``.
@@ -971,17 +950,18 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     :func:`integrate` for the meaning. This thin wrapper is the kernel's only
     Python-level entry point; :mod:`fi_design.simulate` wraps it in a result.
     """
-    p = np.ascontiguousarray(params, dtype=np.float64)
-    y = np.ascontiguousarray(y0, dtype=np.float64)
-    t_out = np.ascontiguousarray(t_out, dtype=np.float64)
+    # fresh writable copies: numba types read-only arrays differently
+    p = np.array(params, dtype=np.float64)
+    y = np.array(y0, dtype=np.float64)
+    t_out = np.array(t_out, dtype=np.float64)
     n = y.shape[0]
     m = t_out.shape[0]
     out_y = np.full((m, n), np.nan)
     out_r = np.full(m, np.nan)
     out_fa = np.full(m, np.nan)
     stats = np.zeros(N_STATS)
-    status = integrate(p, y, np.ascontiguousarray(breaks, dtype=np.float64),
-                       np.ascontiguousarray(coeffs, dtype=np.float64), bool(land), float(t_end),
-                       t_out, float(rtol), np.ascontiguousarray(atol, dtype=np.float64),
+    status = integrate(p, y, np.array(breaks, dtype=np.float64),
+                       np.array(coeffs, dtype=np.float64, order="C"), bool(land), float(t_end),
+                       t_out, float(rtol), np.array(atol, dtype=np.float64),
                        float(h_max), int(max_steps), float(x_bound), out_y, out_r, out_fa, stats)
     return int(status), out_y, out_r, out_fa, stats

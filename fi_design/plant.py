@@ -52,6 +52,16 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 from numba import njit
+from numba import types as _nt
+
+# Explicit signatures: one compilation per function (no literal or layout
+# re-specialisation), done once at import and cached.
+f8 = _nt.float64
+i8 = _nt.int64
+b1 = _nt.boolean
+A1 = _nt.float64[::1]
+A2 = _nt.float64[:, ::1]
+I1 = _nt.int64[::1]
 
 # --------------------------------------------------------------------------- parameters
 
@@ -139,7 +149,7 @@ def state_index(isolated: bool) -> dict[str, int]:
 # --------------------------------------------------------------------------- pieces
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, f8, A1), cache=True, error_model="numpy", _nrt=False)
 def stribeck(v, x2, p):
     """g(v) scaled by position-dependent friction, and its partials.
 
@@ -162,7 +172,7 @@ def stribeck(v, x2, p):
     return sc * g0, sc * dg0, a * kx * math.cos(arg) * g0
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, A1), cache=True, error_model="numpy", _nrt=False)
 def external_force(x1, p):
     """Force ripple plus cable force on the stage and its x1-derivative [N, N/m]."""
     F = 0.0
@@ -181,7 +191,7 @@ def external_force(x1, p):
     return F, dF
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, A1), cache=True, error_model="numpy", _nrt=False)
 def actuator(fa, p):
     """Saturated actuator force and its derivative wrt the command [N, -]."""
     lim = p[P_FLIMIT]
@@ -192,7 +202,7 @@ def actuator(fa, p):
     return fa, 1.0
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, f8, f8, f8, A1), cache=True, error_model="numpy", _nrt=False)
 def lugre(v, x2, z, sgn, p):
     """LuGre bristle rate and friction force with partials (sliding sign frozen).
 
@@ -214,7 +224,7 @@ def lugre(v, x2, z, sgn, p):
     return zd, Ff, dzd_dx, dzd_dv, dzd_dz, s1 * dzd_dx, s1 * dzd_dv + s2, s0 + s1 * dzd_dz
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, A1, i8), cache=True, error_model="numpy", _nrt=False)
 def measured_position(x1, p, level):
     """Position the controller sees [m]: x1, or level * q when quantized."""
     q = p[P_QUANT]
@@ -223,7 +233,7 @@ def measured_position(x1, p, level):
     return x1
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((A1, A1, f8, b1), cache=True, error_model="numpy", _nrt=False)
 def drive_force(y, p, fa, fa_state):
     """Force that drives the cart apart from friction [N] (the switch model's stick test).
 
@@ -248,7 +258,7 @@ def drive_force(y, p, fa, fa_state):
 # --------------------------------------------------------------------------- rhs + jacobian
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, A1, A1, I1, f8, f8, f8, b1, A1), cache=True, error_model="numpy", _nrt=False)
 def rhs(t, y, p, modes, r, rd, fa, fa_state, f):
     """Right-hand side dy/dt for frozen modes, written into ``f``.
 
@@ -329,7 +339,7 @@ def rhs(t, y, p, modes, r, rd, fa, fa_state, f):
         f[iu] = p[P_WT] * (p[P_KP] * e + y[ii] + p[P_KD] * ed - y[iu])
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((f8, A1, A1, I1, f8, f8, f8, b1, A2), cache=True, error_model="numpy", _nrt=False)
 def jacobian(t, y, p, modes, r, rd, fa, fa_state, J):
     """Analytic Jacobian d(rhs)/dy for frozen modes, written into ``J`` (n x n)."""
     n = y.shape[0]
@@ -411,7 +421,7 @@ def jacobian(t, y, p, modes, r, rd, fa, fa_state, J):
         J[iu, iu] = -wt
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit((A1, A1, I1), cache=True, error_model="numpy", _nrt=False)
 def natural_modes(y, p, modes):
     """Modes implied by the state alone (sliding sign kept when the velocity is 0).
 
