@@ -39,7 +39,7 @@ def main() -> None:
         variant["isolator"].pop("stiffness", None)  # let step 3 choose k
         variant["isolator"].pop("damping", None)    # default: damping ratio 0.05 of the joint
         spec = fi_design.load_spec(variant)         # raises fi_design.SpecError on bad values
-        result = fi_design.design(spec).to_dict()
+        result = fi_design.design(spec, confirm=False).to_dict()  # linear steps only
         stiffness = result["stiffness"]
         crossover = result["crossover"]
         print(f"{stroke_mm:>12.2f} {stiffness['maximum']:>12.0f} {stiffness['chosen']:>10.0f} "
@@ -49,7 +49,7 @@ def main() -> None:
     # model_copy does not re-validate, so give SI floats only.
     faster = base_spec.model_copy(update={
         "controller": base_spec.controller.model_copy(update={"crossover": 15.0})})
-    result = fi_design.design(faster).to_dict()
+    result = fi_design.design(faster, confirm=False).to_dict()
     print(f"crossover 15 Hz: achievable {result['crossover']['achievable']:.3g} Hz, "
           f"limited by {result['crossover']['limited_by'] or 'nothing'}")
 

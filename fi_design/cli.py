@@ -231,7 +231,7 @@ def checks_table(checks, title: str = "Checks"):
         if (c.step or "") != step:
             step = c.step or ""
             if step:
-                table.add_row(Text(f"step {step}", style="bold"))
+                table.add_row(Text(step, style="bold"))
         table.add_row(Text(c.name), _status_text(c.status), _fmt(c.value), _fmt(c.limit),
                       Text(c.unit or ""), Text(c.message or ""))
     return table
@@ -266,19 +266,25 @@ def design_command(
     json_out: Annotated[Optional[Path], typer.Option(
         "--json", metavar="OUT.json", help="Write the full result as JSON.",
         show_default=False)] = None,
+    no_simulation: Annotated[bool, typer.Option(
+        "--no-simulation", help="Only the four linear steps: skip the nonlinear "
+                                "confirmation.")] = False,
     force: Annotated[bool, typer.Option(
         "--force", "-f", help="Overwrite existing output files.")] = False,
 ) -> None:
-    """Run the four-step guideline on a spec (the default command).
+    """Run the four-step guideline on a spec and confirm it by simulation (the default command).
 
     Prints the checks (PASS / FAIL / WARN / INFO), the PID gains, the crossover
-    of the four linear limit cases and the conclusion; writes JSON on request.
+    of the four linear limit cases, the simulated verdicts with and without the
+    isolator, the lowest hunting-free crossovers and the conclusion; writes
+    JSON on request.
     """
     from .output import check_output, write_atomic
 
     json_path = check_output(json_out, force=force, protect=(spec,),
                              extensions=(".json",)) if json_out else None
     _check_spec_path(spec)
+    warmup = None if no_simulation else start_kernel_warmup()
 
     from .specfile import load_spec
 
@@ -288,11 +294,17 @@ def design_command(
 
     console = _console()
     err = _console(stderr=True)
-    if err.is_terminal:
-        with err.status("running the design guideline ...", spinner="dots"):
-            result = design(spec_obj)
-    else:
-        result = design(spec_obj)
+    with _status(err, "running the design guideline ...") as status:
+        result = design(spec_obj, confirm=False)
+        if not no_simulation:
+            from .confirm import confirm
+
+            status("compiling the simulation kernel (first run only) ...")
+            wait_kernel_warmup(warmup)
+            advice = result.isolator_advice
+            result = result.with_simulation(confirm(
+                spec_obj, (advice.stroke, advice.stiffness) if advice else None,
+                progress=status))
 
     text = None
     if json_path is not None:
@@ -303,6 +315,83 @@ def design_command(
     if json_path is not None:
         write_atomic(json_path, text)
         console.print(f"wrote {json_path}", markup=False)
+
+
+class _status:
+    """A spinner with a changing message on a terminal; silent otherwise.
+
+    Used as ``with _status(console, text) as update: update("next step")``.
+    """
+
+    def __init__(self, console: "Console", text: str) -> None:
+        self._console = console
+        self._text = text
+        self._live = None
+
+    def __enter__(self):
+        if self._console.is_terminal:
+            self._live = self._console.status(self._text, spinner="dots")
+            self._live.__enter__()
+        return self.update
+
+    def update(self, text: str) -> None:
+        if self._live is not None:
+            self._live.update(text)
+
+    def __exit__(self, *exc) -> None:
+        if self._live is not None:
+            self._live.__exit__(*exc)
+
+
+def start_kernel_warmup():
+    """Compile (or load) the numba kernel in a background process.
+
+    The kernel compiles once per installation (about 10 s, then it loads from
+    numba's on-disk cache in a fraction of a second). Starting it in a second
+    process lets the compilation overlap the linear analysis (python-control
+    takes seconds to import). Returns the process, or None when the cache is
+    already warm or a process cannot be started.
+    """
+    import subprocess
+
+    if kernel_cache_is_warm():
+        return None
+    try:
+        return subprocess.Popen([sys.executable, "-c", "import fi_design.kernel"],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    except OSError:
+        return None
+
+
+def wait_kernel_warmup(process) -> None:
+    """Wait for :func:`start_kernel_warmup`'s process (the kernel then loads from cache)."""
+    if process is not None:
+        process.wait()
+
+
+def kernel_cache_is_warm() -> bool:
+    """Whether numba's cache holds the integrator for the installed kernel source."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("fi_design.kernel")
+    if spec is None or spec.origin is None:
+        return False
+    src = Path(spec.origin)
+    cache_dirs = [src.parent / "__pycache__"]
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        cache_dirs.append(Path(os.environ["NUMBA_CACHE_DIR"]))
+    try:
+        from platformdirs import user_cache_dir
+
+        cache_dirs.append(Path(user_cache_dir("fi_design")) / "numba")
+    except ImportError:  # pragma: no cover - platformdirs is a dependency
+        pass
+    stamp = src.stat().st_mtime
+    for d in cache_dirs:
+        for index in d.rglob("kernel.integrate-*.nbi") if d.is_dir() else ():
+            if index.stat().st_mtime >= stamp:
+                return True
+    return False
 
 
 def print_design(console: "Console", result, spec_path: Path | None = None) -> None:
@@ -374,12 +463,48 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
                 text += f", flexure force at full stroke {_fmt(stiff['force_at_stroke'], 3)} N"
         console.print(Text(text))
 
+    sim = data.get("simulation")
+    if isinstance(sim, dict) and "isolated" in sim:
+        console.print(_simulation_table(sim))
+
     conclusion = getattr(result, "conclusion", "") or data.get("conclusion", "")
     if conclusion:
         console.print(Text("Conclusion: ", style="bold").append(Text(str(conclusion),
                                                                         style="")))
     for w in getattr(result, "warnings", ()) or ():
         console.print(Text("warning: ", style="bold yellow").append(Text(_warning_text(w))))
+
+
+def _simulation_table(sim: dict) -> Any:
+    """Table of the simulated verdicts from the confirmation's JSON form."""
+    from rich import box
+    from rich.table import Table
+    from rich.text import Text
+
+    label = "suggested isolator" if sim.get("suggested_isolator") else "with isolator"
+    t = Table(title="Nonlinear confirmation (LuGre simulation, paper section 2.3)"
+              if sim["isolated"].get("friction_model") == "lugre"
+              else "Nonlinear confirmation (switch friction model)",
+              title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
+    for col, just in (("Plant", "left"), ("Verdict", "left"), ("Cycles", "right"),
+                      ("Amplitude [um]", "right"), ("Period [s]", "right"),
+                      ("Final error [um]", "right"), ("Hunting-free from [Hz]", "right"),
+                      ("Other model", "left")):
+        t.add_column(Text(col), justify=just, no_wrap=True)
+    mins = sim.get("min_hunting_free_crossover") or {}
+    other = sim.get("cross_check") or {}
+    for key, name in (("isolated", label), ("non_isolated", "without isolator")):
+        v = sim[key]
+        verdict = v.get("verdict", "")
+        style = {"settled": "bold green", "hunting": "bold red"}.get(verdict, "bold yellow")
+        m = mins.get(key)
+        t.add_row(name, Text(verdict, style=style), str(v.get("hunting_cycles")),
+                  _fmt(None if v.get("amplitude") is None else 1e6 * v["amplitude"], 3),
+                  _fmt(v.get("period"), 3),
+                  _fmt(None if v.get("final_error") is None else 1e6 * v["final_error"], 3),
+                  "not found" if m is None else f"{m:g} (+-{mins.get('resolution', 0):g})",
+                  (other.get(key) or {}).get("verdict", ""))
+    return t
 
 
 def _spec_name(result) -> str:

@@ -124,7 +124,7 @@ def step1_friction_gap(spec: Spec) -> FrictionGapResult:
     else:
         msg = (f"Fs - Fc = {gap:.3g} N is below the {thr:.3g} N threshold: stick-slip, and so "
                "hunting, is unlikely")
-    check = Check("friction_gap", not risk, gap, thr, "N", msg, step="1 friction gap",
+    check = Check("friction_gap", not risk, gap, thr, "N", msg, step="step 1 friction gap",
                   status=Status.WARN if risk else Status.PASS)
     return FrictionGapResult(static=f.static, coulomb=f.coulomb, gap=gap, threshold=thr,
                              hunting_risk=risk, checks=(check,))
@@ -233,7 +233,7 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
     cases = linear.limit_cases(spec)
     at = linear.analyse(spec, fc, cases=cases)
     ach = linear.achievable_crossover(spec)
-    step = "2 crossover"
+    step = "step 2 crossover"
     checks: list[Check] = []
     reach = ach.frequency is not None and fc <= ach.frequency * (1 + 1e-9)
     if ach.frequency is None:
@@ -358,7 +358,7 @@ def step3_stiffness(spec: Spec) -> StiffnessResult:
     """
     Fs = spec.friction.static
     safety = spec.requirements.stiffness_safety
-    step = "3 drive stiffness"
+    step = "step 3 drive stiffness"
     if spec.isolator is None:
         s = SUGGESTED_STROKE
         kmax = stiffness_limit(spec, s)
@@ -419,7 +419,7 @@ def step3_flexure(spec: Spec, stiffness: StiffnessResult | None = None) -> Flexu
 def _flexure_checks(fx: FlexureResult | None) -> tuple[Check, ...]:
     if fx is None:
         return ()
-    step = "3 flexure"
+    step = "step 3 flexure"
     if not fx.feasible:
         return (Check("flexure", False, None, None, "-",
                       f"no {fx.leaves}-leaf guide within the bounds fits: {fx.reason}",
@@ -496,7 +496,7 @@ def step4_pid(spec: Spec) -> PidResult:
     """
     ctl = spec.controller
     g = tune_pid(spec)
-    step = "4 PID"
+    step = "step 4 PID"
     msg = (f"tuned at {g.crossover:.4g} Hz on {g.tuning_mass:.4g} kg: kp = {g.kp:.4g} N/m, "
            f"ki = {g.ki:.4g} N/(m s), kd = {g.kd:.4g} N s/m, wt = {g.wt:.4g} rad/s")
     checks = [Check("pid", None, g.kp, None, "N/m", msg, step=step)]
@@ -649,15 +649,17 @@ class DesignResult:
 
         Parameters
         ----------
-        simulation : object
-            The simulation's result (anything :func:`fi_design.results.to_jsonable`
-            can serialise, e.g. a frozen dataclass with ``to_dict``).
+        simulation : fi_design.confirm.Confirmation or object
+            The confirmation; its ``checks`` (if any) join the design's checks.
         conclusion : str, optional
-            A conclusion that includes the simulation's verdict; default keeps
-            the linear one.
+            The conclusion; default: the linear one followed by a sentence on
+            the simulated verdicts.
         """
-        return replace(self, simulation=simulation,
-                       conclusion=self.conclusion if conclusion is None else conclusion)
+        extra = tuple(getattr(simulation, "checks", ()))
+        if conclusion is None:
+            conclusion = self.conclusion + _simulation_sentence(self.spec, simulation)
+        return replace(self, simulation=simulation, checks=self.checks + extra,
+                       conclusion=conclusion)
 
     def to_dict(self) -> dict:
         """The JSON contract: SI values, infinite margins as null.
@@ -696,28 +698,36 @@ def _sha256(spec: Spec) -> str:
     return hashlib.sha256(spec.model_dump_json().encode()).hexdigest()
 
 
-def design(spec: Spec | str | Path | Mapping[str, Any], *, simulation: Any = None,
-           ) -> DesignResult:
-    """Run the four guideline steps on a spec.
+def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
+           simulation: Any = None, progress: Any = None) -> DesignResult:
+    """Run the four guideline steps on a spec and confirm them by simulation.
 
     Parameters
     ----------
     spec : Spec, path or mapping
         A validated spec, or a YAML path or mapping for
         :func:`fi_design.specfile.load_spec`.
-    simulation : object, optional
-        A nonlinear confirmation to attach (see :meth:`DesignResult.with_simulation`).
+    confirm : bool, optional
+        Simulate the stage with and without the isolator, scan the crossover
+        for the lowest hunting-free one, check the landing deflection and
+        cross-check with the other friction model
+        (:func:`fi_design.confirm.confirm`, about a second once the kernel is
+        compiled). Default True; CAD loops that only need the linear steps pass
+        False.
+    simulation : fi_design.confirm.Confirmation, optional
+        A confirmation computed elsewhere, attached instead of simulating.
+    progress : callable, optional
+        Called with a short message as the confirmation proceeds.
 
     Returns
     -------
     DesignResult
-        Steps 1 to 4, all checks, warnings and a conclusion.
+        Steps 1 to 4, the confirmation, all checks, warnings and a conclusion.
 
     Raises
     ------
     fi_design.errors.SpecError
         When ``spec`` is a path or mapping that does not validate.
-
     """
     from . import __version__
 
@@ -737,9 +747,40 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, simulation: Any = Non
         isolator_advice=advice, checks=checks, warnings=tuple(warnings_for(spec)),
         conclusion=_conclusion(spec, gap, xo, st, fx, pid, advice, checks),
         fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None)
-    log.info("design of %r: %d checks, %d failed", spec.name, len(checks),
+    if simulation is None and confirm:
+        from .confirm import confirm as _confirm
+
+        suggestion = (advice.stroke, advice.stiffness) if advice is not None else None
+        simulation = _confirm(spec, suggestion, progress=progress)
+    if simulation is not None:
+        result = result.with_simulation(simulation)
+    log.info("design of %r: %d checks, %d failed", spec.name, len(result.checks),
              len(result.failed_checks))
-    return result if simulation is None else result.with_simulation(simulation)
+    return result
+
+
+def _simulation_sentence(spec: Spec, sim: Any) -> str:
+    """The conclusion's sentence on the simulated verdicts."""
+    iso = getattr(sim, "isolated", None)
+    non = getattr(sim, "non_isolated", None)
+    if iso is None or non is None:
+        return ""
+    mins = sim.min_hunting_free_crossover
+    label = "the suggested isolator" if sim.suggested_isolator else "the isolator"
+    fc = spec.controller.crossover
+
+    def f(x):
+        return "beyond the scan" if x is None else f"from {x:g} Hz"
+
+    text = (f" The LuGre simulation at {fc:g} Hz gives: with {label} {iso.verdict}"
+            f" ({iso.hunting_cycles} cycles), without it {non.verdict}"
+            f" ({non.hunting_cycles} cycles); hunting-free {f(mins['isolated'])} with {label} "
+            f"and {f(mins['non_isolated'])} without (resolution {mins['resolution']:g} Hz).")
+    if iso.friction_model != "lugre":
+        text = text.replace("The LuGre simulation", f"The {iso.friction_model} simulation")
+    if not sim.models_agree:
+        text += " The other friction model disagrees on the verdict (see the checks)."
+    return text
 
 
 def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: StiffnessResult,
@@ -807,5 +848,5 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
         parts.append(f"{len(failed)} check(s) fail ({', '.join(failed)}): revise the design "
                      "before the nonlinear confirmation.")
     else:
-        parts.append("No check fails; the nonlinear simulation should confirm the verdict.")
+        parts.append("No check of the four steps fails.")
     return " ".join(parts)

@@ -96,12 +96,14 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
         return fa_hold
 
     def fun(tt, yy):
+        yy = np.ascontiguousarray(yy, dtype=float)
         r, rd = float(ref(tt)), float(ref(tt, 1))
         f = np.empty(n)
         rhs(tt, yy, p, modes, r, rd, fa_at(tt, yy) if not fa_state else 0.0, fa_state, f)
         return f
 
     def jac(tt, yy):
+        yy = np.ascontiguousarray(yy, dtype=float)
         r, rd = float(ref(tt)), float(ref(tt, 1))
         J = np.empty((n, n))
         jacobian(tt, yy, p, modes, r, rd, fa_at(tt, yy) if not fa_state else 0.0, fa_state, J)
@@ -114,7 +116,8 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
         if not stuck:
             evs.append(("sign", lambda tt, yy: sgn * yy[iv2], -1))
         if sw and stuck:
-            evs.append(("unstick", lambda tt, yy: abs(drive_force(yy, p, fa_at(tt, yy), fa_state))
+            evs.append(("unstick", lambda tt, yy: abs(drive_force(
+                np.ascontiguousarray(yy, dtype=float), p, fa_at(tt, yy), fa_state))
                         - params.Fs, 1))
         if iso:
             lim = modes[MODE_LIMIT]
@@ -156,6 +159,7 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
 
     status = "ok"
     code = 0
+    zero_run = 0
     while t < t_end - 1e-12:
         # time events at t
         if discrete and t >= k_sample * Ts - 1e-12:
@@ -192,8 +196,16 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
         if cont_delay:
             t_next = min(t_next, t + delay)
         names, funcs = events()
+        if zero_run > 2:
+            # grazing: the state sits on a switching surface (a cart at rest has
+            # no sliding direction); take a short step with the modes the state
+            # implies and no state events
+            natural_modes(y, p, modes)
+            names, funcs = [], []
+            t_next = min(t_next, t + 1e-4)
+            zero_run = 0
         sol = solve_ivp(fun, (t, t_next), y, method=method, rtol=rtol, atol=atol, jac=jac,
-                        events=funcs, dense_output=True)
+                        events=funcs or None, dense_output=True)
         n_steps += len(sol.t) - 1
         if sol.status == -1:
             code, status = 3, "solver failure: " + sol.message
@@ -211,6 +223,7 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
                     _switch(name, y, p, modes, params, iv2, iu, fa_at(t1, y), fa_state, cont_delay,
                             hist, t1)
                     n_ev += 1
+                    zero_run = zero_run + 1 if t1 - t <= 1e-12 * max(1.0, t) else 0
                     break
         t = t1
         if abs(y[0]) > x_bound or not np.all(np.isfinite(y)):

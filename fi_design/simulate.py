@@ -266,8 +266,9 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
     effects : sequence, optional
         Effect entries replacing the spec's ``effects`` list.
     rtol : float, optional
-        Relative tolerance; default ``spec.simulation.tolerance`` (the
-        reference path uses 1e-4 times it).
+        Relative tolerance of the chosen method; default
+        ``spec.simulation.tolerance`` for the fast path and 1e-4 times it for
+        the reference.
 
     Returns
     -------
@@ -293,7 +294,10 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
     rate = spec.simulation.output_rate
     n_out = int(math.floor(t_end * rate + 1e-9)) + 1
     t_out = np.arange(n_out) / rate
-    tol = spec.simulation.tolerance if rtol is None else rtol
+    if rtol is not None:
+        tol = rtol
+    else:
+        tol = spec.simulation.tolerance * (1.0 if method == "fast" else 1e-4)
     n = params.n_states
     y0 = np.zeros(n)
     y0[0] = initial_position
@@ -314,7 +318,7 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         from .refsolve import solve_reference
 
         code, Y, R, FA, n_steps, n_rej, n_ev, t_reached, status = solve_reference(
-            params, y0, ref, t_end, t_out, tol * 1e-4, tolerances(params, tol * 1e-4), x_bound)
+            params, y0, ref, t_end, t_out, tol, tolerances(params, tol), x_bound)
     wall = _time.perf_counter() - start
     success = code == 0
     message = "" if success else _failure_message(status, t_reached, params, iso)

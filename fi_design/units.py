@@ -10,8 +10,9 @@ Three kinds of quantity need care:
   ``"62.8 rad/s"`` would silently convert to 62.8 Hz. Here any angle unit in a
   frequency (rad/s, deg/s, rpm, cycles/s) is converted through rad/s and divided
   by 2 pi, so ``"62.83 rad/s"`` is 10 Hz.
-- Angles (phase margins) are stored in degrees and must carry a unit: a bare
-  30 could be degrees or radians.
+- Phase margins are stored in degrees and must carry a unit: a bare 30 could
+  be degrees or radians. Other angles (the phases of the effects) are SI
+  radians, bare or with a unit.
 - Gain ratios given in decibels (``"6 dB"``) are stored in dB; a bare number is
   refused for the same reason.
 """
@@ -91,7 +92,7 @@ def to_si(value, unit: str, path: str | None = None) -> float:
     if unit not in KNOWN_UNITS:  # programming error, not user input
         raise ValueError(f"unknown target unit {unit!r}")
     if _is_number(value):
-        if unit in ("deg", "rad"):
+        if unit == "deg":
             raise UnitError(f"a bare number is ambiguous for an angle; write e.g. '{value} deg'",
                             path=path)
         if unit == "dB":
@@ -131,7 +132,7 @@ def _convert(text: str, unit: str, path: str | None) -> float:
             return float(q.to("rad/s").magnitude) / (2.0 * math.pi)
         except pint.errors.DimensionalityError:
             pass
-    if unit in ("deg", "rad") and q.unitless:
+    if unit == "deg" and q.unitless:
         raise UnitError(f"{text!r} has no unit; write e.g. '{text} deg'", path=path)
     try:
         return float(q.to(unit).magnitude)

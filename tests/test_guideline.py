@@ -34,7 +34,8 @@ def variant(spec, **paths):
 
 @pytest.fixture(scope="module")
 def paper_design(paper_spec):
-    return gl.design(paper_spec)
+    """The linear steps only: the simulated confirmation is tested in test_confirm.py."""
+    return gl.design(paper_spec, confirm=False)
 
 
 # --------------------------------------------------------------------------- JSON contract
@@ -112,7 +113,7 @@ def test_step1_small_gap(paper_spec):
     s1 = gl.step1_friction_gap(spec)
     assert s1.gap == pytest.approx(0.3) and not s1.hunting_risk
     assert s1.checks[0].status == Status.PASS
-    assert "isolator may not be needed" in gl.design(spec).conclusion
+    assert "isolator may not be needed" in gl.design(spec, confirm=False).conclusion
 
 
 def test_step3_proposes_half_of_k_max_when_stiffness_is_missing(paper_spec):
@@ -126,7 +127,7 @@ def test_step3_proposes_half_of_k_max_when_stiffness_is_missing(paper_spec):
 
 def test_step3_fails_above_k_max(paper_spec):
     spec = variant(paper_spec, **{"isolator.stiffness": "20 N/mm"})
-    r = gl.design(spec)
+    r = gl.design(spec, confirm=False)
     check = next(c for c in r.checks if c.name == "drive_stiffness")
     assert check.status == Status.FAIL and "exceeds" in check.message
     assert not r.passed and "drive_stiffness" in r.conclusion
@@ -160,7 +161,7 @@ def test_k_max_scales_as_static_friction_over_stroke(paper_spec, fs, stroke, fac
 def test_infeasible_flexure_is_a_failed_check(paper_spec):
     spec = variant(paper_spec, **{"isolator.flexure.thickness": ["0.8 mm", "1 mm"],
                                   "isolator.flexure.length": ["10 mm", "15 mm"]})
-    r = gl.design(spec)
+    r = gl.design(spec, confirm=False)
     assert r.flexure is not None and not r.flexure.feasible
     check = next(c for c in r.checks if c.name == "flexure")
     assert check.status == Status.FAIL and r.flexure.reason in check.message
@@ -168,14 +169,14 @@ def test_infeasible_flexure_is_a_failed_check(paper_spec):
 
 
 def test_no_flexure_section_gives_null(paper_spec):
-    r = gl.design(variant(paper_spec, **{"isolator.flexure": None}))
+    r = gl.design(variant(paper_spec, **{"isolator.flexure": None}), confirm=False)
     assert r.flexure is None and r.to_dict()["flexure"] is None
     assert not any(c.name.startswith("flexure") for c in r.checks)
 
 
 def test_desired_crossover_above_achievable_fails(paper_spec):
     spec = variant(paper_spec, **{"controller.crossover": "60 Hz"})
-    r = gl.design(spec)
+    r = gl.design(spec, confirm=False)
     names = {c.name for c in r.failed_checks}
     assert "crossover_achievable" in names and "parasitic_separation.stage tilt" in names
     assert r.crossover.achievable < 60.0
@@ -186,7 +187,7 @@ def test_desired_crossover_above_achievable_fails(paper_spec):
 
 def test_without_isolator_advises_on_the_need(paper_spec):
     spec = variant(paper_spec, isolator=None, **{"controller.delay": "2 ms"})
-    r = gl.design(spec)
+    r = gl.design(spec, confirm=False)
     assert len(r.crossover.cases) == 2 and r.flexure is None
     adv = r.isolator_advice
     assert adv.needed is True and adv.stroke == 0.3e-3
@@ -196,9 +197,9 @@ def test_without_isolator_advises_on_the_need(paper_spec):
     d = r.to_dict()
     assert d["isolator_advice"]["needed"] is True and len(d["crossover"]["cases"]) == 2
 
-    ideal = gl.design(variant(paper_spec, isolator=None))
+    ideal = gl.design(variant(paper_spec, isolator=None), confirm=False)
     assert ideal.isolator_advice.needed is None       # no crossover limit in the linear model
-    small = gl.design(variant(paper_spec, isolator=None, **{"friction.static": "1.5 N"}))
+    small = gl.design(variant(paper_spec, isolator=None, **{"friction.static": "1.5 N"}), confirm=False)
     assert small.isolator_advice.needed is False
 
 
@@ -211,6 +212,7 @@ def test_simulation_is_attached_only_when_given(paper_spec, paper_design):
         hunting_cycles: int
 
     with_sim = paper_design.with_simulation(FakeSimulation(0), conclusion="confirmed")
+    assert with_sim.checks == paper_design.checks  # the fake carries no checks
     assert with_sim.to_dict()["simulation"] == {"hunting_cycles": 0}
     assert with_sim.conclusion == "confirmed" and paper_design.simulation is None
     assert gl.design(paper_spec, simulation=FakeSimulation(3)).to_dict()["simulation"] == \
@@ -221,10 +223,10 @@ def test_spec_hash_without_origin(paper_spec):
     spec = paper_spec.model_copy()
     spec._origin = None                    # as if built in code, not read by load_spec
     assert origin(spec) is None and origin(paper_spec) is not None
-    r = gl.design(spec)
+    r = gl.design(spec, confirm=False)
     assert r.spec_sha256 == hashlib.sha256(spec.model_dump_json().encode()).hexdigest()
-    assert gl.design(origin(paper_spec).raw).crossover.achievable == \
-        pytest.approx(gl.design(paper_spec).crossover.achievable)
+    assert gl.design(origin(paper_spec).raw, confirm=False).crossover.achievable == \
+        pytest.approx(gl.design(paper_spec, confirm=False).crossover.achievable)
 
 
 def test_results_are_frozen(paper_design):

@@ -1,0 +1,388 @@
+"""Nonlinear confirmation of the guideline's verdict (the design command's last part).
+
+The guideline's four steps are linear and static. This module simulates the
+stage with friction, with and without the isolator, at the design crossover
+(paper section 2.3 and Figure 5), and adds what a reviewer wants to know:
+
+- the verdict of each plant from the hunting metric (``settled``,
+  ``hunting``, ``stuck`` or ``undetermined``);
+- the lowest crossover at which each plant stops hunting, from a scan with
+  the simulation (the paper's headline: the isolator needs far less
+  bandwidth, 5 Hz against 14-20 Hz);
+- where the cart lands: the joint deflection at rest after the move and the
+  flexure force there against Fs. The paper's rule k * stroke < Fs is
+  sufficient but conservative; the force the cart actually sees at rest is
+  k * min(stroke, landing deflection), and once the landing deflection
+  reaches the stroke the limiter carries the cart and hunting returns;
+- a cross-check with the other friction model (LuGre against the
+  Karnopp-type switch model), flagged when the verdicts disagree.
+
+A spec without an isolator is confirmed against the isolator step 3 suggests
+(:func:`fi_design.guideline.isolator_advice`), so the comparison is always
+"with" against "without".
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import spec as _spec
+from .metrics import HuntingMetrics
+from .results import Check, Status, dataclass_dict, frozen_array
+from .simulate import SimulationResult, simulate
+
+PLANTS = ("isolated", "non_isolated")
+
+
+@dataclass(frozen=True, eq=False)
+class PlantVerdict:
+    """Summary of one simulated plant at the design crossover.
+
+    Attributes
+    ----------
+    plant : str
+        ``"isolated"`` or ``"non_isolated"``.
+    friction_model : str
+        Friction model that produced the verdict (``lugre`` or ``switch``).
+    crossover : float
+        Crossover simulated [Hz].
+    hunting_cycles : int
+        Peaks counted by the paper's metric.
+    amplitude : float
+        Peak-to-peak error in the counting window [m].
+    period : float or None
+        Mean period of the counted cycles [s].
+    settled : bool
+        Whether the error stays within the settle band at the window's end.
+    settling_time : float or None
+        Time after the move until the error stays within the band [s].
+    final_error : float
+        Error x1 - r at the end [m].
+    verdict : str
+        ``settled``, ``hunting``, ``stuck`` or ``undetermined``.
+    reason : str
+        The verdict in one sentence.
+    success : bool
+        Whether the integration completed.
+    message : str
+        Failure description, empty on success.
+    """
+
+    plant: str
+    friction_model: str
+    crossover: float
+    hunting_cycles: int
+    amplitude: float
+    period: float | None
+    settled: bool
+    settling_time: float | None
+    final_error: float
+    verdict: str
+    reason: str
+    success: bool
+    message: str
+
+    @classmethod
+    def of(cls, plant: str, result: SimulationResult) -> "PlantVerdict":
+        """Summarise a simulation result."""
+        m: HuntingMetrics = result.metrics
+        return cls(plant=plant, friction_model=result.friction_model, crossover=result.crossover,
+                   hunting_cycles=m.hunting_cycles, amplitude=m.amplitude, period=m.period,
+                   settled=m.settled, settling_time=m.settling_time, final_error=m.final_error,
+                   verdict=m.verdict, reason=m.reason, success=result.success,
+                   message=result.message)
+
+    def to_dict(self) -> dict:
+        """Plain JSON data (SI)."""
+        return dataclass_dict(self)
+
+
+@dataclass(frozen=True, eq=False)
+class CrossoverScan:
+    """Verdicts over a crossover grid and the lowest hunting-free crossover.
+
+    Attributes
+    ----------
+    plant : str
+        ``"isolated"`` or ``"non_isolated"``.
+    crossovers : ndarray, shape (n,)
+        Scanned crossovers [Hz].
+    verdicts : tuple of str
+        Verdict at each crossover.
+    hunting_cycles : ndarray of int, shape (n,)
+        Counted cycles at each crossover.
+    minimum : float or None
+        Lowest scanned crossover from which every higher scanned crossover
+        settles [Hz]; None if the top of the scan does not settle.
+    resolution : float
+        Grid step [Hz]: the true boundary lies within one step below
+        ``minimum``.
+    islands : tuple of float
+        Crossovers below ``minimum`` that settled although a higher one did
+        not [Hz] (hunting that comes and goes, as the paper saw at 9.5 Hz).
+    """
+
+    plant: str
+    crossovers: np.ndarray
+    verdicts: tuple[str, ...]
+    hunting_cycles: np.ndarray
+    minimum: float | None
+    resolution: float
+    islands: tuple[float, ...]
+
+    def to_dict(self) -> dict:
+        """Plain JSON data."""
+        return dataclass_dict(self)
+
+
+@dataclass(frozen=True)
+class Landing:
+    """Where the cart comes to rest after the move (isolated plant).
+
+    Attributes
+    ----------
+    deflection : float
+        Joint deflection x1 - x2 at the end of the simulation [m].
+    stroke : float
+        One-sided stroke [m].
+    stiffness : float
+        Drive stiffness k [N/m].
+    force : float
+        Force the flexure exerts on the resting cart, k * min(|deflection|,
+        stroke) [N].
+    static_friction : float
+        Fs [N].
+    on_limiter : bool
+        Whether the landing deflection reaches the stroke (the limiter then
+        locks the joint and the controller feels the friction again).
+    rule_force : float
+        The paper's conservative bound k * stroke [N].
+    """
+
+    deflection: float
+    stroke: float
+    stiffness: float
+    force: float
+    static_friction: float
+    on_limiter: bool
+    rule_force: float
+
+    def to_dict(self) -> dict:
+        """Plain JSON data (SI)."""
+        return dataclass_dict(self)
+
+
+@dataclass(frozen=True, eq=False)
+class Confirmation:
+    """The simulated confirmation of a design.
+
+    Attributes
+    ----------
+    isolated, non_isolated : PlantVerdict
+        The two plants at the design crossover.
+    min_hunting_free_crossover : dict
+        ``{"isolated": Hz or None, "non_isolated": Hz or None, "resolution":
+        Hz, "scan": [start, stop]}``.
+    scans : dict of CrossoverScan
+        The scans behind the minimum crossovers, by plant.
+    landing : Landing or None
+        Landing of the isolated cart.
+    cross_check : dict of PlantVerdict
+        The same plants with the other friction model, by plant.
+    models_agree : bool
+        Whether both friction models give the same hunting/no-hunting call
+        for both plants.
+    suggested_isolator : bool
+        True when the spec has no isolator and the isolated plant uses the
+        isolator suggested by the guideline.
+    checks : tuple of Check
+        The simulation's checks for the design summary.
+    results : dict of SimulationResult
+        The two full simulations (traces for plots; not in the JSON).
+    """
+
+    isolated: PlantVerdict
+    non_isolated: PlantVerdict
+    min_hunting_free_crossover: dict
+    scans: dict
+    landing: Landing | None
+    cross_check: dict
+    models_agree: bool
+    suggested_isolator: bool
+    checks: tuple[Check, ...]
+    results: dict
+
+    def to_dict(self) -> dict:
+        """Plain JSON data: the verdicts, scans and checks (no traces)."""
+        d = dataclass_dict(self)
+        d.pop("results", None)
+        return d
+
+
+def _hunts(v: PlantVerdict) -> bool:
+    return v.verdict == "hunting"
+
+
+def scan_crossover(spec: _spec.Spec, isolated: bool, start: float | None = None,
+                   stop: float | None = None, step: float | None = None,
+                   progress=None) -> CrossoverScan:
+    """Simulate a crossover grid and find the lowest crossover that stays hunting-free.
+
+    Parameters
+    ----------
+    spec : Spec
+        The design spec (grid from ``spec.simulation.crossover_scan`` unless
+        given).
+    isolated : bool
+        Which plant.
+    start, stop, step : float, optional
+        Grid [Hz].
+    progress : callable, optional
+        Called with a short message before each simulation.
+    """
+    cfg = spec.simulation.crossover_scan
+    start = cfg.start if start is None else start
+    stop = cfg.stop if stop is None else stop
+    step = cfg.step if step is None else step
+    grid = np.arange(start, stop + 0.5 * step, step)
+    verdicts, cycles = [], []
+    plant = "with isolator" if isolated else "without isolator"
+    for i, fc in enumerate(grid):
+        if progress is not None:
+            progress(f"scanning the crossover {plant}: {fc:g} Hz ({i + 1}/{len(grid)})")
+        m = simulate(spec, isolated=isolated, crossover=float(fc)).metrics
+        verdicts.append(m.verdict)
+        cycles.append(m.hunting_cycles)
+    ok = np.array([v == "settled" for v in verdicts])
+    minimum = None
+    if ok[-1]:
+        i = len(ok) - 1
+        while i > 0 and ok[i - 1]:
+            i -= 1
+        minimum = float(grid[i])
+        islands = tuple(float(f) for f in grid[:i][ok[:i]])
+    else:
+        islands = ()
+    return CrossoverScan(plant="isolated" if isolated else "non_isolated",
+                         crossovers=frozen_array(grid), verdicts=tuple(verdicts),
+                         hunting_cycles=frozen_array(cycles, dtype=int), minimum=minimum,
+                         resolution=float(step), islands=islands)
+
+
+def landing(spec: _spec.Spec, result: SimulationResult) -> Landing:
+    """Landing deflection and flexure force of an isolated simulation."""
+    k = _spec.drive_stiffness(spec)
+    s = spec.isolator.stroke
+    d = float(result.deflection[-1])
+    return Landing(deflection=d, stroke=s, stiffness=k, force=k * min(abs(d), s),
+                   static_friction=spec.friction.static, on_limiter=abs(d) >= s,
+                   rule_force=k * s)
+
+
+def with_isolator(spec: _spec.Spec, stroke: float, stiffness: float) -> _spec.Spec:
+    """The spec with an isolator of the given stroke [m] and stiffness [N/m] added."""
+    iso = _spec.Isolator(stiffness=stiffness, stroke=stroke)
+    return spec.model_copy(update={"isolator": iso})
+
+
+def _other_model(spec: _spec.Spec) -> _spec.Spec:
+    other = "switch" if spec.friction.model == "lugre" else "lugre"
+    return spec.model_copy(update={"friction": spec.friction.model_copy(update={"model": other})})
+
+
+def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
+            progress=None) -> Confirmation:
+    """Simulate both plants, scan the crossover, check the landing and cross-check.
+
+    Parameters
+    ----------
+    spec : Spec
+        The design spec.
+    suggestion : (stroke, stiffness), optional
+        Isolator to simulate when the spec has none [m, N/m]; required then.
+    progress : callable, optional
+        Called with a short message as the work proceeds (about 130
+        simulations of a few ms each).
+
+    Returns
+    -------
+    Confirmation
+    """
+    suggested = spec.isolator is None
+    if suggested:
+        if suggestion is None:
+            raise ValueError("a spec without isolator needs a suggested (stroke, stiffness)")
+        spec_iso = with_isolator(spec, *suggestion)
+    else:
+        spec_iso = spec
+    def say(text: str) -> None:
+        if progress is not None:
+            progress(text)
+
+    say("simulating the stage with and without the isolator ...")
+    res_iso = simulate(spec_iso, isolated=True)
+    res_non = simulate(spec, isolated=False)
+    iso = PlantVerdict.of("isolated", res_iso)
+    non = PlantVerdict.of("non_isolated", res_non)
+    scans = {"isolated": scan_crossover(spec_iso, True, progress=progress),
+             "non_isolated": scan_crossover(spec, False, progress=progress)}
+    cfg = spec.simulation.crossover_scan
+    mins = {"isolated": scans["isolated"].minimum, "non_isolated": scans["non_isolated"].minimum,
+            "resolution": cfg.step, "scan": [cfg.start, cfg.stop]}
+    land = landing(spec_iso, res_iso)
+    say("cross-checking with the other friction model ...")
+    other_iso = PlantVerdict.of("isolated", simulate(_other_model(spec_iso), isolated=True))
+    other_non = PlantVerdict.of("non_isolated", simulate(_other_model(spec), isolated=False))
+    agree = _hunts(other_iso) == _hunts(iso) and _hunts(other_non) == _hunts(non)
+    checks = _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested)
+    return Confirmation(isolated=iso, non_isolated=non, min_hunting_free_crossover=mins,
+                        scans=scans, landing=land,
+                        cross_check={"isolated": other_iso, "non_isolated": other_non},
+                        models_agree=agree, suggested_isolator=suggested, checks=tuple(checks),
+                        results={"isolated": res_iso, "non_isolated": res_non})
+
+
+def _fmt_f(f: float | None) -> str:
+    return "not found" if f is None else f"{f:g} Hz"
+
+
+def _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested) -> list[Check]:
+    fc = spec.controller.crossover
+    step = "simulation (paper section 2.3)"
+    label = "suggested isolator" if suggested else "isolated design"
+    out = [
+        Check("simulation_isolated", iso.verdict == "settled", float(iso.hunting_cycles), 0.0,
+              "cycles", f"{label} at {fc:g} Hz: {iso.verdict} ({iso.reason})", step),
+        Check("simulation_non_isolated", None, float(non.hunting_cycles), None, "cycles",
+              f"without isolator at {fc:g} Hz: {non.verdict} ({non.reason})", step),
+    ]
+    m_iso, m_non = mins["isolated"], mins["non_isolated"]
+    res = mins["resolution"]
+    out.append(Check(
+        "min_crossover_isolated", None if m_iso is None else fc >= m_iso, m_iso, fc, "Hz",
+        f"{label} stays hunting-free from {_fmt_f(m_iso)} (scan resolution {res:g} Hz); "
+        f"design crossover {fc:g} Hz", step))
+    out.append(Check(
+        "min_crossover_non_isolated", None, m_non, None, "Hz",
+        f"without isolator hunting-free from {_fmt_f(m_non)} (scan resolution {res:g} Hz)",
+        step))
+    if non.verdict != "hunting":
+        out.append(Check("isolator_needed", None, None, None, "-",
+                         f"the stage without isolator does not hunt at {fc:g} Hz "
+                         f"({non.verdict}): the isolator is not needed at this crossover", step))
+    if land is not None:
+        ok = (not land.on_limiter) and land.force < land.static_friction
+        out.append(Check(
+            "landing_force", ok, land.force, land.static_friction, "N",
+            f"the cart lands at {land.deflection * 1e6:.3g} um joint deflection "
+            f"({'on the limiter' if land.on_limiter else 'inside the stroke'}): flexure force "
+            f"k min(|d|, s) = {land.force:.3g} N against Fs = {land.static_friction:.3g} N "
+            f"(the rule's bound k s = {land.rule_force:.3g} N)", "step 3 refinement: landing"))
+    if not agree:
+        out.append(Check(
+            "friction_model_cross_check", None, None, None, "-",
+            f"the {other_iso.friction_model} model disagrees: isolated {other_iso.verdict}, "
+            f"without isolator {other_non.verdict}", step, status=Status.WARN))
+    return out
