@@ -574,6 +574,111 @@ def _header(key: str) -> str:
     return key.replace("_", " ").capitalize()
 
 
+@app.command("simulate")
+def simulate_command(
+    spec: Annotated[Path, typer.Argument(
+        metavar="SPEC.yaml", help="The design spec (YAML).", show_default=False)],
+    no_isolator: Annotated[bool, typer.Option(
+        "--no-isolator", help="Simulate the stage without the isolator (one rigid mass on the "
+                              "bearing).")] = False,
+    csv_out: Annotated[Optional[Path], typer.Option(
+        "--csv", metavar="TRACE.csv", help="Write the traces at the output rate (1 kHz by "
+                                           "default) in the measured-data layout.",
+        show_default=False)] = None,
+    json_out: Annotated[Optional[Path], typer.Option(
+        "--json", metavar="OUT.json", help="Write the metrics and solver statistics as JSON.",
+        show_default=False)] = None,
+    reference: Annotated[bool, typer.Option(
+        "--reference", help="Integrate with scipy's solve_ivp (Radau, tight tolerance) instead "
+                            "of the fast kernel: slow, for checks.")] = False,
+    force: Annotated[bool, typer.Option(
+        "--force", "-f", help="Overwrite existing output files.")] = False,
+) -> None:
+    """Simulate the stage once and print the hunting metric.
+
+    The CSV has the columns of measured data (DESIGN.md section 4): time_s,
+    reference_m, position_m, force_N (the commanded force) and, with the
+    isolator, deflection_m; overlay it on your measurements.
+    """
+    from .output import check_output, write_atomic
+
+    csv_path = check_output(csv_out, force=force, protect=(spec,),
+                            extensions=(".csv",)) if csv_out else None
+    json_path = check_output(json_out, force=force, protect=(spec,),
+                             extensions=(".json",)) if json_out else None
+    if csv_path is not None and json_path is not None and csv_path == json_path:
+        raise typer.BadParameter("--csv and --json name the same file")
+    _check_spec_path(spec)
+
+    from .specfile import load_spec
+
+    spec_obj = load_spec(spec)
+    isolated = False if no_isolator else None
+    if not no_isolator and spec_obj.isolator is None:
+        isolated = False
+
+    from .simulate import simulate
+
+    err = _console(stderr=True)
+    with _status(err, "simulating ..."):
+        result = simulate(spec_obj, isolated=isolated,
+                          method="reference" if reference else "fast")
+    console = _console()
+    _print_simulation(console, result)
+    if csv_path is not None:
+        write_atomic(csv_path, traces_csv(result.traces()))
+        console.print(f"wrote {csv_path}", markup=False)
+    if json_path is not None:
+        import json
+
+        write_atomic(json_path, json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n")
+        console.print(f"wrote {json_path}", markup=False)
+
+
+def traces_csv(columns: dict) -> str:
+    """CSV text of equal-length columns, header first, full float precision."""
+    import io
+
+    import numpy as np
+
+    names = list(columns)
+    data = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
+    buf = io.StringIO()
+    buf.write(",".join(names) + "\n")
+    np.savetxt(buf, data, delimiter=",", fmt="%.10g")
+    return buf.getvalue()
+
+
+def _print_simulation(console: "Console", result) -> None:
+    from rich import box
+    from rich.table import Table
+    from rich.text import Text
+
+    m = result.metrics
+    plant = "with isolator" if result.isolated else "without isolator"
+    t = Table(title=f"Simulation {plant} at {result.crossover:g} Hz ({result.friction_model}, "
+                    f"{result.method} solver)", title_justify="left", box=box.SIMPLE_HEAD,
+              pad_edge=False)
+    t.add_column("Quantity")
+    t.add_column("Value", justify="right")
+    rows = [
+        ("verdict", m.verdict),
+        ("hunting cycles in the window [-]", str(m.hunting_cycles)),
+        ("amplitude (peak to peak) [um]", _fmt(1e6 * m.amplitude, 4)),
+        ("period [s]", _fmt(m.period, 4)),
+        ("settling time [s]", _fmt(m.settling_time, 4)),
+        ("final error [um]", _fmt(1e6 * m.final_error, 4)),
+        ("integration", "ok" if result.success else result.message),
+        ("steps / rejected / events [-]", f"{result.n_steps} / {result.n_rejected} / "
+                                          f"{result.n_events}"),
+        ("wall time [ms]", _fmt(1e3 * result.wall_time, 3)),
+    ]
+    for k, v in rows:
+        t.add_row(Text(k), Text(str(v)))
+    console.print(t)
+    console.print(Text(m.reason))
+
+
 @app.command("schema")
 def schema_command(
     markdown: Annotated[bool, typer.Option(

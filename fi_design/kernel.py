@@ -864,9 +864,14 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                     for j in range(n):
                         yev[j] = ynew[j]  # keep the trial end (direction of the crossing)
                     pending = kind
-                    h = theta * h
-                    t_land = t + h
-                    continue
+                    if theta < 1.0 - 1e-9:
+                        h = theta * h
+                        t_land = t + h
+                        continue
+                    # The crossing is at the very end of this step: accept the step as it
+                    # is and switch after it. (Redoing it with the same h looped forever
+                    # when two events, e.g. a sign change and a limiter contact, fell on
+                    # the same step end: each redo skipped one and found the other.)
             # ------------------------------------------------ accept
             n_steps += 1
             t_new = t_land if landing else t + h

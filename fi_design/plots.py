@@ -14,6 +14,584 @@ from typing import Any
 
 import numpy as np
 
+# --------------------------------------------------------------------------- design report
+# (fi_design.report: the linear analysis and the nonlinear confirmation of a DesignResult)
+
+#: Colour of each linear limit case (the same in the Bode, Nyquist and sensitivity plots).
+CASE_COLOURS = {"sliding_free": "C0", "stuck_free": "C1", "sliding_limited": "C2",
+                "stuck_limited": "C3", "sliding": "C0", "stuck": "C3"}
+#: Line style of each limit case: the limiter cases dashed (they overlap the free ones).
+CASE_STYLES = {"sliding_limited": "--", "stuck_limited": "--"}
+#: Colour of each simulated plant.
+PLANT_COLOURS = {"isolated": "C0", "non_isolated": "C3"}
+#: Width of a full-width report figure [in]: the A4 text width (170 mm), so 1 pt is 1 pt.
+REPORT_WIDTH = 6.7
+#: matplotlib settings of the report figures: fonts readable on paper, light grid.
+REPORT_RC = {
+    "font.size": 8.5, "axes.titlesize": 9.0, "axes.labelsize": 8.5, "xtick.labelsize": 8.0,
+    "ytick.labelsize": 8.0, "legend.fontsize": 7.5, "axes.grid": True, "grid.color": "0.88",
+    "grid.linewidth": 0.6, "axes.linewidth": 0.7, "lines.linewidth": 1.3,
+    "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False,
+    "figure.dpi": 100,
+}
+
+
+def _report_figure(height: float, width: float = REPORT_WIDTH, *, left: float = 0.62,
+                   right: float = 0.12, top: float = 0.12, bottom: float = 0.45,
+                   hspace: float = 0.35) -> Any:
+    """A report figure with fixed margins [in].
+
+    Fixed margins rather than a layout engine: the report's figures have known
+    contents, and a layout engine draws every figure twice (it doubled the
+    report's figure time).
+    """
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height))
+    fig.subplots_adjust(left=left / width, right=1.0 - right / width, top=1.0 - top / height,
+                        bottom=bottom / height, hspace=hspace)
+    return fig
+
+
+def _styled(draw):
+    """Run a figure function under :data:`REPORT_RC` (fonts are fixed when artists are made)."""
+    import functools
+
+    @functools.wraps(draw)
+    def wrapper(*args, **kwargs):
+        import matplotlib
+
+        with matplotlib.rc_context(REPORT_RC):
+            return draw(*args, **kwargs)
+
+    return wrapper
+
+
+def case_label(case: Any) -> str:
+    """Legend label of a limit case: ``"1 cart sliding, joint free"``.
+
+    Parameters
+    ----------
+    case : fi_design.linear.CaseMargins or LimitCase
+        The case (``name`` and ``description``).
+
+    Returns
+    -------
+    str
+    """
+    from .linear import CASE_NUMBERS
+
+    return f"{CASE_NUMBERS.get(case.name, '')} {case.description}".strip()
+
+
+def frequency_grid(result: Any, points: int = 900) -> np.ndarray:
+    """Frequencies [Hz] for the loop plots of a design: every crossover and mode inside.
+
+    From a third of the lowest gain crossover of any case (and a thirtieth of
+    the desired crossover) to thirty times the desired crossover or twice the
+    highest parasitic mode, log-spaced.
+
+    Parameters
+    ----------
+    result : fi_design.guideline.DesignResult
+        The design.
+    points : int, optional
+        Number of frequencies.
+
+    Returns
+    -------
+    numpy.ndarray, shape (points,)
+    """
+    fc = result.crossover.desired
+    lows = [fc / 30.0] + [c / 3.0 for case in result.crossover.cases
+                          for c in case.crossovers if c and c > 0]
+    spec = result.spec
+    modes = spec.isolator.parasitic_modes if spec.isolator is not None else ()
+    highs = [30.0 * fc] + [2.0 * m.frequency for m in modes]
+    lo = 10.0 ** math.floor(math.log10(min(lows)))
+    hi = 10.0 ** math.ceil(math.log10(max(highs)))
+    return np.geomspace(lo, hi, points)
+
+
+def loop_responses(result: Any, frequency: np.ndarray) -> list[tuple[Any, np.ndarray]]:
+    """The loop L(j 2 pi f) of every limit case of a design, as the margins used it.
+
+    Parameters
+    ----------
+    result : fi_design.guideline.DesignResult
+        The design (spec, PID and the cases of step 2).
+    frequency : numpy.ndarray
+        Frequencies [Hz].
+
+    Returns
+    -------
+    list of (fi_design.linear.LimitCase, numpy.ndarray)
+        Each case with its complex, dimensionless L at ``frequency``.
+    """
+    from . import linear
+
+    spec = result.spec
+    s = 2j * math.pi * np.asarray(frequency, dtype=float)
+    out = []
+    for lc in linear.limit_cases(spec, result.crossover.stiffness):
+        num, den = linear.loop_polynomials(spec, lc, gains=result.pid.gains)
+        out.append((lc, np.polyval(num, s) / np.polyval(den, s)))
+    return out
+
+
+def plain_tick(value: float, _pos: Any = None) -> str:
+    """Tick label of a log axis as a plain number (``0.001``, ``10``, ``1000``).
+
+    Plain text instead of matplotlib's mathtext powers of ten: readable, and
+    much faster to draw.
+
+    Parameters
+    ----------
+    value : float
+        Tick value.
+
+    Returns
+    -------
+    str
+    """
+    if value <= 0:
+        return ""
+    if 1e-4 <= value < 1e5:
+        return f"{value:g}" if value >= 1 else f"{value:.{max(0, -math.floor(math.log10(value) + 1e-9))}f}"
+    return f"{value:.0e}".replace("e+0", "e").replace("e-0", "e-")
+
+
+def _log_x(ax: Any, numticks: int = 12) -> None:
+    """Logarithmic x axis with plain decade labels and no minor ticks (they are slow to draw)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
+
+    ax.set_xscale("log")
+    ax.xaxis.set_major_locator(LogLocator(base=10.0, subs=(1.0,), numticks=numticks))
+    ax.xaxis.set_major_formatter(FuncFormatter(plain_tick))
+    ax.xaxis.set_minor_locator(NullLocator())
+
+
+def _phase_deg(L: np.ndarray, f: np.ndarray, near: float) -> np.ndarray:
+    """Unwrapped phase [deg], shifted by whole turns so it lies in (-270, 90] at ``near`` Hz.
+
+    ``near`` is the case's gain crossover: there the phase margin is read, and
+    the shift puts the phase where the margin is plainly its distance from -180.
+    """
+    ph = np.degrees(np.unwrap(np.angle(L)))
+    i = int(np.argmin(np.abs(np.log(f / near))))
+    return ph - 360.0 * math.ceil((ph[i] - 90.0) / 360.0)
+
+
+@_styled
+def bode_figure(result: Any, responses: list | None = None,
+                frequency: np.ndarray | None = None) -> Any:
+    """Open-loop Bode plot of the four limit cases (paper Figure 2) in one figure.
+
+    Magnitude and phase of L = C D P for every case, the desired crossover
+    (dashed), 0 dB and -180 deg, and each case's gain crossovers (dots).
+
+    Parameters
+    ----------
+    result : fi_design.guideline.DesignResult
+        The design.
+    responses : list, optional
+        :func:`loop_responses` on ``frequency`` (computed when omitted).
+    frequency : numpy.ndarray, optional
+        Frequencies [Hz]; default :func:`frequency_grid`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    f = frequency_grid(result) if frequency is None else frequency
+    responses = loop_responses(result, f) if responses is None else responses
+    fc = result.crossover.desired
+    fig = _report_figure(4.8, top=0.62, right=0.3, hspace=0.1)
+    mag, pha = fig.subplots(2, 1, sharex=True, height_ratios=(1.1, 1.0))
+    by_name = {c.name: c for c in result.crossover.cases}
+    phases = []
+    for lc, L in responses:
+        col = CASE_COLOURS.get(lc.name, None)
+        ls = CASE_STYLES.get(lc.name, "-")
+        db = 20.0 * np.log10(np.abs(L))
+        mag.plot(f, db, color=col, ls=ls, label=case_label(lc))
+        case = by_name.get(lc.name)
+        near = case.crossover if case is not None and case.crossover else fc
+        phases.append(_phase_deg(L, f, near))
+        pha.plot(f, phases[-1], color=col, ls=ls)
+    for lc, L in responses:
+        case = by_name.get(lc.name)
+        for fx in (case.crossovers if case is not None else ()):
+            mag.plot([fx], [0.0], "o", ms=3.5, color=CASE_COLOURS.get(lc.name), zorder=5)
+    for ax in (mag, pha):
+        ax.axvline(fc, color="0.3", lw=0.9, ls="--")
+    mag.axhline(0.0, color="0.3", lw=0.8)
+    pha.axhline(-180.0, color="0.3", lw=0.8)
+    allmag = np.concatenate([20 * np.log10(np.abs(L)) for _, L in responses])
+    top = min(np.nanmax(allmag), 160.0)
+    bottom = max(np.nanmin(allmag), -120.0)
+    mag.set_ylim(bottom - 5, top + 5)
+    _log_x(pha)
+    allpha = np.concatenate(phases)
+    lo = max(-90.0 * math.ceil(-np.nanmin(allpha) / 90.0), -450.0)
+    hi = min(90.0 * math.ceil(np.nanmax(allpha) / 90.0), 180.0)
+    pha.set_ylim(lo, max(hi, 0.0))
+    pha.set_yticks(np.arange(lo, max(hi, 0.0) + 1, 90))
+    mag.set_ylabel("|L| [dB]")
+    pha.set_ylabel("phase of L [deg]")
+    pha.set_xlabel("frequency [Hz]")
+    mag.set_xlim(f[0], f[-1])
+    mag.text(fc, 0.02, f" fc = {fc:g} Hz", transform=mag.get_xaxis_transform(), ha="left",
+             va="bottom", fontsize=7.5, color="0.3")
+    fig.legend(*mag.get_legend_handles_labels(), loc="upper center", ncols=2,
+               bbox_to_anchor=(0.5, 1.0), title="limit case (paper Figure 2)",
+               title_fontsize=7.5)
+    return fig
+
+
+@_styled
+def nyquist_figure(result: Any, responses: list | None = None,
+                   frequency: np.ndarray | None = None) -> Any:
+    """Nyquist plot of the limit cases (positive frequencies), zoomed on the critical point -1.
+
+    Colours and line styles as in :func:`bode_figure`; the circle
+    ``|1 + L| = m`` marks the modulus margin ``m`` (the spec's requirement, else
+    0.5, i.e. 6 dB of sensitivity peak).
+
+    Parameters
+    ----------
+    result : fi_design.guideline.DesignResult
+        The design.
+    responses : list, optional
+        :func:`loop_responses` on ``frequency``.
+    frequency : numpy.ndarray, optional
+        Frequencies [Hz]; default :func:`frequency_grid`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    f = frequency_grid(result) if frequency is None else frequency
+    responses = loop_responses(result, f) if responses is None else responses
+    fig = _report_figure(3.2, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
+    ax = fig.add_subplot()
+    for lc, L in responses:
+        col = CASE_COLOURS.get(lc.name)
+        ax.plot(L.real, L.imag, color=col, ls=CASE_STYLES.get(lc.name, "-"),
+                label=f"case {lc.number}")
+    req = result.spec.requirements.modulus_margin
+    m = req if req is not None else 0.5
+    t = np.linspace(0, 2 * math.pi, 200)
+    ax.plot(-1 + m * np.cos(t), m * np.sin(t), color="0.4", lw=0.8, ls=":")
+    ax.plot([-1], [0], marker="+", color="red", ms=9, mew=1.5, ls="none")
+    ax.annotate(f"|1 + L| = {m:g}", (-1 + m * math.cos(2.3), m * math.sin(2.3)),
+                xytext=(-2.4, 1.15), fontsize=7, color="0.35",
+                arrowprops={"arrowstyle": "-", "color": "0.6", "lw": 0.6})
+    ax.set_xlim(-2.5, 1.0)
+    ax.set_ylim(-2.0, 1.5)
+    ax.set_aspect("equal")
+    ax.set_xlabel("Re L [-]")
+    ax.set_ylabel("Im L [-]")
+    return fig
+
+
+@_styled
+def sensitivity_figure(result: Any, responses: list | None = None,
+                       frequency: np.ndarray | None = None) -> Any:
+    """Sensitivity |S| = |1 / (1 + L)| of the limit cases, peaks marked.
+
+    Parameters
+    ----------
+    result : fi_design.guideline.DesignResult
+        The design.
+    responses : list, optional
+        :func:`loop_responses` on ``frequency``.
+    frequency : numpy.ndarray, optional
+        Frequencies [Hz]; default :func:`frequency_grid`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    f = frequency_grid(result) if frequency is None else frequency
+    responses = loop_responses(result, f) if responses is None else responses
+    fig = _report_figure(3.2, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
+    ax = fig.add_subplot()
+    for lc, L in responses:
+        col = CASE_COLOURS.get(lc.name)
+        s_db = -20.0 * np.log10(np.abs(1.0 + L))
+        ax.plot(f, s_db, color=col, ls=CASE_STYLES.get(lc.name, "-"), label=f"case {lc.number}")
+        i = int(np.argmax(s_db))
+        ax.plot([f[i]], [s_db[i]], "o", ms=3.5, color=col)
+    req = result.spec.requirements.modulus_margin
+    m = req if req is not None else 0.5
+    peak = -20 * math.log10(m)
+    ax.axhline(peak, color="0.4", lw=0.8, ls=":")
+    ax.text(0.02, peak, f"|S| = {peak:.3g} dB (|1 + L| = {m:g})", transform=ax.get_yaxis_transform(),
+            va="bottom", ha="left", fontsize=7, color="0.35")
+    ax.axhline(0.0, color="0.3", lw=0.8)
+    ax.axvline(result.crossover.desired, color="0.3", lw=0.9, ls="--")
+    ax.set_ylim(-60, 15)
+    _log_x(ax, numticks=6)
+    ax.set_xlim(f[0], f[-1])
+    ax.legend(loc="lower right")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("|S| [dB]")
+    return fig
+
+
+def decimate(t: np.ndarray, y: np.ndarray, buckets: int = 1500) -> tuple[np.ndarray, np.ndarray]:
+    """Thin a trace for plotting, keeping each bucket's minimum and maximum.
+
+    Parameters
+    ----------
+    t, y : numpy.ndarray, shape (n,)
+        Sample times and values.
+    buckets : int, optional
+        Number of buckets; at most two samples survive per bucket.
+
+    Returns
+    -------
+    t, y : numpy.ndarray
+        The kept samples, in time order (the input when it is short already).
+    """
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    n = len(t)
+    if n <= 2 * buckets:
+        return t, y
+    edges = np.linspace(0, n, buckets + 1).astype(int)
+    keep = [0, n - 1]
+    for a, b in zip(edges[:-1], edges[1:]):
+        seg = y[a:b]
+        if len(seg):
+            keep += [a + int(np.nanargmin(seg)), a + int(np.nanargmax(seg))]
+    idx = np.unique(np.array(keep))
+    return t[idx], y[idx]
+
+
+def _plant_title(v: Any, label: str) -> str:
+    cycles = f"{v.hunting_cycles} cycle{'s' if v.hunting_cycles != 1 else ''}"
+    return f"{label}: {v.verdict} ({cycles} counted)"
+
+
+@_styled
+def error_figure(confirmation: Any, spec: Any) -> Any:
+    """Position error x1 - r over time with and without the isolator (paper Figure 5).
+
+    Both panels share the axes; the counting window of the hunting metric is
+    shaded, its minimum peak height dashed, the counted peaks circled.
+
+    Parameters
+    ----------
+    confirmation : fi_design.confirm.Confirmation
+        The simulated confirmation (its ``results`` hold the traces).
+    spec : fi_design.spec.Spec
+        The design spec (hunting-metric settings).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    h = spec.requirements.hunting
+    fig = _report_figure(4.2, top=0.3, hspace=0.45)
+    axes = fig.subplots(2, 1, sharex=True, sharey=True)
+    label = "suggested isolator" if confirmation.suggested_isolator else "with isolator"
+    for ax, key, name in zip(axes, ("isolated", "non_isolated"), (label, "without isolator")):
+        res = confirmation.results[key]
+        verdict = getattr(confirmation, key)
+        m = res.metrics
+        ax.axvspan(m.window[0], m.window[1], color="0.93", lw=0, zorder=0)
+        t, e = decimate(res.time, res.error * 1e3)
+        ax.plot(t, e, color=PLANT_COLOURS[key], lw=1.0)
+        ax.axhline(h.min_height * 1e3, color="0.35", lw=0.8, ls="--")
+        ax.axhline(0.0, color="0.6", lw=0.6)
+        if len(m.peak_times):
+            ax.plot(m.peak_times, np.asarray(m.peak_heights) * 1e3, "o", mfc="none",
+                    mec="navy", ms=6, mew=1.1, label="counted peak")
+            ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), borderaxespad=0.1)
+        ax.set_title(_plant_title(verdict, name), loc="left")
+        ax.set_ylabel("x1 - r [mm]")
+        ax.text(m.window[0], 0.03, " counting window", transform=ax.get_xaxis_transform(),
+                va="bottom", ha="left", fontsize=7, color="0.35")
+        ax.text(0.03, h.min_height * 1e3, f"min. peak height {h.min_height * 1e3:g} mm",
+                transform=ax.get_yaxis_transform(), va="bottom", ha="left", fontsize=7,
+                color="0.35", bbox={"facecolor": "white", "alpha": 0.8, "lw": 0, "pad": 0.5})
+    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlim(0, float(confirmation.results["isolated"].time[-1]))
+    return fig
+
+
+@_styled
+def deflection_figure(confirmation: Any, spec: Any) -> Any:
+    """Joint deflection x1 - x2 of the isolated plant over time, against the stroke.
+
+    Parameters
+    ----------
+    confirmation : fi_design.confirm.Confirmation
+        The simulated confirmation.
+    spec : fi_design.spec.Spec
+        The design spec (the stroke; a spec without isolator uses the
+        suggested one of the confirmation).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    res = confirmation.results["isolated"]
+    stroke = confirmation.landing.stroke if confirmation.landing is not None else \
+        spec.isolator.stroke
+    fig = _report_figure(2.5, top=0.35)
+    ax = fig.add_subplot()
+    t, d = decimate(res.time, res.deflection * 1e6)
+    ax.plot(t, d, color=PLANT_COLOURS["isolated"], lw=1.0, label="deflection x1 - x2")
+    for sign in (1, -1):
+        ax.axhline(sign * stroke * 1e6, color="C3", lw=0.9, ls="--",
+                   label="stroke (limiter engages)" if sign > 0 else None)
+    if confirmation.landing is not None:
+        land = confirmation.landing
+        ax.plot([res.time[-1]], [land.deflection * 1e6], "o", color="black", ms=4,
+                label=f"at rest: {land.deflection * 1e6:.0f} µm")
+    ax.set_ylim(-1.35 * stroke * 1e6, 1.35 * stroke * 1e6)
+    ax.set_xlim(0, float(res.time[-1]))
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("x1 - x2 [µm]")
+    fig.legend(*ax.get_legend_handles_labels(), loc="upper center", ncols=3,
+               bbox_to_anchor=(0.5, 1.0))
+    return fig
+
+
+@_styled
+def scan_figure(confirmation: Any, spec: Any) -> Any:
+    """Hunting cycles against the crossover for both plants (the crossover scans).
+
+    Hunting points filled, settled points open, ``stuck`` squares and
+    ``undetermined`` diamonds; the desired crossover dashed, each plant's lowest
+    hunting-free crossover dotted.
+
+    Parameters
+    ----------
+    confirmation : fi_design.confirm.Confirmation
+        The simulated confirmation (its ``scans``).
+    spec : fi_design.spec.Spec
+        The design spec (desired crossover).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = _report_figure(2.8, top=0.35)
+    ax = fig.add_subplot()
+    label = "suggested isolator" if confirmation.suggested_isolator else "with isolator"
+    names = {"isolated": label, "non_isolated": "without isolator"}
+    marks = {"hunting": ("o", True), "settled": ("o", False), "stuck": ("s", False),
+             "undetermined": ("D", False)}
+    offset = {"isolated": -0.08, "non_isolated": 0.08}
+    for key, scan in confirmation.scans.items():
+        col = PLANT_COLOURS[key]
+        fx = np.asarray(scan.crossovers, dtype=float)
+        cyc = np.asarray(scan.hunting_cycles, dtype=float) + offset[key]
+        ax.plot(fx, cyc, color=col, lw=0.8, alpha=0.7, drawstyle="steps-mid",
+                label=f"{names[key]}")
+        verdicts = np.asarray(scan.verdicts)
+        for v, (mk, filled) in marks.items():
+            sel = verdicts == v
+            if sel.any():
+                ax.plot(fx[sel], cyc[sel], mk, ms=3.6, color=col, mfc=col if filled else "white",
+                        mew=0.9, ls="none")
+        if scan.minimum is not None:
+            ax.axvline(scan.minimum, color=col, lw=0.9, ls=":")
+            ax.text(scan.minimum, 0.97 if key == "isolated" else 0.87,
+                    f" hunting-free from {scan.minimum:g} Hz", color=col, fontsize=7,
+                    transform=ax.get_xaxis_transform(), va="top", ha="left")
+    fc = spec.controller.crossover
+    ax.axvline(fc, color="0.3", lw=0.9, ls="--")
+    ax.text(fc, 0.77, f" design {fc:g} Hz", color="0.3", fontsize=7,
+            transform=ax.get_xaxis_transform(), va="top", ha="left")
+    from matplotlib.lines import Line2D
+
+    handles, labels = ax.get_legend_handles_labels()
+    for v, (mk, filled) in marks.items():
+        handles.append(Line2D([], [], marker=mk, ls="none", ms=3.6, color="0.25",
+                              mfc="0.25" if filled else "white", mew=0.9))
+        labels.append(v)
+    fig.legend(handles, labels, loc="upper center", ncols=len(labels), bbox_to_anchor=(0.5, 1.0))
+    ax.set_xlabel("crossover fc [Hz]")
+    ax.set_ylabel("hunting cycles [-]")
+    ax.set_ylim(bottom=-0.5)
+    return fig
+
+
+def equation_svg(tex: str, size: float = 11.0) -> str:
+    """A formula in matplotlib's mathtext as one self-contained SVG path.
+
+    The glyphs become a single ``<path>`` (no fonts, no ids, no script), so the
+    formula renders the same in a browser and in WeasyPrint, which has no
+    MathML.
+
+    Parameters
+    ----------
+    tex : str
+        Mathtext, including the ``$`` delimiters, e.g. ``r"$k = F_s / s$"``.
+    size : float, optional
+        Font size [pt].
+
+    Returns
+    -------
+    str
+        An ``<svg>`` element sized in pt, with ``role="img"``; the caller adds
+        the text alternative around it.
+    """
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.path import Path
+    from matplotlib.textpath import TextPath
+
+    path = TextPath((0.0, 0.0), tex, prop=FontProperties(size=size, math_fontfamily="cm"))
+    ext = path.get_extents()
+    pad = 1.0
+    x0, y1 = ext.x0 - pad, ext.y1 + pad
+    ops = {Path.MOVETO: "M", Path.LINETO: "L", Path.CURVE3: "Q", Path.CURVE4: "C"}
+    parts = []
+    for verts, code in path.iter_segments(simplify=False, curves=True):
+        if code == Path.CLOSEPOLY:
+            parts.append("Z")
+            continue
+        pts = np.asarray(verts, dtype=float).reshape(-1, 2)
+        parts.append(ops[code] + " ".join(f"{x - x0:.2f} {y1 - y:.2f}" for x, y in pts))
+    w = ext.width + 2 * pad
+    h = ext.height + 2 * pad
+    return (f'<svg xmlns="http://www.w3.org/2000/svg" role="img" width="{w:.2f}pt" '
+            f'height="{h:.2f}pt" viewBox="0 0 {w:.2f} {h:.2f}"><path d="{"".join(parts)}"/></svg>')
+
+
+def figure_svg(fig: Any, prefix: str) -> str:
+    """A figure as SVG text for inlining in HTML: no XML prolog, unique ids, scalable.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    prefix : str
+        Prepended to every ``id`` (and the references to it), so several
+        figures can share one HTML page; letters, digits and ``-`` only.
+
+    Returns
+    -------
+    str
+        An ``<svg>`` element with a ``viewBox`` and without fixed width and
+        height (CSS sizes it), reproducible (see :func:`figure_bytes`).
+    """
+    import re
+
+    text = figure_bytes(fig, "svg").decode("utf-8")
+    text = text[text.index("<svg"):]
+    text = re.sub(r'\bid="([^"]+)"', lambda m: f'id="{prefix}-{m.group(1)}"', text)
+    text = re.sub(r'href="#([^"]+)"', lambda m: f'href="#{prefix}-{m.group(1)}"', text)
+    text = re.sub(r"url\(#([^)]+)\)", lambda m: f"url(#{prefix}-{m.group(1)})", text)
+    text = re.sub(r"<metadata>.*?</metadata>\s*", "", text, flags=re.DOTALL)
+    return text.strip()
+
+
 # --------------------------------------------------------------------------- parameter studies
 # (fi_design.sweep: hunting maps, the paper's Figure 4, robustness)
 

@@ -726,6 +726,8 @@ class _Problem:
         self.kind = kind
         self.holds = [(i0, i1) for i0, i1 in _runs(kind == "hold")]
         self.last_move_end = float(t[self.moves[-1][1] - 1]) if self.moves else 0.0
+        r = self.meas.reference
+        self.travel_center = float(0.5 * (np.max(r) + np.min(r)))
 
     def finish_setup(self, nominal: _Trace, max_points: int) -> None:
         """Decide coherent/incoherent holds, the strided samples and the features' scales."""
@@ -1119,13 +1121,19 @@ def _spaces(pb: _Problem, guesses: dict, names: list[str]) -> tuple[list[_Space]
                 build = lambda v, m1=m1, m2=m2: {"stage_mass": m1 * v["scale"],  # noqa: E731
                                                  "cart_mass": m2 * v["scale"]}
         elif name in ("position_dependent_friction", "force_ripple"):
+            # The phase is fitted at the middle of the travel, x_c, where it does not
+            # trade off against the period (the phase at x = 0 does, by 2 pi x_c / period).
             method = "periodic"
-            for p in eff.parameters:
-                if p.periodic:
-                    coords.append(_Coord(p.name, -2 * math.pi, 2 * math.pi, periodic=True))
-                else:
-                    coords.append(_Coord(p.name, p.bounds[0], p.bounds[1], log=p.log))
-            build = lambda v: dict(v)  # noqa: E731
+            amp, per, _ = eff.parameters
+            coords = [_Coord(amp.name, amp.bounds[0], amp.bounds[1], log=amp.log),
+                      _Coord(per.name, per.bounds[0], per.bounds[1], log=per.log),
+                      _Coord("phase_center", -2 * math.pi, 2 * math.pi, periodic=True)]
+            xc = pb.travel_center
+
+            def build(v, per=per.name, xc=xc):
+                phase = v["phase_center"] - 2 * math.pi * xc / v[per]
+                phase = float((phase + math.pi) % (2 * math.pi) - math.pi)
+                return {"amplitude": v["amplitude"], per: v[per], "phase": phase}
         elif name == "time_delay":
             lo = max(2e-4, 0.02 / (2 * math.pi * spec.controller.crossover))
             p = eff.parameters[0]
@@ -1226,11 +1234,26 @@ class _Objective:
 
     def values(self, u: np.ndarray) -> dict:
         v = {c.name: c.value(float(x)) for c, x in zip(self.sp.coords, u)}
-        out = self.sp.build(v)
-        for c in self.sp.coords:
-            if c.periodic:
-                out[c.name] = float((out[c.name] + math.pi) % (2 * math.pi) - math.pi)
-        return out
+        return self.sp.build(v)
+
+    def value_jacobian(self, u: np.ndarray) -> tuple[list[str], np.ndarray]:
+        """d(parameter)/du by central differences of the mapping (phases unwrapped)."""
+        base = self.values(u)
+        names = list(base)
+        G = np.zeros((len(names), len(u)))
+        for j in range(len(u)):
+            h = 1e-6
+            up = np.array(u, float)
+            dn = np.array(u, float)
+            up[j] = min(up[j] + h, 1.0)
+            dn[j] = max(dn[j] - h, 0.0)
+            a, b = self.values(up), self.values(dn)
+            for i, k in enumerate(names):
+                d = a[k] - b[k]
+                if k == "phase":
+                    d = (d + math.pi) % (2 * math.pi) - math.pi
+                G[i, j] = d / (up[j] - dn[j])
+        return names, G
 
     def __call__(self, u: np.ndarray) -> np.ndarray:
         key = tuple(np.round(np.asarray(u, float), 12))
@@ -1282,7 +1305,7 @@ def _fit(ob: _Objective) -> tuple[np.ndarray, float, np.ndarray | None, str]:
     for _, _, u in scored:
         if all(np.max(np.abs(u - c)) > 0.05 for c in chosen):
             chosen.append(u)
-        if len(chosen) >= 2:
+        if len(chosen) >= (3 if sp.method == "periodic" else 2):
             break
     best = (math.inf, None, None)
     lo = np.zeros(len(sp.coords))
@@ -1329,15 +1352,16 @@ def _periodic_starts(ob: _Objective) -> list[np.ndarray]:
     if not lams:
         lams = list(np.geomspace(lam_c.lo * 1.5, lam_c.hi / 1.5, 8))
         amps = [None] * len(lams)
-    phases = np.linspace(-math.pi, math.pi, 8, endpoint=False)
+    phases = np.linspace(-math.pi, math.pi, 12, endpoint=False)
     out = []
     for lam, a in zip(lams, amps):
-        alist = [a] if a is not None else [amp_c.lo + 0.05 * (amp_c.hi - amp_c.lo),
-                                           amp_c.lo + 0.2 * (amp_c.hi - amp_c.lo)]
+        # the closed loop shapes the residual: the periodogram amplitude is only a scale
+        alist = ([0.6 * a, a, 1.6 * a] if a is not None else
+                 [amp_c.lo + f * (amp_c.hi - amp_c.lo) for f in (0.02, 0.06, 0.2)])
         for a_ in alist:
             for ph in phases:
                 out.append(np.array([amp_c.u_of(min(a_, amp_c.hi)), lam_c.u_of(lam),
-                                     ph_c.u_of(ph)]))
+                                     ph_c.u_of(ph)]))  # ph: phase at the travel centre
     return out
 
 
@@ -1606,16 +1630,13 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
             k = len(sp.coords)
             vals = ob.values(u)
             scale = max(1.0, c2 / max(n - k, 1))
-            unc = {}
-            for i, c in enumerate(sp.coords):
-                if cov is not None and cov[i, i] >= 0:
-                    unc[c.name] = abs(c.dvalue(u[i])) * math.sqrt(cov[i, i] * scale)
-                else:
-                    unc[c.name] = None
-            if sp.name == "mass_error" and not pb.iso:
-                s = unc.pop("scale", None)
-                unc = {"stage_mass": None if s is None else s * spec.stage.mass,
-                       "cart_mass": None if s is None else s * spec.cart.mass}
+            pnames, G = ob.value_jacobian(u)
+            if cov is not None:
+                var = np.diag(G @ (cov * scale) @ G.T)
+                unc = {nm: (float(math.sqrt(v)) if v >= 0 and math.isfinite(v) else None)
+                       for nm, v in zip(pnames, var)}
+            else:
+                unc = {nm: None for nm in pnames}
             delta = chi2_cur - c2
             score = delta / scale - k * math.log(n)
             excess = chi2_cur - n

@@ -305,10 +305,10 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         y0[2] = initial_position
     x_bound = 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(initial_position))
 
-    start = _time.perf_counter()
     if method == "fast":
-        from .kernel import STATUS_TEXT, run
+        from .kernel import STATUS_TEXT, run  # compiles or loads the kernel on first use
 
+        start = _time.perf_counter()
         out = run(params.to_array(), y0, ref.breaks, ref.coeffs, ref.land, t_end, t_out, tol,
                   tolerances(params, tol), 0.05, spec.simulation.max_steps, x_bound)
         code, Y, R, FA, stats = out
@@ -317,6 +317,7 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
     else:
         from .refsolve import solve_reference
 
+        start = _time.perf_counter()
         code, Y, R, FA, n_steps, n_rej, n_ev, t_reached, status = solve_reference(
             params, y0, ref, t_end, t_out, tol, tolerances(params, tol), x_bound)
     wall = _time.perf_counter() - start

@@ -1,0 +1,77 @@
+"""The hunting metric and its verdicts on synthetic traces with known answers."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fi_design.metrics import hunting_metrics
+
+T = np.arange(20001) / 1000.0
+
+
+def test_counts_one_peak_per_cycle():
+    e = 0.5e-3 * np.sin(2 * np.pi * T / 2.0)  # 2 s period: 5 cycles in [10, 20)
+    m = hunting_metrics(T, e)
+    assert m.hunting_cycles == 5
+    assert m.period == pytest.approx(2.0, abs=1e-3)
+    assert m.amplitude == pytest.approx(1e-3, rel=1e-4)
+    assert m.verdict == "hunting"
+    assert np.all((m.peak_times >= 10.0) & (m.peak_times < 20.0))
+
+
+def test_small_oscillation_below_min_height_is_not_counted():
+    e = 0.05e-3 * np.sin(2 * np.pi * T / 2.0)
+    m = hunting_metrics(T, e)
+    assert m.hunting_cycles == 0
+    # it still moves by 100 um in the window: not settled, not stuck
+    assert m.verdict == "undetermined"
+
+
+def test_peaks_closer_than_min_distance_count_once():
+    e = 0.5e-3 * np.sin(2 * np.pi * T / 0.3)  # 0.3 s apart < 0.5 s minimum distance
+    m = hunting_metrics(T, e)
+    assert m.hunting_cycles < 10 / 0.3 and m.hunting_cycles == pytest.approx(10 / 0.6, abs=2)
+
+
+def test_stuck_far_from_target_is_stuck_not_settled():
+    e = np.where(T < 3.0, 1e-3 * (1 - T / 3.0), 0.0) + 50e-6  # rests 50 um off
+    m = hunting_metrics(T, e)
+    assert m.hunting_cycles == 0
+    assert m.verdict == "stuck" and not m.settled
+    assert m.final_error == pytest.approx(50e-6)
+
+
+def test_cycle_slower_than_the_window_is_undetermined():
+    e = 1e-3 * np.sin(2 * np.pi * (T - 10.0) / 40.0 - np.pi / 2)  # one slow swing in the window
+    m = hunting_metrics(T, e)
+    assert m.hunting_cycles == 0
+    assert m.verdict == "undetermined"
+    assert "too slow" in m.reason
+
+
+def test_settled_and_settling_time():
+    e = 1e-3 * np.exp(-(T - 2.0).clip(0) / 0.5)
+    m = hunting_metrics(T, e, motion_end=2.0, settle_band=10e-6)
+    assert m.verdict == "settled" and m.settled
+    # exp(-t / 0.5) = 0.01 at t = 0.5 ln 100
+    assert m.settling_time == pytest.approx(0.5 * np.log(100), abs=2e-3)
+
+
+def test_incomplete_simulation_is_undetermined():
+    m = hunting_metrics(T, np.zeros_like(T), success=False, failure="diverged at t = 3 s")
+    assert m.verdict == "undetermined" and "diverged" in m.reason
+    assert m.settling_time is None
+
+
+@settings(max_examples=40, deadline=None)
+@given(period=st.floats(0.6, 3.0), amp=st.floats(0.2e-3, 5e-3), phase=st.floats(0, 6.28))
+def test_cycle_count_matches_the_window(period, amp, phase):
+    """A sine of period P shows floor or ceil of 10 / P peaks in a 10 s window."""
+    e = amp * np.sin(2 * np.pi * T / period + phase)
+    m = hunting_metrics(T, e)
+    assert abs(m.hunting_cycles - 10.0 / period) <= 1.0
+    assert m.verdict == "hunting"
+    assert m.amplitude == pytest.approx(2 * amp, rel=0.01)
