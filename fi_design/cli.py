@@ -25,6 +25,7 @@ matplotlib) and of rich happen inside the command functions, so
 from __future__ import annotations
 
 import difflib
+import math
 import os
 import sys
 from pathlib import Path
@@ -284,27 +285,30 @@ def design_command(
     json_path = check_output(json_out, force=force, protect=(spec,),
                              extensions=(".json",)) if json_out else None
     _check_spec_path(spec)
-    warmup = None if no_simulation else start_kernel_warmup()
 
     from .specfile import load_spec
 
     spec_obj = load_spec(spec)
+    # The simulations run in a second process while this one imports
+    # python-control and does the linear analysis: on a multi-core machine the
+    # two overlap (and a first run compiles the numba kernel there).
+    job = None if no_simulation else _Job(spec_obj)
 
     from .guideline import design
 
     console = _console()
     err = _console(stderr=True)
     with _status(err, "running the design guideline ...") as status:
-        result = design(spec_obj, confirm=False)
-        if not no_simulation:
-            from .confirm import confirm
-
-            status("compiling the simulation kernel (first run only) ...")
-            wait_kernel_warmup(warmup)
-            advice = result.isolator_advice
-            result = result.with_simulation(confirm(
-                spec_obj, (advice.stroke, advice.stiffness) if advice else None,
-                progress=status))
+        try:
+            result = design(spec_obj, confirm=False)
+        except BaseException:
+            if job is not None:
+                job.cancel()
+            raise
+        if job is not None:
+            status("simulating with and without the isolator (the first run on a machine "
+                   "compiles the kernel, about 10 s) ...")
+            result = result.with_simulation(job.result())
 
     text = None
     if json_path is not None:
@@ -343,55 +347,64 @@ class _status:
             self._live.__exit__(*exc)
 
 
-def start_kernel_warmup():
-    """Compile (or load) the numba kernel in a background process.
+class _Job:
+    """A confirmation computed in a forked process (inline where fork is unavailable).
 
-    The kernel compiles once per installation (about 10 s, then it loads from
-    numba's on-disk cache in a fraction of a second). Starting it in a second
-    process lets the compilation overlap the linear analysis (python-control
-    takes seconds to import). Returns the process, or None when the cache is
-    already warm or a process cannot be started.
+    ``result()`` returns the :class:`~fi_design.confirm.Confirmation` or
+    re-raises the worker's exception; ``cancel()`` stops the worker (used
+    when the linear analysis fails first).
     """
-    import subprocess
 
-    if kernel_cache_is_warm():
-        return None
+    def __init__(self, spec) -> None:
+        from .guideline import suggested_isolator
+
+        suggestion = suggested_isolator(spec) if spec.isolator is None else None
+        self._args = (spec, suggestion)
+        self._proc = None
+        self._conn = None
+        try:
+            import multiprocessing
+
+            ctx = multiprocessing.get_context("fork")
+            self._conn, child = ctx.Pipe(duplex=False)
+            self._proc = ctx.Process(target=_confirm_worker, args=(child, *self._args),
+                                     daemon=True)
+            self._proc.start()
+            child.close()
+        except (ValueError, OSError):  # no fork on this platform: run inline later
+            self._proc = None
+
+    def result(self):
+        from .confirm import confirm
+
+        if self._proc is None:
+            return confirm(*self._args)
+        try:
+            ok, value = self._conn.recv()
+        except EOFError:
+            raise RuntimeError("the simulation process ended without a result") from None
+        finally:
+            self._proc.join()
+        if not ok:
+            raise value
+        return value
+
+    def cancel(self) -> None:
+        if self._proc is not None and self._proc.is_alive():
+            self._proc.terminate()
+            self._proc.join()
+
+
+def _confirm_worker(conn, spec, suggestion) -> None:
+    """Body of the :class:`_Job` process: send ``(True, result)`` or ``(False, error)``."""
+    from .confirm import confirm
+
     try:
-        return subprocess.Popen([sys.executable, "-c", "import fi_design.kernel"],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    except OSError:
-        return None
-
-
-def wait_kernel_warmup(process) -> None:
-    """Wait for :func:`start_kernel_warmup`'s process (the kernel then loads from cache)."""
-    if process is not None:
-        process.wait()
-
-
-def kernel_cache_is_warm() -> bool:
-    """Whether numba's cache holds the integrator for the installed kernel source."""
-    import importlib.util
-
-    spec = importlib.util.find_spec("fi_design.kernel")
-    if spec is None or spec.origin is None:
-        return False
-    src = Path(spec.origin)
-    cache_dirs = [src.parent / "__pycache__"]
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        cache_dirs.append(Path(os.environ["NUMBA_CACHE_DIR"]))
-    try:
-        from platformdirs import user_cache_dir
-
-        cache_dirs.append(Path(user_cache_dir("fi_design")) / "numba")
-    except ImportError:  # pragma: no cover - platformdirs is a dependency
-        pass
-    stamp = src.stat().st_mtime
-    for d in cache_dirs:
-        for index in d.rglob("kernel.integrate-*.nbi") if d.is_dir() else ():
-            if index.stat().st_mtime >= stamp:
-                return True
-    return False
+        conn.send((True, confirm(spec, suggestion)))
+    except BaseException as exc:  # noqa: BLE001 - handed back to the parent
+        conn.send((False, exc))
+    finally:
+        conn.close()
 
 
 def print_design(console: "Console", result, spec_path: Path | None = None) -> None:
@@ -714,6 +727,706 @@ def init_command(
     text = files("fi_design").joinpath("example_spec.yaml").read_text(encoding="utf-8")
     write_atomic(out, text)
     typer.echo(f"wrote {out}; edit it, then run: fi-design {out}")
+
+
+# =========================================================================== parameter studies
+# sweep, study, robustness (fi_design.sweep). Executors and the progress bar are made here; the
+# library only receives them.
+
+#: Executors for --executor.
+EXECUTORS = ("local", "dask")
+#: Studies for `fi-design study NAME`.
+STUDIES = ("paper",)
+
+_JOBS_OPTION = typer.Option(
+    "--jobs", "-j", min=0, metavar="N",
+    help="Worker processes (local executor) or local dask workers; 0 = all cores, "
+         "1 = serial in this process.")
+_EXECUTOR_OPTION = typer.Option(
+    "--executor", metavar="local|dask",
+    help="local: a process pool on this machine (default); dask: a dask.distributed "
+         "cluster (--scheduler ADDRESS, or a local cluster).")
+_SCHEDULER_OPTION = typer.Option(
+    "--scheduler", metavar="ADDRESS",
+    help="Address of a running dask scheduler, e.g. tcp://10.0.0.5:8786 (with --executor "
+         "dask). Without it, a local cluster is started.", show_default=False)
+_NO_CACHE_OPTION = typer.Option(
+    "--no-cache", help="Neither read nor write the result cache (FI_DESIGN_CACHE_DIR, else the "
+                       "user cache directory).")
+
+
+class _Executor:
+    """The executor of a study command, as a context manager (None: serial).
+
+    Creates a process pool (fork start method where available, after the
+    kernel is loaded in this process, so that workers inherit it), or a
+    dask.distributed client on a given scheduler or a local cluster.
+    """
+
+    def __init__(self, kind: str, jobs: int, scheduler: Optional[str]) -> None:
+        if kind not in EXECUTORS:
+            raise typer.BadParameter(f"'{kind}' is not one of {', '.join(EXECUTORS)}",
+                                     param_hint="--executor")
+        if scheduler and kind != "dask":
+            raise typer.BadParameter("--scheduler needs --executor dask",
+                                     param_hint="--scheduler")
+        self.kind = kind
+        self.jobs = jobs or (os.cpu_count() or 1)
+        self.scheduler = scheduler
+        self._closers: list = []
+
+    def describe(self) -> str:
+        if self.kind == "dask":
+            return f"dask cluster at {self.scheduler}" if self.scheduler else \
+                f"local dask cluster, {self.jobs} worker(s)"
+        return "serial" if self.jobs == 1 else f"{self.jobs} worker processes"
+
+    def __enter__(self):
+        from .sweep import warm_up
+
+        warm_up()  # compile or load the kernel once here, before any worker starts
+        if self.kind == "local":
+            if self.jobs == 1:
+                return None
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+
+            methods = multiprocessing.get_all_start_methods()
+            ctx = multiprocessing.get_context("fork") if "fork" in methods and \
+                sys.platform.startswith("linux") else None
+            pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx,
+                                       initializer=warm_up)
+            self._closers.append(lambda: pool.shutdown(wait=True, cancel_futures=True))
+            return pool
+        return self._dask()
+
+    def _dask(self):
+        import logging
+
+        from .errors import FiDesignError
+        from .sweep import warm_up
+
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:  # pragma: no cover - a dependency
+            raise FiDesignError("--executor dask needs the 'distributed' package "
+                                "(pip install 'dask[distributed]')") from None
+        logging.getLogger("distributed").setLevel(logging.ERROR)
+        try:
+            if self.scheduler:
+                client = Client(self.scheduler, timeout="10s")
+            else:
+                cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, silence_logs=logging.ERROR)
+                self._closers.append(cluster.close)
+                client = Client(cluster)
+        except (OSError, TimeoutError, ValueError) as exc:
+            where = self.scheduler or "a local cluster"
+            raise FiDesignError(f"cannot connect to the dask scheduler at {where}: {exc}") \
+                from None
+        self._closers.insert(0, client.close)
+        client.run(warm_up)  # every worker loads the kernel before its first chunk
+        return client
+
+    def __exit__(self, *exc) -> None:
+        for close in self._closers:
+            try:
+                close()
+            except Exception:  # noqa: BLE001 -- closing must not hide the real outcome
+                pass
+
+
+class _ProgressBar:
+    """A rich progress bar with ETA on stderr, fed by the library's ``progress(done, total)``."""
+
+    def __init__(self, console: "Console", text: str) -> None:
+        from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
+                                   TimeElapsedColumn, TimeRemainingColumn)
+
+        self._progress = Progress(TextColumn("[progress.description]{task.description}"),
+                                  BarColumn(), MofNCompleteColumn(), TextColumn("points"),
+                                  TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
+                                  console=console, transient=False,
+                                  disable=not console.is_terminal)
+        self._task = self._progress.add_task(text, total=None)
+        self._first: Optional[int] = None
+
+    def __enter__(self) -> "_ProgressBar":
+        self._progress.__enter__()
+        return self
+
+    def __call__(self, done: int, total: int) -> None:
+        if self._first is None:  # cached points arrive at once; the ETA counts the rest
+            self._first = done
+            self._progress.reset(self._task, total=total, completed=done)
+            return
+        self._progress.update(self._task, total=total, completed=done)
+
+    def __exit__(self, *exc) -> None:
+        self._progress.__exit__(*exc)
+
+
+def _cache_for(no_cache: bool):
+    from .sweep import PointCache
+
+    return None if no_cache else PointCache()
+
+
+def _outputs(spec: Path, force: bool, **paths: tuple[Optional[Path], tuple[str, ...]]) -> dict:
+    """Check every output path before the work starts; refuse duplicates."""
+    from .output import check_output
+
+    out: dict = {}
+    seen: list[Path] = []
+    for name, (path, exts) in paths.items():
+        if path is None:
+            out[name] = None
+            continue
+        checked = check_output(path, force=force, protect=(spec, *seen), extensions=exts)
+        seen.append(checked)
+        out[name] = checked
+    return out
+
+
+def _axis_values_text(axis) -> str:
+    from .plots import display_unit
+
+    unit, f = display_unit(axis.unit)
+    v = axis.values
+    scale = "log" if axis.log else "linear"
+    return (f"{axis.path}: {len(v)} values {_fmt(v[0] * f)} to {_fmt(v[-1] * f)} {unit} "
+            f"({scale})")
+
+
+_CELL = {"settled": ("·", "green"), "stuck": ("s", "yellow"), "undetermined": ("?", "yellow"),
+         "invalid": ("-", "dim"), "failed": ("×", "bold red")}
+
+
+def sweep_grid_table(result, max_columns: int = 25):
+    """The map as a rich table: hunting cycles per point, marks for the other verdicts.
+
+    Parameters
+    ----------
+    result : fi_design.sweep.SweepResult
+        A two-dimensional sweep (a line is shown as one row).
+    max_columns : int, optional
+        Wider maps are not tabulated (None is returned).
+
+    Returns
+    -------
+    rich.table.Table or None
+        Rows are y values, columns x values, both in display units; a cell
+        holds the cycle count of a hunting point, ``·`` settled, ``s`` stuck,
+        ``?`` undetermined, ``-`` invalid, ``×`` failed.
+    """
+    from rich import box
+    from rich.table import Table
+    from rich.text import Text
+
+    from .plots import display_unit
+
+    x, y = result.x, result.y
+    if len(x.values) > max_columns:
+        return None
+    xu, xf = display_unit(x.unit)
+    if y is not None:
+        yu, yf = display_unit(y.unit)
+    t = Table(box=box.SIMPLE_HEAD, pad_edge=False)
+    t.add_column(Text("" if y is None else f"[{yu}]"), justify="right", no_wrap=True)
+    for v in x.values:
+        t.add_column(Text(_fmt(v * xf, 3)), justify="right", no_wrap=True)
+    rows = result.verdict.reshape(-1, len(x.values))
+    cycles = result.hunting_cycles.reshape(-1, len(x.values))
+    labels = [""] if y is None else [_fmt(v * yf, 3) for v in y.values]
+    for label, vrow, crow in zip(labels, rows, cycles):
+        cells = []
+        for v, c in zip(vrow, crow):
+            if v == "hunting":
+                cells.append(Text(str(int(c)), style="bold red"))
+            else:
+                mark, style = _CELL.get(str(v), ("", ""))
+                cells.append(Text(mark, style=style))
+        t.add_row(label, *cells)
+    return t
+
+
+def grid_caption(result) -> str:
+    """What the cells and axes of :func:`sweep_grid_table` mean, in one line.
+
+    Parameters
+    ----------
+    result : fi_design.sweep.SweepResult
+        The sweep.
+
+    Returns
+    -------
+    str
+    """
+    from .plots import display_unit
+
+    text = f"hunting cycles in the window; columns {result.x.path} " \
+           f"[{display_unit(result.x.unit)[0]}]"
+    if result.y is not None:
+        text += f", rows {result.y.path} [{display_unit(result.y.unit)[0]}]"
+    return text + "; · settled, s stuck, ? undetermined, - invalid, × failed"
+
+
+def _print_grid(console: "Console", result) -> None:
+    from rich.text import Text
+
+    table = sweep_grid_table(result)
+    if table is not None:
+        console.print(Text(grid_caption(result), style="dim"))
+        console.print(table)
+
+
+def _print_counts(console: "Console", counts: dict) -> None:
+    text = ", ".join(f"{n} {v}" for v, n in counts.items() if n)
+    console.print(f"points: {text}", markup=False, highlight=False)
+
+
+def _print_run(console: "Console", run, executor: str) -> None:
+    console.print(f"{run.points} points: {run.computed} simulated, {run.cached} from the cache; "
+                  f"{executor}; {run.wall_time:.2f} s", markup=False, highlight=False)
+
+
+@app.command("sweep")
+def sweep_command(
+    spec: Annotated[Path, typer.Argument(metavar="SPEC.yaml", help="The design spec (YAML).",
+                                         show_default=False)],
+    x: Annotated[str, typer.Option(
+        "--x", metavar="PATH=START:STOP:N",
+        help="First swept value: a dotted spec path and a range with units, e.g. "
+             "'isolator.stroke=0.05 mm:1 mm:12' (or PATH=V1,V2,...).", show_default=False)],
+    y: Annotated[Optional[str], typer.Option(
+        "--y", metavar="PATH=START:STOP:N",
+        help="Second swept value (rows of the map); omit for a one-dimensional sweep.",
+        show_default=False)] = None,
+    log: Annotated[Optional[list[str]], typer.Option(
+        "--log", metavar="x|y", help="Space an axis logarithmically (repeat for both).",
+        show_default=False)] = None,
+    no_isolator: Annotated[bool, typer.Option(
+        "--no-isolator", help="Simulate the stage without its isolator.")] = False,
+    csv_out: Annotated[Optional[Path], typer.Option(
+        "--csv", metavar="OUT.csv", help="Write one row per point (SI values).",
+        show_default=False)] = None,
+    json_out: Annotated[Optional[Path], typer.Option(
+        "--json", metavar="OUT.json", help="Write the full result as JSON.",
+        show_default=False)] = None,
+    figure_out: Annotated[Optional[Path], typer.Option(
+        "--figure", metavar="OUT.svg|OUT.png", help="Write the heatmap (or line plot).",
+        show_default=False)] = None,
+    report_out: Annotated[Optional[Path], typer.Option(
+        "--report", metavar="OUT.html", help="Write the report of the sweep (HTML, or PDF for "
+                                             "a .pdf name).", show_default=False)] = None,
+    jobs: Annotated[int, _JOBS_OPTION] = 0,
+    executor: Annotated[str, _EXECUTOR_OPTION] = "local",
+    scheduler: Annotated[Optional[str], _SCHEDULER_OPTION] = None,
+    no_cache: Annotated[bool, _NO_CACHE_OPTION] = False,
+    force: Annotated[bool, typer.Option("--force", "-f",
+                                        help="Overwrite existing output files.")] = False,
+) -> None:
+    """Map hunting cycles over one or two spec values (the paper's Figure 4).
+
+    Every point is the spec with the swept values replaced and validated; an
+    invalid point (say Fs < Fc) or a failed simulation is recorded, and the
+    sweep goes on. Finished points are cached, so a repeated or interrupted
+    sweep only simulates what is missing.
+    """
+    outs = _outputs(spec, force, csv=(csv_out, (".csv",)), json=(json_out, (".json",)),
+                    figure=(figure_out, (".svg", ".png")),
+                    report=(report_out, (".html", ".pdf")))
+    _check_spec_path(spec)
+    logs = {v.strip().lower() for v in (log or [])}
+    if logs - {"x", "y"}:
+        raise typer.BadParameter(f"expected x or y, got {', '.join(sorted(logs - {'x', 'y'}))}",
+                                 param_hint="--log")
+    if "y" in logs and y is None:
+        raise typer.BadParameter("--log y needs --y", param_hint="--log")
+    pool = _Executor(executor, jobs, scheduler)
+
+    from .specfile import load_spec
+    from .sweep import parse_axis, sweep
+
+    spec_obj = load_spec(spec)
+    ax = parse_axis(x, log="x" in logs, spec=spec_obj)
+    ay = parse_axis(y, log="y" in logs, spec=spec_obj) if y is not None else None
+    isolated = False if no_isolator else spec_obj.has_isolator
+    if ay is not None and ay.path == ax.path:
+        raise typer.BadParameter("--x and --y sweep the same value", param_hint="--y")
+    console = _console()
+    err = _console(stderr=True)
+    with pool as ex, _ProgressBar(err, "sweep") as bar:
+        result = sweep(spec_obj, ax, ay, isolated=isolated, executor=ex, progress=bar,
+                       cache=_cache_for(no_cache))
+    _write_sweep_outputs(result, outs, console)
+    print_sweep(console, result, spec_path=spec, executor=pool.describe())
+
+
+def _write_sweep_outputs(result, outs: dict, console: "Console") -> None:
+    import json
+
+    from .output import write_atomic
+
+    texts: dict = {}
+    if outs["csv"] is not None:
+        texts["csv"] = result.to_csv()
+    if outs["json"] is not None:
+        texts["json"] = json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n"
+    if outs.get("figure") is not None:
+        from .plots import figure_bytes, sweep_figure
+
+        texts["figure"] = figure_bytes(sweep_figure(result), outs["figure"].suffix)
+    for name, data in texts.items():
+        write_atomic(outs[name], data)
+        console.print(f"wrote {outs[name]}", markup=False, highlight=False)
+    _write_report(result, outs.get("report"), console)
+
+
+def _write_report(result, path: Optional[Path], console: "Console") -> None:
+    """The HTML report of a study (fi_design.report), written atomically."""
+    if path is None:
+        return
+    from .report import render_report
+
+    render_report(result, path, command=_command_line())
+    console.print(f"wrote {path}", markup=False, highlight=False)
+
+
+def _command_line() -> str:
+    """The command as typed, for the report's title block."""
+    import shlex
+
+    return "fi-design " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+
+
+def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
+                executor: str = "") -> None:
+    """Print the summary of a :class:`~fi_design.sweep.SweepResult`.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to print.
+    result : fi_design.sweep.SweepResult
+        The sweep.
+    spec_path : pathlib.Path, optional
+        The spec file, named in the heading.
+    executor : str, optional
+        How the points ran, for the last line.
+    """
+    from rich.text import Text
+
+    from .plots import display_unit
+
+    head = Text(f"Sweep of {result.spec.name}", style="bold")
+    if spec_path is not None:
+        head.append(f"  ({spec_path})", style="dim")
+    console.print(head)
+    plant = "with isolator" if result.isolated else "without isolator"
+    console.print(Text(f"{_axis_values_text(result.x)}; {plant}"))
+    if result.y is not None:
+        console.print(Text(_axis_values_text(result.y)))
+    _print_grid(console, result)
+    _print_counts(console, result.counts())
+    xu, xf = display_unit(result.x.unit)
+    above = result.boundary("above")
+    if result.y is None:
+        if not math.isnan(above[0]):
+            console.print(Text(f"no hunting from {result.x.path} = {_fmt(above[0] * xf)} {xu} "
+                               "upwards"))
+    failed = [p for p in result.points if p.status == "failed"]
+    for p in failed[:3]:
+        console.print(Text(f"failed at {dict(zip(result.paths, p.values))}: {p.message}",
+                           style="red"))
+    if len(failed) > 3:
+        console.print(Text(f"... and {len(failed) - 3} more failed point(s); see --csv or --json",
+                           style="red"))
+    _print_run(console, result.run, executor)
+
+
+@app.command("study")
+def study_command(
+    study: Annotated[str, typer.Argument(metavar="STUDY", help="The study: 'paper' (the four "
+                                                               "maps of the paper's Figure 4).",
+                                         show_default=False)],
+    spec: Annotated[Path, typer.Argument(metavar="SPEC.yaml", help="The design spec (YAML).",
+                                         show_default=False)],
+    out: Annotated[Path, typer.Option(
+        "--out", "-o", metavar="DIR", help="Directory for figure4.svg, figure4.png, "
+                                            "map_A.csv ... map_D.csv and study.json (created "
+                                            "if missing).")] = Path("paper_study"),
+    resolution: Annotated[int, typer.Option(
+        "--resolution", "-n", min=2, max=200, metavar="N",
+        help="Points per axis of every map.")] = 12,
+    report_out: Annotated[Optional[Path], typer.Option(
+        "--report", metavar="OUT.html", help="Also write the report of the four maps (HTML, or "
+                                             "PDF for a .pdf name).", show_default=False)] = None,
+    maps: Annotated[str, typer.Option(
+        "--maps", metavar="ABCD", help="Which maps: A static vs Coulomb friction, B crossover "
+                                       "vs mass (both without isolator), C stroke vs stiffness, "
+                                       "D crossover vs stroke (with isolator).")] = "ABCD",
+    jobs: Annotated[int, _JOBS_OPTION] = 0,
+    executor: Annotated[str, _EXECUTOR_OPTION] = "local",
+    scheduler: Annotated[Optional[str], _SCHEDULER_OPTION] = None,
+    no_cache: Annotated[bool, _NO_CACHE_OPTION] = False,
+    force: Annotated[bool, typer.Option("--force", "-f",
+                                        help="Overwrite existing output files.")] = False,
+) -> None:
+    """Run a named parameter study around the spec's design point.
+
+    `fi-design study paper SPEC.yaml` evaluates the paper's four maps (Figure
+    4) with the spec as the design point and writes the figure, one CSV per
+    map and the JSON of the whole study into --out.
+    """
+    if study not in STUDIES:
+        close = difflib.get_close_matches(study, STUDIES, n=1)
+        raise typer.BadParameter(f"unknown study '{study}'"
+                                 + (f"; did you mean '{close[0]}'?" if close else "")
+                                 + f"; available: {', '.join(STUDIES)}", param_hint="STUDY")
+    letters = [k for k in maps.upper() if not k.isspace()]
+    names = ["figure4.svg", "figure4.png", "study.json"] + [f"map_{k}.csv" for k in letters]
+    targets = _study_targets(out, names, spec, force)
+    report_path = _outputs(spec, force, report=(report_out, (".html", ".pdf")))["report"]
+    if report_path is not None and report_path.resolve() in {p.resolve() for p in
+                                                             targets.values()}:
+        raise typer.BadParameter("the report would overwrite a file of the study",
+                                 param_hint="--report")
+    _check_spec_path(spec)
+    pool = _Executor(executor, jobs, scheduler)
+
+    from .specfile import load_spec
+    from .sweep import paper_study
+
+    spec_obj = load_spec(spec)
+    console = _console()
+    err = _console(stderr=True)
+    with pool as ex, _ProgressBar(err, "paper study") as bar:
+        result = paper_study(spec_obj, resolution, maps="".join(letters), executor=ex,
+                             progress=bar, cache=_cache_for(no_cache))
+    _write_study(result, out, targets, console)
+    _write_report(result, report_path, console)
+    print_study(console, result, spec_path=spec, executor=pool.describe())
+
+
+def _study_targets(out: Path, names: list[str], spec: Path, force: bool) -> dict:
+    from .errors import OutputError
+    from .output import check_output
+
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"{out}: exists and is not a directory")
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir():
+        raise OutputError(f"{out}: directory {parent} does not exist")
+    targets = {}
+    for name in names:
+        path = out / name
+        if out.is_dir():
+            check_output(path, force=force, protect=(spec,))
+        targets[name] = path
+    return targets
+
+
+def _write_study(result, out: Path, targets: dict, console: "Console") -> None:
+    import json
+
+    from .output import write_atomic
+    from .plots import figure_bytes, study_figure
+
+    fig = study_figure(result)
+    data = {"figure4.svg": figure_bytes(fig, "svg"), "figure4.png": figure_bytes(fig, "png"),
+            "study.json": json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n"}
+    for m in result.maps:
+        data[f"map_{m.definition.key}.csv"] = m.result.to_csv()
+    out.mkdir(exist_ok=True)
+    for name, payload in data.items():
+        write_atomic(targets[name], payload)
+    console.print(f"wrote {', '.join(data)} to {out}", markup=False, highlight=False)
+
+
+def print_study(console: "Console", result, spec_path: Optional[Path] = None,
+                executor: str = "") -> None:
+    """Print the summary of a :class:`~fi_design.sweep.StudyResult`: one grid per map.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to print.
+    result : fi_design.sweep.StudyResult
+        The study.
+    spec_path : pathlib.Path, optional
+        The spec file, named in the heading.
+    executor : str, optional
+        How the points ran, for the last line.
+    """
+    from rich.text import Text
+
+    head = Text(f"Paper study (Figure 4) around {result.spec.name}", style="bold")
+    if spec_path is not None:
+        head.append(f"  ({spec_path})", style="dim")
+    console.print(head)
+    for m in result.maps:
+        d = m.definition
+        console.print(Text(f"\n{d.key}) {d.title}", style="bold"))
+        console.print(Text(f"paper: {d.paper}", style="dim"))
+        _print_grid(console, m.result)
+        _print_counts(console, m.result.counts())
+    _print_run(console, result.run, executor)
+
+
+@app.command("robustness")
+def robustness_command(
+    spec: Annotated[Path, typer.Argument(metavar="SPEC.yaml", help="The design spec (YAML).",
+                                         show_default=False)],
+    samples: Annotated[int, typer.Option(
+        "--samples", "-n", min=1, metavar="N", help="Number of random samples.")] = 100,
+    scatter: Annotated[Optional[list[str]], typer.Option(
+        "--scatter", metavar="PATH=SPREAD",
+        help="A scattered spec value and its spread: '10%' of the nominal value (standard "
+             "deviation, or half-width with --distribution uniform), or absolute with units "
+             "('0.3 N'). Repeat for several values.", show_default=False)] = None,
+    position_friction: Annotated[Optional[str], typer.Option(
+        "--position-friction", metavar="AMPLITUDE:WAVELENGTH",
+        help="Add friction varying along the rail (effect position_dependent_friction), e.g. "
+             "'10%:20 mm'; every sample draws its phase.", show_default=False)] = None,
+    distribution: Annotated[str, typer.Option(
+        "--distribution", metavar="normal|uniform", help="Distribution of the scatter.")] =
+        "normal",
+    seed: Annotated[int, typer.Option("--seed", metavar="S",
+                                      help="Seed of the random generator.")] = 0,
+    confidence: Annotated[float, typer.Option(
+        "--confidence", min=0.5, max=0.999, metavar="LEVEL",
+        help="Level of the Wilson confidence interval.")] = 0.95,
+    csv_out: Annotated[Optional[Path], typer.Option(
+        "--csv", metavar="OUT.csv", help="Write one row per sample.", show_default=False)] = None,
+    json_out: Annotated[Optional[Path], typer.Option(
+        "--json", metavar="OUT.json", help="Write the full result as JSON.",
+        show_default=False)] = None,
+    figure_out: Annotated[Optional[Path], typer.Option(
+        "--figure", metavar="OUT.svg|OUT.png", help="Write a bar chart of the probabilities.",
+        show_default=False)] = None,
+    report_out: Annotated[Optional[Path], typer.Option(
+        "--report", metavar="OUT.html", help="Write the report (HTML, or PDF for a .pdf name).",
+        show_default=False)] = None,
+    jobs: Annotated[int, _JOBS_OPTION] = 0,
+    executor: Annotated[str, _EXECUTOR_OPTION] = "local",
+    scheduler: Annotated[Optional[str], _SCHEDULER_OPTION] = None,
+    no_cache: Annotated[bool, _NO_CACHE_OPTION] = False,
+    force: Annotated[bool, typer.Option("--force", "-f",
+                                        help="Overwrite existing output files.")] = False,
+) -> None:
+    """Probability of hunting when friction (or any spec value) scatters.
+
+    Draws the scattered values around the spec's, simulates every sample with
+    and without the isolator, and prints the probability of hunting with its
+    Wilson confidence interval. The same seed gives the same result.
+    """
+    outs = _outputs(spec, force, csv=(csv_out, (".csv",)), json=(json_out, (".json",)),
+                    figure=(figure_out, (".svg", ".png")),
+                    report=(report_out, (".html", ".pdf")))
+    _check_spec_path(spec)
+    if distribution not in ("normal", "uniform"):
+        raise typer.BadParameter(f"'{distribution}' is not normal or uniform",
+                                 param_hint="--distribution")
+    if not scatter and position_friction is None:
+        raise typer.BadParameter("give at least one --scatter PATH=SPREAD (e.g. "
+                                 "--scatter friction.static=10%) or --position-friction",
+                                 param_hint="--scatter")
+    pool = _Executor(executor, jobs, scheduler)
+
+    from .specfile import load_spec
+    from .sweep import parse_position_friction, parse_scatter, robustness
+
+    spec_obj = load_spec(spec)
+    items = [parse_scatter(s, spec_obj) for s in scatter or []]
+    pf = parse_position_friction(position_friction) if position_friction else None
+    console = _console()
+    err = _console(stderr=True)
+    with pool as ex, _ProgressBar(err, "robustness") as bar:
+        result = robustness(spec_obj, items, samples, seed=seed, distribution=distribution,
+                            position_friction=pf, confidence=confidence, executor=ex,
+                            progress=bar, cache=_cache_for(no_cache))
+    import json
+
+    from .output import write_atomic
+
+    texts: dict = {}
+    if outs["csv"] is not None:
+        texts["csv"] = result.to_csv()
+    if outs["json"] is not None:
+        texts["json"] = json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n"
+    if outs["figure"] is not None:
+        from .plots import figure_bytes, robustness_figure
+
+        texts["figure"] = figure_bytes(robustness_figure(result), outs["figure"].suffix)
+    for name, data in texts.items():
+        write_atomic(outs[name], data)
+        console.print(f"wrote {outs[name]}", markup=False, highlight=False)
+    _write_report(result, outs["report"], console)
+    print_robustness(console, result, spec_path=spec, executor=pool.describe())
+
+
+def print_robustness(console: "Console", result, spec_path: Optional[Path] = None,
+                     executor: str = "") -> None:
+    """Print the summary of a :class:`~fi_design.sweep.RobustnessResult`.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to print.
+    result : fi_design.sweep.RobustnessResult
+        The robustness study.
+    spec_path : pathlib.Path, optional
+        The spec file, named in the heading.
+    executor : str, optional
+        How the points ran, for the last line.
+    """
+    from rich import box
+    from rich.table import Table
+    from rich.text import Text
+
+    from .plots import display_unit
+
+    head = Text(f"Robustness of {result.spec.name}", style="bold")
+    if spec_path is not None:
+        head.append(f"  ({spec_path})", style="dim")
+    console.print(head)
+    for sc in result.scatter:
+        unit, f = display_unit("") if sc.relative else display_unit(
+            _path_unit(sc.path, result.spec))
+        spread = f"{sc.spread:.3g} of nominal ({100 * sc.spread:.3g} %)" if sc.relative else \
+            f"{_fmt(sc.spread * f)} {unit}"
+        console.print(Text(f"scatter {sc.path}: {result.distribution}, spread {spread}"))
+    if result.position_friction is not None:
+        pf = result.position_friction
+        console.print(Text(f"position-dependent friction: amplitude {100 * pf.amplitude:.3g} %, "
+                           f"wavelength {pf.wavelength * 1e3:.4g} mm, random phase"))
+    conf = result.not_isolated.confidence
+    t = Table(title=f"Probability of hunting, {result.samples} samples, seed {result.seed}",
+              title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
+    for col in ("Plant", "Hunting", "Valid", "P(hunting) [%]", f"{conf:.0%} interval [%]",
+                "Settled", "Stuck", "Undetermined", "Invalid", "Failed"):
+        t.add_column(col, justify="left" if col == "Plant" else "right", no_wrap=True)
+    for label, p in (("with isolator", result.isolated),
+                     ("without isolator", result.not_isolated)):
+        if p is None:
+            continue
+        prob = "-" if p.probability is None else f"{100 * p.probability:.1f}"
+        c = p.counts
+        t.add_row(label, str(p.hunting), str(p.valid), prob,
+                  f"{100 * p.low:.1f} to {100 * p.high:.1f}", str(c["settled"]), str(c["stuck"]),
+                  str(c["undetermined"]), str(c["invalid"]), str(c["failed"]))
+    console.print(t)
+    _print_run(console, result.run, executor)
+
+
+def _path_unit(path: str, spec) -> str:
+    from .specfile import path_unit
+
+    try:
+        return path_unit(path, spec)
+    except Exception:  # noqa: BLE001 -- a label only
+        return ""
 
 
 def main() -> None:

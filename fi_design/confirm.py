@@ -101,27 +101,31 @@ class PlantVerdict:
 
 @dataclass(frozen=True, eq=False)
 class CrossoverScan:
-    """Verdicts over a crossover grid and the lowest hunting-free crossover.
+    """Verdicts down a crossover grid and the lowest hunting-free crossover.
+
+    The scan runs from the top of the grid downwards and stops at the first
+    crossover that does not settle: everything above it settles, so the
+    minimum is found with the fewest simulations. Hunting that comes and goes
+    below that boundary (the paper saw it at 9.5 Hz) is a matter for a map
+    (``fi-design sweep``), not for this scan.
 
     Attributes
     ----------
     plant : str
         ``"isolated"`` or ``"non_isolated"``.
     crossovers : ndarray, shape (n,)
-        Scanned crossovers [Hz].
+        Scanned crossovers, ascending [Hz].
     verdicts : tuple of str
-        Verdict at each crossover.
+        Verdict at each scanned crossover.
     hunting_cycles : ndarray of int, shape (n,)
-        Counted cycles at each crossover.
+        Counted cycles at each scanned crossover.
     minimum : float or None
-        Lowest scanned crossover from which every higher scanned crossover
-        settles [Hz]; None if the top of the scan does not settle.
+        Lowest grid crossover from which every higher one settles [Hz]; None
+        if the top of the grid does not settle.
     resolution : float
-        Grid step [Hz]: the true boundary lies within one step below
-        ``minimum``.
-    islands : tuple of float
-        Crossovers below ``minimum`` that settled although a higher one did
-        not [Hz] (hunting that comes and goes, as the paper saw at 9.5 Hz).
+        Grid step [Hz]: the boundary lies within one step below ``minimum``.
+    grid : tuple of float
+        The whole grid (start, stop, step) [Hz].
     """
 
     plant: str
@@ -130,7 +134,7 @@ class CrossoverScan:
     hunting_cycles: np.ndarray
     minimum: float | None
     resolution: float
-    islands: tuple[float, ...]
+    grid: tuple[float, float, float]
 
     def to_dict(self) -> dict:
         """Plain JSON data."""
@@ -247,28 +251,24 @@ def scan_crossover(spec: _spec.Spec, isolated: bool, start: float | None = None,
     stop = cfg.stop if stop is None else stop
     step = cfg.step if step is None else step
     grid = np.arange(start, stop + 0.5 * step, step)
-    verdicts, cycles = [], []
+    done: list[tuple[float, str, int]] = []
     plant = "with isolator" if isolated else "without isolator"
-    for i, fc in enumerate(grid):
-        if progress is not None:
-            progress(f"scanning the crossover {plant}: {fc:g} Hz ({i + 1}/{len(grid)})")
-        m = simulate(spec, isolated=isolated, crossover=float(fc)).metrics
-        verdicts.append(m.verdict)
-        cycles.append(m.hunting_cycles)
-    ok = np.array([v == "settled" for v in verdicts])
     minimum = None
-    if ok[-1]:
-        i = len(ok) - 1
-        while i > 0 and ok[i - 1]:
-            i -= 1
-        minimum = float(grid[i])
-        islands = tuple(float(f) for f in grid[:i][ok[:i]])
-    else:
-        islands = ()
+    for fc in grid[::-1]:
+        if progress is not None:
+            progress(f"scanning the crossover {plant}: {fc:g} Hz")
+        m = simulate(spec, isolated=isolated, crossover=float(fc)).metrics
+        done.append((float(fc), m.verdict, m.hunting_cycles))
+        if m.verdict != "settled":
+            break
+        minimum = float(fc)
+    done.reverse()
     return CrossoverScan(plant="isolated" if isolated else "non_isolated",
-                         crossovers=frozen_array(grid), verdicts=tuple(verdicts),
-                         hunting_cycles=frozen_array(cycles, dtype=int), minimum=minimum,
-                         resolution=float(step), islands=islands)
+                         crossovers=frozen_array([d[0] for d in done]),
+                         verdicts=tuple(d[1] for d in done),
+                         hunting_cycles=frozen_array([d[2] for d in done], dtype=int),
+                         minimum=minimum, resolution=float(step),
+                         grid=(float(start), float(stop), float(step)))
 
 
 def landing(spec: _spec.Spec, result: SimulationResult) -> Landing:

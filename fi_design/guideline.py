@@ -539,6 +539,15 @@ class IsolatorAdvice:
     maximum_stiffness: float
 
 
+def suggested_isolator(spec: Spec) -> tuple[float, float]:
+    """Stroke [m] and drive stiffness [N/m] to start from when the spec has no isolator.
+
+    The paper's 0.3 mm stroke (:data:`SUGGESTED_STROKE`) and k = Fs / (2 x
+    safety x stroke), half the maximum of step 3.
+    """
+    return SUGGESTED_STROKE, proposed_stiffness(spec, SUGGESTED_STROKE)
+
+
 def isolator_advice(spec: Spec, gap: FrictionGapResult, crossover: CrossoverResult,
                     ) -> IsolatorAdvice:
     """For a stage without isolator: does one look needed, and where to start.
@@ -559,8 +568,7 @@ def isolator_advice(spec: Spec, gap: FrictionGapResult, crossover: CrossoverResu
         crossover is limited; not needed below the gap threshold; undecided
         when the linear model sets no crossover limit within the scan.
     """
-    s = SUGGESTED_STROKE
-    k = proposed_stiffness(spec, s)
+    s, k = suggested_isolator(spec)
     kmax = stiffness_limit(spec, s)
     start = (f"start from a {s * 1e3:.3g} mm stroke (the paper's) and k = {_g(k)} N/m "
              f"(Fs / (2 x stroke); k_max = {_g(kmax)} N/m)")
@@ -750,7 +758,7 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     if simulation is None and confirm:
         from .confirm import confirm as _confirm
 
-        suggestion = (advice.stroke, advice.stiffness) if advice is not None else None
+        suggestion = suggested_isolator(spec) if spec.isolator is None else None
         simulation = _confirm(spec, suggestion, progress=progress)
     if simulation is not None:
         result = result.with_simulation(simulation)

@@ -71,7 +71,7 @@ from __future__ import annotations
 
 import math
 import time as _time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
 import numpy as np
@@ -546,71 +546,75 @@ def estimate_noise(values: np.ndarray) -> float:
     return 1.4826 * mad / math.sqrt(20.0)
 
 
-def lattice_step(position: np.ndarray, noise: float, lo: float = 1e-9,
-                 hi: float = 1e-4) -> tuple[float | None, float]:
-    """The step of a staircase in sampled positions, if any.
+def sawtooth(x: np.ndarray, q: float) -> np.ndarray:
+    """Quantization error round(x / q) q - x of positions x for a step q [m]."""
+    return np.round(x / q) * q - x
 
-    Scores candidate steps q by the phase coherence C(q) = |mean(exp(2 pi i x / q))|,
-    near 1 when every sample lies on a lattice of pitch q (lowered by noise to
-    about exp(-2 pi^2 sigma^2 / q^2)) and near 1/sqrt(n) otherwise. Pass samples
-    that sweep the travel (moves): many samples at one standstill would make
-    any coarse pitch look coherent. A lattice of pitch q also lies on q / 2,
-    q / 3, ...; with noise those score lower, and without noise the largest
-    pitch within 5 % of the best score is taken. The pitch is then refined to
-    the coherence maximum (a relative precision of about q / travel).
+
+def quantization_step(x_model: np.ndarray, residual: np.ndarray, noise: float,
+                      lo: float = 1e-8, hi: float = 1e-4) -> tuple[float | None, float]:
+    """The step of a staircase in the measured position, from the residual to a smooth model.
+
+    When the sensor quantizes, measured minus modelled position is the
+    quantization error round(x / q) q - x: a sawtooth over position with
+    spatial period q. Its fundamental is found in a Lomb-Scargle periodogram
+    of the residual over the modelled position (which works through the
+    aliasing of a regularly sampled constant-velocity move, where a test of the
+    raw samples would find the sampling pitch v dt instead), then refined by
+    the correlation of the residual with the sawtooth predicted for q.
 
     Parameters
     ----------
-    position : ndarray, shape (n,)
-        Positions [m].
+    x_model : ndarray, shape (n,)
+        Modelled (continuous) position at the samples [m].
+    residual : ndarray, shape (n,)
+        Measured minus modelled position [m].
     noise : float
-        Noise standard deviation [m]; steps below 3 noise levels are not tried.
+        Position noise standard deviation [m]; steps below three noise levels
+        are not tried.
     lo, hi : float
         Range of steps tried [m].
 
     Returns
     -------
     step : float or None
-        The step [m], or None when no pitch is coherent (above
-        max(0.3, 6 / sqrt(n))).
-    score : float
-        The best coherence (0-1).
+        The step [m], or None when the residual does not follow a sawtooth
+        (correlation below 0.3).
+    correlation : float
+        Correlation of the residual with the sawtooth of the step (0-1).
     """
-    from scipy.optimize import minimize_scalar
+    from scipy.signal import lombscargle
 
-    x = np.asarray(position, dtype=float)
+    x = np.asarray(x_model, dtype=float)
+    r = np.asarray(residual, dtype=float)
     if len(x) < 50:
         return None, 0.0
-    if len(x) > 20000:
-        x = x[np.linspace(0, len(x) - 1, 20000).astype(int)]
     span = float(np.ptp(x))
-    top = min(hi, span / 20.0)
     bottom = max(lo, 3.0 * noise)
+    top = min(hi, span / 20.0)
     if not top > bottom:
         return None, 0.0
-    x = x - np.median(x)
-
-    def coherence(q: float) -> float:
-        return float(abs(np.mean(np.exp(2j * np.pi * x / q))))
-
-    n_grid = int(min(4000, max(400, 20 * math.log(top / bottom) * span / top)))
-    qs = np.geomspace(bottom, top, n_grid)
-    scores = np.array([coherence(q) for q in qs])
-    best = float(scores.max())
-    limit = max(0.3, 6.0 / math.sqrt(len(x)))
-    if best < limit:
-        return None, best
-    i = int(np.nonzero(scores >= 0.95 * best)[0][-1])
-    a, b = qs[max(i - 1, 0)], qs[min(i + 1, n_grid - 1)]
-    fine = np.linspace(a, b, 201)
-    fs = np.array([coherence(q) for q in fine])
-    j = int(np.argmax(fs))
-    da = fine[max(j - 1, 0)]
-    db = fine[min(j + 1, len(fine) - 1)]
-    sol = minimize_scalar(lambda q: -coherence(q), bounds=(da, db), method="bounded",
-                          options={"xatol": 1e-9 * fine[j]})
-    q = float(sol.x) if -sol.fun >= fs[j] else float(fine[j])
-    return q, coherence(q)
+    if len(x) > 4000:
+        sel = np.linspace(0, len(x) - 1, 4000).astype(int)
+        x, r = x[sel], r[sel]
+    rc = r - np.mean(r)
+    n_f = int(min(100_000, max(2000, 3.0 * span / bottom)))
+    k = np.linspace(2 * np.pi / top, 2 * np.pi / bottom, n_f)
+    power = lombscargle(x, rc, k)
+    best_q, best_c = None, 0.0
+    for j in np.argsort(power)[::-1][:5]:
+        q0 = 2 * np.pi / k[j]
+        dq = (k[1] - k[0]) / k[j] * q0  # one frequency bin, as a step change
+        for q in np.linspace(q0 - 1.5 * dq, q0 + 1.5 * dq, 31):
+            s = sawtooth(x, q)
+            if np.std(s) == 0:
+                continue
+            c = float(np.corrcoef(s, r)[0, 1])
+            if c > best_c:
+                best_q, best_c = float(q), c
+    if best_q is None or best_c < 0.3:
+        return None, max(best_c, 0.0)
+    return best_q, best_c
 
 
 # --------------------------------------------------------------------------- the problem
@@ -749,6 +753,10 @@ class _Problem:
         stride = max(1, int(math.ceil(len(idx) / max_points)))
         self.idx = idx[::stride]
         self.stride = stride
+        channels = 1 + int(self.has_force) + int(self.has_defl)
+        in_move = np.asarray(self.kind[self.idx] == "move")
+        nf = self.n_points - channels * len(self.idx)
+        self.move_entries = np.concatenate([np.tile(in_move, channels), np.zeros(nf, bool)])
         # feature scales from the measurement
         self.feat_meas = []
         self.feat_sigma = []
@@ -988,11 +996,15 @@ def _signatures(pb: _Problem, nom: _Trace) -> tuple[list[Signature], dict]:
             f"(correlation {corr:.2f})")
         if lag > 0:
             guesses.setdefault("time_delay", []).append({"delay": lag})
-    # staircase
-    q = pb.noise.resolution
+    # staircase: the residual to the smooth model is a sawtooth over position
+    sel = (pb.kind != "hold") & coh
+    q, corr_q = quantization_step(nom.position[sel], (meas.position - nom.position)[sel],
+                                  pb.noise.position)
     if q is not None:
-        add("staircase", ["quantization"], 1.0, q, "m",
-            f"the measured position lies on a lattice of {q * 1e6:.4g} um steps")
+        pb.noise = replace(pb.noise, resolution=q)
+        add("staircase", ["quantization"], corr_q, q, "m",
+            f"the measured position lies on a lattice of {q * 1e6:.4g} um steps (the residual "
+            f"follows the quantization sawtooth with correlation {corr_q:.2f})")
         guesses.setdefault("quantization", []).append({"resolution": q})
     # force above a level (saturation)
     if use_force:
@@ -1300,7 +1312,22 @@ def _fit(ob: _Objective) -> tuple[np.ndarray, float, np.ndarray | None, str]:
         starts += _periodic_starts(ob)
     if sp.method == "scan":
         return _scan(ob)
-    scored = sorted(((ob.chi2(u), i, u) for i, u in enumerate(starts)), key=lambda s: s[0])
+    # Stage A works on the move samples only (robust loss): stick-slip in the settle
+    # and hold segments makes the full objective rugged, the moves keep it smooth.
+    mask = ob.pb.move_entries
+    staged = mask is not None and 0 < mask.sum() < len(mask)
+
+    def sub(u):
+        return ob(u)[mask]
+
+    def sub_jac(u):
+        return ob.jac(u)[mask]
+
+    def score(u):
+        r = sub(u) if staged else ob(u)
+        return float(r @ r)
+
+    scored = sorted(((score(u), i, u) for i, u in enumerate(starts)), key=lambda s: s[0])
     chosen: list[np.ndarray] = []
     for _, _, u in scored:
         if all(np.max(np.abs(u - c)) > 0.05 for c in chosen):
@@ -1313,6 +1340,11 @@ def _fit(ob: _Objective) -> tuple[np.ndarray, float, np.ndarray | None, str]:
     for u0 in chosen:
         u0 = np.clip(u0, 1e-6, 1 - 1e-6)
         try:
+            if staged:
+                sol = least_squares(sub, u0, jac=sub_jac, bounds=(lo, hi), method="trf",
+                                    loss="soft_l1", f_scale=3.0, x_scale=1.0, max_nfev=40,
+                                    ftol=1e-6, xtol=1e-6, gtol=1e-8)
+                u0 = np.clip(sol.x, 1e-6, 1 - 1e-6)
             sol = least_squares(ob, u0, jac=ob.jac, bounds=(lo, hi), method="trf",
                                 x_scale=1.0, max_nfev=60, ftol=1e-6, xtol=1e-6, gtol=1e-8)
         except (ValueError, np.linalg.LinAlgError):
@@ -1589,8 +1621,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
                         column="time_s", source=measured.source)
 
     say("nominal model", 0.0)
-    moving = np.abs(np.gradient(measured.reference, measured.time)) > 0
-    noise = _noise(spec, measured, iso, moving)
+    noise = _noise(spec, measured, iso)
     pb = _Problem(spec, measured, iso, settle_window, list(spec.effects), noise)
     res0 = simulate(pb.spec_sim, iso, reference=pb.ref, initial_position=pb.x0,
                     duration=pb.duration)
@@ -1689,7 +1720,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
         effect=effect, parameters=dict(chosen_params[0]) if chosen_params else {},
         uncertainty=dict(chosen_unc[0]) if chosen_unc else {}, effects=tuple(chosen_names),
         entries=entries, candidates=tuple(first), rounds=tuple(rounds), ambiguous=ambiguous,
-        skipped=skipped_all, gaps=gaps, noise=noise, signatures=tuple(signatures),
+        skipped=skipped_all, gaps=gaps, noise=pb.noise, signatures=tuple(signatures),
         segments=pb.segment_list(), isolated=iso, threshold=float(threshold), n_points=n,
         chi2_nominal=chi2_nom, chi2_corrected=chi2_cor, conclusion=conclusion,
         n_simulations=pb.n_sims, wall_time=_time.perf_counter() - start, measurement=measured,
@@ -1703,7 +1734,7 @@ def _model_trace(pb: _Problem, tr: _Trace) -> ModelTrace:
                       success=tr.success, message=tr.message)
 
 
-def _noise(spec, meas: Measurement, iso: bool, moving: np.ndarray | None = None) -> NoiseLevels:
+def _noise(spec, meas: Measurement, iso: bool) -> NoiseLevels:
     given = spec.measurement
     src: dict[str, str] = {}
 
@@ -1724,10 +1755,7 @@ def _noise(spec, meas: Measurement, iso: bool, moving: np.ndarray | None = None)
     force = level("force", meas.force, given.force_noise if given else None)
     defl = level("deflection", meas.deflection if iso else None,
                  given.deflection_noise if given else None)
-    step = None
-    if moving is not None and moving.sum() >= 50:
-        step, _ = lattice_step(meas.position[moving], pos)
-    return NoiseLevels(position=pos, force=force, deflection=defl, source=src, resolution=step)
+    return NoiseLevels(position=pos, force=force, deflection=defl, source=src, resolution=None)
 
 
 def _fmt_params(vals: dict, unc: dict) -> str:

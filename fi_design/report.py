@@ -266,6 +266,8 @@ def qty(value: Any, unit: str = "", digits: int = 4) -> str:
         return _attach(" \u2013 ".join(parts), shown)
     if value is None or isinstance(value, (str, bool)):
         return num(value, digits)
+    if unit == "m" and 0 < abs(value) < 5e-10:
+        return _attach("< 0.001", "\u00b5m")
     shown, factor = display_scale(unit, value)
     return _attach(num(value * factor, digits), shown)
 
@@ -802,8 +804,11 @@ def spec_inputs(spec: Any) -> list[dict]:
             elif path.endswith(".antiresonance") and isinstance(parent, BaseModel):
                 from .spec import antiresonance
 
-                row["value"] = antiresonance(parent)
-                row["source"] = "derived default: frequency / sqrt(2)"
+                if getattr(parent, "collocated", False):
+                    row["value"] = antiresonance(parent)
+                    row["source"] = "derived default: frequency / sqrt(2)"
+                else:
+                    row["source"] = "not used (mode not collocated)"
             else:
                 row["source"] = "not given"
         if isinstance(value, tuple) and not value:
@@ -882,20 +887,188 @@ def tex_qty(value: float, unit: str, digits: int = 4) -> str:
         return number
     if shown == "\u00b0":
         return number + "^\\circ"
-    unit_tex = shown.replace("\u00b5", "\\mu ").replace("\u00b7", "\\cdot ").replace(
-        "\u00b2", "^2").replace("\u00b3", "^3").replace(" ", "\\ ")
+    unit_tex = shown.replace(" ", "\\,").replace("\u00b5", "\\mu ").replace(
+        "\u00b7", "\\cdot ").replace("\u00b2", "^2").replace("\u00b3", "^3")
     return f"{number}\\ \\mathrm{{{unit_tex}}}"
 
 
-def _equation(tex: str, text: str, svg: bool) -> dict:
-    """An equation: mathtext (rendered to SVG when asked) and a plain-text alternative."""
-    from markupsafe import Markup
+_GREEK = {"alpha": "\u03b1", "beta": "\u03b2", "gamma": "\u03b3", "delta": "\u03b4",
+          "Delta": "\u0394", "epsilon": "\u03b5", "zeta": "\u03b6", "eta": "\u03b7",
+          "theta": "\u03b8", "lambda": "\u03bb", "mu": "\u00b5", "pi": "\u03c0",
+          "rho": "\u03c1", "sigma": "\u03c3", "tau": "\u03c4", "phi": "\u03c6",
+          "omega": "\u03c9", "Omega": "\u03a9"}
+_SYMBOLS = {"times": "\u00d7", "leq": "\u2264", "geq": "\u2265", "cdot": "\u00b7",
+            "infty": "\u221e", "pm": "\u00b1", "approx": "\u2248", "neq": "\u2260",
+            "circ": "\u00b0", "quad": "\u2003", ",": "\u2009", " ": " ", ";": " "}
+_FUNCTIONS = ("min", "max", "ln", "log", "exp", "sin", "cos")
+#: Characters set off by thin spaces at the top level of a formula.
+_SPACED = set("=+<>\u00d7\u2264\u2265\u2248\u2260") | {"-"}
+_THIN = "\u2009"
 
-    out = {"tex": tex, "text": text, "svg": None}
-    if svg:
-        from .plots import equation_svg
 
-        out["svg"] = Markup(equation_svg(f"${tex}$"))
+def _math_tokens(tex: str) -> list[tuple[str, str]]:
+    out, i = [], 0
+    while i < len(tex):
+        c = tex[i]
+        if c == "\\":
+            j = i + 1
+            if j < len(tex) and not tex[j].isalpha():
+                out.append(("cmd", tex[j]))
+                i = j + 1
+                continue
+            while j < len(tex) and tex[j].isalpha():
+                j += 1
+            out.append(("cmd", tex[i + 1:j]))
+            i = j
+        elif c in "{}_^":
+            out.append((c, c))
+            i += 1
+        else:
+            out.append(("char", c))
+            i += 1
+    return out
+
+
+def _math_parse(tokens: list, i: int, upright: bool, until: str | None) -> tuple[list, int]:
+    """Items: ("text", str, italic, sub, sup) or ("frac", items, items)."""
+    items: list = []
+    while i < len(tokens):
+        kind, val = tokens[i]
+        if until is not None and kind == until:
+            return items, i + 1
+        if kind in ("_", "^"):
+            script, i = _math_atom(tokens, i + 1, True)
+            text = "".join(_math_plain(script))
+            if items and items[-1][0] == "text":
+                k, s, it, sub, sup = items[-1]
+                items[-1] = (k, s, it, sub + text if kind == "_" else sub,
+                             sup + text if kind == "^" else sup)
+            else:
+                items.append(("text", "", False, text if kind == "_" else "",
+                              text if kind == "^" else ""))
+            continue
+        atom, i = _math_atom(tokens, i, upright)
+        items.extend(atom)
+    return items, i
+
+
+def _math_atom(tokens: list, i: int, upright: bool) -> tuple[list, int]:
+    kind, val = tokens[i]
+    if kind == "{":
+        return _math_parse(tokens, i + 1, upright, "}")
+    if kind == "cmd":
+        if val == "frac":
+            num, i = _math_atom(tokens, i + 1, upright)
+            den, i = _math_atom(tokens, i, upright)
+            return [("frac", num, den)], i
+        if val in ("mathrm", "text"):
+            return _math_atom(tokens, i + 1, True)
+        if val in ("left", "right"):
+            return [], i + 1
+        if val in _GREEK:
+            return [("text", _GREEK[val], not upright and val[0].islower(), "", "")], i + 1
+        if val in _SYMBOLS:
+            return [("text", _SYMBOLS[val], False, "", "")], i + 1
+        if val in _FUNCTIONS:
+            return [("text", val, False, "", "")], i + 1
+        return [("text", val, False, "", "")], i + 1
+    if kind == "char":
+        if val == " ":
+            return [], i + 1
+        return [("text", val, val.isalpha() and not upright, "", "")], i + 1
+    return [], i + 1
+
+
+def _math_plain(items: list) -> list[str]:
+    out = []
+    for it in items:
+        if it[0] == "frac":
+            out.append("(" + "".join(_math_plain(it[1])) + ")/(" + "".join(_math_plain(it[2]))
+                       + ")")
+        else:
+            out.append(it[1] + (f"_{it[3]}" if it[3] else "") + (f"^{it[4]}" if it[4] else ""))
+    return out
+
+
+def _math_leaves(items: list, spaced: bool) -> list[dict]:
+    """Merge runs of upright text without scripts; set off relations and operators."""
+    out: list[dict] = []
+    for _, text, italic, sub, sup in items:
+        if spaced and text in _SPACED:
+            text = _THIN + ("\u2212" if text == "-" else text) + _THIN
+        elif text == "-":
+            text = "\u2212"
+        if (out and not italic and not out[-1]["var"] and not out[-1]["sub"]
+                and not out[-1]["sup"]):
+            out[-1]["text"] += text
+            out[-1]["sub"], out[-1]["sup"] = sub, sup
+            continue
+        out.append({"frac": False, "text": text, "var": bool(italic), "sub": sub, "sup": sup})
+    return out
+
+
+def math_nodes(tex: str) -> list[dict]:
+    """A formula in a small TeX subset, as nodes for the ``equation.html.jinja`` template.
+
+    Supported: letters (italic variables), ``_`` and ``^`` (with braces),
+    ``\\frac{..}{..}`` (one level), ``\\mathrm{..}``, Greek letters, ``\\times``,
+    ``\\leq``, ``\\geq``, ``\\cdot``, ``\\min``, ``\\max``, ``\\left``/``\\right``,
+    and the spaces ``\\,``, ``\\ ``, ``\\quad``. Subscripts and superscripts are
+    upright text. The result renders with HTML and CSS only, identically in
+    browsers and in WeasyPrint (which has no MathML).
+
+    Parameters
+    ----------
+    tex : str
+        The formula, without ``$`` delimiters.
+
+    Returns
+    -------
+    list of dict
+        Leaves ``{"frac": False, "text", "var", "sub", "sup"}`` and fractions
+        ``{"frac": True, "num": [leaves], "den": [leaves]}``.
+
+    Examples
+    --------
+    >>> [n["text"] for n in math_nodes(r"F_s = 4")]
+    ['F', '\u2009=\u20094']
+    """
+    items, _ = _math_parse(_math_tokens(tex), 0, False, None)
+    nodes: list[dict] = []
+    run: list = []
+    for it in items + [None]:
+        if it is None or it[0] == "frac":
+            nodes.extend(_math_leaves(run, True))
+            run = []
+            if it is not None:
+                nodes.append({"frac": True, "num": _math_leaves(it[1], True),
+                              "den": _math_leaves(it[2], True)})
+        else:
+            run.append(it)
+    return nodes
+
+
+def math_text(tex: str) -> str:
+    """Plain-text reading of a formula (for screen readers and text search).
+
+    Parameters
+    ----------
+    tex : str
+        The formula (TeX subset of :func:`math_nodes`).
+
+    Returns
+    -------
+    str
+    """
+    items, _ = _math_parse(_math_tokens(tex), 0, False, None)
+    return "".join(_math_plain(items)).replace(_THIN, " ")
+
+
+def _equation(tex: str, render: bool = True) -> dict:
+    """An equation: its TeX source, a plain-text reading and (when asked) its HTML."""
+    out = {"tex": tex, "text": math_text(tex), "html": None}
+    if render:
+        out["html"] = _render("equation.html.jinja", nodes=math_nodes(tex))
     return out
 
 
@@ -917,13 +1090,9 @@ def _steps(result: Any, svg: bool) -> list[dict]:
         "number": 1, "title": "Friction gap", "source": "paper \u00a74 step 1; Figure 4A",
         "equations": [
             _equation(f"\\Delta F = F_s - F_c = {tex_qty(gap.static, 'N')} - "
-                      f"{tex_qty(gap.coulomb, 'N')} = {tex_qty(gap.gap, 'N')}",
-                      f"dF = Fs - Fc = {qty(gap.static, 'N')} - {qty(gap.coulomb, 'N')} = "
-                      f"{qty(gap.gap, 'N')}", svg),
+                      f"{tex_qty(gap.coulomb, 'N')} = {tex_qty(gap.gap, 'N')}", svg),
             _equation(f"\\Delta F = {tex_qty(gap.gap, 'N')} \\ {rel}\\ \\Delta F_\\mathrm{{lim}}"
-                      f" = {tex_qty(gap.threshold, 'N')}",
-                      f"dF {'>=' if gap.hunting_risk else '<'} dF_lim = "
-                      f"{qty(gap.threshold, 'N')}", svg),
+                      f" = {tex_qty(gap.threshold, 'N')}", svg),
         ],
         "results": [
             {"quantity": "friction gap Fs \u2212 Fc", "value": gap.gap, "unit": "N"},
@@ -947,18 +1116,15 @@ def _steps(result: Any, svg: bool) -> list[dict]:
     sep = req.parasitic_separation
     need = sep * xo.desired
     eqs = [_equation(f"\\omega_c = 2\\pi f_c = 2\\pi \\times {tex_qty(xo.desired, 'Hz')} = "
-                     f"{tex_qty(2 * math.pi * xo.desired, 'rad/s')}",
-                     f"wc = 2 pi fc = {qty(2 * math.pi * xo.desired, 'rad/s')}", svg)]
+                     f"{tex_qty(2 * math.pi * xo.desired, 'rad/s')}", svg)]
     if xo.achievable is not None:
         ok = xo.desired <= xo.achievable * (1 + 1e-9)
         rel = "\\leq" if ok else ">"
         eqs.append(_equation(
             f"f_c = {tex_qty(xo.desired, 'Hz')}\\ {rel}\\ "
-            f"f_{{c,\\mathrm{{ach}}}} = {tex_qty(xo.achievable, 'Hz')}",
-            f"fc {'<=' if ok else '>'} fc_ach = {qty(xo.achievable, 'Hz')}", svg))
+            f"f_{{c,\\mathrm{{ach}}}} = {tex_qty(xo.achievable, 'Hz')}", svg))
     eqs.append(_equation(f"f_\\mathrm{{par}} \\geq n_\\mathrm{{sep}}\\, f_c = {tex_num(sep)} "
-                         f"\\times {tex_qty(xo.desired, 'Hz')} = {tex_qty(need, 'Hz')}",
-                         f"f_par >= n_sep fc = {qty(need, 'Hz')}", svg))
+                         f"\\times {tex_qty(xo.desired, 'Hz')} = {tex_qty(need, 'Hz')}", svg))
     pms = [c.phase_margin_deg for c in xo.cases]
     gms = [abs(c.gain_margin_db) for c in xo.cases]
     results = [
@@ -997,14 +1163,12 @@ def _steps(result: Any, svg: bool) -> list[dict]:
         eqs.append(_equation(
             f"k_\\max = \\frac{{F_s}}{{\\gamma\\, s}} = \\frac{{{tex_qty(st.static, 'N')}}}"
             f"{{{tex_num(gamma)} \\times {tex_qty(st.stroke, 'm')}}} = "
-            f"{tex_qty(st.maximum, 'N/m')}",
-            f"k_max = Fs / (gamma s) = {qty(st.maximum, 'N/m')}", svg))
+            f"{tex_qty(st.maximum, 'N/m')}", svg))
         ok = st.chosen <= st.maximum * (1 + 1e-12)
         rel = "<" if st.force_at_stroke < st.static else "\\geq"
         eqs.append(_equation(
             f"F_k = k\\, s = {tex_qty(st.chosen, 'N/m')} \\times {tex_qty(st.stroke, 'm')} = "
-            f"{tex_qty(st.force_at_stroke, 'N')}\\ {rel}\\ F_s = {tex_qty(st.static, 'N')}",
-            f"F_k = k s = {qty(st.force_at_stroke, 'N')} vs Fs = {qty(st.static, 'N')}", svg))
+            f"{tex_qty(st.force_at_stroke, 'N')}\\ {rel}\\ F_s = {tex_qty(st.static, 'N')}", svg))
         results += [
             {"quantity": "stroke s", "value": st.stroke, "unit": "m"},
             {"quantity": "safety factor \u03b3 (requirements.stiffness_safety)",
@@ -1022,14 +1186,12 @@ def _steps(result: Any, svg: bool) -> list[dict]:
         eqs.append(_equation(
             f"k = \\frac{{n E b t^3}}{{L^3}} = \\frac{{{fx.leaves} \\times {tex_qty(E, 'Pa')} "
             f"\\times {tex_qty(fx.width, 'm')} \\times ({tex_qty(fx.thickness, 'm')})^3}}"
-            f"{{({tex_qty(fx.length, 'm')})^3}} = {tex_qty(fx.drive_stiffness, 'N/m')}",
-            f"k = n E b t^3 / L^3 = {qty(fx.drive_stiffness, 'N/m')}", svg))
+            f"{{({tex_qty(fx.length, 'm')})^3}} = {tex_qty(fx.drive_stiffness, 'N/m')}", svg))
         rel = "\\leq" if fx.stress <= fx.allowed_stress else ">"
         eqs.append(_equation(
             f"\\sigma = \\frac{{3 E t s}}{{L^2}} = {tex_qty(fx.stress, 'Pa')}\\ "
             f"{rel}\\ \\sigma_\\mathrm{{allow}} = "
-            f"{tex_qty(fx.allowed_stress, 'Pa')}",
-            f"sigma = 3 E t s / L^2 = {qty(fx.stress, 'Pa')}", svg))
+            f"{tex_qty(fx.allowed_stress, 'Pa')}", svg))
         results += [
             {"quantity": "leaves n", "value": fx.leaves, "unit": "1"},
             {"quantity": "leaf length L", "value": fx.length, "unit": "m"},
@@ -1052,8 +1214,7 @@ def _steps(result: Any, svg: bool) -> list[dict]:
     if land is not None:
         eqs.append(_equation(
             f"F_\\mathrm{{rest}} = k \\min(|d|, s) = {tex_qty(land.stiffness, 'N/m')} \\times "
-            f"{tex_qty(min(abs(land.deflection), land.stroke), 'm')} = {tex_qty(land.force, 'N')}",
-            f"F_rest = k min(|d|, s) = {qty(land.force, 'N')}", svg))
+            f"{tex_qty(min(abs(land.deflection), land.stroke), 'm')} = {tex_qty(land.force, 'N')}", svg))
         results.append({"quantity": "simulated deflection at rest d", "value": land.deflection,
                         "unit": "m"})
         results.append({"quantity": "flexure force on the resting cart", "value": land.force,
@@ -1079,25 +1240,18 @@ def _steps(result: Any, svg: bool) -> list[dict]:
     # step 4
     m_text = ("m_1 + m_2" if spec.controller.tuning_mass == "total" else "m_1")
     eqs = [
-        _equation(f"m = {m_text} = {tex_qty(g.tuning_mass, 'kg')}",
-                  f"m = {qty(g.tuning_mass, 'kg')}", svg),
+        _equation(f"m = {m_text} = {tex_qty(g.tuning_mass, 'kg')}", svg),
         _equation("C(s) = k_s \\left(1 + \\frac{\\omega_i}{s}\\right)"
-                  "\\frac{1 + s/\\omega_d}{1 + s/\\omega_t}",
-                  "C(s) = ks (1 + wi/s) (1 + s/wd) / (1 + s/wt)", svg),
+                  "\\frac{1 + s/\\omega_d}{1 + s/\\omega_t}", svg),
         _equation(f"k_s = \\frac{{m\\, \\omega_c^2}}{{r}} = \\frac{{{tex_qty(g.tuning_mass, 'kg')}"
                   f" \\times ({tex_qty(g.wc, 'rad/s')})^2}}{{{tex_num(result.pid.derivative_ratio)}"
-                  f"}} = {tex_qty(g.ks, 'N/m')}",
-                  f"ks = m wc^2 / r = {qty(g.ks, 'N/m')}", svg),
+                  f"}} = {tex_qty(g.ks, 'N/m')}", svg),
         _equation(f"\\omega_d = \\omega_c / r = {tex_qty(g.wd, 'rad/s')},\\quad \\omega_t = "
                   f"r\\, \\omega_c = {tex_qty(g.wt, 'rad/s')},\\quad \\omega_i = \\omega_c / r_i = "
-                  f"{tex_qty(g.wi, 'rad/s')}",
-                  f"wd = {qty(g.wd, 'rad/s')}, wt = {qty(g.wt, 'rad/s')}, "
-                  f"wi = {qty(g.wi, 'rad/s')}", svg),
+                  f"{tex_qty(g.wi, 'rad/s')}", svg),
         _equation(f"k_p = k_s (1 + \\omega_i/\\omega_d) = {tex_qty(g.kp, 'N/m')},\\quad "
                   f"k_i = k_s \\omega_i = {tex_qty(g.ki, 'N/(m s)')},\\quad "
-                  f"k_d = k_s / \\omega_d = {tex_qty(g.kd, 'N s/m')}",
-                  f"kp = {qty(g.kp, 'N/m')}, ki = {qty(g.ki, 'N/(m s)')}, "
-                  f"kd = {qty(g.kd, 'N s/m')}", svg),
+                  f"k_d = k_s / \\omega_d = {tex_qty(g.kd, 'N s/m')}", svg),
     ]
     steps.append({
         "number": 4, "title": "PID gains", "source": "paper \u00a72.2 and \u00a74 step 4",

@@ -10,6 +10,7 @@ the YAML line, with a suggestion for misspelt keys.
 from __future__ import annotations
 
 import difflib
+import functools
 import hashlib
 import json
 import re
@@ -488,13 +489,18 @@ class _Open:
 
     def __init__(self, obj: Any) -> None:
         self.model = type(obj)
-        self.fields: dict[str, Any] = {}
-        for name, info in self.model.model_fields.items():
-            value = getattr(obj, name)
-            self.fields[name] = _input_form(value, _unit_of(info))
+        units = _field_units(self.model)
+        self.fields: dict[str, Any] = {name: _input_form(getattr(obj, name), unit)
+                                       for name, unit in units.items()}
 
     def plain(self) -> dict:
         return {k: _plain_tree(v) for k, v in self.fields.items()}
+
+
+@functools.lru_cache(maxsize=None)
+def _field_units(model: type) -> dict[str, str]:
+    """Unit of every field of a spec section (``""`` for values without a unit)."""
+    return {name: _unit_of(info) for name, info in model.model_fields.items()}
 
 
 def _plain_tree(value: Any) -> Any:
@@ -532,7 +538,7 @@ def _assign(root: _Open, path: str, value: Any) -> None:
             raise SpecError(_unknown(name, node.model.model_fields, _dotted_tokens(tokens[:n])),
                             path=done)
         container, key = node.fields, name
-        unit = _unit_of(node.model.model_fields[name])
+        unit = _field_units(node.model)[name]
         for sel in selectors:
             seq = container[key]
             if seq is None:
@@ -568,7 +574,7 @@ def _assign(root: _Open, path: str, value: Any) -> None:
         if current is None:
             raise SpecError(f"is not set in this spec, so '{path}' cannot be varied; add the "
                             f"'{name}' section to the spec first", path=done)
-        if hasattr(current, "model_fields") and not isinstance(current, _Open):
+        if hasattr(type(current), "model_fields") and not isinstance(current, _Open):
             current = _Open(current)
             container[key] = current
         node = current

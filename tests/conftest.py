@@ -31,3 +31,24 @@ def paper_spec(paper_spec_path):
     from fi_design.specfile import load_spec
 
     return load_spec(paper_spec_path)
+
+
+# --------------------------------------------------------------------------- parameter studies
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _private_result_cache(tmp_path_factory):
+    """Point the sweep result cache (FI_DESIGN_CACHE_DIR) at a temporary directory.
+
+    No test ever reads or writes the user's cache; tests that need an empty
+    cache of their own pass ``cache=tmp_path`` or set the variable again.
+    """
+    import os
+
+    old = os.environ.get("FI_DESIGN_CACHE_DIR")
+    os.environ["FI_DESIGN_CACHE_DIR"] = str(tmp_path_factory.mktemp("fi_design_cache"))
+    yield
+    if old is None:
+        os.environ.pop("FI_DESIGN_CACHE_DIR", None)
+    else:
+        os.environ["FI_DESIGN_CACHE_DIR"] = old

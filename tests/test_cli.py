@@ -123,10 +123,13 @@ def test_wrong_extension_and_missing_directory(tmp_path, paper_spec_path):
 def test_internal_error_exit_1_without_traceback(paper_spec_path, monkeypatch):
     import fi_design.guideline
 
-    def boom(spec):
+    def boom(spec, **kwargs):
         raise RuntimeError("kaboom")
 
     monkeypatch.setattr(fi_design.guideline, "design", boom)
+    import fi_design.cli
+
+    monkeypatch.setattr(fi_design.cli, "_Job", _FakeJob)
     monkeypatch.delenv("FI_DESIGN_DEBUG", raising=False)
     r = runner.invoke(app, [str(paper_spec_path)])
     assert r.exit_code == 1
@@ -252,16 +255,34 @@ class _FakeResult:
     conclusion = "fake"
     warnings = ()
 
+    isolator_advice = None
+
     def to_dict(self):
         return {"fi_design_version": __version__}
 
+    def with_simulation(self, simulation):
+        return self
+
+
+class _FakeJob:
+    def __init__(self, spec):
+        pass
+
+    def result(self):
+        return None
+
+    def cancel(self):
+        pass
+
 
 def _fake_design(monkeypatch, calls):
-    """Replace the (slow) design by a stub: these tests are about the CLI plumbing."""
+    """Replace the (slow) design and simulations by stubs: these tests are about plumbing."""
+    import fi_design.cli
     import fi_design.guideline
 
-    def fake(spec):
+    def fake(spec, **kwargs):
         calls.append(spec)
         return _FakeResult()
 
     monkeypatch.setattr(fi_design.guideline, "design", fake)
+    monkeypatch.setattr(fi_design.cli, "_Job", _FakeJob)

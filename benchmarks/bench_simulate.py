@@ -1,0 +1,193 @@
+"""Benchmark of the simulation kernel, all figures measured in one run.
+
+Usage::
+
+    python benchmarks/bench_simulate.py [--repeat 20] [--skip-cold]
+
+Prints a Markdown section for BENCHMARKS.md:
+
+- one 20 s simulation of each paper-setup plant with the fast RODAS4 kernel
+  (best of ``--repeat``), with a plain scipy solve_ivp call (LSODA and Radau,
+  the same right-hand side and analytic Jacobian, modes taken from the
+  state, no events) at the same nominal tolerance, and with python-control's
+  ``input_output_response`` on the same right-hand side;
+- the accuracy of each against a tight reference (Radau, rtol 1e-10);
+- the numba compile time with an empty cache and the cache-load time, each
+  in a fresh process;
+- the first-ever and the cached ``fi-design examples/paper_setup.yaml``.
+
+Ratios are against the fast kernel measured in the same run, so the machine's
+load cancels out as far as it can.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "examples" / "paper_setup.yaml"
+
+
+def best(fn, repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def plain_solve_ivp(spec, isolated: bool, t_end: float, method: str):
+    """The same equations in a plain solve_ivp call: modes from the state, no events."""
+    from scipy.integrate import solve_ivp
+
+    from fi_design import plant
+    from fi_design.reference import from_moves
+    from fi_design.simulate import plant_parameters, tolerances
+
+    par = plant_parameters(spec, isolated)
+    p = par.to_array()
+    ref = from_moves(spec.motion.moves, t_end)
+    n = par.n_states
+    modes = np.zeros(4, dtype=np.int64)
+    modes[0] = 1
+
+    def f(t, x):
+        x = np.ascontiguousarray(x, dtype=float)
+        plant.natural_modes(x, p, modes)
+        out = np.empty(n)
+        plant.rhs(t, x, p, modes, float(ref(t)), float(ref(t, 1)), 0.0, True, out)
+        return out
+
+    def jac(t, x):
+        x = np.ascontiguousarray(x, dtype=float)
+        plant.natural_modes(x, p, modes)
+        J = np.empty((n, n))
+        plant.jacobian(t, x, p, modes, float(ref(t)), float(ref(t, 1)), 0.0, True, J)
+        return J
+
+    t = np.arange(int(t_end * 1000) + 1) / 1000.0
+    sol = solve_ivp(f, (0.0, t_end), np.zeros(n), method=method, t_eval=t, rtol=1e-6,
+                    atol=tolerances(par, 1e-6), jac=jac)
+    return sol.y[0]
+
+
+def python_control_run(spec, isolated: bool, t_end: float):
+    """The same equations through control.input_output_response (LSODA, modes from the state)."""
+    import control
+
+    from fi_design import plant
+    from fi_design.reference import from_moves
+    from fi_design.simulate import plant_parameters, tolerances
+
+    par = plant_parameters(spec, isolated)
+    p = par.to_array()
+    ref = from_moves(spec.motion.moves, t_end)
+    n = par.n_states
+    modes = np.zeros(4, dtype=np.int64)
+    modes[0] = 1
+
+    def upd(t, x, u, params):
+        x = np.ascontiguousarray(x, dtype=float)
+        plant.natural_modes(x, p, modes)
+        out = np.empty(n)
+        plant.rhs(t, x, p, modes, float(ref(t)), float(ref(t, 1)), 0.0, True, out)
+        return out
+
+    sys_ = control.nlsys(upd, None, inputs=0, outputs=n, states=n)
+    t = np.arange(int(t_end * 1000) + 1) / 1000.0
+    atol = tolerances(par, 1e-6)
+    res = control.input_output_response(sys_, t, 0, np.zeros(n), solve_ivp_method="LSODA",
+                                        solve_ivp_kwargs={"rtol": 1e-6, "atol": atol})
+    return res.outputs[0]
+
+
+def fresh(code: str, env: dict) -> float:
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-c", code], check=True, env=env, cwd=ROOT)
+    return time.perf_counter() - t0
+
+
+def cli_time(env: dict) -> float:
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "fi_design", str(SPEC)], check=True, env=env, cwd=ROOT,
+                   stdout=subprocess.DEVNULL)
+    return time.perf_counter() - t0
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=20)
+    ap.add_argument("--skip-cold", action="store_true")
+    args = ap.parse_args()
+
+    from fi_design.simulate import simulate
+    from fi_design.specfile import load_spec
+
+    spec = load_spec(SPEC)
+    simulate(spec, isolated=True)  # compile or load the kernel
+    rows = []
+    total_fast = 0.0
+    total_lsoda = 0.0
+    for iso, name in ((True, "isolated"), (False, "non-isolated")):
+        fast = simulate(spec, isolated=iso)
+        t_fast = best(lambda: simulate(spec, isolated=iso), args.repeat)
+        tight = simulate(spec, isolated=iso, method="reference", rtol=1e-10)
+        out = {}
+        for method in ("LSODA", "Radau"):
+            t0 = time.perf_counter()
+            x = plain_solve_ivp(spec, iso, spec.motion.duration, method)
+            out[method] = (time.perf_counter() - t0, x)
+        t0 = time.perf_counter()
+        pc = python_control_run(spec, iso, spec.motion.duration)
+        out["control"] = (time.perf_counter() - t0, pc)
+
+        errors = {k: 1e6 * float(np.max(np.abs(x - tight.position))) for k, (_, x) in out.items()}
+        total_fast += t_fast
+        total_lsoda += out["LSODA"][0]
+        rows.append((name, fast.n_steps, t_fast,
+                     1e6 * float(np.max(np.abs(fast.position - tight.position))), out, errors))
+    print("## Simulation kernel (`benchmarks/bench_simulate.py`)\n")
+    print(f"Measured {time.strftime('%Y-%m-%d')} on this machine in one run; paper setup, 20 s, "
+          "outputs at 1 kHz. Accuracy: largest position difference from Radau at rtol 1e-10.\n")
+    print("| plant | method | time [ms] | ratio to fast | max error [um] |")
+    print("| --- | --- | ---: | ---: | ---: |")
+    for name, steps, t_fast, e_fast, out, errors in rows:
+        print(f"| {name} | fast RODAS4 kernel ({steps} steps) | {1e3 * t_fast:.2f} | 1 | "
+              f"{e_fast:.3f} |")
+        for label, key in (("plain solve_ivp LSODA, rtol 1e-6, analytic Jacobian", "LSODA"),
+                           ("plain solve_ivp Radau, rtol 1e-6, analytic Jacobian", "Radau"),
+                           ("python-control input_output_response (LSODA, no events)",
+                            "control")):
+            t, _ = out[key]
+            print(f"| {name} | {label} | {1e3 * t:.0f} | {t / t_fast:.0f} | {errors[key]:.3f} |")
+    print(f"\nBoth plants together: fast {1e3 * total_fast:.2f} ms, LSODA "
+          f"{1e3 * total_lsoda:.0f} ms, ratio {total_lsoda / total_fast:.0f}.\n")
+
+    if not args.skip_cold:
+        with tempfile.TemporaryDirectory() as cache:
+            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+            cold = fresh("import fi_design.kernel", env)
+            warm = fresh("import fi_design.kernel", env)
+        with tempfile.TemporaryDirectory() as cache:
+            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+            first = cli_time(env)
+            second = cli_time(env)
+        print("| start-up | time [s] |")
+        print("| --- | ---: |")
+        print(f"| kernel compile, empty cache (fresh process) | {cold:.1f} |")
+        print(f"| kernel load from cache (fresh process) | {warm:.2f} |")
+        print(f"| first-ever `fi-design examples/paper_setup.yaml` (empty cache) | {first:.1f} |")
+        print(f"| `fi-design examples/paper_setup.yaml`, cache warm | {second:.1f} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,366 @@
+"""Parameter studies (fi_design.sweep): maps, the paper's trends, executors, cache, robustness.
+
+The trend tests run coarse maps of examples/paper_setup.yaml (Fs = 4 N, Fc = 1 N,
+crossover 8 Hz, k = 6667 N/m, stroke 0.3 mm) and assert what the model does;
+docs/paper_reproduction.md compares it with the paper. The boundaries asserted
+here are the ones measured on finer maps (resolution 12 to 20), with the coarse
+grid points placed away from them.
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+import pytest
+
+from fi_design import sweep as sw
+from fi_design.errors import SpecError
+from fi_design.specfile import with_values
+
+
+@pytest.fixture(scope="module")
+def kernel():
+    sw.warm_up()
+
+
+@pytest.fixture(scope="module")
+def pool(kernel):
+    ctx = multiprocessing.get_context("fork") if "fork" in \
+        multiprocessing.get_all_start_methods() else None
+    with ProcessPoolExecutor(2, mp_context=ctx, initializer=sw.warm_up) as ex:
+        yield ex
+
+
+def cycles_at(result, x, y=None):
+    """Hunting verdict and cycles of the grid point nearest to (x, y)."""
+    i = int(np.argmin(np.abs(result.x.values - x)))
+    if y is None:
+        return result.verdict[i], result.hunting_cycles[i]
+    j = int(np.argmin(np.abs(result.y.values - y)))
+    return result.verdict[j, i], result.hunting_cycles[j, i]
+
+
+# --------------------------------------------------------------------------- axes
+
+
+def test_parse_axis_with_units():
+    ax = sw.parse_axis("isolator.stroke=0.05 mm:1 mm:12")
+    assert ax.path == "isolator.stroke" and ax.unit == "m" and len(ax.values) == 12
+    assert ax.values[0] == pytest.approx(5e-5) and ax.values[-1] == pytest.approx(1e-3)
+    lg = sw.parse_axis("isolator.stiffness=1 N/mm:100 N/mm:3", log=True)
+    np.testing.assert_allclose(lg.values, [1e3, 1e4, 1e5])
+    assert sw.parse_axis("controller.crossover=62.83 rad/s:20:2").values[0] == pytest.approx(10.0,
+                                                                                             1e-3)
+    assert list(sw.parse_axis("stage.mass=1,2,4").values) == [1.0, 2.0, 4.0]
+    assert list(sw.parse_axis("stage.mass=2 kg:2 kg:1").values) == [2.0]
+
+
+@pytest.mark.parametrize("text,words", [
+    ("isolator.strok=1 mm:2 mm:3", "did you mean 'stroke'"),
+    ("isolator.stroke=1 mm:2 mm", "START:STOP:N"),
+    ("isolator.stroke=1 mm:2 mm:0", "at least 1"),
+    ("isolator.stroke=1 mm:2 mm:x", "whole number"),
+    ("isolator.stroke=1 N:2 N:3", "not a length"),
+    ("isolator.stroke", "PATH=START:STOP:N"),
+    ("friction.model=1:2:3", "not a numeric value"),
+    ("friction=1:2:3", "section"),
+])
+def test_parse_axis_errors(text, words):
+    with pytest.raises(SpecError, match=words):
+        sw.parse_axis(text)
+
+
+def test_log_axis_needs_positive_values():
+    with pytest.raises(SpecError, match="above zero"):
+        sw.parse_axis("motion.moves[0].distance=-1 mm:1 mm:3", log=True)
+
+
+# --------------------------------------------------------------------------- points
+
+
+def test_invalid_and_failed_points_are_recorded(paper_spec, kernel):
+    # Fs below Fc = 1 N is invalid; a step budget of 1000 makes the simulation fail
+    res = sw.sweep(paper_spec, ("friction.static", [0.5, 4.0]),
+                   ("simulation.max_steps", [1000, 2_000_000]), isolated=False)
+    v = res.verdict
+    assert list(v[:, 0]) == ["invalid", "invalid"]
+    assert v[0, 1] == "failed" and v[1, 1] == "hunting"
+    bad = res.points[0]
+    assert bad.status == "invalid" and "friction" in bad.message and "Coulomb" in bad.message
+    failed = res.points[1]
+    assert failed.status == "failed" and "step budget" in failed.message
+    assert math.isnan(res.hunting_cycles[0, 0]) and math.isnan(res.hunting_cycles[0, 1])
+    assert res.counts()["invalid"] == 2 and res.counts()["failed"] == 1
+    rows = res.to_csv().splitlines()
+    assert rows[0] == ("friction.static,simulation.max_steps,hunting_cycles,amplitude,period,"
+                       "verdict,status,message")
+    assert rows[1].startswith("0.5,1000.0,,,,invalid,invalid,")
+
+
+def test_result_is_frozen_and_json_ready(paper_spec, kernel):
+    import json
+
+    res = sw.sweep(paper_spec, "controller.crossover=4:12:2")
+    with pytest.raises(ValueError):
+        res.hunting_cycles[0] = 3
+    with pytest.raises(AttributeError):
+        res.isolated = False  # type: ignore[misc]
+    data = json.loads(json.dumps(res.to_dict(), allow_nan=False))
+    assert data["x"]["path"] == "controller.crossover" and data["y"] is None
+    assert data["design_point"] == [8.0]
+    assert data["isolated"] is True
+    assert len(res.table()["verdict"]) == 2
+
+
+def test_design_point_resolves_derived_stiffness(paper_spec):
+    spec = with_values(paper_spec, {"isolator.stiffness": None})
+    assert sw.design_value(spec, "isolator.stiffness") == pytest.approx(4 / 3e-4 / 2)
+
+
+def test_library_is_silent_and_reports_progress(paper_spec, kernel, capsys):
+    calls = []
+    sw.sweep(paper_spec, "controller.crossover=4:12:5", progress=lambda d, n: calls.append((d, n)),
+             chunksize=2)
+    out = capsys.readouterr()
+    assert out.out == "" and out.err == ""
+    assert calls[0] == (0, 5) and calls[-1] == (5, 5)
+    assert [d for d, _ in calls] == sorted(d for d, _ in calls)
+
+
+def test_sweep_of_isolated_plant_needs_an_isolator(paper_spec):
+    bare = with_values(paper_spec, {"isolator": None})
+    with pytest.raises(SpecError, match="no isolator"):
+        sw.sweep(bare, "controller.crossover=4:12:2", isolated=True)
+
+
+def test_fi_design_sweep_callable_after_module_import(paper_spec, kernel):
+    import fi_design
+    import fi_design.sweep  # noqa: F401  (sets the package attribute to the module)
+
+    res = fi_design.sweep(paper_spec, x=("controller.crossover", [8.0]))
+    assert res.verdict[0] == "settled"
+
+
+# --------------------------------------------------------------------------- the paper's trends
+
+
+def test_map_a_friction_gap(paper_spec, kernel):
+    """Without isolator: hunting only from a friction gap Fs - Fc of about 1 N."""
+    res = sw.sweep(paper_spec, "friction.coulomb=0.5,1,1.5,2",
+                   "friction.static=1.25,1.75,2.25,2.75,3.25,3.75,4.25", isolated=False)
+    for pt in res.points:
+        fc, fs = pt.values
+        gap = fs - fc
+        if gap < 0:
+            assert pt.verdict == "invalid"
+        elif gap <= 0.75:
+            assert pt.verdict != "hunting", (fs, fc, pt.verdict)
+        elif gap >= 1.75:
+            assert pt.verdict == "hunting", (fs, fc, pt.verdict)
+    # a larger gap, more cycles: the largest gap of each column hunts more than its smallest
+    for i in range(len(res.x.values)):
+        col = [c for c, v in zip(res.hunting_cycles[:, i], res.verdict[:, i]) if v == "hunting"]
+        assert col[-1] > col[0]
+
+
+def test_map_b_crossover_without_isolator(paper_spec, kernel):
+    """Without isolator: hunting stops above a crossover of about 18 to 20 Hz at 1.6 kg;
+    a heavier stage stops hunting at a lower crossover."""
+    res = sw.sweep(paper_spec, "controller.crossover=6,12,24,30", "stage.mass=0.8,1.6,3.2",
+                   isolated=False)
+    assert cycles_at(res, 12, 1.6)[0] == "hunting"
+    assert cycles_at(res, 24, 1.6)[0] == "settled"
+    free = res.boundary("above")  # lowest crossover from which no point hunts, per mass
+    assert free[1] == 24.0 and free[2] == 12.0 and free[0] >= 30.0
+    line = sw.sweep(paper_spec, "controller.crossover=10,15,20,25", isolated=False)
+    assert list(line.verdict) == ["hunting", "hunting", "settled", "settled"]
+
+
+def test_map_c_stroke_and_stiffness(paper_spec, kernel):
+    """With isolator: a limited stiffness and a stroke above about 0.2 mm are hunting-free."""
+    res = sw.sweep(paper_spec, "isolator.stroke=0.05 mm,0.3 mm,1 mm",
+                   "isolator.stiffness=2000,6667,40000")
+    v = res.verdict
+    assert all(v[j, 0] == "hunting" for j in range(3))  # 0.05 mm: no stiffness helps
+    assert v[0, 1] == v[1, 1] == v[0, 2] == v[1, 2] == "settled"
+    assert v[2, 1] == v[2, 2] == "hunting"  # 40 N/mm: too stiff, whatever the stroke
+
+
+def test_map_d_crossover_with_isolator(paper_spec, pool):
+    """With isolator: 0.3 mm stroke hunting-free from about 5 Hz; a 0.05 mm stroke hunts like
+    the stage without isolator."""
+    res = sw.sweep(paper_spec, "controller.crossover=2,4,6,8,12",
+                   "isolator.stroke=0.05 mm,0.3 mm,1 mm", executor=pool)
+    assert [str(v) for v in res.verdict[1]] == ["hunting", "hunting", "settled", "settled",
+                                                "settled"]
+    assert res.boundary("above")[1] == 6.0 and res.boundary("above")[2] == 6.0
+    assert res.verdict[0, 3] == res.verdict[0, 4] == "hunting"
+
+
+@pytest.mark.slow
+def test_paper_study_boundaries(paper_spec, pool, tmp_path):
+    """The four maps at resolution 10; boundaries as in docs/paper_reproduction.md."""
+    st = sw.paper_study(paper_spec, 10, executor=pool, cache=tmp_path)
+    a, b, c, d = (st.map(k) for k in "ABCD")
+    for pt in a.points:
+        fs, fc = pt.values
+        if 0 <= fs - fc < 0.8:
+            assert pt.verdict != "hunting"
+    j = int(np.argmin(np.abs(b.y.values - 1.6)))
+    assert 15.0 <= b.boundary("above")[j] <= 21.0
+    j = int(np.argmin(np.abs(d.y.values - 3e-4)))
+    assert 3.0 <= d.boundary("above")[j] <= 6.5
+    assert d.boundary("above")[0] > 12.0  # 0.05 mm stroke: like no isolator
+    assert np.all(c.verdict[-1] == "hunting")  # the stiffest joint hunts at every stroke
+
+
+# --------------------------------------------------------------------------- executors, cache
+
+
+def _same(a, b) -> bool:
+    return a.points == b.points and np.array_equal(a.hunting_cycles, b.hunting_cycles,
+                                                   equal_nan=True)
+
+
+def test_process_pool_serial_and_dask_identical(paper_spec, pool):
+    x, y = "controller.crossover=3,6,12", "isolator.stroke=0.1 mm,0.3 mm"
+    serial = sw.sweep(paper_spec, x, y)
+    pooled = sw.sweep(paper_spec, x, y, executor=pool, chunksize=1)
+    assert _same(serial, pooled)
+
+    distributed = pytest.importorskip("distributed")
+    import logging
+
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
+            distributed.Client(cluster) as client:
+        via_dask = sw.sweep(paper_spec, x, y, executor=client)
+    assert _same(serial, via_dask)
+    assert via_dask.run.executor == "Client" and serial.run.executor == "serial"
+
+
+def test_cache_skips_finished_points(paper_spec, kernel, tmp_path):
+    cache = sw.PointCache(tmp_path)
+    first = sw.sweep(paper_spec, "controller.crossover=4:12:4", cache=cache)
+    assert first.run.computed == 4 and first.run.cached == 0 and len(cache) == 4
+    again = sw.sweep(paper_spec, "controller.crossover=4:12:4", cache=cache)
+    assert again.run.computed == 0 and again.run.cached == 4
+    assert _same(first, again)
+    # another plant, another spec value: other keys
+    other = sw.sweep(paper_spec, "controller.crossover=4:12:4", isolated=False, cache=cache)
+    assert other.run.computed == 4
+    moved = with_values(paper_spec, {"friction.static": 4.5})
+    assert sw.sweep(moved, "controller.crossover=4:12:4", cache=cache).run.computed == 4
+
+
+def test_cache_key_covers_version_and_code(paper_spec, monkeypatch):
+    h = sw.spec_digest(paper_spec)
+    key = sw.point_key(h, (("controller.crossover", 8.0),), True)
+    assert key == sw.point_key(h, (("controller.crossover", 8.0),), True)
+    assert key != sw.point_key(h, (("controller.crossover", 8.000000001),), True)
+    import fi_design
+
+    monkeypatch.setattr(fi_design, "__version__", "99.0")
+    assert key != sw.point_key(h, (("controller.crossover", 8.0),), True)
+    monkeypatch.setattr(sw, "_CODE_DIGEST", "edited")
+    monkeypatch.setattr(fi_design, "__version__", fi_design.__version__)
+
+
+def test_interrupted_sweep_resumes(paper_spec, kernel, tmp_path):
+    class Interrupt(Exception):
+        pass
+
+    def stop_after_two_chunks(done, total):
+        if done >= 4:
+            raise Interrupt
+
+    x = "controller.crossover=3:15:7"
+    with pytest.raises(Interrupt):
+        sw.sweep(paper_spec, x, cache=tmp_path, chunksize=2, progress=stop_after_two_chunks)
+    resumed = sw.sweep(paper_spec, x, cache=tmp_path, chunksize=2)
+    assert resumed.run.cached == 4 and resumed.run.computed == 3
+    assert _same(resumed, sw.sweep(paper_spec, x))
+
+
+def test_default_cache_dir_follows_environment(tmp_path, monkeypatch):
+    monkeypatch.setenv(sw.CACHE_ENV, str(tmp_path / "c"))
+    assert sw.PointCache().directory == tmp_path / "c"
+
+
+def test_chunks_interleave():
+    assert sw._chunks(7, 3) == [[0, 3, 6], [1, 4], [2, 5]]
+    assert sorted(i for c in sw._chunks(1000, None) for i in c) == list(range(1000))
+    assert max(len(c) for c in sw._chunks(100_000, None)) <= sw.MAX_CHUNK
+
+
+# --------------------------------------------------------------------------- robustness
+
+
+def test_wilson_interval():
+    lo, hi = sw.wilson_interval(0, 10)
+    assert lo == 0.0 and hi == pytest.approx(0.2775, abs=1e-4)
+    lo, hi = sw.wilson_interval(5, 10)
+    assert (lo, hi) == (pytest.approx(0.2366, abs=1e-4), pytest.approx(0.7634, abs=1e-4))
+    assert sw.wilson_interval(0, 0) == (0.0, 1.0)
+
+
+def test_parse_scatter():
+    assert sw.parse_scatter("friction.static=10%") == sw.Scatter("friction.static", 0.1, True)
+    assert sw.parse_scatter("friction.static=0.3 N") == sw.Scatter("friction.static", 0.3, False)
+    with pytest.raises(SpecError, match="fraction"):
+        sw.parse_scatter("friction.static=3")
+    with pytest.raises(SpecError, match="not a force"):
+        sw.parse_scatter("friction.static=3 mm")
+    assert sw.parse_position_friction("10%:20 mm") == sw.PositionFriction(0.1, 0.02)
+
+
+def test_robustness_is_reproducible(paper_spec, pool):
+    kw = dict(samples=6, seed=3, position_friction=sw.PositionFriction(0.1, 0.02))
+    scatter = ["friction.static=10%", "friction.coulomb=10%"]
+    a = sw.robustness(paper_spec, scatter, executor=pool, **kw)
+    b = sw.robustness(paper_spec, scatter, **kw)
+    assert np.array_equal(a.draws, b.draws) and np.array_equal(a.phases, b.phases)
+    assert a.points == b.points
+    assert a.isolated.probability == b.isolated.probability
+    c = sw.robustness(paper_spec, scatter, samples=6, seed=4)
+    assert not np.array_equal(a.draws, c.draws)
+    assert a.draws.shape == (6, 2) and len(a.points) == 12
+    # the design point hunts without the isolator and settles with it, under 10 % scatter too
+    assert a.not_isolated.hunting >= 4 and a.isolated.hunting <= 1
+    assert 0 <= a.isolated.low <= a.isolated.high <= 1
+    cols = a.table()
+    assert list(cols)[:4] == ["sample", "friction.static", "friction.coulomb", "phase"]
+
+
+def test_robustness_invalid_draws_and_errors(paper_spec, kernel):
+    # Fc scattered by 300 %: some samples exceed Fs and are invalid, left out of the trials
+    r = sw.robustness(paper_spec, [sw.Scatter("friction.coulomb", 3.0)], samples=6, seed=0,
+                      distribution="uniform")
+    for p in (r.isolated, r.not_isolated):
+        assert p.counts["invalid"] > 0 and p.valid == p.samples - p.counts["invalid"] \
+            - p.counts["failed"]
+    with pytest.raises(SpecError, match="nothing scatters"):
+        sw.robustness(paper_spec, [])
+    with pytest.raises(SpecError, match="distribution"):
+        sw.robustness(paper_spec, ["friction.static=10%"], distribution="cauchy")
+
+
+# --------------------------------------------------------------------------- figures
+
+
+def test_figures(paper_spec, kernel):
+    from fi_design import plots
+
+    res = sw.sweep(paper_spec, ("friction.static", [0.5, 4.0]), ("controller.crossover", [4, 8]),
+                   isolated=False)
+    svg = plots.figure_bytes(plots.sweep_figure(res), "svg")
+    assert svg.startswith(b"<?xml") and b"friction.static [N]" not in svg  # text as paths
+    assert svg == plots.figure_bytes(plots.sweep_figure(res), "svg")  # reproducible
+    png = plots.figure_bytes(plots.sweep_figure(sw.sweep(paper_spec, "isolator.stroke=1e-4,3e-4")),
+                             "png")
+    assert png.startswith(b"\x89PNG")
+    assert plots.axis_label("isolator.stroke", "m") == "isolator.stroke [mm]"
+    assert plots.display_unit("N/m") == ("N/mm", 1e-3)
