@@ -35,33 +35,24 @@ Discontinuities are never stepped over:
 Failures (step budget exhausted, step-size underflow, NaN, divergence,
 history overflow) end the run with a status code and the time reached; the
 caller reports them, never silent garbage.
+
+Compilation: every function has an explicit signature, so it compiles once,
+at import, and numba caches it on disk (``cache=True``). The cache lives in
+the package's ``__pycache__``; when the package folder is read-only (a
+system-wide install) numba itself falls back to a user-wide cache directory
+(``~/.cache/numba`` or ``$NUMBA_CACHE_DIR``). A cold compile takes about
+10-15 s on a 2-core machine, loading from the cache about 0.5 s.
 """
 
 from __future__ import annotations
 
-import os
+import math
 
-# Cache compiled code next to the package; fall back to a user cache directory
-# when the package folder is read-only (e.g. a system-wide install).
-_HERE = os.path.dirname(os.path.abspath(__file__))
-if "NUMBA_CACHE_DIR" not in os.environ and not os.access(os.path.join(_HERE, "__pycache__")
-                                                         if os.path.isdir(os.path.join(_HERE, "__pycache__"))
-                                                         else _HERE, os.W_OK):
-    try:
-        from platformdirs import user_cache_dir
+import numpy as np
+from numba import njit
 
-        os.environ["NUMBA_CACHE_DIR"] = os.path.join(user_cache_dir("fi_design"), "numba")
-    except ImportError:  # pragma: no cover - platformdirs is a dependency
-        os.environ["NUMBA_CACHE_DIR"] = os.path.join(os.path.expanduser("~"), ".cache",
-                                                     "fi_design", "numba")
-
-import math  # noqa: E402
-
-import numpy as np  # noqa: E402
-from numba import njit  # noqa: E402
-
-from .plant import A1, A2, I1, b1, f8, i8  # noqa: E402  (numba signature types)
-from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, P_AD11, P_AD12,  # noqa: E402
+from .plant import A1, A2, I1, b1, f8, i8  # numba signature types
+from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, P_AD11, P_AD12,
                     P_AD21, P_AD22, P_BD1, P_BD2, P_CD1, P_CD2, P_DD, P_DELAY, P_FS, P_ISO,
                     P_KD, P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_WT, actuator,
                     drive_force, jacobian, measured_position, natural_modes, rhs)

@@ -161,6 +161,8 @@ def from_moves(moves, duration: float) -> Reference:
         sgn = 1.0 if mv.distance > 0 else -1.0
         vel = 0.0
         for dur, jerk, acc in _move_jerks(mv.distance, mv.velocity, mv.acceleration, mv.jerk):
+            if dur <= 1e-12:  # a phase the limits leave out (round-off of the bisection)
+                continue
             jk, ak = sgn * jerk, sgn * acc
             coeffs.append((p, vel, ak / 2.0, jk / 6.0))
             p = p + vel * dur + ak * dur ** 2 / 2.0 + jk * dur ** 3 / 6.0

@@ -1,0 +1,106 @@
+"""The integrator's pieces against exact answers: linear algebra, dense output, order."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fi_design import kernel
+from fi_design.plant import MODE_SIGN, jacobian
+from fi_design.reference import from_moves
+from fi_design.simulate import plant_parameters
+
+
+@pytest.mark.parametrize("isolated", [True, False])
+def test_structured_solve_equals_dense_solve(paper_spec, isolated):
+    """Eliminating the leaf states gives the same solution as a dense solve."""
+    p = plant_parameters(paper_spec, isolated).to_array()
+    n = 7 if isolated else 5
+    rng = np.random.default_rng(1)
+    modes = np.zeros(4, dtype=np.int64)
+    modes[MODE_SIGN] = 1
+    for _ in range(20):
+        y = rng.normal(size=n) * np.array([1e-3, 1e-2, 1e-3, 1e-2, 1e-6, 1.0, 1.0][:n])
+        J = np.empty((n, n))
+        jacobian(0.0, y, p, modes, 0.0, 0.0, 0.0, True, J)
+        sigma = 10 ** rng.uniform(1, 6)
+        M = np.empty((n - 3, n - 3))
+        piv = np.empty(n - 3, dtype=np.int64)
+        w = np.empty((4, max(n - 3, 3)))
+        assert kernel.struct_factor(J, sigma, M, piv, w)
+        b = rng.normal(size=n)
+        x = b.copy()
+        kernel.struct_solve(J, M, piv, w, x, np.empty(n))
+        exact = np.linalg.solve(sigma * np.eye(n) - J, b)
+        assert np.allclose(x, exact, rtol=1e-9, atol=1e-12 * np.max(np.abs(exact)))
+
+
+@settings(max_examples=60, deadline=None)
+@given(t=st.floats(0.0, 25.0))
+def test_reference_lookup_matches_the_vectorised_evaluation(paper_spec, t):
+    ref = from_moves(paper_spec.motion.moves, 20.0)
+    r, rd, rdd, _ = kernel.reference_at(t, np.array(ref.breaks), np.array(ref.coeffs), 0)
+    assert r == pytest.approx(float(ref(t)), abs=1e-15)
+    assert rd == pytest.approx(float(ref(t, 1)), abs=1e-12)
+
+
+def test_trapezoid_reference_reaches_the_target(paper_spec):
+    mv = paper_spec.motion.moves[0]
+    ref = from_moves(paper_spec.motion.moves, 20.0)
+    t = np.linspace(0, 20, 200001)
+    assert ref.final == pytest.approx(mv.distance, abs=1e-15)
+    assert np.max(ref(t, 1)) == pytest.approx(mv.velocity)
+    assert np.max(np.abs(ref(t, 2))) == pytest.approx(mv.acceleration)
+
+
+def test_jerk_limited_reference_respects_all_limits(paper_spec):
+    from fi_design.spec import Move
+
+    moves = (Move(distance=0.01, velocity=0.05, acceleration=1.0, jerk=50.0),
+             Move(distance=-0.002, velocity=0.05, acceleration=1.0, jerk=50.0, start=5.0))
+    ref = from_moves(moves, 10.0)
+    t = np.linspace(0, 10, 400001)
+    assert ref.final == pytest.approx(0.008, abs=1e-12)
+    assert np.max(np.abs(ref(t, 1))) <= 0.05 * (1 + 1e-9)
+    assert np.max(np.abs(ref(t, 2))) <= 1.0 * (1 + 1e-9)
+    acc = ref(t, 2)
+    assert np.max(np.abs(np.diff(acc) / np.diff(t))) <= 50.0 * (1 + 1e-6)
+    assert ref(4.9) == pytest.approx(0.01)
+
+
+def test_dense_output_is_as_accurate_as_the_steps(paper_spec):
+    """The 1 kHz outputs lie between steps (a few thousand steps for 20 001 samples);
+    the continuous extension keeps them at the tolerance's accuracy, and tighter
+    tolerance makes them better."""
+    from fi_design.simulate import simulate
+
+    exact = simulate(paper_spec, isolated=True, method="reference", rtol=1e-10)
+    errs = []
+    for rtol in (1e-4, 1e-6):
+        r = simulate(paper_spec, isolated=True, rtol=rtol)
+        assert r.n_steps < len(r.time) / 20
+        errs.append(np.max(np.abs(r.position - exact.position)))
+    assert errs[0] > 10 * errs[1]
+    assert errs[1] < 1e-8  # 10 nm over a 10 mm move at rtol 1e-6
+
+
+@pytest.mark.slow
+def test_cache_falls_back_to_a_user_directory(tmp_path):
+    """With no writable __pycache__ beside the source, numba caches in the user cache dir."""
+    src = tmp_path / "pkg"
+    shutil.copytree(os.path.dirname(kernel.__file__), src / "fi_design",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    (src / "fi_design" / "__pycache__").write_text("a file, so no cache directory here")
+    cache = tmp_path / "xdg"
+    env = dict(os.environ, PYTHONPATH=str(src), XDG_CACHE_HOME=str(cache))
+    env.pop("NUMBA_CACHE_DIR", None)
+    subprocess.run([sys.executable, "-c", "import fi_design.kernel"], check=True, env=env,
+                   cwd=tmp_path)
+    assert list(cache.rglob("kernel.integrate-*.nbi"))
