@@ -270,6 +270,14 @@ def design_command(
     no_simulation: Annotated[bool, typer.Option(
         "--no-simulation", help="Only the four linear steps: skip the nonlinear "
                                 "confirmation.")] = False,
+    report_out: Annotated[Optional[Path], typer.Option(
+        "--report", metavar="OUT.html|OUT.pdf",
+        help="Write the sign-off report: one self-contained HTML file, or a PDF (A4), "
+             "chosen by the extension.", show_default=False)] = None,
+    with_map: Annotated[bool, typer.Option(
+        "--map", help="Add a crossover x stroke hunting map around the design point to the "
+                      "report (about 50 more simulations; also `report: {map: true}` in the "
+                      "spec).")] = False,
     force: Annotated[bool, typer.Option(
         "--force", "-f", help="Overwrite existing output files.")] = False,
 ) -> None:
@@ -278,12 +286,19 @@ def design_command(
     Prints the checks (PASS / FAIL / WARN / INFO), the PID gains, the crossover
     of the four linear limit cases, the simulated verdicts with and without the
     isolator, the lowest hunting-free crossovers and the conclusion; writes
-    JSON on request.
+    JSON and the sign-off report (HTML or PDF) on request.
     """
-    from .output import check_output, write_atomic
+    from .output import write_atomic
 
-    json_path = check_output(json_out, force=force, protect=(spec,),
-                             extensions=(".json",)) if json_out else None
+    if with_map and report_out is None:
+        raise typer.BadParameter("the map is part of the report; add --report OUT.html or "
+                                 "--report OUT.pdf", param_hint="--map")
+    if with_map and no_simulation:
+        raise typer.BadParameter("the map simulates; it cannot go with --no-simulation",
+                                 param_hint="--map")
+    outs = _outputs(spec, force, json=(json_out, (".json",)),
+                    report=(report_out, (".html", ".pdf")))
+    json_path, report_path = outs["json"], outs["report"]
     _check_spec_path(spec)
 
     from .specfile import load_spec
@@ -319,6 +334,14 @@ def design_command(
     if json_path is not None:
         write_atomic(json_path, text)
         console.print(f"wrote {json_path}", markup=False)
+    if report_path is not None:
+        from .report import render_report
+
+        with _status(err, "writing the report ...") as status:
+            render_report(result, report_path, command=_command_line(),
+                          map=True if with_map else (False if no_simulation else None),
+                          progress=status)
+        console.print(f"wrote {report_path}", markup=False)
 
 
 class _status:
@@ -782,6 +805,13 @@ class _Executor:
         return "serial" if self.jobs == 1 else f"{self.jobs} worker processes"
 
     def __enter__(self):
+        try:
+            return self._start()
+        except BaseException:
+            self.__exit__(None, None, None)
+            raise
+
+    def _start(self):
         from .sweep import warm_up
 
         warm_up()  # compile or load the kernel once here, before any worker starts
@@ -797,6 +827,9 @@ class _Executor:
             pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx,
                                        initializer=warm_up)
             self._closers.append(lambda: pool.shutdown(wait=True, cancel_futures=True))
+            # start the workers now, before the progress bar's thread exists (fork and threads
+            # do not mix); with fork all workers start at the first submit
+            pool.submit(int).result()
             return pool
         return self._dask()
 
@@ -864,6 +897,21 @@ class _ProgressBar:
 
     def __exit__(self, *exc) -> None:
         self._progress.__exit__(*exc)
+
+
+#: Exit code of a study interrupted with Ctrl-C (128 + SIGINT, as shells report it).
+EXIT_INTERRUPTED = 130
+
+
+def _interrupted(err: "Console", no_cache: bool) -> None:
+    """Say what an interruption kept, then exit 130; no output file is written."""
+    if no_cache:
+        text = "interrupted; nothing was kept (--no-cache) and no output was written"
+    else:
+        text = ("interrupted; the finished points are in the result cache: run the same command "
+                "again to resume. No output was written")
+    err.print(text, markup=False, highlight=False)
+    raise typer.Exit(EXIT_INTERRUPTED)
 
 
 def _cache_for(no_cache: bool):
@@ -1056,9 +1104,12 @@ def sweep_command(
         raise typer.BadParameter("--x and --y sweep the same value", param_hint="--y")
     console = _console()
     err = _console(stderr=True)
-    with pool as ex, _ProgressBar(err, "sweep") as bar:
-        result = sweep(spec_obj, ax, ay, isolated=isolated, executor=ex, progress=bar,
-                       cache=_cache_for(no_cache))
+    try:
+        with pool as ex, _ProgressBar(err, "sweep") as bar:
+            result = sweep(spec_obj, ax, ay, isolated=isolated, executor=ex, progress=bar,
+                           cache=_cache_for(no_cache))
+    except KeyboardInterrupt:
+        _interrupted(err, no_cache)
     _write_sweep_outputs(result, outs, console)
     print_sweep(console, result, spec_path=spec, executor=pool.describe())
 
@@ -1201,9 +1252,12 @@ def study_command(
     spec_obj = load_spec(spec)
     console = _console()
     err = _console(stderr=True)
-    with pool as ex, _ProgressBar(err, "paper study") as bar:
-        result = paper_study(spec_obj, resolution, maps="".join(letters), executor=ex,
-                             progress=bar, cache=_cache_for(no_cache))
+    try:
+        with pool as ex, _ProgressBar(err, "paper study") as bar:
+            result = paper_study(spec_obj, resolution, maps="".join(letters), executor=ex,
+                                 progress=bar, cache=_cache_for(no_cache))
+    except KeyboardInterrupt:
+        _interrupted(err, no_cache)
     _write_study(result, out, targets, console)
     _write_report(result, report_path, console)
     print_study(console, result, spec_path=spec, executor=pool.describe())
@@ -1342,10 +1396,13 @@ def robustness_command(
     pf = parse_position_friction(position_friction) if position_friction else None
     console = _console()
     err = _console(stderr=True)
-    with pool as ex, _ProgressBar(err, "robustness") as bar:
-        result = robustness(spec_obj, items, samples, seed=seed, distribution=distribution,
-                            position_friction=pf, confidence=confidence, executor=ex,
-                            progress=bar, cache=_cache_for(no_cache))
+    try:
+        with pool as ex, _ProgressBar(err, "robustness") as bar:
+            result = robustness(spec_obj, items, samples, seed=seed, distribution=distribution,
+                                position_friction=pf, confidence=confidence, executor=ex,
+                                progress=bar, cache=_cache_for(no_cache))
+    except KeyboardInterrupt:
+        _interrupted(err, no_cache)
     import json
 
     from .output import write_atomic
@@ -1404,9 +1461,12 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
     conf = result.not_isolated.confidence
     t = Table(title=f"Probability of hunting, {result.samples} samples, seed {result.seed}",
               title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
-    for col in ("Plant", "Hunting", "Valid", "P(hunting) [%]", f"{conf:.0%} interval [%]",
-                "Settled", "Stuck", "Undetermined", "Invalid", "Failed"):
-        t.add_column(col, justify="left" if col == "Plant" else "right", no_wrap=True)
+    t.caption = Text(f"P: probability of hunting among the valid samples; CI: {conf:.0%} Wilson "
+                     "interval", style="dim")
+    t.caption_justify = "left"
+    for col in ("Plant", "Hunting", "Valid", "P [%]", "CI [%]", "Settled", "Stuck",
+                "Undetermined", "Invalid", "Failed"):
+        t.add_column(Text(col), justify="left" if col == "Plant" else "right", no_wrap=True)
     for label, p in (("with isolator", result.isolated),
                      ("without isolator", result.not_isolated)):
         if p is None:
@@ -1427,6 +1487,153 @@ def _path_unit(path: str, spec) -> str:
         return path_unit(path, spec)
     except Exception:  # noqa: BLE001 -- a label only
         return ""
+
+
+# --------------------------------------------------------------------------- reconcile
+# (model against measurement: fi_design.reconcile, fi_design.measured, fi_design.gapreport)
+
+
+@app.command("reconcile")
+def reconcile_command(
+    spec: Annotated[Path, typer.Argument(
+        metavar="SPEC.yaml", help="The spec of the stage (YAML).", show_default=False)],
+    measured: Annotated[Path, typer.Argument(
+        metavar="MEASURED.csv", help="The measured trace: columns time_s, reference_m, "
+                                     "position_m, optional force_N and deflection_m.",
+        show_default=False)],
+    report_out: Annotated[Optional[Path], typer.Option(
+        "--report", metavar="GAP.html", help="Write the report: overlays, gap table, ranked "
+                                             "candidates (HTML, or PDF for a .pdf name).",
+        show_default=False)] = None,
+    json_out: Annotated[Optional[Path], typer.Option(
+        "--json", metavar="OUT.json", help="Write the full result as JSON.",
+        show_default=False)] = None,
+    write_spec: Annotated[Optional[Path], typer.Option(
+        "--write-spec", metavar="FIXED.yaml", help="Write the spec with the named effect added "
+                                                   "to its effects list (never the input).",
+        show_default=False)] = None,
+    max_effects: Annotated[int, typer.Option(
+        "--max-effects", min=1, max=10, metavar="N",
+        help="Name up to N effects, each searched on the gap the earlier ones leave.")] = 1,
+    force: Annotated[bool, typer.Option(
+        "--force", "-f", help="Overwrite existing output files.")] = False,
+) -> None:
+    """Find the physical effect the model misses in a measured trace.
+
+    Replays the measured reference through the model, compares it with the
+    measurement segment by segment and by hunting features against the sensor
+    noise, fits every effect of the catalogue, and names the one that explains
+    the gap best (or 'none'), with its fitted size and the gap before and after.
+    """
+    outs = _outputs(spec, force, report=(report_out, (".html", ".pdf")),
+                    json=(json_out, (".json",)), fixed=(write_spec, (".yaml", ".yml")))
+    from .output import check_output
+
+    for key in ("report", "json", "fixed"):
+        if outs[key] is not None:
+            check_output(outs[key], force=force, protect=(spec, measured))
+    _check_spec_path(spec)
+
+    from .measured import load_measurement
+    from .reconcile import fixed_spec_text, reconcile
+    from .specfile import load_spec
+
+    spec_obj = load_spec(spec)
+    data = load_measurement(measured)
+    err = _console(stderr=True)
+    with _FractionBar(err, "reconciling") as bar:
+        result = reconcile(spec_obj, data, max_effects=max_effects, progress=bar)
+    console = _console()
+    print_reconcile(console, result)
+    import json
+
+    from .output import write_atomic
+
+    fixed_text = fixed_spec_text(result) if outs["fixed"] is not None else None
+    if outs["json"] is not None:
+        write_atomic(outs["json"], json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n")
+        console.print(f"wrote {outs['json']}", markup=False, highlight=False)
+    if outs["fixed"] is not None:
+        write_atomic(outs["fixed"], fixed_text)
+        console.print(f"wrote {outs['fixed']}"
+                      + ("" if result.entries else " (no effect found: the spec is unchanged)"),
+                      markup=False, highlight=False)
+    if outs["report"] is not None:
+        from .gapreport import render_gap_report
+
+        render_gap_report(result, outs["report"], command=_command_line())
+        console.print(f"wrote {outs['report']}", markup=False, highlight=False)
+
+
+class _FractionBar:
+    """A rich progress bar on stderr fed by ``progress(message, fraction)``."""
+
+    def __init__(self, console: "Console", text: str) -> None:
+        from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+        self._progress = Progress(TextColumn("{task.description}"), BarColumn(),
+                                  TimeElapsedColumn(), console=console, transient=True,
+                                  disable=not console.is_terminal)
+        self._text = text
+        self._task = self._progress.add_task(text, total=1.0)
+
+    def __enter__(self) -> "_FractionBar":
+        self._progress.__enter__()
+        return self
+
+    def __call__(self, message: str, fraction: float) -> None:
+        self._progress.update(self._task, completed=fraction,
+                              description=f"{self._text}: {message}")
+
+    def __exit__(self, *exc) -> None:
+        self._progress.__exit__(*exc)
+
+
+def print_reconcile(console: "Console", result) -> None:
+    """Print the readable summary of a :class:`~fi_design.reconcile.ReconcileResult`.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to print.
+    result : fi_design.reconcile.ReconcileResult
+        The reconciliation.
+    """
+    from rich import box
+    from rich.table import Table
+    from rich.text import Text
+
+    head = Text("Effect: ", style="bold")
+    head.append(Text(result.effect, style="bold green" if result.effect != "none" else "bold"))
+    console.print(head)
+    console.print(Text(result.conclusion))
+    t = Table(title="Candidates (best first)", title_justify="left", box=box.SIMPLE_HEAD,
+              pad_edge=False)
+    for col, just in (("Effect", "left"), ("Score", "right"), ("Explained", "right"),
+                      ("Fitted parameters (SI)", "left")):
+        t.add_column(col, justify=just)
+    for c in result.candidates:
+        params = ", ".join(f"{k} = {_fmt(v)}" + (f" +- {_fmt(c.uncertainty.get(k), 2)}"
+                                                 if c.uncertainty.get(k) else "")
+                           for k, v in c.parameters.items() if v is not None)
+        t.add_row(Text(c.name), _fmt(c.score), f"{100 * c.explained:.1f} %", Text(params))
+    console.print(t)
+    g = Table(title="Gap before and after", title_justify="left", box=box.SIMPLE_HEAD,
+              pad_edge=False)
+    for col in ("Metric", "Unit", "Before", "After", "Noise"):
+        g.add_column(col, justify="left" if col in ("Metric", "Unit") else "right")
+    for m in result.gaps:
+        g.add_row(Text(m.name), Text(m.unit), _fmt(m.before), _fmt(m.after), _fmt(m.noise))
+    console.print(g)
+    nz = result.noise
+    parts = [f"position {_fmt(nz.position, 3)} m ({nz.source.get('position')})"]
+    if nz.force is not None:
+        parts.append(f"force {_fmt(nz.force, 3)} N ({nz.source.get('force')})")
+    if nz.deflection is not None:
+        parts.append(f"deflection {_fmt(nz.deflection, 3)} m ({nz.source.get('deflection')})")
+    console.print(Text("Noise: " + ", ".join(parts)))
+    for name, why in result.skipped.items():
+        console.print(Text(f"skipped {name}: {why}", style="dim"))
 
 
 def main() -> None:

@@ -84,7 +84,7 @@ def case_label(case: Any) -> str:
     return f"{CASE_NUMBERS.get(case.name, '')} {case.description}".strip()
 
 
-def frequency_grid(result: Any, points: int = 900) -> np.ndarray:
+def frequency_grid(result: Any, points: int = 500) -> np.ndarray:
     """Frequencies [Hz] for the loop plots of a design: every crossover and mode inside.
 
     From a third of the lowest gain crossover of any case (and a thirtieth of
@@ -206,7 +206,7 @@ def bode_figure(result: Any, responses: list | None = None,
     f = frequency_grid(result) if frequency is None else frequency
     responses = loop_responses(result, f) if responses is None else responses
     fc = result.crossover.desired
-    fig = _report_figure(4.8, top=0.62, right=0.3, hspace=0.1)
+    fig = _report_figure(4.3, top=0.62, right=0.3, hspace=0.1)
     mag, pha = fig.subplots(2, 1, sharex=True, height_ratios=(1.1, 1.0))
     by_name = {c.name: c for c in result.crossover.cases}
     phases = []
@@ -241,8 +241,9 @@ def bode_figure(result: Any, responses: list | None = None,
     pha.set_ylabel("phase of L [deg]")
     pha.set_xlabel("frequency [Hz]")
     mag.set_xlim(f[0], f[-1])
-    mag.text(fc, 0.02, f" fc = {fc:g} Hz", transform=mag.get_xaxis_transform(), ha="left",
-             va="bottom", fontsize=7.5, color="0.3")
+    mag.annotate(f"fc = {fc:g} Hz", (fc, 0.02), xycoords=mag.get_xaxis_transform(),
+                 xytext=(3, 0), textcoords="offset points", ha="left", va="bottom",
+                 fontsize=7.5, color="0.3")
     fig.legend(*mag.get_legend_handles_labels(), loc="upper center", ncols=2,
                bbox_to_anchor=(0.5, 1.0), title="limit case (paper Figure 2)",
                title_fontsize=7.5)
@@ -273,7 +274,7 @@ def nyquist_figure(result: Any, responses: list | None = None,
     """
     f = frequency_grid(result) if frequency is None else frequency
     responses = loop_responses(result, f) if responses is None else responses
-    fig = _report_figure(3.2, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
+    fig = _report_figure(3.0, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
     ax = fig.add_subplot()
     for lc, L in responses:
         col = CASE_COLOURS.get(lc.name)
@@ -315,7 +316,7 @@ def sensitivity_figure(result: Any, responses: list | None = None,
     """
     f = frequency_grid(result) if frequency is None else frequency
     responses = loop_responses(result, f) if responses is None else responses
-    fig = _report_figure(3.2, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
+    fig = _report_figure(3.0, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
     ax = fig.add_subplot()
     for lc, L in responses:
         col = CASE_COLOURS.get(lc.name)
@@ -340,7 +341,7 @@ def sensitivity_figure(result: Any, responses: list | None = None,
     return fig
 
 
-def decimate(t: np.ndarray, y: np.ndarray, buckets: int = 1500) -> tuple[np.ndarray, np.ndarray]:
+def decimate(t: np.ndarray, y: np.ndarray, buckets: int = 700) -> tuple[np.ndarray, np.ndarray]:
     """Thin a trace for plotting, keeping each bucket's minimum and maximum.
 
     Parameters
@@ -402,10 +403,10 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
         verdict = getattr(confirmation, key)
         m = res.metrics
         ax.axvspan(m.window[0], m.window[1], color="0.93", lw=0, zorder=0)
+        ax.axhline(0.0, color="0.6", lw=0.6, zorder=1)
+        ax.axhline(h.min_height * 1e3, color="0.35", lw=0.8, ls="--", zorder=1)
         t, e = decimate(res.time, res.error * 1e3)
-        ax.plot(t, e, color=PLANT_COLOURS[key], lw=1.0)
-        ax.axhline(h.min_height * 1e3, color="0.35", lw=0.8, ls="--")
-        ax.axhline(0.0, color="0.6", lw=0.6)
+        ax.plot(t, e, color=PLANT_COLOURS[key], lw=1.0, zorder=2)
         if len(m.peak_times):
             ax.plot(m.peak_times, np.asarray(m.peak_heights) * 1e3, "o", mfc="none",
                     mec="navy", ms=6, mew=1.1, label="counted peak")
@@ -630,7 +631,8 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
 
     A map is a heatmap of hunting cycles (paper Figure 4): white where no
     cycle was counted, invalid points hatched grey, stuck points marked ``s``,
-    undetermined ``?``, failed ``×``, the design point a red cross. A line is a step plot of the cycles over x.
+    undetermined ``?``, failed ``×``, the design point a red cross. A line is
+    a step plot of the cycles over x.
 
     Parameters
     ----------
@@ -872,3 +874,129 @@ def figure_bytes(fig: Any, fmt: str = "svg") -> bytes:
     with matplotlib.rc_context({"svg.hashsalt": "fi_design", "svg.fonttype": "path"}):
         fig.savefig(buf, format=fmt, dpi=150 if fmt == "png" else None, metadata=meta)
     return buf.getvalue()
+
+
+# --------------------------------------------------------------------------- reconciliation
+# (fi_design.reconcile: measured trace against the nominal and the corrected model)
+
+#: Colours of the reconciliation overlays.
+GAP_COLOURS = {"measured": "0.25", "nominal": "C3", "corrected": "C0"}
+
+
+def _gap_label(result: Any) -> str:
+    return ("corrected: + " + ", ".join(result.effects)) if result.effects else \
+        "corrected (no effect added)"
+
+
+@_styled
+def gap_overlay_figure(result: Any) -> Any:
+    """Measured trace with the nominal and the corrected model on top.
+
+    Panels: position error x1 - r [um]; commanded force [N] when measured;
+    joint deflection [um] when measured. Segments compared by features
+    (stick-slip holds) are shaded.
+
+    Parameters
+    ----------
+    result : fi_design.reconcile.ReconcileResult
+        The reconciliation.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    meas = result.measurement
+    t = result.nominal.time
+    r = np.asarray(meas.reference)
+    panels = [("position", "x1 - r [µm]", 1e6, True)]
+    if meas.force is not None:
+        panels.append(("force", "force u [N]", 1.0, False))
+    if meas.deflection is not None and result.nominal.deflection is not None:
+        panels.append(("deflection", "deflection x1 - x2 [µm]", 1e6, False))
+    fig = _report_figure(1.9 * len(panels) + 0.7, top=0.3, hspace=0.3)
+    axes = np.atleast_1d(fig.subplots(len(panels), 1, sharex=True))
+    for ax, (key, label, scale, minus_ref) in zip(axes, panels):
+        for seg in result.segments:
+            if not seg.coherent:
+                ax.axvspan(seg.start, seg.end, color="0.94", lw=0, zorder=0)
+        for name, src in (("measured", meas), ("nominal", result.nominal),
+                          ("corrected", result.corrected)):
+            if name == "corrected" and not result.effects:
+                continue
+            y = np.asarray(getattr(src, key), dtype=float)
+            if minus_ref:
+                y = y - r
+            tt, yy = decimate(t, y * scale)
+            ax.plot(tt, yy, color=GAP_COLOURS[name], lw=0.9 if name == "measured" else 1.1,
+                    ls="-" if name != "nominal" else "--",
+                    label={"measured": "measured", "nominal": "nominal model",
+                           "corrected": _gap_label(result)}[name])
+        ax.set_ylabel(label)
+    axes[0].legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3, borderaxespad=0.1)
+    axes[-1].set_xlabel("time from the first sample [s]")
+    axes[-1].set_xlim(float(t[0]), float(t[-1]))
+    return fig
+
+
+@_styled
+def gap_residual_figure(result: Any) -> Any:
+    """Measured minus modelled position, nominal and corrected, against the noise band.
+
+    Parameters
+    ----------
+    result : fi_design.reconcile.ReconcileResult
+        The reconciliation.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    meas = result.measurement
+    t = result.nominal.time
+    x = np.asarray(meas.position)
+    sigma = result.noise.position * 1e6
+    fig = _report_figure(2.6, top=0.3)
+    ax = fig.subplots()
+    ax.axhspan(-2 * sigma, 2 * sigma, color="0.9", lw=0, zorder=0)
+    for name, src in (("nominal", result.nominal), ("corrected", result.corrected)):
+        if name == "corrected" and not result.effects:
+            continue
+        tt, yy = decimate(t, (x - np.asarray(src.position)) * 1e6)
+        ax.plot(tt, yy, color=GAP_COLOURS[name], lw=0.9,
+                label="nominal model" if name == "nominal" else _gap_label(result))
+    ax.set_ylabel("measured - model [µm]")
+    ax.set_xlabel("time from the first sample [s]")
+    ax.set_xlim(float(t[0]), float(t[-1]))
+    ax.text(0.01, 2 * sigma, " ±2 noise std", transform=ax.get_yaxis_transform(), va="bottom",
+            fontsize=7, color="0.35")
+    ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, borderaxespad=0.1)
+    return fig
+
+
+@_styled
+def candidate_scores_figure(result: Any) -> Any:
+    """Score of every fitted candidate effect (horizontal bars), with the threshold.
+
+    Parameters
+    ----------
+    result : fi_design.reconcile.ReconcileResult
+        The reconciliation.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    cands = list(result.candidates)[::-1]
+    fig = _report_figure(0.28 * max(len(cands), 1) + 0.9, left=1.9, top=0.15)
+    ax = fig.subplots()
+    names = [c.name for c in cands]
+    # signed log scale: scores span many decades
+    vals = np.array([math.copysign(math.log10(1.0 + abs(c.score)), c.score) for c in cands])
+    colours = ["C0" if c.name in result.effects else "0.6" for c in cands]
+    ax.barh(names, vals, color=colours)
+    thr = math.log10(1.0 + result.threshold)
+    ax.axvline(thr, color="C3", lw=0.9, ls="--")
+    ax.text(thr, 1.0, " threshold", transform=ax.get_xaxis_transform(), va="bottom",
+            fontsize=7, color="C3")
+    ax.set_xlabel("score: sign(s) log10(1 + |s|), s = BIC difference")
+    return fig

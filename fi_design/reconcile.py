@@ -506,15 +506,14 @@ def spec_with_entries(spec, entries):
     Returns
     -------
     Spec
-        Validated.
+        The entries are validated; the rest of the spec is shared.
     """
-    new = [entry_input(e["type"], {k: v for k, v in e.items() if k != "type"}) for e in entries]
-    names = {e["type"] for e in new}
-    kept = [entry_input(e.type, e.model_dump(exclude={"type"})) for e in spec.effects
-            if e.type not in names]
-    data = spec.model_dump()
-    data["effects"] = kept + new
-    return _spec.Spec.model_validate(data)
+    new = [make_entry(e["type"], {k: v for k, v in e.items() if k != "type"}) for e in entries]
+    names = {e.type for e in new}
+    kept = [e for e in spec.effects if e.type not in names]
+    if "joint_damping" in names and spec.isolator is None:
+        raise SimulationError("effect joint_damping needs an isolator")
+    return spec.model_copy(update={"effects": tuple(kept + new)})
 
 
 # --------------------------------------------------------------------------- noise
@@ -557,8 +556,9 @@ def quantization_step(x_model: np.ndarray, residual: np.ndarray, noise: float,
 
     When the sensor quantizes, measured minus modelled position is the
     quantization error round(x / q) q - x: a sawtooth over position with
-    spatial period q. Its fundamental is found in a Lomb-Scargle periodogram
-    of the residual over the modelled position (which works through the
+    spatial period q. Its fundamental is found in the power spectrum of the
+    residual over the modelled position (binned at an eighth of the smallest
+    step and Fourier transformed; this works through the
     aliasing of a regularly sampled constant-velocity move, where a test of the
     raw samples would find the sampling pitch v dt instead), then refined by
     the correlation of the residual with the sawtooth predicted for q.
@@ -583,8 +583,6 @@ def quantization_step(x_model: np.ndarray, residual: np.ndarray, noise: float,
     correlation : float
         Correlation of the residual with the sawtooth of the step (0-1).
     """
-    from scipy.signal import lombscargle
-
     x = np.asarray(x_model, dtype=float)
     r = np.asarray(residual, dtype=float)
     if len(x) < 50:
@@ -594,17 +592,21 @@ def quantization_step(x_model: np.ndarray, residual: np.ndarray, noise: float,
     top = min(hi, span / 20.0)
     if not top > bottom:
         return None, 0.0
-    if len(x) > 4000:
-        sel = np.linspace(0, len(x) - 1, 4000).astype(int)
-        x, r = x[sel], r[sel]
     rc = r - np.mean(r)
-    n_f = int(min(100_000, max(2000, 3.0 * span / bottom)))
-    k = np.linspace(2 * np.pi / top, 2 * np.pi / bottom, n_f)
-    power = lombscargle(x, rc, k)
+    b = max(bottom / 8.0, span / 2 ** 21)
+    idx = np.floor((x - x.min()) / b).astype(np.int64)
+    m = 1 << int(math.ceil(math.log2(2 * (int(idx.max()) + 1))))
+    series = np.bincount(idx, weights=rc, minlength=m)
+    power = np.abs(np.fft.rfft(series)) ** 2
+    freq = np.arange(len(power)) / (m * b)  # cycles per metre
+    band = np.nonzero((freq >= 1.0 / top) & (freq <= 1.0 / bottom))[0]
+    if len(band) == 0:
+        return None, 0.0
     best_q, best_c = None, 0.0
-    for j in np.argsort(power)[::-1][:5]:
-        q0 = 2 * np.pi / k[j]
-        dq = (k[1] - k[0]) / k[j] * q0  # one frequency bin, as a step change
+    df = 1.0 / (m * b)
+    for j in band[np.argsort(power[band])[::-1][:5]]:
+        q0 = 1.0 / freq[j]
+        dq = df / freq[j] * q0  # one frequency bin, as a step change
         for q in np.linspace(q0 - 1.5 * dq, q0 + 1.5 * dq, 31):
             s = sawtooth(x, q)
             if np.std(s) == 0:
@@ -656,6 +658,7 @@ class _Problem:
         self.has_defl = meas.deflection is not None and isolated
         self._segments(settle_window)
         self.x0 = self._initial_position()
+        self.rtol = model_tolerance(spec, noise)
 
     # ---- model runs
 
@@ -682,7 +685,7 @@ class _Problem:
         """Simulate with effect entries (model objects) and sample at the measured times."""
         self.n_sims += 1
         res = simulate(self.spec_sim, self.iso, reference=self.ref, initial_position=self.x0,
-                       duration=self.duration, effects=list(entries))
+                       duration=self.duration, effects=list(entries), rtol=self.rtol)
         return self.sample(res, quantize)
 
     def sample(self, res: SimulationResult, quantize: float | None) -> _Trace:
@@ -825,6 +828,21 @@ class _Problem:
             out.append(Segment(kind=str(kind), start=float(self.t[i0]),
                                end=float(self.t[i1 - 1]), coherent=coh))
         return tuple(out)
+
+
+def model_tolerance(spec, noise: NoiseLevels) -> float:
+    """Relative tolerance of the reconciliation's simulations.
+
+    The integrator's absolute position tolerance is ``rtol`` times 1 mm
+    (:func:`fi_design.simulate.tolerances`). Integration errors of the size of
+    a fraction of the sensor noise, summed over thousands of samples, would
+    otherwise let a fit "explain" numerical jitter: the tolerance is set so
+    that the position tolerance is a hundredth of the smallest position or
+    deflection noise (at most the spec's ``simulation.tolerance``, at least
+    1e-9).
+    """
+    sig = min(v for v in (noise.position, noise.deflection) if v is not None)
+    return float(min(spec.simulation.tolerance, max(1e-9, sig / 100.0 / 1e-3)))
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -1332,7 +1350,7 @@ def _fit(ob: _Objective) -> tuple[np.ndarray, float, np.ndarray | None, str]:
     for _, _, u in scored:
         if all(np.max(np.abs(u - c)) > 0.05 for c in chosen):
             chosen.append(u)
-        if len(chosen) >= (3 if sp.method == "periodic" else 2):
+        if len(chosen) >= 2:
             break
     best = (math.inf, None, None)
     lo = np.zeros(len(sp.coords))
@@ -1342,11 +1360,11 @@ def _fit(ob: _Objective) -> tuple[np.ndarray, float, np.ndarray | None, str]:
         try:
             if staged:
                 sol = least_squares(sub, u0, jac=sub_jac, bounds=(lo, hi), method="trf",
-                                    loss="soft_l1", f_scale=3.0, x_scale=1.0, max_nfev=40,
-                                    ftol=1e-6, xtol=1e-6, gtol=1e-8)
+                                    loss="soft_l1", f_scale=3.0, x_scale=1.0, max_nfev=25,
+                                    ftol=1e-6, xtol=1e-5, gtol=1e-8)
                 u0 = np.clip(sol.x, 1e-6, 1 - 1e-6)
             sol = least_squares(ob, u0, jac=ob.jac, bounds=(lo, hi), method="trf",
-                                x_scale=1.0, max_nfev=60, ftol=1e-6, xtol=1e-6, gtol=1e-8)
+                                x_scale=1.0, max_nfev=30, ftol=1e-6, xtol=1e-5, gtol=1e-8)
         except (ValueError, np.linalg.LinAlgError):
             continue
         c2 = float(sol.fun @ sol.fun)
@@ -1367,12 +1385,80 @@ def _fit(ob: _Objective) -> tuple[np.ndarray, float, np.ndarray | None, str]:
     return u, c2, cov, note
 
 
+class _JointObjective:
+    """Residuals of several effects fitted together (u concatenated)."""
+
+    def __init__(self, pb: _Problem, spaces: list, base_entries: list) -> None:
+        self.obs = [_Objective(pb, sp, []) for sp in spaces]
+        names = {sp.name for sp in spaces}
+        self.base = [e for e in base_entries if e.type not in names]
+        self.pb = pb
+        self.slices = []
+        i = 0
+        for sp in spaces:
+            self.slices.append(slice(i, i + len(sp.coords)))
+            i += len(sp.coords)
+        self.coords = [c for sp in spaces for c in sp.coords]
+        self.cache: dict[tuple, np.ndarray] = {}
+
+    def parts(self, u: np.ndarray):
+        out = []
+        for ob, sl in zip(self.obs, self.slices):
+            names, G = ob.value_jacobian(u[sl])
+            out.append((ob.values(u[sl]), names, G, sl))
+        return out
+
+    def __call__(self, u: np.ndarray) -> np.ndarray:
+        key = tuple(np.round(np.asarray(u, float), 12))
+        if key in self.cache:
+            return self.cache[key]
+        entries = list(self.base)
+        q = None
+        for ob, sl in zip(self.obs, self.slices):
+            vals = ob.values(u[sl])
+            entries.append(_spec.EFFECT_MODELS[ob.sp.name].model_construct(type=ob.sp.name,
+                                                                            **vals))
+            if ob.sp.quantize:
+                q = vals["resolution"]
+        r = self.pb.residuals(self.pb.run(entries, quantize=q))
+        self.cache[key] = r
+        return r
+
+    def jac(self, u: np.ndarray) -> np.ndarray:
+        r0 = self(u)
+        J = np.empty((len(r0), len(u)))
+        for j, c in enumerate(self.coords):
+            h = c.step
+            up = np.array(u, float)
+            if up[j] + h <= 1.0:
+                up[j] += h
+            else:
+                up[j] -= h
+                h = -h
+            J[:, j] = (self(up) - r0) / h
+        return J
+
+
+def _joint_fit(jo: _JointObjective, u0: np.ndarray) -> tuple[float, np.ndarray, np.ndarray | None]:
+    from scipy.optimize import least_squares
+
+    u0 = np.clip(u0, 1e-6, 1 - 1e-6)
+    try:
+        sol = least_squares(jo, u0, jac=jo.jac, bounds=(np.zeros(len(u0)), np.ones(len(u0))),
+                            method="trf", max_nfev=60, ftol=1e-6, xtol=1e-6, gtol=1e-8)
+    except (ValueError, np.linalg.LinAlgError):
+        r = jo(u0)
+        return float(r @ r), u0, None
+    return float(sol.fun @ sol.fun), sol.x, np.linalg.pinv(sol.jac.T @ sol.jac)
+
+
 def _periodic_starts(ob: _Objective) -> list[np.ndarray]:
     """Starting points of a spatially periodic effect: periodogram peaks x phase grid."""
     pb, sp = ob.pb, ob.sp
     amp_c, lam_c, ph_c = sp.coords
     peaks = getattr(pb, "periods", []) or []
-    lams = [p[0] for p in peaks if lam_c.lo <= p[0] <= lam_c.hi]
+    peaks = [p for p in peaks if lam_c.lo <= p[0] <= lam_c.hi][:3]
+    lams = [p[0] for p in peaks]
     amps = []
     for p in peaks:
         a = p[1]
@@ -1399,7 +1485,10 @@ def _periodic_starts(ob: _Objective) -> list[np.ndarray]:
 
 def _scan(ob: _Objective) -> tuple[np.ndarray, float, np.ndarray | None, str]:
     """1-D nested scan (for staircase objectives such as the quantization step)."""
-    grid = list(np.linspace(0.0, 1.0, 21)) + [float(u[0]) for u in ob.sp.starts]
+    # quantized simulations are slow (every level crossing is an event): a coarse
+    # grid, plus a fine neighbourhood of a step the staircase signature measured
+    grid = list(np.linspace(0.0, 1.0, 13 if not ob.sp.guess_u else 7))
+    grid += [float(u[0]) for u in ob.sp.starts]
     c = ob.sp.coords[0]
     span = float(np.ptp(ob.pb.meas.position)) or 1.0
     for u in ob.sp.guess_u:
@@ -1408,9 +1497,9 @@ def _scan(ob: _Objective) -> tuple[np.ndarray, float, np.ndarray | None, str]:
         du = math.log1p(0.25 * q / span) / math.log(c.hi / c.lo) if c.log else 0.25 * q / span
         grid += [min(max(u + k * du, 0.0), 1.0) for k in range(-4, 5)]
     vals = {u: ob.chi2(np.array([u])) for u in grid}
-    width = 1.0 / 20
+    width = 1.0 / 12 if not ob.sp.guess_u else 1.0 / 200
     best = min(vals, key=vals.get)
-    for _ in range(2):
+    for _ in range(2 if not ob.sp.guess_u else 1):
         fine = np.clip(np.linspace(best - width, best + width, 9), 0.0, 1.0)
         for u in fine:
             if float(u) not in vals:
@@ -1488,6 +1577,11 @@ def _gaps(pb: _Problem, nom: _Trace, cor: _Trace, chi2_nom: float, chi2_cor: flo
     out.append(GapMetric("misfit", "-", "RMS weighted residual of the comparison (1 = noise)",
                          None, None, None, mb, ma, 1.0, bool(mb > chi_noise),
                          bool(ma > chi_noise)))
+    eb, ea = max(chi2_nom / n - 1.0, 0.0), max(chi2_cor / n - 1.0, 0.0)
+    lim = 3.0 * math.sqrt(2.0 / max(n, 1))
+    out.append(GapMetric("excess", "-", "mean squared weighted residual beyond noise, "
+                                        "chi2 / n - 1 (0 = explained down to noise)",
+                         None, None, None, eb, ea, lim, bool(eb > lim), bool(ea > lim)))
 
     def rms(a, b, mask):
         if mask.sum() == 0:
@@ -1624,7 +1718,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     noise = _noise(spec, measured, iso)
     pb = _Problem(spec, measured, iso, settle_window, list(spec.effects), noise)
     res0 = simulate(pb.spec_sim, iso, reference=pb.ref, initial_position=pb.x0,
-                    duration=pb.duration)
+                    duration=pb.duration, rtol=pb.rtol)
     pb.n_sims += 1
     nom = pb.sample(res0, None)
     if not nom.success:
@@ -1640,6 +1734,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     chosen_names: list[str] = []
     chosen_params: list[dict] = []
     chosen_unc: list[dict] = []
+    chosen_spaces: list[tuple] = []
     rounds: list[SearchRound] = []
     skipped_all: dict[str, str] = {}
     chi2_cur = chi2_nom
@@ -1678,20 +1773,41 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
                 delta_chi2=float(delta), explained=explained, n_parameters=k,
                 n_simulations=ob.n_sims, wall_time=_time.perf_counter() - t0, success=bool(ok),
                 message=note if ok else "every simulation of this candidate failed"))
-            fitted[sp.name] = (vals, unc, sp)
+            fitted[sp.name] = (vals, unc, sp, u)
         cands.sort(key=lambda c: -c.score)
         pick = cands[0] if cands and cands[0].score > threshold and cands[0].success else None
         rounds.append(SearchRound(index=rnd, chi2_start=chi2_cur, candidates=tuple(cands),
                                   selected=pick.name if pick else None))
         if pick is None:
             break
-        vals, unc, sp = fitted[pick.name]
+        vals, unc, sp, u_pick = fitted[pick.name]
+        chosen_spaces.append((sp, u_pick))
         entry = make_entry(pick.name, vals)
         chosen_entries.append(entry)
         chosen_names.append(pick.name)
         chosen_params.append(vals)
         chosen_unc.append(unc)
         chi2_cur = pick.chi2
+    if len(chosen_spaces) > 1:
+        # the effects were chosen one after another: refine them together
+        say("refining the chosen effects together", 0.95)
+        jo = _JointObjective(pb, [sp for sp, _ in chosen_spaces], base)
+        u0 = np.concatenate([u for _, u in chosen_spaces])
+        c2, u, cov = _joint_fit(jo, u0)
+        if c2 < chi2_cur:
+            chi2_cur = c2
+            scale = max(1.0, c2 / max(n - len(u), 1))
+            chosen_params, chosen_unc, chosen_entries = [], [], []
+            for (sp, _), (vals, names_j, G, sl) in zip(chosen_spaces, jo.parts(u)):
+                chosen_params.append(vals)
+                if cov is not None:
+                    sub = cov[sl, sl] * scale
+                    var = np.diag(G @ sub @ G.T)
+                    chosen_unc.append({nm: (float(math.sqrt(v)) if v >= 0 else None)
+                                       for nm, v in zip(names_j, var)})
+                else:
+                    chosen_unc.append({nm: None for nm in names_j})
+                chosen_entries.append(make_entry(sp.name, vals))
     # corrected model
     say("corrected model", 0.97)
     q = None
@@ -1822,7 +1938,8 @@ def fixed_spec_text(result: ReconcileResult) -> str:
 
     spec = result.spec
     org = origin(spec)
-    entries = [dict(e) for e in result.entries]
+    entries = [entry_input(e["type"], {k: v for k, v in e.items() if k != "type"})
+               for e in result.entries]
     names = {e["type"] for e in entries}
     comment = ("# effects added by fi-design reconcile"
                + (f" from {result.measurement.source}" if result.measurement.source else "")
@@ -1862,5 +1979,5 @@ def _flow(entry: dict) -> str:
     for k, v in entry.items():
         if k == "type":
             continue
-        parts.append(f"{k}: {float(v)!r}")
+        parts.append(f"{k}: {v!r}" if isinstance(v, float) else f"{k}: '{v}'")
     return "{" + ", ".join(parts) + "}"

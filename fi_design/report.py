@@ -61,6 +61,7 @@ import datetime as _dt
 import functools
 import math
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Sequence
@@ -269,7 +270,8 @@ def qty(value: Any, unit: str = "", digits: int = 4) -> str:
     if unit == "m" and 0 < abs(value) < 5e-10:
         return _attach("< 0.001", "\u00b5m")
     shown, factor = display_scale(unit, value)
-    return _attach(num(value * factor, digits), shown)
+    scaled = value if factor == 1.0 else value * factor
+    return _attach(num(scaled, digits), shown)
 
 
 def _attach(text: str, shown: str) -> str:
@@ -970,11 +972,13 @@ def _math_atom(tokens: list, i: int, upright: bool) -> tuple[list, int]:
         if val in _SYMBOLS:
             return [("text", _SYMBOLS[val], False, "", "")], i + 1
         if val in _FUNCTIONS:
-            return [("text", val, False, "", "")], i + 1
+            return [("text", val if upright else _THIN + val, False, "", "")], i + 1
         return [("text", val, False, "", "")], i + 1
     if kind == "char":
         if val == " ":
             return [], i + 1
+        if val == "," and not upright:
+            return [("text", "," + _THIN, False, "", "")], i + 1
         return [("text", val, val.isalpha() and not upright, "", "")], i + 1
     return [], i + 1
 
@@ -1060,8 +1064,19 @@ def math_text(tex: str) -> str:
     -------
     str
     """
-    items, _ = _math_parse(_math_tokens(tex), 0, False, None)
-    return "".join(_math_plain(items)).replace(_THIN, " ")
+    def leaf(n: dict) -> str:
+        return n["text"] + (f"_{n['sub']}" if n["sub"] else "") + \
+            (f"^{n['sup']}" if n["sup"] else "")
+
+    parts = []
+    for n in math_nodes(tex):
+        if n["frac"]:
+            parts.append("(" + "".join(leaf(m) for m in n["num"]) + ")/("
+                         + "".join(leaf(m) for m in n["den"]) + ")")
+        else:
+            parts.append(leaf(n))
+    text = "".join(parts).replace(_THIN, " ").replace("\u2212", "-").replace("\u2003", " ")
+    return re.sub(r"\s+", " ", text).strip()
 
 
 def _equation(tex: str, render: bool = True) -> dict:
@@ -1356,6 +1371,10 @@ def _linear(result: Any, figures: bool, fig_no: _Numbering) -> dict:
     }
 
 
+#: Friction models as the literature names them.
+_MODEL_NAMES = {"lugre": "LuGre", "switch": "switch (Karnopp-type)"}
+
+
 def _plant_rows(sim: Any) -> list[dict]:
     mins = sim.min_hunting_free_crossover
     label = "suggested isolator" if sim.suggested_isolator else "with isolator"
@@ -1391,7 +1410,8 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
     out = {
         "intro": (
             f"The stage is simulated with and without {label} at the design crossover, with "
-            f"{sim.isolated.friction_model} friction, through the spec's moves and then at "
+            f"{_MODEL_NAMES.get(sim.isolated.friction_model, sim.isolated.friction_model)} "
+            "friction, through the spec's moves and then at "
             "rest. The paper's hunting metric (section 2.3) counts the peaks of the position "
             f"error x1 - r of at least {qty(h.min_height, 'm')}, at least "
             f"{qty(h.min_distance, 's')} apart, in the window [{num(h.window_start)} s, "
@@ -1410,10 +1430,11 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
                               "stroke; beyond the dashed lines the limiter carries the cart.",
                               fig_no()),
         "scan": _figure((lambda: plots.scan_figure(sim, spec)) if figures else None, "scan",
-                        f"Hunting cycles over the crossover scan ({num(scan.crossovers[0])} to "
-                        f"{num(scan.crossovers[-1])} Hz in steps of {num(scan.resolution)} Hz), "
-                        "both plants; dotted: the lowest crossover from which every scanned "
-                        "crossover settles.", fig_no()),
+                        f"Hunting cycles down the crossover scan (grid {num(scan.grid[0])} to "
+                        f"{num(scan.grid[1])} Hz in steps of {num(scan.grid[2])} Hz), both "
+                        "plants. The scan runs from the top down and stops at the first "
+                        "crossover that does not settle; dotted: the lowest hunting-free "
+                        "crossover, dashed: the design crossover.", fig_no()),
         "landing": None if land is None else {
             "deflection": land.deflection, "stroke": land.stroke, "force": land.force,
             "static_friction": land.static_friction, "rule_force": land.rule_force,
@@ -1421,13 +1442,12 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
         },
         "models_agree": sim.models_agree,
         "cross_check": (
-            f"Cross-check with the {sim.cross_check['isolated'].friction_model} friction model: "
+            f"Cross-check with the {_MODEL_NAMES.get(sim.cross_check['isolated'].friction_model, '')}"
+            " friction model: "
             + ("both models give the same hunting / no-hunting call for both plants."
                if sim.models_agree else
                "the models disagree on the verdict (see the checks); treat the margin to hunting "
                "as small.")),
-        "islands": [{"plant": k, "crossovers": ", ".join(num(x) for x in s.islands)}
-                    for k, s in sim.scans.items() if s.islands],
         "solver": {"steps": iso.n_steps, "rejected": iso.n_rejected, "events": iso.n_events},
     }
     return out
@@ -1443,10 +1463,19 @@ def _map_section(result: Any, map_result: Any, figures: bool, fig_no: _Numbering
         from matplotlib.figure import Figure
         import matplotlib
 
+        from matplotlib.ticker import FuncFormatter, NullFormatter
+
         with matplotlib.rc_context(plots.REPORT_RC):
             fig = Figure(figsize=(plots.REPORT_WIDTH, 3.8), layout="constrained")
             ax = fig.add_subplot()
             plots.draw_sweep(ax, map_result, title="")
+            for axis, swept in ((ax.xaxis, map_result.x), (ax.yaxis, map_result.y)):
+                if swept is not None and swept.log:  # plain numbers, not mathtext powers
+                    _, factor = plots.display_unit(swept.unit)
+                    axis.set_major_formatter(FuncFormatter(plots.plain_tick))
+                    axis.set_minor_formatter(NullFormatter())
+                    lo, hi = min(swept.values) * factor, max(swept.values) * factor
+                    axis.set_ticks([v for v in _nice_ticks(lo, hi)])
         return fig
 
     counts = map_result.counts()
@@ -1459,8 +1488,19 @@ def _map_section(result: Any, map_result: Any, figures: bool, fig_no: _Numbering
         "figure": _figure(make if figures else None, "map",
                           f"Hunting cycles over {x.path} and {y.path} (isolated). Marks: "
                           "s stuck, ? undetermined, \u00d7 failed.", fig_no()),
-        "counts": [{"verdict": k, "count": v} for k, v in counts.items() if v],
+        "counts": ", ".join(f"{k} {v}" for k, v in counts.items() if v),
     }
+
+
+def _nice_ticks(lo: float, hi: float) -> list[float]:
+    """1-2-5 ticks between lo and hi (log axes of the map)."""
+    out = []
+    for exp in range(math.floor(math.log10(lo)) - 1, math.ceil(math.log10(hi)) + 1):
+        for m in (1.0, 2.0, 5.0):
+            v = m * 10.0 ** exp
+            if lo * 0.999 <= v <= hi * 1.001:
+                out.append(float(f"{v:.6g}"))
+    return out
 
 
 def _assumptions(result: Any) -> dict:

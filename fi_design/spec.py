@@ -319,6 +319,8 @@ def _effect_model(effect: _effects.Effect):
 
 
 EFFECT_MODELS = {name: _effect_model(e) for name, e in _effects.CATALOGUE.items()}
+# Module attributes under their own names, so that specs with effects pickle (process pools).
+globals().update({m.__name__: m for m in EFFECT_MODELS.values()})
 
 
 def _effect_tag(value: Any) -> str | None:

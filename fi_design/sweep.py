@@ -386,7 +386,7 @@ def run_chunk(spec: _spec.Spec, tasks: Sequence[tuple[tuple[tuple[str, Any], ...
 
 
 def warm_up() -> None:
-    """Compile or load the simulation kernel in this process.
+    """Compile or load the simulation kernel, and import what a point needs, in this process.
 
     Call it once in the parent before starting worker processes (numba then
     writes its on-disk cache, and forked workers inherit the compiled code),
@@ -397,7 +397,10 @@ def warm_up() -> None:
     -------
     None
     """
-    from . import kernel  # noqa: F401  (compiles at import, or loads numba's cache)
+    import scipy.signal  # noqa: F401  (the metric's peak finder, imported on first use)
+
+    from . import kernel, simulate  # noqa: F401  (the kernel compiles at import or loads
+    #                                  numba's on-disk cache)
 
 
 # --------------------------------------------------------------------------- cache
@@ -1476,7 +1479,9 @@ def wilson_interval(successes: int, trials: int, confidence: float = 0.95) \
     denom = 1.0 + z * z / trials
     centre = (p + z * z / (2 * trials)) / denom
     half = z / denom * math.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials))
-    return max(0.0, centre - half), min(1.0, centre + half)
+    low = 0.0 if successes <= 0 else max(0.0, centre - half)
+    high = 1.0 if successes >= trials else min(1.0, centre + half)
+    return low, high
 
 
 @dataclass(frozen=True, eq=False)

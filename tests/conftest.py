@@ -52,3 +52,14 @@ def _private_result_cache(tmp_path_factory):
         os.environ.pop("FI_DESIGN_CACHE_DIR", None)
     else:
         os.environ["FI_DESIGN_CACHE_DIR"] = old
+
+
+# --------------------------------------------------------------------------- reports
+
+
+@pytest.fixture(scope="session")
+def paper_confirmed_design(paper_spec):
+    """The design of examples/paper_setup.yaml with its simulated confirmation, computed once."""
+    from fi_design.guideline import design
+
+    return design(paper_spec)

@@ -44,6 +44,11 @@ class Case:
 
 def base_spec(case: Case):
     """The spec the reconciliation sees: the paper stage (with or without isolator), no effect."""
+    return load_spec(spec_mapping(case))
+
+
+def spec_mapping(case: Case) -> dict:
+    """The spec of :func:`base_spec` as a YAML-ready mapping."""
     import yaml
 
     src = EXAMPLES / ("paper_setup.yaml" if case.isolated else "no_isolator.yaml")
@@ -59,7 +64,7 @@ def base_spec(case: Case):
         for p in parts[:-1]:
             node = node.setdefault(p, {})
         node[parts[-1]] = value
-    return load_spec(raw)
+    return raw
 
 
 def measure(case: Case, spec=None) -> Measurement:
@@ -74,7 +79,8 @@ def measure(case: Case, spec=None) -> Measurement:
         effects = [EFFECT_MODELS[e["type"]].model_validate(e)]
         if e["type"] == "quantization":
             q = float(effects[0].resolution)
-    res = simulate(spec, case.isolated, effects=effects)
+    # tight tolerance: the "true" stage carries no integration error of its own
+    res = simulate(spec, case.isolated, effects=effects, rtol=1e-8)
     assert res.success, res.message
     rng = np.random.default_rng(case.seed)
     n = len(res.time)

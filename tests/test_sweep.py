@@ -210,7 +210,7 @@ def test_paper_study_boundaries(paper_spec, pool, tmp_path):
         if 0 <= fs - fc < 0.8:
             assert pt.verdict != "hunting"
     j = int(np.argmin(np.abs(b.y.values - 1.6)))
-    assert 15.0 <= b.boundary("above")[j] <= 21.0
+    assert 18.0 <= b.boundary("above")[j] <= 22.5  # hunting comes and goes near 18 to 20 Hz
     j = int(np.argmin(np.abs(d.y.values - 3e-4)))
     assert 3.0 <= d.boundary("above")[j] <= 6.5
     assert d.boundary("above")[0] > 12.0  # 0.05 mm stroke: like no isolator
@@ -357,7 +357,7 @@ def test_figures(paper_spec, kernel):
     res = sw.sweep(paper_spec, ("friction.static", [0.5, 4.0]), ("controller.crossover", [4, 8]),
                    isolated=False)
     svg = plots.figure_bytes(plots.sweep_figure(res), "svg")
-    assert svg.startswith(b"<?xml") and b"friction.static [N]" not in svg  # text as paths
+    assert svg.startswith(b"<?xml") and b"<text" not in svg  # text drawn as paths
     assert svg == plots.figure_bytes(plots.sweep_figure(res), "svg")  # reproducible
     png = plots.figure_bytes(plots.sweep_figure(sw.sweep(paper_spec, "isolator.stroke=1e-4,3e-4")),
                              "png")

@@ -1,0 +1,121 @@
+"""Measured-data files (DESIGN.md section 4): good layouts load, bad ones name column and row."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fi_design.errors import DataError
+from fi_design.measured import load_measurement, measurement_from_arrays, to_csv_text
+
+HEADER = "time_s,reference_m,position_m,force_N,deflection_m"
+
+
+def _rows(n=30, dt=1e-3):
+    return [f"{i * dt:.6f},{1e-4 * i:.6e},{1e-4 * i + 1e-7:.6e},{0.1 * i:.4f},{1e-6:.3e}"
+            for i in range(n)]
+
+
+def _write(tmp_path, text, name="trace.csv"):
+    p = tmp_path / name
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+def test_good_file_loads(tmp_path):
+    m = load_measurement(_write(tmp_path, HEADER + "\n" + "\n".join(_rows()) + "\n"))
+    assert m.n == 30 and m.uniform
+    assert m.columns == ("time_s", "reference_m", "position_m", "force_N", "deflection_m")
+    assert m.force[3] == pytest.approx(0.3)
+    assert not m.time.flags.writeable
+
+
+def test_columns_by_header_any_order_extra_and_comments(tmp_path):
+    lines = ["# recorded on stage 42", "# sample rate 1 kHz",
+             "Position_m,temperature_C,time_s,reference_m"]
+    lines += [f"{1e-5 * i},{21.5},{i * 1e-3},{1e-5 * i}" for i in range(25)]
+    m = load_measurement(_write(tmp_path, "\n".join(lines) + "\n"))
+    assert m.columns == ("time_s", "reference_m", "position_m")
+    assert m.force is None and m.deflection is None
+    assert m.position[5] == pytest.approx(5e-5)
+
+
+def test_non_uniform_sampling_accepted(tmp_path):
+    t = np.cumsum(np.r_[0.0, np.random.default_rng(0).uniform(0.5e-3, 1.5e-3, 40)])
+    lines = [HEADER.rsplit(",", 2)[0]] + [f"{x:.9f},0,0" for x in t]
+    m = load_measurement(_write(tmp_path, "\n".join(lines)))
+    assert not m.uniform and m.n == 41
+
+
+def test_round_trip_through_csv_text(tmp_path):
+    m = measurement_from_arrays(np.arange(25) * 1e-3, np.zeros(25), np.linspace(0, 1e-3, 25),
+                                force_N=np.ones(25))
+    again = load_measurement(_write(tmp_path, to_csv_text(m, comment="two\nlines")))
+    assert np.allclose(again.position, m.position) and again.columns == m.columns
+
+
+@pytest.mark.parametrize("text,column,row,words", [
+    ("", None, None, "empty file"),
+    ("# only a comment\n", None, None, "empty file"),
+    (HEADER + "\n", None, None, "no data rows"),
+    ("time_s,position_m\n" + "\n".join(f"{i},0" for i in range(30)), "reference_m", None,
+     "missing"),
+    ("time_s,reference_m,position_m,position_m\n" + "\n".join(f"{i},0,0,0" for i in range(30)),
+     "position_m", None, "duplicate"),
+    ("time_ms,reference_m,position_m\n" + "\n".join(f"{i},0,0" for i in range(30)), "time_ms",
+     None, "unit 'ms'"),
+    ("time_s,reference_m,position_mm\n" + "\n".join(f"{i},0,0" for i in range(30)), "position_mm",
+     None, "unit 'mm'"),
+    (HEADER + "\n" + "\n".join(_rows()[:5] + ["0.005,1e-4,nan,0,0"] + _rows()[6:]),
+     "position_m", 6, "not a finite number"),
+    (HEADER + "\n" + "\n".join(_rows()[:7] + ["0.007,1e-4,,0,0"] + _rows()[8:]),
+     "position_m", 8, "empty cell"),
+    (HEADER + "\n" + "\n".join(_rows()[:2] + ["0.002,0.2 mm,0,0,0"] + _rows()[3:]),
+     "reference_m", 3, "carries a unit"),
+    (HEADER + "\n" + "\n".join(_rows()[:2] + ["0.002,abc,0,0,0"] + _rows()[3:]),
+     "reference_m", 3, "not a number"),
+    (HEADER + "\n" + "\n".join(_rows()[:10] + ["0.005,0,0,0,0"] + _rows()[11:]), "time_s", 11,
+     "does not increase"),
+    (HEADER + "\n" + "\n".join(_rows()[:4] + ["0.004,0,0"] + _rows()[5:]), None, 5, "field"),
+    (HEADER + "\n" + "\n".join(_rows(10)), "time_s", None, "too short"),
+    (HEADER + "\n" + "\n".join(_rows()[:3] + ["0.003,15.0,0,0,0"] + _rows()[4:]), "reference_m", 4,
+     "implausibly large"),
+])
+def test_bad_files_name_column_and_row(tmp_path, text, column, row, words):
+    with pytest.raises(DataError) as info:
+        load_measurement(_write(tmp_path, text))
+    err = info.value
+    assert words in str(err)
+    assert err.column == column
+    assert err.row == row
+    if column:
+        assert column in str(err)
+    if row is not None:
+        assert f"row {row}" in str(err)
+    assert "trace.csv" in str(err)
+
+
+def test_missing_file_and_directory(tmp_path):
+    with pytest.raises(DataError, match="no such file"):
+        load_measurement(tmp_path / "nope.csv")
+    with pytest.raises(DataError, match="directory"):
+        load_measurement(tmp_path)
+
+
+def test_binary_file(tmp_path):
+    p = tmp_path / "trace.csv"
+    p.write_bytes(b"\xff\xfe\x00\x81" * 10)
+    with pytest.raises(DataError, match="not a text file"):
+        load_measurement(p)
+
+
+def test_arrays_checked_like_files():
+    t = np.arange(30) * 1e-3
+    with pytest.raises(DataError) as info:
+        measurement_from_arrays(t, np.zeros(30), np.zeros(29))
+    assert info.value.column == "position_m"
+    bad = np.zeros(30)
+    bad[7] = np.inf
+    with pytest.raises(DataError) as info:
+        measurement_from_arrays(t, np.zeros(30), np.zeros(30), force_N=bad)
+    assert (info.value.column, info.value.row) == ("force_N", 8)

@@ -1,0 +1,108 @@
+"""`fi-design reconcile` through typer's CliRunner: outputs, contract, bad input."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from fi_design.cli import app
+from fi_design.measured import to_csv_text
+from fi_design.specfile import load_spec
+
+from hidden_effect import Case, base_spec, measure, spec_mapping
+
+runner = CliRunner()
+
+CASE = Case("cli", True, {"type": "cable_force", "stiffness": 60.0, "preload": -0.4}, {},
+            duration=3.0, seed=91)
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("reconcile")
+    raw = spec_mapping(CASE)
+    raw["name"] = "Stage <script>alert(1)</script> & co"
+    spec_path = d / "stage.yaml"
+    spec_path.write_text("# the test stage\n" + yaml.safe_dump(raw, sort_keys=False))
+    data = measure(CASE, base_spec(CASE))
+    csv_path = d / "trace.csv"
+    csv_path.write_text(to_csv_text(data))
+    return d, spec_path, csv_path
+
+
+@pytest.fixture(scope="module")
+def run(files):
+    d, spec_path, csv_path = files
+    out = {k: d / n for k, n in (("json", "gap.json"), ("spec", "fixed.yaml"),
+                                 ("report", "gap.html"))}
+    result = runner.invoke(app, ["reconcile", str(spec_path), str(csv_path), "--json",
+                                 str(out["json"]), "--write-spec", str(out["spec"]), "--report",
+                                 str(out["report"])])
+    return result, out
+
+
+def test_reconcile_command_names_the_effect(run):
+    result, out = run
+    assert result.exit_code == 0, result.output
+    assert "Effect: cable_force" in result.stdout
+    for word in ("Candidates", "Gap before and after", "misfit", "Noise:"):
+        assert word in result.stdout
+
+
+def test_json_contract(run):
+    _, out = run
+    d = json.loads(out["json"].read_text())
+    assert d["effect"] == "cable_force"
+    assert set(d["parameters"]) == {"stiffness", "preload"}
+    assert abs(d["parameters"]["stiffness"] - 60.0) < 6.0
+    assert [c["name"] for c in d["candidates"]][0] == "cable_force"
+    for c in d["candidates"]:
+        assert {"name", "score", "parameters"} <= set(c)
+    assert set(d["gap_before"]) == set(d["gap_after"])
+    assert d["gap_after"]["misfit"] < d["gap_before"]["misfit"]
+    assert d["noise"]["position"] > 0
+
+
+def test_written_spec_reads_back_with_the_effect(run, files):
+    _, out = run
+    _, spec_path, _ = files
+    text = out["spec"].read_text()
+    assert text.startswith("# the test stage")  # the input's text and comments are kept
+    fixed = load_spec(out["spec"])
+    assert [e.type for e in fixed.effects] == ["cable_force"]
+    assert load_spec(spec_path).effects == ()  # the input is untouched
+
+
+def test_report_is_escaped_html(run):
+    _, out = run
+    html = out["report"].read_text()
+    assert html.startswith("<!DOCTYPE html>")
+    for anchor in ('id="finding"', 'id="gap"', 'id="candidates"', 'id="signatures"', "<svg"):
+        assert anchor in html
+    assert "<script>alert(1)</script>" not in html
+    assert "&lt;script&gt;" in html
+
+
+def test_outputs_never_overwrite_inputs(files):
+    d, spec_path, csv_path = files
+    for opt, target in (("--write-spec", spec_path), ("--json", csv_path)):
+        target_copy = target.read_bytes()
+        r = runner.invoke(app, ["reconcile", str(spec_path), str(csv_path), opt, str(target),
+                                "--force"])
+        assert r.exit_code == 2, r.output
+        assert target.read_bytes() == target_copy
+        assert "Traceback" not in r.output
+
+
+def test_bad_measurement_exits_2_naming_the_column(files, tmp_path):
+    _, spec_path, _ = files
+    bad = tmp_path / "bad.csv"
+    bad.write_text("time_s,reference_m,position_mm\n" + "\n".join(f"{i},0,0" for i in range(30)))
+    r = runner.invoke(app, ["reconcile", str(spec_path), str(bad)])
+    assert r.exit_code == 2
+    assert "position_mm" in r.output and "Traceback" not in r.output
+    r = runner.invoke(app, ["reconcile", str(spec_path), str(tmp_path / "missing.csv")])
+    assert r.exit_code == 2 and "no such file" in r.output

@@ -1,0 +1,609 @@
+"""Reports: filters, the design report's context (golden), HTML structure and escaping, the
+PDF (pdftotext), headless Chromium, the CLI's --report and --map, templates in the wheel.
+
+The design of the paper setup is computed once per session (``paper_confirmed_design``);
+the artifacts a person looks at (report.html, report.pdf, page images, the Chromium
+screenshot) are kept under tests/artifacts/ (gitignored).
+"""
+
+from __future__ import annotations
+
+import html.parser
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from fi_design import report
+from fi_design.cli import app
+
+from conftest import EXAMPLES, ROOT
+
+ARTIFACTS = ROOT / "tests" / "artifacts"
+DATE = "2026-01-01"
+COMMAND = "fi-design examples/paper_setup.yaml --report report.html"
+NNBSP = "\u202f"
+NBSP = "\u00a0"
+
+#: Sections of the design report, in the order the issue asks for.
+DESIGN_SECTIONS = ["verdict", "inputs", "steps", "linear", "nonlinear", "assumptions",
+                   "references", "appendix"]
+
+runner = CliRunner()
+
+
+def _artifacts() -> Path:
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    return ARTIFACTS
+
+
+# --------------------------------------------------------------------------- filters
+
+
+@pytest.mark.parametrize("value,expected", [
+    (None, "\u2013"), (True, "yes"), (False, "no"), ("text", "text"), (0, "0"), (0.0, "0"),
+    (2.0, "2"), (0.3, "0.3"), (47.306, "47.31"), (47.30, "47.3"), (13333.33, f"13{NNBSP}333"),
+    (6667.0, "6667"), (-0.6247, "-0.6247"), (1e6, f"1 \u00d7 10\u2076"),
+    (3.2e-8, "3.2 \u00d7 10\u207b\u2078"), (2.5e-4, "0.00025"), (float("inf"), "\u221e"),
+    (float("-inf"), "-\u221e"), (float("nan"), "n/a"), (12345, f"12{NNBSP}345"),
+    (150.8, "150.8"), (0.001348, "0.001348"),
+])
+def test_num(value, expected):
+    assert report.num(value) == expected
+
+
+def test_num_digits():
+    assert report.num(math.pi, 3) == "3.14"
+    assert report.num(123456.7, 3) == f"123{NNBSP}457"
+
+
+@pytest.mark.parametrize("value,unit,expected", [
+    (3e-4, "m", f"0.3{NBSP}mm"), (1e-5, "m", f"10{NBSP}\u00b5m"), (-2.78e-4, "m", f"-0.278{NBSP}mm"),
+    (1.4e-12, "m", f"< 0.001{NBSP}\u00b5m"), (3e-3, "m/s", f"3{NBSP}mm/s"),
+    (2e11, "Pa", f"200{NBSP}GPa"), (3.155e7, "Pa", f"31.55{NBSP}MPa"),
+    (47.31, "deg", "47.31\u00b0"), (6.0, "dB", f"6{NBSP}dB"), (5, "cycles", f"5{NBSP}cycles"),
+    (20.0, "N*s/m", f"20{NBSP}N\u00b7s/m"), (1.0, "m/s**2", f"1{NBSP}m/s\u00b2"),
+    (7800.0, "kg/m**3", f"7800{NBSP}kg/m\u00b3"), (0.02, "1", "0.02"), (None, "Hz", "\u2013"),
+    ("lugre", "", "lugre"), ([0.01, 0.06], "m", f"10 \u2013 60{NBSP}mm"),
+    ([1.0, 30.0], "Hz", f"1 \u2013 30{NBSP}Hz"), ((), "m", "\u2013"),
+])
+def test_qty(value, unit, expected):
+    assert report.qty(value, unit) == expected
+
+
+@pytest.mark.parametrize("unit,expected", [
+    ("N*s/m", "N\u00b7s/m"), ("m/s**2", "m/s\u00b2"), ("kg/m**3", "kg/m\u00b3"), ("1", ""),
+    ("-", ""), ("Hz", "Hz"), ("deg", "\u00b0"), ("N/(m s)", "N/(m\u00b7s)"), (None, ""),
+])
+def test_unit_text(unit, expected):
+    assert report.unit_text(unit) == expected
+
+
+def test_display_scale_shares_a_unit_between_value_and_limit():
+    row = report.check_row(_check("flexure.stress", 3.155e7, 3e8, "Pa"))
+    assert row["unit"] == "MPa"
+    assert row["value"] == pytest.approx(31.55) and row["limit"] == pytest.approx(300.0)
+    assert row["sense"] == "\u2264" and row["status"] == "PASS" and row["css"] == "pass"
+    assert row["label"] == "Flexure bending stress at full stroke"
+
+
+def _check(name, value, limit, unit, passed=True):
+    from fi_design.results import Check
+
+    return Check(name, passed, value, limit, unit, "msg", step="step 3 flexure")
+
+
+def test_check_labels_name_the_limit_case():
+    assert report.check_label("phase_margin.stuck_free") == \
+        "Phase margin, case 2 (cart stuck, joint free)"
+    assert report.check_label("parasitic_separation.tilt").startswith("Parasitic mode \u2018tilt")
+    assert report.check_label("some_new_check") == "Some new check"
+
+
+def test_tex_quantities():
+    assert report.tex_num(13333.3) == "13\\,333"
+    assert report.tex_num(2e11) == "2 \\times 10^{11}"
+    assert report.tex_qty(3e-4, "m") == "0.3\\ \\mathrm{mm}"
+    assert report.tex_qty(100.5, "N s/m") == "100.5\\ \\mathrm{N\\cdot s/m}"
+    assert report.tex_qty(47.3, "deg") == "47.3^\\circ"
+
+
+def test_math_nodes_fraction_scripts_and_greek():
+    nodes = report.math_nodes(r"k_\max = \frac{F_s}{\gamma\, s} = 13\,333\ \mathrm{N/m}")
+    assert nodes[0] == {"frac": False, "text": "k", "var": True, "sub": "max", "sup": ""}
+    frac = next(n for n in nodes if n["frac"])
+    assert [m["text"] for m in frac["num"]] == ["F"] and frac["num"][0]["sub"] == "s"
+    assert [m["text"] for m in frac["den"]] == ["\u03b3", "\u2009", "s"]
+    tail = "".join(n["text"] for n in nodes if not n["frac"])
+    assert "13\u2009333" in tail and "N/m" in tail and "\u2009=\u2009" in tail
+
+
+def test_math_nodes_superscripts_and_upright_units():
+    nodes = report.math_nodes(r"(0.4\ \mathrm{mm})^3 \leq \omega_c^2")
+    text = "".join(n["text"] for n in nodes)
+    assert "\u2264" in text and not any(n["var"] for n in nodes if "mm" in n["text"])
+    assert any(n["sup"] == "3" for n in nodes) and any(n["sub"] == "c" and n["sup"] == "2"
+                                                       for n in nodes)
+
+
+def test_math_text_is_readable():
+    assert report.math_text(r"\Delta F = F_s - F_c") == "\u0394F = F_s - F_c"
+    assert report.math_text(r"k = \frac{F_s}{s}") == "k = (F_s)/(s)"
+
+
+def test_report_date(monkeypatch):
+    import datetime as dt
+
+    assert report.report_date("2026-01-01") == "2026-01-01"
+    assert report.report_date(dt.date(2025, 3, 4)) == "2025-03-04"
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "0")
+    assert report.report_date() == "1970-01-01"
+
+
+# --------------------------------------------------------------------------- templates
+
+
+ALLOWED_TAGS = {"extends", "block", "endblock", "for", "endfor", "if", "else", "endif"}
+OPERATORS = re.compile(r"==|!=|<=|>=|<|>|\+|(?<![\w.])-|\*|/|%|\band\b|\bor\b|\bnot\b|~")
+
+
+def _templates():
+    return sorted(report.template_dir().glob("*.jinja"))
+
+
+def test_templates_found_in_the_source_tree():
+    assert report.template_dir() == ROOT / "templates"
+    names = {p.name for p in _templates()}
+    for section in DESIGN_SECTIONS + ["map", "generic", "section", "report", "equation"]:
+        assert f"{section}.html.jinja" in names
+
+
+@pytest.mark.parametrize("path", _templates(), ids=lambda p: p.name)
+def test_templates_are_logic_free(path):
+    text = path.read_text(encoding="utf-8")
+    tags = set(re.findall(r"{%-?\s*(\w+)", text))
+    assert tags <= ALLOWED_TAGS, f"{path.name}: {sorted(tags - ALLOWED_TAGS)}"
+    if path.name != "section.html.jinja" and path.name not in ("report.html.jinja",
+                                                                "equation.html.jinja"):
+        assert text.lstrip().startswith('{% extends "section.html.jinja" %}'), path.name
+    exprs = re.findall(r"{{(.*?)}}", text) + re.findall(r"{%-?\s*(?:if|for)\s(.*?)%}", text)
+    for expr in exprs:
+        bare = re.sub(r"\"[^\"]*\"|'[^']*'", "", expr)
+        bare = re.sub(r"^\s*\w+\s+in\s+", "", bare)  # the `x in xs` of a for loop
+        filters = re.findall(r"\|\s*(\w+)", bare)
+        assert set(filters) <= {"num", "qty", "unit"}, f"{path.name}: {expr}"
+        assert not OPERATORS.search(bare.replace("|", " ")), f"{path.name}: {{{{{expr}}}}}"
+
+
+def test_environment_escapes_and_is_strict():
+    import jinja2
+
+    env = report.environment()
+    assert env.undefined is jinja2.StrictUndefined
+    tmpl = env.from_string("{{ x }}")
+    assert tmpl.render(x="<b>&") == "&lt;b&gt;&amp;"
+    with pytest.raises(jinja2.UndefinedError):
+        tmpl.render()
+    assert env.get_template("section.html.jinja").render(
+        section={"id": "a", "number": 1, "title": "<i>"}).count("&lt;i&gt;") == 1
+
+
+# --------------------------------------------------------------------------- golden context
+
+
+def _for_golden(obj, key=None):
+    """Drop rendered markup and machine-dependent parts; round floats to 4 significant digits."""
+    if isinstance(obj, dict):
+        return {k: _for_golden(v, k) for k, v in obj.items()
+                if k not in ("html", "svg", "versions")}
+    if isinstance(obj, (list, tuple)):
+        return [_for_golden(v) for v in obj]
+    if isinstance(obj, float):
+        if not math.isfinite(obj):
+            return str(obj)
+        if abs(obj) < 1e-10:
+            return 0.0
+        return float(f"{obj:.4g}")
+    return obj
+
+
+def test_design_context_golden(paper_confirmed_design, data_regression):
+    ctx = report.build_context(paper_confirmed_design, date=DATE, command=COMMAND,
+                               figures=False)
+    ctx["meta"]["spec_path"] = Path(ctx["meta"]["spec_path"]).name
+    ctx["meta"]["tool"] = "fi-design VERSION"
+    for row in ctx["appendix"]["solver"]:  # solver statistics: not the report's findings
+        if row["quantity"].startswith("steps / rejected / events"):
+            row["value"] = "steps / rejected / events"
+    assert [s["id"] for s in ctx["sections"]] == DESIGN_SECTIONS
+    data_regression.check(_for_golden(ctx))
+
+
+def test_context_numbers(paper_confirmed_design):
+    ctx = report.build_context(paper_confirmed_design, date=DATE, command=COMMAND,
+                               figures=False)
+    rows = {r["name"]: r for g in ctx["verdict"]["groups"] for r in g["rows"]}
+    assert rows["drive_stiffness"]["value"] == pytest.approx(6667.0)
+    assert rows["drive_stiffness"]["limit"] == pytest.approx(4.0 / 0.3e-3)
+    assert rows["friction_gap"]["status"] == "WARN"
+    assert len(rows) == len(paper_confirmed_design.checks)
+    assert ctx["verdict"]["overall"] == "PASS with warnings"
+    inputs = {r["path"]: r for g in ctx["inputs"] for r in g["rows"]}
+    assert inputs["friction.static"]["source"] == "given"
+    assert inputs["friction.static"]["written"] == "4 N"
+    assert inputs["isolator.limiter.stiffness"]["source"] == "default"
+    assert inputs["isolator.limiter.damping"]["source"].startswith("derived default")
+    assert inputs["isolator.limiter.damping"]["value"] == pytest.approx(
+        2 * 0.2 * math.sqrt(1e6 * 1.6))
+    assert [s["number"] for s in ctx["steps"]] == [1, 2, 3, 4]
+    assert all(s["equations"] for s in ctx["steps"])
+
+
+# --------------------------------------------------------------------------- HTML
+
+
+class _Tags(html.parser.HTMLParser):
+    """Collects tags with attributes, section ids and text."""
+
+    def __init__(self) -> None:
+        super().__init__(convert_charrefs=True)
+        self.tags: list[tuple[str, dict]] = []
+        self.text: list[str] = []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append((tag, dict(attrs)))
+
+    def handle_startendtag(self, tag, attrs):
+        self.tags.append((tag, dict(attrs)))
+
+    def handle_data(self, data):
+        self.text.append(data)
+
+
+def _parse(text: str) -> _Tags:
+    p = _Tags()
+    p.feed(text)
+    p.close()
+    return p
+
+
+@pytest.fixture(scope="module")
+def design_html(paper_confirmed_design) -> str:
+    ctx = report.build_context(paper_confirmed_design, date=DATE, command=COMMAND)
+    text = report.render_html(ctx)
+    (_artifacts() / "report.html").write_text(text, encoding="utf-8")
+    return text
+
+
+def test_html_has_every_section_in_order(design_html):
+    p = _parse(design_html)
+    ids = [a["id"] for t, a in p.tags if t == "section"]
+    assert ids == DESIGN_SECTIONS
+    toc = [a["href"] for t, a in p.tags if t == "a"]
+    assert toc[:len(ids)] == [f"#{i}" for i in ids]
+    text = " ".join(p.text)
+    for words in ("Friction isolator design report", "Prepared", "Checked", "Approved",
+                  "Spec SHA-256", COMMAND, DATE, "Canudas de Wit", "Hensen", "Hairer",
+                  "Okwudire", "RODAS4"):
+        assert words in text, words
+
+
+def test_html_is_self_contained(design_html):
+    p = _parse(design_html)
+    assert not any(t == "script" for t, _ in p.tags)
+    assert not any(t in ("link", "img", "iframe", "object", "embed") for t, _ in p.tags)
+    for tag, attrs in p.tags:
+        for name, value in attrs.items():
+            if name in ("href", "src", "xlink:href", "action", "data"):
+                assert value is None or value.startswith("#"), (tag, name, value)
+            if name.startswith("on"):
+                pytest.fail(f"event handler {name} on <{tag}>")
+            if name not in ("xmlns", "xmlns:xlink") and value:
+                assert not re.search(r"https?://", value), (tag, name, value)
+    styles = re.findall(r"<style>(.*?)</style>", design_html, flags=re.S)
+    assert styles and not any(re.search(r"url\(\s*['\"]?(?!#)", s) for s in styles)
+    assert "@import" not in design_html
+
+
+def test_html_figures_and_equations_inline(design_html):
+    p = _parse(design_html)
+    figures = [a["id"] for t, a in p.tags if t == "figure"]
+    assert figures == ["fig-bode", "fig-nyquist", "fig-sensitivity", "fig-error",
+                       "fig-deflection", "fig-scan"]
+    svgs = re.findall(r"<figure[^>]*>\s*<svg", design_html)
+    assert len(svgs) == len(figures)
+    ids = re.findall(r'\sid="([^"]+)"', design_html)
+    assert len(ids) == len(set(ids)), "duplicate ids across the inline figures"
+    assert design_html.count('class="math"') >= 12
+    assert 'class="frac"' in design_html
+
+
+def test_html_is_reproducible(paper_confirmed_design, design_html):
+    again = report.render_html(report.build_context(paper_confirmed_design, date="2027-12-31",
+                                                    command=COMMAND))
+    assert again.replace("2027-12-31", DATE) == design_html
+
+
+@pytest.fixture(scope="module")
+def hostile_design():
+    raw = yaml.safe_load((EXAMPLES / "paper_setup.yaml").read_text(encoding="utf-8"))
+    raw["name"] = "<script>alert('x')</script> & \"Co\""
+    raw["report"] = {"document_id": "<b>FI-9</b>", "revision": "B&C", "status": "for review",
+                     "author": "<img src=x onerror=alert(1)>"}
+    from fi_design.guideline import design
+
+    return design(raw, confirm=False)
+
+
+def test_user_text_is_escaped(hostile_design):
+    text = report.render_html(report.build_context(hostile_design, date=DATE, command="x",
+                                                   figures=False))
+    p = _parse(text)
+    assert not any(t in ("script", "img", "b") for t, _ in p.tags)
+    assert "&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt; &amp; &#34;Co&#34;" in text
+    assert "&lt;b&gt;FI-9&lt;/b&gt;" in text and "B&amp;C" in text
+    assert "<script" not in text and "onerror=alert" not in text.replace("onerror=alert(1)&gt;",
+                                                                         "")
+    assert "not run" in " ".join(p.text)  # no simulation: the section says so
+    assert "FOR REVIEW" not in text and "for review" in text
+
+
+# --------------------------------------------------------------------------- PDF
+
+
+needs_poppler = pytest.mark.skipif(shutil.which("pdftotext") is None,
+                                   reason="poppler-utils (pdftotext) is not installed")
+
+
+@pytest.fixture(scope="module")
+def design_pdf(paper_confirmed_design) -> Path:
+    out = _artifacts() / "report.pdf"
+    report.render_report(paper_confirmed_design, out, date=DATE, command=COMMAND)
+    return out
+
+
+@needs_poppler
+def test_pdf_opens_with_page_numbers_and_key_numbers(design_pdf):
+    info = subprocess.run(["pdfinfo", str(design_pdf)], capture_output=True, text=True,
+                          timeout=60)
+    assert info.returncode == 0, info.stderr
+    pages = int(re.search(r"Pages:\s+(\d+)", info.stdout).group(1))
+    assert pages >= 8
+    assert re.search(r"Page size:\s+595\.\d* x 841\.\d*", info.stdout), "not A4"
+    out = subprocess.run(["pdftotext", "-layout", str(design_pdf), "-"], capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    text = out.stdout.replace(NNBSP, " ").replace(NBSP, " ")
+    for n in range(1, pages + 1):
+        assert f"Page {n} of {pages}" in text
+    assert text.count("FI-0001 rev. A (draft)") >= pages  # the running header
+    for number in ("13 333", "6667", "11.82", "2190", "8467", "100.5", "5.5 Hz", "20 Hz",
+                   "PASS with warnings", "Conclusion", "k max", DATE):
+        assert number in text, number
+    if shutil.which("pdftoppm"):
+        subprocess.run(["pdftoppm", "-r", "50", "-png", str(design_pdf),
+                        str(_artifacts() / "report-page")], check=True, timeout=120)
+
+
+# --------------------------------------------------------------------------- Chromium
+
+
+def _chromium() -> str | None:
+    for name in ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable"):
+        if shutil.which(name):
+            return shutil.which(name)
+    return None
+
+
+needs_chromium = pytest.mark.skipif(_chromium() is None,
+                                    reason="no headless Chromium (apt install chromium) to "
+                                           "render the HTML report")
+
+
+def _headless(page: Path, tmp: Path, *extra: str) -> subprocess.CompletedProcess:
+    cmd = [_chromium(), "--headless", "--no-sandbox", "--disable-gpu",
+           "--disable-background-networking", "--disable-component-update", "--no-first-run",
+           f"--user-data-dir={tmp / 'chromium-profile'}", "--hide-scrollbars",
+           "--enable-logging=stderr", "--v=0", *extra, page.as_uri()]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+
+
+CONSOLE = re.compile(r":CONSOLE[:(]")
+
+
+@needs_chromium
+def test_chromium_console_check_sees_errors(tmp_path):
+    """The check below is real: a page with a script error shows up on the console log."""
+    page = tmp_path / "bad.html"
+    page.write_text("<!DOCTYPE html><p>x</p><script>console.error('boom')</script>")
+    p = _headless(page, tmp_path, "--dump-dom")
+    assert CONSOLE.search(p.stderr), p.stderr[-2000:]
+
+
+@needs_chromium
+def test_html_renders_in_chromium_without_console_errors(design_html, tmp_path):
+    page = _artifacts() / "report.html"
+    shot = _artifacts() / "report-chromium.png"
+    shot.unlink(missing_ok=True)
+    p = _headless(page, tmp_path, f"--screenshot={shot}", "--window-size=1000,9000")
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert not CONSOLE.search(p.stderr), [ln for ln in p.stderr.splitlines()
+                                          if CONSOLE.search(ln)]
+    assert shot.is_file() and shot.stat().st_size > 50_000
+    dom = _headless(page, tmp_path, "--dump-dom")
+    assert dom.returncode == 0 and not CONSOLE.search(dom.stderr)
+    for sid in DESIGN_SECTIONS:
+        assert f'id="{sid}"' in dom.stdout
+
+
+# --------------------------------------------------------------------------- CLI
+
+
+def _refuse_work(monkeypatch):
+    import fi_design.specfile
+
+    def boom(*a, **k):
+        raise AssertionError("the spec was read: the output path was not checked first")
+
+    monkeypatch.setattr(fi_design.specfile, "load_spec", boom)
+
+
+def test_cli_refuses_a_wrong_extension_before_any_work(tmp_path, monkeypatch, paper_spec_path):
+    _refuse_work(monkeypatch)
+    out = tmp_path / "report.docx"
+    r = runner.invoke(app, [str(paper_spec_path), "--report", str(out)])
+    assert r.exit_code == 2, r.output
+    assert ".html or .pdf" in r.output and not out.exists()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_refuses_an_existing_report_without_force(tmp_path, monkeypatch, paper_spec_path):
+    _refuse_work(monkeypatch)
+    out = tmp_path / "report.pdf"
+    out.write_text("old")
+    r = runner.invoke(app, [str(paper_spec_path), "--report", str(out)])
+    assert r.exit_code == 2 and "--force" in r.output
+    assert out.read_text() == "old"
+
+
+def test_cli_refuses_the_spec_as_report_even_with_force(tmp_path, monkeypatch):
+    _refuse_work(monkeypatch)
+    spec = tmp_path / "stage.html"
+    shutil.copy(EXAMPLES / "paper_setup.yaml", spec)
+    before = spec.read_bytes()
+    r = runner.invoke(app, [str(spec), "--report", str(spec), "--force"])
+    assert r.exit_code == 2 and "input file" in r.output
+    assert spec.read_bytes() == before
+
+
+def test_cli_refuses_report_and_json_on_one_file(tmp_path, monkeypatch, paper_spec_path):
+    _refuse_work(monkeypatch)
+    out = tmp_path / "x.html"
+    r = runner.invoke(app, [str(paper_spec_path), "--report", str(out), "--json", str(out)])
+    assert r.exit_code == 2
+
+
+def test_cli_map_needs_a_report(monkeypatch, paper_spec_path):
+    _refuse_work(monkeypatch)
+    r = runner.invoke(app, [str(paper_spec_path), "--map"])
+    assert r.exit_code == 2 and "--report" in r.output
+
+
+def test_cli_writes_the_html_report_with_force(tmp_path, paper_spec_path):
+    out = tmp_path / "report.html"
+    out.write_text("old")
+    r = runner.invoke(app, [str(paper_spec_path), "--report", str(out), "--force"])
+    assert r.exit_code == 0, r.output
+    assert f"wrote {out}" in r.output.replace("\n", "")
+    text = out.read_text(encoding="utf-8")
+    assert text.startswith("<!DOCTYPE html>") and "fi-design" in text
+    assert [a["id"] for t, a in _parse(text).tags if t == "section"] == DESIGN_SECTIONS
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".report.html.")]
+
+
+# --------------------------------------------------------------------------- map, other reports
+
+
+def test_design_map_section(paper_confirmed_design):
+    small, note = report.design_map(paper_confirmed_design, resolution=(3, 2))
+    assert small.shape == (2, 3) and "fi_design.sweep" in note
+    ctx = report.build_context(paper_confirmed_design, date=DATE, map_result=small,
+                               map_note=note)
+    assert [s["id"] for s in ctx["sections"]][5] == "map"
+    text = report.render_html(ctx)
+    assert 'id="fig-map"' in text and re.search(r'id="fig-map">\s*<svg', text)
+
+
+def test_generic_document(tmp_path, paper_spec):
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(3, 2))
+    fig.add_subplot().plot([0, 1], [1, 0])
+    sections = [report.Section("finding", "Finding <1>", paragraphs=("a <b>bold</b> claim",),
+                               tables=(report.Table(("Effect", "Score [-]"),
+                                                    (("none", report.num(1.5)),)),),
+                               figures=(report.figure_block(fig, "A line", name="line"),),
+                               notes=("n1",))]
+    out = report.render_document(tmp_path / "doc.html", title="Reconciliation",
+                                 spec=paper_spec, sections=sections, kind="reconcile",
+                                 date=DATE, conclusion="All good.")
+    text = out.read_text(encoding="utf-8")
+    p = _parse(text)
+    assert [a["id"] for t, a in p.tags if t == "section"] == ["summary", "finding", "appendix"]
+    assert "a &lt;b&gt;bold&lt;/b&gt; claim" in text and "Finding &lt;1&gt;" in text
+    assert re.search(r'id="fig-line">\s*<svg', text) and "Figure 1." in text
+    with pytest.raises(report.OutputError):
+        report.render_document(tmp_path / "doc.txt", title="x", spec=paper_spec, sections=[])
+
+
+def test_sweep_report(tmp_path, paper_spec):
+    from fi_design.sweep import sweep
+
+    result = sweep(paper_spec, x=("controller.crossover", [4.0, 8.0]),
+                   y=("isolator.stroke", [2e-4, 3e-4]))
+    out = report.render_report(result, tmp_path / "map.html", date=DATE, command="fi-design sweep")
+    text = out.read_text(encoding="utf-8")
+    assert "Hunting map" in text and re.search(r"<figure[^>]*>\s*<svg", text)
+    assert "Points per verdict" in text
+
+
+def test_render_report_refuses_other_extensions_and_kinds(tmp_path, paper_confirmed_design):
+    with pytest.raises(report.OutputError, match=r"\.html or \.pdf"):
+        report.render_report(paper_confirmed_design, tmp_path / "r.htm")
+    with pytest.raises(TypeError):
+        report.render_report(object(), tmp_path / "r.html")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_public_api_exports_render_report():
+    import fi_design
+
+    assert fi_design.render_report is report.render_report
+
+
+# --------------------------------------------------------------------------- packaging
+
+
+def test_templates_ship_in_the_wheel_and_load_from_an_installed_copy(tmp_path):
+    """Build the wheel, install it into a target directory, find the templates from there."""
+    wheels = tmp_path / "wheels"
+    build = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps",
+                            "--no-build-isolation", "-q", "-w", str(wheels)],
+                           capture_output=True, text=True, timeout=300)
+    assert build.returncode == 0, build.stderr[-3000:]
+    wheel = next(wheels.glob("fi_design-*.whl"))
+    with zipfile.ZipFile(wheel) as zf:
+        names = set(zf.namelist())
+    expected = {f"fi_design/templates/{p.name}" for p in (ROOT / "templates").iterdir()
+                if p.is_file()}
+    assert expected and expected <= names, sorted(expected - names)
+    site = tmp_path / "site"
+    inst = subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q",
+                           "--target", str(site), str(wheel)], capture_output=True, text=True,
+                          timeout=300)
+    assert inst.returncode == 0, inst.stderr[-3000:]
+    probe = ("import fi_design, fi_design.report as r\n"
+             "print(fi_design.__file__)\n"
+             "print(r.template_dir())\n"
+             "print(len(r.environment().get_template('report.html.jinja').render("
+             "meta={'project': 'p', 'title': 't', 'document_id': 'd', 'revision': 'r', "
+             "'status': 's', 'date': 'x', 'tool': 't', 'spec_path': 's', 'spec_sha256': 'h', "
+             "'command': 'c', 'signatures': [{'role': 'Prepared', 'name': ''}], "
+             "'running': 'r', 'kind': 'design'}, sections=[], body=[], css='')))\n")
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(site)
+    run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         cwd=tmp_path, env=env, timeout=120)
+    assert run.returncode == 0, run.stderr[-3000:]
+    module, templates, size = run.stdout.split()
+    assert Path(module).resolve().is_relative_to(site.resolve())
+    assert Path(templates) == (site / "fi_design" / "templates").resolve()
+    assert int(size) > 1000

@@ -1,0 +1,150 @@
+"""`fi-design sweep`, `study` and `robustness` through typer's CliRunner."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from fi_design.cli import app
+
+runner = CliRunner()
+
+
+def run(*args: str):
+    return runner.invoke(app, [str(a) for a in args], catch_exceptions=False)
+
+
+def test_sweep_writes_csv_json_and_figure(paper_spec_path, tmp_path):
+    out_csv, out_json, fig = tmp_path / "m.csv", tmp_path / "m.json", tmp_path / "m.svg"
+    r = run("sweep", paper_spec_path, "--x", "controller.crossover=3 Hz:9 Hz:3",
+            "--y", "isolator.stroke=0.1 mm:0.3 mm:2", "--csv", out_csv, "--json", out_json,
+            "--figure", fig, "--jobs", "1")
+    assert r.exit_code == 0, r.output
+    assert "points:" in r.output and "hunting cycles in the window" in r.output
+    rows = list(csv.DictReader(out_csv.open()))
+    assert list(rows[0])[:6] == ["controller.crossover", "isolator.stroke", "hunting_cycles",
+                                 "amplitude", "period", "verdict"]
+    assert len(rows) == 6 and float(rows[0]["isolator.stroke"]) == pytest.approx(1e-4)
+    data = json.loads(out_json.read_text())
+    assert data["x"]["unit"] == "Hz" and data["y"]["values"][1] == pytest.approx(3e-4)
+    assert fig.read_bytes().startswith(b"<?xml")
+
+
+def test_sweep_default_executor_and_cache(paper_spec_path, tmp_path, monkeypatch):
+    monkeypatch.setenv("FI_DESIGN_CACHE_DIR", str(tmp_path / "cache"))
+    args = ("sweep", paper_spec_path, "--x", "controller.crossover=2:20:4", "--no-isolator")
+    first = run(*args)
+    assert first.exit_code == 0, first.output
+    assert "4 simulated, 0 from the cache" in first.output and "worker processes" in first.output
+    second = run(*args)
+    assert "0 simulated, 4 from the cache" in second.output
+    third = run(*args, "--no-cache", "--jobs", "1")
+    assert "4 simulated" in third.output and "serial" in third.output
+
+
+def test_sweep_one_dimensional_with_invalid_points(paper_spec_path, tmp_path):
+    out = tmp_path / "line.csv"
+    r = run("sweep", paper_spec_path, "--x", "friction.static=0.5 N:4 N:2", "--no-isolator",
+            "--csv", out, "--jobs", "1")
+    assert r.exit_code == 0, r.output
+    rows = list(csv.DictReader(out.open()))
+    assert rows[0]["verdict"] == "invalid" and "Coulomb" in rows[0]["message"]
+    assert rows[1]["verdict"] == "hunting"
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--x", "isolator.strok=1 mm:2 mm:3"], "did you mean 'stroke'"),
+    (["--x", "isolator.stroke=1 mm:2 mm"], "START:STOP:N"),
+    (["--x", "isolator.stroke=1 N:2 N:3"], "not a length"),
+    (["--x", "isolator.stroke=1 mm:2 mm:0"], "at least 1"),
+    (["--x", "isolator.stroke=1 mm:2 mm:2", "--log", "z"], "expected x or y"),
+    (["--x", "isolator.stroke=1 mm:2 mm:2", "--executor", "spark"], "local, dask"),
+    (["--x", "isolator.stroke=1 mm:2 mm:2", "--scheduler", "tcp://x:1"], "--executor dask"),
+])
+def test_sweep_bad_input_exits_2(paper_spec_path, tmp_path, args, words):
+    out = tmp_path / "never.csv"
+    r = runner.invoke(app, ["sweep", str(paper_spec_path), *args, "--csv", str(out), "--jobs",
+                            "1"])
+    assert r.exit_code == 2, r.output
+    assert words in r.output
+    assert not out.exists()
+
+
+def test_existing_output_refused_before_any_work(paper_spec_path, tmp_path):
+    csv_out, json_out = tmp_path / "m.csv", tmp_path / "m.json"
+    csv_out.write_text("keep me")
+    r = runner.invoke(app, ["sweep", str(paper_spec_path), "--x", "controller.crossover=3:9:2",
+                            "--json", str(json_out), "--csv", str(csv_out)])
+    assert r.exit_code == 2 and "file exists; use --force" in r.output
+    assert csv_out.read_text() == "keep me" and not json_out.exists()
+    r = run("sweep", paper_spec_path, "--x", "controller.crossover=3:9:2", "--csv", csv_out,
+            "--force", "--jobs", "1")
+    assert r.exit_code == 0 and csv_out.read_text().startswith("controller.crossover,")
+
+
+def test_study_paper(paper_spec_path, tmp_path):
+    out = tmp_path / "study"
+    r = run("study", "paper", paper_spec_path, "--out", out, "--resolution", "2", "--jobs", "1")
+    assert r.exit_code == 0, r.output
+    for name in ("figure4.svg", "figure4.png", "study.json", "map_A.csv", "map_B.csv",
+                 "map_C.csv", "map_D.csv"):
+        assert (out / name).is_file(), name
+    data = json.loads((out / "study.json").read_text())
+    assert [m["definition"]["key"] for m in data["maps"]] == ["A", "B", "C", "D"]
+    assert "D) crossover vs stroke, with isolator" in r.output
+    again = runner.invoke(app, ["study", "paper", str(paper_spec_path), "--out", str(out),
+                                "--resolution", "2", "--jobs", "1"])
+    assert again.exit_code == 2 and "file exists" in again.output
+
+
+def test_study_errors(paper_spec_path, repo_root, tmp_path):
+    r = runner.invoke(app, ["study", "papr", str(paper_spec_path), "--out", str(tmp_path / "s")])
+    assert r.exit_code == 2 and "did you mean 'paper'" in r.output
+    r = runner.invoke(app, ["study", "paper", str(repo_root / "examples" / "no_isolator.yaml"),
+                            "--out", str(tmp_path / "s"), "--jobs", "1"])
+    assert r.exit_code == 2 and "isolator" in r.output and not (tmp_path / "s").exists()
+
+
+def test_robustness_reproducible_with_seed(paper_spec_path, tmp_path):
+    outs = []
+    for k in range(2):
+        out = tmp_path / f"r{k}.json"
+        r = run("robustness", paper_spec_path, "--samples", "4", "--scatter",
+                "friction.static=10%", "--scatter", "friction.coulomb=0.1 N", "--seed", "7",
+                "--position-friction", "10%:20 mm", "--json", out, "--jobs", "1",
+                *(["--no-cache"] if k else []))
+        assert r.exit_code == 0, r.output
+        assert "Probability of hunting" in r.output
+        outs.append(json.loads(out.read_text()))
+    a, b = outs
+    assert a["draws"] == b["draws"] and a["points"] == b["points"]
+    assert a["isolated"]["probability"] == b["isolated"]["probability"]
+    assert a["scatter"][1] == {"path": "friction.coulomb", "spread": 0.1, "relative": False}
+
+
+@pytest.mark.parametrize("args,words", [
+    ([], "--scatter"),
+    (["--scatter", "friction.statik=10%"], "did you mean 'static'"),
+    (["--scatter", "friction.static=10"], "fraction"),
+    (["--scatter", "friction.static=10%", "--distribution", "cauchy"], "normal or uniform"),
+    (["--scatter", "friction.static=10%", "--position-friction", "10%"], "AMPLITUDE:WAVELENGTH"),
+])
+def test_robustness_bad_input_exits_2(paper_spec_path, tmp_path, args, words):
+    out = tmp_path / "never.json"
+    r = runner.invoke(app, ["robustness", str(paper_spec_path), "--samples", "2", *args,
+                            "--json", str(out), "--jobs", "1"])
+    assert r.exit_code == 2, r.output
+    assert words in r.output
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_sweep_on_local_dask_cluster(paper_spec_path, tmp_path):
+    out = tmp_path / "d.csv"
+    r = run("sweep", paper_spec_path, "--x", "controller.crossover=3:9:3", "--executor", "dask",
+            "--jobs", "2", "--csv", out, "--no-cache")
+    assert r.exit_code == 0, r.output
+    assert "local dask cluster" in r.output and len(out.read_text().splitlines()) == 4
