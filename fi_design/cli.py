@@ -323,6 +323,10 @@ def design_command(
         if job is not None:
             status("simulating with and without the isolator (the first run on a machine "
                    "compiles the kernel, about 10 s) ...")
+            if report_path is not None:  # use the wait: import the report's libraries
+                from .report import preload
+
+                preload(report_path)
             result = result.with_simulation(job.result())
 
     text = None

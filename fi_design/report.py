@@ -5,9 +5,15 @@ How a report is made
 1. :func:`build_context` turns a result into plain data: strings, SI floats
    with their unit, lists and dicts. All arithmetic, comparison and wording
    happens here; the golden tests compare this dict (with ``figures=False``).
-2. The figures (matplotlib's ``Figure`` API, :mod:`fi_design.plots`) and the
-   equations (matplotlib mathtext, turned into one SVG path each) are inlined
-   as SVG, so the HTML makes no external request and the PDF needs no MathML.
+2. The figures (matplotlib's ``Figure`` API, :mod:`fi_design.plots`) are
+   inlined as SVG (fixed id salt, no date, ids prefixed per figure), so the
+   HTML makes no external request. Equations are written in a small TeX
+   subset (:func:`math_nodes`) and rendered as HTML and CSS by
+   ``equation.html.jinja`` (italic variables, sub- and superscripts, stacked
+   fractions): no script, no MathML (WeasyPrint has none), identical in a
+   browser and in the PDF, and searchable. (matplotlib mathtext as SVG paths
+   was the first route; WeasyPrint draws SVG paths in Python, and the
+   equations alone cost over a second of the PDF.)
 3. One jinja environment (:func:`environment`: autoescape on,
    ``StrictUndefined``) renders each section with its own small template, which
    extends ``section.html.jinja``; ``report.html.jinja`` puts the title block,
@@ -33,8 +39,9 @@ Public functions
 - :func:`render_document` -- for the other commands' reports: a title and a
   list of :class:`Section` values (paragraphs, :class:`Table` values,
   :class:`FigureBlock` values from :func:`figure_block`), rendered with the same
-  title block, page layout, assumptions-free generic section template and
-  appendix as the design report::
+  title block, page layout, running header and appendix as the design report,
+  each section by ``generic.html.jinja``. :mod:`fi_design.gapreport` (the
+  reconciliation report) is built this way::
 
       from fi_design import report
       sections = [report.Section("summary", "Summary", paragraphs=("...",),
@@ -45,9 +52,11 @@ Public functions
 
   A result class may instead define ``report_sections(self) -> list[Section]``
   and ``report_title`` (str); :func:`render_report` then renders it.
-- :func:`build_context`, :func:`render_html`, :func:`environment`,
-  :func:`template_dir`, and the filters :func:`num`, :func:`qty`,
-  :func:`unit_text`.
+- :func:`build_context` (the design report's content), :func:`sweep_context` and
+  :func:`document_context` (the others'), :func:`render_html`,
+  :func:`design_map` (the crossover x stroke map), :func:`preload` (import the
+  rendering libraries early), :func:`environment`, :func:`template_dir`, and
+  the filters :func:`num`, :func:`qty` and :func:`unit_text`.
 
 Reproducibility: the same spec and result give the same HTML apart from the
 date (passed in; the CLI uses today, or ``SOURCE_DATE_EPOCH`` when set):
@@ -62,7 +71,7 @@ import functools
 import math
 import os
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
@@ -71,8 +80,9 @@ from .results import Status
 
 __all__ = [
     "FORMATS", "Section", "Table", "FigureBlock", "figure_block", "template_dir", "environment",
-    "num", "qty", "unit_text", "build_context", "render_html", "render_report",
-    "render_document", "report_date",
+    "num", "qty", "unit_text", "math_nodes", "math_text", "build_context", "sweep_context",
+    "document_context", "design_map", "render_html", "render_report", "render_document",
+    "report_date", "preload",
 ]
 
 #: Output formats by file extension.
@@ -585,7 +595,7 @@ def check_label(name: str) -> str:
     str
     """
     head, _, tail = name.partition(".")
-    case = _case_words(tail)
+    case = _case_words(tail) if head in ("phase_margin", "gain_margin", "modulus_margin") else tail
     labels = {
         "friction_gap": "Friction gap Fs \u2212 Fc",
         "crossover_achievable": "Desired crossover within the achievable",
@@ -688,7 +698,6 @@ def _verdict(result: Any) -> dict:
         headline = "Every check passes."
     groups: list[dict] = []
     for row, check in zip(rows, result.checks):
-        source = row["source"]
         if not groups or groups[-1]["step"] != check.step:
             groups.append({"step": check.step, "title": _step_title(check.step), "rows": []})
         groups[-1]["rows"].append(row)
@@ -1757,9 +1766,10 @@ def design_map(result: Any, *, resolution: tuple[int, int] = (8, 6), progress: A
             progress(f"hunting map: {done}/{total} simulations")
 
     out = sweep(spec, x, y, isolated=True, executor=executor, progress=tick)
+    held = ("the drive stiffness held at the design value" if spec.isolator.stiffness is not None
+            else "the drive stiffness following the stroke (k_max / 2: the spec gives none)")
     note += (f"Computed with fi_design.sweep.sweep: crossover {num(xs[0])} to {num(xs[-1])} Hz, "
-             f"stroke {qty(ys[0], 'm')} to {qty(ys[-1], 'm')} (log), the drive stiffness held "
-             "at the design value.")
+             f"stroke {qty(ys[0], 'm')} to {qty(ys[-1], 'm')} (log), {held}.")
     return out, note
 
 
@@ -1807,6 +1817,36 @@ def _write(html: str, path: Path, fmt: str) -> Path:
     with atomic_path(path) as tmp:
         document.write_pdf(str(tmp))
     return path
+
+
+def preload(path: str | os.PathLike) -> None:
+    """Import the rendering libraries a report at ``path`` needs, ahead of time.
+
+    matplotlib for the figures; WeasyPrint too for a ``.pdf``. The CLI calls it
+    while it waits for the simulations, so the imports (about a second) cost no
+    time later.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The report's file name (the extension selects the format).
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    fi_design.errors.OutputError
+        The extension is not .html or .pdf.
+    """
+    fmt = _fmt_format(path)
+    import matplotlib.backends.backend_svg  # noqa: F401
+    import matplotlib.figure  # noqa: F401
+
+    environment()
+    if fmt == "pdf":
+        import weasyprint  # noqa: F401
 
 
 def _no_fetch(url: str, *args: Any, **kwargs: Any) -> dict:
@@ -1881,8 +1921,10 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
                                getattr(result, "spec"), result.report_sections(), date=date,
                                command=command, kind=getattr(result, "report_kind", "report"))
     else:
+        hint = ("; for a reconciliation use fi_design.gapreport.render_gap_report"
+                if kind == "ReconcileResult" else "")
         raise TypeError(f"no report for a {kind}; expected a DesignResult, a sweep result or an "
-                        "object with report_sections()")
+                        f"object with report_sections(){hint}")
     html = render_html(ctx)
     say("writing the PDF ..." if fmt == "pdf" else "writing the HTML ...")
     return _write(html, out, fmt)
