@@ -402,9 +402,9 @@ class _Job:
             self._proc = None
 
     def result(self):
-        from .confirm import confirm
-
         if self._proc is None:
+            from .confirm import confirm
+
             return confirm(*self._args)
         try:
             ok, value = self._conn.recv()

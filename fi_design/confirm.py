@@ -24,7 +24,7 @@ A spec without an isolator is confirmed against the isolator step 3 suggests
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -216,13 +216,11 @@ class Confirmation:
     models_agree: bool
     suggested_isolator: bool
     checks: tuple[Check, ...]
-    results: dict
+    results: dict = field(repr=False)  # traces for plots; not in the JSON
 
     def to_dict(self) -> dict:
         """Plain JSON data: the verdicts, scans and checks (no traces)."""
-        d = dataclass_dict(self)
-        d.pop("results", None)
-        return d
+        return dataclass_dict(self)
 
 
 def _hunts(v: PlantVerdict) -> bool:

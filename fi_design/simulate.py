@@ -27,7 +27,7 @@ from .metrics import HuntingMetrics, hunting_metrics
 from .pid import tune_pid
 from .plant import PlantParameters, state_index
 from .reference import Reference, from_moves
-from .results import dataclass_dict, frozen_array
+from .results import frozen_array, to_jsonable
 
 METHODS = ("fast", "reference")
 
@@ -134,9 +134,10 @@ class SimulationResult:
 
     def to_dict(self, traces: bool = False) -> dict:
         """Plain JSON data: metadata and metrics; the traces only when asked."""
-        d = {k: v for k, v in dataclass_dict(self).items()
-             if traces or not isinstance(getattr(self, k), np.ndarray)}
-        return d
+        from dataclasses import fields
+
+        return {f.name: to_jsonable(getattr(self, f.name)) for f in fields(self)
+                if traces or not isinstance(getattr(self, f.name), np.ndarray)}
 
 
 # --------------------------------------------------------------------------- parameters
