@@ -62,6 +62,7 @@ def pool():
 
 
 def main() -> None:
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--write", action="store_true", help="update the section of BENCHMARKS.md")
@@ -115,14 +116,19 @@ def main() -> None:
             client.run(warm_up)
             return cluster, client
 
-        t = time.perf_counter()
-        cluster, client = start()
-        t_start = time.perf_counter() - t
-        try:
-            t_dask, res = best(lambda: sweep(spec, X, Y, executor=client), args.repeat)
-        finally:
-            client.close()
-            cluster.close()
+        # a fresh cluster per repetition: dask keys tasks by their arguments, so a repeated
+        # map on the same cluster could be served from results it still holds
+        t_start = t_dask = math.inf
+        for _ in range(min(3, args.repeat)):
+            t = time.perf_counter()
+            cluster, client = start()
+            t_start = min(t_start, time.perf_counter() - t)
+            try:
+                t, res = best(lambda: sweep(spec, X, Y, executor=client), 1)
+                t_dask = min(t_dask, t)
+            finally:
+                client.close()
+                cluster.close()
         assert res.points == ref.points, "dask changed the results"
         rows.append(("dask, local cluster of 2 workers: cluster start + kernel load",
                      f"{t_start:.2f} s", "once per command"))
@@ -154,7 +160,24 @@ def main() -> None:
             f"{args.repeat}; imports and kernel load in this process {t_import:.2f} s.")
     table = ["| Run | Time | Note |", "| --- | --- | --- |"] + [f"| {a} | {b} | {c} |"
                                                                   for a, b, c in rows]
-    text = head + "\n\n" + "\n".join(table) + "\n"
+    notes = [
+        f"Target: a 20 x 20 map in under 3 s with the default executor: the map takes "
+        f"{t_pool:.2f} s on the process pool, pool start included "
+        f"({'met' if t_pool < 3 else 'NOT met'}). The command end to end takes {t_cli:.2f} s: "
+        "a fresh interpreter first imports numpy, pydantic, scipy.signal (the metric's peak "
+        "finder, which pulls in scipy.stats) and loads the numba kernel from its cache, about "
+        "2 to 3 s before the first simulation on this machine.",
+        f"Target: the cache makes a repeated sweep at least 20 times faster: "
+        f"{t_first / t_hit:.0f} times ({'met' if t_first / t_hit >= 20 else 'NOT met'}).",
+    ]
+    if not args.no_dask:
+        notes.append(
+            f"Dask: a local cluster costs {t_start:.2f} s to start (spawned worker processes "
+            "import fi_design and load the kernel) and the map itself "
+            f"{t_dask - t_pool:+.2f} s against the process pool (task scheduling, "
+            "serialising the spec with every chunk); on a cluster that is already running "
+            "(--scheduler) only the second part applies. The results are identical.")
+    text = head + "\n\n" + "\n".join(table) + "\n\n" + "\n\n".join(notes) + "\n"
     print(text)
     if args.write:
         write_section(text)
