@@ -43,7 +43,7 @@ def trace(effect: str, isolated: bool):
     import yaml
 
     from fi_design.measured import measurement_from_arrays
-    from fi_design.simulate import simulate
+    from fi_design.simulation import simulate
     from fi_design.spec import EFFECT_MODELS
     from fi_design.specfile import load_spec
 
@@ -77,8 +77,8 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--effect", default="position_dependent_friction", choices=sorted(HIDDEN))
     ap.add_argument("--no-isolator", action="store_true")
     args = ap.parse_args(argv)
-    from fi_design.reconcile import reconcile
-    from fi_design.simulate import simulate
+    from fi_design.reconciliation import reconcile
+    from fi_design.simulation import simulate
 
     isolated = not args.no_isolator
     spec, data = trace(args.effect, isolated)

@@ -51,7 +51,7 @@ def plain_solve_ivp(spec, isolated: bool, t_end: float, method: str):
 
     from fi_design import plant
     from fi_design.reference import from_moves
-    from fi_design.simulate import plant_parameters, tolerances
+    from fi_design.simulation import plant_parameters, tolerances
 
     par = plant_parameters(spec, isolated)
     p = par.to_array()
@@ -86,7 +86,7 @@ def python_control_run(spec, isolated: bool, t_end: float):
 
     from fi_design import plant
     from fi_design.reference import from_moves
-    from fi_design.simulate import plant_parameters, tolerances
+    from fi_design.simulation import plant_parameters, tolerances
 
     par = plant_parameters(spec, isolated)
     p = par.to_array()
@@ -129,7 +129,7 @@ def main() -> None:
     ap.add_argument("--skip-cold", action="store_true")
     args = ap.parse_args()
 
-    from fi_design.simulate import simulate
+    from fi_design.simulation import simulate
     from fi_design.specfile import load_spec
 
     spec = load_spec(SPEC)

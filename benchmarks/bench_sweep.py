@@ -1,4 +1,4 @@
-"""Benchmark of the parameter studies (fi_design.sweep); all figures from one run.
+"""Benchmark of the parameter studies (fi_design.studies); all figures from one run.
 
 Measures, on examples/paper_setup.yaml, a 20 x 20 map (the paper's map D:
 controller.crossover 2 to 20 Hz x isolator.stroke 0.05 to 1 mm, isolated plant,
@@ -12,7 +12,7 @@ controller.crossover 2 to 20 Hz x isolator.stroke 0.05 to 1 mm, isolated plant,
 4. dask.distributed on a local cluster with 2 worker processes: the cluster
    start (workers importing fi_design and loading the kernel) and the map on
    the running cluster;
-5. the cache: the same map again from a warm :class:`~fi_design.sweep.PointCache`.
+5. the cache: the same map again from a warm :class:`~fi_design.studies.PointCache`.
 
 Each timing is the best of ``--repeat`` runs (default 3). Run from the
 repository root::
@@ -54,7 +54,7 @@ def best(fn, repeat: int) -> tuple[float, object]:
 
 
 def pool():
-    from fi_design.sweep import warm_up
+    from fi_design.studies import warm_up
 
     ctx = multiprocessing.get_context("fork") if "fork" in \
         multiprocessing.get_all_start_methods() else None
@@ -71,7 +71,7 @@ def main() -> None:
 
     t0 = time.perf_counter()
     from fi_design.specfile import load_spec
-    from fi_design.sweep import PointCache, sweep, warm_up
+    from fi_design.studies import PointCache, sweep, warm_up
 
     spec = load_spec(SPEC)
     warm_up()

@@ -657,7 +657,7 @@ def simulate_command(
     if not no_isolator and spec_obj.isolator is None:
         isolated = False
 
-    from .simulate import simulate
+    from .simulation import simulate
 
     err = _console(stderr=True)
     with _status(err, "simulating ..."):
@@ -757,7 +757,7 @@ def init_command(
 
 
 # =========================================================================== parameter studies
-# sweep, study, robustness (fi_design.sweep). Executors and the progress bar are made here; the
+# sweep, study, robustness (fi_design.studies). Executors and the progress bar are made here; the
 # library only receives them.
 
 #: Executors for --executor.
@@ -816,7 +816,7 @@ class _Executor:
             raise
 
     def _start(self):
-        from .sweep import warm_up
+        from .studies import warm_up
 
         warm_up()  # compile or load the kernel once here, before any worker starts
         if self.kind == "local":
@@ -841,7 +841,7 @@ class _Executor:
         import logging
 
         from .errors import FiDesignError
-        from .sweep import warm_up
+        from .studies import warm_up
 
         try:
             from distributed import Client, LocalCluster
@@ -919,7 +919,7 @@ def _interrupted(err: "Console", no_cache: bool) -> None:
 
 
 def _cache_for(no_cache: bool):
-    from .sweep import PointCache
+    from .studies import PointCache
 
     return None if no_cache else PointCache()
 
@@ -959,7 +959,7 @@ def sweep_grid_table(result, max_columns: int = 25):
 
     Parameters
     ----------
-    result : fi_design.sweep.SweepResult
+    result : fi_design.studies.SweepResult
         A two-dimensional sweep (a line is shown as one row).
     max_columns : int, optional
         Wider maps are not tabulated (None is returned).
@@ -1007,7 +1007,7 @@ def grid_caption(result) -> str:
 
     Parameters
     ----------
-    result : fi_design.sweep.SweepResult
+    result : fi_design.studies.SweepResult
         The sweep.
 
     Returns
@@ -1098,7 +1098,7 @@ def sweep_command(
     pool = _Executor(executor, jobs, scheduler)
 
     from .specfile import load_spec
-    from .sweep import parse_axis, sweep
+    from .studies import parse_axis, sweep
 
     spec_obj = load_spec(spec)
     ax = parse_axis(x, log="x" in logs, spec=spec_obj)
@@ -1157,13 +1157,13 @@ def _command_line() -> str:
 
 def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
                 executor: str = "") -> None:
-    """Print the summary of a :class:`~fi_design.sweep.SweepResult`.
+    """Print the summary of a :class:`~fi_design.studies.SweepResult`.
 
     Parameters
     ----------
     console : rich.console.Console
         Where to print.
-    result : fi_design.sweep.SweepResult
+    result : fi_design.studies.SweepResult
         The sweep.
     spec_path : pathlib.Path, optional
         The spec file, named in the heading.
@@ -1251,7 +1251,7 @@ def study_command(
     pool = _Executor(executor, jobs, scheduler)
 
     from .specfile import load_spec
-    from .sweep import paper_study
+    from .studies import paper_study
 
     spec_obj = load_spec(spec)
     console = _console()
@@ -1304,13 +1304,13 @@ def _write_study(result, out: Path, targets: dict, console: "Console") -> None:
 
 def print_study(console: "Console", result, spec_path: Optional[Path] = None,
                 executor: str = "") -> None:
-    """Print the summary of a :class:`~fi_design.sweep.StudyResult`: one grid per map.
+    """Print the summary of a :class:`~fi_design.studies.StudyResult`: one grid per map.
 
     Parameters
     ----------
     console : rich.console.Console
         Where to print.
-    result : fi_design.sweep.StudyResult
+    result : fi_design.studies.StudyResult
         The study.
     spec_path : pathlib.Path, optional
         The spec file, named in the heading.
@@ -1393,7 +1393,7 @@ def robustness_command(
     pool = _Executor(executor, jobs, scheduler)
 
     from .specfile import load_spec
-    from .sweep import parse_position_friction, parse_scatter, robustness
+    from .studies import parse_position_friction, parse_scatter, robustness
 
     spec_obj = load_spec(spec)
     items = [parse_scatter(s, spec_obj) for s in scatter or []]
@@ -1429,13 +1429,13 @@ def robustness_command(
 
 def print_robustness(console: "Console", result, spec_path: Optional[Path] = None,
                      executor: str = "") -> None:
-    """Print the summary of a :class:`~fi_design.sweep.RobustnessResult`.
+    """Print the summary of a :class:`~fi_design.studies.RobustnessResult`.
 
     Parameters
     ----------
     console : rich.console.Console
         Where to print.
-    result : fi_design.sweep.RobustnessResult
+    result : fi_design.studies.RobustnessResult
         The robustness study.
     spec_path : pathlib.Path, optional
         The spec file, named in the heading.
@@ -1494,7 +1494,7 @@ def _path_unit(path: str, spec) -> str:
 
 
 # --------------------------------------------------------------------------- reconcile
-# (model against measurement: fi_design.reconcile, fi_design.measured, fi_design.gapreport)
+# (model against measurement: fi_design.reconciliation, fi_design.measured, fi_design.gapreport)
 
 
 @app.command("reconcile")
@@ -1539,7 +1539,7 @@ def reconcile_command(
     _check_spec_path(spec)
 
     from .measured import load_measurement
-    from .reconcile import fixed_spec_text, reconcile
+    from .reconciliation import fixed_spec_text, reconcile
     from .specfile import load_spec
 
     spec_obj = load_spec(spec)
@@ -1594,13 +1594,13 @@ class _FractionBar:
 
 
 def print_reconcile(console: "Console", result) -> None:
-    """Print the readable summary of a :class:`~fi_design.reconcile.ReconcileResult`.
+    """Print the readable summary of a :class:`~fi_design.reconciliation.ReconcileResult`.
 
     Parameters
     ----------
     console : rich.console.Console
         Where to print.
-    result : fi_design.reconcile.ReconcileResult
+    result : fi_design.reconciliation.ReconcileResult
         The reconciliation.
     """
     from rich import box

@@ -31,7 +31,7 @@ import numpy as np
 from . import spec as _spec
 from .metrics import HuntingMetrics
 from .results import Check, Status, dataclass_dict, frozen_array
-from .simulate import SimulationResult, simulate
+from .simulation import SimulationResult, simulate
 
 PLANTS = ("isolated", "non_isolated")
 

@@ -1,6 +1,6 @@
 """The reconciliation report: which effect the model misses, and the gap before and after.
 
-Built from :class:`fi_design.reconcile.ReconcileResult` as generic report
+Built from :class:`fi_design.reconciliation.ReconcileResult` as generic report
 sections (:class:`fi_design.report.Section`) and rendered with the report
 engineer's templates through :func:`fi_design.report.render_document`: the
 same title block, layout, escaping and appendix as the design report. All
@@ -47,7 +47,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
 
     Parameters
     ----------
-    result : fi_design.reconcile.ReconcileResult
+    result : fi_design.reconciliation.ReconcileResult
         The reconciliation.
     figures : bool, optional
         Draw the figures (False: captions only, for golden tests).
@@ -166,7 +166,7 @@ def render_gap_report(result: Any, path: str | os.PathLike, *, date: Any = None,
 
     Parameters
     ----------
-    result : fi_design.reconcile.ReconcileResult
+    result : fi_design.reconciliation.ReconcileResult
         The reconciliation.
     path : str or os.PathLike
         ``.html`` or ``.pdf``.

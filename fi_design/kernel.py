@@ -944,7 +944,7 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
 
     Returns ``(status, out_y, out_r, out_fa, stats)`` as numpy arrays; see
     :func:`integrate` for the meaning. This thin wrapper is the kernel's only
-    Python-level entry point; :mod:`fi_design.simulate` wraps it in a result.
+    Python-level entry point; :mod:`fi_design.simulation` wraps it in a result.
     """
     # fresh writable copies: numba types read-only arrays differently
     p = np.array(params, dtype=np.float64)

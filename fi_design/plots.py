@@ -559,7 +559,7 @@ def figure_svg(fig: Any, prefix: str) -> str:
 
 
 # --------------------------------------------------------------------------- parameter studies
-# (fi_design.sweep: hunting maps, the paper's Figure 4, robustness)
+# (fi_design.studies: hunting maps, the paper's Figure 4, robustness)
 
 #: SI unit -> (unit shown on axes, factor applied to SI values).
 DISPLAY_UNITS: dict[str, tuple[str, float]] = {
@@ -627,7 +627,7 @@ def _edges(values: np.ndarray, log: bool) -> np.ndarray:
 
 def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool = True,
                annotate: bool | None = None, vmax: float | None = None) -> Any:
-    """Draw a :class:`~fi_design.sweep.SweepResult` into ``ax``.
+    """Draw a :class:`~fi_design.studies.SweepResult` into ``ax``.
 
     A map is a heatmap of hunting cycles (paper Figure 4): white where no
     cycle was counted, invalid points hatched grey, stuck points marked ``s``,
@@ -638,7 +638,7 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
     ----------
     ax : matplotlib.axes.Axes
         Where to draw.
-    result : fi_design.sweep.SweepResult
+    result : fi_design.studies.SweepResult
         The sweep.
     title : str, optional
         Axes title; default the swept paths and the plant; ``""`` for none.
@@ -749,7 +749,7 @@ def sweep_figure(result: Any, *, title: str | None = None) -> Any:
 
     Parameters
     ----------
-    result : fi_design.sweep.SweepResult
+    result : fi_design.studies.SweepResult
         The sweep.
     title : str, optional
         Figure title; default from the spec name; ``""`` for none.
@@ -779,11 +779,11 @@ def _legend_text(result: Any) -> str:
 
 
 def study_figure(study: Any, *, title: str | None = None) -> Any:
-    """The paper's Figure 4: maps A to D of a :class:`~fi_design.sweep.StudyResult`.
+    """The paper's Figure 4: maps A to D of a :class:`~fi_design.studies.StudyResult`.
 
     Parameters
     ----------
-    study : fi_design.sweep.StudyResult
+    study : fi_design.studies.StudyResult
         The study.
     title : str, optional
         Figure title; default from the spec name; ``""`` for none.
@@ -817,7 +817,7 @@ def robustness_figure(result: Any, *, title: str | None = None) -> Any:
 
     Parameters
     ----------
-    result : fi_design.sweep.RobustnessResult
+    result : fi_design.studies.RobustnessResult
         The robustness study.
     title : str, optional
         Figure title; default from the spec name; ``""`` for none.
@@ -877,7 +877,7 @@ def figure_bytes(fig: Any, fmt: str = "svg") -> bytes:
 
 
 # --------------------------------------------------------------------------- reconciliation
-# (fi_design.reconcile: measured trace against the nominal and the corrected model)
+# (fi_design.reconciliation: measured trace against the nominal and the corrected model)
 
 #: Colours of the reconciliation overlays.
 GAP_COLOURS = {"measured": "0.25", "nominal": "C3", "corrected": "C0"}
@@ -898,7 +898,7 @@ def gap_overlay_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.reconcile.ReconcileResult
+    result : fi_design.reconciliation.ReconcileResult
         The reconciliation.
 
     Returns
@@ -944,7 +944,7 @@ def gap_residual_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.reconcile.ReconcileResult
+    result : fi_design.reconciliation.ReconcileResult
         The reconciliation.
 
     Returns
@@ -979,7 +979,7 @@ def candidate_scores_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.reconcile.ReconcileResult
+    result : fi_design.reconciliation.ReconcileResult
         The reconciliation.
 
     Returns

@@ -33,8 +33,8 @@ Public functions
 ----------------
 - :func:`render_report` -- ``render_report(result, "out.html" | "out.pdf", date=...,
   command=...)`` for a :class:`~fi_design.guideline.DesignResult`, a
-  :class:`~fi_design.sweep.SweepResult`, :class:`~fi_design.sweep.StudyResult` or
-  :class:`~fi_design.sweep.RobustnessResult`; other results (the
+  :class:`~fi_design.studies.SweepResult`, :class:`~fi_design.studies.StudyResult` or
+  :class:`~fi_design.studies.RobustnessResult`; other results (the
   reconciliation) when they offer ``report_sections()`` (see below).
 - :func:`render_document` -- for the other commands' reports: a title and a
   list of :class:`Section` values (paragraphs, :class:`Table` values,
@@ -1673,7 +1673,7 @@ def build_context(result: Any, *, date: Any = None, command: str | None = None,
         The report date; default :func:`report_date` (today).
     command : str, optional
         The command line that made the report (shown in the title block).
-    map_result : fi_design.sweep.SweepResult, optional
+    map_result : fi_design.studies.SweepResult, optional
         A crossover x stroke map to show (see :func:`design_map`).
     map_note : str, optional
         How the map was computed, for its section.
@@ -1731,18 +1731,18 @@ def design_map(result: Any, *, resolution: tuple[int, int] = (8, 6), progress: A
     progress : callable, optional
         ``progress(text)`` with a short message.
     executor : concurrent.futures-style executor, optional
-        Passed to :func:`fi_design.sweep.sweep`.
+        Passed to :func:`fi_design.studies.sweep`.
 
     Returns
     -------
-    map : fi_design.sweep.SweepResult
+    map : fi_design.studies.SweepResult
         The map (x: ``controller.crossover``, y: ``isolator.stroke``).
     note : str
         How it was computed, for the report.
     """
     import numpy as np
 
-    from .sweep import make_axis, sweep
+    from .studies import make_axis, sweep
 
     spec = result.spec
     note = ""
@@ -1768,7 +1768,7 @@ def design_map(result: Any, *, resolution: tuple[int, int] = (8, 6), progress: A
     out = sweep(spec, x, y, isolated=True, executor=executor, progress=tick)
     held = ("the drive stiffness held at the design value" if spec.isolator.stiffness is not None
             else "the drive stiffness following the stroke (k_max / 2: the spec gives none)")
-    note += (f"Computed with fi_design.sweep.sweep: crossover {num(xs[0])} to {num(xs[-1])} Hz, "
+    note += (f"Computed with fi_design.studies.sweep: crossover {num(xs[0])} to {num(xs[-1])} Hz, "
              f"stroke {qty(ys[0], 'm')} to {qty(ys[-1], 'm')} (log), {held}.")
     return out, note
 
@@ -1876,12 +1876,12 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     map : bool, optional
         Design reports: add the crossover x stroke map (about 50 extra
         simulations); None follows the spec's ``report.map``.
-    map_result : fi_design.sweep.SweepResult, optional
+    map_result : fi_design.studies.SweepResult, optional
         A map computed elsewhere, shown instead of computing one.
     progress : callable, optional
         ``progress(text)`` with a short message as the work proceeds.
     executor : concurrent.futures-style executor, optional
-        Runs the map's simulations (:func:`fi_design.sweep.sweep`).
+        Runs the map's simulations (:func:`fi_design.studies.sweep`).
 
     Returns
     -------
@@ -1909,7 +1909,7 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
         if map_result is None and want_map:
             map_result, note = design_map(result, progress=progress, executor=executor)
         elif map_result is not None:
-            note = "Computed with fi_design.sweep.sweep."
+            note = "Computed with fi_design.studies.sweep."
         say("drawing the report's figures ...")
         ctx = build_context(result, date=date, command=command, map_result=map_result,
                             map_note=note)

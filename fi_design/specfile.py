@@ -133,7 +133,6 @@ def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, dict]:
         raw = loader.construct_document(node)
     except yaml.constructor.ConstructorError as exc:
         line = exc.problem_mark.line + 1 if exc.problem_mark else None
-        tag = getattr(exc.problem_mark, "name", "")
         what = exc.problem or "unsupported YAML"
         if "constructor for the tag" in what:
             what = (what.replace("could not determine a constructor for the tag",
@@ -354,7 +353,7 @@ def _unit_at(loc: tuple) -> str:
 
 
 # --------------------------------------------------------------------------- dotted-path values
-# (parameter studies: fi_design.sweep varies spec values by their dotted path)
+# (parameter studies: fi_design.studies varies spec values by their dotted path)
 
 _PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[[^\]]*\])*)$")
 _SELECTOR = re.compile(r"\[([^\]]*)\]")

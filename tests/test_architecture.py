@@ -56,3 +56,15 @@ def test_cli_help_is_light(argv):
 def test_cli_module_imports_no_library_at_top_level():
     loaded = _loaded_after("import fi_design.cli")
     assert not loaded & (set(HEAVY) | {"pydantic", "numpy", "pint", "rich"}), sorted(loaded)
+
+
+def test_public_functions_stay_callable_after_their_modules_are_imported():
+    """``fi_design.simulate`` etc. are functions, whatever was imported before."""
+    code = ("import fi_design.simulation, fi_design.studies, fi_design.reconciliation, "
+            "fi_design.guideline, fi_design.report, fi_design.measured\n"
+            "import fi_design\n"
+            "names = ['simulate', 'sweep', 'robustness', 'reconcile', 'design', 'load_spec',\n"
+            "         'load_measurement', 'render_report']\n"
+            "bad = [n for n in names if not callable(getattr(fi_design, n))]\n"
+            "assert not bad, bad\n")
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)

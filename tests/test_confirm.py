@@ -39,7 +39,7 @@ def test_paper_headline_isolator_needs_far_less_bandwidth(paper_confirmation):
 
 def test_more_bandwidth_means_fewer_cycles_without_isolator(paper_spec):
     """Paper Figure 4 B: the hunting cycles fall away with crossover; none above ~20 Hz."""
-    from fi_design.simulate import simulate
+    from fi_design.simulation import simulate
 
     cycles = [simulate(paper_spec, isolated=False, crossover=fc).metrics.hunting_cycles
               for fc in (8.0, 12.0, 16.0, 19.0, 22.0, 26.0)]
@@ -55,7 +55,7 @@ def test_landing_refinement(paper_confirmation, paper_spec):
     assert land.force <= land.rule_force < land.static_friction
     # lower crossover: the cart lands on the limiter and the stage is stuck (hunting returns later)
     spec = paper_spec
-    from fi_design.simulate import simulate
+    from fi_design.simulation import simulate
     from fi_design.confirm import landing
 
     low = simulate(spec, isolated=True, crossover=5.0)

@@ -17,7 +17,7 @@ import yaml
 
 from fi_design import effects as fx
 from fi_design.plant import PlantParameters
-from fi_design.simulate import plant_parameters, simulate
+from fi_design.simulation import plant_parameters, simulate
 from fi_design.spec import EFFECT_MODELS
 from fi_design.specfile import load_spec, origin
 from fi_design.units import KNOWN_UNITS

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from fi_design import kernel
 from fi_design.plant import MODE_SIGN, jacobian
 from fi_design.reference import from_moves
-from fi_design.simulate import plant_parameters
+from fi_design.simulation import plant_parameters
 
 
 @pytest.mark.parametrize("isolated", [True, False])
@@ -79,7 +79,7 @@ def test_dense_output_is_as_accurate_as_the_steps(paper_spec):
     """The 1 kHz outputs lie between steps (a few thousand steps for 20 001 samples);
     the continuous extension keeps them at the tolerance's accuracy, and tighter
     tolerance makes them better."""
-    from fi_design.simulate import simulate
+    from fi_design.simulation import simulate
 
     exact = simulate(paper_spec, isolated=True, method="reference", rtol=1e-10)
     errs = []

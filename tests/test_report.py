@@ -514,7 +514,7 @@ def test_cli_writes_the_html_report_with_force(tmp_path, paper_spec_path):
 
 def test_design_map_section(paper_confirmed_design):
     small, note = report.design_map(paper_confirmed_design, resolution=(3, 2))
-    assert small.shape == (2, 3) and "fi_design.sweep" in note
+    assert small.shape == (2, 3) and "fi_design.studies" in note
     ctx = report.build_context(paper_confirmed_design, date=DATE, map_result=small,
                                map_note=note)
     assert [s["id"] for s in ctx["sections"]][5] == "map"
@@ -545,7 +545,7 @@ def test_generic_document(tmp_path, paper_spec):
 
 
 def test_sweep_report(tmp_path, paper_spec):
-    from fi_design.sweep import sweep
+    from fi_design.studies import sweep
 
     result = sweep(paper_spec, x=("controller.crossover", [4.0, 8.0]),
                    y=("isolator.stroke", [2e-4, 3e-4]))

@@ -53,9 +53,7 @@ import math
 import os
 import queue
 import sqlite3
-import sys
 import time as _time
-import types
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -327,7 +325,7 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool) 
         ``period``, ``settling_time``, ``final_error``, ``message`` and
         ``cacheable`` (False for outcomes that depend on the machine).
     """
-    from .simulate import simulate
+    from .simulation import simulate
 
     try:
         point = with_values(spec, values) if values else spec
@@ -399,7 +397,7 @@ def warm_up() -> None:
     """
     import scipy.signal  # noqa: F401  (the metric's peak finder, imported on first use)
 
-    from . import kernel, simulate  # noqa: F401  (the kernel compiles at import or loads
+    from . import kernel, simulation  # noqa: F401  (the kernel compiles at import or loads
     #                                  numba's on-disk cache)
 
 
@@ -1772,24 +1770,3 @@ def _probability(points: Sequence[PointResult], iso: bool, confidence: float) \
         probability=hunting / valid if valid else None, low=low, high=high,
         confidence=confidence, counts=counts, hunting_cycles=frozen_array(cycles),
         verdict=verdict)
-
-
-# --------------------------------------------------------------------------- fi_design.sweep(...)
-
-
-class _CallableModule(types.ModuleType):
-    """This module, callable as :func:`sweep`.
-
-    ``fi_design.sweep`` is a lazily exported function of the package, and also
-    the name of this module. Once the module is imported (``from
-    fi_design.sweep import PointCache``, or by the CLI), Python's import system
-    sets the package attribute ``fi_design.sweep`` to the module, shadowing the
-    function; calling the module keeps ``fi_design.sweep(spec, x, ...)``
-    working either way.
-    """
-
-    def __call__(self, *args: Any, **kwargs: Any) -> SweepResult:
-        return sweep(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule

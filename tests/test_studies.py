@@ -1,4 +1,4 @@
-"""Parameter studies (fi_design.sweep): maps, the paper's trends, executors, cache, robustness.
+"""Parameter studies (fi_design.studies): maps, the paper's trends, executors, cache, robustness.
 
 The trend tests run coarse maps of examples/paper_setup.yaml (Fs = 4 N, Fc = 1 N,
 crossover 8 Hz, k = 6667 N/m, stroke 0.3 mm) and assert what the model does;
@@ -16,7 +16,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pytest
 
-from fi_design import sweep as sw
+from fi_design import studies as sw
 from fi_design.errors import SpecError
 from fi_design.specfile import with_values
 
@@ -138,7 +138,7 @@ def test_sweep_of_isolated_plant_needs_an_isolator(paper_spec):
 
 def test_fi_design_sweep_callable_after_module_import(paper_spec, kernel):
     import fi_design
-    import fi_design.sweep  # noqa: F401  (sets the package attribute to the module)
+    import fi_design.studies  # noqa: F401  (sets the package attribute to the module)
 
     res = fi_design.sweep(paper_spec, x=("controller.crossover", [8.0]))
     assert res.verdict[0] == "settled"

@@ -20,7 +20,7 @@ from scipy.integrate import solve_ivp
 from fi_design import plant
 from fi_design.errors import SimulationError
 from fi_design.plant import MODE_SIGN, PlantParameters
-from fi_design.simulate import simulate
+from fi_design.simulation import simulate
 from fi_design.specfile import load_spec
 
 

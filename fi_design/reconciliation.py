@@ -79,9 +79,7 @@ The library never prints; pass ``progress`` to follow the work.
 from __future__ import annotations
 
 import math
-import sys
 import time as _time
-import types
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable
 
@@ -94,7 +92,7 @@ from .measured import Measurement
 from .metrics import hunting_metrics
 from .reference import from_samples
 from .results import dataclass_dict, frozen_array, to_jsonable
-from .simulate import SimulationResult, simulate
+from .simulation import SimulationResult, simulate
 
 #: Default significance threshold on the score (BIC difference).
 THRESHOLD = 10.0
@@ -845,7 +843,7 @@ def model_tolerance(spec, noise: NoiseLevels) -> float:
     """Relative tolerance of the reconciliation's simulations.
 
     The integrator's absolute position tolerance is ``rtol`` times 1 mm
-    (:func:`fi_design.simulate.tolerances`). Integration errors of the size of
+    (:func:`fi_design.simulation.tolerances`). Integration errors of the size of
     a fraction of the sensor noise, summed over thousands of samples, would
     otherwise let a fit "explain" numerical jitter: the tolerance is set so
     that the position tolerance is a hundredth of the smallest position or
@@ -1985,23 +1983,3 @@ def _flow(entry: dict) -> str:
             continue
         parts.append(f"{k}: {v!r}" if isinstance(v, float) else f"{k}: '{v}'")
     return "{" + ", ".join(parts) + "}"
-
-
-# --------------------------------------------------------------------------- fi_design.reconcile(...)
-
-
-class _CallableModule(types.ModuleType):
-    """This module, callable as :func:`reconcile`.
-
-    ``fi_design.reconcile`` is a lazily exported function of the package and
-    also the name of this module. Once the module is imported, Python's import
-    system sets the package attribute to the module, shadowing the function;
-    calling the module keeps ``fi_design.reconcile(spec, measured, ...)``
-    working either way (as :mod:`fi_design.sweep` does).
-    """
-
-    def __call__(self, *args: Any, **kwargs: Any) -> ReconcileResult:
-        return reconcile(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule

@@ -21,7 +21,7 @@ import math
 import numpy as np
 import pytest
 
-from fi_design.reconcile import reconcile
+from fi_design.reconciliation import reconcile
 
 from hidden_effect import Case, base_spec, measure, parameter_error
 
@@ -230,7 +230,7 @@ def test_non_uniform_sampling():
 
 def test_two_effects_with_max_effects():
     from fi_design.spec import EFFECT_MODELS
-    from fi_design.simulate import simulate
+    from fi_design.simulation import simulate
     from fi_design.measured import measurement_from_arrays
 
     case = Case("two", True, None, {}, duration=3.0, moves=LONG)
