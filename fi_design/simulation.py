@@ -75,7 +75,8 @@ class SimulationResult:
     t_reached : float
         Last time integrated [s].
     n_steps, n_rejected, n_events : int
-        Accepted steps, rejected steps and mode switches.
+        Accepted steps, discarded trial steps (rejected by the error test or
+        redone to end at a mode change) and mode switches.
     wall_time : float
         Integration time [s] (excluding JIT compilation on first use only if
         the kernel was already compiled).
