@@ -63,3 +63,28 @@ def paper_confirmed_design(paper_spec):
     from fi_design.guideline import design
 
     return design(paper_spec)
+
+
+def variant(spec, **paths):
+    """The spec re-read from its YAML mapping with dotted paths replaced.
+
+    ``variant(spec, **{"friction.static": "3 N", "isolator": None})``: a value
+    replaces (or adds) the key, None removes it; values are written as in the
+    YAML file (SI numbers or strings with units). Unlike
+    :func:`fi_design.specfile.with_values` it may add or drop whole sections.
+    """
+    import copy
+
+    from fi_design.specfile import load_spec, origin
+
+    raw = copy.deepcopy(origin(spec).raw)
+    for path, value in paths.items():
+        node = raw
+        *head, last = path.split(".")
+        for key in head:
+            node = node.setdefault(key, {})
+        if value is None:
+            node.pop(last, None)
+        else:
+            node[last] = value
+    return load_spec(raw)

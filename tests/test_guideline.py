@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import hashlib
 import json
@@ -14,22 +13,10 @@ from hypothesis import given, settings, strategies as st
 import fi_design
 from fi_design import guideline as gl
 from fi_design.results import Check, Status
-from fi_design.specfile import load_spec, origin
+from fi_design.specfile import origin
+from conftest import variant
 
 
-def variant(spec, **paths):
-    """A copy of ``spec``'s YAML mapping with dotted paths replaced (None removes)."""
-    raw = copy.deepcopy(origin(spec).raw)
-    for path, value in paths.items():
-        node = raw
-        *head, last = path.split(".")
-        for key in head:
-            node = node.setdefault(key, {})
-        if value is None:
-            node.pop(last, None)
-        else:
-            node[last] = value
-    return load_spec(raw)
 
 
 @pytest.fixture(scope="module")

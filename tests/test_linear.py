@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import copy
 import math
 
 import control
@@ -11,25 +10,13 @@ import pytest
 from scipy.optimize import brentq
 
 from fi_design import linear
-from fi_design.specfile import load_spec, origin
+
+from conftest import variant
 
 W = np.geomspace(0.05, 5e3, 9)            # test frequencies [rad/s]...
 S = 1j * np.concatenate([W, [2 * math.pi * 150.0, 2 * math.pi * 10.3]])  # ...near modes too
 
 
-def variant(spec, **paths):
-    """A copy of ``spec``'s YAML mapping with dotted paths replaced, validated again."""
-    raw = copy.deepcopy(origin(spec).raw)
-    for path, value in paths.items():
-        node = raw
-        *head, last = path.split(".")
-        for key in head:
-            node = node.setdefault(key, {})
-        if value is None:
-            node.pop(last, None)
-        else:
-            node[last] = value
-    return load_spec(raw)
 
 
 # --------------------------------------------------------------------------- hand derivations

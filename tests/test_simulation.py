@@ -9,7 +9,6 @@ way physics says.
 
 from __future__ import annotations
 
-import copy
 import math
 
 import numpy as np
@@ -22,23 +21,9 @@ from fi_design.errors import SimulationError
 from fi_design.plant import MODE_SIGN, PlantParameters
 from fi_design.simulation import simulate
 from fi_design.specfile import load_spec
+from conftest import variant
 
 
-def spec_with(spec, **changes):
-    """The spec with dotted-path changes (``"friction.static": "3 N"``), re-validated."""
-    from fi_design.specfile import origin
-
-    raw = copy.deepcopy(origin(spec).raw)
-    for path, value in changes.items():
-        node = raw
-        *head, last = path.split(".")
-        for key in head:
-            node = node.setdefault(key, {})
-        if value is None:
-            node.pop(last, None)
-        else:
-            node[last] = value
-    return load_spec(raw)
 
 
 @pytest.fixture(scope="module")
@@ -105,7 +90,7 @@ def test_steady_lugre_force_during_a_constant_velocity_move(paper_spec, speed, v
     vs = paper_spec.friction.stribeck_velocity
     v = speed * vs
     dist = v * 8.5
-    spec = spec_with(paper_spec, **{"friction.viscous": viscous, "motion.moves": [
+    spec = variant(paper_spec, **{"friction.viscous": viscous, "motion.moves": [
         {"distance": dist, "velocity": v, "acceleration": 1.0}], "motion.duration": 9.0,
         "requirements.hunting.window_start": 0.0, "requirements.hunting.window_length": 9.0})
     f = paper_spec.friction
@@ -199,7 +184,7 @@ def test_friction_dissipates_energy():
 
 def test_frictionless_stage_settles_under_the_pid(paper_spec):
     """A free mass under the PID settles exponentially: no friction, no hunting."""
-    spec = spec_with(paper_spec, **{"friction.static": 1e-9, "friction.coulomb": 1e-9,
+    spec = variant(paper_spec, **{"friction.static": 1e-9, "friction.coulomb": 1e-9,
                                     "friction.viscous": 0.0})
     for isolated in (True, False):
         r = simulate(spec, isolated=isolated)
@@ -213,7 +198,7 @@ def test_frictionless_stage_settles_under_the_pid(paper_spec):
 
 def test_a_delay_lowers_the_phase(paper_spec):
     """Extra delay lowers the phase margin: the free stage overshoots more after the move."""
-    spec = spec_with(paper_spec, **{"friction.static": 1e-9, "friction.coulomb": 1e-9})
+    spec = variant(paper_spec, **{"friction.static": 1e-9, "friction.coulomb": 1e-9})
     over = []
     for delay in (0.0, 0.005, 0.01):
         r = simulate(spec, isolated=False, effects=_effects({"type": "time_delay",
@@ -224,7 +209,7 @@ def test_a_delay_lowers_the_phase(paper_spec):
 
 
 def test_delay_matches_the_reference_path(paper_spec):
-    spec = spec_with(paper_spec, **{"controller.delay": "2 ms", "motion.duration": 3.0,
+    spec = variant(paper_spec, **{"controller.delay": "2 ms", "motion.duration": 3.0,
                                     "requirements.hunting.window_start": 1.0,
                                     "requirements.hunting.window_length": 2.0})
     fast = simulate(spec, isolated=True)
@@ -239,7 +224,7 @@ def test_delay_matches_the_reference_path(paper_spec):
 def test_quantization_makes_the_controller_see_steps(paper_spec):
     q = 20e-6
     quant = _effects({"type": "quantization", "resolution": q})
-    short = spec_with(paper_spec, **{"motion.duration": 0.6,
+    short = variant(paper_spec, **{"motion.duration": 0.6,
                                      "requirements.hunting.window_start": 0.3,
                                      "requirements.hunting.window_length": 0.3})
     r = simulate(short, isolated=True, effects=quant)
@@ -265,9 +250,9 @@ def test_saturation_caps_the_force(paper_spec):
 
 def test_discrete_controller_approaches_the_continuous_one(paper_spec):
     cont = simulate(paper_spec, isolated=True)
-    fast_sampled = simulate(spec_with(paper_spec, **{"controller.sample_rate": "20 kHz"}),
+    fast_sampled = simulate(variant(paper_spec, **{"controller.sample_rate": "20 kHz"}),
                             isolated=True)
-    slow_sampled = simulate(spec_with(paper_spec, **{"controller.sample_rate": "300 Hz"}),
+    slow_sampled = simulate(variant(paper_spec, **{"controller.sample_rate": "300 Hz"}),
                             isolated=True)
     assert fast_sampled.success and slow_sampled.success
     d_fast = np.max(np.abs(fast_sampled.position - cont.position))
@@ -281,7 +266,7 @@ def test_discrete_controller_approaches_the_continuous_one(paper_spec):
 
 
 def test_discrete_controller_matches_the_reference_path(paper_spec):
-    spec = spec_with(paper_spec, **{"controller.sample_rate": "1 kHz", "controller.delay": "0.5 ms",
+    spec = variant(paper_spec, **{"controller.sample_rate": "1 kHz", "controller.delay": "0.5 ms",
                                     "motion.duration": 2.0,
                                     "requirements.hunting.window_start": 1.0,
                                     "requirements.hunting.window_length": 1.0})
@@ -292,11 +277,11 @@ def test_discrete_controller_matches_the_reference_path(paper_spec):
 
 
 def test_switch_model_matches_its_reference_and_the_paper_trend(paper_spec):
-    spec = spec_with(paper_spec, **{"friction.model": "switch"})
+    spec = variant(paper_spec, **{"friction.model": "switch"})
     non = simulate(spec, isolated=False)
     iso = simulate(spec, isolated=True)
     assert non.metrics.verdict == "hunting" and iso.metrics.verdict == "settled"
-    short = spec_with(spec, **{"motion.duration": 6.0,
+    short = variant(spec, **{"motion.duration": 6.0,
                                "requirements.hunting.window_start": 2.0,
                                "requirements.hunting.window_length": 4.0})
     fast = simulate(short, isolated=False)
@@ -320,7 +305,7 @@ def test_reference_signal_drives_the_model(paper_spec):
 
 def test_cable_force_and_ripple_push_the_stage(paper_spec):
     """At rest the controller supplies exactly what the cable pulls: kc x1 + F0."""
-    free = spec_with(paper_spec, **{"friction.static": 1e-9, "friction.coulomb": 1e-9})
+    free = variant(paper_spec, **{"friction.static": 1e-9, "friction.coulomb": 1e-9})
     base = simulate(free, isolated=False)
     cable = simulate(free, isolated=False,
                      effects=_effects({"type": "cable_force", "stiffness": 50.0, "preload": 0.5}))
@@ -340,7 +325,7 @@ def test_cable_force_and_ripple_push_the_stage(paper_spec):
 
 
 def test_unstable_loop_is_reported_not_garbage(paper_spec):
-    spec = spec_with(paper_spec, **{"controller.crossover": "60 Hz", "controller.delay": "5 ms"})
+    spec = variant(paper_spec, **{"controller.crossover": "60 Hz", "controller.delay": "5 ms"})
     r = simulate(spec, isolated=False)
     assert not r.success
     assert "t =" in r.message and "likely cause" in r.message
@@ -348,14 +333,14 @@ def test_unstable_loop_is_reported_not_garbage(paper_spec):
 
 
 def test_step_budget_is_reported(paper_spec):
-    spec = spec_with(paper_spec, **{"simulation.max_steps": 1000})
+    spec = variant(paper_spec, **{"simulation.max_steps": 1000})
     r = simulate(spec, isolated=False)
     assert not r.success and r.status == "step budget exhausted"
     assert 0 < r.t_reached < paper_spec.motion.duration
 
 
 def test_isolated_plant_needs_an_isolator(paper_spec):
-    spec = spec_with(paper_spec, isolator=None)
+    spec = variant(paper_spec, isolator=None)
     with pytest.raises(SimulationError, match="no isolator"):
         simulate(spec, isolated=True)
     with pytest.raises(SimulationError, match="method"):
