@@ -666,27 +666,15 @@ def simulate_command(
     console = _console()
     _print_simulation(console, result)
     if csv_path is not None:
-        write_atomic(csv_path, traces_csv(result.traces()))
+        from .measured import columns_csv
+
+        write_atomic(csv_path, columns_csv(result.traces()))
         console.print(f"wrote {csv_path}", markup=False)
     if json_path is not None:
         import json
 
         write_atomic(json_path, json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n")
         console.print(f"wrote {json_path}", markup=False)
-
-
-def traces_csv(columns: dict) -> str:
-    """CSV text of equal-length columns, header first, full float precision."""
-    import io
-
-    import numpy as np
-
-    names = list(columns)
-    data = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
-    buf = io.StringIO()
-    buf.write(",".join(names) + "\n")
-    np.savetxt(buf, data, delimiter=",", fmt="%.10g")
-    return buf.getvalue()
 
 
 def _print_simulation(console: "Console", result) -> None:

@@ -51,7 +51,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .plant import A1, A2, I1, b1, f8, i8  # numba signature types
+from .plant import A1, A2, I1, Integration, b1, f8, i8  # signature types, result
 from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, P_AD11, P_AD12,
                     P_AD21, P_AD22, P_BD1, P_BD2, P_CD1, P_CD2, P_DD, P_DELAY, P_FS, P_ISO,
                     P_KD, P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_WT, actuator,
@@ -81,7 +81,7 @@ ST_STEPS, ST_REJECTED, ST_EVENTS, ST_T, ST_H, ST_OUT, ST_ZERO_EVENTS, ST_LIMIT_E
 N_STATS = 8
 
 # Event kinds.
-EV_NONE, EV_SIGN, EV_LIMIT, EV_LEVEL, EV_UNSTICK, EV_STOP = 0, 1, 2, 3, 4, 5
+EV_NONE, EV_SIGN, EV_LIMIT, EV_LEVEL, EV_UNSTICK = 0, 1, 2, 3, 4
 
 HIST = 8192  # delay history ring size
 FIFO = 256  # pending discrete outputs (delay / sample period < FIFO)
@@ -942,9 +942,9 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
         max_steps=2_000_000, x_bound=10.0):
     """Allocate outputs and call :func:`integrate`.
 
-    Returns ``(status, out_y, out_r, out_fa, stats)`` as numpy arrays; see
-    :func:`integrate` for the meaning. This thin wrapper is the kernel's only
-    Python-level entry point; :mod:`fi_design.simulation` wraps it in a result.
+    Returns a :class:`fi_design.plant.Integration`; see :func:`integrate` for
+    the arguments. This thin wrapper is the kernel's only Python-level entry
+    point; :mod:`fi_design.simulation` wraps it in a result.
     """
     # fresh writable copies: numba types read-only arrays differently
     p = np.array(params, dtype=np.float64)
@@ -960,4 +960,7 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
                        np.array(coeffs, dtype=np.float64, order="C"), bool(land), float(t_end),
                        t_out, float(rtol), np.array(atol, dtype=np.float64),
                        float(h_max), int(max_steps), float(x_bound), out_y, out_r, out_fa, stats)
-    return int(status), out_y, out_r, out_fa, stats
+    return Integration(code=int(status), status=STATUS_TEXT[int(status)], states=out_y,
+                       reference=out_r, applied_force=out_fa, n_steps=int(stats[ST_STEPS]),
+                       n_rejected=int(stats[ST_REJECTED]), n_events=int(stats[ST_EVENTS]),
+                       t_reached=float(stats[ST_T]))

@@ -34,6 +34,7 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Mapping
 
 import numpy as np
 
@@ -356,18 +357,30 @@ def to_csv_text(measurement: Measurement, comment: str | None = None) -> str:
     comment : str, optional
         Lines written before the header, each prefixed with ``# ``.
     """
-    cols = [("time_s", measurement.time), ("reference_m", measurement.reference),
-            ("position_m", measurement.position)]
+    cols = {"time_s": measurement.time, "reference_m": measurement.reference,
+            "position_m": measurement.position}
     if measurement.force is not None:
-        cols.append(("force_N", measurement.force))
+        cols["force_N"] = measurement.force
     if measurement.deflection is not None:
-        cols.append(("deflection_m", measurement.deflection))
+        cols["deflection_m"] = measurement.deflection
+    return columns_csv(cols, comment)
+
+
+def columns_csv(columns: Mapping[str, np.ndarray], comment: str | None = None) -> str:
+    """CSV text of equal-length columns in the measured-data layout, header first.
+
+    Parameters
+    ----------
+    columns : mapping of str to ndarray
+        Header (``time_s``, ``position_m``, ...) to values (SI), in order.
+    comment : str, optional
+        Lines written before the header, each prefixed with ``# ``.
+    """
     out = io.StringIO()
     if comment:
         for line in comment.splitlines():
             out.write(f"# {line}\n")
-    out.write(",".join(c for c, _ in cols) + "\n")
-    data = np.column_stack([v for _, v in cols])
-    for row in data:
-        out.write(",".join(f"{x:.10g}" for x in row) + "\n")
+    out.write(",".join(columns) + "\n")
+    data = np.column_stack([np.asarray(v, dtype=float) for v in columns.values()])
+    np.savetxt(out, data, delimiter=",", fmt="%.10g")
     return out.getvalue()

@@ -127,6 +127,39 @@ class PlantParameters:
         return 7 if self.isolated else 5
 
 
+@dataclass(frozen=True, eq=False)
+class Integration:
+    """What an integrator of these equations returns (kernel or reference path).
+
+    Attributes
+    ----------
+    code : int
+        0 on success, a failure code otherwise.
+    status : str
+        ``"ok"`` or the failure kind.
+    states : ndarray, shape (m, n)
+        States at the output times (NaN after a failure).
+    reference : ndarray, shape (m,)
+        Reference r at the output times [m].
+    applied_force : ndarray, shape (m,)
+        Actuator force on the stage after delay and saturation [N].
+    n_steps, n_rejected, n_events : int
+        Accepted steps, discarded trial steps, mode switches.
+    t_reached : float
+        Last time integrated [s].
+    """
+
+    code: int
+    status: str
+    states: np.ndarray
+    reference: np.ndarray
+    applied_force: np.ndarray
+    n_steps: int
+    n_rejected: int
+    n_events: int
+    t_reached: float
+
+
 (P_M1, P_M2, P_K, P_C, P_S, P_KSTOP, P_CSTOP, P_FS, P_FC, P_VS, P_SIGMA0, P_SIGMA1, P_SIGMA2,
  P_KP, P_KI, P_KD, P_WT, P_DELAY, P_TS, P_QUANT, P_FLIMIT, P_PDF_A, P_PDF_L, P_PDF_PHI,
  P_RIP_A, P_RIP_P, P_RIP_PHI, P_CABLE_K, P_CABLE_F0, P_ISO, P_SWITCH,

@@ -134,6 +134,12 @@ def _move_jerks(distance: float, v: float, a: float, j: float | None) -> list[tu
     return segs
 
 
+def profile_duration(distance: float, velocity: float, acceleration: float,
+                     jerk: float | None = None) -> float:
+    """Duration [s] of one move over ``distance`` [m] with the given limits (SI)."""
+    return sum(seg[0] for seg in _move_jerks(distance, velocity, acceleration, jerk))
+
+
 def from_moves(moves, duration: float) -> Reference:
     """Build the reference of a sequence of moves starting from r = 0 at rest.
 

@@ -20,7 +20,8 @@ import math
 
 import numpy as np
 
-from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, PlantParameters, actuator,
+from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, Integration, PlantParameters,
+                    actuator,
                     drive_force, jacobian, natural_modes, rhs)
 from .reference import Reference
 
@@ -48,9 +49,8 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
                     rtol: float, atol, x_bound: float, method: str = "Radau"):
     """Integrate with solve_ivp; same outputs as :func:`fi_design.kernel.run`.
 
-    Returns ``(code, out_y, out_r, out_fa, n_steps, n_rejected, n_events,
-    t_reached, status)``: code 0 on success, 3 on a solver failure, 4 on
-    divergence.
+    Returns a :class:`fi_design.plant.Integration`: code 0 on success, 3 on a
+    solver failure, 4 on divergence.
     """
     from scipy.integrate import solve_ivp
 
@@ -220,8 +220,7 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
                 if len(te):
                     y = ye[0].copy()
                     t1 = float(te[0])
-                    _switch(name, y, p, modes, params, iv2, iu, fa_at(t1, y), fa_state, cont_delay,
-                            hist, t1)
+                    _switch(name, y, p, modes, params, iv2, iu, fa_at(t1, y), fa_state)
                     n_ev += 1
                     zero_run = zero_run + 1 if t1 - t <= 1e-12 * max(1.0, t) else 0
                     break
@@ -229,10 +228,12 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
         if abs(y[0]) > x_bound or not np.all(np.isfinite(y)):
             code, status = 4, "solution diverged"
             break
-    return code, out_y, out_r, out_fa, n_steps, n_rej, n_ev, t, status
+    return Integration(code=code, status=status, states=out_y, reference=out_r,
+                       applied_force=out_fa, n_steps=n_steps, n_rejected=n_rej, n_events=n_ev,
+                       t_reached=t)
 
 
-def _switch(name, y, p, modes, params, iv2, iu, fa, fa_state, cont_delay, hist, t) -> None:
+def _switch(name, y, p, modes, params, iv2, iu, fa, fa_state) -> None:
     """Mode change at an event located by solve_ivp."""
     if name == "sign":
         if params.switch_model:

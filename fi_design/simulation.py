@@ -232,11 +232,6 @@ def tolerances(params: PlantParameters, rtol: float) -> np.ndarray:
     return rtol * np.array(scale)
 
 
-def motion_end(spec: _spec.Spec) -> float:
-    """End time of the last move [s]."""
-    return _spec._motion_end(spec)
-
-
 # --------------------------------------------------------------------------- simulate
 
 
@@ -307,27 +302,25 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         y0[2] = initial_position
     x_bound = 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(initial_position))
 
+    start = _time.perf_counter()
     if method == "fast":
-        from .kernel import STATUS_TEXT, run  # compiles or loads the kernel on first use
+        from .kernel import run  # compiles or loads the kernel on first use
 
         start = _time.perf_counter()
         out = run(params.to_array(), y0, ref.breaks, ref.coeffs, ref.land, t_end, t_out, tol,
                   tolerances(params, tol), 0.05, spec.simulation.max_steps, x_bound)
-        code, Y, R, FA, stats = out
-        status = STATUS_TEXT[code]
-        n_steps, n_rej, n_ev, t_reached = int(stats[0]), int(stats[1]), int(stats[2]), stats[3]
     else:
         from .refsolve import solve_reference
 
-        start = _time.perf_counter()
-        code, Y, R, FA, n_steps, n_rej, n_ev, t_reached, status = solve_reference(
-            params, y0, ref, t_end, t_out, tol, tolerances(params, tol), x_bound)
+        out = solve_reference(params, y0, ref, t_end, t_out, tol, tolerances(params, tol),
+                              x_bound)
     wall = _time.perf_counter() - start
-    success = code == 0
-    message = "" if success else _failure_message(status, t_reached, params, iso)
+    success = out.code == 0
+    message = "" if success else _failure_message(out.status, out.t_reached, params, iso)
+    Y, R = out.states, out.reference
     idx = state_index(iso)
     metrics = _metrics(spec, t_out, Y[:, idx["x1"]] - R, success, message,
-                       motion_end(spec) if reference is None else 0.0)
+                       spec.motion.end_time if reference is None else 0.0)
     return SimulationResult(
         isolated=iso, method=method, friction_model=spec.friction.model,
         crossover=spec.controller.crossover if crossover is None else float(crossover),
@@ -335,9 +328,10 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         time=frozen_array(t_out), reference=frozen_array(R), position=frozen_array(Y[:, idx["x1"]]),
         cart_position=frozen_array(Y[:, idx["x2"]]), velocity=frozen_array(Y[:, idx["v1"]]),
         cart_velocity=frozen_array(Y[:, idx["v2"]]), force=frozen_array(Y[:, idx["u"]]),
-        applied_force=frozen_array(FA), bristle=frozen_array(Y[:, idx["z"]]),
-        success=success, status=status, message=message, t_reached=float(t_reached),
-        n_steps=n_steps, n_rejected=n_rej, n_events=n_ev, wall_time=wall, metrics=metrics,
+        applied_force=frozen_array(out.applied_force), bristle=frozen_array(Y[:, idx["z"]]),
+        success=success, status=out.status, message=message, t_reached=out.t_reached,
+        n_steps=out.n_steps, n_rejected=out.n_rejected, n_events=out.n_events, wall_time=wall,
+        metrics=metrics,
         parameters=params)
 
 

@@ -21,7 +21,7 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Discriminator, Fie
                       Tag, WithJsonSchema, create_model, model_validator)
 
 from . import effects as _effects
-from .reference import jerk_profile_times
+from .reference import profile_duration
 from .units import to_si
 
 # --------------------------------------------------------------------------- quantities
@@ -213,13 +213,27 @@ class Motion(StrictModel):
 
     @model_validator(mode="after")
     def _in_order(self) -> "Motion":
-        t = 0.0
-        for i, mv in enumerate(self.moves):
-            if mv.start is not None and mv.start < t - 1e-12:
-                raise ValueError(f"moves[{i}] starts at {mv.start:g} s, before moves[{i - 1}] ends "
-                                 f"at {t:.4g} s")
-            t = (mv.start if mv.start is not None else t) + move_duration(mv)
+        end = 0.0
+        for i, (start, stop) in enumerate(self.spans()):
+            if start < end - 1e-12:
+                raise ValueError(f"moves[{i}] starts at {start:g} s, before moves[{i - 1}] ends "
+                                 f"at {end:.4g} s")
+            end = stop
         return self
+
+    def spans(self) -> list[tuple[float, float]]:
+        """Start and end time of each move [s]: a move without ``start`` follows the last."""
+        out, t = [], 0.0
+        for mv in self.moves:
+            t0 = mv.start if mv.start is not None else t
+            t = t0 + move_duration(mv)
+            out.append((t0, t))
+        return out
+
+    @property
+    def end_time(self) -> float:
+        """End of the last move [s]."""
+        return self.spans()[-1][1]
 
 
 class Hunting(StrictModel):
@@ -475,7 +489,7 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
             out.append(("isolator.stroke",
                         f"stroke {spec.isolator.stroke * 1e3:.3g} mm is within 5x the presliding "
                         f"range Fs/sigma0 = {presl * 1e6:.3g} um: the joint can hardly isolate"))
-    t_end = _motion_end(spec)
+    t_end = spec.motion.end_time
     if t_end > spec.requirements.hunting.window_start:
         out.append(("requirements.hunting.window_start",
                     f"the last move ends at {t_end:.3g} s, inside the hunting window that starts at "
@@ -483,20 +497,6 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     return out
 
 
-def _motion_end(spec: Spec) -> float:
-    t = 0.0
-    for mv in spec.motion.moves:
-        t0 = mv.start if mv.start is not None else t
-        t = t0 + move_duration(mv)
-    return t
-
-
 def move_duration(mv: Move) -> float:
     """Duration of one move [s] (trapezoidal, or jerk-limited when ``jerk`` is set)."""
-    d, v, a, j = abs(mv.distance), mv.velocity, mv.acceleration, mv.jerk
-    if j is None:
-        if v * v / a >= d:  # triangular
-            return 2.0 * math.sqrt(d / a)
-        return d / v + v / a
-    tj, ta, tv = jerk_profile_times(d, v, a, j)
-    return 4 * tj + 2 * ta + tv
+    return profile_duration(mv.distance, mv.velocity, mv.acceleration, mv.jerk)
