@@ -152,8 +152,7 @@ def _convert(text: str, unit: str, path: str | None) -> float:
 def _has_angle(q) -> bool:
     """True if the quantity's units contain an angle (radian, degree, revolution, ...)."""
     ureg = registry()
-    for name in q.unit_items() if hasattr(q, "unit_items") else q._units.items():
-        uname = name[0]
+    for uname, _power in q.unit_items():
         _, root = ureg.get_root_units(uname)
         if "radian" in str(root):
             return True
