@@ -11,7 +11,13 @@ reference_m    m      yes      the controller's reference r
 position_m     m      yes      the measured stage position x1 (what the controller saw)
 force_N        N      no       commanded actuator force u, before delay or saturation
 deflection_m   m      no       joint deflection x1 - x2 (isolated stages)
+disturbance_N  N      no       known force injected at the actuator by the experiment
 ============== ====== ======== =====================================================
+
+``force_N`` is the total force command the actuator received, an injected
+disturbance included; the controller's own output is ``force_N -
+disturbance_N``. A record may start in motion: replays start from the state
+in the first samples (:mod:`fi_design.simulation`).
 
 Lines starting with ``#`` before the header are comments (e.g. how the trace
 was recorded); other columns are ignored. Every value must be a plain number
@@ -44,20 +50,21 @@ from .results import dataclass_dict, frozen_array
 #: Required columns, in the order of the layout.
 REQUIRED = ("time_s", "reference_m", "position_m")
 #: Optional columns.
-OPTIONAL = ("force_N", "deflection_m")
+OPTIONAL = ("force_N", "deflection_m", "disturbance_N")
 #: Unit of every known column.
 UNITS = {"time_s": "s", "reference_m": "m", "position_m": "m", "force_N": "N",
-         "deflection_m": "m"}
+         "deflection_m": "m", "disturbance_N": "N"}
 #: Fewest samples accepted.
 MIN_SAMPLES = 20
 #: Largest file accepted [bytes] (about 3 million rows of five columns).
 MAX_BYTES = 300_000_000
 #: Magnitudes above these are taken as a wrong unit (e.g. mm written into a _m column).
-PLAUSIBLE = {"reference_m": 10.0, "position_m": 10.0, "deflection_m": 0.1, "force_N": 1e6}
+PLAUSIBLE = {"reference_m": 10.0, "position_m": 10.0, "deflection_m": 0.1, "force_N": 1e6,
+             "disturbance_N": 1e6}
 
 _BASES = {"time": "time_s", "t": "time_s", "reference": "reference_m", "ref": "reference_m",
           "position": "position_m", "pos": "position_m", "force": "force_N",
-          "deflection": "deflection_m"}
+          "deflection": "deflection_m", "disturbance": "disturbance_N"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,6 +83,9 @@ class Measurement:
         Commanded actuator force u [N], when recorded.
     deflection : ndarray, shape (n,), or None
         Joint deflection x1 - x2 [m], when recorded.
+    disturbance : ndarray, shape (n,), or None
+        Known force injected at the actuator by the experiment [N], when
+        recorded; included in ``force``.
     source : str or None
         File the trace was read from.
     """
@@ -85,6 +95,7 @@ class Measurement:
     position: np.ndarray
     force: np.ndarray | None = None
     deflection: np.ndarray | None = None
+    disturbance: np.ndarray | None = None
     source: str | None = None
 
     @property
@@ -116,6 +127,8 @@ class Measurement:
             out.append("force_N")
         if self.deflection is not None:
             out.append("deflection_m")
+        if self.disturbance is not None:
+            out.append("disturbance_N")
         return tuple(out)
 
     def to_dict(self, traces: bool = False) -> dict:
@@ -129,7 +142,7 @@ class Measurement:
 
 
 def measurement_from_arrays(time_s, reference_m, position_m, force_N=None, deflection_m=None,
-                            source: str | None = None) -> Measurement:
+                            disturbance_N=None, source: str | None = None) -> Measurement:
     """Build a :class:`Measurement` from arrays, with the checks of :func:`load_measurement`.
 
     Parameters
@@ -144,6 +157,8 @@ def measurement_from_arrays(time_s, reference_m, position_m, force_N=None, defle
         Commanded actuator force [N].
     deflection_m : array_like, shape (n,), optional
         Joint deflection [m].
+    disturbance_N : array_like, shape (n,), optional
+        Known force injected at the actuator [N] (part of ``force_N``).
     source : str, optional
         Where the data came from (used in error messages).
 
@@ -158,7 +173,7 @@ def measurement_from_arrays(time_s, reference_m, position_m, force_N=None, defle
         for its unit, too short, or the time does not increase.
     """
     cols = {"time_s": time_s, "reference_m": reference_m, "position_m": position_m,
-            "force_N": force_N, "deflection_m": deflection_m}
+            "force_N": force_N, "deflection_m": deflection_m, "disturbance_N": disturbance_N}
     arrays: dict[str, np.ndarray | None] = {}
     n = None
     for name, values in cols.items():
@@ -211,6 +226,8 @@ def _checked(arrays: dict, source: str | None) -> Measurement:
                        frozen_array(arrays["force_N"]),
                        deflection=None if arrays.get("deflection_m") is None else
                        frozen_array(arrays["deflection_m"]),
+                       disturbance=None if arrays.get("disturbance_N") is None else
+                       frozen_array(arrays["disturbance_N"]),
                        source=source)
 
 
@@ -221,7 +238,8 @@ def load_measurement(path: str | os.PathLike) -> Measurement:
     ----------
     path : str or os.PathLike
         The CSV file. Columns by header: ``time_s``, ``reference_m``,
-        ``position_m`` required; ``force_N`` and ``deflection_m`` optional;
+        ``position_m`` required; ``force_N``, ``deflection_m`` and
+        ``disturbance_N`` optional;
         other columns are ignored; ``#`` lines before the header are comments.
 
     Returns
@@ -363,6 +381,8 @@ def to_csv_text(measurement: Measurement, comment: str | None = None) -> str:
         cols["force_N"] = measurement.force
     if measurement.deflection is not None:
         cols["deflection_m"] = measurement.deflection
+    if measurement.disturbance is not None:
+        cols["disturbance_N"] = measurement.disturbance
     return columns_csv(cols, comment)
 
 

@@ -119,3 +119,27 @@ def test_arrays_checked_like_files():
     with pytest.raises(DataError) as info:
         measurement_from_arrays(t, np.zeros(30), np.zeros(30), force_N=bad)
     assert (info.value.column, info.value.row) == ("force_N", 8)
+
+
+def test_disturbance_column_loads_and_round_trips(tmp_path):
+    lines = [HEADER + ",disturbance_N"] + [r + f",{0.5 if 10 <= i < 15 else 0.0}"
+                                           for i, r in enumerate(_rows())]
+    m = load_measurement(_write(tmp_path, "\n".join(lines) + "\n"))
+    assert m.columns[-1] == "disturbance_N"
+    assert m.disturbance[12] == 0.5 and m.disturbance[0] == 0.0
+    again = load_measurement(_write(tmp_path, to_csv_text(m), name="again.csv"))
+    assert np.array_equal(again.disturbance, m.disturbance)
+
+
+def test_disturbance_nan_names_column_and_row(tmp_path):
+    lines = [HEADER + ",disturbance_N"] + [r + (",nan" if i == 6 else ",0")
+                                           for i, r in enumerate(_rows())]
+    with pytest.raises(DataError) as err:
+        load_measurement(_write(tmp_path, "\n".join(lines) + "\n"))
+    assert err.value.column == "disturbance_N" and err.value.row == 7
+
+
+def test_disturbance_with_other_unit_refused(tmp_path):
+    lines = [HEADER + ",disturbance_kN"] + [r + ",0" for r in _rows()]
+    with pytest.raises(DataError, match="disturbance_N"):
+        load_measurement(_write(tmp_path, "\n".join(lines) + "\n"))
