@@ -33,6 +33,48 @@ def paper_spec(paper_spec_path):
     return load_spec(paper_spec_path)
 
 
+# --------------------------------------------------------------------------- real records
+
+#: Environment variable naming the folder of real measured records (``.ci/run`` sets it to
+#: the absolute path beside the original checkout, because CI tests a copy of the repository).
+REALDATA_ENV = "FI_DESIGN_REALDATA"
+
+
+def realdata_dir() -> Path:
+    """Folder of the real records: ``$FI_DESIGN_REALDATA``, else ``../shared/realdata``."""
+    import os
+
+    given = os.environ.get(REALDATA_ENV)
+    return Path(given) if given else ROOT.parent / "shared" / "realdata"
+
+
+@pytest.fixture(scope="session")
+def emps_path() -> Path:
+    """The EMPS estimation record (a real ball-screw axis under PD control, not redistributable).
+
+    Skips with the reason when the record is absent (a clone of the repository alone), but
+    fails under CI (``CI`` set), where the record must be found.
+    """
+    import os
+
+    path = realdata_dir() / "emps" / "emps_estimation.csv"
+    if not path.is_file():
+        reason = (f"the real EMPS record is not at {path} (set {REALDATA_ENV} to the folder "
+                  "holding emps/emps_estimation.csv); it is not part of the repository")
+        if os.environ.get("CI"):
+            pytest.fail(reason)
+        pytest.skip(reason)
+    return path
+
+
+@pytest.fixture(scope="session")
+def emps_record(emps_path):
+    """The EMPS estimation record as a :class:`~fi_design.measured.Measurement`."""
+    from fi_design.measured import load_measurement
+
+    return load_measurement(emps_path)
+
+
 # --------------------------------------------------------------------------- parameter studies
 
 

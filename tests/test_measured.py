@@ -143,3 +143,14 @@ def test_disturbance_with_other_unit_refused(tmp_path):
     lines = [HEADER + ",disturbance_kN"] + [r + ",0" for r in _rows()]
     with pytest.raises(DataError, match="disturbance_N"):
         load_measurement(_write(tmp_path, "\n".join(lines) + "\n"))
+
+
+def test_emps_record_loads_as_documented(emps_record):
+    """The real EMPS record: 24,841 rows at 1 kHz, starting in motion, in whole encoder counts."""
+    m = emps_record
+    assert m.n == 24841 and m.uniform and m.sample_period == pytest.approx(1e-3)
+    counts = m.position / 5e-8
+    assert np.max(np.abs(counts - np.round(counts))) < 1e-6
+    r0 = (m.reference[1] - m.reference[0]) / (m.time[1] - m.time[0])
+    v0 = (m.position[5] - m.position[0]) / (m.time[5] - m.time[0])
+    assert r0 == pytest.approx(13.4e-3, rel=0.05) and v0 > 5e-3   # it starts in motion
