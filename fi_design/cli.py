@@ -323,10 +323,6 @@ def design_command(
         if job is not None:
             status("simulating with and without the isolator (the first run on a machine "
                    "compiles the kernel, about 10 s) ...")
-            if report_path is not None:  # use the wait: import the report's libraries
-                from .report import preload
-
-                preload(report_path)
             result = result.with_simulation(job.result())
 
     text = None
@@ -341,9 +337,15 @@ def design_command(
     if report_path is not None:
         from .report import render_report
 
+        dmap = None
+        if with_map or (not no_simulation and result.spec.report.map):
+            from .studies import design_map
+
+            with _status(err, "computing the hunting map ...") as status:
+                dmap = design_map(result, progress=lambda done, total: status(
+                    f"hunting map: {done}/{total} simulations"))
         with _status(err, "writing the report ...") as status:
-            render_report(result, report_path, command=_command_line(),
-                          map=True if with_map else (False if no_simulation else None),
+            render_report(result, report_path, command=_command_line(), design_map=dmap,
                           progress=status)
         console.print(f"wrote {report_path}", markup=False)
 
@@ -1482,7 +1484,7 @@ def _path_unit(path: str, spec) -> str:
 
 
 # --------------------------------------------------------------------------- reconcile
-# (model against measurement: fi_design.reconciliation, fi_design.measured, fi_design.gapreport)
+# (model against measurement: fi_design.reconciliation, fi_design.measured, fi_design.report.gap)
 
 
 @app.command("reconcile")
@@ -1551,7 +1553,7 @@ def reconcile_command(
                       + ("" if result.entries else " (no effect found: the spec is unchanged)"),
                       markup=False, highlight=False)
     if outs["report"] is not None:
-        from .gapreport import render_gap_report
+        from .report import render_gap_report
 
         render_gap_report(result, outs["report"], command=_command_line())
         console.print(f"wrote {outs['report']}", markup=False, highlight=False)

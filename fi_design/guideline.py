@@ -37,9 +37,11 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
 
+import numpy as np
+
 from .flexure import FlexureResult, size_flexure
 from .pid import PidGains, tune_pid
-from .results import Check, Status, dataclass_dict, to_jsonable
+from .results import Check, Status, dataclass_dict, frozen_array, to_jsonable
 from .spec import Spec, drive_stiffness, proposed_stiffness, stiffness_limit, warnings_for
 
 __all__ = [
@@ -290,6 +292,90 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
         limiting_case=ach.case, feasible_ranges=ach.feasible_ranges, delay=at.delay,
         stiffness=at.stiffness, cases=at.cases, parasitic_modes=tuple(modes),
         checks=tuple(checks))
+
+
+# --------------------------------------------------------------------------- loop responses
+
+
+@dataclass(frozen=True, eq=False)
+class CaseResponse:
+    """The open loop of one linear limit case over a frequency grid.
+
+    Attributes
+    ----------
+    name : str
+        Case name (``sliding_free``, ``stuck_free``, ...).
+    number : int
+        1 to 4 in the paper's order (Figure 2).
+    description : str
+        The case in words.
+    loop : ndarray of complex, shape (n,)
+        L(j 2 pi f) = C D P at the grid's frequencies [-].
+    """
+
+    name: str
+    number: int
+    description: str
+    loop: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class LoopResponses:
+    """Frequency responses of the loop in every limit case (for the Bode, Nyquist and
+    sensitivity plots), as the margins of step 2 used it.
+
+    Attributes
+    ----------
+    frequency : ndarray, shape (n,)
+        Log-spaced frequencies [Hz]: from a third of the lowest gain crossover
+        of any case (and a thirtieth of the desired crossover) to thirty times
+        the desired crossover or twice the highest parasitic mode.
+    cases : tuple of CaseResponse
+        One per limit case, in the paper's order.
+    """
+
+    frequency: np.ndarray
+    cases: tuple[CaseResponse, ...]
+
+
+def loop_responses(spec: Spec, crossover: CrossoverResult, gains: PidGains,
+                   points: int = 500) -> LoopResponses:
+    """The loop of every limit case over a frequency grid that holds every crossover and mode.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The design spec.
+    crossover : CrossoverResult
+        Step 2 (desired crossover, the gain crossovers of each case, the
+        joint stiffness the cases use).
+    gains : fi_design.pid.PidGains
+        Step 4's gains.
+    points : int, optional
+        Number of frequencies.
+
+    Returns
+    -------
+    LoopResponses
+    """
+    from . import linear
+
+    fc = crossover.desired
+    lows = [fc / 30.0] + [c / 3.0 for case in crossover.cases for c in case.crossovers
+                          if c and c > 0]
+    modes = spec.isolator.parasitic_modes if spec.isolator is not None else ()
+    highs = [30.0 * fc] + [2.0 * m.frequency for m in modes]
+    lo = 10.0 ** math.floor(math.log10(min(lows)))
+    hi = 10.0 ** math.ceil(math.log10(max(highs)))
+    f = np.geomspace(lo, hi, points)
+    s = 2j * math.pi * f
+    cases = []
+    for lc in linear.limit_cases(spec, crossover.stiffness):
+        num, den = linear.loop_polynomials(spec, lc, gains=gains)
+        cases.append(CaseResponse(name=lc.name, number=lc.number, description=lc.description,
+                                  loop=frozen_array(np.polyval(num, s) / np.polyval(den, s),
+                                                    dtype=complex)))
+    return LoopResponses(frequency=frozen_array(f), cases=tuple(cases))
 
 
 # --------------------------------------------------------------------------- step 3
@@ -610,6 +696,9 @@ class DesignResult:
         Step 3 leaf-spring sizing; None without ``isolator.flexure``.
     pid : PidResult
         Step 4.
+    loop : LoopResponses
+        The loop of every limit case over frequency, for the plots (not in
+        JSON).
     isolator_advice : IsolatorAdvice or None
         Only for a spec without isolator.
     checks : tuple of Check
@@ -634,6 +723,7 @@ class DesignResult:
     stiffness: StiffnessResult
     flexure: FlexureResult | None
     pid: PidResult
+    loop: LoopResponses = field(repr=False)
     isolator_advice: IsolatorAdvice | None
     checks: tuple[Check, ...]
     warnings: tuple[tuple[str, str], ...]
@@ -752,7 +842,7 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     checks = gap.checks + xo.checks + st.checks + _flexure_checks(fx) + pid.checks
     result = DesignResult(
         spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,
-        isolator_advice=advice, checks=checks, warnings=tuple(warnings_for(spec)),
+        loop=loop_responses(spec, xo, pid.gains), isolator_advice=advice, checks=checks, warnings=tuple(warnings_for(spec)),
         conclusion=_conclusion(spec, gap, xo, st, fx, pid, advice, checks),
         fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None)
     if simulation is None and confirm:

@@ -1058,6 +1058,75 @@ def _verdicts(points: Sequence[PointResult], shape: tuple[int, ...]) -> np.ndarr
     return arr
 
 
+@dataclass(frozen=True, eq=False)
+class DesignMap:
+    """A crossover x stroke hunting map around a design point (paper Figure 4D).
+
+    Attributes
+    ----------
+    sweep : SweepResult
+        The map: x ``controller.crossover``, y ``isolator.stroke`` (log), the
+        isolated plant, the PID retuned at every crossover.
+    suggested : bool
+        True when the design's spec has no isolator and the map uses the
+        isolator the guideline suggests.
+    stroke : float
+        Stroke of that suggested isolator [m] (the spec's own when not
+        suggested).
+    stiffness : float or None
+        Drive stiffness of the suggested isolator [N/m]; the spec's given
+        stiffness otherwise, None when the spec leaves it to step 3 (it then
+        follows the stroke across the map, k_max / 2).
+    """
+
+    sweep: SweepResult
+    suggested: bool
+    stroke: float
+    stiffness: float | None
+
+
+def design_map(result: Any, *, resolution: tuple[int, int] = (8, 6),
+               executor: Any = None, progress: ProgressCallback | None = None,
+               cache: Any = None) -> DesignMap:
+    """A small crossover x stroke hunting map around the design point (paper Figure 4D).
+
+    Crossover from 0.125 to 2.5 times the design's, stroke from 1/6 to 10/3
+    times (logarithmic), the isolated plant with the PID retuned at every
+    crossover.
+
+    Parameters
+    ----------
+    result : fi_design.guideline.DesignResult
+        The design; a spec without isolator is mapped with the isolator the
+        guideline suggests (``result.isolator_advice``).
+    resolution : (int, int), optional
+        Points along the crossover and the stroke (default 8 x 6 = 48
+        simulations, a few seconds).
+    executor, progress, cache
+        As for :func:`sweep`.
+
+    Returns
+    -------
+    DesignMap
+    """
+    from .confirm import with_isolator
+
+    spec = result.spec
+    suggested = spec.isolator is None
+    if suggested:
+        adv = result.isolator_advice
+        spec = with_isolator(spec, adv.stroke, adv.stiffness)
+    fc = spec.controller.crossover
+    s = spec.isolator.stroke
+    nx, ny = resolution
+    x = make_axis("controller.crossover", np.linspace(0.125 * fc, 2.5 * fc, nx), spec=spec)
+    y = make_axis("isolator.stroke", np.geomspace(s / 6.0, s * 10.0 / 3.0, ny), log=True,
+                  spec=spec)
+    out = sweep(spec, x, y, isolated=True, executor=executor, progress=progress, cache=cache)
+    return DesignMap(sweep=out, suggested=suggested, stroke=s,
+                     stiffness=spec.isolator.stiffness)
+
+
 # --------------------------------------------------------------------------- the paper's maps
 
 
