@@ -19,10 +19,10 @@ checks (:class:`~fi_design.results.Check`):
 an isolator in the spec, :func:`isolator_advice` says whether one looks needed
 and which stroke and stiffness to start from.
 
-The nonlinear confirmation is not part of this module: a simulation result is
-attached with ``design(spec, simulation=...)`` or
-:meth:`DesignResult.with_simulation`, and appears in JSON under ``simulation``
-only when set.
+:func:`design` also runs the nonlinear confirmation
+(:func:`fi_design.confirm.confirm`) on the executor the caller passes, so that
+its simulations overlap the linear analysis; it appears in JSON under
+``simulation`` when it ran.
 
 The linear analysis (python-control) is imported inside the step functions,
 so importing this module stays fast.
@@ -35,7 +35,7 @@ import logging
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
@@ -43,6 +43,10 @@ from .flexure import FlexureResult, size_flexure
 from .pid import PidGains, tune_pid
 from .results import Check, Status, dataclass_dict, frozen_array, to_jsonable
 from .spec import Spec, drive_stiffness, proposed_stiffness, stiffness_limit, warnings_for
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .confirm import Confirmation
+    from .execution import Executor
 
 __all__ = [
     "SUGGESTED_STROKE", "FrictionGapResult", "ModeSeparation", "CrossoverResult",
@@ -712,9 +716,9 @@ class DesignResult:
         Version of fi_design that computed it.
     spec_sha256 : str
         SHA-256 of the spec file (of the spec's JSON when not read from a file).
-    simulation : object or None
-        The nonlinear confirmation, when attached (:meth:`with_simulation`);
-        emitted in JSON only when set.
+    simulation : fi_design.confirm.Confirmation or None
+        The nonlinear confirmation; None when it was not run (``confirm=False``),
+        and then left out of the JSON.
     """
 
     spec: Spec = field(repr=False)
@@ -730,7 +734,7 @@ class DesignResult:
     conclusion: str
     fi_design_version: str
     spec_sha256: str
-    simulation: Any = None
+    simulation: "Confirmation | None" = None
 
     @property
     def passed(self) -> bool:
@@ -741,23 +745,6 @@ class DesignResult:
     def failed_checks(self) -> tuple[Check, ...]:
         """The checks with status FAIL."""
         return tuple(c for c in self.checks if c.status == Status.FAIL)
-
-    def with_simulation(self, simulation: Any, conclusion: str | None = None) -> "DesignResult":
-        """A copy with the nonlinear confirmation attached.
-
-        Parameters
-        ----------
-        simulation : fi_design.confirm.Confirmation or object
-            The confirmation; its ``checks`` (if any) join the design's checks.
-        conclusion : str, optional
-            The conclusion; default: the linear one followed by a sentence on
-            the simulated verdicts.
-        """
-        extra = tuple(getattr(simulation, "checks", ()))
-        if conclusion is None:
-            conclusion = self.conclusion + _simulation_sentence(self.spec, simulation)
-        return replace(self, simulation=simulation, checks=self.checks + extra,
-                       conclusion=conclusion)
 
     def to_dict(self) -> dict:
         """The JSON contract: SI values, infinite margins as null.
@@ -797,7 +784,8 @@ def _sha256(spec: Spec) -> str:
 
 
 def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
-           simulation: Any = None, progress: Any = None) -> DesignResult:
+           executor: Executor | None = None,
+           progress: Callable[[str], None] | None = None) -> DesignResult:
     """Run the four guideline steps on a spec and confirm them by simulation.
 
     Parameters
@@ -812,10 +800,15 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         (:func:`fi_design.confirm.confirm`, about a second once the kernel is
         compiled). Default True; CAD loops that only need the linear steps pass
         False.
-    simulation : fi_design.confirm.Confirmation, optional
-        A confirmation computed elsewhere, attached instead of simulating.
+    executor : concurrent.futures-style executor, optional
+        Runs the confirmation (``submit`` returning a future with ``result``
+        and ``cancel``) while this process does the linear analysis: with a
+        process pool the two overlap (and a first run compiles the simulation
+        kernel there). None runs it here, after the linear steps. The library
+        creates no pool.
     progress : callable, optional
-        Called with a short message as the confirmation proceeds.
+        ``progress(text)`` with a short message as the work proceeds (the
+        confirmation's own messages too when it runs here).
 
     Returns
     -------
@@ -828,41 +821,50 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         When ``spec`` is a path or mapping that does not validate.
     """
     from . import __version__
+    from .confirm import confirm as run_confirmation
 
     if not isinstance(spec, Spec):
         from .specfile import load_spec
 
         spec = load_spec(spec)
-    gap = step1_friction_gap(spec)
-    xo = step2_crossover(spec)
-    st = step3_stiffness(spec)
-    fx = step3_flexure(spec, st)
-    pid = step4_pid(spec)
+    suggestion = suggested_isolator(spec) if spec.isolator is None else None
+    pending = None
+    if confirm and executor is not None:
+        pending = executor.submit(run_confirmation, spec, suggestion)
+    try:
+        gap = step1_friction_gap(spec)
+        xo = step2_crossover(spec)
+        st = step3_stiffness(spec)
+        fx = step3_flexure(spec, st)
+        pid = step4_pid(spec)
+    except BaseException:
+        if pending is not None:
+            pending.cancel()
+        raise
     advice = isolator_advice(spec, gap, xo) if spec.isolator is None else None
     checks = gap.checks + xo.checks + st.checks + _flexure_checks(fx) + pid.checks
     result = DesignResult(
         spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,
-        loop=loop_responses(spec, xo, pid.gains), isolator_advice=advice, checks=checks, warnings=tuple(warnings_for(spec)),
+        loop=loop_responses(spec, xo, pid.gains), isolator_advice=advice, checks=checks,
+        warnings=tuple(warnings_for(spec)),
         conclusion=_conclusion(spec, gap, xo, st, fx, pid, advice, checks),
         fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None)
-    if simulation is None and confirm:
-        from .confirm import confirm as _confirm
-
-        suggestion = suggested_isolator(spec) if spec.isolator is None else None
-        simulation = _confirm(spec, suggestion, progress=progress)
-    if simulation is not None:
-        result = result.with_simulation(simulation)
+    if confirm:
+        if progress is not None:
+            progress("simulating with and without the isolator (the first run on a machine "
+                     "compiles the kernel, about 10 s) ...")
+        sim = pending.result() if pending is not None else \
+            run_confirmation(spec, suggestion, progress=progress)
+        result = replace(result, simulation=sim, checks=result.checks + sim.checks,
+                         conclusion=result.conclusion + _simulation_sentence(spec, sim))
     log.info("design of %r: %d checks, %d failed", spec.name, len(result.checks),
              len(result.failed_checks))
     return result
 
 
-def _simulation_sentence(spec: Spec, sim: Any) -> str:
+def _simulation_sentence(spec: Spec, sim: Confirmation) -> str:
     """The conclusion's sentence on the simulated verdicts."""
-    iso = getattr(sim, "isolated", None)
-    non = getattr(sim, "non_isolated", None)
-    if iso is None or non is None:
-        return ""
+    iso, non = sim.isolated, sim.non_isolated
     mins = sim.min_hunting_free_crossover
     label = "the suggested isolator" if sim.suggested_isolator else "the isolator"
     fc = spec.controller.crossover

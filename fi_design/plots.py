@@ -206,7 +206,6 @@ def nyquist_figure(result: Any) -> Any:
     -------
     matplotlib.figure.Figure
     """
-    f = result.loop.frequency
     responses = [(c, c.loop) for c in result.loop.cases]
     fig = _report_figure(3.0, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
     ax = fig.add_subplot()

@@ -68,18 +68,18 @@ def _linear(result: Any, figures: bool, fig_no: _Numbering) -> dict:
             "from the roots of the characteristic polynomial. A case can cross 0 dB more than "
             "once; the table gives the crossing with the smallest phase margin and the "
             "number of crossings."),
-        "bode": figure_entry((lambda: plots.bode_figure(result)) if figures else None,
-                        "bode", f"Open-loop Bode plot of the {n} limit cases. Dots: gain "
-                        "crossovers; dashed: the desired crossover.", fig_no()),
-        "nyquist": figure_entry((lambda: plots.nyquist_figure(result))
-                           if figures else None, "nyquist",
-                           f"Nyquist plot near the critical point -1 (+). Dotted: |1 + L| = "
-                           f"{num(m)}. Colours and line styles as in the Bode plot.",
-                           fig_no(), "half"),
-        "sensitivity": figure_entry((lambda: plots.sensitivity_figure(result))
-                               if figures else None, "sensitivity",
-                               "Sensitivity |S| = |1/(1 + L)|; dots mark each peak "
-                               "(1 / modulus margin).", fig_no(), "half"),
+        "bode": figure_entry(
+            (lambda: plots.bode_figure(result)) if figures else None, "bode",
+            f"Open-loop Bode plot of the {n} limit cases. Dots: gain crossovers; dashed: the "
+            "desired crossover.", fig_no()),
+        "nyquist": figure_entry(
+            (lambda: plots.nyquist_figure(result)) if figures else None, "nyquist",
+            f"Nyquist plot near the critical point -1 (+). Dotted: |1 + L| = {num(m)}. Colours "
+            "and line styles as in the Bode plot.", fig_no(), "half"),
+        "sensitivity": figure_entry(
+            (lambda: plots.sensitivity_figure(result)) if figures else None, "sensitivity",
+            "Sensitivity |S| = |1/(1 + L)|; dots mark each peak (1 / modulus margin).",
+            fig_no(), "half"),
         "cases": _cases_table(result),
         "requirements": {"phase_margin": req.phase_margin, "gain_margin": req.gain_margin,
                          "modulus_margin": req.modulus_margin},
@@ -140,20 +140,22 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
         "plants": _plant_rows(sim),
         "resolution": mins["resolution"],
         "scan_range": mins["scan"],
-        "error": figure_entry((lambda: plots.error_figure(sim, spec)) if figures else None, "error",
-                         "Position error with and without the isolator (as the paper's Figure 5). "
-                         "Grey: the counting window; dashed: the minimum peak height; circles: "
-                         "the peaks the metric counts.", fig_no()),
-        "deflection": figure_entry((lambda: plots.deflection_figure(sim, spec)) if figures else None,
-                              "deflection", "Joint deflection of the isolated stage against the "
-                              "stroke; beyond the dashed lines the limiter carries the cart.",
-                              fig_no()),
-        "scan": figure_entry((lambda: plots.scan_figure(sim, spec)) if figures else None, "scan",
-                        f"Hunting cycles down the crossover scan (grid {num(scan.grid[0])} to "
-                        f"{num(scan.grid[1])} Hz in steps of {num(scan.grid[2])} Hz), both "
-                        "plants. The scan runs from the top down and stops at the first "
-                        "crossover that does not settle; dotted: the lowest hunting-free "
-                        "crossover, dashed: the design crossover.", fig_no()),
+        "error": figure_entry(
+            (lambda: plots.error_figure(sim, spec)) if figures else None, "error",
+            "Position error with and without the isolator (as the paper's Figure 5). Grey: the "
+            "counting window; dashed: the minimum peak height; circles: the peaks the metric "
+            "counts.", fig_no()),
+        "deflection": figure_entry(
+            (lambda: plots.deflection_figure(sim, spec)) if figures else None, "deflection",
+            "Joint deflection of the isolated stage against the stroke; beyond the dashed lines "
+            "the limiter carries the cart.", fig_no()),
+        "scan": figure_entry(
+            (lambda: plots.scan_figure(sim, spec)) if figures else None, "scan",
+            f"Hunting cycles down the crossover scan (grid {num(scan.grid[0])} to "
+            f"{num(scan.grid[1])} Hz in steps of {num(scan.grid[2])} Hz), both plants. The scan "
+            "runs from the top down and stops at the first crossover that does not settle; "
+            "dotted: the lowest hunting-free crossover, dashed: the design crossover.",
+            fig_no()),
         "landing": None if land is None else {
             "deflection": land.deflection, "stroke": land.stroke, "force": land.force,
             "static_friction": land.static_friction, "rule_force": land.rule_force,
@@ -161,8 +163,8 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
         },
         "models_agree": sim.models_agree,
         "cross_check": (
-            f"Cross-check with the {_MODEL_NAMES.get(sim.cross_check['isolated'].friction_model, '')}"
-            " friction model: "
+            "Cross-check with the "
+            f"{_MODEL_NAMES.get(sim.cross_check['isolated'].friction_model, '')} friction model: "
             + ("both models give the same hunting / no-hunting call for both plants."
                if sim.models_agree else
                "the models disagree on the verdict (see the checks); treat the margin to hunting "
