@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import spec as _spec
+from .errors import ArgumentError
 from .metrics import HuntingMetrics
 from .results import Check, Status, dataclass_dict, frozen_array
 from .simulation import SimulationResult, simulate
@@ -311,7 +312,7 @@ def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
     suggested = spec.isolator is None
     if suggested:
         if suggestion is None:
-            raise ValueError("a spec without isolator needs a suggested (stroke, stiffness)")
+            raise ArgumentError("a spec without isolator needs a suggested (stroke, stiffness)")
         spec_iso = with_isolator(spec, *suggestion)
     else:
         spec_iso = spec

@@ -91,6 +91,10 @@ class ArgumentError(FiDesignError, ValueError):
     a chunk size, a resolution, a method name)."""
 
 
+class ReportError(FiDesignError, TypeError):
+    """There is no report for this kind of result."""
+
+
 class OutputError(FiDesignError, OSError):
     """An output path is refused (exists without --force, equals the spec, bad extension)."""
 

@@ -56,6 +56,7 @@ from typing import Any, Sequence
 import control
 import numpy as np
 
+from .errors import ArgumentError
 from .pid import PidGains, tune_pid
 from .results import dataclass_dict, frozen_array
 from .spec import (Spec, antiresonance, bristle_damping, drive_stiffness, joint_damping)
@@ -239,7 +240,7 @@ def _case(spec: Spec, case, stiffness: float | None) -> LimitCase:
         if c.name == case or c.number == case:
             return c
     names = ", ".join(c.name for c in limit_cases(spec, stiffness))
-    raise ValueError(f"unknown limit case {case!r}; this spec has: {names}")
+    raise ArgumentError(f"unknown limit case {case!r}; this spec has: {names}")
 
 
 # --------------------------------------------------------------------------- controller, delay

@@ -31,6 +31,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from .errors import ArgumentError
+
 __all__ = ["PidGains", "tune_pid", "pid_gains"]
 
 
@@ -114,9 +116,9 @@ def pid_gains(mass: float, crossover: float, derivative_ratio: float = 3.0,
     (1684.4, 2189.7, 150.8)
     """
     if not (mass > 0 and crossover > 0):
-        raise ValueError(f"mass and crossover must be positive, got {mass!r} kg, {crossover!r} Hz")
+        raise ArgumentError(f"mass and crossover must be positive, got {mass!r} kg, {crossover!r} Hz")
     if not (derivative_ratio > 1 and integrator_ratio > 1):
-        raise ValueError("derivative_ratio and integrator_ratio must exceed 1")
+        raise ArgumentError("derivative_ratio and integrator_ratio must exceed 1")
     wc = 2.0 * math.pi * crossover
     wd = wc / derivative_ratio
     wt = derivative_ratio * wc

@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from .errors import ArgumentError
+
 # --------------------------------------------------------------------------- design report
 # (fi_design.report: the linear analysis and the nonlinear confirmation of a DesignResult)
 
@@ -853,7 +855,7 @@ def figure_bytes(fig: Any, fmt: str = "svg") -> bytes:
 
     fmt = fmt.lower().lstrip(".")
     if fmt not in ("svg", "png"):
-        raise ValueError(f"unsupported figure format {fmt!r}; use svg or png")
+        raise ArgumentError(f"unsupported figure format {fmt!r}; use svg or png")
     buf = io.BytesIO()
     meta = {"Date": None} if fmt == "svg" else {"Software": None}
     with matplotlib.rc_context({"svg.hashsalt": "fi_design", "svg.fonttype": "path"}):

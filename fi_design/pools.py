@@ -19,7 +19,7 @@ import sys
 from collections.abc import Iterator
 from typing import Any
 
-from .errors import FiDesignError
+from .errors import ArgumentError, FiDesignError
 
 __all__ = ["EXECUTORS", "confirmation_pool", "StudyPool"]
 
@@ -91,7 +91,7 @@ class StudyPool:
 
     def __init__(self, kind: str, jobs: int, scheduler: str | None = None) -> None:
         if kind not in EXECUTORS:
-            raise ValueError(f"executor kind must be one of {EXECUTORS}, got {kind!r}")
+            raise ArgumentError(f"executor kind must be one of {EXECUTORS}, got {kind!r}")
         self.kind = kind
         self.jobs = jobs or (os.cpu_count() or 1)
         self.scheduler = scheduler

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+from fi_design.errors import ArgumentError
 from fi_design import linear
 
 from conftest import variant
@@ -117,7 +118,7 @@ def test_controller_and_loop(paper_spec):
     np.testing.assert_allclose(ss_response(sens, S), 1 / (1 + ss_response(lp, S)), rtol=1e-9)
     comp = linear.complementary_sensitivity(paper_spec, 2)
     np.testing.assert_allclose(ss_response(comp, S) + ss_response(sens, S), 1.0, rtol=1e-9)
-    with pytest.raises(ValueError, match="unknown limit case"):
+    with pytest.raises(ArgumentError, match="unknown limit case"):
         linear.loop_transfer_function(paper_spec, "floating")
 
 

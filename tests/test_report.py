@@ -23,7 +23,7 @@ import yaml
 from typer.testing import CliRunner
 
 from fi_design import report
-from fi_design.errors import OutputError
+from fi_design.errors import OutputError, ReportError
 from fi_design.cli import app
 
 from conftest import EXAMPLES, ROOT
@@ -571,7 +571,7 @@ def test_sweep_report(tmp_path, paper_spec):
 def test_render_report_refuses_other_extensions_and_kinds(tmp_path, paper_confirmed_design):
     with pytest.raises(OutputError, match=r"\.html or \.pdf"):
         report.render_report(paper_confirmed_design, tmp_path / "r.htm")
-    with pytest.raises(TypeError):
+    with pytest.raises(ReportError, match="no report for a object"):
         report.render_report(object(), tmp_path / "r.html")
     assert list(tmp_path.iterdir()) == []
 

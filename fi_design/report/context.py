@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 from typing import Any, Sequence
 
+from ..errors import ReportError
 from .blocks import Section
 from .meta import spec_listing, title_block, versions
 
@@ -51,15 +52,15 @@ def build_context(result: Any, *, date: Any = None, command: str | None = None,
 
     Raises
     ------
-    TypeError
-        There is no report for this kind of result.
+    fi_design.errors.ReportError
+        There is no report for this kind of result (a ``TypeError`` too).
     """
     if hasattr(result, "report_sections"):
         return document_context(getattr(result, "report_title", "Report"), result.spec,
                                 result.report_sections(), date=date, command=command,
                                 kind=getattr(result, "report_kind", "report"))
-    raise TypeError(f"no report for a {type(result).__name__}; expected a DesignResult, a sweep "
-                    "result or an object with report_sections()")
+    raise ReportError(f"no report for a {type(result).__name__}; expected a DesignResult, a "
+                      "sweep result or an object with report_sections()")
 
 
 def document_context(title: str, spec: Any, sections: Sequence[Section], *, date: Any = None,

@@ -201,8 +201,8 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     ------
     fi_design.errors.OutputError
         The extension is not .html or .pdf, or the file cannot be written.
-    TypeError
-        ``result`` is of a kind there is no report for.
+    fi_design.errors.ReportError
+        ``result`` is of a kind there is no report for (a ``TypeError`` too).
     """
     out = Path(path)
     fmt = output_format(out)

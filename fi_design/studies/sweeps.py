@@ -116,7 +116,7 @@ class SweepResult:
             ``stuck`` or ``undetermined`` do not count as hunting.
         """
         if free not in ("above", "below"):
-            raise ValueError("free must be 'above' or 'below'")
+            raise ArgumentError("free must be 'above' or 'below'")
         verdicts = self.verdict.reshape(-1, len(self.x.values))
         xs = self.x.values
         out = np.full(verdicts.shape[0], np.nan)
