@@ -985,5 +985,5 @@ def candidate_scores_figure(result: Any) -> Any:
     ax.axvline(thr, color="C3", lw=0.9, ls="--")
     ax.text(thr, 1.0, " threshold", transform=ax.get_xaxis_transform(), va="bottom",
             fontsize=7, color="C3")
-    ax.set_xlabel("score: sign(s) log10(1 + |s|), s = BIC difference")
+    ax.set_xlabel("score: sign(s) log10(1 + |s|), s = BIC difference [-]")
     return fig
