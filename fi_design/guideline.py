@@ -342,9 +342,11 @@ class LoopResponses:
     cases: tuple[CaseResponse, ...]
 
 
-def loop_responses(spec: Spec, crossover: CrossoverResult, gains: PidGains,
-                   points: int = 500) -> LoopResponses:
+def loop_responses(spec: Spec, crossover: CrossoverResult, points: int = 500) -> LoopResponses:
     """The loop of every limit case over a frequency grid that holds every crossover and mode.
+
+    The loop is the one whose margins step 2 reports: the spec's controller at
+    the desired crossover, the joint stiffness of the cases.
 
     Parameters
     ----------
@@ -353,8 +355,6 @@ def loop_responses(spec: Spec, crossover: CrossoverResult, gains: PidGains,
     crossover : CrossoverResult
         Step 2 (desired crossover, the gain crossovers of each case, the
         joint stiffness the cases use).
-    gains : fi_design.pid.PidGains
-        Step 4's gains.
     points : int, optional
         Number of frequencies.
 
@@ -375,7 +375,7 @@ def loop_responses(spec: Spec, crossover: CrossoverResult, gains: PidGains,
     s = 2j * math.pi * f
     cases = []
     for lc in linear.limit_cases(spec, crossover.stiffness):
-        num, den = linear.loop_polynomials(spec, lc, gains=gains)
+        num, den = linear.loop_polynomials(spec, lc)
         cases.append(CaseResponse(name=lc.name, number=lc.number, description=lc.description,
                                   loop=frozen_array(np.polyval(num, s) / np.polyval(den, s),
                                                     dtype=complex)))
@@ -845,7 +845,7 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     checks = gap.checks + xo.checks + st.checks + _flexure_checks(fx) + pid.checks
     result = DesignResult(
         spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,
-        loop=loop_responses(spec, xo, pid.gains), isolator_advice=advice, checks=checks,
+        loop=loop_responses(spec, xo), isolator_advice=advice, checks=checks,
         warnings=tuple(warnings_for(spec)),
         conclusion=_conclusion(spec, gap, xo, st, fx, pid, advice, checks),
         fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None)
