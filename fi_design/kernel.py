@@ -494,7 +494,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     y0 : ndarray, float64, shape (n,)
         Initial state (7 isolated, 5 rigid).
     breaks, coeffs : ndarray
-        Reference as a piecewise cubic (:class:`fi_design.reference.Reference`).
+        Reference as a piecewise cubic (:class:`fi_design.trajectory.Trajectory`).
     land : bool
         Land steps on the reference breaks.
     t_end : float

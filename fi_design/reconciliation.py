@@ -90,7 +90,7 @@ from . import spec as _spec
 from .errors import DataError, SimulationError
 from .measured import Measurement
 from .metrics import hunting_metrics
-from .reference import from_samples
+from .trajectory import from_samples
 from .results import dataclass_dict, frozen_array, to_jsonable
 from .simulation import SimulationResult, simulate
 

@@ -23,7 +23,7 @@ import numpy as np
 from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, Integration, PlantParameters,
                     actuator,
                     drive_force, jacobian, natural_modes, rhs)
-from .reference import Reference
+from .trajectory import Trajectory
 
 
 class _History:
@@ -45,7 +45,7 @@ class _History:
         return float(self.pieces[k](t)[self.iu])
 
 
-def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t_out,
+def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, t_out,
                     rtol: float, atol, x_bound: float, method: str = "Radau"):
     """Integrate with solve_ivp; same outputs as :func:`fi_design.kernel.run`.
 

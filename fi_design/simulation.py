@@ -26,7 +26,7 @@ from .errors import SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from .pid import tune_pid
 from .plant import PlantParameters, state_index
-from .reference import Reference, from_moves
+from .trajectory import Trajectory, from_moves
 from .results import frozen_array, to_jsonable
 
 METHODS = ("fast", "reference")
@@ -236,7 +236,7 @@ def tolerances(params: PlantParameters, rtol: float) -> np.ndarray:
 
 
 def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast", *,
-             crossover: float | None = None, reference: Reference | None = None,
+             crossover: float | None = None, reference: Trajectory | None = None,
              initial_position: float = 0.0, duration: float | None = None,
              effects=None, rtol: float | None = None) -> SimulationResult:
     """Simulate the stage and evaluate the hunting metric.
@@ -253,7 +253,7 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         equations for checks and benchmarks.
     crossover : float, optional
         Crossover to tune the PID for [Hz]; default the spec's.
-    reference : Reference, optional
+    reference : Trajectory, optional
         A given reference signal (measured data) instead of the spec's moves.
     initial_position : float
         Stage and cart position at t = 0 [m], at rest.
@@ -284,7 +284,7 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         if initial_position:
             c = np.array(ref.coeffs)
             c[:, 0] += initial_position
-            ref = Reference(ref.breaks, c, land=True)
+            ref = Trajectory(ref.breaks, c, land=True)
     else:
         ref = reference
         t_end = float(ref.breaks[-1]) if duration is None else duration

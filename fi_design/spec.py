@@ -21,7 +21,7 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Discriminator, Fie
                       Tag, WithJsonSchema, create_model, model_validator)
 
 from . import effects as _effects
-from .reference import profile_duration
+from .trajectory import profile_duration
 from .units import to_si
 
 # --------------------------------------------------------------------------- quantities

@@ -73,8 +73,8 @@ METHOD = "fast"
 #: Verdicts of the hunting metric plus the two outcomes of a point that has no metric.
 POINT_VERDICTS = ("settled", "hunting", "stuck", "undetermined", "invalid", "failed")
 #: Modules whose source decides a point's outcome; their digest is part of the cache key.
-_CODE_MODULES = ("kernel", "plant", "simulate", "metrics", "pid", "reference", "effects", "spec",
-                 "specfile", "sweep")
+_CODE_MODULES = ("kernel", "plant", "simulation", "metrics", "pid", "trajectory", "effects",
+                 "spec", "specfile", "studies")
 #: Largest number of points in one chunk (bounds the work lost by an interruption).
 MAX_CHUNK = 64
 #: Chunks per sweep when the chunk size is chosen automatically.
@@ -564,10 +564,7 @@ def code_digest() -> str:
         here = Path(__file__).resolve().parent
         h = hashlib.sha256()
         for name in _CODE_MODULES:
-            try:
-                h.update((here / f"{name}.py").read_bytes())
-            except OSError:
-                h.update(name.encode())
+            h.update((here / f"{name}.py").read_bytes())
         _CODE_DIGEST = h.hexdigest()
     return _CODE_DIGEST
 

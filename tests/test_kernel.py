@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from fi_design import kernel
 from fi_design.plant import MODE_SIGN, jacobian
-from fi_design.reference import from_moves
+from fi_design.trajectory import from_moves
 from fi_design.simulation import plant_parameters
 
 

@@ -364,3 +364,24 @@ def test_figures(paper_spec, kernel):
     assert png.startswith(b"\x89PNG")
     assert plots.axis_label("isolator.stroke", "m") == "isolator.stroke [mm]"
     assert plots.display_unit("N/m") == ("N/mm", 1e-3)
+
+
+def test_code_digest_covers_existing_modules_and_changes_with_them(tmp_path, monkeypatch):
+    """The cache key's code digest reads every module that decides an outcome (a renamed
+    module must not silently drop out of it) and changes when one of them changes."""
+    from pathlib import Path
+
+    import fi_design.studies as st
+
+    here = Path(st.__file__).resolve().parent
+    missing = [n for n in st._CODE_MODULES if not (here / f"{n}.py").is_file()]
+    assert not missing
+    assert {"simulation", "kernel", "plant", "trajectory"} <= set(st._CODE_MODULES)
+    monkeypatch.setattr(st, "_CODE_DIGEST", None)
+    before = st.code_digest()
+    for n in st._CODE_MODULES:
+        (tmp_path / f"{n}.py").write_bytes((here / f"{n}.py").read_bytes())
+    (tmp_path / "simulation.py").write_bytes(b"# edited\n" + (here / "simulation.py").read_bytes())
+    monkeypatch.setattr(st, "__file__", str(tmp_path / "studies.py"))
+    monkeypatch.setattr(st, "_CODE_DIGEST", None)
+    assert st.code_digest() != before
