@@ -108,8 +108,16 @@ def test_no_isolator_is_one_rigid_mass(paper_spec):
 
 
 def test_controller_and_loop(paper_spec):
-    g = linear.tune_pid(paper_spec)
+    from fi_design.pid import control_law, tune_pid
+
+    g = tune_pid(paper_spec)
     np.testing.assert_allclose(ss_response(linear.controller_tf(g), S), pid(S), rtol=1e-9)
+    law = control_law(paper_spec)
+    np.testing.assert_allclose(ss_response(linear.controller_tf(law), S), pid(S), rtol=1e-9)
+    # the rule in the filtered-D form the hardware gains use is the same C(s)
+    from dataclasses import replace
+    general = replace(law, source="gains")
+    np.testing.assert_allclose(ss_response(linear.controller_tf(general), S), pid(S), rtol=1e-9)
     lp = linear.loop_transfer_function(paper_spec, "stuck_free")
     np.testing.assert_allclose(ss_response(lp, S), pid(S) * HAND["stuck_free"](S) * mode(S),
                                rtol=1e-9)
