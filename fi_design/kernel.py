@@ -1046,8 +1046,9 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             # ------------------------------------------------ accept
             n_steps += 1
             t_new = t_land if landing else t + h
-            # outputs inside (t, t_new]
-            while i_out < m_out and t_out[i_out] <= t_new + 1e-12 * max(1.0, t_new):
+            # outputs inside (t, t_new); those at t_new follow its time events (a
+            # controller sample there shows its new output, as a drive records it)
+            while i_out < m_out and t_out[i_out] < t_new - 1e-12 * max(1.0, t_new):
                 th = (t_out[i_out] - t) / h
                 if th > 1.0:
                     th = 1.0

@@ -171,8 +171,11 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
         return [e[0] for e in evs], funcs
 
     def write_outputs(t0, t1, sol):
+        """Outputs in [t0, t1) from ``sol`` (at t0 only, from the state, when ``sol`` is None):
+        those at t1 follow its time events."""
         lo = bisect.bisect_left(t_out, t0 - 1e-12)
-        hi = bisect.bisect_right(t_out, t1 + 1e-12)
+        hi = bisect.bisect_left(t_out, t1 - 1e-12) if sol is not None else \
+            bisect.bisect_right(t_out, t0 + 1e-12)
         for i in range(lo, hi):
             if not np.isnan(out_r[i]):
                 continue
@@ -263,6 +266,8 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
         if abs(y[0]) > x_bound or not np.all(np.isfinite(y)):
             code, status = 4, "solution diverged"
             break
+    if code == 0:
+        write_outputs(t, t, None)
     return Integration(code=code, status=status, states=out_y, reference=out_r,
                        applied_force=out_fa, command=out_cmd, n_steps=n_steps, n_rejected=n_rej,
                        n_events=n_ev, t_reached=t)
