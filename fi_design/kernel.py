@@ -837,8 +837,9 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             t_land = t_sample
         if f_count > 0 and fifo_t[f_head] < t_land:
             t_land = fifo_t[f_head]
-        if n_in > 0:
-            while i_in < n_in and in_t[i_in] + delay <= t + 1e-12 * max(1.0, t):
+        if n_in > 0:  # the input's next change (an unchanged sample is no event)
+            while i_in < n_in and (in_t[i_in] + delay <= t + 1e-12 * max(1.0, t)
+                                   or (i_in > 0 and in_f[i_in] == in_f[i_in - 1])):
                 i_in += 1
             if i_in < n_in and in_t[i_in] + delay < t_land:
                 t_land = in_t[i_in] + delay

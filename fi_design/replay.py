@@ -26,7 +26,7 @@ from .pid import ControlLaw
 from .plant import P_SIGMA2_NEG, PlantParameters, state_index, stribeck
 
 #: Span of samples the local velocity estimate fits [s].
-VELOCITY_SPAN = 0.02
+VELOCITY_SPAN = 0.01
 #: Fewest samples the local velocity estimate needs.
 MIN_FIT_SAMPLES = 5
 
@@ -158,10 +158,10 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
         kf = law.kernel_form()
         v_wo_i = kf["kp"] * e + kf["kd"] * (rd - v1) - kf["kdm"] * v1
         target = v_wo_i if command is None else command - feedforward
-        if law.integrator:
+        if law.integrator:  # the integrator takes what P and D leave of the first sample
             y0[idx["I"]] = target - v_wo_i
-        if not math.isinf(kf["wt"]):
-            y0[idx["u"]] = target if law.integrator else v_wo_i
+        if not math.isinf(kf["wt"]):  # the filter state is the output itself
+            y0[idx["u"]] = target
     if command is not None:
         changes["u_initial"] = command
     return y0, replace(params, **changes)
@@ -181,14 +181,18 @@ def _discrete_state(params: PlantParameters, law: ControlLaw, e: float, xm: floa
 
     The D term is taken in steady state for the present rate of its input
     (``ed`` = e' or ``-xd``), which both the Tustin and the backward-difference
-    form reproduce exactly; the integrator takes what the first force sample
-    needs beyond P and D (only when the loop has one).
+    form reproduce exactly. What the first force sample needs beyond P and
+    that D goes to the integrator when the loop has one, else to the D term
+    (whose state is then the one the drive really had).
     """
     on_meas = law.derivative_on == "measurement"
     d_in, d_rate = (-xm, -xd) if on_meas else (e, ed)
     D0 = law.kd * d_rate
-    dx2 = D0 - params.db * d_in
     dx1 = 0.0
-    if law.integrator and command is not None:
-        dx1 = command - feedforward - params.dp * e - params.dc * e - D0
-    return dict(dx1=dx1, dx2=dx2)
+    if command is not None:
+        rest = command - feedforward - params.dp * e - params.dc * e - D0
+        if law.integrator:
+            dx1 = rest
+        else:
+            D0 += rest
+    return dict(dx1=dx1, dx2=D0 - params.db * d_in)

@@ -33,7 +33,7 @@ from .trajectory import Trajectory, from_moves, from_samples
 METHODS = ("fast", "reference")
 
 #: Default length of the re-anchored windows of an open-loop replay [s].
-WINDOW = 0.25
+WINDOW = 0.1
 
 
 @dataclass(frozen=True, eq=False)
