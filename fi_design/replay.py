@@ -56,6 +56,50 @@ class RecordState:
     velocity: float
 
 
+@dataclass(frozen=True)
+class ReplayFit:
+    """How a replay agrees with the record it replays.
+
+    Attributes
+    ----------
+    samples : int
+        Samples compared (those the replay reached).
+    position_rms : float
+        RMS of model minus measured stage position [m].
+    position_max : float
+        Largest absolute position difference [m].
+    tracking_rms_model : float
+        RMS tracking error r - x1 of the model [m].
+    tracking_rms_measured : float
+        RMS tracking error r - x1 of the measurement [m].
+    force_rms : float or None
+        RMS of model minus measured commanded force [N]; None without ``force_N``.
+    """
+
+    samples: int
+    position_rms: float
+    position_max: float
+    tracking_rms_model: float
+    tracking_rms_measured: float
+    force_rms: float | None
+
+
+def replay_fit(record: Measurement, position: np.ndarray, force: np.ndarray) -> ReplayFit:
+    """Compare a replay's position [m] and commanded force [N] with the record."""
+    ok = np.isfinite(position)
+
+    def rms(x):
+        return float(np.sqrt(np.mean(x[ok] ** 2))) if ok.any() else math.nan
+
+    dx = position - record.position
+    return ReplayFit(
+        samples=int(ok.sum()), position_rms=rms(dx),
+        position_max=float(np.max(np.abs(dx[ok]))) if ok.any() else math.nan,
+        tracking_rms_model=rms(record.reference - position),
+        tracking_rms_measured=rms(record.reference - record.position),
+        force_rms=None if record.force is None else rms(force - record.force))
+
+
 def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPAN) -> RecordState:
     """Position and velocity of the stage at sample ``index``, from the data.
 

@@ -180,3 +180,78 @@ def test_open_loop_replay_needs_the_force(paper_spec):
         simulate(paper_spec, isolated=False, record=rec, drive="force")
     with pytest.raises(SimulationError, match="drive"):
         simulate(paper_spec, isolated=False, record=rec, drive="torque")
+
+
+# --------------------------------------------------------------------------- command line
+
+
+def _emps_yaml(tmp_path, fit: dict):
+    import yaml
+
+    p = tmp_path / "emps.yaml"
+    p.write_text(yaml.safe_dump({
+        "name": "EMPS axis", "stage": {"mass": float(fit["mass"]) - 1.0}, "cart": {"mass": 1.0},
+        "friction": {"static": float(fit["coulomb"]), "coulomb": float(fit["coulomb"]),
+                     "stribeck_velocity": "1 mm/s", "viscous": float(fit["viscous"]),
+                     "viscous_negative": float(fit["viscous_negative"]),
+                     "offset": float(fit["offset"]), "bristle_stiffness": "1e7 N/m"},
+        "controller": EMPS_CONTROLLER,
+        "motion": {"moves": [{"distance": "0.1 m", "velocity": "0.1 m/s",
+                              "acceleration": "1 m/s^2"}], "duration": "25 s"}}))
+    return p
+
+
+def test_cli_simulate_record(tmp_path, emps_path, emps_fit):
+    from typer.testing import CliRunner
+
+    from fi_design.cli import app
+    from fi_design.measured import load_measurement
+
+    spec = _emps_yaml(tmp_path, emps_fit)
+    out = tmp_path / "replay.csv"
+    res = CliRunner().invoke(app, ["simulate", str(spec), "--record", str(emps_path),
+                                   "--csv", str(out), "--json", str(tmp_path / "r.json")])
+    assert res.exit_code == 0, res.output
+    assert "model - measured, rms [um]" in res.output and "hunting cycles" not in res.output
+    back = load_measurement(out)
+    assert back.n == 24841 and back.columns[:4] == ("time_s", "reference_m", "position_m",
+                                                    "force_N")
+    import json
+
+    fit = json.loads((tmp_path / "r.json").read_text())["replay"]
+    assert fit["position_rms"] < 20e-6 and fit["samples"] == 24841
+    opened = tmp_path / "open.csv"
+    res = CliRunner().invoke(app, ["simulate", str(spec), "--record", str(emps_path), "--drive",
+                                   "force", "--window", "0.2", "--csv", str(opened)])
+    assert res.exit_code == 0, res.output
+    header = opened.read_text().splitlines()[0]
+    assert header.endswith(",window")
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--drive", "torque"], "--drive"),
+    (["--drive", "force"], "give --record"),
+    (["--window", "0"], "--window"),
+])
+def test_cli_simulate_bad_replay_options(paper_spec_path, args, words):
+    from typer.testing import CliRunner
+
+    from fi_design.cli import app
+
+    res = CliRunner().invoke(app, ["simulate", str(paper_spec_path), *args])
+    assert res.exit_code == 2 and words in res.output
+
+
+def test_cli_simulate_record_with_nan_disturbance_names_the_row(tmp_path, paper_spec_path):
+    from typer.testing import CliRunner
+
+    from fi_design.cli import app
+
+    rows = ["time_s,reference_m,position_m,force_N,disturbance_N"]
+    rows += [f"{i * 1e-3},0,0,0,{'nan' if i == 30 else 0}" for i in range(100)]
+    p = tmp_path / "rec.csv"
+    p.write_text("\n".join(rows) + "\n")
+    res = CliRunner().invoke(app, ["simulate", str(paper_spec_path), "--record", str(p)])
+    assert res.exit_code == 2
+    assert "disturbance_N" in res.output and "row 31" in res.output
+    assert "Traceback" not in res.output
