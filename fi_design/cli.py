@@ -469,13 +469,29 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
 
     pid = data.get("pid") or {}
     if pid:
-        t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
-                  pad_edge=False)
-        for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]", "tuning mass [kg]"):
-            t.add_column(Text(col), justify="right", no_wrap=True)
-        t.add_row(_fmt(pid.get("kp")), _fmt(pid.get("ki")), _fmt(pid.get("kd")),
-                  _fmt(pid.get("wt")), _fmt(pid.get("tuning_mass")))
-        console.print(t)
+        if pid.get("source") == "gains":
+            # the hardware's loop beside the rule's gains in the same form
+            hw, rule = pid["controller"], pid["rule_in_hardware_form"]
+            t = Table(title="PID gains (step 4): the hardware's, and the rule's at the same "
+                            "crossover", title_justify="left", box=box.SIMPLE_HEAD,
+                      pad_edge=False)
+            t.add_column("")
+            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "D roll-off [Hz]"):
+                t.add_column(Text(col), justify="right", no_wrap=True)
+            for label, g in (("hardware", hw), ("rule", rule)):
+                wf = g.get("roll_off")
+                t.add_row(label, _fmt(g.get("kp")), _fmt(g.get("ki")), _fmt(g.get("kd")),
+                          "none" if wf is None else _fmt(wf / (2 * 3.141592653589793)))
+            console.print(t)
+        else:
+            t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
+                      pad_edge=False)
+            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]",
+                        "tuning mass [kg]"):
+                t.add_column(Text(col), justify="right", no_wrap=True)
+            t.add_row(_fmt(pid.get("kp")), _fmt(pid.get("ki")), _fmt(pid.get("kd")),
+                      _fmt(pid.get("wt")), _fmt(pid.get("tuning_mass")))
+            console.print(t)
 
     xo = data.get("crossover") or {}
     if xo:
