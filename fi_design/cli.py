@@ -469,13 +469,29 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
 
     pid = data.get("pid") or {}
     if pid:
-        t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
-                  pad_edge=False)
-        for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]", "tuning mass [kg]"):
-            t.add_column(Text(col), justify="right", no_wrap=True)
-        t.add_row(_fmt(pid.get("kp")), _fmt(pid.get("ki")), _fmt(pid.get("kd")),
-                  _fmt(pid.get("wt")), _fmt(pid.get("tuning_mass")))
-        console.print(t)
+        if pid.get("source") == "gains":
+            # the hardware's loop beside the rule's gains in the same form
+            hw, rule = pid["controller"], pid["rule_in_hardware_form"]
+            t = Table(title="PID gains (step 4): the hardware's, and the rule's at the same "
+                            "crossover", title_justify="left", box=box.SIMPLE_HEAD,
+                      pad_edge=False)
+            t.add_column("")
+            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "D roll-off [Hz]"):
+                t.add_column(Text(col), justify="right", no_wrap=True)
+            for label, g in (("hardware", hw), ("rule", rule)):
+                wf = g.get("roll_off")
+                t.add_row(label, _fmt(g.get("kp")), _fmt(g.get("ki")), _fmt(g.get("kd")),
+                          "none" if wf is None else _fmt(wf / (2 * 3.141592653589793)))
+            console.print(t)
+        else:
+            t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
+                      pad_edge=False)
+            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]",
+                        "tuning mass [kg]"):
+                t.add_column(Text(col), justify="right", no_wrap=True)
+            t.add_row(_fmt(pid.get("kp")), _fmt(pid.get("ki")), _fmt(pid.get("kd")),
+                      _fmt(pid.get("wt")), _fmt(pid.get("tuning_mass")))
+            console.print(t)
 
     xo = data.get("crossover") or {}
     if xo:
@@ -631,16 +647,44 @@ def simulate_command(
     reference: Annotated[bool, typer.Option(
         "--reference", help="Integrate with scipy's solve_ivp (Radau, tight tolerance) instead "
                             "of the fast kernel: slow, for checks.")] = False,
+    record: Annotated[Optional[Path], typer.Option(
+        "--record", metavar="MEASURED.csv", help="Replay this measured record instead of the "
+                                                 "spec's motion: the model starts from the "
+                                                 "state in the data and is driven by its "
+                                                 "reference_m (and disturbance_N).",
+        show_default=False)] = None,
+    drive: Annotated[str, typer.Option(
+        "--drive", metavar="closed|force", help="With --record: 'closed' (the model's "
+                                                "controller closes the loop) or 'force' (the "
+                                                "plant driven open loop by the measured "
+                                                "force_N, re-anchored every --window)."
+                                                )] = "closed",
+    window: Annotated[float, typer.Option(
+        "--window", metavar="SECONDS", help="With --drive force: length of the windows after "
+                                            "which the model is re-anchored to the "
+                                            "measurement [s].")] = 0.1,
     force: Annotated[bool, typer.Option(
         "--force", "-f", help="Overwrite existing output files.")] = False,
 ) -> None:
-    """Simulate the stage once and print the hunting metric.
+    """Simulate the stage once, or replay a measured record, and print the result.
 
     The CSV has the columns of measured data (DESIGN.md section 4): time_s,
     reference_m, position_m, force_N (the commanded force) and, with the
-    isolator, deflection_m; overlay it on your measurements.
+    isolator, deflection_m; overlay it on your measurements. An open-loop
+    replay (--drive force) adds a column ``window`` numbering the re-anchored
+    windows.
     """
     from .output import check_output, write_atomic
+
+    if drive not in ("closed", "force"):
+        raise typer.BadParameter(f"expected 'closed' or 'force', got {drive!r}",
+                                 param_hint="--drive")
+    if drive == "force" and record is None:
+        raise typer.BadParameter("--drive force replays a record: give --record MEASURED.csv",
+                                 param_hint="--drive")
+    if not window > 0:
+        raise typer.BadParameter(f"must be a positive time in seconds, got {window!r}",
+                                 param_hint="--window")
 
     csv_path = check_output(csv_out, force=force, protect=(spec,),
                             extensions=(".csv",)) if csv_out else None
@@ -653,6 +697,11 @@ def simulate_command(
     from .specfile import load_spec
 
     spec_obj = load_spec(spec)
+    measured = None
+    if record is not None:
+        from .measured import load_measurement
+
+        measured = load_measurement(record)
     isolated = False if no_isolator else None
     if not no_isolator and spec_obj.isolator is None:
         isolated = False
@@ -660,9 +709,10 @@ def simulate_command(
     from .simulation import simulate
 
     err = _console(stderr=True)
-    with _status(err, "simulating ..."):
+    with _status(err, "replaying the record ..." if measured is not None else "simulating ..."):
         result = simulate(spec_obj, isolated=isolated,
-                          method="reference" if reference else "fast")
+                          method="reference" if reference else "fast", record=measured,
+                          drive=drive, window=window)
     console = _console()
     _print_simulation(console, result)
     if csv_path is not None:
@@ -684,18 +734,36 @@ def _print_simulation(console: "Console", result) -> None:
 
     m = result.metrics
     plant = "with isolator" if result.isolated else "without isolator"
-    t = Table(title=f"Simulation {plant} at {result.crossover:g} Hz ({result.friction_model}, "
+    loop = "closed loop" if result.drive == "closed" else "open loop, measured force"
+    what = "Simulation" if result.replay is None else f"Replay of {result.record} ({loop})"
+    t = Table(title=f"{what} {plant} at {result.crossover:.4g} Hz ({result.friction_model}, "
                     f"{result.method} solver)", title_justify="left", box=box.SIMPLE_HEAD,
               pad_edge=False)
     t.add_column("Quantity")
     t.add_column("Value", justify="right")
-    rows = [
-        ("verdict", m.verdict),
-        ("hunting cycles in the window [-]", str(m.hunting_cycles)),
-        ("amplitude (peak to peak) [um]", _fmt(1e6 * m.amplitude, 4)),
-        ("period [s]", _fmt(m.period, 4)),
-        ("settling time [s]", _fmt(m.settling_time, 4)),
-        ("final error [um]", _fmt(1e6 * m.final_error, 4)),
+    rows = []
+    fit = result.replay
+    if fit is not None:
+        rows += [
+            ("position, model - measured, rms [um]", _fmt(1e6 * fit.position_rms, 4)),
+            ("position, model - measured, max [um]", _fmt(1e6 * fit.position_max, 4)),
+            ("tracking error r - x1 rms, model [um]", _fmt(1e6 * fit.tracking_rms_model, 4)),
+            ("tracking error r - x1 rms, measured [um]",
+             _fmt(1e6 * fit.tracking_rms_measured, 4)),
+            ("commanded force, model - measured, rms [N]", _fmt(fit.force_rms, 4)),
+        ]
+        if result.window is not None:
+            rows.append(("re-anchored windows [-]", str(int(result.window.max()) + 1)))
+    else:  # the hunting metric judges a settling stage, not a record in motion
+        rows += [
+            ("verdict", m.verdict),
+            ("hunting cycles in the window [-]", str(m.hunting_cycles)),
+            ("amplitude (peak to peak) [um]", _fmt(1e6 * m.amplitude, 4)),
+            ("period [s]", _fmt(m.period, 4)),
+            ("settling time [s]", _fmt(m.settling_time, 4)),
+            ("final error [um]", _fmt(1e6 * m.final_error, 4)),
+        ]
+    rows += [
         ("integration", "ok" if result.success else result.message),
         ("steps / rejected / events [-]", f"{result.n_steps} / {result.n_rejected} / "
                                           f"{result.n_events}"),
@@ -704,7 +772,8 @@ def _print_simulation(console: "Console", result) -> None:
     for k, v in rows:
         t.add_row(Text(k), Text(str(v)))
     console.print(t)
-    console.print(Text(m.reason))
+    if result.replay is None:
+        console.print(Text(m.reason))
 
 
 @app.command("schema")

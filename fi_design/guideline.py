@@ -847,7 +847,12 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
     from .linear import CASE_NUMBERS
 
     parts = []
-    if gap.hunting_risk:
+    if gap.hunting_risk and not pid.controller.integrator:
+        parts.append(f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, at or above "
+                     f"the {gap.threshold:.3g} N threshold, but the loop has no integrator to "
+                     "push the cart through stiction, so it cannot hunt by the paper's "
+                     "mechanism.")
+    elif gap.hunting_risk:
         parts.append(f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, at or above "
                      f"the {gap.threshold:.3g} N threshold, so stick-slip can make the "
                      "integrating controller hunt.")
@@ -870,14 +875,16 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
                f"{xo.achievable:.4g} Hz")
     else:
         ach = f"the achievable crossover is {xo.achievable:.3g} Hz, limited by {xo.limited_by}"
+    at = ("the desired crossover" if pid.controller.source == "rule"
+          else "the hardware's crossover")
     if not bad:
         every = "both" if n == 2 else f"all {n}"
-        parts.append(f"At the desired crossover of {xo.desired:.3g} Hz {every} linear limit "
+        parts.append(f"At {at} of {xo.desired:.3g} Hz {every} linear limit "
                      f"cases are stable with {margins}; {ach}.")
     else:
         which = ", ".join(f"case {CASE_NUMBERS[c.name]} ({c.description}: "
                           f"{', '.join(c.failed)})" for c in bad)
-        parts.append(f"At the desired crossover of {xo.desired:.3g} Hz the margins fail in "
+        parts.append(f"At {at} of {xo.desired:.3g} Hz the margins fail in "
                      f"{which}; {ach}.")
     if spec.isolator is not None:
         ok = st.chosen <= st.maximum * (1 + 1e-12)

@@ -26,7 +26,7 @@ from .pid import ControlLaw
 from .plant import P_SIGMA2_NEG, PlantParameters, state_index, stribeck
 
 #: Span of samples the local velocity estimate fits [s].
-VELOCITY_SPAN = 0.02
+VELOCITY_SPAN = 0.01
 #: Fewest samples the local velocity estimate needs.
 MIN_FIT_SAMPLES = 5
 
@@ -54,6 +54,50 @@ class RecordState:
     time: float
     position: float
     velocity: float
+
+
+@dataclass(frozen=True)
+class ReplayFit:
+    """How a replay agrees with the record it replays.
+
+    Attributes
+    ----------
+    samples : int
+        Samples compared (those the replay reached).
+    position_rms : float
+        RMS of model minus measured stage position [m].
+    position_max : float
+        Largest absolute position difference [m].
+    tracking_rms_model : float
+        RMS tracking error r - x1 of the model [m].
+    tracking_rms_measured : float
+        RMS tracking error r - x1 of the measurement [m].
+    force_rms : float or None
+        RMS of model minus measured commanded force [N]; None without ``force_N``.
+    """
+
+    samples: int
+    position_rms: float
+    position_max: float
+    tracking_rms_model: float
+    tracking_rms_measured: float
+    force_rms: float | None
+
+
+def replay_fit(record: Measurement, position: np.ndarray, force: np.ndarray) -> ReplayFit:
+    """Compare a replay's position [m] and commanded force [N] with the record."""
+    ok = np.isfinite(position)
+
+    def rms(x):
+        return float(np.sqrt(np.mean(x[ok] ** 2))) if ok.any() else math.nan
+
+    dx = position - record.position
+    return ReplayFit(
+        samples=int(ok.sum()), position_rms=rms(dx),
+        position_max=float(np.max(np.abs(dx[ok]))) if ok.any() else math.nan,
+        tracking_rms_model=rms(record.reference - position),
+        tracking_rms_measured=rms(record.reference - record.position),
+        force_rms=None if record.force is None else rms(force - record.force))
 
 
 def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPAN) -> RecordState:
@@ -158,10 +202,10 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
         kf = law.kernel_form()
         v_wo_i = kf["kp"] * e + kf["kd"] * (rd - v1) - kf["kdm"] * v1
         target = v_wo_i if command is None else command - feedforward
-        if law.integrator:
+        if law.integrator:  # the integrator takes what P and D leave of the first sample
             y0[idx["I"]] = target - v_wo_i
-        if not math.isinf(kf["wt"]):
-            y0[idx["u"]] = target if law.integrator else v_wo_i
+        if not math.isinf(kf["wt"]):  # the filter state is the output itself
+            y0[idx["u"]] = target
     if command is not None:
         changes["u_initial"] = command
     return y0, replace(params, **changes)
@@ -181,14 +225,18 @@ def _discrete_state(params: PlantParameters, law: ControlLaw, e: float, xm: floa
 
     The D term is taken in steady state for the present rate of its input
     (``ed`` = e' or ``-xd``), which both the Tustin and the backward-difference
-    form reproduce exactly; the integrator takes what the first force sample
-    needs beyond P and D (only when the loop has one).
+    form reproduce exactly. What the first force sample needs beyond P and
+    that D goes to the integrator when the loop has one, else to the D term
+    (whose state is then the one the drive really had).
     """
     on_meas = law.derivative_on == "measurement"
     d_in, d_rate = (-xm, -xd) if on_meas else (e, ed)
     D0 = law.kd * d_rate
-    dx2 = D0 - params.db * d_in
     dx1 = 0.0
-    if law.integrator and command is not None:
-        dx1 = command - feedforward - params.dp * e - params.dc * e - D0
-    return dict(dx1=dx1, dx2=dx2)
+    if command is not None:
+        rest = command - feedforward - params.dp * e - params.dc * e - D0
+        if law.integrator:
+            dx1 = rest
+        else:
+            D0 += rest
+    return dict(dx1=dx1, dx2=D0 - params.db * d_in)

@@ -293,3 +293,19 @@ def test_a_pd_rule_is_allowed_and_reported_as_such():
 def test_controller_needs_a_crossover_or_gains():
     with pytest.raises(SpecError, match="crossover .* or the hardware's gains"):
         load_spec(axis(**{"controller": {"derivative_on": "measurement"}}))
+
+
+def test_industrial_example_reports_the_hardware_loop(repo_root):
+    """examples/industrial_axis.yaml: the drive's PD loop, the rule beside it, no integrator."""
+    spec = load_spec(repo_root / "examples" / "industrial_axis.yaml")
+    d = design(spec, confirm=False).to_dict()
+    pid = d["pid"]
+    assert pid["source"] == "gains" and pid["integrator"] is False
+    assert pid["controller"]["kp"] == pytest.approx(1.37e6)
+    assert pid["controller"]["derivative_on"] == "measurement"
+    assert pid["controller"]["sample_period"] == pytest.approx(1e-3)
+    assert pid["static_error"] == pytest.approx(20.0 / 1.37e6)
+    law = control_law(spec)
+    assert set(pid["rule_in_hardware_form"]) == {"kp", "ki", "kd", "roll_off"}
+    assert d["crossover"]["desired"] == pytest.approx(law.crossover)
+    assert "no integrator" in d["conclusion"] and "hardware's crossover" in d["conclusion"]
