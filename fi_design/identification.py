@@ -15,12 +15,17 @@ EMPS axis):
    :data:`MAX_CUTOFF_FRACTION` of it. Because every term of the equation of
    motion but the sign of the velocity is linear, filtering both sides keeps
    the equation.
-2. **Force alignment.** ``force_N`` is a command held by the controller's
-   zero-order hold over the sample after it, so its average acts half a
-   sample later; the filtered force is read half a sample (plus the spec's
-   computational delay) later, by interpolation.
-3. **Central differences** (:func:`numpy.gradient`) of the filtered position
-   give velocity and acceleration.
+2. **Central differences** of the filtered position give the velocity
+   (:func:`numpy.gradient`) and the acceleration (the second central
+   difference ``(x[k+1] - 2 x[k] + x[k-1]) / T^2``). ``force_N`` is usually
+   a command held by the controller's zero-order hold over the sample
+   interval after it; the second difference of the position of a mass
+   pushed by a held force is then exactly the mean of the two force samples
+   around t_k (the hold equivalent of the double integrator,
+   ``T^2 (z + 1) / (2 m (z - 1)^2)``), and that mean is used. Whether the
+   force is held or a sampled continuous signal is decided from the data:
+   the reading that fits better (:attr:`Processing.force_hold`). A
+   computational delay of the spec shifts the force by interpolation.
 4. **Parallel filtering and decimation.** Every regressor column, the
    nonlinear ones (sign and one-sided parts of the velocity) included, passes
    the same low-pass as the force, then :func:`scipy.signal.decimate` (a
@@ -32,7 +37,8 @@ EMPS axis):
    correlated samples.
 5. **Sample selection.** Only sliding samples are used: speed above the
    velocity threshold throughout the filters' reach (the indicator of
-   sliding, filtered and decimated like the data, stays within 1 % of one;
+   sliding, filtered and decimated like the data, stays within
+   :data:`SLIDE_TOLERANCE` of one;
    default threshold :data:`THRESHOLD_FRACTION` of the peak speed,
    with a spec at least :data:`STRIBECK_FACTOR` times its Stribeck velocity;
    below it friction is not Coulomb plus viscous: Stribeck effect,
@@ -75,17 +81,21 @@ LuGre's dynamic parameters (static friction, Stribeck velocity, bristle
 stiffness) need an excitation that sliding data do not hold: a breakaway
 from rest, or a slow velocity sweep through zero (static friction and
 Stribeck velocity), small-amplitude reversals in presliding (bristle
-stiffness). :func:`excitation` detects them; where the record holds them and
-a spec gives the controller, the replay of the record
-(:func:`fi_design.simulate` with ``record=``) is fitted to the measured
-position. Otherwise the parameter is reported as not identifiable, with the
-experiment that would identify it, and no value.
+stiffness). :func:`excitation` detects them in the record. They are never
+estimated here: every one is reported as not identifiable, with no value,
+and a note that says whether the record holds its excitation (and where) and
+which experiment identifies it. A fit of the replayed record
+(:func:`fi_design.simulate` with ``record=``) to the breakaways was built and
+validated on simulated records, and rejected: the replay of a stick-slip
+record is so sensitive to the sliding friction that sub-percent errors in
+it (within their standard errors) moved the static friction and Stribeck
+velocity by many of their own standard errors.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any, Callable, Mapping
 
@@ -93,7 +103,7 @@ import numpy as np
 
 from .errors import DataError
 from .measured import Measurement, measurement_from_arrays
-from .results import dataclass_dict, frozen_array, to_jsonable
+from .results import dataclass_dict, frozen_array
 
 #: Parameters of an identification, in the order of DESIGN.md section 8.
 NAMES = ("mass", "coulomb", "coulomb_negative", "viscous", "viscous_negative", "offset",
@@ -125,6 +135,9 @@ THRESHOLD_FRACTION = 0.1
 STRIBECK_FACTOR = 3.0
 #: Samples dropped at each end of the record: this many cut-off periods.
 EDGE_PERIODS = 4.0
+#: A sample is used when the filtered, decimated sliding indicator is within this of one: a
+#: direction change inside the filters' reach would leak up to this times 2 Fc into it.
+SLIDE_TOLERANCE = 1e-3
 #: Sampling jitter accepted as uniform: fraction of the median step.
 JITTER = 0.01
 #: Largest factor of one decimation stage (scipy recommends below 13).
@@ -138,10 +151,6 @@ REST_BAND = 1e-6
 PRESLIDING_BAND = 50e-6
 #: Fewest events (breakaways, presliding reversals) that make a parameter identifiable.
 MIN_EVENTS = 3
-#: A breakaway's replay window ends this long after the stage slides again [s].
-AFTER_BREAKAWAY = 0.05
-#: Most breakaway windows the replay fit uses (evenly chosen).
-MAX_WINDOWS = 8
 
 ProgressCallback = Callable[[str, float], None]
 
@@ -244,8 +253,12 @@ class Processing:
     velocity_threshold : float
         Samples slower than this are not used [m/s].
     force_delay : float
-        The filtered force is read this much later [s] (half a sample of the
-        zero-order hold plus the spec's computational delay).
+        The filtered force is read this much later [s]: the spec's
+        computational delay.
+    force_hold : bool
+        Whether ``force_N`` is taken as a command held over each sample
+        interval (zero-order hold) rather than a sampled continuous force;
+        chosen by :func:`identify` as the reading that fits the record better.
     edge : float
         Time dropped at each end of the record [s].
     """
@@ -257,6 +270,7 @@ class Processing:
     decimation: int
     velocity_threshold: float
     force_delay: float
+    force_hold: bool
     edge: float
 
     def to_dict(self) -> dict:
@@ -288,14 +302,9 @@ class Excitation:
         Largest motion during a rest [m].
     presliding_band : float
         Largest excursion of a presliding reversal [m].
-    windows : tuple of (float, float, float)
-        Per breakaway: the last sliding sample before the rest, the start of
-        the rest, and :data:`AFTER_BREAKAWAY` after the stage slides again [s]
-        (the replay fit's windows).
-    breakaway_forces : tuple of float
-        Per breakaway: the largest actuator force magnitude during the rest
-        before it [N] (the force the bearing held: a first look at static
-        friction, the offset included).
+    events : tuple of (float, float)
+        Per breakaway: the start of the rest and the time the stage slides
+        again [s].
     """
 
     breakaways: int
@@ -306,8 +315,7 @@ class Excitation:
     dwell: float
     rest_band: float
     presliding_band: float
-    windows: tuple[tuple[float, float, float], ...] = ()
-    breakaway_forces: tuple[float, ...] = ()
+    events: tuple[tuple[float, float], ...] = ()
 
     @property
     def breakaway(self) -> bool:
@@ -422,9 +430,6 @@ class IdentificationResult:
         Filter, decimation and selection settings.
     excitation : Excitation
         What the record holds for the dynamic parameters.
-    dynamic_fit : dict or None
-        The replay fit of the dynamic parameters (which, drive, position RMS
-        residual [m], success, message); None when none was run.
     notes : tuple of str
         What is and is not identifiable, and why.
     samples : Samples
@@ -442,7 +447,6 @@ class IdentificationResult:
     masses: Masses
     processing: Processing
     excitation: Excitation
-    dynamic_fit: dict | None
     notes: tuple[str, ...]
     samples: Samples = field(repr=False)
     measurement: Measurement = field(repr=False)
@@ -464,7 +468,6 @@ class IdentificationResult:
             "masses": self.masses.to_dict(),
             "processing": self.processing.to_dict(),
             "excitation": self.excitation.to_dict(),
-            "dynamic_fit": to_jsonable(self.dynamic_fit),
             "notes": list(self.notes),
             "measurement": self.measurement.to_dict(),
             "fi_design_version": __version__,
@@ -594,11 +597,11 @@ def processing(measured: Measurement, spec=None, *, cutoff: float | None = None,
     elif not velocity_threshold > 0.0:
         raise DataError(f"velocity threshold {velocity_threshold!r}: must be positive [m/s]",
                         column="position_m", source=measured.source)
-    delay = 0.5 / fs + (spec.controller.delay if spec is not None else 0.0)
+    delay = spec.controller.delay if spec is not None else 0.0
     return Processing(sample_rate=fs, cutoff=float(cutoff), cutoff_rule=rule,
                       filter_order=FILTER_ORDER, decimation=int(decimation),
                       velocity_threshold=float(velocity_threshold), force_delay=float(delay),
-                      edge=EDGE_PERIODS / float(cutoff))
+                      force_hold=True, edge=EDGE_PERIODS / float(cutoff))
 
 
 def _smooth_factor(n: int) -> int:
@@ -704,30 +707,45 @@ def _prepare(m: Measurement, proc: Processing, joint: _Joint) -> _Prepared:
     dt = 1.0 / fs
     x1 = _lowpass(m.position, proc.cutoff, fs)
     u = _lowpass(m.force, proc.cutoff, fs)
-    u = np.interp(t - proc.force_delay, t, u)  # the held command acts half a sample later
+    if proc.force_delay > 0.0:  # the command acts this much later
+        u = np.interp(t - proc.force_delay, t, u)
+    if proc.force_hold:  # the mean of the two held samples around t_k
+        u = np.concatenate([u[:1], 0.5 * (u[1:] + u[:-1])])
     v1 = np.gradient(x1, dt)
-    a1 = np.gradient(v1, dt)
+    a1 = _second_difference(x1, dt)
+    raw = np.gradient(np.asarray(m.position, dtype=float), dt)  # filtered once, below
     if joint.model == "rigid":
         v2, a2, fj = v1, a1, None
     else:
         d = _lowpass(m.deflection, proc.cutoff, fs)
         dd = np.gradient(d, dt)
         v2 = v1 - dd
-        a2 = a1 - np.gradient(dd, dt)
+        a2 = a1 - _second_difference(d, dt)
+        raw = raw - np.gradient(np.asarray(m.deflection, dtype=float), dt)
         fj = joint.k * d + joint.c * dd if joint.model == "two_mass" else None
-    cols = {"one": np.ones_like(v2), "sign": np.sign(v2), "pos": (v2 > 0).astype(float),
-            "neg": (v2 < 0).astype(float), "vpos": np.maximum(v2, 0.0),
-            "vneg": np.minimum(v2, 0.0),
+    # the direction from the filtered velocity; the one-sided velocities from the raw one, so
+    # that, filtered like the force, they hold the velocity filtered once, as the force does
+    pos, neg = (v2 > 0).astype(float), (v2 < 0).astype(float)
+    cols = {"one": np.ones_like(v2), "sign": pos - neg, "pos": pos, "neg": neg,
+            "vpos": pos * raw, "vneg": neg * raw,
             "slide": (np.abs(v2) > proc.velocity_threshold).astype(float)}
     # the same low-pass and decimation as the force: the equation holds on the filtered data
     dec = {k: _decimate(_lowpass(c, proc.cutoff, fs), q) for k, c in cols.items()}
     td = t[::q]
     vd = _decimate(v2, q)
     # sliding faster than the threshold throughout the filters' reach ("one": their own gain)
-    used = np.abs(dec["slide"] - dec["one"]) < 0.01 * dec["one"]
+    used = np.abs(dec["slide"] - dec["one"]) < SLIDE_TOLERANCE * dec["one"]
     used &= (td >= t[0] + proc.edge) & (td <= t[-1] - proc.edge)
     return _Prepared(time=td, force=_decimate(u, q), a1=_decimate(a1, q), a2=_decimate(a2, q),
                      v=vd, joint=None if fj is None else _decimate(fj, q), cols=dec, used=used)
+
+
+def _second_difference(x: np.ndarray, dt: float) -> np.ndarray:
+    """Acceleration by the second central difference (x[k+1] - 2 x[k] + x[k-1]) / dt^2."""
+    a = np.empty_like(x)
+    a[1:-1] = np.diff(x, 2) / (dt * dt)
+    a[0], a[-1] = a[1], a[-2]
+    return a
 
 
 # --------------------------------------------------------------------------- least squares
@@ -881,17 +899,12 @@ def excitation(measured: Measurement, proc: Processing, *, spec=None,
     runs = _runs(rest)
     t = np.asarray(measured.time, dtype=float)
     sliding = np.abs(v) > proc.velocity_threshold
-    windows, forces = [], []
+    events = []
     for a, b in runs:
         later = np.nonzero(sliding[b:])[0]
-        before = np.nonzero(sliding[:a])[0]
-        if b - a < w or not len(later) or not len(before) or later[0] > 20 * w:
-            continue
-        end = min(len(t) - 1, b + int(later[0]) + int(round(AFTER_BREAKAWAY * fs)))
-        windows.append((float(t[before[-1]]), float(t[a]), float(t[end])))
-        if measured.force is not None:
-            forces.append(float(np.max(np.abs(measured.force[a:b]))))
-    breakaways = len(windows)
+        if b - a >= w and len(later) and later[0] <= 20 * w and np.any(sliding[:a]):
+            events.append((float(t[a]), float(t[b + int(later[0])])))
+    breakaways = len(events)
     prom = max(10.0 * noise, 1e-12)
     ext = np.sort(np.concatenate([find_peaks(xf, prominence=prom)[0],
                                   find_peaks(-xf, prominence=prom)[0]]))
@@ -902,7 +915,7 @@ def excitation(measured: Measurement, proc: Processing, *, spec=None,
                       presliding_reversals=int(np.sum(excursions < presliding_band)),
                       min_speed=float(np.min(np.abs(v[inner]))), dwell=float(dwell),
                       rest_band=float(band), presliding_band=float(presliding_band),
-                      windows=tuple(windows), breakaway_forces=tuple(forces))
+                      events=tuple(events))
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -984,10 +997,15 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     proc = processing(measured, spec, cutoff=cutoff, decimation=decimation,
                       velocity_threshold=velocity_threshold)
     joint = _joint(measured, spec)
-    prep = _prepare(measured, proc, joint)
-    _check_directions(prep, proc, measured.source)
     say("least squares", 0.3)
-    sol = _solve(_equations(prep, form, joint), prep.used)
+    fits = []
+    for hold in (True, False):  # the force as a held command, or as a sampled force
+        p = replace(proc, force_hold=hold)
+        prep = _prepare(measured, p, joint)
+        _check_directions(prep, p, measured.source)
+        sol = _solve(_equations(prep, form, joint), prep.used)
+        fits.append((_force_rss(prep, sol, joint), p, prep, sol))
+    _, proc, prep, sol = min(fits, key=lambda f: f[0])
     samples, fit = _fit_statistics(prep, sol, joint)
     say("excitation", 0.5)
     exc = excitation(measured, proc, spec=spec)
@@ -997,13 +1015,18 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     if measured.disturbance is not None:
         notes.append("force_N is used as the force that acts (the injected disturbance_N "
                      "included); the controller's own output force_N - disturbance_N is not")
-    dyn, dyn_fit = _dynamic(measured, spec, exc, params, masses, form, sol, say)
-    params.update(dyn)
+    params.update(_dynamic(exc))
     say("done", 1.0)
     return IdentificationResult(
         parameters=MappingProxyType({k: params[k] for k in NAMES}), fit=fit, form=form,
-        model=joint.model, masses=masses, processing=proc, excitation=exc, dynamic_fit=dyn_fit,
+        model=joint.model, masses=masses, processing=proc, excitation=exc,
         notes=tuple(notes), samples=samples, measurement=measured, spec=spec)
+
+
+def _force_rss(prep: _Prepared, sol: _Solution, joint: _Joint) -> float:
+    """Residual sum of squares of the actuator force per used sample [N^2]."""
+    _, fit = _fit_statistics(prep, sol, joint)
+    return fit.force_rms_residual ** 2
 
 
 def _check_directions(prep: _Prepared, proc: Processing, source: str | None) -> None:
@@ -1121,315 +1144,30 @@ def _threshold_note(proc: Processing) -> str:
 # --------------------------------------------------------------------------- dynamic parameters
 
 
-def _dynamic(measured, spec, exc: Excitation, params, masses, form, sol, say):
-    """Parameters static, stribeck_velocity, bristle_stiffness: fitted or not identifiable."""
-    wanted = []
-    if exc.breakaway:
-        wanted += ["static", "stribeck_velocity"]
-    if exc.presliding:
-        wanted.append("bristle_stiffness")
-    out = {name: _not_identifiable(name, exc) for name in DYNAMIC}
-    if not wanted:
-        return out, None
-    if spec is None:
-        for name in wanted:
-            out[name] = Parameter(None, None, UNITS[name], False,
-                                  "the record holds the excitation, but the fit replays the "
-                                  "record through the stage's controller: give a spec")
-        return out, None
-    say("replay fit of the dynamic parameters", 0.6)
-    base = identified_spec(spec, params, masses, form)
-    variants = [identified_spec(spec, *_moved(params, masses, shift), form)
-                for shift in _principal_shifts(sol)]
-    fit = fit_dynamic(base, measured, wanted, exc, variants=variants,
-                      progress=lambda f: say("replay fit of the dynamic parameters",
-                                             0.6 + 0.4 * f))
-    for name in wanted:
-        if fit.success:
-            out[name] = Parameter(fit.values[name], fit.std_errors[name], UNITS[name], True,
-                                  f"from a fit of the replayed record to the measured "
-                                  f"position ({_how(name)}); {fit.note}")
-        else:
-            out[name] = Parameter(None, None, UNITS[name], False,
-                                  f"the record holds the excitation, but the replay fit "
-                                  f"failed: {fit.message}")
-    return out, fit.to_dict()
+def _dynamic(exc: Excitation) -> dict[str, Parameter]:
+    """Parameters static, stribeck_velocity, bristle_stiffness: never estimated here.
 
-
-@dataclass(frozen=True)
-class DynamicFit:
-    """The replay fit of LuGre's dynamic parameters.
-
-    Attributes
-    ----------
-    parameters : tuple of str
-        The fitted parameters (of :data:`DYNAMIC`).
-    values : mapping of str to float
-        Estimates [SI].
-    std_errors : mapping of str to float
-        Standard errors [SI]: the cluster-robust (sandwich) covariance of
-        the fit, each replayed window a cluster (with fewer than three, the
-        residual variance scaled by the effective sample count), plus the
-        uncertainty of the identified mass and sliding friction carried
-        through the replays.
-    position_rms_residual : float
-        RMS of measured minus replayed position at the optimum [m].
-    position_rms_before : float
-        The same with the spec's values, before the fit [m].
-    evaluations : int
-        Replays run.
-    success : bool
-        Whether the fit converged with successful replays.
-    message : str
-        The optimiser's or the replay's message.
-    note : str
-        What the fit held fixed.
+    Where the record holds the excitation the note says so and names the
+    events; the estimate itself is left to a dedicated experiment and fit
+    (see the module docstring): none is reported rather than an unreliable one.
     """
-
-    parameters: tuple[str, ...]
-    values: Mapping[str, float]
-    std_errors: Mapping[str, float]
-    position_rms_residual: float
-    position_rms_before: float
-    evaluations: int
-    success: bool
-    message: str
-    note: str
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return to_jsonable({k: getattr(self, k) for k in self.__dataclass_fields__})
-
-
-#: Bounds of the dynamic parameters in the replay fit [SI]; static friction from Fc up.
-_DYNAMIC_BOUNDS = {"stribeck_velocity": (1e-6, 1.0), "bristle_stiffness": (1e2, 1e10)}
-#: Largest static friction tried, in multiples of the Coulomb friction.
-_STATIC_MAX = 20.0
-#: Starting grid of the scans (log-spaced, inclusive).
-_SCAN = {"stribeck_velocity": (1e-5, 0.1, 9), "bristle_stiffness": (1e3, 1e9, 7)}
-
-
-def fit_dynamic(spec, measured: Measurement, which, exc: Excitation, *, variants=(),
-                progress: Callable[[float], None] | None = None,
-                max_replays: int = 120) -> DynamicFit:
-    """Fit LuGre's dynamic parameters by replaying the record through the model.
-
-    Two kinds of replay (:func:`fi_design.simulate` with ``record=``), each
-    compared with the measured position, position noise as the unit:
-
-    - static friction and Stribeck velocity: every breakaway window of
-      ``exc`` (from sliding, through the rest, to just after the breakaway)
-      replayed open loop, the plant driven by the measured force
-      (``drive="force"``, one window anchored at its sliding start). The stop
-      and the moment the bearing breaks loose under the measured force fix
-      the two parameters; from the stop on the displacement since the stop
-      is compared, so that an error in where the stage stopped does not
-      weigh on the rest. A closed-loop replay of a whole stick-slip record
-      is not used: its timing drifts chaotically with any model error.
-    - bristle stiffness: the closed-loop replay of the whole record (small
-      reversals in presliding do not drift).
-
-    :func:`scipy.optimize.least_squares` adjusts the logarithms of the
-    parameters within physical bounds, starting from the best point of a
-    coarse scan (static friction starts from the median breakaway force
-    minus the offset). Every other value stays as in ``spec``, which should
-    carry the identified mass and sliding friction.
-
-    Parameters
-    ----------
-    spec : fi_design.spec.Spec
-        The stage with its controller, the sliding friction identified.
-    measured : Measurement
-        The record.
-    which : sequence of str
-        Names from :data:`DYNAMIC`.
-    exc : Excitation
-        The detected events (breakaway windows).
-    variants : sequence of fi_design.spec.Spec
-        ``spec`` with the identified mass and sliding friction moved by one
-        standard deviation along each principal axis of their covariance;
-        the change of the residual they cause at the optimum carries that
-        uncertainty into the standard errors of the fit.
-    progress : callable, optional
-        Called with the fraction of the replay budget used.
-    max_replays : int
-        Budget of replays for the least-squares refinement.
-
-    Returns
-    -------
-    DynamicFit
-    """
-    from scipy.optimize import least_squares
-
-    which = tuple(which)
-    f = spec.friction
-    fc = max(f.coulomb, f.coulomb_negative if f.coulomb_negative is not None else f.coulomb)
-    bounds = dict(_DYNAMIC_BOUNDS, static=(fc * (1.0 + 1e-3), fc * _STATIC_MAX))
-    start = {"static": f.static, "stribeck_velocity": f.stribeck_velocity,
-             "bristle_stiffness": f.bristle_stiffness}
-    if "static" in which and exc.breakaway_forces:
-        start["static"] = float(np.median(exc.breakaway_forces)) - f.offset
-    lo = np.log10([bounds[n][0] for n in which])
-    hi = np.log10([bounds[n][1] for n in which])
-    x_meas = np.asarray(measured.position, dtype=float)
-    fs = 1.0 / measured.sample_period
-    noise = max(float(np.std(x_meas - _lowpass(x_meas, CUTOFF_FRACTION * fs, fs))), 1e-12)
-    residual = _ReplayResidual(spec, measured, which, exc, noise, progress, max_replays)
-    x0 = np.clip(np.log10([start[n] for n in which]), lo + 1e-6, hi - 1e-6)
-    x0 = _scan(residual, which, x0, lo, hi)
-    r0 = residual(np.clip(np.log10([start[n] for n in which]), lo + 1e-6, hi - 1e-6))
-    try:
-        res = least_squares(residual, x0, bounds=(lo, hi), diff_step=1e-3, x_scale=0.1,
-                            xtol=1e-4, ftol=1e-4,
-                            max_nfev=max(5, max_replays // (len(which) + 1)))
-    except Exception as err:  # noqa: BLE001 -- reported in the result, never raised
-        return DynamicFit(which, {}, {}, math.nan, _rms(r0) * noise, residual.count, False,
-                          f"{type(err).__name__}: {err}", "")
-    cov = _replay_covariance(residual, res, variants)
-    r = res.fun
-    se_log = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    values = {nm: float(10.0 ** xi) for nm, xi in zip(which, res.x)}
-    errors = {nm: float(values[nm] * math.log(10.0) * si) for nm, si in zip(which, se_log)}
-    held = [nm for nm in DYNAMIC if nm not in which]
-    note = ("held at the spec's values: " + ", ".join(
-        f"{nm} = {start[nm]:.4g} {UNITS[nm]}" for nm in held)) if held else "all three fitted"
-    ok = res.status >= 0 and not residual.failure and _rms(r) <= _rms(r0)
-    message = str(res.message) if not residual.failure else \
-        f"a replay failed: {residual.failure}"
-    if res.status == 0:
-        note += "; the fit stopped at its budget of replays (converged no further)"
-    at_bound = [nm for nm, xi, a, b in zip(which, res.x, lo, hi) if min(xi - a, b - xi) < 1e-3]
-    if at_bound:
-        ok = False
-        message = f"{', '.join(at_bound)} ran into the bound of the search"
-    return DynamicFit(parameters=which, values=values, std_errors=errors,
-                      position_rms_residual=_rms(r) * noise,
-                      position_rms_before=_rms(r0) * noise, evaluations=residual.count,
-                      success=ok, message=message, note=note)
-
-
-def _rms(r: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(np.asarray(r) ** 2)))
-
-
-def _replay_covariance(residual: "_ReplayResidual", res, variants) -> np.ndarray:
-    """Covariance of the fitted log10 parameters: the fit's own plus the propagated rigid part."""
-    from scipy.linalg import pinv, pinvh
-
-    r, J = res.fun, res.jac
-    n, k = J.shape
-    bread = pinvh(J.T @ J)
-    sizes = residual.sizes
-    if len(sizes) >= 3:
-        meat = np.zeros((k, k))
-        for part_J, part_r in zip(np.split(J, np.cumsum(sizes)[:-1]),
-                                  np.split(r, np.cumsum(sizes)[:-1])):
-            g = part_J.T @ part_r
-            meat += np.outer(g, g)
-        g_count = len(sizes)
-        cov = bread @ meat @ bread * g_count / max(g_count - 1, 1)
-    else:
-        cov = float(r @ r) / max(n - k, 1) * bread * _effective_fraction(r)
-    if variants:
-        Jp = pinv(J)
-        for v in variants:
-            dx = -Jp @ (residual(res.x, spec=v) - r)
-            cov = cov + np.outer(dx, dx)
-    return cov
-
-
-class _ReplayResidual:
-    """Measured minus replayed position over the fit's replays, in units of the noise."""
-
-    def __init__(self, spec, measured, which, exc, noise, progress, budget):
-        self.spec, self.measured, self.which, self.noise = spec, measured, which, noise
-        self.progress, self.budget = progress, budget
-        self.count, self.failure = 0, ""
-        wins = list(exc.windows)
-        if len(wins) > MAX_WINDOWS:
-            wins = [wins[i] for i in np.linspace(0, len(wins) - 1, MAX_WINDOWS).round().astype(int)]
-        self.windows = [(segment(measured, a, c), int(np.searchsorted(measured.time[
-            (measured.time >= a) & (measured.time < c)], b))) for a, b, c in wins] \
-            if {"static", "stribeck_velocity"} & set(which) else []
-        self.closed = "bristle_stiffness" in which
-
-    @property
-    def sizes(self) -> list[int]:
-        """Samples per replayed part (the clusters of the covariance)."""
-        return [seg.n for seg, _ in self.windows] + ([self.measured.n] if self.closed else [])
-
-    def __call__(self, x: np.ndarray, spec=None) -> np.ndarray:
-        from .simulation import simulate
-        from .specfile import with_values
-
-        self.count += 1
-        if self.progress is not None:
-            self.progress(min(1.0, self.count / self.budget))
-        spec = with_values(spec if spec is not None else self.spec,
-                           {f"friction.{n}": float(10.0 ** xi) for n, xi in zip(self.which, x)})
-        parts = []
-        for seg, rest in self.windows:
-            sim = simulate(spec, record=seg, drive="force", window=2.0 * seg.duration + 1.0)
-            d = self._diff(sim, seg)
-            d[rest:] -= d[rest]  # from the stop on: the displacement since the stop
-            parts.append(d)
-        if self.closed:
-            parts.append(self._diff(simulate(spec, record=self.measured), self.measured))
-        return np.concatenate(parts)
-
-    def _diff(self, sim, seg) -> np.ndarray:
-        if not sim.success:
-            self.failure = sim.message
-            return np.full(seg.n, 1e3)
-        return (sim.position - np.asarray(seg.position)) / self.noise
-
-
-def _scan(residual: _ReplayResidual, which, x0, lo, hi) -> np.ndarray:
-    """The best starting point: each scanned parameter on its grid, one after the other."""
-    x = np.array(x0, dtype=float)
-    for i, name in enumerate(which):
-        if name not in _SCAN:
+    out = {}
+    for name in DYNAMIC:
+        held = exc.presliding if name == "bristle_stiffness" else exc.breakaway
+        if not held:
+            out[name] = _not_identifiable(name, exc)
             continue
-        a, b, n = _SCAN[name]
-        grid = np.clip(np.linspace(math.log10(a), math.log10(b), n), lo[i] + 1e-6, hi[i] - 1e-6)
-        costs = []
-        for g in grid:
-            trial = x.copy()
-            trial[i] = g
-            costs.append(_rms(residual(trial)))
-        x[i] = grid[int(np.argmin(costs))]
-    return x
-
-
-def _principal_shifts(sol: _Solution) -> list[dict[str, float]]:
-    """One standard deviation along each principal axis of the rigid fit's covariance."""
-    lam, vec = np.linalg.eigh(sol.cov)
-    return [{n: float(math.sqrt(lv) * c) for n, c in zip(sol.names, vec[:, i])}
-            for i, lv in enumerate(lam) if lv > 0.0]
-
-
-def _moved(params: dict, masses: Masses, shift: dict[str, float]) -> tuple[dict, Masses]:
-    """Parameters and masses moved by ``shift`` (internal names of the least squares)."""
-    from dataclasses import replace
-
-    out = dict(params)
-    for name, d in shift.items():
-        if name in out and out[name].value is not None:
-            out[name] = replace(out[name], value=out[name].value + d)
-    total = masses.stage + masses.cart
-    if "mass" in shift:
-        r = masses.stage / total
-        masses = replace(masses, stage=masses.stage + r * shift["mass"],
-                         cart=masses.cart + (1.0 - r) * shift["mass"])
-    masses = replace(masses, stage=masses.stage + shift.get("stage_mass", 0.0),
-                     cart=masses.cart + shift.get("cart_mass", 0.0))
-    return out, masses
-
-
-def _how(name: str) -> str:
-    if name == "bristle_stiffness":
-        return "closed-loop replay of the whole record"
-    return "the breakaway windows replayed open loop under the measured force"
+        what = (f"{exc.presliding_reversals} presliding reversals" if name == "bristle_stiffness"
+                else f"{exc.breakaways} breakaways from rest, at t = " + ", ".join(
+                    f"{e[1]:.3g} s" for e in exc.events[:6]) + (" ..." if len(exc.events) > 6
+                                                                 else ""))
+        out[name] = Parameter(None, None, UNITS[name], False,
+                              f"the record holds an excitation for it ({what}), but it is not "
+                              "estimated: a fit of the replayed breakaways and reversals was not "
+                              "reliable in validation (its estimates moved by many standard "
+                              "errors under sub-percent errors of the sliding friction); "
+                              f"{_EXPERIMENT[name]} identifies it")
+    return out
 
 
 def _not_identifiable(name: str, exc: Excitation) -> Parameter:

@@ -235,18 +235,16 @@ def identification_sections(result: Any, figures: bool = True) -> list:
                 ("shortest rest counted", qty(e.dwell, "s")),
                 ("largest motion at rest", qty(e.rest_band, "m")),
                 ("largest presliding excursion", qty(e.presliding_band, "m")))
-    notes = list(result.notes)
-    if result.dynamic_fit is not None:
-        d = result.dynamic_fit
-        notes.append(f"Replay fit of {', '.join(d['parameters'])}: position RMS residual "
-                     f"{qty(d['position_rms_residual'], 'm')} (before: "
-                     f"{qty(d['position_rms_before'], 'm')}), {d['evaluations']} replays; "
-                     f"{d['message']}")
+    notes = [f"{name}: {result.parameters[name].note}"
+             for name in ("static", "stribeck_velocity", "bristle_stiffness")]
+    notes += list(result.notes)
     s4 = Section(
         "identifiability", "What is and is not identifiable",
         paragraphs=("Static friction, Stribeck velocity and bristle stiffness act only near "
-                    "zero velocity; they are estimated only where the record holds a breakaway "
-                    "from rest or presliding reversals, never guessed.",),
+                    "zero velocity, where this record's samples are left out; they need a "
+                    "breakaway from rest, a slow velocity sweep through zero or presliding "
+                    "reversals, and a dedicated fit. They are not estimated here, never "
+                    "guessed: the table says what the record holds.",),
         tables=(Table(("Excitation", "Value"), exc_rows, caption="Excitation in the record"),),
         notes=tuple(notes))
     p = result.processing
