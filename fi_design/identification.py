@@ -154,6 +154,11 @@ MIN_EVENTS = 3
 
 ProgressCallback = Callable[[str, float], None]
 
+_IMPLAUSIBLE = ("physically impossible, so the model (mass, Coulomb and viscous friction "
+                "constant along the travel) does not describe this record; an unmodelled effect "
+                "(friction varying along the rail, a cable force, force ripple) or too little "
+                "sliding can cause it, and fi-design reconcile names such effects")
+
 _EXPERIMENT = {
     "static": "a slow velocity sweep through zero (the reference's velocity ramped slowly "
               "across zero), or moves that come to rest and break away again",
@@ -1012,6 +1017,10 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     params = _rigid_parameters(sol, form, joint)
     masses = _masses(sol, joint, spec, params["mass"])
     notes = list(joint.notes) + [_form_note(form), _threshold_note(proc)]
+    for name, p in list(params.items()):
+        if p.value is not None and p.value <= 0.0 and name != "offset":
+            params[name] = replace(p, note=p.note + "; " + _IMPLAUSIBLE)
+            notes.append(f"{name} = {p.value:.4g} {p.unit} is not positive: {_IMPLAUSIBLE}")
     if measured.disturbance is not None:
         notes.append("force_N is used as the force that acts (the injected disturbance_N "
                      "included); the controller's own output force_N - disturbance_N is not")
@@ -1243,12 +1252,13 @@ def identified_spec(spec, params, masses, form):
     from .specfile import with_values
 
     values = _values(spec, params, masses, form)
-    bad = [k for k in ("friction.coulomb", "friction.coulomb_negative") if k in values
-           and not values[k] > 0.0]
+    bad = [k for k in ("stage.mass", "cart.mass", "friction.coulomb",
+                       "friction.coulomb_negative", "friction.viscous",
+                       "friction.viscous_negative") if k in values and values[k] < 0.0
+           or k in values and values[k] == 0.0 and "viscous" not in k]
     if bad:
-        raise SpecError(f"identified {bad[0]} = {values[bad[0]]:.4g} N is not positive, which "
-                        "a spec cannot hold: the offset dominates; use the symmetric form",
-                        path=bad[0])
+        raise SpecError(f"the identified value {values[bad[0]]:.4g} {_SPEC_UNITS[bad[0]]} is "
+                        f"not positive, which a spec cannot hold: {_IMPLAUSIBLE}", path=bad[0])
     return with_values(spec, {k: float(x) for k, x in values.items()})
 
 
