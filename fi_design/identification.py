@@ -149,7 +149,7 @@ DWELL = 0.05
 REST_BAND = 1e-6
 #: A presliding reversal: the excursion between two reversals stays below this [m].
 PRESLIDING_BAND = 50e-6
-#: Fewest events (breakaways, presliding reversals) that make a parameter identifiable.
+#: Fewest events (breakaways, presliding reversals) that count as an excitation.
 MIN_EVENTS = 3
 
 ProgressCallback = Callable[[str, float], None]
@@ -299,8 +299,10 @@ class Excitation:
     presliding_reversals : int
         Reversals whose excursion to the next reversal stays below
         ``presliding_band``.
-    min_speed : float
-        Lowest speed of the bearing side between the edges of the record [m/s].
+    low_speed_time : float
+        Time the bearing side moves, but slower than the velocity threshold,
+        between the edges of the record [s]: where static friction and the
+        Stribeck effect act.
     dwell : float
         Shortest rest counted [s].
     rest_band : float
@@ -316,7 +318,7 @@ class Excitation:
     rest_time: float
     reversals: int
     presliding_reversals: int
-    min_speed: float
+    low_speed_time: float
     dwell: float
     rest_band: float
     presliding_band: float
@@ -918,7 +920,8 @@ def excitation(measured: Measurement, proc: Processing, *, spec=None,
                       rest_time=float(sum(b - a for a, b in runs if b - a >= w) / fs),
                       reversals=int(len(ext)),
                       presliding_reversals=int(np.sum(excursions < presliding_band)),
-                      min_speed=float(np.min(np.abs(v[inner]))), dwell=float(dwell),
+                      low_speed_time=float(np.sum((np.abs(v) < proc.velocity_threshold)[inner]
+                                                  & ~rest[inner]) / fs), dwell=float(dwell),
                       rest_band=float(band), presliding_band=float(presliding_band),
                       events=tuple(events))
 
@@ -1186,8 +1189,9 @@ def _not_identifiable(name: str, exc: Excitation) -> Parameter:
                f"{MIN_EVENTS} needed)")
     else:
         why = (f"the record holds no breakaway from rest ({exc.breakaways} rest(s) of at least "
-               f"{exc.dwell * 1e3:.3g} ms followed by sliding, {MIN_EVENTS} needed; the lowest "
-               f"speed reached is {exc.min_speed:.3g} m/s) and no slow sweep through zero")
+               f"{exc.dwell * 1e3:.3g} ms followed by sliding, {MIN_EVENTS} needed); it moves "
+               f"slower than the velocity threshold for {exc.low_speed_time:.3g} s in all, "
+               "passing through, and those samples are left out of the fit")
     return Parameter(None, None, UNITS[name], False,
                      f"not identifiable: {why}; {_EXPERIMENT[name]} would identify it")
 

@@ -231,7 +231,7 @@ def identification_sections(result: Any, figures: bool = True) -> list:
                 ("time at rest", qty(e.rest_time, "s")),
                 ("reversals", str(e.reversals)),
                 ("presliding reversals", str(e.presliding_reversals)),
-                ("lowest speed", qty(e.min_speed, "m/s")),
+                ("time moving below the velocity threshold", qty(e.low_speed_time, "s")),
                 ("shortest rest counted", qty(e.dwell, "s")),
                 ("largest motion at rest", qty(e.rest_band, "m")),
                 ("largest presliding excursion", qty(e.presliding_band, "m")))

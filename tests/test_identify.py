@@ -332,6 +332,15 @@ def test_written_spec_from_a_mapping_is_written_anew(symmetric_record):
     assert load_spec(data).friction.viscous == pytest.approx(r.value("viscous"), rel=1e-5)
 
 
+def test_public_api_entry_stays_the_function():
+    """``fi_design.identify`` is the function even after its module is imported."""
+    import fi_design
+    import fi_design.identification  # noqa: F401
+
+    assert fi_design.identify is identify and callable(fi_design.identify)
+    assert fi_design.IdentificationResult.__name__ == "IdentificationResult"
+
+
 # --------------------------------------------------------------------------- bad input
 
 
