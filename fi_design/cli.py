@@ -1709,8 +1709,8 @@ def identify_command(
         show_default=False)],
     spec: Annotated[Optional[Path], typer.Option(
         "--spec", metavar="SPEC.yaml", help="The stage's spec: its loop sets the filter, its "
-                                            "isolator the flexure force, its controller the "
-                                            "replay; needed for --write-spec and --report.",
+                                            "isolator gives the flexure force, its masses the "
+                                            "split; needed for --write-spec and --report.",
         show_default=False)] = None,
     json_out: Annotated[Optional[Path], typer.Option(
         "--json", metavar="OUT.json", help="Write the identification as JSON.",

@@ -951,8 +951,8 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     spec : fi_design.spec.Spec, optional
         The stage: its loop's crossover sets the filter, its isolator's
         stiffness and damping give the flexure force, its mass ratio splits
-        the total mass, its controller replays the record for the dynamic
-        LuGre parameters. Without it: one rigid mass, no dynamic fit.
+        the total mass, its Stribeck velocity bounds the velocity threshold
+        from below. Without it: one rigid mass.
     form : {"symmetric", "per_direction"}
         ``"symmetric"``: one Coulomb friction (``coulomb``) and an ``offset``;
         ``"per_direction"``: ``coulomb`` (positive direction) and
