@@ -2,78 +2,54 @@
 
 The EMPS record is a real ball-screw axis under its own PD loop (D on the
 measured velocity, 1 kHz), recorded in motion; nobody here generated it. Its
-documented controller and friction fitted on the record itself (not typed in
-from elsewhere) must reproduce the measured position to micrometres and the
-tracking error to within 10 %.
+documented controller (examples/emps_axis.yaml) and the mass and friction the
+tool identifies from the record itself (:func:`fi_design.identify`, not typed
+in from elsewhere) must reproduce the measured position to micrometres and
+the tracking error to within 10 %.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.signal import butter, sosfiltfilt
 
 from fi_design.errors import DataError, SimulationError
 from fi_design.measured import measurement_from_arrays
 from fi_design.replay import record_state
 from fi_design.simulation import simulate
-from fi_design.specfile import load_spec
-
-#: The EMPS drive's documented loop in force units (its README): gtau kp kv and gtau kv.
-EMPS_CONTROLLER = {"gains": {"kp": "1.371e6 N/m", "kd": "8557 N*s/m"},
-                   "derivative_on": "measurement", "sample_rate": "1 kHz"}
-
-
-def fitted_friction(record) -> dict:
-    """Mass, Coulomb friction, viscous friction per direction and offset by least squares.
-
-    Inverse dynamics on the record: zero-phase 20 Hz low-pass of position and
-    force, central differences, samples faster than 5 mm/s, one regression
-    m a + Fc sign(v) + c+ v[v>0] + c- v[v<0] + offset = force.
-    """
-    T = record.sample_period
-    sos = butter(4, 20.0, fs=1.0 / T, output="sos")
-    v = np.gradient(sosfiltfilt(sos, record.position), T)
-    a = np.gradient(v, T)
-    f = sosfiltfilt(sos, record.force)
-    use = slice(200, -200, 10)
-    v, a, f = v[use], a[use], f[use]
-    keep = np.abs(v) > 5e-3
-    X = np.column_stack([a, np.sign(v), v * (v > 0), v * (v < 0), np.ones_like(v)])[keep]
-    (m, fc, cp, cn, off), *_ = np.linalg.lstsq(X, f[keep], rcond=None)
-    return dict(mass=m, coulomb=fc, viscous=cp, viscous_negative=cn, offset=off)
-
-
-def emps_spec(fit: dict, **friction):
-    """The EMPS axis as a spec: no isolator, rigid mass, Coulomb + viscous friction."""
-    return load_spec({
-        "name": "EMPS axis",
-        "stage": {"mass": fit["mass"] - 1.0}, "cart": {"mass": 1.0},
-        "friction": {"static": fit["coulomb"], "coulomb": fit["coulomb"],
-                     "stribeck_velocity": "1 mm/s", "viscous": fit["viscous"],
-                     "viscous_negative": fit["viscous_negative"], "offset": fit["offset"],
-                     "bristle_stiffness": "1e7 N/m", **friction},
-        "controller": EMPS_CONTROLLER,
-        "motion": {"moves": [{"distance": "0.1 m", "velocity": "0.1 m/s",
-                              "acceleration": "1 m/s^2"}], "duration": "25 s"},
-    })
+from fi_design.specfile import load_spec, with_values
+from conftest import EXAMPLES
 
 
 @pytest.fixture(scope="module")
-def emps_fit(emps_record):
-    return fitted_friction(emps_record)
+def emps_identification(emps_record):
+    from fi_design.identification import identify
+
+    return identify(emps_record, load_spec(EXAMPLES / "emps_axis.yaml"))
 
 
-def test_emps_fit_is_physical(emps_fit):
+@pytest.fixture(scope="module")
+def emps_axis(emps_identification, tmp_path_factory):
+    """examples/emps_axis.yaml with the mass and friction identified from the record."""
+    from fi_design.identification import identified_spec_text
+
+    path = tmp_path_factory.mktemp("emps") / "emps_identified.yaml"
+    path.write_text(identified_spec_text(emps_identification))
+    return load_spec(path)
+
+
+def test_emps_identified_axis_is_physical(emps_axis):
     """The documented order of the moving mass (about 100 kg) and positive friction."""
-    assert 60.0 < emps_fit["mass"] < 150.0
-    assert emps_fit["coulomb"] > 0 and emps_fit["viscous"] > 0 and emps_fit["viscous_negative"] > 0
+    f = emps_axis.friction
+    assert 60.0 < emps_axis.total_mass < 150.0
+    assert f.coulomb > 0 and f.viscous > 0 and f.viscous_negative > 0
+    assert emps_axis.controller.derivative_on == "measurement"
 
 
-def test_emps_closed_loop_replay_reproduces_the_measurement(emps_record, emps_fit):
-    """Measured 1.8 um rms position error and 0.02 % tracking error on this machine."""
+def test_emps_closed_loop_replay_reproduces_the_measurement(emps_record, emps_axis):
+    """Measured 2.0 um rms position error and 0.02 % tracking error on this machine."""
     rec = emps_record
-    r = simulate(emps_spec(emps_fit), record=rec)
+    r = simulate(emps_axis, record=rec)
     assert r.success, r.message
     assert r.time[0] == rec.time[0] and len(r.time) == rec.n and r.record == rec.source
     err = r.position - rec.position
@@ -85,12 +61,12 @@ def test_emps_closed_loop_replay_reproduces_the_measurement(emps_record, emps_fi
     assert np.sqrt(np.mean((r.force - rec.force) ** 2)) < 0.1 * np.sqrt(np.mean(rec.force ** 2))
 
 
-def test_emps_replay_starts_from_the_state_in_the_data(emps_record, emps_fit):
+def test_emps_replay_starts_from_the_state_in_the_data(emps_record, emps_axis):
     """The record starts in motion: from rest the replay lags by metres per second squared."""
     rec = emps_record
     st = record_state(rec, 0)
     assert st.velocity > 5e-3
-    r = simulate(emps_spec(emps_fit), record=rec)
+    r = simulate(emps_axis, record=rec)
     assert r.velocity[0] == pytest.approx(st.velocity)
     assert r.force[0] == pytest.approx(rec.force[0], rel=1e-9)  # the D state took the rest
     # the velocity estimated at the first sample (6.37 mm/s) sets off a small closed-loop
@@ -99,20 +75,20 @@ def test_emps_replay_starts_from_the_state_in_the_data(emps_record, emps_fit):
     assert np.max(np.abs(r.position[:50] - rec.position[:50])) < 15e-6
 
 
-def test_emps_without_its_offset_and_asymmetry_misses_more(emps_record, emps_fit):
-    """The fitted per-direction viscous friction is worth keeping: symmetric, the replay is worse."""
+def test_emps_without_its_asymmetry_misses_more(emps_record, emps_axis):
+    """The identified per-direction viscous friction is worth keeping: symmetric, the replay is worse."""
     rec = emps_record
-    full = simulate(emps_spec(emps_fit), record=rec)
-    sym = dict(emps_fit, viscous_negative=emps_fit["viscous"], offset=0.0)
-    plain = simulate(emps_spec(sym), record=rec)
+    full = simulate(emps_axis, record=rec)
+    sym = with_values(emps_axis, {"friction.viscous_negative": emps_axis.friction.viscous})
+    plain = simulate(sym, record=rec)
     rms = [np.sqrt(np.mean((x.position - rec.position) ** 2)) for x in (full, plain)]
     assert rms[0] < rms[1]
 
 
-def test_emps_open_loop_replay_in_windows(emps_record, emps_fit):
+def test_emps_open_loop_replay_in_windows(emps_record, emps_axis):
     """Driven by the measured force with no controller model, re-anchored every 0.1 s."""
     rec = emps_record
-    r = simulate(emps_spec(emps_fit), record=rec, drive="force")
+    r = simulate(emps_axis, record=rec, drive="force")
     assert r.success and r.drive == "force"
     assert r.window[0] == 0 and r.window[-1] == r.window.max()
     starts = np.nonzero(np.diff(r.window))[0] + 1
@@ -185,29 +161,21 @@ def test_open_loop_replay_needs_the_force(paper_spec):
 # --------------------------------------------------------------------------- command line
 
 
-def _emps_yaml(tmp_path, fit: dict):
-    import yaml
+def _emps_yaml(tmp_path, identification):
+    from fi_design.identification import identified_spec_text
 
     p = tmp_path / "emps.yaml"
-    p.write_text(yaml.safe_dump({
-        "name": "EMPS axis", "stage": {"mass": float(fit["mass"]) - 1.0}, "cart": {"mass": 1.0},
-        "friction": {"static": float(fit["coulomb"]), "coulomb": float(fit["coulomb"]),
-                     "stribeck_velocity": "1 mm/s", "viscous": float(fit["viscous"]),
-                     "viscous_negative": float(fit["viscous_negative"]),
-                     "offset": float(fit["offset"]), "bristle_stiffness": "1e7 N/m"},
-        "controller": EMPS_CONTROLLER,
-        "motion": {"moves": [{"distance": "0.1 m", "velocity": "0.1 m/s",
-                              "acceleration": "1 m/s^2"}], "duration": "25 s"}}))
+    p.write_text(identified_spec_text(identification))
     return p
 
 
-def test_cli_simulate_record(tmp_path, emps_path, emps_fit):
+def test_cli_simulate_record(tmp_path, emps_path, emps_identification):
     from typer.testing import CliRunner
 
     from fi_design.cli import app
     from fi_design.measured import load_measurement
 
-    spec = _emps_yaml(tmp_path, emps_fit)
+    spec = _emps_yaml(tmp_path, emps_identification)
     out = tmp_path / "replay.csv"
     res = CliRunner().invoke(app, ["simulate", str(spec), "--record", str(emps_path),
                                    "--csv", str(out), "--json", str(tmp_path / "r.json")])
