@@ -98,6 +98,16 @@ __all__ = ["Truth", "Record", "generate"]
 #: Two instants closer than this [s] are the same instant (breakpoints, sample look-ups).
 TIME_TOL = 1e-9
 
+#: Chattering on a quantization edge (a sliding mode: a continuous controller whose
+#: equilibrium lies on the edge switches infinitely often). After ZENO_COUNT level crossings in
+#: a row, each within ZENO_HOLD [s] of the previous restart, the level is read once per segment
+#: (a sampled encoder): segments of ZENO_HOLD, doubling up to ``hold_cap`` (1 ms, at most a
+#: tenth of the controller's fastest time constant), while x1 stays within ZENO_BAND * q of
+#: the edge; then crossings are located by events again.
+ZENO_COUNT = 8
+ZENO_HOLD = 1e-6
+ZENO_BAND = 0.01
+
 #: Default limiter stiffness [N/m] (DESIGN.md section 2).
 K_STOP = 1e6
 
@@ -307,17 +317,21 @@ class _Moves:
             out += [t0, t0 + ta, t0 + ta + tc, t0 + 2 * ta + tc]
         return out
 
-    def __call__(self, t):
-        i = bisect.bisect_right(self.starts, t) - 1
+    def __call__(self, t, at=None):
+        """(r, r', r'') at t [s]; the piece of the profile is the one holding ``at``
+        (default t), so that a solver segment between corners sees one smooth polynomial
+        up to and including its end points."""
+        at = t if at is None else at
+        i = bisect.bisect_right(self.starts, at) - 1
         if i < 0:
             return self.r0, 0.0, 0.0
         t0, ta, tc, a, vp, sign, p0, dist = self.segments[i]
-        tau = t - t0
-        if tau < ta:
+        tau, phase = t - t0, at - t0
+        if phase < ta:
             return p0 + sign * 0.5 * a * tau * tau, sign * a * tau, sign * a
-        if tau < ta + tc:
+        if phase < ta + tc:
             return p0 + sign * (0.5 * a * ta * ta + vp * (tau - ta)), sign * vp, 0.0
-        if tau < 2 * ta + tc:
+        if phase < 2 * ta + tc:
             rest = 2 * ta + tc - tau
             return p0 + dist - sign * 0.5 * a * rest * rest, sign * a * rest, -sign * a
         return p0 + dist, 0.0, 0.0
@@ -340,11 +354,14 @@ class _SampledReference:
     def corners(self):
         return [self.x[0], self.x[-1]]
 
-    def __call__(self, t):
+    def __call__(self, t, at=None):
+        """(r, r', r'') at t [s]. ``at`` (default t) decides between the holds before and
+        after the samples and the spline (C2 inside: its knots need no such care)."""
         x = self.x
-        if t < x[0]:
+        at = t if at is None else at
+        if at < x[0]:
             return self.first, 0.0, 0.0
-        if t > x[-1]:
+        if at > x[-1]:
             return self.last, 0.0, 0.0
         i = min(max(bisect.bisect_right(x, t) - 1, 0), len(x) - 2)
         dt = t - x[i]
@@ -567,6 +584,7 @@ class _Simulation:
             self.B = wi + wd - wt - self.A
             self.wt = wt
             self.n_ctrl = 2  # q = int(e), p = e / (s + wt)
+            self.hold_cap = min(1e-3, 0.1 / wt)
         else:
             _check_keys(ctl, _COMMON_CONTROLLER_KEYS | _GAIN_KEYS, "controller")
             if "kp" not in ctl:
@@ -582,6 +600,7 @@ class _Simulation:
             if self.on_error is None:
                 raise ValueError("controller.derivative_on: 'error' or 'measurement'")
             self.n_ctrl = 1 + (self.wf is not None)  # I = int(e), [f = low-passed x]
+            self.hold_cap = 1e-3 if self.wf is None else min(1e-3, 0.1 / self.wf)
         sr = ctl.get("sample_rate")
         self.fs = None if sr is None else float(sr)
         if self.fs is not None:
@@ -730,15 +749,16 @@ class _Simulation:
 
     # ..................................................................... continuous law
 
-    def control(self, t, Y, xm):
-        """Continuous controller at time t [s], state Y, measured position xm [m].
+    def control(self, t, Y, xm, at=None):
+        """Continuous controller at time t [s], state Y, measured position xm [m]; ``at``
+        picks the piece of the reference (see :class:`_Moves`).
 
         Returns
         -------
         (float, list of float)
             Feedback + feedforward [N]; the controller state derivatives.
         """
-        r, rd, rdd = self.ref(t)
+        r, rd, rdd = self.ref(t, at)
         v1 = Y[1]
         e = r - xm
         c = Y[self.ic:]
@@ -834,7 +854,8 @@ class _Simulation:
         delayed = continuous and self.delay > 0
         control = self.control if continuous else None
         # segment constants: held force, delayed disturbance, limiter cell, measured level
-        seg = self.seg = {"u": 0.0, "dist": 0.0, "cell": 0, "xm": None}
+        seg = self.seg = {"u": 0.0, "dist": 0.0, "cell": 0, "xm": None, "mid": 0.0,
+                          "xm_late": None}
         history = self.history_command
         delay = self.delay
 
@@ -843,9 +864,10 @@ class _Simulation:
             x1, v1 = Y[0], Y[1]
             if continuous:
                 xm = seg["xm"]
-                u, dc = control(t, Y, x1 if xm is None else xm)
+                at = seg["mid"]
+                u, dc = control(t, Y, x1 if xm is None else xm, at)
                 if delayed:
-                    u = history(t - delay)
+                    u = history(t - delay, at - delay, seg["xm_late"])
                 ua = saturate(u + seg["dist"])
             else:
                 ua = seg["u"]
@@ -870,13 +892,25 @@ class _Simulation:
 
         return rhs
 
-    def history_command(self, t):
-        """Continuous command (no disturbance) at an earlier time t, from the dense output."""
+    def history_command(self, t, at=None, xm=None):
+        """Continuous command (no disturbance) at an earlier time t [s], from the dense
+        output; ``at`` picks the reference piece, ``xm`` overrides the measured position."""
         if t <= 0:
             return self.u0
         i = bisect.bisect_right(self.hist_t, t) - 1
         Y = self.hist_sol[i](t).tolist()
-        return self.control(t, Y, self.measure(Y[0]))[0]
+        if xm is None:
+            xm = self.seen(t if at is None else at, Y[0])
+        return self.control(t, Y, xm, at)[0]
+
+    def seen(self, t, x1):
+        """Position the continuous controller saw at time t [m]: x1, or the quantization level
+        of the segment holding t (the level the right-hand side used, so that the delayed
+        command jumps exactly where the level changed)."""
+        if self.q is None:
+            return x1
+        i = bisect.bisect_right(self.level_t, t + TIME_TOL * 1e-3) - 1
+        return self.level_v[max(i, 0)] * self.q
 
     # ..................................................................... events
 
@@ -906,6 +940,14 @@ class _Simulation:
             if not inside:
                 return False
         return level is None or abs(float(y[0]) / self.q - level) <= 0.5 + 1e-6
+
+    def _set_cells(self, t, y):
+        """Cell and level of state y at time t, recording a level change."""
+        cell, level = self.cells(y)
+        if level is not None and level != self.level_v[-1]:
+            self.level_t.append(t)
+            self.level_v.append(level)
+        return cell, level
 
     # ..................................................................... the run
 
@@ -954,7 +996,9 @@ class _Simulation:
         n_seg = nfev = n_events = 0
         next_k = 0
         cell, level = self.cells(self.y0)
-        stuck = resyncs = 0
+        self.level_t, self.level_v = [0.0], [level]  # what a continuous controller saw
+        short = resyncs = holds = 0
+        hold_len = hold_edge = None  # in a chattering hold: its length [s] and edge [m]
         start = _time.perf_counter()
         while t < self.t_end - TIME_TOL:
             # ---- what holds on this segment
@@ -972,12 +1016,28 @@ class _Simulation:
             t_b = heap[0] if heap else self.t_end
             if delayed:
                 t_b = min(t_b, t + self.delay)
-            if not self._consistent(y, cell, level):  # a missed crossing: trust the state
-                cell, level = self.cells(y)
+            if hold_len is None and short >= ZENO_COUNT:  # chattering on a level's edge
+                hold_len = ZENO_HOLD
+                hold_edge = (math.floor(float(y[0]) / self.q) + 0.5) * self.q
+                short = 0
+            hold = hold_len is not None
+            if hold:  # read the level once for the whole segment, as a sampled encoder does
+                t_b = min(t_b, t + hold_len)
+                holds += 1
+                new_cell, new_level = self._set_cells(t, y)
+                if delayed and new_level != level:
+                    heapq.heappush(heap, t + self.delay)
+                    t_b = min(t_b, t + self.delay)
+                cell, level = new_cell, new_level
+            elif not self._consistent(y, cell, level):  # a missed crossing: trust the state
+                cell, level = self._set_cells(t, y)
                 resyncs += 1
             self.seg["cell"] = cell
             self.seg["xm"] = None if level is None else level * self.q
-            events = self._events(cell, level)
+            self.seg["mid"] = 0.5 * (t + t_b)
+            if delayed and self.q is not None:  # the level seen a delay ago: one per segment
+                self.seg["xm_late"] = self.seen(self.seg["mid"] - self.delay, 0.0)
+            events = self._events(cell, None if hold else level)
             # errstate: scipy's finite-difference Jacobian grows its step without bound in a
             # column the right-hand side does not depend on (a free mass's position, an unused
             # integrator); the overflow it reports is harmless there
@@ -991,17 +1051,25 @@ class _Simulation:
             t_new = float(sol.t[-1])
             if sol.status == 1:  # a terminal event: restart at the discontinuity
                 n_events += 1
-                stuck = stuck + 1 if t_new - t < 1e-13 else 0
-                if stuck > 100:
-                    raise RuntimeError(f"chattering at an edge at t = {t:.9g} s (Zeno)")
+                quick = t_new - t < ZENO_HOLD
                 for ev, te in zip(events, sol.t_events):
                     if len(te) and te[-1] >= t_new - TIME_TOL:
                         if ev.cell is not None:
                             cell = ev.cell
                         if ev.level is not None:
                             level = ev.level
+                            self.level_t.append(t_new)
+                            self.level_v.append(level)
+                            short = short + 1 if quick else 0
                             if delayed:  # the measured position jumps: so does u, later
                                 heapq.heappush(heap, t_new + self.delay)
+            elif not hold:
+                short = 0
+            if hold:  # still on the edge: a longer hold next; off it: events again
+                if abs(float(sol.y[0, -1]) - hold_edge) > ZENO_BAND * self.q:
+                    hold_len = hold_edge = None
+                else:
+                    hold_len = min(2 * hold_len, self.hold_cap)
             last = t_new >= self.t_end - TIME_TOL
             j = i_out
             while j < n_out and (t_out[j] < t_new - TIME_TOL or (last and j < n_out)):
@@ -1017,6 +1085,7 @@ class _Simulation:
             self.discrete_step(next_k / self.fs, float(y[0]))  # the sample at t_end
             next_k += 1
         self.info = dict(segments=n_seg, nfev=nfev, events=n_events, resyncs=resyncs,
+                         zeno_holds=holds,
                          seconds=_time.perf_counter() - start)
         return t_out, states
 
@@ -1037,7 +1106,7 @@ class _Simulation:
         for i, t in enumerate(t_out.tolist()):
             Y = states[:, i].tolist()
             ref[i] = self.ref(t)[0]
-            measured[i] = self.measure(Y[0])
+            measured[i] = self.seen(t, Y[0]) if continuous else self.measure(Y[0])
             friction[i] = self.friction_force(float(v2[i]), float(z[i]), float(x2[i]))[0]
             dt = self.disturbance_at(t)
             if dist is not None:

@@ -292,6 +292,46 @@ def test_offset_shifts_the_rest_position_by_offset_over_kp():
         assert rec.truth.command[-1] == pytest.approx(off, rel=1e-8)
 
 
+def test_known_disturbance_is_added_to_the_command():
+    """A held 0.5 N injection on a free mass under PD: rest at r + F_d / kp, where the
+    controller's own output is -F_d and the recorded force (command + injection) is zero."""
+    kp, Fd = 1000.0, 0.5
+    rec = generate(m1=1.0, controller=dict(kp=kp, kd=60.0, delay=1e-3),
+                   moves=[dict(distance=1e-3, velocity=50e-3, acceleration=1.0)],
+                   disturbance=([0.1], [Fd]), t_end=1.0, rate=1000.0)
+    assert rec.truth.x1[-1] == pytest.approx(1e-3 + Fd / kp, abs=1e-12)
+    assert rec.force[-1] == pytest.approx(0.0, abs=1e-8)
+    assert rec.force[-1] - rec.disturbance[-1] == pytest.approx(-Fd, rel=1e-7)
+    assert np.all(rec.disturbance[rec.time < 0.1] == 0.0)
+
+
+def test_starting_in_motion_continues_the_steady_state():
+    """Started in steady sliding with a consistent controller state, the loop stays there:
+    a sampled PD on the measurement keeps e = (F_f(v) + kd v) / kp from the first sample;
+    the rule's integrator holding F_f keeps e = 0 on the isolated stage."""
+    v, T = 0.05, 1e-3
+    t_s = np.arange(0.0, 0.31, 0.01)
+    r_s = 0.01 + v * t_s
+    fr = dict(Fs=25.0, Fc=20.0, vs=1e-3, sigma0=1e7, sigma1=1e4, sigma2=100.0)
+    F = 20.0 + 100.0 * v   # exp(-(50)^2) = 0
+    kp, kd = 1.371e6, 8557.0
+    e_ss = (F + kd * v) / kp
+    rec = generate(m1=100.0, friction=fr, reference=(t_s, r_s),
+                   controller=dict(kp=kp, kd=kd, derivative_on="measurement", sample_rate=1 / T),
+                   initial=dict(x1=0.01 - e_ss, v1=v), t_end=0.3, rate=1000.0)
+    e = rec.reference - rec.truth.x1
+    assert np.allclose(e, e_ss, rtol=1e-6)
+    assert np.allclose(rec.truth.command, F, rtol=1e-6)
+    # the paper stage under the continuous rule, integrator preloaded with the friction
+    F = g_steady(v, 4.0, 1.0, 3e-3) + 20.0 * v
+    rec = generate(m1=1.6, m2=0.4, friction=LUGRE, isolator=ISOLATOR,
+                   controller=dict(rule=dict(fc=8.0)), reference=(t_s, r_s),
+                   initial=dict(v1=v, integral=F), t_end=0.3, rate=1000.0)
+    assert np.max(np.abs(rec.reference - rec.truth.x1)) < 1e-10
+    assert np.allclose(rec.truth.command, F, rtol=1e-6)
+    assert np.allclose(rec.truth.x1 - rec.truth.x2, F / ISOLATOR["k"], rtol=1e-6)
+
+
 def test_rule_crosses_a_free_mass_over_at_wc():
     """The loop gain x1 / e of the rule on m = m1 + m2 at wc is C(j wc) / (-m wc^2), |.| ~ 1."""
     m1, m2, fc = 1.6, 0.4, 8.0
@@ -414,7 +454,7 @@ def test_undamped_joint_conserves_energy_and_momentum_through_limiter_contacts()
     """No friction, c = c_stop = 0: after a force pulse, energy and momentum stay constant."""
     m1, m2, k, s = 1.6, 0.4, 6667.0, 2e-5
     iso = dict(k=k, c=0.0, s=s, c_stop=0.0)
-    rec = generate(m1=m1, m2=m2, isolator=iso, drive_force=PULSE, t_end=0.3, rate=20000.0)
+    rec = generate(m1=m1, m2=m2, isolator=iso, drive_force=PULSE, t_end=0.15, rate=20000.0)
     after = rec.time >= 0.002
     E = _oscillation_energy(rec, m1, m2, k, s, 1e6, IMPULSE)[after]
     d = (rec.truth.x1 - rec.truth.x2)[after]
@@ -523,13 +563,28 @@ def test_continuous_delay_and_quantization():
     rec = generate(m1=2.0, friction=dict(sigma2=10.0),
                    controller=dict(kp=2000.0, kd=60.0, roll_off=2000.0, delay=delay),
                    moves=[dict(distance=1e-3, velocity=20e-3, acceleration=1.0)],
-                   effects={"quantization": {"resolution": q}}, t_end=0.6, rate=1000.0)
+                   effects={"quantization": {"resolution": q}}, t_end=0.4, rate=1000.0)
     tr = rec.truth
     assert np.allclose(tr.measured / q, np.round(tr.measured / q), atol=1e-6)
     assert np.allclose(tr.measured, np.round(tr.x1 / q) * q, atol=1e-15)
     assert np.allclose(tr.applied[2:], tr.command[:-2], rtol=1e-6, atol=1e-6)  # 2 ms = 2 samples
     assert abs(tr.x1[-1] - 1e-3) <= 0.5 * q * (1 + 1e-6)   # kp e = 0 needs the right count
     assert len(np.unique(tr.measured)) > 50                    # it went through the counts
+
+
+def test_chattering_on_a_quantization_edge_is_held_not_endless():
+    """Without a delay the same loop comes to rest on the edge between two counts, where the
+    command switches infinitely often (a sliding mode): the level is then read once per short
+    segment, and the stage stays on the edge."""
+    q = 10e-6
+    rec = generate(m1=2.0, friction=dict(sigma2=10.0),
+                   controller=dict(kp=2000.0, kd=60.0, roll_off=500.0),
+                   moves=[dict(distance=1e-3, velocity=20e-3, acceleration=1.0)],
+                   effects={"quantization": {"resolution": q}}, t_end=0.42, rate=1000.0)
+    assert rec.info["zeno_holds"] > 0
+    edge = 1e-3 + 0.5 * q
+    assert np.all(np.abs(rec.truth.x1[-30:] - edge) < 0.02 * q)
+    assert set(np.round(rec.truth.measured[-30:] / q)) <= {100, 101}
 
 
 # --------------------------------------------------------------------------- the record
@@ -542,7 +597,7 @@ def test_noise_seed_resolution_and_the_measurement_layout(tmp_path):
     kw = dict(m1=1.6, m2=0.4, friction=LUGRE, isolator=ISOLATOR,
               controller=dict(rule=dict(fc=8.0)),
               moves=[dict(distance=1e-3, velocity=50e-3, acceleration=1.0)],
-              noise=dict(position=0.3e-6, deflection=0.05e-6, force=0.01), t_end=2.0,
+              noise=dict(position=0.3e-6, deflection=0.05e-6, force=0.01), t_end=1.0,
               rate=5000.0, disturbance=([0.5, 0.52], [0.2, 0.0]))
     a = generate(**kw, seed=3)
     b = generate(**kw, seed=3)
