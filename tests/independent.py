@@ -308,7 +308,6 @@ class _Moves:
             p += dist
         self.starts = [s[0] for s in self.segments]
         self.r0 = float(r0)
-        self.end = t_free
 
     def corners(self):
         """Instants where r'' jumps [s]."""
@@ -545,7 +544,6 @@ class _Simulation:
             self.drive = _Held(drive_force, "drive_force", "first")
             self.kind = None
             self.fs = None
-            _check_keys(ctl, set(), "controller")
         else:
             if controller is None:
                 raise ValueError("give a controller, or a drive_force for open loop")
@@ -577,7 +575,6 @@ class _Simulation:
             wd, wt, wi = wc / ratio, ratio * wc, wc / ri
             ks = mass * wc * wc / ratio
             self.kind = "rule"
-            self.rule_gains = dict(ks=ks, wd=wd, wt=wt, wi=wi)
             # partial fractions: C(s) = K [1 + A/s + B/(s + wt)]
             self.K = ks * wt / wd
             self.A = wi * wd / wt
@@ -670,7 +667,8 @@ class _Simulation:
         -------
         (int, int or None)
             Limiter cell 1 (d > s), -1 (d < -s), 0 (free), always 0 on a rigid plant; the
-            level n of the position the controller sees (n q), None without quantization.
+            level n of the position a continuous controller sees (n q), None without
+            quantization or with a sampled controller (it reads the position at its samples).
         """
         Y = y.tolist() if hasattr(y, "tolist") else list(y)
         cell = 0
@@ -682,7 +680,7 @@ class _Simulation:
             elif d < -s - tol or (d <= -s + tol and w < 0):
                 cell = -1
         level = None
-        if self.q is not None:
+        if self.q is not None and self.fs is None and self.drive is None:
             u = Y[0] / self.q
             level = math.floor(u + 0.5)
             frac = u - level
@@ -925,7 +923,7 @@ class _Simulation:
             if cell <= 0:
                 events.append(_event(lambda t, y: y[0] - y[2] + s, 1 if cell == -1 else -1,
                                      cell=0 if cell == -1 else -1))
-        if level is not None and self.fs is None and self.drive is None:
+        if level is not None:
             hi, lo = (level + 0.5) * self.q, (level - 0.5) * self.q
             events.append(_event(lambda t, y: y[0] - hi, 1, level=level + 1))
             events.append(_event(lambda t, y: y[0] - lo, -1, level=level - 1))
@@ -997,7 +995,7 @@ class _Simulation:
         next_k = 0
         cell, level = self.cells(self.y0)
         self.level_t, self.level_v = [0.0], [level]  # what a continuous controller saw
-        short = resyncs = holds = 0
+        short = resyncs = holds = zero_length = 0
         hold_len = hold_edge = None  # in a chattering hold: its length [s] and edge [m]
         start = _time.perf_counter()
         while t < self.t_end - TIME_TOL:
@@ -1052,6 +1050,9 @@ class _Simulation:
             if sol.status == 1:  # a terminal event: restart at the discontinuity
                 n_events += 1
                 quick = t_new - t < ZENO_HOLD
+                zero_length = zero_length + 1 if t_new - t < 1e-12 else 0
+                if zero_length > 1000:  # a safety net: no progress at all
+                    raise RuntimeError(f"events without progress at t = {t:.9g} s")
                 for ev, te in zip(events, sol.t_events):
                     if len(te) and te[-1] >= t_new - TIME_TOL:
                         if ev.cell is not None:

@@ -171,12 +171,12 @@ def test_breakaway_force_is_the_static_friction_per_direction():
     t = np.arange(0.0, 0.6, 0.005)
     for sign, Fs_dir in ((1.0, 4.0), (-1.0, 4.0 * 0.5 / 1.0)):
         F = sign * 8.0 * t  # 8 N/s in steps of 0.04 N
-        t_end = 1.2 * Fs_dir / 8.0
+        t_end = 1.1 * Fs_dir / 8.0
         rec = generate(m1=1.0, friction=fr, drive_force=(t, F), t_end=t_end, rate=2000.0)
         peak = np.max(sign * rec.truth.friction)
         # LuGre under a slow ramp breaks away just below Fs (the bristles creep)
         assert 0.97 * Fs_dir < peak <= Fs_dir * 1.001
-        assert np.max(np.abs(rec.truth.v1)) > 10 * fr["vs"]      # it did break loose
+        assert np.max(np.abs(rec.truth.v1)) > 5 * fr["vs"]       # it did break loose
 
 
 def test_presliding_oscillation_at_the_bristle_frequency():
@@ -559,17 +559,17 @@ def test_force_ripple_is_a_conservative_periodic_force():
 def test_continuous_delay_and_quantization():
     """Continuous PD (filtered D) with a delay: the applied force is the command delayed; the
     controller sees whole counts and the loop settles within a few counts of the target."""
-    q, delay = 10e-6, 2e-3
+    q, delay = 20e-6, 2e-3
     rec = generate(m1=2.0, friction=dict(sigma2=10.0),
                    controller=dict(kp=2000.0, kd=60.0, roll_off=2000.0, delay=delay),
                    moves=[dict(distance=1e-3, velocity=20e-3, acceleration=1.0)],
-                   effects={"quantization": {"resolution": q}}, t_end=0.4, rate=1000.0)
+                   effects={"quantization": {"resolution": q}}, t_end=0.3, rate=1000.0)
     tr = rec.truth
     assert np.allclose(tr.measured / q, np.round(tr.measured / q), atol=1e-6)
     assert np.allclose(tr.measured, np.round(tr.x1 / q) * q, atol=1e-15)
     assert np.allclose(tr.applied[2:], tr.command[:-2], rtol=1e-6, atol=1e-6)  # 2 ms = 2 samples
     assert abs(tr.x1[-1] - 1e-3) <= 0.5 * q * (1 + 1e-6)   # kp e = 0 needs the right count
-    assert len(np.unique(tr.measured)) > 50                    # it went through the counts
+    assert len(np.unique(tr.measured)) > 25                    # it went through the counts
 
 
 def test_chattering_on_a_quantization_edge_is_held_not_endless():
@@ -598,7 +598,7 @@ def test_noise_seed_resolution_and_the_measurement_layout(tmp_path):
               controller=dict(rule=dict(fc=8.0)),
               moves=[dict(distance=1e-3, velocity=50e-3, acceleration=1.0)],
               noise=dict(position=0.3e-6, deflection=0.05e-6, force=0.01), t_end=1.0,
-              rate=5000.0, disturbance=([0.5, 0.52], [0.2, 0.0]))
+              rate=2000.0, disturbance=([0.5, 0.52], [0.2, 0.0]))
     a = generate(**kw, seed=3)
     b = generate(**kw, seed=3)
     c = generate(**kw, seed=4)
