@@ -280,6 +280,42 @@ def test_mass_feedforward_cancels_the_tracking_error():
     assert np.max(np.abs(without.reference - without.truth.x1)) > 1e-5
 
 
+def trapezoid_rates(t, t0, distance, v, a):
+    """(r', r'') of one trapezoidal move starting at t0 (the cruise is reached)."""
+    ta = v / a
+    tc = abs(distance) / v - ta
+    sign = np.sign(distance)
+    tau = t - t0
+    rd = np.where(tau < 0, 0.0, np.where(tau < ta, a * tau, np.where(
+        tau < ta + tc, v, np.where(tau < 2 * ta + tc, a * (2 * ta + tc - tau), 0.0))))
+    rdd = np.where(tau < 0, 0.0, np.where(tau < ta, a, np.where(
+        tau < ta + tc, 0.0, np.where(tau < 2 * ta + tc, -a, 0.0))))
+    return sign * rd, sign * rdd
+
+
+def test_feedforward_force_is_mass_viscous_and_coulomb_on_the_reference():
+    """command - (kp e + kd de/dt) = m_ff r'' + c_ff r' + F_ff sign(r'), forward and back."""
+    kp, kd = 2000.0, 40.0
+    ff = dict(mass=1.5, viscous=7.0, coulomb=0.8)
+    moves = [dict(distance=4e-3, velocity=40e-3, acceleration=1.0),
+             dict(distance=-4e-3, velocity=40e-3, acceleration=1.0, start=0.3)]
+    rec = generate(m1=2.0, friction=dict(sigma2=3.0),
+                   controller=dict(kp=kp, kd=kd, feedforward=ff), moves=moves, t_end=0.5,
+                   rate=1000.0)
+    t = rec.time
+    rd1, rdd1 = trapezoid_rates(t, 0.0, 4e-3, 40e-3, 1.0)
+    rd2, rdd2 = trapezoid_rates(t, 0.3, -4e-3, 40e-3, 1.0)
+    rd, rdd = rd1 + rd2, rdd1 + rdd2
+    e = rec.reference - rec.truth.x1
+    feedback = kp * e + kd * (rd - rec.truth.v1)
+    expected = ff["mass"] * rdd + ff["viscous"] * rd + ff["coulomb"] * np.sign(rd)
+    # away from the corners, where r'' jumps between output samples
+    corners = np.array([0.0, 0.04, 0.1, 0.14, 0.3, 0.34, 0.4, 0.44])
+    clear = np.min(np.abs(t[:, None] - corners[None, :]), axis=1) > 1.5e-3
+    assert np.allclose((rec.truth.command - feedback)[clear], expected[clear], atol=1e-9)
+    assert np.any(expected[clear] > 1.0) and np.any(expected[clear] < -1.0)
+
+
 def test_offset_shifts_the_rest_position_by_offset_over_kp():
     """m1 a1 = u - offset: a PD loop rests at r - offset / kp (friction key or effect)."""
     kp, off = 1000.0, 0.5
@@ -296,9 +332,15 @@ def test_known_disturbance_is_added_to_the_command():
     """A held 0.5 N injection on a free mass under PD: rest at r + F_d / kp, where the
     controller's own output is -F_d and the recorded force (command + injection) is zero."""
     kp, Fd = 1000.0, 0.5
-    rec = generate(m1=1.0, controller=dict(kp=kp, kd=60.0, delay=1e-3),
-                   moves=[dict(distance=1e-3, velocity=50e-3, acceleration=1.0)],
-                   disturbance=([0.1], [Fd]), t_end=1.0, rate=1000.0)
+    kw = dict(m1=1.0, controller=dict(kp=kp, kd=60.0, delay=1e-3),
+              moves=[dict(distance=1e-3, velocity=50e-3, acceleration=1.0)], t_end=1.0,
+              rate=1000.0)
+    rec = generate(**kw, disturbance=([0.1], [Fd]))
+    quiet = generate(**kw)
+    # the injection reaches the stage a delay (1 ms) later, then pushes it as Fd / m
+    diff = rec.truth.x1 - quiet.truth.x1
+    assert np.max(np.abs(diff[rec.time <= 0.101])) < 1e-11   # not yet (1e-14: integration)
+    assert diff[103] == pytest.approx(0.5 * Fd * 0.002 ** 2, rel=0.01)
     assert rec.truth.x1[-1] == pytest.approx(1e-3 + Fd / kp, abs=1e-12)
     assert rec.force[-1] == pytest.approx(0.0, abs=1e-8)
     assert rec.force[-1] - rec.disturbance[-1] == pytest.approx(-Fd, rel=1e-7)
@@ -509,13 +551,14 @@ def _double_integral(F, dt, m):
 
 @pytest.mark.parametrize("effect", [None, "mass_error", "time_delay", "force_saturation"])
 def test_open_loop_force_drive_of_a_free_mass(effect):
-    """x = double integral of F / m, with the true mass, the delay or the clipping."""
+    """x = double integral of F / m, with the true mass (rigid: stage + cart), the delay or
+    the clipping."""
     dt, m = 0.01, 2.0
     t = np.arange(0, 1.0 + dt / 2, dt)
     F = np.sin(7 * t) + 0.5 * np.cos(23 * t)
     applied, mass, effects = F, m, None
     if effect == "mass_error":
-        mass, effects = 2.7, {"mass_error": {"stage_mass": 2.7}}
+        mass, effects = 2.7, {"mass_error": {"stage_mass": 2.2, "cart_mass": 0.5}}
     elif effect == "time_delay":
         applied = np.concatenate([[F[0], F[0], F[0]], F[:-3]])
         effects = {"time_delay": {"delay": 3 * dt}}
