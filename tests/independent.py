@@ -58,27 +58,44 @@ Integration
 The run is split into segments at every instant where the right-hand side jumps: controller
 samples and their application ``delay`` later, samples of the disturbance or drive (and
 ``delay`` later), corners of the trapezoidal reference (and ``delay`` later). Inside a segment a
-zero-order-held force is a constant. Limiter contacts (|d| = s) and, with a continuous
-controller, quantization levels (x1 = (n + 1/2) q) end a segment through terminal events, so the
-solver restarts at the discontinuity instead of stepping across it; the right-hand side itself
-always evaluates the true (clipped, quantized, in-contact) forces, so a missed event costs steps,
-never correctness. A continuous controller with a delay is a delay differential equation, solved
-by the method of steps: segments no longer than the delay, the delayed command evaluated from
-the dense output of the earlier segments. Each segment is one ``solve_ivp(method="Radau")`` call
-(LuGre is stiff: sqrt(sigma0 / m2) ~ 1.6 kHz and a bristle relaxation rate sigma0 |v| / g up to
-~1e5 1/s); outputs are read from its dense output.
+zero-order-held force is a constant and the reference is one polynomial piece (chosen at the
+segment's middle, so the end points see the same piece). A continuous controller with a delay
+is a delay differential equation, solved by the method of steps: segments no longer than the
+delay, the delayed command evaluated from the dense output of the earlier segments. Each
+segment is one ``solve_ivp(method="Radau")`` call (LuGre is stiff: sqrt(sigma0 / m2) ~ 1.6 kHz
+and a bristle relaxation rate sigma0 |v| / g up to ~1e5 1/s); outputs are read from its dense
+output.
 
-Figures (2 shared cores, Python 3.11, scipy 1.17, rtol = 1e-8, measured when this was written):
+Figures (wall time of :func:`generate`, best of two, Python 3.11, scipy 1.17, rtol = 1e-8,
+measured on 2 cores shared with other jobs, load ~2; an idle machine is faster):
 
-* paper stage (isolated, m1 = 1.6 kg, m2 = 0.4 kg, the LuGre values above), continuous rule at
-  fc = 8 Hz, one 10 mm move, 10 s: {paper_time};
-* 100 kg rigid axis (Coulomb 20 N, viscous 100 N s/m), PD at 1 kHz, derivative on the
-  measurement, 5 s of 0.1 m moves: {axis_time};
-* the paper stage with a continuous rule and a 2 ms delay (method of steps), 10 s: {delay_time}.
+* paper stage (isolated, m1 = 1.6 kg, m2 = 0.4 kg, Fs = 4 N, Fc = 1 N, vs = 3 mm/s,
+  sigma0 = 1e6 N/m, sigma1 = 1414 N s/m, sigma2 = 20 N s/m, k = 6667 N/m, s = 0.3 mm),
+  continuous rule at fc = 8 Hz, one 10 mm move, 10 s: 0.2 s;
+* the same without isolator (it hunts), 20 s: 2.1 s;
+* the isolated stage with a 2 ms delay on the continuous rule (method of steps), 10 s: 3.0 s;
+* the isolated stage with the rule sampled at 1 kHz (10 000 segments), 10 s: 4.8 s;
+* a 100 kg rigid axis (LuGre, Fc = 20 N, sigma0 = 1e7 N/m, sigma2 = 100 N s/m), PD at 1 kHz
+  with the derivative on the measurement (kp = 1.37e6 N/m, kd = 8557 N s/m), two 0.1 m
+  moves, 5 s (5000 segments): 2.6 s.
+
+Edges and chattering: inside a segment the limiter cell (free or in contact on either side)
+and, for a continuous controller, the quantization level are fixed, so the right-hand side is
+smooth there; terminal events (solve_ivp's, located at step ends) end the segment where x1 - x2
+or x1 reaches the edge of its cell, and the next segment starts in the neighbouring cell. A
+contact entered and left within one solver step would be missed (at rtol = 1e-8 the steps are
+far shorter than any contact); a state found outside its cell is re-synchronised (counted in
+``Record.info["resyncs"]``). A continuous controller whose equilibrium lies on a quantization
+edge switches infinitely often (a sliding mode); after ZENO_COUNT quick crossings the level is
+read once per short segment instead (a sampled read-out, ``Record.info["zeno_holds"]``),
+see ZENO_HOLD.
 
 What it does not model: parasitic flexure modes, the Karnopp switch friction, jerk-limited
-moves, sensor dynamics, a sensor noise that reaches the controller (noise is added to the
-record only), actuator dynamics beyond delay and saturation.
+moves, sensor dynamics, sensor noise seen by the controller (noise is added to the record
+only), actuator dynamics beyond delay and saturation. A zero-order-held force is delayed and
+saturated like the command (the disturbance goes through the drive's delay); before t = 0 the
+controller is taken to have output its t = 0 command (what the actuator applies for the first
+``delay``).
 """
 
 from __future__ import annotations
