@@ -930,7 +930,7 @@ class _Simulation:
     # ..................................................................... events
 
     def _events(self, cell, level):
-        """Terminal events that end a segment: leaving the limiter cell or the quantization level."""
+        """Terminal events that end a segment: leaving the limiter cell or quantization level."""
         events = []
         if self.isolated:
             s = self.s
@@ -1178,7 +1178,8 @@ def generate(m1, m2=0.0, *, friction=None, isolator=None, controller=None, moves
         m1). None: rigid plant.
     controller : dict or None
         Either ``rule=dict(fc [Hz], r=3, ri=10, mass=m1 + m2 [kg])`` or gains ``kp`` [N/m],
-        ``ki`` [N/(m s)], ``kd`` [N s/m], ``roll_off`` [rad/s] (None: ideal D),
+        ``ki`` [N/(m s)], ``kd`` [N s/m], ``roll_off`` [rad/s, unlike the spec's Hz]
+        (None: ideal D; with a continuous controller and quantization a roll-off is needed),
         ``derivative_on`` ("error" or "measurement"); plus ``sample_rate`` [Hz] (None:
         continuous), ``delay`` [s], ``force_limit`` [N], ``feedforward=dict(mass [kg], viscous
         [N s/m], coulomb [N])``. None only with ``drive_force``.
@@ -1199,7 +1200,9 @@ def generate(m1, m2=0.0, *, friction=None, isolator=None, controller=None, moves
         Standard deviations of Gaussian recording noise: ``position`` [m], ``deflection``
         [m], ``force`` [N]. The controller sees the noise-free position.
     position_resolution : float or None
-        Recording resolution of the position column [m] (whole counts, after the noise).
+        Recording resolution of the position column [m] (whole counts, after the noise). The
+        ``quantization`` effect acts on what the controller sees only; give both the same
+        value to record the encoder the controller reads.
     seed : int
         Seed of the noise generator.
     disturbance : (array_like, array_like) or None
@@ -1229,6 +1232,10 @@ def generate(m1, m2=0.0, *, friction=None, isolator=None, controller=None, moves
     RuntimeError
         The integration failed.
     """
+    nz = dict(noise or {})
+    _check_keys(nz, {"position", "deflection", "force"}, "noise")
+    if position_resolution is not None and not float(position_resolution) > 0:
+        raise ValueError("position_resolution must be positive")
     sim = _Simulation(m1=m1, m2=m2, friction=friction, isolator=isolator,
                       controller=controller, moves=moves, reference=reference, t_end=t_end,
                       rate=rate, effects=effects, disturbance=disturbance,
@@ -1236,8 +1243,6 @@ def generate(m1, m2=0.0, *, friction=None, isolator=None, controller=None, moves
     t_out, states = sim.run()
     ref, dist, truth = sim.signals(t_out, states)
 
-    nz = dict(noise or {})
-    _check_keys(nz, {"position", "deflection", "force"}, "noise")
     rng = np.random.default_rng(seed)
     n = len(t_out)
     e_pos, e_def, e_force = (rng.standard_normal(n) for _ in range(3))

@@ -100,7 +100,8 @@ def test_bad_input_is_refused():
                 dict(moves=[dict(distance=1e-3, velocity=0.01, acceleration=1.0)],
                      reference=([0, 1], [0, 0])),
                 dict(controller=dict(kp=1e3, derivative_on="velocity")),
-                dict(effects={"joint_damping": {"damping": 1.0}})):   # rigid plant
+                dict(effects={"joint_damping": {"damping": 1.0}}),    # rigid plant
+                dict(noise=dict(postion=1e-6))):                       # typo
         with pytest.raises(ValueError):
             generate(**{**base, **bad})
 
