@@ -31,10 +31,10 @@ def g_steady(v, Fs, Fc, vs):
 
 
 def step_response(num, den, t):
-    """Exact unit-step response of num/den at times t >= 0 (matrix exponential).
+    """Exact unit-step response of a strictly proper num/den at times t >= 0.
 
-    The input integrator is part of the augmented state, so the polynomial input responses
-    below (den multiplied by s^k) are exact too.
+    Controllable canonical form; the constant input is one more state of the matrix
+    exponential (Van Loan), so the state at t is exact, not a numerical integration.
     """
     num = np.atleast_1d(np.asarray(num, float))
     den = np.atleast_1d(np.asarray(den, float))
@@ -90,6 +90,7 @@ def test_imports_nothing_of_the_product_but_the_measurement_container():
 
 
 def test_bad_input_is_refused():
+    """Typos and inconsistent arguments are a ValueError, never silently ignored."""
     base = dict(m1=1.0, controller=dict(kp=1e3, kd=10.0), t_end=0.1)
     for bad in (dict(effects={"no_such_effect": {}}),
                 dict(effects={"time_delay": {"dly": 1e-3}}),
@@ -181,7 +182,8 @@ def test_breakaway_force_is_the_static_friction_per_direction():
 
 
 def test_presliding_oscillation_at_the_bristle_frequency():
-    """A stuck mass under a small force step rings at sqrt(sigma0 / m)."""
+    """A stuck mass (rigid plant, m = m1 + m2) under a small force step rings on its bristles
+    at sqrt(sigma0 / m), measured from the upward zero crossings of the trace."""
     m = 0.4
     fr = dict(LUGRE, sigma1=0.0, sigma2=0.0)
     rec = generate(m1=m, friction=fr, drive_force=([0.0], [0.01]), t_end=0.06, rate=100000.0,
