@@ -31,13 +31,7 @@ from fi_design.specfile import parse_yaml
 
 from conftest import EXAMPLES
 
-try:
-    import independent
-except ModuleNotFoundError:  # pragma: no cover -- until the simulator is merged everywhere
-    independent = None
-#: Tests on records of the independent simulator.
-generated = pytest.mark.skipif(independent is None, reason="tests/independent.py (the "
-                               "independent simulator) is not on this branch: merge main")
+import independent
 
 runner = CliRunner()
 
@@ -80,7 +74,6 @@ def symmetric_record():
                             sigma2_neg=220.0, offset=-1.5))
 
 
-@generated
 def test_symmetric_truth_recovered_within_standard_errors(symmetric_record):
     r = identify(symmetric_record)
     assert r.form == "symmetric" and r.model == "rigid"
@@ -91,7 +84,6 @@ def test_symmetric_truth_recovered_within_standard_errors(symmetric_record):
     assert not r.parameters["coulomb_negative"].identifiable
 
 
-@generated
 def test_per_direction_form_reads_the_same_fit(symmetric_record):
     """Per direction: Fc+ = Fc + offset, Fc- = Fc - offset; the residual is the same."""
     sym = identify(symmetric_record)
@@ -105,7 +97,6 @@ def test_per_direction_form_reads_the_same_fit(symmetric_record):
     assert per.parameters["offset"].value is None and "absorbed" in per.parameters["offset"].note
 
 
-@generated
 def test_per_direction_truth_recovered_in_both_forms():
     """Coulomb friction that differs between the directions, with an offset on top."""
     rec = axis_record(dict(Fs=22.0, Fc=18.0, Fc_neg=23.0, vs=0.002, sigma0=1e6, sigma2=150.0,
@@ -118,7 +109,6 @@ def test_per_direction_truth_recovered_in_both_forms():
     assert_recovered(sym, dict(coulomb=(18.8 + 22.2) / 2, offset=(18.8 - 22.2) / 2))
 
 
-@generated
 def test_disturbance_column_the_force_that_acts_is_used():
     """Injected pulses: force_N (which includes them) is the force on the stage."""
     t = np.arange(0.0, 7.0, 0.05)
@@ -132,7 +122,6 @@ def test_disturbance_column_the_force_that_acts_is_used():
     assert any("disturbance_N" in n for n in r.notes)
 
 
-@generated
 def test_standard_errors_are_calibrated_over_seeds():
     """Across noise seeds the errors scatter like the standard errors say (RMS z about 1)."""
     friction = dict(Fs=25.0, Fc=20.0, vs=0.002, sigma0=1e6, sigma2=150.0, sigma2_neg=220.0,
@@ -146,7 +135,6 @@ def test_standard_errors_are_calibrated_over_seeds():
     assert 0.3 < rms < 2.0, z
 
 
-@generated
 def test_two_mass_record_with_the_specs_stiffness():
     """Stage and cart masses separately, the cart's friction, the offset on the stage."""
     moves = [dict(distance=0.02, velocity=0.05, acceleration=1.0),
@@ -188,7 +176,6 @@ def _two_mass_spec(stiffness) -> dict:
             "motion": {"moves": [{"distance": 0.02, "velocity": 0.05, "acceleration": 1.0}]}}
 
 
-@generated
 def test_breakaways_are_detected_and_still_not_estimated():
     """Moves that stop and break away again: detected, named, and no number is given."""
     moves, t = [], 0.0
@@ -278,7 +265,6 @@ def test_emps_closed_loop_replay_with_the_identified_friction(emps_record, emps_
 # --------------------------------------------------------------------------- JSON and spec
 
 
-@generated
 def test_json_is_the_contract_of_design_section_8(symmetric_record):
     d = json.loads(json.dumps(identify(symmetric_record).to_dict(), allow_nan=False))
     assert list(d["parameters"]) == list(NAMES)
@@ -317,7 +303,6 @@ def test_written_spec_per_direction(emps_record, emps_spec):
     assert spec.friction.offset == 0.0
 
 
-@generated
 def test_written_spec_from_a_mapping_is_written_anew(symmetric_record):
     spec = load_spec({"name": "axis", "stage": {"mass": 90.0}, "cart": {"mass": 10.0},
                       "friction": {"static": 25.0, "coulomb": 20.0, "stribeck_velocity": 0.002},
@@ -408,7 +393,6 @@ def test_cli_on_emps_json_spec_and_report(emps_path, tmp_path):
     assert "crosses over" in design.output
 
 
-@generated
 def test_report_escapes_user_text(symmetric_record, tmp_path):
     from fi_design.identreport import render_identification_report
 
