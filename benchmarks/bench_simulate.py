@@ -48,7 +48,7 @@ def best(fn, repeat: int) -> float:
 def kernel_only(spec, isolated: bool):
     """Time only the compiled integrator (the same call simulate() makes)."""
     from fi_design.kernel import run
-    from fi_design.reference import from_moves
+    from fi_design.trajectory import from_moves
     from fi_design.simulation import plant_parameters, tolerances
 
     key = (id(spec), isolated)
@@ -70,7 +70,7 @@ def plain_solve_ivp(spec, isolated: bool, t_end: float, method: str):
     from scipy.integrate import solve_ivp
 
     from fi_design import plant
-    from fi_design.reference import from_moves
+    from fi_design.trajectory import from_moves
     from fi_design.simulation import plant_parameters, tolerances
 
     par = plant_parameters(spec, isolated)
@@ -105,7 +105,7 @@ def python_control_run(spec, isolated: bool, t_end: float):
     import control
 
     from fi_design import plant
-    from fi_design.reference import from_moves
+    from fi_design.trajectory import from_moves
     from fi_design.simulation import plant_parameters, tolerances
 
     par = plant_parameters(spec, isolated)

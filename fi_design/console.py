@@ -160,13 +160,29 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
 
     pid = data.get("pid") or {}
     if pid:
-        t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
-                  pad_edge=False)
-        for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]", "tuning mass [kg]"):
-            t.add_column(Text(col), justify="right", no_wrap=True)
-        t.add_row(_fmt(pid.get("kp")), _fmt(pid.get("ki")), _fmt(pid.get("kd")),
-                  _fmt(pid.get("wt")), _fmt(pid.get("tuning_mass")))
-        console.print(t)
+        if pid.get("source") == "gains":
+            # the hardware's loop beside the rule's gains in the same form
+            hw, rule = pid["controller"], pid["rule_in_hardware_form"]
+            t = Table(title="PID gains (step 4): the hardware's, and the rule's at the same "
+                            "crossover", title_justify="left", box=box.SIMPLE_HEAD,
+                      pad_edge=False)
+            t.add_column("")
+            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "D roll-off [Hz]"):
+                t.add_column(Text(col), justify="right", no_wrap=True)
+            for label, g in (("hardware", hw), ("rule", rule)):
+                wf = g.get("roll_off")
+                t.add_row(label, _fmt(g.get("kp")), _fmt(g.get("ki")), _fmt(g.get("kd")),
+                          "none" if wf is None else _fmt(wf / (2 * math.pi)))
+            console.print(t)
+        else:
+            t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
+                      pad_edge=False)
+            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]",
+                        "tuning mass [kg]"):
+                t.add_column(Text(col), justify="right", no_wrap=True)
+            t.add_row(_fmt(pid.get("kp")), _fmt(pid.get("ki")), _fmt(pid.get("kd")),
+                      _fmt(pid.get("wt")), _fmt(pid.get("tuning_mass")))
+            console.print(t)
 
     xo = data.get("crossover") or {}
     if xo:
@@ -304,6 +320,10 @@ def _header(key: str) -> str:
 def print_simulation(console: "Console", result) -> None:
     """Print the metrics and solver statistics of a :class:`~fi_design.simulation.SimulationResult`.
 
+    A replay of a measured record shows its agreement with the record
+    instead of the hunting metric (which judges a settling stage, not a
+    record in motion).
+
     Parameters
     ----------
     console : rich.console.Console
@@ -317,18 +337,36 @@ def print_simulation(console: "Console", result) -> None:
 
     m = result.metrics
     plant = "with isolator" if result.isolated else "without isolator"
-    t = Table(title=f"Simulation {plant} at {result.crossover:g} Hz ({result.friction_model}, "
+    loop = "closed loop" if result.drive == "closed" else "open loop, measured force"
+    what = "Simulation" if result.replay is None else f"Replay of {result.record} ({loop})"
+    t = Table(title=f"{what} {plant} at {result.crossover:.4g} Hz ({result.friction_model}, "
                     f"{result.method} solver)", title_justify="left", box=box.SIMPLE_HEAD,
               pad_edge=False)
     t.add_column("Quantity")
     t.add_column("Value", justify="right")
-    rows = [
-        ("verdict", m.verdict),
-        ("hunting cycles in the window [-]", str(m.hunting_cycles)),
-        ("amplitude (peak to peak) [um]", _fmt(1e6 * m.amplitude, 4)),
-        ("period [s]", _fmt(m.period, 4)),
-        ("settling time [s]", _fmt(m.settling_time, 4)),
-        ("final error [um]", _fmt(1e6 * m.final_error, 4)),
+    rows = []
+    fit = result.replay
+    if fit is not None:
+        rows += [
+            ("position, model - measured, rms [um]", _fmt(1e6 * fit.position_rms, 4)),
+            ("position, model - measured, max [um]", _fmt(1e6 * fit.position_max, 4)),
+            ("tracking error r - x1 rms, model [um]", _fmt(1e6 * fit.tracking_rms_model, 4)),
+            ("tracking error r - x1 rms, measured [um]",
+             _fmt(1e6 * fit.tracking_rms_measured, 4)),
+            ("commanded force, model - measured, rms [N]", _fmt(fit.force_rms, 4)),
+        ]
+        if result.window is not None:
+            rows.append(("re-anchored windows [-]", str(int(result.window.max()) + 1)))
+    else:
+        rows += [
+            ("verdict", m.verdict),
+            ("hunting cycles in the window [-]", str(m.hunting_cycles)),
+            ("amplitude (peak to peak) [um]", _fmt(1e6 * m.amplitude, 4)),
+            ("period [s]", _fmt(m.period, 4)),
+            ("settling time [s]", _fmt(m.settling_time, 4)),
+            ("final error [um]", _fmt(1e6 * m.final_error, 4)),
+        ]
+    rows += [
         ("integration", "ok" if result.success else result.message),
         ("steps / rejected / events [-]", f"{result.n_steps} / {result.n_rejected} / "
                                           f"{result.n_events}"),
@@ -337,7 +375,8 @@ def print_simulation(console: "Console", result) -> None:
     for k, v in rows:
         t.add_row(Text(k), Text(str(v)))
     console.print(t)
-    console.print(Text(m.reason))
+    if result.replay is None:
+        console.print(Text(m.reason))
 
 
 class ProgressBar:
@@ -685,3 +724,47 @@ def print_reconcile(console: "Console", result) -> None:
     console.print(Text("Noise: " + ", ".join(parts)))
     for name, why in result.skipped.items():
         console.print(Text(f"skipped {name}: {why}", style="dim"))
+
+
+def print_identification(console: "Console", result) -> None:
+    """Print an :class:`~fi_design.identification.IdentificationResult`: table, fit, notes.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to print.
+    result : fi_design.identification.IdentificationResult
+        The identification.
+    """
+    from rich import box
+    from rich.table import Table
+    from rich.text import Text
+
+    m = result.measurement
+    console.print(Text(f"Identification from {m.source or 'the record'}: {m.n} samples, "
+                       f"{result.form.replace('_', '-')} form, {result.model.replace('_', ' ')} "
+                       "model", style="bold"))
+    t = Table(title="Parameters (SI; standard error one sigma)", title_justify="left",
+              box=box.SIMPLE_HEAD, pad_edge=False)
+    for col, just in (("Parameter", "left"), ("Value", "right"), ("Std. error", "right"),
+                      ("Unit", "left"), ("Identifiable", "left")):
+        t.add_column(col, justify=just, no_wrap=True)
+    for name, p in result.parameters.items():
+        t.add_row(Text(name), _fmt(p.value, 6), _fmt(p.std_error, 3), Text(p.unit),
+                  Text("yes" if p.identifiable else "no",
+                       style="green" if p.identifiable else "yellow"))
+    console.print(t)
+    f = result.fit
+    console.print(Text(f"Fit: RMS force residual {_fmt(f.force_rms_residual, 3)} N, relative "
+                       f"error {_fmt(f.relative_error, 3)}, condition number "
+                       f"{_fmt(f.condition_number, 3)}, {f.samples_used} samples used "
+                       f"({_fmt(f.effective_samples, 3)} effective)"))
+    ms = result.masses
+    console.print(Text(f"Masses: stage {_fmt(ms.stage, 5)} kg, cart {_fmt(ms.cart, 5)} kg "
+                       f"({ms.source})"))
+    for name in ("static", "stribeck_velocity", "bristle_stiffness"):
+        p = result.parameters[name]
+        if not p.identifiable:
+            console.print(Text(f"{name}: {p.note}", style="dim"))
+    for note in result.notes:
+        console.print(Text(f"note: {note}", style="dim"))

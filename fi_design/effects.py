@@ -166,6 +166,17 @@ CATALOGUE: dict[str, Effect] = {e.name: e for e in (
                   relative=True, required=False),)),
     Effect("joint_damping", "the joint damping c of the isolator differs from nominal", (
         Parameter("damping", "N*s/m", "true joint damping c", "c", (0.0, 200.0), neutral=None),)),
+    Effect("force_offset", "a constant load force on the stage, m1 a1 = u - offset - ... "
+                           "(drive offset, an inclined axis)", (
+        Parameter("offset", "N", "constant load force on the stage", "offset", (-10.0, 10.0),
+                  neutral=None),)),
+    Effect("friction_asymmetry", "Coulomb and viscous friction differ when the cart slides in "
+                                 "the negative direction (static friction scales with Coulomb)", (
+        Parameter("coulomb_negative", "N", "Coulomb friction in the negative direction",
+                  "Fc_neg", (0.25, 4.0), neutral=None, relative=True, log=True),
+        Parameter("viscous_negative", "N*s/m", "viscous friction in the negative direction",
+                  "sigma2_neg", (0.25, 4.0), neutral=None, relative=True, log=True,
+                  required=False),)),
 )}
 
 #: Stable effect names, in catalogue order.

@@ -31,6 +31,9 @@ Discontinuities are never stepped over:
 - *Delay*: the applied force u(t - delay) comes from a history of the
   controller output (cubic Hermite between accepted steps); steps are capped
   at the delay so every stage only needs the past.
+- *Input force*: a known force (a measured disturbance, or the whole measured
+  force of an open-loop replay) given as samples held constant between them
+  (zero-order hold) is added to the command; steps land on its samples.
 
 Failures (step budget exhausted, step-size underflow, NaN, divergence,
 history overflow) end the run with a status code and the time reached; the
@@ -52,10 +55,12 @@ import numpy as np
 from numba import njit
 
 from .plant import A1, A2, I1, Integration, b1, f8, i8  # signature types, result
-from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, P_AD11, P_AD12,
-                    P_AD21, P_AD22, P_BD1, P_BD2, P_CD1, P_CD2, P_DD, P_DELAY, P_FS, P_ISO,
-                    P_KD, P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_WT, actuator,
-                    drive_force, jacobian, measured_position, natural_modes, rhs)
+from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, N_CORE_ISO, N_CORE_RIGID,
+                    P_DA, P_DB, P_DC, P_DELAY, P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F,
+                    P_FF_M, P_ISO, P_KD, P_KDM, P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH,
+                    P_TS, P_U0, P_WT, actuator, control_law, controller_output, drive_force,
+                    feedforward, jacobian, measured_position, natural_modes, rhs,
+                    static_friction)
 
 # Status codes of :func:`integrate`.
 OK = 0
@@ -84,6 +89,9 @@ N_STATS = 8
 EV_NONE, EV_SIGN, EV_LIMIT, EV_LEVEL, EV_UNSTICK = 0, 1, 2, 3, 4
 
 HIST = 8192  # delay history ring size
+HT, HU, HDU, HUR, HDUR = range(5)  # rows of the history: time, value and rate in, out
+H_REF, H_FF, H_IN, H_OUT = range(4)  # search hints: reference, delayed reference, input, output
+N_HINTS = 4
 FIFO = 256  # pending discrete outputs (delay / sample period < FIFO)
 
 # RODAS4 coefficients (Hairer and Wanner, rodas.f, METH = 1).
@@ -120,18 +128,21 @@ FAC_MAX = 6.0  # hnew / h <= 6
 
 @njit((f8, A1, A2, i8), cache=True, error_model="numpy", _nrt=False)
 def reference_at(t, breaks, coeffs, k):
-    """Reference position, velocity, acceleration at ``t`` and the segment index.
+    """Reference position, velocity, acceleration and jerk at ``t``, and the segment index.
 
     ``k`` is a hint (the last segment used); the search walks from there.
+    Before the first break the reference holds ``coeffs[0, 0]`` and after the
+    last its end value, at rest; at a break it takes the values of the segment
+    that starts there (right-continuous).
     """
     nseg = coeffs.shape[0]
     if t >= breaks[nseg]:
         k = nseg - 1
         tau = breaks[nseg] - breaks[k]
         c0, c1, c2, c3 = coeffs[k, 0], coeffs[k, 1], coeffs[k, 2], coeffs[k, 3]
-        return c0 + tau * (c1 + tau * (c2 + tau * c3)), 0.0, 0.0, k
-    if t <= breaks[0]:
-        return coeffs[0, 0], 0.0, 0.0, 0
+        return c0 + tau * (c1 + tau * (c2 + tau * c3)), 0.0, 0.0, 0.0, k
+    if t < breaks[0]:
+        return coeffs[0, 0], 0.0, 0.0, 0.0, 0
     while k < nseg - 1 and t >= breaks[k + 1]:
         k += 1
     while k > 0 and t < breaks[k]:
@@ -141,7 +152,59 @@ def reference_at(t, breaks, coeffs, k):
     r = c0 + tau * (c1 + tau * (c2 + tau * c3))
     rd = c1 + tau * (2.0 * c2 + 3.0 * tau * c3)
     rdd = 2.0 * c2 + 6.0 * tau * c3
-    return r, rd, rdd, k
+    return r, rd, rdd, 6.0 * c3, k
+
+
+@njit((f8, A1, A1, i8), cache=True, error_model="numpy", _nrt=False)
+def input_at(t, in_t, in_f, j):
+    """Known input force at ``t`` [N], held from sample to sample, and the sample index.
+
+    ``in_t`` (increasing) and ``in_f`` are the samples; before the first the
+    input is 0, after the last it holds. ``j`` is a hint; a time within a
+    relative 1e-12 of a sample counts as at the sample (steps land there).
+    """
+    m = in_t.shape[0]
+    if m == 0 or t < in_t[0] - 1e-12 * max(1.0, abs(t)):
+        return 0.0, 0
+    if j < 0:
+        j = 0
+    while j < m - 1 and t >= in_t[j + 1] - 1e-12 * max(1.0, abs(t)):
+        j += 1
+    while j > 0 and t < in_t[j] - 1e-12 * max(1.0, abs(t)):
+        j -= 1
+    return in_f[j], j
+
+
+@njit((f8, A1, A1, A2, i8, A1, A1, i8, b1), cache=True, error_model="numpy", _nrt=False)
+def extra_at(tq, p, breaks, coeffs, kref, in_t, in_f, j, with_ff):
+    """The command's parts beyond the feedback at ``tq``: feedforward and input force.
+
+    Returns ``(F, dF/dt, kref, j)`` [N, N/s] with the updated hints. The
+    feedforward is included when ``with_ff`` (a continuous controller; a
+    discrete one adds it at its samples).
+    """
+    F = 0.0
+    dF = 0.0
+    if with_ff:
+        _, rd, rdd, r3, kref = reference_at(tq, breaks, coeffs, kref)
+        F, dF = feedforward(rd, rdd, r3, p)
+    if in_t.shape[0] > 0:
+        fin, j = input_at(tq, in_t, in_f, j)
+        F += fin
+    return F, dF, kref, j
+
+
+@njit((A1, A1, I1, f8, f8, f8, A1, i8), cache=True, error_model="numpy", _nrt=False)
+def law_rate(y, p, modes, r, rd, rdd, f, ii):
+    """Time derivative of the unfiltered continuous controller output v [N/s].
+
+    ``f`` is the right-hand side at the state ``y`` (for the acceleration).
+    """
+    _, _, _, e = control_law(y, p, modes, r, rd, ii)
+    quant = p[P_QUANT] > 0.0
+    xd = 0.0 if quant else y[1]
+    xdd = 0.0 if quant else f[1]
+    return p[P_KI] * e + p[P_KP] * (rd - xd) + p[P_KD] * (rdd - xdd) - p[P_KDM] * xdd
 
 
 @njit((A2, I1), cache=True, error_model="numpy", _nrt=False)
@@ -178,18 +241,19 @@ def struct_factor(J, sigma, M, piv, w):
     """Factor E = sigma I - J using the plant's structure.
 
     The last three states (bristle z, integrator I, controller output u) are
-    "leaves": z depends only on the mechanical core, I on x1, u on x1, v1, I
-    and itself, and the core sees only z and u. Eliminating them leaves a
-    Schur complement on the core (4 x 4 isolated, 2 x 2 rigid), factored with
-    partial pivoting. ``w`` (shape (3, nc) + 3) keeps the elimination
-    coefficients for :func:`struct_solve`. Returns False if singular.
+    "leaves": each depends only on the mechanical core and itself (u also on
+    I), and the core sees them through its own rows of J. Eliminating them
+    leaves a Schur complement on the core (4 x 4 isolated, 2 x 2 rigid),
+    factored with partial pivoting. ``w`` (shape (4, max(nc, 3)))
+    keeps the elimination coefficients for :func:`struct_solve`. Returns
+    False if singular.
     """
     n = J.shape[0]
     nc = n - 3
     iz = nc
     ii = nc + 1
     iu = nc + 2
-    dI = 1.0 / sigma
+    dI = 1.0 / (sigma - J[ii, ii])
     du = 1.0 / (sigma - J[iu, iu])
     dz = 1.0 / (sigma - J[iz, iz])
     w[3, 0] = dI
@@ -202,7 +266,7 @@ def struct_factor(J, sigma, M, piv, w):
         w[2, c] = J[iz, c] * dz
     for i in range(nc):
         for c in range(nc):
-            v = -J[i, c] - J[i, iu] * w[1, c] - J[i, iz] * w[2, c]
+            v = -J[i, c] - J[i, iu] * w[1, c] - J[i, iz] * w[2, c] - J[i, ii] * w[0, c]
             if i == c:
                 v += sigma
             M[i, c] = v
@@ -221,7 +285,7 @@ def struct_solve(J, M, piv, w, b, tmp):
     gu = (b[iu] + J[iu, ii] * gI) * w[3, 1]
     gz = b[iz] * w[3, 2]
     for i in range(nc):
-        tmp[i] = b[i] + J[i, iu] * gu + J[i, iz] * gz
+        tmp[i] = b[i] + J[i, iu] * gu + J[i, iz] * gz + J[i, ii] * gI
     # forward and back substitution on the core
     for k in range(nc):
         m = piv[k]
@@ -268,41 +332,42 @@ def dense_component(y0, y1, k2, k3, theta, i):
     return y0[i] * s1 + theta * (y1[i] + s1 * (k2[i] + theta * k3[i]))
 
 
-@njit((f8, A1, A1, A1, A1, A1, i8, i8), cache=True, error_model="numpy", _nrt=False)
-def history_at(tq, ht, hu, hdu, hur, hdur, head, count):
+@njit((f8, A2, i8, i8, f8), cache=True, error_model="numpy", _nrt=False)
+def history_at(tq, hist, head, count, u_before):
     """Delayed controller output u(tq) and its rate from the history ring.
 
-    Each entry i holds the time ``ht``, the value and rate arriving from the
-    left (``hu``, ``hdu``) and leaving to the right (``hur``, ``hdur``), which
-    differ only where u jumps. Returns ``(u, du, ok)``; ``ok`` is False when
-    ``tq`` is older than the oldest entry.
+    Each entry i holds the time (row ``HT``), the value and rate arriving from
+    the left (``HU``, ``HDU``) and leaving to the right (``HUR``, ``HDUR``),
+    which differ only where u jumps. Before t = 0 the output is
+    ``u_before``. Returns ``(u, du, ok)``; ``ok`` is False when ``tq`` is
+    older than the oldest entry.
     """
     if count == 0 or tq <= 0.0:
-        return 0.0, 0.0, True
+        return u_before, 0.0, True
     newest = (head - 1) % HIST
-    if tq >= ht[newest]:
-        return hur[newest], hdur[newest], True
+    if tq >= hist[HT, newest]:
+        return hist[HUR, newest], hist[HDUR, newest], True
     oldest = (head - count) % HIST
-    if tq < ht[oldest]:
+    if tq < hist[HT, oldest]:
         return 0.0, 0.0, False
     lo = 0
     hi = count - 1  # logical indices; entry lo <= tq < entry hi
     while hi - lo > 1:
         mid = (lo + hi) // 2
-        if ht[(head - count + mid) % HIST] <= tq:
+        if hist[HT, (head - count + mid) % HIST] <= tq:
             lo = mid
         else:
             hi = mid
     a = (head - count + lo) % HIST
     b = (head - count + hi) % HIST
-    h = ht[b] - ht[a]
+    h = hist[HT, b] - hist[HT, a]
     if h <= 0.0:
-        return hur[b], hdur[b], True
-    s = (tq - ht[a]) / h
-    u0 = hur[a]
-    u1 = hu[b]
-    m0 = hdur[a] * h
-    m1 = hdu[b] * h
+        return hist[HUR, b], hist[HDUR, b], True
+    s = (tq - hist[HT, a]) / h
+    u0 = hist[HUR, a]
+    u1 = hist[HU, b]
+    m0 = hist[HDUR, a] * h
+    m1 = hist[HDU, b] * h
     s2 = s * s
     s3 = s2 * s
     u = (2 * s3 - 3 * s2 + 1) * u0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * u1 + (s3 - s2) * m1
@@ -323,12 +388,19 @@ def _limit_mode(d, s):
     return 0
 
 
-@njit((f8, f8, A1, A1, A1, A1, i8, i8, i8, f8, A1, f8, b1, A1), cache=True, error_model="numpy", _nrt=False)
-def _root(g0, g1, y0, y1, k2, k3, kind, idx, idx2, offset, p, fa, fa_state, ybuf):
+@njit((f8, A1), cache=True, error_model="numpy", _nrt=False)
+def breakaway(F, p):
+    """Switch model: > 0 once the drive force ``F`` [N] exceeds static friction its way [N]."""
+    return max(F - static_friction(1.0, p), -F - static_friction(-1.0, p))
+
+
+@njit((f8, f8, A1, A1, A1, A1, i8, i8, i8, f8, A1, I1, f8, f8, f8, b1, A1), cache=True,
+      error_model="numpy", _nrt=False)
+def _root(g0, g1, y0, y1, k2, k3, kind, idx, idx2, offset, p, modes, r, rd, fa, fa_state, ybuf):
     """Locate the zero of a switching function on the dense output, theta in [0, 1].
 
     kind 0: y[idx] - offset; kind 1: y[idx] - y[idx2] - offset;
-    kind 2: |drive force| - offset (switch model breakaway).
+    kind 2: :func:`breakaway` of the drive force (switch model).
     """
     a, b = 0.0, 1.0
     ga, gb = g0, g1
@@ -345,7 +417,7 @@ def _root(g0, g1, y0, y1, k2, k3, kind, idx, idx2, offset, p, fa, fa_state, ybuf
                  - dense_component(y0, y1, k2, k3, theta, idx2) - offset)
         else:
             dense(y0, y1, k2, k3, theta, ybuf)
-            g = abs(drive_force(ybuf, p, fa, fa_state)) - offset
+            g = breakaway(drive_force(ybuf, p, modes, r, rd, fa, fa_state), p)
         if g == 0.0:
             return theta
         if (g > 0.0) == (gb > 0.0):
@@ -365,13 +437,15 @@ def _root(g0, g1, y0, y1, k2, k3, kind, idx, idx2, offset, p, fa, fa_state, ybuf
     return b
 
 
-@njit((A1, A1, A1, A1, A1, I1, i8, f8, b1, A1, i8), cache=True, error_model="numpy", _nrt=False)
-def find_event(y0, y1, k2, k3, p, modes, iv2, fa, fa_state, ybuf, skip):
+@njit((A1, A1, A1, A1, A1, I1, i8, f8, f8, f8, b1, A1, i8), cache=True, error_model="numpy",
+      _nrt=False)
+def find_event(y0, y1, k2, k3, p, modes, iv2, r, rd, fa, fa_state, ybuf, skip):
     """Earliest mode change within a trial step.
 
     Returns ``(kind, theta)``: the event kind (``EV_*``) and where it happens
     as a fraction of the step. ``skip`` is an event kind to ignore (the one
-    the step was shortened to reach).
+    the step was shortened to reach). ``r``, ``rd`` and ``fa`` are taken at
+    the start of the step.
     """
     best = EV_NONE
     tbest = 2.0
@@ -384,16 +458,17 @@ def find_event(y0, y1, k2, k3, p, modes, iv2, fa, fa_state, ybuf, skip):
         v0 = y0[iv2] * sgn
         v1 = y1[iv2] * sgn
         if v1 < 0.0:
-            th = 0.0 if v0 < 0.0 else _root(v0, v1, y0, y1, k2, k3, 0, iv2, 0, 0.0, p, fa, fa_state, ybuf)
+            th = 0.0 if v0 < 0.0 else _root(v0, v1, y0, y1, k2, k3, 0, iv2, 0, 0.0, p, modes, r,
+                                            rd, fa, fa_state, ybuf)
             if th < tbest:
                 tbest = th
                 best = EV_SIGN
     if sw and stuck and skip != EV_UNSTICK:
-        Fs = p[P_FS]
-        g1 = abs(drive_force(y1, p, fa, fa_state)) - Fs
+        g1 = breakaway(drive_force(y1, p, modes, r, rd, fa, fa_state), p)
         if g1 > 0.0:
-            g0 = abs(drive_force(y0, p, fa, fa_state)) - Fs
-            th = 0.0 if g0 > 0.0 else _root(g0, g1, y0, y1, k2, k3, 2, 0, 0, Fs, p, fa, fa_state, ybuf)
+            g0 = breakaway(drive_force(y0, p, modes, r, rd, fa, fa_state), p)
+            th = 0.0 if g0 > 0.0 else _root(g0, g1, y0, y1, k2, k3, 2, 0, 0, 0.0, p, modes, r, rd,
+                                            fa, fa_state, ybuf)
             if th < tbest:
                 tbest = th
                 best = EV_UNSTICK
@@ -414,7 +489,8 @@ def find_event(y0, y1, k2, k3, p, modes, iv2, fa, fa_state, ybuf, skip):
             if _limit_mode(d0, s) != lim or g0 == 0.0 or (g0 > 0.0) == (g1 > 0.0):
                 th = 0.0
             else:
-                th = _root(g0, g1, y0, y1, k2, k3, 1, 0, 2, off, p, fa, fa_state, ybuf)
+                th = _root(g0, g1, y0, y1, k2, k3, 1, 0, 2, off, p, modes, r, rd, fa, fa_state,
+                           ybuf)
             if th < tbest:
                 tbest = th
                 best = EV_LIMIT
@@ -430,34 +506,35 @@ def find_event(y0, y1, k2, k3, p, modes, iv2, fa, fa_state, ybuf, skip):
             if l0 != lev or g0 == 0.0 or (g0 > 0.0) == (g1 > 0.0):
                 th = 0.0
             else:
-                th = _root(g0, g1, y0, y1, k2, k3, 0, 0, 0, off, p, fa, fa_state, ybuf)
+                th = _root(g0, g1, y0, y1, k2, k3, 0, 0, 0, off, p, modes, r, rd, fa, fa_state,
+                           ybuf)
             if th < tbest:
                 tbest = th
                 best = EV_LEVEL
     return best, tbest
 
 
-@njit((i8, A1, A1, I1, i8, i8, f8, b1, A1), cache=True, error_model="numpy", _nrt=False)
-def apply_event(kind, y, p, modes, iv2, iu, fa, fa_state, y_trial):
+@njit((i8, A1, A1, I1, i8, i8, f8, f8, f8, b1, A1), cache=True, error_model="numpy", _nrt=False)
+def apply_event(kind, y, p, modes, iv2, iu, r, rd, fa, fa_state, y_trial):
     """Switch the mode for event ``kind`` at the current state (jumps included).
 
     ``y_trial`` is the end of the trial step that detected the event: it tells
-    the direction of limiter and quantization crossings. Returns the jump of
-    the controller output u [N] (quantization with a continuous controller).
+    the direction of limiter and quantization crossings. A quantization level
+    change with a filtered continuous controller makes its output u jump by
+    the derivative terms' impulse, -wt (kd + kdm) q per level.
     """
-    du = 0.0
     if kind == EV_SIGN:
         if p[P_SWITCH] != 0.0:
             y[iv2] = 0.0
-            F = drive_force(y, p, fa, fa_state)
-            if abs(F) <= p[P_FS]:
+            F = drive_force(y, p, modes, r, rd, fa, fa_state)
+            if breakaway(F, p) <= 0.0:
                 modes[MODE_STICK] = 1
             else:
                 modes[MODE_SIGN] = 1 if F > 0.0 else -1
         else:
             modes[MODE_SIGN] = -modes[MODE_SIGN]
     elif kind == EV_UNSTICK:
-        F = drive_force(y, p, fa, fa_state)
+        F = drive_force(y, p, modes, r, rd, fa, fa_state)
         modes[MODE_STICK] = 0
         modes[MODE_SIGN] = 1 if F > 0.0 else -1
     elif kind == EV_LIMIT:
@@ -474,17 +551,97 @@ def apply_event(kind, y, p, modes, iv2, iu, fa, fa_state, y_trial):
         l1 = int(math.floor(y_trial[0] / q + 0.5))
         step = 1 if l1 > lev else -1
         modes[MODE_LEVEL] = lev + step
-        du = -p[P_WT] * p[P_KD] * q * step
-        y[iu] += du
-    return du
+        if not math.isinf(p[P_WT]):
+            y[iu] += -p[P_WT] * (p[P_KD] + p[P_KDM]) * q * step
+
+
+# --------------------------------------------------------------------------- commands
+
+
+@njit((f8, A1, A1, A2, A1, A1, I1, f8, A2, i8, i8), cache=True, error_model="numpy", _nrt=False)
+def stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold, hist, head, count):
+    """The ``fa`` argument of :func:`fi_design.plant.rhs` at time ``ts``, and its rate.
+
+    Continuous controller without delay: the command's parts beyond the
+    controller output (feedforward, input force). With a delay: the whole
+    command ``delay`` earlier (controller output from the history, plus those
+    parts then). Discrete controller: the held output plus the input force
+    ``delay`` earlier. Returns ``(fa, dfa/dt, ok)`` [N, N/s]; ``ok`` is False
+    when the history no longer reaches back far enough. ``hints`` holds the
+    search hints of the lookups (updated).
+    """
+    discrete = p[P_TS] > 0.0
+    delay = p[P_DELAY]
+    tq = ts - delay
+    if discrete:
+        if in_t.shape[0] == 0:
+            return fa_hold, 0.0, True
+        fin, j = input_at(tq, in_t, in_f, hints[H_IN])
+        hints[H_IN] = j
+        return fa_hold + fin, 0.0, True
+    with_ff = p[P_FF_M] != 0.0 or p[P_FF_C] != 0.0 or p[P_FF_F] != 0.0
+    F, dF, kff, j = extra_at(tq, p, breaks, coeffs, hints[H_FF], in_t, in_f, hints[H_IN], with_ff)
+    hints[H_FF] = kff
+    hints[H_IN] = j
+    if delay == 0.0:
+        return F, dF, True
+    u, du, ok = history_at(tq, hist, head, count, p[P_U0])
+    return u + F, du + dF, ok
+
+
+@njit((i8, f8, A1, A1, I1, A1, A2, A1, A1, I1, f8, A2, i8, i8, b1, A2, A1, A1, A1), cache=True,
+      error_model="numpy", _nrt=False)
+def write_output(i, tq, yq, p, modes, breaks, coeffs, in_t, in_f, hints, fa_hold, hist, head,
+                 count, need_cmd, out_y, out_r, out_fa, out_cmd):
+    """Store the state ``yq`` at output time ``tq`` as output row ``i``, with r and the forces.
+
+    ``out_cmd`` gets the commanded force (controller output plus feedforward
+    plus input force, before delay and saturation), ``out_fa`` the force
+    applied to the stage. ``need_cmd`` false (a continuous controller without
+    delay, feedforward or input force) takes the short way: the command is
+    the controller's output.
+    """
+    n = yq.shape[0]
+    iu = n - 1
+    ii = n - 2
+    for j in range(n):
+        out_y[i, j] = yq[j]
+    rr, rdr, _, _, kout = reference_at(tq, breaks, coeffs, hints[H_OUT])
+    hints[H_OUT] = kout
+    out_r[i] = rr
+    if not need_cmd:
+        uc = controller_output(yq, p, modes, rr, rdr, ii, iu)
+        out_cmd[i] = uc
+        out_fa[i], _ = actuator(uc, p)
+        return
+    discrete = p[P_TS] > 0.0
+    fa, _, _ = stage_command(tq, p, breaks, coeffs, in_t, in_f, hints, fa_hold, hist, head,
+                             count)
+    if discrete:
+        fin = 0.0
+        if in_t.shape[0] > 0:
+            fin, _ = input_at(tq, in_t, in_f, hints[H_IN])
+        out_cmd[i] = yq[iu] + fin
+        out_fa[i], _ = actuator(fa, p)
+        return
+    uc = controller_output(yq, p, modes, rr, rdr, ii, iu)
+    if p[P_DELAY] == 0.0:
+        out_cmd[i] = uc + fa
+        out_fa[i], _ = actuator(uc + fa, p)
+        return
+    with_ff = p[P_FF_M] != 0.0 or p[P_FF_C] != 0.0 or p[P_FF_F] != 0.0
+    F, _, _, _ = extra_at(tq, p, breaks, coeffs, hints[H_OUT], in_t, in_f, hints[H_IN], with_ff)
+    out_cmd[i] = uc + F
+    out_fa[i], _ = actuator(fa, p)
 
 
 # --------------------------------------------------------------------------- the integrator
 
 
-@njit((A1, A1, A1, A2, b1, f8, A1, f8, A1, f8, i8, f8, A2, A1, A1, A1), cache=True, error_model="numpy")
+@njit((A1, A1, A1, A2, b1, f8, A1, f8, A1, f8, i8, f8, A1, A1, A2, A1, A1, A1, A1), cache=True,
+      error_model="numpy")
 def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_steps, x_bound,
-              out_y, out_r, out_fa, stats):
+              in_t, in_f, out_y, out_r, out_fa, out_cmd, stats):
     """Integrate the plant from ``y0`` at t = 0 to ``t_end``.
 
     Parameters
@@ -494,7 +651,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     y0 : ndarray, float64, shape (n,)
         Initial state (7 isolated, 5 rigid).
     breaks, coeffs : ndarray
-        Reference as a piecewise cubic (:class:`fi_design.reference.Reference`).
+        Reference as a piecewise cubic (:class:`fi_design.trajectory.Trajectory`).
     land : bool
         Land steps on the reference breaks.
     t_end : float
@@ -511,6 +668,9 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
         Step budget (accepted and rejected).
     x_bound : float
         |x1| beyond which the solution counts as diverged [m].
+    in_t, in_f : ndarray, shape (k,)
+        Known input force added to the command, held between its samples:
+        sample times [s] (increasing) and values [N]; empty for none.
     out_y : ndarray, shape (m, n)
         Output: states at ``t_out``.
     out_r : ndarray, shape (m,)
@@ -518,6 +678,9 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     out_fa : ndarray, shape (m,)
         Output: applied actuator force at ``t_out`` [N] (after delay and
         saturation).
+    out_cmd : ndarray, shape (m,)
+        Output: commanded force at ``t_out`` [N] (controller output,
+        feedforward and input force, before delay and saturation).
     stats : ndarray, shape (N_STATS,)
         Output: counters (``ST_*``).
 
@@ -528,14 +691,25 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     """
     n = y0.shape[0]
     iso = p[P_ISO] != 0.0
+    nc = N_CORE_ISO if iso else N_CORE_RIGID
     iv2 = 3 if iso else 1
-    ii = n - 2
-    iu = n - 1
+    iz = nc
+    ii = nc + 1
+    iu = nc + 2
     Ts = p[P_TS]
     delay = p[P_DELAY]
     discrete = Ts > 0.0
     fa_state = (not discrete) and delay == 0.0
     cont_delay = (not discrete) and delay > 0.0
+    algebraic = math.isinf(p[P_WT])
+    has_ff = p[P_FF_M] != 0.0 or p[P_FF_C] != 0.0 or p[P_FF_F] != 0.0
+    n_in = in_t.shape[0]
+    # the command needs computing at every stage unless it is the bare controller state
+    # or (``held``) the discrete controller's held output; calls with many array
+    # arguments cost about 0.2 us each, so the common cases stay inline
+    need_cmd = (not fa_state) or has_ff or n_in > 0
+    held = discrete and n_in == 0
+    m_acc = p[P_M1] if iso else p[P_M1] + p[P_M2]
     if cont_delay and h_max > delay:
         h_max = delay
     sw = p[P_SWITCH] != 0.0
@@ -566,24 +740,21 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     natural_modes(y, p, modes)
     if sw:
         modes[MODE_STICK] = 1 if y[iv2] == 0.0 else 0
+    hints = np.zeros(N_HINTS, dtype=np.int64)
 
-    # delay history (continuous controller)
-    ht = np.zeros(HIST)
-    hu = np.zeros(HIST)
-    hdu = np.zeros(HIST)
-    hur = np.zeros(HIST)
-    hdur = np.zeros(HIST)
+    # delay history of the continuous controller's output (rows HT, HU, HDU, HUR, HDUR)
+    hist = np.zeros((5, HIST))
     head = 0
     count = 0
     jump_pending = False
     jump_u = 0.0
     jump_du = 0.0
     # discrete controller
-    qd1 = 0.0
-    qd2 = 0.0
+    dx1 = p[P_DX1]
+    dx2 = p[P_DX2]
     k_sample = 0
     t_sample = 0.0 if discrete else math.inf
-    fa_hold = 0.0
+    fa_hold = p[P_U0]
     fifo_t = np.zeros(FIFO)
     fifo_u = np.zeros(FIFO)
     f_head = 0
@@ -610,20 +781,24 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     ib = 0
     while ib < nb and breaks[ib] <= 0.0:
         ib += 1
+    i_in = 0
 
     while True:
         # ---------------------------------------------------- time events at t
         if discrete and t >= t_sample - 1e-12 * max(1.0, t):
-            r_s, _, _, kref = reference_at(t, breaks, coeffs, kref)
+            r_s, rd_s, rdd_s, r3_s, kref = reference_at(t, breaks, coeffs, kref)
             lev = int(math.floor(y[0] / p[P_QUANT] + 0.5)) if p[P_QUANT] > 0.0 else 0
-            e_k = r_s - measured_position(y[0], p, lev)
-            u_k = p[P_CD1] * qd1 + p[P_CD2] * qd2 + p[P_DD] * e_k
-            n1 = p[P_AD11] * qd1 + p[P_AD12] * qd2 + p[P_BD1] * e_k
-            n2 = p[P_AD21] * qd1 + p[P_AD22] * qd2 + p[P_BD2] * e_k
-            qd1 = n1
-            qd2 = n2
+            xm = measured_position(y[0], p, lev)
+            e_k = r_s - xm
+            d_k = -xm if p[P_DMEAS] != 0.0 else e_k
+            u_k = p[P_DP] * e_k + dx1 + p[P_DC] * e_k + dx2 + p[P_DB] * d_k
+            if has_ff:
+                ff_k, _ = feedforward(rd_s, rdd_s, r3_s, p)
+                u_k += ff_k
+            dx1 += 2.0 * p[P_DC] * e_k
+            dx2 = p[P_DA] * (dx2 + p[P_DB] * d_k) - p[P_DB] * d_k
             y[iu] = u_k
-            y[ii] = qd1
+            y[ii] = dx1
             if delay == 0.0:
                 fa_hold = u_k
             else:
@@ -640,28 +815,19 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             f_head = (f_head + 1) % FIFO
             f_count -= 1
         if sw and modes[MODE_STICK] == 1:
-            fa_now = fa_hold
-            if cont_delay:
-                fa_now, _, _ = history_at(t - delay, ht, hu, hdu, hur, hdur, head, count)
-            F = drive_force(y, p, fa_now, fa_state)
-            if abs(F) > p[P_FS]:
+            r_n, rd_n, _, _, kref = reference_at(t, breaks, coeffs, kref)
+            fa_now, _, _ = stage_command(t, p, breaks, coeffs, in_t, in_f, hints, fa_hold, hist,
+                                         head, count)
+            F = drive_force(y, p, modes, r_n, rd_n, fa_now, fa_state)
+            if breakaway(F, p) > 0.0:
                 modes[MODE_STICK] = 0
                 modes[MODE_SIGN] = 1 if F > 0.0 else -1
                 n_events += 1
 
         # ---------------------------------------------------- outputs at t
         while i_out < m_out and t_out[i_out] <= t + 1e-12 * max(1.0, t):
-            for j in range(n):
-                out_y[i_out, j] = y[j]
-            rr, _, _, kref = reference_at(t_out[i_out], breaks, coeffs, kref)
-            out_r[i_out] = rr
-            if fa_state:
-                fa_o = y[iu]
-            elif cont_delay:
-                fa_o, _, _ = history_at(t_out[i_out] - delay, ht, hu, hdu, hur, hdur, head, count)
-            else:
-                fa_o = fa_hold
-            out_fa[i_out], _ = actuator(fa_o, p)
+            write_output(i_out, t_out[i_out], y, p, modes, breaks, coeffs, in_t, in_f, hints,
+                         fa_hold, hist, head, count, need_cmd, out_y, out_r, out_fa, out_cmd)
             i_out += 1
 
         if t >= t_end * (1.0 - 1e-14):
@@ -681,13 +847,20 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             t_land = t_sample
         if f_count > 0 and fifo_t[f_head] < t_land:
             t_land = fifo_t[f_head]
+        if n_in > 0:  # the input's next change (an unchanged sample is no event)
+            while i_in < n_in and (in_t[i_in] + delay <= t + 1e-12 * max(1.0, t)
+                                   or (i_in > 0 and in_f[i_in] == in_f[i_in - 1])):
+                i_in += 1
+            if i_in < n_in and in_t[i_in] + delay < t_land:
+                t_land = in_t[i_in] + delay
 
         # ---------------------------------------------------- f, J, f_t at (t, y)
-        r0, rd0, rdd0, kref = reference_at(t, breaks, coeffs, kref)
-        fa0 = fa_hold
+        r0, rd0, rdd0, _, kref = reference_at(t, breaks, coeffs, kref)
+        fa0 = 0.0
         dfa0 = 0.0
-        if cont_delay:
-            fa0, dfa0, ok = history_at(t - delay, ht, hu, hdu, hur, hdur, head, count)
+        if need_cmd:
+            fa0, dfa0, ok = stage_command(t, p, breaks, coeffs, in_t, in_f, hints, fa_hold, hist,
+                                          head, count)
             if not ok:
                 status = HISTORY_OVERFLOW
                 break
@@ -697,28 +870,37 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             ft[j] = 0.0
         if not discrete:
             ft[ii] = p[P_KI] * rd0
-            ft[iu] = p[P_WT] * (p[P_KP] * rd0 + p[P_KD] * rdd0)
+            dv_dt = p[P_KP] * rd0 + p[P_KD] * rdd0  # explicit time derivative of v
+            if not algebraic:
+                ft[iu] = p[P_WT] * dv_dt
+            if fa_state:
+                if algebraic or has_ff or n_in > 0:
+                    uc = controller_output(y, p, modes, r0, rd0, ii, iu)
+                    _, dsat = actuator(uc + fa0, p)
+                    ft[1] = dsat * (dfa0 + (dv_dt if algebraic else 0.0)) / m_acc
+            else:
+                _, dsat = actuator(fa0, p)
+                ft[1] = dsat * dfa0 / m_acc
         if cont_delay:
-            _, dsat = actuator(fa0, p)
-            m_acc = p[P_M1] if iso else p[P_M1] + p[P_M2]
-            ft[1] = dsat * dfa0 / m_acc
             # record the controller output for the delayed force
+            uc = controller_output(y, p, modes, r0, rd0, ii, iu)
+            duc = law_rate(y, p, modes, r0, rd0, rdd0, f0, ii) if algebraic else f0[iu]
             newest = (head - 1) % HIST
-            if count > 0 and t == ht[newest]:
-                hur[newest] = y[iu]
-                hdur[newest] = f0[iu]
+            if count > 0 and t == hist[HT, newest]:
+                hist[HUR, newest] = uc
+                hist[HDUR, newest] = duc
             else:
                 if count == HIST:
                     count -= 1
-                ht[head] = t
-                hur[head] = y[iu]
-                hdur[head] = f0[iu]
+                hist[HT, head] = t
+                hist[HUR, head] = uc
+                hist[HDUR, head] = duc
                 if jump_pending:
-                    hu[head] = jump_u
-                    hdu[head] = jump_du
+                    hist[HU, head] = jump_u
+                    hist[HDU, head] = jump_du
                 else:
-                    hu[head] = y[iu]
-                    hdu[head] = f0[iu]
+                    hist[HU, head] = uc
+                    hist[HDU, head] = duc
                 head = (head + 1) % HIST
                 count += 1
             jump_pending = False
@@ -752,10 +934,13 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             for j in range(n):
                 ytmp[j] = y[j] + A21 * k1[j]
             ts = t + C2 * h
-            rs, rds, _, kref = reference_at(ts, breaks, coeffs, kref)
-            fas = fa_hold
-            if cont_delay:
-                fas, _, _ = history_at(ts - delay, ht, hu, hdu, hur, hdur, head, count)
+            rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
+            fas = 0.0
+            if held:
+                fas = fa_hold
+            elif need_cmd:
+                fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
+                                          hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
                 k2[j] = fs[j] + C21 / h * k1[j] + h * D2 * ft[j]
@@ -764,9 +949,10 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             for j in range(n):
                 ytmp[j] = y[j] + A31 * k1[j] + A32 * k2[j]
             ts = t + C3 * h
-            rs, rds, _, kref = reference_at(ts, breaks, coeffs, kref)
-            if cont_delay:
-                fas, _, _ = history_at(ts - delay, ht, hu, hdu, hur, hdur, head, count)
+            rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
+            if need_cmd and not held:
+                fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
+                                          hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
                 k3[j] = fs[j] + (C31 * k1[j] + C32 * k2[j]) / h + h * D3 * ft[j]
@@ -775,9 +961,10 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             for j in range(n):
                 ytmp[j] = y[j] + A41 * k1[j] + A42 * k2[j] + A43 * k3[j]
             ts = t + C4 * h
-            rs, rds, _, kref = reference_at(ts, breaks, coeffs, kref)
-            if cont_delay:
-                fas, _, _ = history_at(ts - delay, ht, hu, hdu, hur, hdur, head, count)
+            rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
+            if need_cmd and not held:
+                fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
+                                          hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
                 k4[j] = fs[j] + (C41 * k1[j] + C42 * k2[j] + C43 * k3[j]) / h + h * D4 * ft[j]
@@ -786,9 +973,10 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             for j in range(n):
                 ytmp[j] = y[j] + A51 * k1[j] + A52 * k2[j] + A53 * k3[j] + A54 * k4[j]
             ts = t + h
-            rs, rds, _, kref = reference_at(ts, breaks, coeffs, kref)
-            if cont_delay:
-                fas, _, _ = history_at(ts - delay, ht, hu, hdu, hur, hdur, head, count)
+            rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
+            if need_cmd and not held:
+                fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
+                                          hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
                 k5[j] = fs[j] + (C51 * k1[j] + C52 * k2[j] + C53 * k3[j] + C54 * k4[j]) / h
@@ -830,18 +1018,23 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 cd3[j] = DD31 * k1[j] + DD32 * k2[j] + DD33 * k3[j] + DD34 * k4[j] + DD35 * k5[j]
             # state events
             if not suppress:
-                kind, theta = find_event(y, ynew, cd2, cd3, p, modes, iv2, fa0, fa_state, ybuf,
-                                         pending)
+                kind, theta = find_event(y, ynew, cd2, cd3, p, modes, iv2, r0, rd0, fa0, fa_state,
+                                         ybuf, pending)
                 if kind != EV_NONE:
                     if theta * h < 1e-12 * max(1.0, t) or theta <= 0.0:
                         # crossing at the start of the step: switch now, no step
                         for j in range(n):
                             ybuf[j] = ynew[j]
-                        du = apply_event(kind, y, p, modes, iv2, iu, fa0, fa_state, ybuf)
-                        if du != 0.0 and cont_delay:
-                            jump_pending = True
-                            jump_u = y[iu] - du
-                            jump_du = f0[iu]
+                        u_before = 0.0
+                        if cont_delay:
+                            u_before = controller_output(y, p, modes, r0, rd0, ii, iu)
+                        apply_event(kind, y, p, modes, iv2, iu, r0, rd0, fa0, fa_state, ybuf)
+                        if cont_delay:
+                            u_after = controller_output(y, p, modes, r0, rd0, ii, iu)
+                            if u_after != u_before:
+                                jump_pending = True
+                                jump_u = u_before
+                                jump_du = f0[iu]
                         n_events += 1
                         n_zero += 1
                         zero_run += 1
@@ -866,24 +1059,30 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             # ------------------------------------------------ accept
             n_steps += 1
             t_new = t_land if landing else t + h
-            # outputs inside (t, t_new]
-            while i_out < m_out and t_out[i_out] <= t_new + 1e-12 * max(1.0, t_new):
+            # outputs inside (t, t_new); those at t_new follow its time events (a
+            # controller sample there shows its new output, as a drive records it)
+            while i_out < m_out and t_out[i_out] < t_new - 1e-12 * max(1.0, t_new):
                 th = (t_out[i_out] - t) / h
                 if th > 1.0:
                     th = 1.0
                 dense(y, ynew, cd2, cd3, th, ybuf)
-                for j in range(n):
-                    out_y[i_out, j] = ybuf[j]
-                rr, _, _, kref = reference_at(t_out[i_out], breaks, coeffs, kref)
-                out_r[i_out] = rr
-                if fa_state:
-                    fa_o = ybuf[iu]
-                elif cont_delay:
-                    fa_o, _, _ = history_at(t_out[i_out] - delay, ht, hu, hdu, hur, hdur, head,
-                                            count)
-                else:
-                    fa_o = fa_hold
-                out_fa[i_out], _ = actuator(fa_o, p)
+                if need_cmd and not held:
+                    write_output(i_out, t_out[i_out], ybuf, p, modes, breaks, coeffs, in_t, in_f,
+                                 hints, fa_hold, hist, head, count, need_cmd, out_y, out_r,
+                                 out_fa, out_cmd)
+                else:  # the common cases inline (see ``held``): as write_output would
+                    for j in range(n):
+                        out_y[i_out, j] = ybuf[j]
+                    rr, rdr, _, _, kref = reference_at(t_out[i_out], breaks, coeffs, kref)
+                    out_r[i_out] = rr
+                    if held:
+                        out_cmd[i_out] = ybuf[iu]
+                        out_fa[i_out], _ = actuator(fa_hold, p)
+                    else:
+                        uc = ybuf[iu] if not algebraic else controller_output(
+                            ybuf, p, modes, rr, rdr, ii, iu)
+                        out_cmd[i_out] = uc
+                        out_fa[i_out], _ = actuator(uc, p)
                 i_out += 1
             # predictive step control (Gustafsson)
             if n_steps > 1:
@@ -904,17 +1103,22 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 # the step ended at a located crossing: switch the mode
                 if pending == EV_LIMIT:
                     stats[ST_LIMIT_EVENTS] += 1.0
-                u_before = y[iu]
+                r_e, rd_e, rdd_e, _, kref = reference_at(t, breaks, coeffs, kref)
+                u_before = 0.0
                 du_before = 0.0
                 if cont_delay and pending == EV_LEVEL:
-                    r_e, rd_e, _, kref = reference_at(t, breaks, coeffs, kref)
-                    rhs(t, y, p, modes, r_e, rd_e, 0.0, True, fs)
-                    du_before = fs[iu]
-                du = apply_event(pending, y, p, modes, iv2, iu, fa0, fa_state, yev)
-                if du != 0.0 and cont_delay:
-                    jump_pending = True
-                    jump_u = u_before
-                    jump_du = du_before
+                    fa_e, _, _ = stage_command(t, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
+                                               hist, head, count)
+                    rhs(t, y, p, modes, r_e, rd_e, fa_e, False, fs)
+                    u_before = controller_output(y, p, modes, r_e, rd_e, ii, iu)
+                    du_before = law_rate(y, p, modes, r_e, rd_e, rdd_e, fs, ii) if algebraic \
+                        else fs[iu]
+                apply_event(pending, y, p, modes, iv2, iu, r_e, rd_e, fa0, fa_state, yev)
+                if cont_delay and pending == EV_LEVEL:
+                    if controller_output(y, p, modes, r_e, rd_e, ii, iu) != u_before:
+                        jump_pending = True
+                        jump_u = u_before
+                        jump_du = du_before
                 n_events += 1
                 zero_run = 0
                 # after an event the old step size may be far too large
@@ -939,28 +1143,33 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
 
 
 def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
-        max_steps=2_000_000, x_bound=10.0):
+        max_steps=2_000_000, x_bound=10.0, input_time=None, input_force=None):
     """Allocate outputs and call :func:`integrate`.
 
     Returns a :class:`fi_design.plant.Integration`; see :func:`integrate` for
-    the arguments. This thin wrapper is the kernel's only Python-level entry
-    point; :mod:`fi_design.simulation` wraps it in a result.
+    the arguments (``input_time``, ``input_force``: the known input force's
+    samples [s, N], None for none). This thin wrapper is the kernel's only
+    Python-level entry point; :mod:`fi_design.simulation` wraps it in a result.
     """
     # fresh writable copies: numba types read-only arrays differently
     p = np.array(params, dtype=np.float64)
     y = np.array(y0, dtype=np.float64)
     t_out = np.array(t_out, dtype=np.float64)
+    in_t = np.zeros(0) if input_time is None else np.array(input_time, dtype=np.float64)
+    in_f = np.zeros(0) if input_force is None else np.array(input_force, dtype=np.float64)
     n = y.shape[0]
     m = t_out.shape[0]
     out_y = np.full((m, n), np.nan)
     out_r = np.full(m, np.nan)
     out_fa = np.full(m, np.nan)
+    out_cmd = np.full(m, np.nan)
     stats = np.zeros(N_STATS)
     status = integrate(p, y, np.array(breaks, dtype=np.float64),
                        np.array(coeffs, dtype=np.float64, order="C"), bool(land), float(t_end),
                        t_out, float(rtol), np.array(atol, dtype=np.float64),
-                       float(h_max), int(max_steps), float(x_bound), out_y, out_r, out_fa, stats)
+                       float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r,
+                       out_fa, out_cmd, stats)
     return Integration(code=int(status), status=STATUS_TEXT[int(status)], states=out_y,
-                       reference=out_r, applied_force=out_fa, n_steps=int(stats[ST_STEPS]),
-                       n_rejected=int(stats[ST_REJECTED]), n_events=int(stats[ST_EVENTS]),
-                       t_reached=float(stats[ST_T]))
+                       reference=out_r, applied_force=out_fa, command=out_cmd,
+                       n_steps=int(stats[ST_STEPS]), n_rejected=int(stats[ST_REJECTED]),
+                       n_events=int(stats[ST_EVENTS]), t_reached=float(stats[ST_T]))

@@ -20,15 +20,21 @@ Without an isolator the stage is one rigid mass m1 + m2: cases ``sliding``
 rigid in cases 3 and 4 (its contact stiffness is far above the joint's).
 
 Sliding linearises LuGre at a speed well above the Stribeck velocity, where the
-friction slope is sigma2; sticking linearises it at rest, where ``dz/dt = v``
-and the friction force is ``sigma0 x2 + (sigma1 + sigma2) v2``.
+friction slope is sigma2 (with direction-dependent friction the smaller of
+``viscous`` and ``viscous_negative``: the less damped direction); sticking
+linearises it at rest, where ``dz/dt = v`` and the friction force is
+``sigma0 x2 + (sigma1 + sigma2) v2``.
 
 Parasitic flexure modes (``spec.isolator.parasitic_modes``) multiply every
 isolated case: a non-collocated mode by ``wr^2 / (s^2 + 2 zeta wr s + wr^2)``;
 a collocated one also by ``(s^2 + 2 zeta wa s + wa^2) / wa^2``, its
 antiresonance ``wa`` below ``wr`` (:func:`fi_design.spec.antiresonance`).
 
-The controller is the PID of :mod:`fi_design.pid`. The computational delay
+The controller is the loop's :class:`fi_design.pid.ControlLaw` (the rule's
+PID or the hardware's gains), the same description the simulation uses. The
+margins do not depend on where the D term acts (error or measurement: the
+loop broken at the plant input is the same); the closed loop from the
+reference does (:func:`complementary_sensitivity`). The computational delay
 ``controller.delay``, plus half a sample period for the zero-order hold when
 ``controller.sample_rate`` is set, enters as a Pade approximation of order
 ``controller.pade_order``; otherwise the controller is analysed in continuous
@@ -56,10 +62,11 @@ from typing import Any, Sequence
 import control
 import numpy as np
 
-from .errors import ArgumentError
-from .pid import PidGains, tune_pid
+from .errors import SpecError
+from .pid import ControlLaw, PidGains, control_law
 from .results import dataclass_dict, frozen_array
-from .spec import (Spec, antiresonance, bristle_damping, drive_stiffness, joint_damping)
+from .spec import (Spec, antiresonance, bristle_damping, design_crossover, drive_stiffness,
+                   joint_damping)
 
 __all__ = [
     "ISOLATED_CASES", "RIGID_CASES", "CASE_DESCRIPTIONS", "CASE_NUMBERS", "SCAN_LIMIT",
@@ -207,7 +214,8 @@ def limit_cases(spec: Spec, stiffness: float | None = None) -> tuple[LimitCase, 
     """
     f = spec.friction
     m1, m2, M = spec.stage.mass, spec.cart.mass, spec.total_mass
-    s0, s1, s2 = f.bristle_stiffness, bristle_damping(spec), f.viscous
+    s0, s1 = f.bristle_stiffness, bristle_damping(spec)
+    s2 = f.viscous if f.viscous_negative is None else min(f.viscous, f.viscous_negative)
     if spec.isolator is None:
         raw = {"sliding": _rigid(M, s2, 0.0), "stuck": _rigid(M, s1 + s2, s0)}
         modes = ()
@@ -240,7 +248,7 @@ def _case(spec: Spec, case, stiffness: float | None) -> LimitCase:
         if c.name == case or c.number == case:
             return c
     names = ", ".join(c.name for c in limit_cases(spec, stiffness))
-    raise ArgumentError(f"unknown limit case {case!r}; this spec has: {names}")
+    raise SpecError(f"unknown limit case {case!r}; this spec has: {names}")
 
 
 # --------------------------------------------------------------------------- controller, delay
@@ -287,40 +295,70 @@ def delay_polynomials(spec: Spec) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(num, float), np.asarray(den, float)
 
 
-def controller_polynomials(gains: PidGains) -> tuple[np.ndarray, np.ndarray]:
-    """C(s) = ks (1 + wi/s)(1 + s/wd)/(1 + s/wt) as numerator and denominator.
+def controller_polynomials(controller: ControlLaw | PidGains) -> tuple[np.ndarray, np.ndarray]:
+    """The loop's controller C(s) as numerator and denominator.
 
     Parameters
     ----------
-    gains : PidGains
-        The PID (:func:`fi_design.pid.tune_pid`).
+    controller : ControlLaw or PidGains
+        The loop's controller (:func:`fi_design.pid.control_law`), or the
+        rule's gains.
 
     Returns
     -------
     num, den : numpy.ndarray
-        Descending powers of s [rad/s], C in N/m:
-        ``ks wt (s + wi)(s + wd) / (wd s (s + wt))``.
+        Descending powers of s [rad/s], C in N/m. The rule:
+        ``ks wt (s + wi)(s + wd) / (wd s (s + wt))``; in general
+        ``kp + ki/s + kd s wf / (s + wf)``. Without an integrator the factor
+        s cancels (no pole at the origin).
     """
-    g = gains
-    num = (g.ks * g.wt / g.wd) * np.polymul([1.0, g.wi], [1.0, g.wd])
-    den = np.array([1.0, g.wt, 0.0])
-    return num, den
+    if isinstance(controller, PidGains) or controller.is_rule:
+        g = controller if isinstance(controller, PidGains) else controller.rule
+        if g.wi == 0.0:
+            return (g.ks * g.wt / g.wd) * np.array([1.0, g.wd]), np.array([1.0, g.wt])
+        num = (g.ks * g.wt / g.wd) * np.polymul([1.0, g.wi], [1.0, g.wd])
+        return num, np.array([1.0, g.wt, 0.0])
+    c = controller
+    return _parallel(c.kp, c.ki, c.kd, c.roll_off)
 
 
-def controller_tf(gains: PidGains):
-    """The PID as a transfer function.
+def _parallel(kp: float, ki: float, kd: float, wf: float) -> tuple[np.ndarray, np.ndarray]:
+    """kp + ki/s + kd s wf / (s + wf) (wf = inf: an ideal D) as polynomials in s."""
+    if math.isinf(wf):
+        num, den = np.array([kd, kp, ki]), np.array([1.0, 0.0])
+    else:
+        num, den = np.array([kp + kd * wf, kp * wf + ki, ki * wf]), np.array([1.0, wf, 0.0])
+    if ki == 0.0:  # no integrator: cancel the common s
+        num, den = num[:-1], den[:-1]
+    nz = np.nonzero(num)[0]
+    return (num[nz[0]:] if nz.size else np.array([0.0])), den
+
+
+def reference_polynomials(controller: ControlLaw) -> tuple[np.ndarray, np.ndarray]:
+    """The part of C(s) that acts on the error (the reference path) [N/m].
+
+    All of C with the D term on the error; kp + ki/s with the D term on the
+    measurement (velocity feedback does not see the reference).
+    """
+    if controller.derivative_on == "error":
+        return controller_polynomials(controller)
+    return _parallel(controller.kp, controller.ki, 0.0, math.inf)
+
+
+def controller_tf(controller: ControlLaw | PidGains):
+    """The loop's controller as a transfer function.
 
     Parameters
     ----------
-    gains : PidGains
-        The PID.
+    controller : ControlLaw or PidGains
+        The loop's controller, or the rule's gains.
 
     Returns
     -------
     control.TransferFunction
         C(s) [N/m], s in rad/s.
     """
-    return control.tf(*controller_polynomials(gains))
+    return control.tf(*controller_polynomials(controller))
 
 
 def delay_tf(spec: Spec):
@@ -339,9 +377,14 @@ def delay_tf(spec: Spec):
     return control.tf(*delay_polynomials(spec))
 
 
+def _controller(spec: Spec, crossover: float | None,
+                gains: ControlLaw | PidGains | None) -> ControlLaw | PidGains:
+    return control_law(spec, crossover) if gains is None else gains
+
+
 def loop_polynomials(spec: Spec, case, crossover: float | None = None,
                      stiffness: float | None = None,
-                     gains: PidGains | None = None) -> tuple[np.ndarray, np.ndarray]:
+                     gains: ControlLaw | PidGains | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Numerator and denominator of the loop L = C D P of one case.
 
     Parameters
@@ -351,11 +394,11 @@ def loop_polynomials(spec: Spec, case, crossover: float | None = None,
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
     crossover : float, optional
-        Crossover the PID is tuned for [Hz]; default the spec's.
+        Shift the controller to this crossover [Hz]; default the spec's.
     stiffness : float, optional
         Joint drive stiffness [N/m]; default the spec's.
-    gains : PidGains, optional
-        Use these gains instead of tuning (``crossover`` is then ignored).
+    gains : ControlLaw or PidGains, optional
+        Use this controller (``crossover`` is then ignored).
 
     Returns
     -------
@@ -363,14 +406,14 @@ def loop_polynomials(spec: Spec, case, crossover: float | None = None,
         Descending powers of s [rad/s]; L is dimensionless.
     """
     lc = _case(spec, case, stiffness)
-    g = tune_pid(spec, crossover) if gains is None else gains
-    cn, cd = controller_polynomials(g)
+    cn, cd = controller_polynomials(_controller(spec, crossover, gains))
     dn, dd = delay_polynomials(spec)
     return (np.polymul(np.polymul(cn, dn), lc.num), np.polymul(np.polymul(cd, dd), lc.den))
 
 
 def loop_transfer_function(spec: Spec, case, crossover: float | None = None,
-                           stiffness: float | None = None, gains: PidGains | None = None):
+                           stiffness: float | None = None,
+                           gains: ControlLaw | PidGains | None = None):
     """Loop transfer function L(s) = C(s) D(s) P(s) of one limit case.
 
     Parameters
@@ -380,11 +423,11 @@ def loop_transfer_function(spec: Spec, case, crossover: float | None = None,
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
     crossover : float, optional
-        Crossover the PID is tuned for [Hz]; default the spec's.
+        Shift the controller to this crossover [Hz]; default the spec's.
     stiffness : float, optional
         Joint drive stiffness [N/m]; default the spec's.
-    gains : PidGains, optional
-        Use these gains instead of tuning (``crossover`` is then ignored).
+    gains : ControlLaw or PidGains, optional
+        Use this controller (``crossover`` is then ignored).
 
     Returns
     -------
@@ -395,7 +438,7 @@ def loop_transfer_function(spec: Spec, case, crossover: float | None = None,
 
 
 def sensitivity(spec: Spec, case, crossover: float | None = None,
-                stiffness: float | None = None, gains: PidGains | None = None):
+                stiffness: float | None = None, gains: ControlLaw | PidGains | None = None):
     """Sensitivity S = 1 / (1 + L) of one limit case.
 
     Parameters
@@ -405,11 +448,11 @@ def sensitivity(spec: Spec, case, crossover: float | None = None,
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
     crossover : float, optional
-        Crossover the PID is tuned for [Hz]; default the spec's.
+        Shift the controller to this crossover [Hz]; default the spec's.
     stiffness : float, optional
         Joint drive stiffness [N/m]; default the spec's.
-    gains : PidGains, optional
-        Use these gains instead of tuning (``crossover`` is then ignored).
+    gains : ControlLaw or PidGains, optional
+        Use this controller (``crossover`` is then ignored).
 
     Returns
     -------
@@ -421,8 +464,13 @@ def sensitivity(spec: Spec, case, crossover: float | None = None,
 
 
 def complementary_sensitivity(spec: Spec, case, crossover: float | None = None,
-                              stiffness: float | None = None, gains: PidGains | None = None):
-    """Complementary sensitivity T = L / (1 + L) of one limit case.
+                              stiffness: float | None = None,
+                              gains: ControlLaw | PidGains | None = None):
+    """The closed loop from the reference to x1 of one limit case.
+
+    T = C_r D P / (1 + L), where C_r is the part of the controller acting on
+    the error (all of C, or kp + ki/s when the D term acts on the
+    measurement); with the D term on the error it is L / (1 + L).
 
     Parameters
     ----------
@@ -431,19 +479,29 @@ def complementary_sensitivity(spec: Spec, case, crossover: float | None = None,
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
     crossover : float, optional
-        Crossover the PID is tuned for [Hz]; default the spec's.
+        Shift the controller to this crossover [Hz]; default the spec's.
     stiffness : float, optional
         Joint drive stiffness [N/m]; default the spec's.
-    gains : PidGains, optional
-        Use these gains instead of tuning (``crossover`` is then ignored).
+    gains : ControlLaw or PidGains, optional
+        Use this controller (``crossover`` is then ignored).
 
     Returns
     -------
     control.TransferFunction
-        T(s), dimensionless: the closed loop from reference to x1.
+        T(s), dimensionless.
     """
-    num, den = loop_polynomials(spec, case, crossover, stiffness, gains)
-    return control.tf(num, np.polyadd(den, num))
+    ctl = _controller(spec, crossover, gains)
+    num, den = loop_polynomials(spec, case, crossover, stiffness, ctl)
+    closed = np.polyadd(den, num)
+    if isinstance(ctl, PidGains) or ctl.derivative_on == "error":
+        return control.tf(num, closed)
+    # reference path: C_r D P (1 + L)^-1 = rn dn pn (cd / rd) / closed, where rd divides cd
+    lc = _case(spec, case, stiffness)
+    cn, cd = controller_polynomials(ctl)
+    rn, rd = reference_polynomials(ctl)
+    dn, _ = delay_polynomials(spec)
+    q, _ = np.polydiv(cd, rd)
+    return control.tf(np.polymul(np.polymul(rn, dn), np.polymul(lc.num, q)), closed)
 
 
 # --------------------------------------------------------------------------- margins
@@ -588,13 +646,13 @@ class LoopAnalysis:
     Attributes
     ----------
     crossover : float
-        Crossover the PID is tuned for [Hz].
+        Crossover of the controller [Hz].
     stiffness : float or None
         Joint drive stiffness used [N/m]; None without isolator.
     delay : float
         Loop delay modelled [s] (Pade approximation).
-    gains : PidGains
-        The PID.
+    controller : fi_design.pid.ControlLaw
+        The loop's controller.
     cases : tuple of CaseMargins
         One per limit case, in the paper's order.
     passed : bool
@@ -604,7 +662,7 @@ class LoopAnalysis:
     crossover: float
     stiffness: float | None
     delay: float
-    gains: PidGains
+    controller: ControlLaw
     cases: tuple[CaseMargins, ...]
     passed: bool
 
@@ -615,14 +673,15 @@ class LoopAnalysis:
 
 def analyse(spec: Spec, crossover: float | None = None, stiffness: float | None = None,
             cases: Sequence[LimitCase] | None = None) -> LoopAnalysis:
-    """Margins of all limit cases for the PID tuned at ``crossover``.
+    """Margins of all limit cases with the loop's controller at ``crossover``.
 
     Parameters
     ----------
     spec : fi_design.spec.Spec
-        The design spec (plant, controller rule, delay, requirements).
+        The design spec (plant, controller, delay, requirements).
     crossover : float, optional
-        Tuned crossover [Hz]; default ``spec.controller.crossover``.
+        Shift the controller to this crossover [Hz] (the rule retunes,
+        explicit gains scale); default the spec's.
     stiffness : float, optional
         Joint drive stiffness [N/m]; default the spec's.
     cases : sequence of LimitCase, optional
@@ -633,22 +692,31 @@ def analyse(spec: Spec, crossover: float | None = None, stiffness: float | None 
     LoopAnalysis
         Per-case margins judged against ``spec.requirements``.
     """
-    fc = spec.controller.crossover if crossover is None else float(crossover)
     lcs = limit_cases(spec, stiffness) if cases is None else tuple(cases)
-    g = tune_pid(spec, fc)
-    cn, cd = controller_polynomials(g)
-    dn, dd = delay_polynomials(spec)
-    ln, ld = np.polymul(cn, dn), np.polymul(cd, dd)
-    out = []
-    for lc in lcs:
-        m = loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den), scale=g.wc,
-                         name=lc.name, description=lc.description)
-        out.append(_judge(m, spec))
+    law = control_law(spec, crossover)
+    out = _margins(spec, law, lcs, first_fail=False)
     k = None
     if spec.isolator is not None:
         k = drive_stiffness(spec) if stiffness is None else float(stiffness)
-    return LoopAnalysis(crossover=fc, stiffness=k, delay=delay_time(spec), gains=g,
-                        cases=tuple(out), passed=all(c.passed for c in out))
+    return LoopAnalysis(crossover=law.crossover, stiffness=k, delay=delay_time(spec),
+                        controller=law, cases=tuple(out), passed=all(c.passed for c in out))
+
+
+def _margins(spec: Spec, law: ControlLaw, lcs: Sequence[LimitCase],
+             first_fail: bool) -> list[CaseMargins]:
+    """Judged margins of each case (stopping at the first failing one when ``first_fail``)."""
+    cn, cd = controller_polynomials(law)
+    dn, dd = delay_polynomials(spec)
+    ln, ld = np.polymul(cn, dn), np.polymul(cd, dd)
+    wc = 2.0 * math.pi * law.crossover
+    out = []
+    for lc in lcs:
+        m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den), scale=wc,
+                                name=lc.name, description=lc.description), spec)
+        out.append(m)
+        if first_fail and not m.passed:
+            break
+    return out
 
 
 # --------------------------------------------------------------------------- achievable crossover
@@ -709,8 +777,9 @@ def achievable_crossover(spec: Spec, stiffness: float | None = None,
                          rtol: float = 1e-3) -> AchievableCrossover:
     """The highest crossover at which all limit cases meet the requirements.
 
-    At each crossover the PID is retuned by the spec's rule; a crossover is
-    feasible when every case is stable and meets ``requirements.phase_margin``,
+    At each crossover the PID is retuned by the spec's rule (explicit gains
+    scale in frequency, :meth:`fi_design.pid.ControlLaw.at_crossover`); a
+    crossover is feasible when every case is stable and meets ``requirements.phase_margin``,
     ``requirements.gain_margin`` and ``requirements.modulus_margin`` (if set),
     and every parasitic mode lies at or above ``requirements.parasitic_separation``
     times the crossover. A log scan (:data:`SCAN_POINTS_PER_DECADE`) finds the
@@ -742,7 +811,7 @@ def achievable_crossover(spec: Spec, stiffness: float | None = None,
     sep = req.parasitic_separation
     modes = spec.isolator.parasitic_modes if spec.isolator is not None else ()
     ctl = spec.controller
-    f_lo = min(SCAN_START, ctl.crossover / 10.0) if start is None else float(start)
+    f_lo = min(SCAN_START, design_crossover(spec) / 10.0) if start is None else float(start)
     scan_limit = SCAN_LIMIT if stop is None else float(stop)
     if ctl.sample_rate is not None:
         scan_limit = min(scan_limit, 0.5 * ctl.sample_rate)
@@ -807,18 +876,7 @@ def achievable_crossover(spec: Spec, stiffness: float | None = None,
 
 def _analyse_until_fail(spec: Spec, fc: float, lcs: Sequence[LimitCase]) -> list[CaseMargins]:
     """Like :func:`analyse` but stops at the first failing case (for the scan)."""
-    g = tune_pid(spec, fc)
-    cn, cd = controller_polynomials(g)
-    dn, dd = delay_polynomials(spec)
-    ln, ld = np.polymul(cn, dn), np.polymul(cd, dd)
-    out = []
-    for lc in lcs:
-        m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den), scale=g.wc,
-                                name=lc.name, description=lc.description), spec)
-        out.append(m)
-        if not m.passed:
-            break
-    return out
+    return _margins(spec, control_law(spec, fc), lcs, first_fail=True)
 
 
 def _describe(m: CaseMargins, spec: Spec, above: float | None = None) -> str:

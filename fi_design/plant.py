@@ -1,10 +1,12 @@
-"""The nonlinear plant: parameters, right-hand side and Jacobian (DESIGN.md section 2).
+"""The nonlinear plant: parameters, right-hand side and Jacobian (DESIGN.md sections 2, 8).
 
 Plain functions on floats, compiled with numba and shared by the fast
 integrator (:mod:`fi_design.kernel`) and the scipy reference path, so both
 integrate the same equations.
 
-Units of the kernel parameters (:class:`PlantParameters`):
+Units of the kernel parameters (:class:`PlantParameters`, whose field order is
+the kernel's parameter-array layout; the ``P_*`` indices are derived from it by
+name at import, so a reordering can never mis-wire the kernel):
 
 ============== ========= =====================================================
 symbol         unit      meaning
@@ -13,13 +15,18 @@ m1, m2         kg        stage and cart mass (rigid plant: m1 + m2 moves)
 k, c           N/m, Ns/m joint drive stiffness and damping
 s              m         one-sided stroke before the limiter engages
 k_stop, c_stop N/m, Ns/m limiter contact stiffness and damping
-Fs, Fc         N         static and Coulomb friction
+Fs, Fc         N         static and Coulomb friction (positive direction)
 vs             m/s       Stribeck velocity
 sigma0         N/m       bristle stiffness
 sigma1         N s/m     bristle damping
-sigma2         N s/m     viscous friction
-kp, ki, kd     N/m, N/(m s), N s/m  parallel PID gains
-wt             rad/s     roll-off of C(s) = (kp + ki/s + kd s) / (1 + s/wt)
+sigma2         N s/m     viscous friction (positive direction)
+kp, ki         N/m, N/(m s)  continuous controller: proportional and integral gain
+kd, kdm        N s/m     derivative gains on the error and on the measured position
+wt             rad/s     corner of the controller's output filter (inf: none)
+Fc_neg         N         Coulomb friction for v < 0 (nan: Fc); Fs scales with it
+sigma2_neg     N s/m     viscous friction for v < 0 (nan: sigma2)
+offset         N         constant load force on the stage (m1 a1 = u - offset - ...)
+ff_*           kg, N s/m, N  feedforward m r'' + c r' + F sign(r')
 delay          s         delay between controller output and applied force
 sample_period  s         discrete controller period (0: continuous)
 quantization   m         position quantization the controller sees (0: none)
@@ -27,22 +34,46 @@ force_limit    N         actuator saturation (inf: none)
 pdf_*          -, m, rad position-dependent friction amplitude, wavelength, phase
 ripple_*       N, m, rad force ripple amplitude, pitch, phase
 cable_*        N/m, N    cable stiffness and preload
+dp, dc, da, db N/m, N/m, -, N/m  discrete controller (see below)
+dmeas          -         1: the discrete D term acts on the measurement
+dx1, dx2       N         discrete controller states at t = 0
+u_initial      N         command applied before the controller's first output
 x1_initial     m         stage position at t = 0 (the cable force's zero)
 ============== ========= =====================================================
 
-States. Isolated plant (7): x1, v1, x2, v2, z, I, u. Rigid plant (5): x, v, z,
-I, u. Positions in m, velocities in m/s, the bristle deflection z in m, the
-integrator force I = ki * integral(e) and the controller output u in N.
+States (one table, :data:`ISOLATED_STATES` and :data:`RIGID_STATES`). Isolated
+plant (7): x1, v1, x2, v2, z, I, u. Rigid plant (5): x, v, z, I, u. Positions
+in m, velocities in m/s, the bristle deflection z in m, the integrator force
+I = ki * integral(e) and the controller output u in N. The last three are the
+"leaves" the kernel's structured linear solve eliminates; the layout is checked
+at import.
 
-The continuous controller is realised as ``u' = wt (kp e + I + kd e' - u)``
-with ``I' = ki e`` and ``e' = r' - v1``: exactly C(s) acting on e, with the
-derivative taken from the velocity state instead of a numerical difference.
+The continuous controller, one law for every controller the spec describes
+(:mod:`fi_design.pid` maps the tuning rule and explicit hardware gains onto
+it)::
+
+    v = kp e + I + kd e' - kdm x'       e = r - x, x the measured position
+    I' = ki e
+    u' = wt (v - u)                     (wt = inf: u = v, no filter)
+
+with the derivatives taken from the velocity state instead of a numerical
+difference (``x' = v1``; 0 between the levels of a quantized measurement).
+With wt finite this is C(s) = (kp + ki/s + kd s)/(1 + s/wt) on the error plus
+-kdm s/(1 + s/wt) on the measurement. The applied force is the saturated
+command u + feedforward + a known input force, ``delay`` later.
+
+The discrete controller (zero-order hold, period ``sample_period``) computes
+at each sample ``u_k = dp e_k + (dx1 + dc e_k) + (dx2 + db d_k) + ff_k``,
+then ``dx1 += 2 dc e_k`` and ``dx2 = da (dx2 + db d_k) - db d_k``, where
+``d_k`` is ``e_k`` or, with ``dmeas``, the measurement ``-x_k``: a
+trapezoidal integrator and a derivative by the Tustin rule (or, with
+``da = 0``, the backward difference).
 
 Modes (int array, frozen during a step so the right-hand side is smooth):
-``MODE_SIGN`` direction of cart sliding (+1/-1; the LuGre |v| and the switch
-model's friction sign), ``MODE_LIMIT`` limiter state (-1, 0, +1),
-``MODE_LEVEL`` quantization level n (the controller sees n q),
-``MODE_STICK`` switch model: 1 while the cart sticks.
+``MODE_SIGN`` direction of cart sliding (+1/-1; the LuGre |v|, the friction
+values of a direction and the switch model's friction sign), ``MODE_LIMIT``
+limiter state (-1, 0, +1), ``MODE_LEVEL`` quantization level n (the
+controller sees n q), ``MODE_STICK`` switch model: 1 while the cart sticks.
 """
 
 from __future__ import annotations
@@ -70,8 +101,8 @@ I1 = _nt.int64[::1]
 class PlantParameters:
     """All numbers the kernel needs, SI (see the module table for units).
 
-    Field order is the kernel's parameter-array layout; :data:`P_M1` etc. are
-    the matching indices.
+    Field order is the kernel's parameter-array layout; the ``P_*`` indices
+    below are derived from it by name.
     """
 
     m1: float
@@ -91,6 +122,13 @@ class PlantParameters:
     ki: float
     kd: float
     wt: float
+    kdm: float = 0.0
+    Fc_neg: float = math.nan
+    sigma2_neg: float = math.nan
+    offset: float = 0.0
+    ff_mass: float = 0.0
+    ff_viscous: float = 0.0
+    ff_coulomb: float = 0.0
     delay: float = 0.0
     sample_period: float = 0.0
     quantization: float = 0.0
@@ -105,26 +143,34 @@ class PlantParameters:
     cable_preload: float = 0.0
     isolated: float = 1.0
     switch_model: float = 0.0
-    # discrete controller (Tustin) state space, used when sample_period > 0
-    ad11: float = 0.0
-    ad12: float = 0.0
-    ad21: float = 0.0
-    ad22: float = 0.0
-    bd1: float = 0.0
-    bd2: float = 0.0
-    cd1: float = 0.0
-    cd2: float = 0.0
-    dd: float = 0.0
+    # discrete controller, used when sample_period > 0
+    dp: float = 0.0
+    dc: float = 0.0
+    da: float = 0.0
+    db: float = 0.0
+    dmeas: float = 0.0
+    dx1: float = 0.0
+    dx2: float = 0.0
+    u_initial: float = 0.0
     x1_initial: float = 0.0
 
     def to_array(self) -> np.ndarray:
-        """The kernel's float64 parameter array."""
-        return np.array([getattr(self, f.name) for f in fields(self)], dtype=np.float64)
+        """The kernel's float64 parameter array (negative-direction friction resolved)."""
+        out = np.array([getattr(self, f.name) for f in fields(self)], dtype=np.float64)
+        if math.isnan(self.Fc_neg):
+            out[P_FC_NEG] = self.Fc
+        if math.isnan(self.sigma2_neg):
+            out[P_SIGMA2_NEG] = self.sigma2
+        return out
+
+    def value(self, name: str) -> float:
+        """The value the kernel uses for field ``name`` (negative-direction friction resolved)."""
+        return float(self.to_array()[PARAMETER_INDEX[name]])
 
     @property
     def n_states(self) -> int:
         """Number of states: 7 isolated, 5 rigid."""
-        return 7 if self.isolated else 5
+        return len(ISOLATED_STATES if self.isolated else RIGID_STATES)
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,6 +189,9 @@ class Integration:
         Reference r at the output times [m].
     applied_force : ndarray, shape (m,)
         Actuator force on the stage after delay and saturation [N].
+    command : ndarray, shape (m,)
+        Commanded actuator force before delay and saturation [N]: the
+        controller output plus feedforward plus a known input force.
     n_steps, n_rejected, n_events : int
         Accepted steps, discarded trial steps, mode switches.
     t_reached : float
@@ -154,17 +203,43 @@ class Integration:
     states: np.ndarray
     reference: np.ndarray
     applied_force: np.ndarray
+    command: np.ndarray
     n_steps: int
     n_rejected: int
     n_events: int
     t_reached: float
 
 
-(P_M1, P_M2, P_K, P_C, P_S, P_KSTOP, P_CSTOP, P_FS, P_FC, P_VS, P_SIGMA0, P_SIGMA1, P_SIGMA2,
- P_KP, P_KI, P_KD, P_WT, P_DELAY, P_TS, P_QUANT, P_FLIMIT, P_PDF_A, P_PDF_L, P_PDF_PHI,
- P_RIP_A, P_RIP_P, P_RIP_PHI, P_CABLE_K, P_CABLE_F0, P_ISO, P_SWITCH,
- P_AD11, P_AD12, P_AD21, P_AD22, P_BD1, P_BD2, P_CD1, P_CD2, P_DD, P_X10) = range(41)
-N_PARAMS = 41
+#: Kernel parameter index of every :class:`PlantParameters` field, by name.
+PARAMETER_INDEX = {f.name: i for i, f in enumerate(fields(PlantParameters))}
+N_PARAMS = len(PARAMETER_INDEX)
+_P = PARAMETER_INDEX
+(P_M1, P_M2, P_K, P_C, P_S, P_KSTOP, P_CSTOP, P_FS, P_FC, P_VS, P_SIGMA0, P_SIGMA1,
+ P_SIGMA2, P_KP, P_KI, P_KD, P_WT, P_KDM, P_FC_NEG, P_SIGMA2_NEG, P_OFFSET, P_FF_M, P_FF_C,
+ P_FF_F, P_DELAY, P_TS, P_QUANT, P_FLIMIT, P_PDF_A, P_PDF_L, P_PDF_PHI, P_RIP_A, P_RIP_P,
+ P_RIP_PHI, P_CABLE_K, P_CABLE_F0, P_ISO, P_SWITCH, P_DP, P_DC, P_DA, P_DB, P_DMEAS, P_DX1,
+ P_DX2, P_U0, P_X10) = (
+    _P[n] for n in (
+        "m1", "m2", "k", "c", "s", "k_stop", "c_stop", "Fs", "Fc", "vs", "sigma0", "sigma1",
+        "sigma2", "kp", "ki", "kd", "wt", "kdm", "Fc_neg", "sigma2_neg", "offset", "ff_mass",
+        "ff_viscous", "ff_coulomb", "delay", "sample_period", "quantization", "force_limit",
+        "pdf_amplitude", "pdf_wavelength", "pdf_phase", "ripple_amplitude", "ripple_pitch",
+        "ripple_phase", "cable_stiffness", "cable_preload", "isolated", "switch_model", "dp",
+        "dc", "da", "db", "dmeas", "dx1", "dx2", "u_initial", "x1_initial"))
+if len(set(_P)) != N_PARAMS or any(f.type not in ("float", float) for f in fields(PlantParameters)):
+    raise RuntimeError("PlantParameters must be a flat table of distinct float fields")
+
+#: State names of the two plants; the index of a name is its place in the state vector.
+ISOLATED_STATES = ("x1", "v1", "x2", "v2", "z", "I", "u")
+RIGID_STATES = ("x1", "v1", "z", "I", "u")
+#: The states the kernel's structured solve eliminates, last and in this order.
+LEAVES = ("z", "I", "u")
+#: Number of mechanical ("core") states before the leaves.
+N_CORE_ISO = len(ISOLATED_STATES) - len(LEAVES)
+N_CORE_RIGID = len(RIGID_STATES) - len(LEAVES)
+if (ISOLATED_STATES[-3:] != LEAVES or RIGID_STATES[-3:] != LEAVES
+        or ISOLATED_STATES[:2] != RIGID_STATES[:2] or ISOLATED_STATES[2:4] != ("x2", "v2")):
+    raise RuntimeError("state layout: x1, v1 first, (x2, v2 isolated), then z, I, u")
 
 MODE_SIGN, MODE_LIMIT, MODE_LEVEL, MODE_STICK = 0, 1, 2, 3
 N_MODES = 4
@@ -173,24 +248,33 @@ TWO_PI = 2.0 * math.pi
 
 
 def state_index(isolated: bool) -> dict[str, int]:
-    """Names of the state components and their index for one plant."""
-    if isolated:
-        return {"x1": 0, "v1": 1, "x2": 2, "v2": 3, "z": 4, "I": 5, "u": 6}
-    return {"x1": 0, "v1": 1, "x2": 0, "v2": 1, "z": 2, "I": 3, "u": 4}
+    """Names of the state components and their index for one plant.
+
+    The rigid plant's cart is the stage: ``x2`` and ``v2`` name ``x1`` and ``v1``.
+    """
+    names = ISOLATED_STATES if isolated else RIGID_STATES
+    out = {n: i for i, n in enumerate(names)}
+    if not isolated:
+        out.update(x2=out["x1"], v2=out["v1"])
+    return out
 
 
 # --------------------------------------------------------------------------- pieces
 
 
-@njit((f8, f8, A1), cache=True, error_model="numpy", _nrt=False)
-def stribeck(v, x2, p):
-    """g(v) scaled by position-dependent friction, and its partials.
+@njit((f8, f8, f8, A1), cache=True, error_model="numpy", _nrt=False)
+def stribeck(v, x2, sgn, p):
+    """g(v) of the sliding direction ``sgn``, scaled by position-dependent friction.
 
     Returns ``(g, dg/dv, dg/dx2)`` [N, N s/m, N/m] with
-    g = (1 + a sin(2 pi x2 / lambda + phi)) (Fc + (Fs - Fc) exp(-(v / vs)^2)).
+    g = (1 + a sin(2 pi x2 / lambda + phi)) (Fc + (Fs - Fc) exp(-(v / vs)^2)),
+    where for ``sgn < 0`` Fc is ``Fc_neg`` and Fs scales with it (Fs Fc_neg / Fc).
     """
     Fs = p[P_FS]
     Fc = p[P_FC]
+    if sgn < 0.0:
+        Fs = Fs * p[P_FC_NEG] / Fc
+        Fc = p[P_FC_NEG]
     vs = p[P_VS]
     w = v / vs
     ex = (Fs - Fc) * math.exp(-w * w)
@@ -206,9 +290,17 @@ def stribeck(v, x2, p):
 
 
 @njit((f8, A1), cache=True, error_model="numpy", _nrt=False)
+def static_friction(direction, p):
+    """Static friction Fs of a sliding direction (+1 or -1) [N] (the switch model's breakaway)."""
+    if direction < 0.0:
+        return p[P_FS] * p[P_FC_NEG] / p[P_FC]
+    return p[P_FS]
+
+
+@njit((f8, A1), cache=True, error_model="numpy", _nrt=False)
 def external_force(x1, p):
-    """Force ripple plus cable force on the stage and its x1-derivative [N, N/m]."""
-    F = 0.0
+    """Force ripple, cable force and load offset on the stage, and the x1-derivative [N, N/m]."""
+    F = -p[P_OFFSET]
     dF = 0.0
     A = p[P_RIP_A]
     if A != 0.0:
@@ -241,12 +333,12 @@ def lugre(v, x2, z, sgn, p):
 
     Returns ``(zd, Ff, dzd_dx2, dzd_dv, dzd_dz, dFf_dx2, dFf_dv, dFf_dz)``:
     dz/dt = v - sigma0 |v| z / g(v), F = sigma0 z + sigma1 dz/dt + sigma2 v,
-    with |v| = sgn * v.
+    with |v| = sgn * v and g, sigma2 those of the direction ``sgn``.
     """
     s0 = p[P_SIGMA0]
     s1 = p[P_SIGMA1]
-    s2 = p[P_SIGMA2]
-    g, dg_dv, dg_dx = stribeck(v, x2, p)
+    s2 = p[P_SIGMA2] if sgn > 0.0 else p[P_SIGMA2_NEG]
+    g, dg_dv, dg_dx = stribeck(v, x2, sgn, p)
     av = sgn * v
     q = s0 * z / g
     zd = v - av * q
@@ -266,12 +358,62 @@ def measured_position(x1, p, level):
     return x1
 
 
-@njit((A1, A1, f8, b1), cache=True, error_model="numpy", _nrt=False)
-def drive_force(y, p, fa, fa_state):
+@njit((f8, f8, f8, A1), cache=True, error_model="numpy", _nrt=False)
+def feedforward(rd, rdd, r3, p):
+    """Feedforward force and its time derivative [N, N/s].
+
+    ``ff_mass r'' + ff_viscous r' + ff_coulomb sign(r')`` from the reference's
+    velocity ``rd``, acceleration ``rdd`` and jerk ``r3``.
+    """
+    F = p[P_FF_M] * rdd + p[P_FF_C] * rd
+    Fc = p[P_FF_F]
+    if Fc != 0.0:
+        if rd > 0.0:
+            F += Fc
+        elif rd < 0.0:
+            F -= Fc
+    return F, p[P_FF_M] * r3 + p[P_FF_C] * rdd
+
+
+@njit((A1, A1, I1, f8, f8, i8), cache=True, error_model="numpy", _nrt=False)
+def control_law(y, p, modes, r, rd, ii):
+    """The continuous controller's unfiltered output v and its partials.
+
+    Returns ``(v, dv_dx1, dv_dv1, e)``: v = kp e + I + kd e' - kdm x' [N] with
+    e = r - x and x the measured position (x' = v1, or 0 between quantization
+    levels), its derivatives with respect to x1 and v1 [N/m, N s/m] (dv/dI = 1),
+    and the error e [m].
+    """
+    quant = p[P_QUANT] > 0.0
+    x1 = y[0]
+    xm = measured_position(x1, p, modes[MODE_LEVEL])
+    xd = 0.0 if quant else y[1]
+    e = r - xm
+    kd = p[P_KD]
+    kdm = p[P_KDM]
+    v = p[P_KP] * e + y[ii] + kd * (rd - xd) - kdm * xd
+    if quant:
+        return v, 0.0, 0.0, e
+    return v, -p[P_KP], -(kd + kdm), e
+
+
+@njit((A1, A1, I1, f8, f8, i8, i8), cache=True, error_model="numpy", _nrt=False)
+def controller_output(y, p, modes, r, rd, ii, iu):
+    """Output u of the continuous controller [N]: the filter state, or v without a filter."""
+    if math.isinf(p[P_WT]):
+        v, _, _, _ = control_law(y, p, modes, r, rd, ii)
+        return v
+    return y[iu]
+
+
+@njit((A1, A1, I1, f8, f8, f8, b1), cache=True, error_model="numpy", _nrt=False)
+def drive_force(y, p, modes, r, rd, fa, fa_state):
     """Force that drives the cart apart from friction [N] (the switch model's stick test).
 
     Isolated: the joint and limiter force. Rigid: actuator plus external force,
-    with the command ``fa`` or, when ``fa_state`` is true, the state u.
+    with the command ``fa`` or, when ``fa_state`` is true, the continuous
+    controller's output (at reference ``r`` [m], ``rd`` [m/s]) plus ``fa``, as
+    in :func:`rhs`.
     """
     if p[P_ISO] != 0.0:
         d = y[0] - y[2]
@@ -283,7 +425,10 @@ def drive_force(y, p, fa, fa_state):
         elif d < -s:
             F += p[P_KSTOP] * (d + s) + p[P_CSTOP] * dv
         return F
-    Fa, _ = actuator(y[4] if fa_state else fa, p)
+    if fa_state:
+        ii = N_CORE_RIGID + 1
+        fa = fa + controller_output(y, p, modes, r, rd, ii, ii + 1)
+    Fa, _ = actuator(fa, p)
     Fe, _ = external_force(y[0], p)
     return Fa + Fe
 
@@ -308,22 +453,35 @@ def rhs(t, y, p, modes, r, rd, fa, fa_state, f):
     r, rd : float
         Reference position [m] and velocity [m/s] at ``t``.
     fa : float
-        Actuator command [N] used when ``fa_state`` is false (delayed or held).
+        With ``fa_state`` false: the actuator command [N] (delayed or held).
+        With ``fa_state`` true: the part of the command that is not the
+        controller's output (feedforward plus a known input force) [N].
     fa_state : bool
-        True: the command is the controller state u (continuous, no delay).
+        True: the command is the continuous controller's output u plus ``fa``
+        (continuous controller, no delay).
     f : ndarray
         Output, same shape as ``y``.
     """
     iso = p[P_ISO] != 0.0
     if iso:
-        iz, ii, iu = 4, 5, 6
+        iz, ii, iu = N_CORE_ISO, N_CORE_ISO + 1, N_CORE_ISO + 2
         x1, v1, x2, v2 = y[0], y[1], y[2], y[3]
     else:
-        iz, ii, iu = 2, 3, 4
+        iz, ii, iu = N_CORE_RIGID, N_CORE_RIGID + 1, N_CORE_RIGID + 2
         x1, v1 = y[0], y[1]
         x2, v2 = x1, v1
     z = y[iz]
-    Fa, _ = actuator(y[iu] if fa_state else fa, p)
+    discrete = p[P_TS] > 0.0
+    wt = p[P_WT]
+    v = 0.0
+    e = 0.0
+    if not discrete:
+        v, _, _, e = control_law(y, p, modes, r, rd, ii)
+    if fa_state:
+        u = v if math.isinf(wt) else y[iu]
+        Fa, _ = actuator(u + fa, p)
+    else:
+        Fa, _ = actuator(fa, p)
     Fe, _ = external_force(x1, p)
     stick = p[P_SWITCH] != 0.0 and modes[MODE_STICK] == 1
     sgn = float(modes[MODE_SIGN])
@@ -332,8 +490,9 @@ def rhs(t, y, p, modes, r, rd, fa, fa_state, f):
         if stick:
             Ff = 0.0
         else:
-            g, _, _ = stribeck(v2, x2, p)
-            Ff = sgn * g + p[P_SIGMA2] * v2
+            g, _, _ = stribeck(v2, x2, sgn, p)
+            s2 = p[P_SIGMA2] if sgn > 0.0 else p[P_SIGMA2_NEG]
+            Ff = sgn * g + s2 * v2
     else:
         zd, Ff, _, _, _, _, _, _ = lugre(v2, x2, z, sgn, p)
     if iso:
@@ -361,15 +520,12 @@ def rhs(t, y, p, modes, r, rd, fa, fa_state, f):
             f[0] = v1
             f[1] = (Fa + Fe - Ff) / (p[P_M1] + p[P_M2])
     f[iz] = zd
-    if p[P_TS] > 0.0:
+    if discrete:
         f[ii] = 0.0
         f[iu] = 0.0
     else:
-        xm = measured_position(x1, p, modes[MODE_LEVEL])
-        e = r - xm
-        ed = rd if p[P_QUANT] > 0.0 else rd - v1
         f[ii] = p[P_KI] * e
-        f[iu] = p[P_WT] * (p[P_KP] * e + y[ii] + p[P_KD] * ed - y[iu])
+        f[iu] = 0.0 if math.isinf(wt) else wt * (v - y[iu])
 
 
 @njit((f8, A1, A1, I1, f8, f8, f8, b1, A2), cache=True, error_model="numpy", _nrt=False)
@@ -381,16 +537,23 @@ def jacobian(t, y, p, modes, r, rd, fa, fa_state, J):
             J[i, j] = 0.0
     iso = p[P_ISO] != 0.0
     if iso:
-        iz, ii, iu = 4, 5, 6
-        x1, v1, x2, v2 = y[0], y[1], y[2], y[3]
+        iz, ii, iu = N_CORE_ISO, N_CORE_ISO + 1, N_CORE_ISO + 2
+        x1, x2, v2 = y[0], y[2], y[3]
     else:
-        iz, ii, iu = 2, 3, 4
-        x1, v1 = y[0], y[1]
-        x2, v2 = x1, v1
+        iz, ii, iu = N_CORE_RIGID, N_CORE_RIGID + 1, N_CORE_RIGID + 2
+        x1 = y[0]
+        x2, v2 = x1, y[1]
     z = y[iz]
-    _, dFa = actuator(y[iu] if fa_state else fa, p)
-    if not fa_state:
-        dFa = 0.0
+    discrete = p[P_TS] > 0.0
+    algebraic = math.isinf(p[P_WT])
+    v = 0.0
+    dv_dx = 0.0
+    dv_dv = 0.0
+    if not discrete:
+        v, dv_dx, dv_dv, _ = control_law(y, p, modes, r, rd, ii)
+    dFa = 0.0
+    if fa_state:
+        _, dFa = actuator((v if algebraic else y[iu]) + fa, p)
     _, dFe = external_force(x1, p)
     stick = p[P_SWITCH] != 0.0 and modes[MODE_STICK] == 1
     sgn = float(modes[MODE_SIGN])
@@ -402,11 +565,22 @@ def jacobian(t, y, p, modes, r, rd, fa, fa_state, J):
     dF_dz = 0.0
     if p[P_SWITCH] != 0.0:
         if not stick:
-            _, dg_dv, dg_dx = stribeck(v2, x2, p)
-            dF_dv = sgn * dg_dv + p[P_SIGMA2]
+            _, dg_dv, dg_dx = stribeck(v2, x2, sgn, p)
+            dF_dv = sgn * dg_dv + (p[P_SIGMA2] if sgn > 0.0 else p[P_SIGMA2_NEG])
             dF_dx = sgn * dg_dx
     else:
         _, _, dzd_dx, dzd_dv, dzd_dz, dF_dx, dF_dv, dF_dz = lugre(v2, x2, z, sgn, p)
+    # the actuator force's dependence on the states, through u (filtered) or v (algebraic)
+    if algebraic:
+        dA_dx = dFa * dv_dx
+        dA_dv = dFa * dv_dv
+        dA_dI = dFa
+        dA_du = 0.0
+    else:
+        dA_dx = 0.0
+        dA_dv = 0.0
+        dA_dI = 0.0
+        dA_du = dFa
     if iso:
         m1 = p[P_M1]
         m2 = p[P_M2]
@@ -417,11 +591,12 @@ def jacobian(t, y, p, modes, r, rd, fa, fa_state, J):
             kk += p[P_KSTOP]
             cc += p[P_CSTOP]
         J[0, 1] = 1.0
-        J[1, 0] = (-kk + dFe) / m1
-        J[1, 1] = -cc / m1
+        J[1, 0] = (-kk + dFe + dA_dx) / m1
+        J[1, 1] = (-cc + dA_dv) / m1
         J[1, 2] = kk / m1
         J[1, 3] = cc / m1
-        J[1, iu] = dFa / m1
+        J[1, ii] = dA_dI / m1
+        J[1, iu] = dA_du / m1
         if not stick:
             J[2, 3] = 1.0
             J[3, 0] = kk / m2
@@ -436,22 +611,22 @@ def jacobian(t, y, p, modes, r, rd, fa, fa_state, J):
         m = p[P_M1] + p[P_M2]
         if not stick:
             J[0, 1] = 1.0
-            J[1, 0] = (dFe - dF_dx) / m
-            J[1, 1] = -dF_dv / m
+            J[1, 0] = (dFe - dF_dx + dA_dx) / m
+            J[1, 1] = (-dF_dv + dA_dv) / m
             J[1, iz] = -dF_dz / m
-            J[1, iu] = dFa / m
+            J[1, ii] = dA_dI / m
+            J[1, iu] = dA_du / m
         J[iz, 0] = dzd_dx
         J[iz, 1] = dzd_dv
         J[iz, iz] = dzd_dz
-    if p[P_TS] == 0.0:
-        de_dx = 0.0 if p[P_QUANT] > 0.0 else -1.0
-        J[ii, 0] = p[P_KI] * de_dx
-        wt = p[P_WT]
-        J[iu, 0] = wt * p[P_KP] * de_dx
-        if p[P_QUANT] == 0.0:
-            J[iu, 1] = -wt * p[P_KD]
-        J[iu, ii] = wt
-        J[iu, iu] = -wt
+    if not discrete:
+        J[ii, 0] = 0.0 if p[P_QUANT] > 0.0 else -p[P_KI]
+        if not algebraic:
+            wt = p[P_WT]
+            J[iu, 0] = wt * dv_dx
+            J[iu, 1] = wt * dv_dv
+            J[iu, ii] = wt
+            J[iu, iu] = -wt
 
 
 @njit((A1, A1, I1), cache=True, error_model="numpy", _nrt=False)

@@ -90,7 +90,7 @@ from . import spec as _spec
 from .errors import DataError, SimulationError
 from .measured import Measurement
 from .metrics import hunting_metrics
-from .reference import from_samples
+from .trajectory import from_samples
 from .results import dataclass_dict, frozen_array, to_jsonable
 from .simulation import SimulationResult, simulate
 
@@ -731,7 +731,8 @@ class _Problem:
         self.moves = [(i0, i1) for i0, i1 in merged if i1 - i0 >= 2]
         ctl = self.spec.controller
         if settle_window is None:
-            settle_window = 5.0 * ctl.integrator_ratio / (2.0 * math.pi * ctl.crossover)
+            ri = ctl.integrator_ratio if math.isfinite(ctl.integrator_ratio) else 1.0
+            settle_window = 5.0 * ri / (2.0 * math.pi * _spec.design_crossover(self.spec))
         self.settle_window = float(settle_window)
         kind = np.full(self.n, "hold", dtype=object)
         for k, (i0, i1) in enumerate(self.moves):
@@ -1168,7 +1169,7 @@ def _spaces(pb: _Problem, guesses: dict, names: list[str]) -> tuple[list[_Space]
                 phase = float((phase + math.pi) % (2 * math.pi) - math.pi)
                 return {"amplitude": v["amplitude"], per: v[per], "phase": phase}
         elif name == "time_delay":
-            lo = max(2e-4, 0.02 / (2 * math.pi * spec.controller.crossover))
+            lo = max(2e-4, 0.02 / (2 * math.pi * _spec.design_crossover(spec)))
             p = eff.parameters[0]
             coords = [_Coord("delay", lo, p.bounds[1], log=True)]
             build = lambda v: dict(v)  # noqa: E731

@@ -21,44 +21,54 @@ import math
 import numpy as np
 
 from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, Integration, PlantParameters,
-                    actuator,
-                    drive_force, jacobian, natural_modes, rhs)
-from .reference import Reference
+                    actuator, controller_output, drive_force, feedforward, jacobian,
+                    natural_modes, rhs, static_friction, state_index)
+from .trajectory import Trajectory
 
 
 class _History:
-    """Controller output u(t) from the dense outputs of finished chunks."""
+    """Controller output u(t) from the dense outputs of finished chunks (u0 before t = 0)."""
 
-    def __init__(self, iu: int) -> None:
+    def __init__(self, u0: float, output) -> None:
         self.starts: list[float] = []
         self.pieces: list = []
-        self.iu = iu
+        self.u0 = u0
+        self.output = output  # (t, y, modes) -> controller output
 
-    def add(self, t0: float, sol) -> None:
+    def add(self, t0: float, sol, modes) -> None:
         self.starts.append(t0)
-        self.pieces.append(sol)
+        self.pieces.append((sol, modes.copy()))
 
     def __call__(self, t: float) -> float:
         if t <= 0.0 or not self.pieces:
-            return 0.0
+            return self.u0
         k = max(bisect.bisect_right(self.starts, t) - 1, 0)
-        return float(self.pieces[k](t)[self.iu])
+        sol, modes = self.pieces[k]
+        return self.output(t, np.ascontiguousarray(sol(t), dtype=float), modes)
 
 
-def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t_out,
-                    rtol: float, atol, x_bound: float, method: str = "Radau"):
+def _breakaway(F: float, p) -> float:
+    """Switch model: > 0 once the drive force exceeds static friction in its direction [N]."""
+    return max(F - static_friction(1.0, p), -F - static_friction(-1.0, p))
+
+
+def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, t_out,
+                    rtol: float, atol, x_bound: float, method: str = "Radau",
+                    input_time=None, input_force=None):
     """Integrate with solve_ivp; same outputs as :func:`fi_design.kernel.run`.
 
-    Returns a :class:`fi_design.plant.Integration`: code 0 on success, 3 on a
-    solver failure, 4 on divergence.
+    ``input_time``, ``input_force``: a known input force added to the
+    command, held between its samples [s, N] (None for none). Returns a
+    :class:`fi_design.plant.Integration`: code 0 on success, 3 on a solver
+    failure, 4 on divergence.
     """
     from scipy.integrate import solve_ivp
 
     p = params.to_array()
     n = len(y0)
     iso = bool(params.isolated)
-    iv2 = 3 if iso else 1
-    ii, iu = n - 2, n - 1
+    idx = state_index(iso)
+    iv2, ii, iu = idx["v2"], idx["I"], idx["u"]
     Ts = params.sample_period
     delay = params.delay
     discrete = Ts > 0
@@ -67,11 +77,16 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
     sw = bool(params.switch_model)
     q = params.quantization
     s = params.s
+    in_t = np.zeros(0) if input_time is None else np.asarray(input_time, dtype=float)
+    in_f = np.zeros(0) if input_force is None else np.asarray(input_force, dtype=float)
+    # times at which the delayed input changes value
+    changes = (in_t[np.r_[True, np.diff(in_f) != 0]] + delay) if len(in_t) else in_t
 
     t_out = np.asarray(t_out, dtype=float)
     out_y = np.full((len(t_out), n), np.nan)
     out_r = np.full(len(t_out), np.nan)
     out_fa = np.full(len(t_out), np.nan)
+    out_cmd = np.full(len(t_out), np.nan)
 
     y = np.array(y0, dtype=float)
     modes = np.zeros(4, dtype=np.int64)
@@ -79,35 +94,55 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
     natural_modes(y, p, modes)
     if sw:
         modes[MODE_STICK] = 1 if y[iv2] == 0.0 else 0
-    hist = _History(iu)
-    fa_hold = 0.0
-    qd = np.zeros(2)
+    dx = [params.dx1, params.dx2]
+    fa_hold = params.u_initial
     fifo: list[tuple[float, float]] = []
     k_sample = 0
     t = 0.0
     n_steps = n_rej = n_ev = 0
     breaks = list(ref.breaks) if ref.land else []
 
-    def fa_at(tt: float, yy) -> float:
+    def r_of(tt: float) -> tuple[float, float]:
+        return float(ref(tt)), float(ref(tt, 1))
+
+    def u_of(tt: float, yy, mm) -> float:
+        return controller_output(yy, p, mm, *r_of(tt), ii, iu)
+
+    hist = _History(params.u_initial, u_of)
+
+    def input_of(tt: float) -> float:
+        k = bisect.bisect_right(in_t, tt + 1e-12 * max(1.0, abs(tt))) - 1
+        return float(in_f[k]) if k >= 0 else 0.0
+
+    def extras(tt: float) -> float:
+        """Feedforward (continuous controller) plus input force at tt [N]."""
+        F = input_of(tt)
+        if not discrete:
+            F += feedforward(float(ref(tt, 1)), float(ref(tt, 2)), 0.0, p)[0]
+        return F
+
+    def fa_at(tt: float) -> float:
         if fa_state:
-            return yy[iu]
+            return extras(tt)
         if cont_delay:
-            return hist(tt - delay)
-        return fa_hold
+            return hist(tt - delay) + extras(tt - delay)
+        return fa_hold + input_of(tt - delay)
 
     def fun(tt, yy):
         yy = np.ascontiguousarray(yy, dtype=float)
-        r, rd = float(ref(tt)), float(ref(tt, 1))
         f = np.empty(n)
-        rhs(tt, yy, p, modes, r, rd, fa_at(tt, yy) if not fa_state else 0.0, fa_state, f)
+        rhs(tt, yy, p, modes, *r_of(tt), fa_at(tt), fa_state, f)
         return f
 
     def jac(tt, yy):
         yy = np.ascontiguousarray(yy, dtype=float)
-        r, rd = float(ref(tt)), float(ref(tt, 1))
         J = np.empty((n, n))
-        jacobian(tt, yy, p, modes, r, rd, fa_at(tt, yy) if not fa_state else 0.0, fa_state, J)
+        jacobian(tt, yy, p, modes, *r_of(tt), fa_at(tt), fa_state, J)
         return J
+
+    def drive(tt, yy) -> float:
+        return drive_force(np.ascontiguousarray(yy, dtype=float), p, modes, *r_of(tt), fa_at(tt),
+                           fa_state)
 
     def events():
         evs = []
@@ -116,9 +151,7 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
         if not stuck:
             evs.append(("sign", lambda tt, yy: sgn * yy[iv2], -1))
         if sw and stuck:
-            evs.append(("unstick", lambda tt, yy: abs(drive_force(
-                np.ascontiguousarray(yy, dtype=float), p, fa_at(tt, yy), fa_state))
-                        - params.Fs, 1))
+            evs.append(("unstick", lambda tt, yy: _breakaway(drive(tt, yy), p), 1))
         if iso:
             lim = modes[MODE_LIMIT]
             if lim == 0:
@@ -139,23 +172,25 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
             funcs.append(g)
         return [e[0] for e in evs], funcs
 
-    def write_outputs(t0, t1, sol, fa_piece):
+    def write_outputs(t0, t1, sol):
+        """Outputs in [t0, t1) from ``sol`` (at t0 only, from the state, when ``sol`` is None):
+        those at t1 follow its time events."""
         lo = bisect.bisect_left(t_out, t0 - 1e-12)
-        hi = bisect.bisect_right(t_out, t1 + 1e-12)
+        hi = bisect.bisect_left(t_out, t1 - 1e-12) if sol is not None else \
+            bisect.bisect_right(t_out, t0 + 1e-12)
         for i in range(lo, hi):
             if not np.isnan(out_r[i]):
                 continue
             tt = t_out[i]
-            yy = sol(tt) if sol is not None else y
+            yy = np.ascontiguousarray(sol(tt) if sol is not None else y, dtype=float)
             out_y[i] = yy
             out_r[i] = float(ref(tt))
-            if fa_state:
-                fa = yy[iu]
-            elif cont_delay:
-                fa = hist(tt - delay)
+            if discrete:
+                out_cmd[i] = yy[iu] + input_of(tt)
+                out_fa[i] = actuator(fa_at(tt), p)[0]
             else:
-                fa = fa_piece
-            out_fa[i] = actuator(fa, p)[0]
+                out_cmd[i] = u_of(tt, yy, modes) + extras(tt)
+                out_fa[i] = actuator(out_cmd[i] if fa_state else fa_at(tt), p)[0]
 
     status = "ok"
     code = 0
@@ -166,11 +201,13 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
             lev = math.floor(y[0] / q + 0.5) if q > 0 else 0
             xm = lev * q if q > 0 else y[0]
             e_k = float(ref(t)) - xm
-            u_k = params.cd1 * qd[0] + params.cd2 * qd[1] + params.dd * e_k
-            qd = np.array([params.ad11 * qd[0] + params.ad12 * qd[1] + params.bd1 * e_k,
-                           params.ad21 * qd[0] + params.ad22 * qd[1] + params.bd2 * e_k])
+            d_k = -xm if params.dmeas else e_k
+            u_k = params.dp * e_k + dx[0] + params.dc * e_k + dx[1] + params.db * d_k
+            u_k += feedforward(float(ref(t, 1)), float(ref(t, 2)), 0.0, p)[0]
+            dx = [dx[0] + 2.0 * params.dc * e_k,
+                  params.da * (dx[1] + params.db * d_k) - params.db * d_k]
             y[iu] = u_k
-            y[ii] = qd[0]
+            y[ii] = dx[0]
             if delay == 0:
                 fa_hold = u_k
             else:
@@ -179,11 +216,11 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
         while fifo and t >= fifo[0][0] - 1e-12:
             fa_hold = fifo.pop(0)[1]
         if sw and modes[MODE_STICK] == 1:
-            F = drive_force(y, p, fa_at(t, y), fa_state)
-            if abs(F) > params.Fs:
+            F = drive(t, y)
+            if _breakaway(F, p) > 0:
                 modes[MODE_STICK] = 0
                 modes[MODE_SIGN] = 1 if F > 0 else -1
-        write_outputs(t, t, None, fa_hold)
+        write_outputs(t, t, None)
         # next time event
         t_next = t_end
         k = bisect.bisect_right(breaks, t + 1e-12)
@@ -195,6 +232,9 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
             t_next = min(t_next, fifo[0][0])
         if cont_delay:
             t_next = min(t_next, t + delay)
+        k = bisect.bisect_right(changes, t + 1e-12 * max(1.0, t))
+        if k < len(changes):
+            t_next = min(t_next, changes[k])
         names, funcs = events()
         if zero_run > 2:
             # grazing: the state sits on a switching surface (a cart at rest has
@@ -212,15 +252,15 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
             break
         t1 = float(sol.t[-1])
         if cont_delay:
-            hist.add(t, sol.sol)
-        write_outputs(t, t1, sol.sol, fa_hold)
+            hist.add(t, sol.sol, modes)
+        write_outputs(t, t1, sol.sol)
         y = sol.y[:, -1].copy()
         if sol.status == 1:  # an event
             for name, te, ye in zip(names, sol.t_events, sol.y_events):
                 if len(te):
                     y = ye[0].copy()
                     t1 = float(te[0])
-                    _switch(name, y, p, modes, params, iv2, iu, fa_at(t1, y), fa_state)
+                    _switch(name, y, p, modes, params, iv2, iu, *r_of(t1), fa_at(t1), fa_state)
                     n_ev += 1
                     zero_run = zero_run + 1 if t1 - t <= 1e-12 * max(1.0, t) else 0
                     break
@@ -228,25 +268,27 @@ def solve_reference(params: PlantParameters, y0, ref: Reference, t_end: float, t
         if abs(y[0]) > x_bound or not np.all(np.isfinite(y)):
             code, status = 4, "solution diverged"
             break
+    if code == 0:
+        write_outputs(t, t, None)
     return Integration(code=code, status=status, states=out_y, reference=out_r,
-                       applied_force=out_fa, n_steps=n_steps, n_rejected=n_rej, n_events=n_ev,
-                       t_reached=t)
+                       applied_force=out_fa, command=out_cmd, n_steps=n_steps, n_rejected=n_rej,
+                       n_events=n_ev, t_reached=t)
 
 
-def _switch(name, y, p, modes, params, iv2, iu, fa, fa_state) -> None:
+def _switch(name, y, p, modes, params, iv2, iu, r, rd, fa, fa_state) -> None:
     """Mode change at an event located by solve_ivp."""
     if name == "sign":
         if params.switch_model:
             y[iv2] = 0.0
-            F = drive_force(y, p, fa, fa_state)
-            if abs(F) <= params.Fs:
+            F = drive_force(y, p, modes, r, rd, fa, fa_state)
+            if _breakaway(F, p) <= 0:
                 modes[MODE_STICK] = 1
             else:
                 modes[MODE_SIGN] = 1 if F > 0 else -1
         else:
             modes[MODE_SIGN] = -modes[MODE_SIGN]
     elif name == "unstick":
-        F = drive_force(y, p, fa, fa_state)
+        F = drive_force(y, p, modes, r, rd, fa, fa_state)
         modes[MODE_STICK] = 0
         modes[MODE_SIGN] = 1 if F > 0 else -1
     elif name == "limit+":
@@ -258,5 +300,5 @@ def _switch(name, y, p, modes, params, iv2, iu, fa, fa_state) -> None:
     elif name in ("level+", "level-"):
         step = 1 if name == "level+" else -1
         modes[MODE_LEVEL] += step
-        if params.sample_period == 0:
-            y[iu] += -params.wt * params.kd * params.quantization * step
+        if params.sample_period == 0 and not math.isinf(params.wt):
+            y[iu] += -params.wt * (params.kd + params.kdm) * params.quantization * step

@@ -24,12 +24,16 @@ from . import effects as _effects
 from . import spec as _spec
 from .errors import SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
-from .pid import tune_pid
+from .pid import ControlLaw, control_law
 from .plant import PlantParameters, state_index
-from .reference import Reference, from_moves
+from .replay import DRIVES, ReplayFit, initial_state, record_state, replay_fit
 from .results import frozen_array, to_jsonable
+from .trajectory import Trajectory, from_moves, from_samples
 
 METHODS = ("fast", "reference")
+
+#: Default length of the re-anchored windows of an open-loop replay [s].
+WINDOW = 0.1
 
 
 @dataclass(frozen=True, eq=False)
@@ -45,7 +49,7 @@ class SimulationResult:
     friction_model : str
         ``"lugre"`` or ``"switch"``.
     crossover : float
-        Controller crossover the PID was tuned for [Hz].
+        Crossover of the controller [Hz] (the rule's, or the hardware gains').
     effects : tuple of str
         Names of the effects in the model.
     time : ndarray, shape (n,)
@@ -61,7 +65,9 @@ class SimulationResult:
     cart_velocity : ndarray, shape (n,)
         Cart velocity v2 [m/s].
     force : ndarray, shape (n,)
-        Commanded actuator force u [N], before delay and saturation.
+        Commanded actuator force [N], before delay and saturation: the
+        controller's output plus feedforward plus a known input force (a
+        record's disturbance; in an open-loop replay the measured force).
     applied_force : ndarray, shape (n,)
         Force acting on the stage [N], after delay and saturation.
     bristle : ndarray, shape (n,)
@@ -84,6 +90,17 @@ class SimulationResult:
         Hunting metric and verdict of this trace.
     parameters : PlantParameters
         The kernel parameters used.
+    drive : str
+        ``"closed"`` (the model's controller closes the loop) or ``"force"``
+        (open-loop replay of a record's measured force).
+    record : str or None
+        Source of the replayed record; None for the spec's own motion.
+    window : ndarray of int, shape (n,), or None
+        Open-loop replay: the number of the re-anchored window of each
+        sample (the state is reset to the measurement at each window's
+        start); None otherwise.
+    replay : ReplayFit or None
+        How a record's replay agrees with the measurement; None otherwise.
     """
 
     isolated: bool
@@ -110,6 +127,10 @@ class SimulationResult:
     wall_time: float
     metrics: HuntingMetrics
     parameters: PlantParameters
+    drive: str = "closed"
+    record: str | None = None
+    window: np.ndarray | None = None
+    replay: ReplayFit | None = None
 
     @property
     def error(self) -> np.ndarray:
@@ -131,6 +152,8 @@ class SimulationResult:
                 "force_N": self.force}
         if self.isolated:
             cols["deflection_m"] = self.deflection
+        if self.window is not None:
+            cols["window"] = self.window
         return cols
 
     def to_dict(self, traces: bool = False) -> dict:
@@ -145,7 +168,7 @@ class SimulationResult:
 
 
 def plant_parameters(spec: _spec.Spec, isolated: bool, crossover: float | None = None,
-                     effects=None) -> PlantParameters:
+                     effects=None, law: ControlLaw | None = None) -> PlantParameters:
     """Kernel parameters of a spec.
 
     Parameters
@@ -155,21 +178,25 @@ def plant_parameters(spec: _spec.Spec, isolated: bool, crossover: float | None =
     isolated : bool
         Two-mass plant with joint and limiters (True) or one rigid mass.
     crossover : float, optional
-        Crossover to tune the PID for [Hz]; default the spec's.
+        Shift the controller to this crossover [Hz] (the rule retunes,
+        explicit gains scale); default the spec's.
     effects : sequence, optional
         Effect entries (spec ``effects`` items) to apply; default the spec's.
+    law : ControlLaw, optional
+        The controller; default :func:`fi_design.pid.control_law` of the spec
+        (and ``crossover``).
 
     Returns
     -------
     PlantParameters
-        PID gains from the nominal masses; effects then change the true
+        The controller from the nominal masses; effects then change the true
         plant (a mass error does not retune the controller).
     """
     if isolated and spec.isolator is None:
         raise SimulationError("the spec has no isolator: cannot simulate the isolated plant")
-    pid = tune_pid(spec, crossover)
+    if law is None:
+        law = control_law(spec, crossover)
     fr = spec.friction
-    ctl = spec.controller
     iso = spec.isolator
     if isolated:
         k = _spec.drive_stiffness(spec)
@@ -180,12 +207,14 @@ def plant_parameters(spec: _spec.Spec, isolated: bool, crossover: float | None =
     params = PlantParameters(
         m1=spec.stage.mass, m2=spec.cart.mass, **joint,
         Fs=fr.static, Fc=fr.coulomb, vs=fr.stribeck_velocity, sigma0=fr.bristle_stiffness,
-        sigma1=_spec.bristle_damping(spec), sigma2=fr.viscous,
-        kp=pid.kp, ki=pid.ki, kd=pid.kd, wt=pid.wt, delay=ctl.delay,
+        sigma1=_spec.bristle_damping(spec), sigma2=fr.viscous, **law.kernel_form(),
+        Fc_neg=math.nan if fr.coulomb_negative is None else fr.coulomb_negative,
+        sigma2_neg=math.nan if fr.viscous_negative is None else fr.viscous_negative,
+        offset=fr.offset, ff_mass=law.ff_mass, ff_viscous=law.ff_viscous,
+        ff_coulomb=law.ff_coulomb, delay=law.delay, force_limit=law.force_limit,
         isolated=1.0 if isolated else 0.0, switch_model=1.0 if fr.model == "switch" else 0.0)
-    if ctl.sample_rate:
-        params = replace(params, sample_period=1.0 / ctl.sample_rate,
-                         **_discrete_controller(pid, 1.0 / ctl.sample_rate))
+    if law.sample_period > 0.0:
+        params = replace(params, sample_period=law.sample_period, **law.discrete_form())
     return apply_effects(params, spec.effects if effects is None else effects)
 
 
@@ -202,20 +231,6 @@ def apply_effects(params: PlantParameters, entries) -> PlantParameters:
                 value = getattr(params, par.kernel_field) + value
             changes[par.kernel_field] = float(value)
     return replace(params, **changes) if changes else params
-
-
-def _discrete_controller(pid, Ts: float) -> dict:
-    """Tustin discretisation of C(s) = (kd s^2 + kp s + ki) / (s (1 + s/wt))."""
-    from scipy.signal import cont2discrete
-
-    wt, kp, ki, kd = pid.wt, pid.kp, pid.ki, pid.kd
-    A = np.array([[0.0, 1.0], [0.0, -wt]])
-    B = np.array([[0.0], [1.0]])
-    C = np.array([[wt * ki, wt * (kp - wt * kd)]])
-    D = np.array([[wt * kd]])
-    Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), Ts, method="bilinear")
-    return dict(ad11=Ad[0, 0], ad12=Ad[0, 1], ad21=Ad[1, 0], ad22=Ad[1, 1], bd1=Bd[0, 0],
-                bd2=Bd[1, 0], cd1=Cd[0, 0], cd2=Cd[0, 1], dd=Dd[0, 0])
 
 
 def tolerances(params: PlantParameters, rtol: float) -> np.ndarray:
@@ -236,9 +251,10 @@ def tolerances(params: PlantParameters, rtol: float) -> np.ndarray:
 
 
 def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast", *,
-             crossover: float | None = None, reference: Reference | None = None,
+             crossover: float | None = None, reference: Trajectory | None = None,
              initial_position: float = 0.0, duration: float | None = None,
-             effects=None, rtol: float | None = None) -> SimulationResult:
+             effects=None, rtol: float | None = None, record=None, drive: str = "closed",
+             window: float = WINDOW) -> SimulationResult:
     """Simulate the stage and evaluate the hunting metric.
 
     Parameters
@@ -252,31 +268,56 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         RODAS4 kernel, or scipy solve_ivp (Radau, tight tolerance) on the same
         equations for checks and benchmarks.
     crossover : float, optional
-        Crossover to tune the PID for [Hz]; default the spec's.
-    reference : Reference, optional
-        A given reference signal (measured data) instead of the spec's moves.
+        Shift the controller to this crossover [Hz]; default the spec's.
+    reference : Trajectory, optional
+        A given reference signal instead of the spec's moves.
     initial_position : float
         Stage and cart position at t = 0 [m], at rest.
     duration : float, optional
         Simulated time [s]; default ``spec.motion.duration`` (or the end of a
-        given reference).
+        given reference or record).
     effects : sequence, optional
         Effect entries replacing the spec's ``effects`` list.
     rtol : float, optional
         Relative tolerance of the chosen method; default
         ``spec.simulation.tolerance`` for the fast path and 1e-4 times it for
         the reference.
+    record : fi_design.measured.Measurement, optional
+        Replay this measured record (DESIGN.md section 8) instead of the
+        spec's motion: the model starts from the state in the data (position
+        and velocity from the first samples, the controller consistent with
+        the first force sample) and its outputs are at the record's times.
+    drive : {"closed", "force"}
+        With a record: ``"closed"`` drives the model and its controller with
+        the measured reference (and ``disturbance_N``); ``"force"`` drives the
+        plant open loop with the measured ``force_N`` (no controller model),
+        re-anchored to the measurement every ``window`` seconds.
+    window : float
+        Length of the re-anchored windows of an open-loop replay [s].
 
     Returns
     -------
     SimulationResult
         Integration failures are reported in ``success``, ``status`` and
         ``message``, never raised.
+
+    Raises
+    ------
+    SimulationError
+        An unknown method or drive, or a drive that needs what the record
+        lacks (``force_N`` for ``drive="force"``).
     """
     if method not in METHODS:
         raise SimulationError(f"method must be one of {METHODS}, got {method!r}")
+    if drive not in DRIVES:
+        raise SimulationError(f"drive must be one of {DRIVES}, got {drive!r}")
     iso = spec.has_isolator if isolated is None else bool(isolated)
-    params = plant_parameters(spec, iso, crossover, effects)
+    law = control_law(spec, crossover)
+    params = plant_parameters(spec, iso, effects=effects, law=law)
+    if record is not None:
+        return _replay(spec, iso, method, law, params, record, drive, window, rtol, effects)
+    if drive != "closed":
+        raise SimulationError("drive='force' replays a record: give record=")
     params = replace(params, x1_initial=float(initial_position))
     if reference is None:
         t_end = spec.motion.duration if duration is None else duration
@@ -284,55 +325,148 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         if initial_position:
             c = np.array(ref.coeffs)
             c[:, 0] += initial_position
-            ref = Reference(ref.breaks, c, land=True)
+            ref = Trajectory(ref.breaks, c, land=True)
     else:
         ref = reference
         t_end = float(ref.breaks[-1]) if duration is None else duration
     rate = spec.simulation.output_rate
     n_out = int(math.floor(t_end * rate + 1e-9)) + 1
     t_out = np.arange(n_out) / rate
-    if rtol is not None:
-        tol = rtol
-    else:
-        tol = spec.simulation.tolerance * (1.0 if method == "fast" else 1e-4)
-    n = params.n_states
-    y0 = np.zeros(n)
-    y0[0] = initial_position
-    if iso:
-        y0[2] = initial_position
-    x_bound = 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(initial_position))
+    y0 = np.zeros(params.n_states)
+    idx = state_index(iso)
+    y0[idx["x1"]] = initial_position
+    y0[idx["x2"]] = initial_position
+    out, wall = _integrate(spec, method, params, y0, ref, t_end, t_out, rtol)
+    return _result(spec, iso, method, law, params, out, t_out, wall,
+                   effects, move_end=spec.motion.end_time if reference is None else 0.0)
 
+
+def _integrate(spec, method, params, y0, ref, t_end, t_out, rtol, input_time=None,
+               input_force=None):
+    """One integration with the chosen method; returns the Integration and its wall time [s]."""
+    tol = rtol if rtol is not None else spec.simulation.tolerance * (
+        1.0 if method == "fast" else 1e-4)
+    x_bound = 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(y0[0]))
     start = _time.perf_counter()
     if method == "fast":
         from .kernel import run  # compiles or loads the kernel on first use
 
         start = _time.perf_counter()
         out = run(params.to_array(), y0, ref.breaks, ref.coeffs, ref.land, t_end, t_out, tol,
-                  tolerances(params, tol), 0.05, spec.simulation.max_steps, x_bound)
+                  tolerances(params, tol), 0.05, spec.simulation.max_steps, x_bound,
+                  input_time, input_force)
     else:
         from .refsolve import solve_reference
 
         out = solve_reference(params, y0, ref, t_end, t_out, tol, tolerances(params, tol),
-                              x_bound)
-    wall = _time.perf_counter() - start
+                              x_bound, input_time=input_time, input_force=input_force)
+    return out, _time.perf_counter() - start
+
+
+def _result(spec, iso, method, law, params, out, t_out, wall, effects, *, move_end,
+            time_offset=0.0, drive="closed", record=None, window=None) -> SimulationResult:
+    """The result of an integration; ``record`` (a Measurement) for a replay."""
     success = out.code == 0
     message = "" if success else _failure_message(out.status, out.t_reached, params, iso)
     Y, R = out.states, out.reference
     idx = state_index(iso)
-    metrics = _metrics(spec, t_out, Y[:, idx["x1"]] - R, success, message,
-                       spec.motion.end_time if reference is None else 0.0)
+    t = t_out + time_offset
+    metrics = _metrics(spec, t, Y[:, idx["x1"]] - R, success, message, move_end)
     return SimulationResult(
         isolated=iso, method=method, friction_model=spec.friction.model,
-        crossover=spec.controller.crossover if crossover is None else float(crossover),
+        crossover=law.crossover,
         effects=tuple(e.type for e in (spec.effects if effects is None else effects)),
-        time=frozen_array(t_out), reference=frozen_array(R), position=frozen_array(Y[:, idx["x1"]]),
+        time=frozen_array(t), reference=frozen_array(R), position=frozen_array(Y[:, idx["x1"]]),
         cart_position=frozen_array(Y[:, idx["x2"]]), velocity=frozen_array(Y[:, idx["v1"]]),
-        cart_velocity=frozen_array(Y[:, idx["v2"]]), force=frozen_array(Y[:, idx["u"]]),
+        cart_velocity=frozen_array(Y[:, idx["v2"]]), force=frozen_array(out.command),
         applied_force=frozen_array(out.applied_force), bristle=frozen_array(Y[:, idx["z"]]),
-        success=success, status=out.status, message=message, t_reached=out.t_reached,
+        success=success, status=out.status, message=message, t_reached=out.t_reached + time_offset,
         n_steps=out.n_steps, n_rejected=out.n_rejected, n_events=out.n_events, wall_time=wall,
-        metrics=metrics,
-        parameters=params)
+        metrics=metrics, parameters=params, drive=drive,
+        record=None if record is None else (record.source or "record"),
+        window=None if window is None else frozen_array(window, dtype=int),
+        replay=None if record is None else replay_fit(record, Y[:, idx["x1"]], out.command))
+
+
+def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects):
+    """Replay a measured record, closed loop or open loop in re-anchored windows."""
+    t0 = float(record.time[0])
+    t_out = np.asarray(record.time, dtype=float) - t0
+    ref = from_samples(t_out, record.reference)
+    if drive == "closed":
+        dist = record.disturbance
+        command = None if record.force is None else float(
+            record.force[0] - (dist[0] if dist is not None else 0.0))
+        y0, p0 = _anchor(law, params, record, 0, ref, command)
+        out, wall = _integrate(spec, method, p0, y0, ref, float(t_out[-1]), t_out, rtol,
+                               None if dist is None else t_out, dist)
+        return _result(spec, iso, method, law, p0, out, t_out, wall, effects, move_end=0.0,
+                       time_offset=t0, record=record)
+    if record.force is None:
+        raise SimulationError("an open-loop replay (drive='force') needs the record's force_N "
+                              "column")
+    if not window > 0.0:
+        raise SimulationError(f"window must be a positive time [s], got {window!r}")
+    # the plant alone, driven by the measured force: no controller, no feedforward
+    open_loop = replace(params, kp=0.0, ki=0.0, kd=0.0, kdm=0.0, wt=math.inf, ff_mass=0.0,
+                        ff_viscous=0.0, ff_coulomb=0.0, sample_period=0.0, delay=0.0)
+    starts = np.unique(np.append(
+        np.searchsorted(t_out, np.arange(0.0, t_out[-1], window), side="left"), len(t_out)))
+    pieces, wall = [], 0.0
+    for a, b in zip(starts[:-1], starts[1:]):
+        stop = min(b + 1, len(t_out))  # integrate to the next window's start
+        y0, p0 = _anchor(law, open_loop, record, a, ref, None)
+        tw = t_out[a:stop] - t_out[a]
+        seg = Trajectory(ref.breaks - t_out[a], ref.coeffs, land=False)
+        out, dt = _integrate(spec, method, p0, y0, seg, float(tw[-1]), tw, rtol, tw,
+                             record.force[a:stop])
+        wall += dt
+        pieces.append((int(a), int(b - a), out))
+        if out.code != 0:
+            break
+    merged, labels = _merge(pieces, t_out)
+    return _result(spec, iso, method, law, open_loop, merged, t_out, wall, effects, move_end=0.0,
+                   time_offset=t0, drive="force", record=record, window=labels)
+
+
+def _anchor(law, params, record, index, ref, command):
+    """Initial state and parameters for a replay starting at sample ``index``."""
+    from .plant import feedforward
+
+    st = record_state(record, index)
+    tau = float(record.time[index] - record.time[0])
+    r, rd, rdd = (float(ref(tau, k)) for k in (0, 1, 2))
+    ff = feedforward(rd, rdd, 0.0, params.to_array())[0]
+    defl = None if record.deflection is None or not params.isolated else \
+        float(record.deflection[index])
+    return initial_state(params, law, st, deflection=defl, command=command,
+                         reference=(r, rd, rdd), feedforward=ff)
+
+
+def _merge(pieces, t_out):
+    """One Integration, and the window number per sample, from the windows of a replay.
+
+    ``pieces`` holds ``(first sample, samples kept, Integration)`` per window;
+    samples after a failed window stay NaN (window -1).
+    """
+    from .plant import Integration
+
+    n = len(t_out)
+    states = np.full((n, pieces[0][2].states.shape[1]), np.nan)
+    cols = {k: np.full(n, np.nan) for k in ("reference", "applied_force", "command")}
+    labels = np.full(n, -1, dtype=int)
+    for w, (a, m, out) in enumerate(pieces):
+        states[a:a + m] = out.states[:m]
+        for k in cols:
+            cols[k][a:a + m] = getattr(out, k)[:m]
+        labels[a:a + m] = w
+    a, _, last = pieces[-1]
+    return Integration(
+        code=last.code, status=last.status, states=states, reference=cols["reference"],
+        applied_force=cols["applied_force"], command=cols["command"],
+        n_steps=sum(p[2].n_steps for p in pieces), n_rejected=sum(p[2].n_rejected for p in pieces),
+        n_events=sum(p[2].n_events for p in pieces),
+        t_reached=float(t_out[a]) + last.t_reached), labels
 
 
 def _metrics(spec, t, err, success, message, move_end) -> HuntingMetrics:

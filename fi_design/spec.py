@@ -21,7 +21,7 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Discriminator, Fie
                       Tag, WithJsonSchema, create_model, model_validator)
 
 from . import effects as _effects
-from .reference import profile_duration
+from .trajectory import profile_duration
 from .units import to_si
 
 # --------------------------------------------------------------------------- quantities
@@ -84,6 +84,17 @@ class Friction(StrictModel):
     bristle_damping: OptQ("N*s/m") = Field(
         None, ge=0, description="Bristle damping sigma1 [N s/m]. Default sqrt(sigma0 (m1 + m2)): "
                                 "damping ratio 0.5 of the whole moving mass on the bristles.")
+    coulomb_negative: OptQ("N") = Field(
+        None, gt=0, description="Coulomb friction when the cart slides in the negative direction "
+                                "[N]; static friction that way scales with it (Fs coulomb_negative "
+                                "/ coulomb). Default: coulomb (symmetric friction).")
+    viscous_negative: OptQ("N*s/m") = Field(
+        None, ge=0, description="Viscous friction coefficient in the negative direction [N s/m]. "
+                                "Default: viscous.")
+    offset: Q("N") = Field(0.0, description="Constant load force on the stage [N] (drive offset, "
+                                            "gravity on an inclined axis), with the sign of a "
+                                            "friction force: m1 a1 = u - offset - ..., so u = "
+                                            "offset holds the stage. Default 0.")
 
     @model_validator(mode="after")
     def _static_above_coulomb(self) -> "Friction":
@@ -171,20 +182,71 @@ class Isolator(StrictModel):
                                                       "guide that realises the stiffness.")
 
 
-class Controller(StrictModel):
-    """PID controller tuned from the crossover (DESIGN.md section 2, paper section 2.2)."""
+class Gains(StrictModel):
+    """The hardware's own controller gains, parallel form: u = kp e + ki integral(e) + kd e'."""
 
-    crossover: Q("Hz") = Field(gt=0, description="Desired crossover frequency fc [Hz].")
-    derivative_ratio: float = Field(3.0, gt=1, description="wd = wc / ratio and wt = ratio * wc. "
-                                                           "Default 3.")
-    integrator_ratio: float = Field(10.0, gt=1, description="wi = wc / ratio. Default 10.")
+    kp: Q("N/m") = Field(gt=0, description="Proportional gain kp [N/m].")
+    ki: Q("N/(m*s)") = Field(0.0, ge=0, description="Integral gain ki [N/(m s)]; 0: a PD loop "
+                                                    "(no integrator). Default 0.")
+    kd: Q("N*s/m") = Field(0.0, ge=0, description="Derivative gain kd [N s/m]. Default 0.")
+
+
+class Feedforward(StrictModel):
+    """Force from the reference, added to the feedback force: mass r'' + viscous r' + coulomb sign(r')."""
+
+    mass: Q("kg") = Field(0.0, ge=0, description="Acceleration feedforward mass [kg]. Default 0.")
+    viscous: Q("N*s/m") = Field(0.0, ge=0, description="Velocity feedforward [N s/m]. Default 0.")
+    coulomb: Q("N") = Field(0.0, ge=0, description="Coulomb feedforward, times the sign of the "
+                                                   "reference velocity [N]. Default 0.")
+
+
+class Controller(StrictModel):
+    """The position controller: the paper's PID rule (DESIGN.md section 2) or the hardware's gains.
+
+    Without ``gains`` the PID is tuned from ``crossover`` by the rule; with
+    ``gains`` the loop, the four limit cases, the simulation and the report
+    use the given gains, and the rule's gains are shown beside them.
+    """
+
+    crossover: OptQ("Hz") = Field(None, gt=0, description="Desired crossover frequency fc [Hz]; "
+                                                           "the rule tunes the PID for it. "
+                                                           "Optional with `gains` (the achieved "
+                                                           "crossover is computed and must then "
+                                                           "agree within 10 %).")
+    gains: Gains | None = Field(None, description="The hardware's own gains; omit to tune by the "
+                                                  "rule.")
+    derivative_on: Literal["error", "measurement"] = Field(
+        "error", description="Input of the D term: 'error' (default) or 'measurement' (-x1 only: "
+                             "velocity feedback, as most industrial drives do).")
+    roll_off: OptQ("Hz") = Field(None, gt=0, description="First-order low-pass of the D term "
+                                                         "[Hz]. Default: with the rule its wt "
+                                                         "(derivative_ratio x crossover); with "
+                                                         "`gains` none (an ideal D, sampled when "
+                                                         "sample_rate is set).")
+    force_limit: OptQ("N") = Field(None, gt=0, description="Actuator saturation of the hardware "
+                                                           "[N]; null: none.")
+    feedforward: Feedforward | None = Field(None, description="Feedforward from the reference; "
+                                                              "null: none.")
+    derivative_ratio: float = Field(3.0, gt=1, description="Rule: wd = wc / ratio and wt = ratio "
+                                                           "* wc. Default 3.")
+    integrator_ratio: float = Field(10.0, gt=1, allow_inf_nan=True,
+                                    description="Rule: wi = wc / ratio; .inf for a PD rule (no "
+                                                "integrator). Default 10.")
     tuning_mass: Literal["total", "stage"] = Field(
-        "total", description="Mass the gains are tuned on: 'total' (m1 + m2, default) or 'stage'.")
+        "total", description="Mass the rule tunes on: 'total' (m1 + m2, default) or 'stage'.")
     sample_rate: OptQ("Hz") = Field(None, gt=0, description="Sample rate of a discrete controller "
-                                                            "[Hz]; null for continuous time.")
+                                                            "[Hz] (zero-order hold); null for "
+                                                            "continuous time.")
     delay: Q("s") = Field(0.0, ge=0, description="Computational delay [s]. Default 0.")
     pade_order: int = Field(3, ge=1, le=10, description="Order of the Pade approximation of the "
                                                         "delay in the linear analysis. Default 3.")
+
+    @model_validator(mode="after")
+    def _crossover_or_gains(self) -> "Controller":
+        if self.crossover is None and self.gains is None:
+            raise ValueError("give the desired crossover (the PID rule tunes for it) or the "
+                             "hardware's gains")
+        return self
 
 
 class Move(StrictModel):
@@ -387,6 +449,15 @@ class Spec(StrictModel):
             raise ValueError(f"effect listed twice: {', '.join(dupes)}")
         if "joint_damping" in names and self.isolator is None:
             raise ValueError("effect joint_damping needs an isolator")
+        ctl = self.controller
+        if ctl.gains is not None and ctl.crossover is not None:
+            achieved = gains_crossover(self)
+            if abs(achieved / ctl.crossover - 1.0) > CROSSOVER_AGREEMENT:
+                raise ValueError(
+                    f"controller.crossover: {ctl.crossover:.4g} Hz contradicts controller.gains, "
+                    f"which cross over at {achieved:.4g} Hz on the tuning mass "
+                    f"{tuning_mass(self):.4g} kg; give one of the two, or a crossover within "
+                    f"{CROSSOVER_AGREEMENT:.0%} of the gains'")
         return self
 
     # convenience views, all SI
@@ -402,6 +473,55 @@ class Spec(StrictModel):
 
 
 # --------------------------------------------------------------------------- derived defaults
+
+#: How closely a given crossover must agree with the crossover of given gains [-].
+CROSSOVER_AGREEMENT = 0.10
+
+
+def tuning_mass(spec: Spec) -> float:
+    """Mass the controller is tuned on [kg]: m1 + m2 (``total``) or m1 (``stage``)."""
+    return spec.total_mass if spec.controller.tuning_mass == "total" else spec.stage.mass
+
+
+def gains_crossover(spec: Spec) -> float:
+    """Crossover of the hardware's gains on the tuning mass [Hz].
+
+    The frequency where |C(j w)| = m w^2, i.e. where the loop of the gains
+    around a free tuning mass m crosses 0 dB (the rule's definition of the
+    crossover, DESIGN.md section 2), with C(s) = kp + ki / s + kd s / (1 + s / wf)
+    and wf the D term's roll-off (none when not given). Found by bisection
+    on a log scale (|C| / (m w^2) falls with w for every such C).
+    """
+    ctl = spec.controller
+    g = ctl.gains
+    m = tuning_mass(spec)
+    wf = 2.0 * math.pi * ctl.roll_off if ctl.roll_off is not None else math.inf
+
+    def excess(w: float) -> float:
+        d = 1j * w * g.kd if math.isinf(wf) else 1j * w * g.kd / (1.0 + 1j * w / wf)
+        return abs(g.kp + g.ki / (1j * w) + d) / (m * w * w) - 1.0
+
+    lo, hi = 1e-6, 1e9
+    for _ in range(200):
+        mid = math.sqrt(lo * hi)
+        if excess(mid) > 0.0:
+            lo = mid
+        else:
+            hi = mid
+        if hi / lo < 1.0 + 1e-12:
+            break
+    return math.sqrt(lo * hi) / (2.0 * math.pi)
+
+
+def design_crossover(spec: Spec) -> float:
+    """The loop's crossover [Hz]: ``controller.crossover`` for the rule, else the gains' own.
+
+    With explicit gains a given crossover only has to agree with theirs
+    (:data:`CROSSOVER_AGREEMENT`); the loop crosses over where the gains do.
+    """
+    ctl = spec.controller
+    return ctl.crossover if ctl.gains is None else gains_crossover(spec)
+
 
 
 def bristle_damping(spec: Spec) -> float:

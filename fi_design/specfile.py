@@ -224,6 +224,8 @@ def _validate(raw: dict, org: SpecOrigin) -> Spec:
         errors = exc.errors(include_url=False)
         msgs = [_describe(e, raw) for e in errors]
         first_loc = _clean_loc(errors[0]["loc"], raw)
+        if not first_loc and msgs[0][0]:
+            first_loc = tuple(msgs[0][0].split("."))
         line = _line_for(first_loc, org.lines)
         text = msgs[0][1]
         if len(msgs) > 1:
@@ -329,7 +331,11 @@ def _describe(err: dict, raw: dict) -> tuple[str, str]:
         return path + ".type", (f"unknown effect '{given}'{hint}; known: "
                                 f"{', '.join(_effects.EFFECT_NAMES)}")
     if kind == "value_error":
-        return path, msg.removeprefix("Value error, ")
+        text = msg.removeprefix("Value error, ")
+        named = _NAMED.match(text) if not path else None
+        if named and named.group(1).split(".")[0].split("[")[0] in Spec.model_fields:
+            return named.group(1), named.group(2)
+        return path, text
     if kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
         unit = _unit_at(loc)
         bound = list(err.get("ctx", {}).values())[0]
@@ -345,6 +351,10 @@ def _describe(err: dict, raw: dict) -> tuple[str, str]:
         keys = ", ".join(model.model_fields) if model is not None else ""
         return path, f"expected a mapping{' with keys ' + keys if keys else ''}, got {err['input']!r}"
     return path, msg
+
+
+#: A top-level validator's message that names its field: ``"controller.crossover: ..."``.
+_NAMED = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]=]*): (.+)$", re.S)
 
 
 def _unit_at(loc: tuple) -> str:

@@ -34,6 +34,7 @@ KNOWN_UNITS = {
     "N": "force",
     "N/m": "stiffness (force per length)",
     "N*s/m": "damping (force per velocity)",
+    "N/(m*s)": "integral gain (force per length and time)",
     "m/s": "velocity",
     "m/s**2": "acceleration",
     "m/s**3": "jerk",

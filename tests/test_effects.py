@@ -34,6 +34,8 @@ ACTIVE = {
     "force_saturation": {"limit": 2.0},
     "mass_error": {"stage_mass": 2.0, "cart_mass": 0.5},
     "joint_damping": {"damping": 20.0},
+    "force_offset": {"offset": 0.8},
+    "friction_asymmetry": {"coulomb_negative": 2.0, "viscous_negative": 40.0},
 }
 
 
@@ -42,7 +44,7 @@ def neutral_values(effect: fx.Effect, params: PlantParameters) -> dict:
     out = {}
     for p in effect.parameters:
         if p.neutral is None:
-            out[p.name] = getattr(params, p.kernel_field)
+            out[p.name] = params.value(p.kernel_field)
         elif p.combine == "add":
             out[p.name] = 0.0
         elif math.isinf(p.neutral):  # a spec holds finite numbers: a limit never reached
@@ -58,7 +60,7 @@ def entry(name: str, values: dict):
 
 def test_catalogue_matches_design_md():
     assert fx.EFFECT_NAMES == tuple(ACTIVE)
-    assert len(fx.EFFECT_NAMES) == 10
+    assert len(fx.EFFECT_NAMES) == 12
 
 
 @pytest.mark.parametrize("name", fx.EFFECT_NAMES)

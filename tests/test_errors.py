@@ -37,7 +37,7 @@ def test_misuse_raises_library_errors():
     from fi_design.pid import pid_gains
     from fi_design.plots import figure_bytes
 
-    with pytest.raises(ArgumentError, match="positive"):
+    with pytest.raises(SpecError, match="positive"):
         pid_gains(-1.0, 8.0)
     with pytest.raises(ArgumentError, match="svg or png"):
         figure_bytes(object(), "jpg")

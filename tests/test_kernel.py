@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from fi_design import kernel
 from fi_design.plant import MODE_SIGN, jacobian
-from fi_design.reference import from_moves
+from fi_design.trajectory import from_moves
 from fi_design.simulation import plant_parameters
 
 
@@ -46,9 +46,10 @@ def test_structured_solve_equals_dense_solve(paper_spec, isolated):
 @given(t=st.floats(0.0, 25.0))
 def test_reference_lookup_matches_the_vectorised_evaluation(paper_spec, t):
     ref = from_moves(paper_spec.motion.moves, 20.0)
-    r, rd, rdd, _ = kernel.reference_at(t, np.array(ref.breaks), np.array(ref.coeffs), 0)
+    r, rd, rdd, _, _ = kernel.reference_at(t, np.array(ref.breaks), np.array(ref.coeffs), 0)
     assert r == pytest.approx(float(ref(t)), abs=1e-15)
     assert rd == pytest.approx(float(ref(t, 1)), abs=1e-12)
+    assert rdd == pytest.approx(float(ref(t, 2)), abs=1e-9)
 
 
 def test_trapezoid_reference_reaches_the_target(paper_spec):

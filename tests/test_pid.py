@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from fi_design.errors import ArgumentError
 from fi_design.pid import PidGains, pid_gains, tune_pid
 
 
@@ -105,7 +104,7 @@ def test_rule_invariants(mass, fc, r, ri):
 
 @pytest.mark.parametrize("args", [(0.0, 8.0), (2.0, -1.0), (2.0, 8.0, 1.0, 10.0)])
 def test_bad_arguments(args):
-    with pytest.raises(ArgumentError):
+    with pytest.raises(ValueError):
         pid_gains(*args)
 
 

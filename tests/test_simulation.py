@@ -293,7 +293,7 @@ def test_switch_model_matches_its_reference_and_the_paper_trend(paper_spec):
 
 def test_reference_signal_drives_the_model(paper_spec):
     """A sampled reference (measured data) gives the same motion as the spec's moves."""
-    from fi_design.reference import from_samples
+    from fi_design.trajectory import from_samples
 
     r1 = simulate(paper_spec, isolated=True)
     t = r1.time

@@ -276,14 +276,6 @@ def test_cache_key_covers_version_and_code(paper_spec, monkeypatch):
     assert key != cachemod.point_key(h, (("controller.crossover", 8.0),), True)
 
 
-def test_code_digest_reads_every_module_that_decides_a_point():
-    from pathlib import Path
-
-    package = Path(cachemod.__file__).resolve().parents[1]
-    assert all((package / name).is_file() for name in cachemod.CODE_MODULES)
-    assert {"studies/points.py", "simulation.py", "kernel.py"} <= set(cachemod.CODE_MODULES)
-
-
 def test_interrupted_sweep_resumes(paper_spec, kernel, tmp_path):
     class Interrupt(Exception):
         pass
@@ -388,3 +380,24 @@ def test_figures(paper_spec, kernel):
     assert png.startswith(b"\x89PNG")
     assert plots.axis_label("isolator.stroke", "m") == "isolator.stroke [mm]"
     assert plots.display_unit("N/m") == ("N/mm", 1e-3)
+
+
+def test_code_digest_covers_existing_modules_and_changes_with_them(tmp_path, monkeypatch):
+    """The cache key's code digest reads every module that decides an outcome (a renamed
+    module must not silently drop out of it) and changes when one of them changes."""
+    from pathlib import Path
+
+    package = Path(cachemod.__file__).resolve().parents[1]
+    missing = [n for n in cachemod.CODE_MODULES if not (package / n).is_file()]
+    assert not missing
+    assert {"simulation.py", "kernel.py", "plant.py", "trajectory.py",
+            "studies/points.py"} <= set(cachemod.CODE_MODULES)
+    monkeypatch.setattr(cachemod, "_CODE_DIGEST", None)
+    before = cachemod.code_digest()
+    for n in cachemod.CODE_MODULES:
+        (tmp_path / n).parent.mkdir(exist_ok=True)
+        (tmp_path / n).write_bytes((package / n).read_bytes())
+    (tmp_path / "simulation.py").write_bytes(b"# edited\n" + (package / "simulation.py").read_bytes())
+    monkeypatch.setattr(cachemod, "__file__", str(tmp_path / "studies" / "cache.py"))
+    monkeypatch.setattr(cachemod, "_CODE_DIGEST", None)
+    assert cachemod.code_digest() != before

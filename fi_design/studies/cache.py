@@ -30,7 +30,7 @@ CACHE_ENV = "FI_DESIGN_CACHE_DIR"
 METHOD = "fast"
 #: Source files (in the package) that decide a point's outcome; their digest is in every key.
 CODE_MODULES = ("kernel.py", "plant.py", "simulation.py", "metrics.py", "pid.py",
-                "reference.py", "effects.py", "spec.py", "specfile.py", "studies/points.py")
+                "trajectory.py", "effects.py", "spec.py", "specfile.py", "studies/points.py")
 
 
 def default_cache_dir() -> Path:

@@ -322,7 +322,7 @@ def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
     if suggested:
         adv = result.isolator_advice
         spec = with_isolator(spec, adv.stroke, adv.stiffness)
-    fc = spec.controller.crossover
+    fc = _spec.design_crossover(spec)
     s = spec.isolator.stroke
     nx, ny = resolution
     x = make_axis("controller.crossover", np.linspace(0.125 * fc, 2.5 * fc, nx), spec=spec)

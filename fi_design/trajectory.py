@@ -1,4 +1,4 @@
-"""Reference motion r(t) as a piecewise cubic polynomial.
+"""The reference trajectory r(t) (the setpoint the stage follows) as a piecewise cubic.
 
 Both kinds of reference the simulation needs are stored the same way, so the
 kernel evaluates one representation:
@@ -24,8 +24,8 @@ import numpy as np
 
 
 @dataclass(frozen=True, eq=False)
-class Reference:
-    """A piecewise cubic reference trajectory.
+class Trajectory:
+    """A piecewise cubic reference trajectory r(t).
 
     Attributes
     ----------
@@ -140,7 +140,7 @@ def profile_duration(distance: float, velocity: float, acceleration: float,
     return sum(seg[0] for seg in _move_jerks(distance, velocity, acceleration, jerk))
 
 
-def from_moves(moves, duration: float) -> Reference:
+def from_moves(moves, duration: float) -> Trajectory:
     """Build the reference of a sequence of moves starting from r = 0 at rest.
 
     Parameters
@@ -176,10 +176,10 @@ def from_moves(moves, duration: float) -> Reference:
             t += dur
             breaks.append(t)
     hold(max(duration, t + 1e-9))
-    return Reference(np.array(breaks), np.array(coeffs), land=True)
+    return Trajectory(np.array(breaks), np.array(coeffs), land=True)
 
 
-def from_samples(time_s: np.ndarray, reference_m: np.ndarray) -> Reference:
+def from_samples(time_s: np.ndarray, reference_m: np.ndarray) -> Trajectory:
     """A C2 cubic spline through sampled reference values (measured data).
 
     Parameters
@@ -195,4 +195,4 @@ def from_samples(time_s: np.ndarray, reference_m: np.ndarray) -> Reference:
     r = np.asarray(reference_m, dtype=float)
     cs = CubicSpline(t, r, bc_type="natural")
     c = cs.c[::-1].T  # scipy stores highest power first, shape (4, n-1)
-    return Reference(t, c, land=False)
+    return Trajectory(t, c, land=False)
