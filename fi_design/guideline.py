@@ -33,20 +33,22 @@ from __future__ import annotations
 import hashlib
 import logging
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
-from .flexure import FlexureResult, size_flexure
-from .pid import ControlLaw, PidGains, control_law
-from .results import Check, Status, dataclass_dict, frozen_array, to_jsonable
+from .flexure import size_flexure
+from .pid import ControlLaw, control_law
+from .results import Check, Status, frozen_array
+from .results.design import (CaseResponse, Confirmation, CrossoverResult, DesignResult,
+                             FlexureResult, FrictionGapResult, IsolatorAdvice, LoopResponses,
+                             ModeSeparation, PidResult, StiffnessResult)
 from .spec import (Spec, design_crossover, drive_stiffness, proposed_stiffness, stiffness_limit,
                    warnings_for)
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .confirm import Confirmation
     from .execution import Executor
 
 __all__ = [
@@ -72,38 +74,6 @@ def _g(x: float | None, digits: int = 4) -> str:
 
 
 # --------------------------------------------------------------------------- step 1
-
-
-@dataclass(frozen=True)
-class FrictionGapResult:
-    """Step 1: the gap between static and Coulomb friction.
-
-    Attributes
-    ----------
-    static : float
-        Static friction Fs [N].
-    coulomb : float
-        Coulomb friction Fc [N].
-    gap : float
-        Fs - Fc [N].
-    threshold : float
-        ``requirements.friction_gap`` [N]: above it hunting is a risk.
-    hunting_risk : bool
-        ``gap >= threshold``.
-    checks : tuple of Check
-        The step's checks (also in :attr:`DesignResult.checks`).
-    """
-
-    static: float
-    coulomb: float
-    gap: float
-    threshold: float
-    hunting_risk: bool
-    checks: tuple[Check, ...] = field(default=(), repr=False)
-
-    def to_dict(self) -> dict:
-        """Plain JSON data (checks are listed once, in the design's ``checks``)."""
-        return dataclass_dict(self)
 
 
 def step1_friction_gap(spec: Spec) -> FrictionGapResult:
@@ -138,80 +108,6 @@ def step1_friction_gap(spec: Spec) -> FrictionGapResult:
 
 
 # --------------------------------------------------------------------------- step 2
-
-
-@dataclass(frozen=True)
-class ModeSeparation:
-    """A parasitic mode against the crossover.
-
-    Attributes
-    ----------
-    name : str
-        The mode's label.
-    frequency : float
-        Its frequency [Hz].
-    required : float
-        ``parasitic_separation`` x desired crossover [Hz].
-    collocated : bool
-        Collocated (antiresonance first) or not.
-    passed : bool
-        ``frequency >= required``.
-    """
-
-    name: str
-    frequency: float
-    required: float
-    collocated: bool
-    passed: bool
-
-
-@dataclass(frozen=True)
-class CrossoverResult:
-    """Step 2: desired and achievable crossover, margins per limit case.
-
-    Attributes
-    ----------
-    desired : float
-        ``controller.crossover`` [Hz].
-    achievable : float or None
-        Highest crossover meeting all requirements [Hz]; None if none does.
-    limited_by : str
-        What limits the achievable crossover, in words.
-    limit_kind : str
-        ``margin``, ``mode``, ``scan_limit`` or ``infeasible``
-        (see :class:`fi_design.linear.AchievableCrossover`).
-    limiting_case : str or None
-        Case name when a margin limits.
-    feasible_ranges : tuple of tuple of float
-        Feasible crossover stretches of the scan [Hz].
-    delay : float
-        Loop delay in the linear analysis [s] (computational plus half a
-        sample period).
-    stiffness : float or None
-        Joint stiffness the cases use [N/m]; None without isolator.
-    cases : tuple of fi_design.linear.CaseMargins
-        Margins of each limit case with the PID tuned at the desired crossover.
-    parasitic_modes : tuple of ModeSeparation
-        Each parasitic mode against ``parasitic_separation`` x desired crossover.
-    checks : tuple of Check
-        The step's checks.
-    """
-
-    desired: float
-    achievable: float | None
-    limited_by: str
-    limit_kind: str
-    limiting_case: str | None
-    feasible_ranges: tuple[tuple[float, float], ...]
-    delay: float
-    stiffness: float | None
-    cases: tuple[Any, ...]
-    parasitic_modes: tuple[ModeSeparation, ...]
-    checks: tuple[Check, ...] = field(default=(), repr=False)
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return dataclass_dict(self)
 
 
 def step2_crossover(spec: Spec) -> CrossoverResult:
@@ -302,47 +198,6 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
 # --------------------------------------------------------------------------- loop responses
 
 
-@dataclass(frozen=True, eq=False)
-class CaseResponse:
-    """The open loop of one linear limit case over a frequency grid.
-
-    Attributes
-    ----------
-    name : str
-        Case name (``sliding_free``, ``stuck_free``, ...).
-    number : int
-        1 to 4 in the paper's order (Figure 2).
-    description : str
-        The case in words.
-    loop : ndarray of complex, shape (n,)
-        L(j 2 pi f) = C D P at the grid's frequencies [-].
-    """
-
-    name: str
-    number: int
-    description: str
-    loop: np.ndarray
-
-
-@dataclass(frozen=True, eq=False)
-class LoopResponses:
-    """Frequency responses of the loop in every limit case (for the Bode, Nyquist and
-    sensitivity plots), as the margins of step 2 used it.
-
-    Attributes
-    ----------
-    frequency : ndarray, shape (n,)
-        Log-spaced frequencies [Hz]: from a third of the lowest gain crossover
-        of any case (and a thirtieth of the desired crossover) to thirty times
-        the desired crossover or twice the highest parasitic mode.
-    cases : tuple of CaseResponse
-        One per limit case, in the paper's order.
-    """
-
-    frequency: np.ndarray
-    cases: tuple[CaseResponse, ...]
-
-
 def loop_responses(spec: Spec, crossover: CrossoverResult, points: int = 500) -> LoopResponses:
     """The loop of every limit case over a frequency grid that holds every crossover and mode.
 
@@ -384,48 +239,6 @@ def loop_responses(spec: Spec, crossover: CrossoverResult, points: int = 500) ->
 
 
 # --------------------------------------------------------------------------- step 3
-
-
-@dataclass(frozen=True)
-class StiffnessResult:
-    """Step 3: the maximum and the chosen drive stiffness.
-
-    Attributes
-    ----------
-    maximum : float
-        k_max = Fs / (stiffness_safety x stroke) [N/m].
-    chosen : float
-        The spec's stiffness, else the proposed k_max / 2 [N/m]. Without an
-        isolator: the stiffness suggested to start from.
-    source : str
-        Where ``chosen`` comes from, in words.
-    stroke : float
-        One-sided stroke [m] (the suggested one without isolator).
-    static : float
-        Static friction Fs [N].
-    safety : float
-        ``requirements.stiffness_safety`` [-].
-    force_at_stroke : float
-        Flexure force at full stroke, chosen x stroke [N]; stays below Fs.
-    suggested : bool
-        True when the spec has no isolator and the values are a suggestion.
-    checks : tuple of Check
-        The step's checks.
-    """
-
-    maximum: float
-    chosen: float
-    source: str
-    stroke: float
-    static: float
-    safety: float
-    force_at_stroke: float
-    suggested: bool
-    checks: tuple[Check, ...] = field(default=(), repr=False)
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return dataclass_dict(self)
 
 
 def step3_stiffness(spec: Spec) -> StiffnessResult:
@@ -539,51 +352,6 @@ def _flexure_checks(fx: FlexureResult | None) -> tuple[Check, ...]:
 # --------------------------------------------------------------------------- step 4
 
 
-@dataclass(frozen=True)
-class PidResult:
-    """Step 4: the PID gains, and the loop's controller.
-
-    Attributes
-    ----------
-    gains : fi_design.pid.PidGains
-        The rule's gains at the loop's crossover (JSON: flattened into the
-        ``pid`` object); with explicit hardware gains, the recommendation.
-    tuning_rule : str
-        ``total`` (m1 + m2, the paper's choice) or ``stage`` (m1).
-    derivative_ratio : float
-        wd = wc / ratio, wt = ratio x wc [-].
-    integrator_ratio : float
-        wi = wc / ratio [-].
-    controller : fi_design.pid.ControlLaw
-        The loop's controller: the rule's, or the hardware's own gains
-        (``source``), as the analysis and the simulation use it.
-    static_error : float or None
-        Static position error of a loop without integrator against Coulomb
-        friction, Fc / kp [m]; None when the loop integrates.
-    checks : tuple of Check
-        The step's checks.
-    """
-
-    gains: PidGains
-    tuning_rule: str
-    derivative_ratio: float
-    integrator_ratio: float
-    controller: ControlLaw
-    static_error: float | None
-    checks: tuple[Check, ...] = field(default=(), repr=False)
-
-    def to_dict(self) -> dict:
-        """Flat JSON: the rule's gains plus the rule, its ratios and the loop's controller."""
-        out = {**self.gains.to_dict(), "tuning_rule": self.tuning_rule,
-               "derivative_ratio": self.derivative_ratio,
-               "integrator_ratio": to_jsonable(self.integrator_ratio),
-               "source": self.controller.source, "integrator": self.controller.integrator,
-               "static_error": self.static_error, "controller": self.controller.to_dict()}
-        if self.controller.source == "gains":
-            out["rule_in_hardware_form"] = to_jsonable(self.controller.rule_in_this_form())
-        return out
-
-
 def _controller_words(c: ControlLaw) -> str:
     """The structure of a controller in words (D input, roll-off, sampling)."""
     parts = [f"D on the {c.derivative_on}",
@@ -653,32 +421,6 @@ def step4_pid(spec: Spec) -> PidResult:
 # --------------------------------------------------------------------------- no isolator
 
 
-@dataclass(frozen=True)
-class IsolatorAdvice:
-    """Whether a stage without isolator looks like it needs one.
-
-    Attributes
-    ----------
-    needed : bool or None
-        True: an isolator is recommended; False: not needed; None: it depends
-        on whether a higher crossover removes hunting (simulate to decide).
-    reason : str
-        Why, in words.
-    stroke : float
-        Stroke to start from [m] (the paper's 0.3 mm).
-    stiffness : float
-        Stiffness to start from, Fs / (2 x safety x stroke) [N/m].
-    maximum_stiffness : float
-        k_max for that stroke [N/m].
-    """
-
-    needed: bool | None
-    reason: str
-    stroke: float
-    stiffness: float
-    maximum_stiffness: float
-
-
 def suggested_isolator(spec: Spec) -> tuple[float, float]:
     """Stroke [m] and drive stiffness [N/m] to start from when the spec has no isolator.
 
@@ -730,98 +472,6 @@ def isolator_advice(spec: Spec, gap: FrictionGapResult, crossover: CrossoverResu
 
 
 # --------------------------------------------------------------------------- the design
-
-
-@dataclass(frozen=True)
-class DesignResult:
-    """The four guideline steps for one spec.
-
-    Attributes
-    ----------
-    spec : fi_design.spec.Spec
-        The spec that produced the result (not in JSON; see ``spec_sha256``).
-    friction_gap : FrictionGapResult
-        Step 1.
-    crossover : CrossoverResult
-        Step 2.
-    stiffness : StiffnessResult
-        Step 3 (a suggestion without isolator).
-    flexure : fi_design.flexure.FlexureResult or None
-        Step 3 leaf-spring sizing; None without ``isolator.flexure``.
-    pid : PidResult
-        Step 4.
-    loop : LoopResponses
-        The loop of every limit case over frequency, for the plots (not in
-        JSON).
-    isolator_advice : IsolatorAdvice or None
-        Only for a spec without isolator.
-    checks : tuple of Check
-        All checks of the four steps, in step order.
-    warnings : tuple of (str, str)
-        ``(path, message)`` of suspicious spec values
-        (:func:`fi_design.spec.warnings_for`).
-    conclusion : str
-        One paragraph in plain words.
-    fi_design_version : str
-        Version of fi_design that computed it.
-    spec_sha256 : str
-        SHA-256 of the spec file (of the spec's JSON when not read from a file).
-    simulation : fi_design.confirm.Confirmation or None
-        The nonlinear confirmation; None when it was not run (``confirm=False``),
-        and then left out of the JSON.
-    """
-
-    spec: Spec = field(repr=False)
-    friction_gap: FrictionGapResult
-    crossover: CrossoverResult
-    stiffness: StiffnessResult
-    flexure: FlexureResult | None
-    pid: PidResult
-    loop: LoopResponses = field(repr=False)
-    isolator_advice: IsolatorAdvice | None
-    checks: tuple[Check, ...]
-    warnings: tuple[tuple[str, str], ...]
-    conclusion: str
-    fi_design_version: str
-    spec_sha256: str
-    simulation: "Confirmation | None" = None
-
-    @property
-    def passed(self) -> bool:
-        """No check failed (warnings and information do not count)."""
-        return not any(c.status == Status.FAIL for c in self.checks)
-
-    @property
-    def failed_checks(self) -> tuple[Check, ...]:
-        """The checks with status FAIL."""
-        return tuple(c for c in self.checks if c.status == Status.FAIL)
-
-    def to_dict(self) -> dict:
-        """The JSON contract: SI values, infinite margins as null.
-
-        Keys: ``name``, ``passed``, ``friction_gap``, ``crossover``, ``stiffness``,
-        ``flexure``, ``pid``, ``isolator_advice``, ``checks``, ``warnings``,
-        ``conclusion``, ``fi_design_version``, ``spec_sha256`` and, when set,
-        ``simulation``.
-        """
-        out = {
-            "name": self.spec.name,
-            "passed": self.passed,
-            "friction_gap": self.friction_gap.to_dict(),
-            "crossover": self.crossover.to_dict(),
-            "stiffness": self.stiffness.to_dict(),
-            "flexure": None if self.flexure is None else self.flexure.to_dict(),
-            "pid": self.pid.to_dict(),
-            "isolator_advice": to_jsonable(self.isolator_advice),
-            "checks": [to_jsonable(c) for c in self.checks],
-            "warnings": [{"path": p, "message": m} for p, m in self.warnings],
-            "conclusion": self.conclusion,
-            "fi_design_version": self.fi_design_version,
-            "spec_sha256": self.spec_sha256,
-        }
-        if self.simulation is not None:
-            out["simulation"] = to_jsonable(self.simulation)
-        return out
 
 
 def _sha256(spec: Spec) -> str:
@@ -914,7 +564,7 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
 
 def _simulation_sentence(spec: Spec, sim: Confirmation) -> str:
     """The conclusion's sentence on the simulated verdicts."""
-    iso, non = sim.isolated, sim.non_isolated
+    iso, non = sim.isolated.metrics, sim.non_isolated.metrics
     mins = sim.min_hunting_free_crossover
     label = "the suggested isolator" if sim.suggested_isolator else "the isolator"
     fc = design_crossover(spec)
@@ -926,8 +576,9 @@ def _simulation_sentence(spec: Spec, sim: Confirmation) -> str:
             f" ({iso.hunting_cycles} cycles), without it {non.verdict}"
             f" ({non.hunting_cycles} cycles); hunting-free {f(mins['isolated'])} with {label} "
             f"and {f(mins['non_isolated'])} without (resolution {mins['resolution']:g} Hz).")
-    if iso.friction_model != "lugre":
-        text = text.replace("The LuGre simulation", f"The {iso.friction_model} simulation")
+    model = sim.isolated.friction_model
+    if model != "lugre":
+        text = text.replace("The LuGre simulation", f"The {model} simulation")
     if not sim.models_agree:
         text += " The other friction model disagrees on the verdict (see the checks)."
     return text

@@ -303,8 +303,9 @@ def decimate(t: np.ndarray, y: np.ndarray, buckets: int = 700) -> tuple[np.ndarr
 
 
 def _plant_title(v: Any, label: str) -> str:
-    cycles = f"{v.hunting_cycles} cycle{'s' if v.hunting_cycles != 1 else ''}"
-    return f"{label}: {v.verdict} ({cycles} counted)"
+    m = v.metrics
+    cycles = f"{m.hunting_cycles} cycle{'s' if m.hunting_cycles != 1 else ''}"
+    return f"{label}: {m.verdict} ({cycles} counted)"
 
 
 @_styled

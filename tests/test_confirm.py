@@ -24,7 +24,7 @@ def paper_confirmation(paper_spec):
 def test_paper_headline_isolator_needs_far_less_bandwidth(paper_confirmation):
     """Paper: hunting-free at 5 Hz with the isolator, 14-20 Hz needed without."""
     c = paper_confirmation
-    assert c.isolated.verdict == "settled" and c.non_isolated.verdict == "hunting"
+    assert c.isolated.metrics.verdict == "settled" and c.non_isolated.metrics.verdict == "hunting"
     m = c.min_hunting_free_crossover
     assert m["resolution"] == 0.5
     assert 4.0 <= m["isolated"] <= 7.0
@@ -66,7 +66,7 @@ def test_landing_refinement(paper_confirmation, paper_spec):
 def test_friction_models_agree_on_the_paper_setup(paper_confirmation):
     assert paper_confirmation.models_agree
     assert paper_confirmation.cross_check["non_isolated"].friction_model == "switch"
-    assert paper_confirmation.cross_check["non_isolated"].verdict == "hunting"
+    assert paper_confirmation.cross_check["non_isolated"].metrics.verdict == "hunting"
 
 
 def test_design_json_contract_simulation(paper_confirmed_design):
@@ -122,8 +122,8 @@ def test_spec_without_isolator_is_confirmed_against_the_suggestion(repo_root):
     r = design(spec)
     sim = r.simulation
     assert sim.suggested_isolator
-    assert sim.non_isolated.verdict == "hunting"
-    assert sim.isolated.verdict == "settled"
+    assert sim.non_isolated.metrics.verdict == "hunting"
+    assert sim.isolated.metrics.verdict == "settled"
     assert "suggested isolator" in r.conclusion
 
 

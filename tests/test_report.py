@@ -102,9 +102,11 @@ def _check(name, value, limit, unit, passed=True):
     return Check(name, passed, value, limit, unit, "msg", step="step 3 flexure")
 
 
-def test_check_labels_name_the_limit_case():
-    assert report.check_label("phase_margin.stuck_free") == \
+def test_check_labels_name_the_limit_case(paper_confirmed_design):
+    cases = {c.name: c for c in paper_confirmed_design.loop.cases}
+    assert report.check_label("phase_margin.stuck_free", cases) == \
         "Phase margin, case 2 (cart stuck, joint free)"
+    assert report.check_label("phase_margin.stuck_free") == "Phase margin, stuck_free"
     assert report.check_label("parasitic_separation.tilt").startswith("Parasitic mode \u2018tilt")
     assert report.check_label("some_new_check") == "Some new check"
 

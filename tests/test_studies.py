@@ -19,6 +19,7 @@ import pytest
 from fi_design import studies as sw
 from fi_design.errors import ArgumentError, SpecError
 from fi_design.execution import chunks
+from fi_design.results.studies import spec_digest
 from fi_design.studies import cache as cachemod, points
 from fi_design.specfile import with_values
 
@@ -262,7 +263,7 @@ def test_cache_skips_finished_points(paper_spec, kernel, tmp_path):
 
 
 def test_cache_key_covers_version_and_code(paper_spec, monkeypatch):
-    h = cachemod.spec_digest(paper_spec)
+    h = spec_digest(paper_spec)
     key = cachemod.point_key(h, (("controller.crossover", 8.0),), True)
     assert key == cachemod.point_key(h, (("controller.crossover", 8.0),), True)
     assert key != cachemod.point_key(h, (("controller.crossover", 8.000000001),), True)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 from ..results import Status
@@ -31,20 +32,26 @@ SENSE = {
 }
 
 
-def check_label(name: str) -> str:
+def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
     """A check's name in words: ``phase_margin.stuck_free`` -> ``Phase margin, case 2 ...``.
 
     Parameters
     ----------
     name : str
         :attr:`fi_design.results.Check.name`.
+    cases : mapping, optional
+        The design's limit cases by name (``number`` and ``description``,
+        e.g. :attr:`fi_design.results.design.LoopResponses.cases`), which name
+        the case of a margin check.
 
     Returns
     -------
     str
     """
     head, _, tail = name.partition(".")
-    case = _case_words(tail) if head in ("phase_margin", "gain_margin", "modulus_margin") else tail
+    case = tail
+    if head in ("phase_margin", "gain_margin", "modulus_margin") and tail in (cases or {}):
+        case = f"case {cases[tail].number} ({cases[tail].description})"
     labels = {
         "friction_gap": "Friction gap Fs \u2212 Fc",
         "crossover_achievable": "Desired crossover within the achievable",
@@ -74,29 +81,21 @@ def check_label(name: str) -> str:
     return labels.get(head, name.replace("_", " ").capitalize())
 
 
-def _case_words(name: str) -> str:
-    try:
-        from ..linear import CASE_DESCRIPTIONS, CASE_NUMBERS
-    except ImportError:  # pragma: no cover - python-control is a dependency
-        return name
-    if name in CASE_NUMBERS:
-        return f"case {CASE_NUMBERS[name]} ({CASE_DESCRIPTIONS[name]})"
-    return name
-
-
 def _sense(name: str) -> str:
     if name in SENSE:
         return SENSE[name]
     return SENSE.get(name.split(".")[0], "")
 
 
-def check_row(check: Any) -> dict:
+def check_row(check: Any, cases: Mapping[str, Any] | None = None) -> dict:
     """One row of the verdict table: label, status, value and limit in a shared unit, source.
 
     Parameters
     ----------
     check : fi_design.results.Check
         The check.
+    cases : mapping, optional
+        The design's limit cases by name (:func:`check_label`).
 
     Returns
     -------
@@ -119,7 +118,7 @@ def check_row(check: Any) -> dict:
 
     return {
         "name": check.name,
-        "label": check_label(check.name),
+        "label": check_label(check.name, cases),
         "status": status,
         "css": status.lower(),
         "value": conv(check.value),
@@ -136,7 +135,7 @@ def verdict(result: Any) -> dict:
 
     Parameters
     ----------
-    result : fi_design.guideline.DesignResult
+    result : fi_design.results.design.DesignResult
         The design.
 
     Returns
@@ -146,7 +145,8 @@ def verdict(result: Any) -> dict:
         (``step``, ``title``, ``rows`` of :func:`check_row`), ``conclusion``
         and ``warnings``.
     """
-    rows = [check_row(c) for c in result.checks]
+    cases = {c.name: c for c in result.loop.cases}
+    rows = [check_row(c, cases) for c in result.checks]
     counts = {s.value: sum(1 for r in rows if r["status"] == s.value) for s in Status}
     if counts["FAIL"]:
         overall, css = "FAIL", "fail"

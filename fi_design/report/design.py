@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..guideline import DesignResult
-from ..studies import DesignMap
+from ..results.design import DesignResult
+from ..results.studies import DesignMap
 from .blocks import figure_entry
 from .checks import verdict
 from .context import build_context
@@ -99,16 +99,16 @@ def _plant_rows(sim: Any) -> list[dict]:
     label = "suggested isolator" if sim.suggested_isolator else "with isolator"
     rows = []
     for key, name in (("isolated", label), ("non_isolated", "without isolator")):
-        v = getattr(sim, key)
+        m = getattr(sim, key).metrics
         other = sim.cross_check.get(key)
         rows.append({
-            "plant": name, "verdict": v.verdict,
-            "css": {"settled": "pass", "hunting": "fail"}.get(v.verdict, "warn"),
-            "cycles": v.hunting_cycles, "amplitude": v.amplitude, "period": v.period,
-            "settling_time": v.settling_time, "final_error": v.final_error,
-            "minimum": mins.get(key), "other": other.verdict if other is not None else "",
+            "plant": name, "verdict": m.verdict,
+            "css": {"settled": "pass", "hunting": "fail"}.get(m.verdict, "warn"),
+            "cycles": m.hunting_cycles, "amplitude": m.amplitude, "period": m.period,
+            "settling_time": m.settling_time, "final_error": m.final_error,
+            "minimum": mins.get(key), "other": other.metrics.verdict if other is not None else "",
             "other_model": other.friction_model if other is not None else "",
-            "reason": v.reason,
+            "reason": m.reason,
         })
     return rows
 

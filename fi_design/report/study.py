@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..studies import RobustnessResult, StudyResult, SweepResult
+from ..results.studies import RobustnessResult, StudyResult, SweepResult
 from .blocks import FigureBlock, Section, Table, figure_block
 from .context import build_context, document_context
 from .filters import num, qty

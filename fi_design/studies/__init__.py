@@ -3,11 +3,13 @@
 Engineers choose an isolator from maps: the hunting metric over two design
 parameters with the design point marked (paper Figure 4). This package
 evaluates such maps and the probability of hunting under friction scatter,
-one module per topic:
+one module per topic (the result types they return are in
+:mod:`fi_design.results.studies`, re-exported here):
 
-- :mod:`.axes` -- :class:`Axis`, a swept spec value (:func:`make_axis` from SI
-  values, :func:`parse_axis` from the command line's ``PATH=START:STOP:N``),
-  and :func:`design_value`, the spec's own value at a dotted path;
+- :mod:`.axes` -- :func:`make_axis` (an :class:`Axis`, a swept spec value, from
+  SI values), :func:`parse_axis` (from the command line's
+  ``PATH=START:STOP:N``) and :func:`design_value`, the spec's own value at a
+  dotted path;
 - :mod:`.sweeps` -- :func:`sweep` over one or two axes, :class:`SweepResult`;
   :func:`design_map`, the crossover x stroke map around a design point;
 - :mod:`.paper` -- :func:`paper_study`, the paper's maps A to D;
@@ -46,13 +48,15 @@ validation message; a simulation that does not complete, or raises, is
 
 from __future__ import annotations
 
-from .axes import Axis, design_value, make_axis, parse_axis
+from ..results.studies import (POINT_VERDICTS, Axis, DesignMap, HuntingProbability,
+                               MapDefinition, PointResult, PositionFriction, RobustnessResult,
+                               RunInfo, Scatter, StudyMap, StudyResult, SweepResult)
+from .axes import design_value, make_axis, parse_axis
 from .cache import CACHE_ENV, PointCache, default_cache_dir
-from .paper import PAPER_MAPS, MapDefinition, StudyMap, StudyResult, paper_study
-from .points import POINT_VERDICTS, PointResult, RunInfo, warm_up
-from .scatter import (HuntingProbability, PositionFriction, RobustnessResult, Scatter,
-                         parse_position_friction, parse_scatter, robustness, wilson_interval)
-from .sweeps import DesignMap, SweepResult, design_map, sweep
+from .paper import PAPER_MAPS, paper_study
+from .points import warm_up
+from .scatter import parse_position_friction, parse_scatter, robustness, wilson_interval
+from .sweeps import design_map, sweep
 
 __all__ = [
     "Axis", "CACHE_ENV", "DesignMap", "HuntingProbability", "MapDefinition", "PAPER_MAPS",

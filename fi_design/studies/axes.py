@@ -9,54 +9,15 @@ own value at a path, the design point a study is drawn around.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from .. import spec as _spec
 from ..errors import SpecError
-from ..results import frozen_array, to_jsonable
+from ..results.studies import Axis
 from ..specfile import path_unit, value_at
 
-__all__ = ["Axis", "make_axis", "parse_axis", "design_value", "is_number"]
-
-
-@dataclass(frozen=True, eq=False)
-class Axis:
-    """One swept spec value.
-
-    Attributes
-    ----------
-    path : str
-        Dotted spec path (``"controller.crossover"``).
-    values : ndarray, shape (n,)
-        The values, in the path's unit (SI; frequencies in Hz).
-    unit : str
-        Unit of ``values`` (``"Hz"``, ``"m"``, ``"N/m"``, ...; ``"1"`` for a
-        plain number).
-    log : bool
-        Whether the values are spaced logarithmically (plots use a log axis).
-    """
-
-    path: str
-    values: np.ndarray
-    unit: str = ""
-    log: bool = False
-
-    def __post_init__(self) -> None:
-        vals = np.asarray(self.values, dtype=float)
-        if vals.ndim != 1 or len(vals) == 0:
-            raise SpecError("an axis needs at least one value", path=self.path)
-        if not np.all(np.isfinite(vals)):
-            raise SpecError("axis values must be finite numbers", path=self.path)
-        if self.log and np.any(vals <= 0):
-            raise SpecError("a logarithmic axis needs values above zero", path=self.path)
-        object.__setattr__(self, "values", frozen_array(vals))
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return {"path": self.path, "values": to_jsonable(self.values), "unit": self.unit,
-                "log": self.log}
+__all__ = ["make_axis", "parse_axis", "design_value", "is_number"]
 
 
 def make_axis(path: str, values: Sequence[float], log: bool = False,

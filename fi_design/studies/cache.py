@@ -18,11 +18,10 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .. import spec as _spec
 from ..errors import CacheError
 
 __all__ = ["CACHE_ENV", "METHOD", "CODE_MODULES", "PointCache", "default_cache_dir",
-           "open_cache", "code_digest", "spec_digest", "point_key"]
+           "open_cache", "code_digest", "point_key"]
 
 #: Environment variable naming the cache directory (tests and CI point it at a temporary one).
 CACHE_ENV = "FI_DESIGN_CACHE_DIR"
@@ -192,24 +191,6 @@ def code_digest() -> str:
             h.update((package / name).read_bytes())
         _CODE_DIGEST = h.hexdigest()
     return _CODE_DIGEST
-
-
-def spec_digest(spec: _spec.Spec) -> str:
-    """SHA-256 of a spec's validated content (every value, defaults included).
-
-    Parameters
-    ----------
-    spec : Spec
-        The spec.
-
-    Returns
-    -------
-    str
-        Hex digest; equal for specs that simulate identically however they
-        were written (units, key order, comments).
-    """
-    data = spec.model_dump(mode="json")
-    return hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
 
 
 def point_key(spec_hash: str, values: Sequence[tuple[str, Any]], isolated: bool) -> str:

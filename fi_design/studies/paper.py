@@ -4,55 +4,19 @@ from __future__ import annotations
 
 import os
 import time as _time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 
 from .. import spec as _spec
 from ..errors import SpecError
 from ..execution import Executor
-from ..results import to_jsonable
-from .axes import Axis, design_value, make_axis
+from ..results.studies import Axis, MapDefinition, StudyMap, StudyResult, SweepResult
+from .axes import design_value, make_axis
 from .cache import PointCache
-from .points import ProgressCallback, RunInfo, evaluate, grid, point_result, verdict_grid
-from .sweeps import SweepResult
+from .points import ProgressCallback, evaluate, grid, point_result, verdict_grid
 
-__all__ = ["MapDefinition", "PAPER_MAPS", "StudyMap", "StudyResult", "paper_axes",
-           "paper_study"]
-
-
-@dataclass(frozen=True)
-class MapDefinition:
-    """One of the paper's maps (Figure 4), as factors on the spec's design values.
-
-    Attributes
-    ----------
-    key : str
-        ``"A"`` to ``"D"`` (the panel of Figure 4).
-    title : str
-        What the map shows.
-    x_path, y_path : str
-        Swept dotted paths.
-    x_range, y_range : tuple of float
-        (low, high) as factors on the design value.
-    x_log, y_log : bool
-        Logarithmic spacing.
-    isolated : bool
-        Plant simulated.
-    paper : str
-        The paper's finding for this map, in one sentence.
-    """
-
-    key: str
-    title: str
-    x_path: str
-    x_range: tuple[float, float]
-    x_log: bool
-    y_path: str
-    y_range: tuple[float, float]
-    y_log: bool
-    isolated: bool
-    paper: str
+__all__ = ["PAPER_MAPS", "paper_axes", "paper_study"]
 
 
 #: The paper's four maps (Figure 4), ranges as factors on the design point.
@@ -76,72 +40,6 @@ PAPER_MAPS: tuple[MapDefinition, ...] = (
                   "hunting only below a crossover of about 5 Hz; a 0.3 mm stroke is "
                   "sufficient"),
 )
-
-
-@dataclass(frozen=True, eq=False)
-class StudyMap:
-    """One map of a study with its definition.
-
-    Attributes
-    ----------
-    definition : MapDefinition
-        Which map and how its ranges were chosen.
-    result : SweepResult
-        The map.
-    """
-
-    definition: MapDefinition
-    result: SweepResult
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        d = to_jsonable({f: getattr(self.definition, f)
-                         for f in self.definition.__dataclass_fields__})
-        return {"definition": d, "result": self.result.to_dict()}
-
-
-@dataclass(frozen=True, eq=False)
-class StudyResult:
-    """The paper's four maps around a design point.
-
-    Attributes
-    ----------
-    spec : Spec
-        The spec whose design point the maps surround.
-    maps : tuple of StudyMap
-        Maps A to D, in order.
-    resolution : int
-        Points per axis.
-    run : RunInfo
-        How the whole study ran (all maps together).
-    """
-
-    spec: _spec.Spec
-    maps: tuple[StudyMap, ...]
-    resolution: int
-    run: RunInfo = field(repr=False)
-
-    def map(self, key: str) -> SweepResult:
-        """The map ``key`` (``"A"`` to ``"D"``).
-
-        Parameters
-        ----------
-        key : str
-            Panel letter.
-
-        Returns
-        -------
-        SweepResult
-        """
-        for m in self.maps:
-            if m.definition.key == key.upper():
-                return m.result
-        raise KeyError(key)
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return {"spec_name": self.spec.name, "resolution": self.resolution,
-                "maps": [m.to_dict() for m in self.maps], "run": self.run.to_dict()}
 
 
 def paper_axes(spec: _spec.Spec, definition: MapDefinition, resolution: int) -> tuple[Axis, Axis]:

@@ -12,8 +12,6 @@ they ran.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import os
 import time as _time
@@ -26,75 +24,17 @@ import numpy as np
 from .. import spec as _spec
 from ..errors import ArgumentError, FiDesignError, SpecError
 from ..execution import Executor, chunks, run_chunks
-from ..results import frozen_array, to_jsonable
+from ..results import frozen_array
+from ..results.studies import PointResult, RunInfo, spec_digest
 from ..specfile import with_values
-from .cache import METHOD, PointCache, open_cache, point_key, spec_digest
+from .cache import METHOD, PointCache, open_cache, point_key
 
-__all__ = ["POINT_VERDICTS", "MAX_CHUNK", "TARGET_CHUNKS", "Task", "ProgressCallback",
-           "PointResult", "RunInfo", "Evaluation", "evaluate_point", "run_chunk", "warm_up",
-           "chunk_size", "evaluate", "point_result", "grid", "verdict_grid", "columns",
-           "csv_text"]
-
-#: Verdicts of the hunting metric plus the two outcomes of a point that has no metric.
-POINT_VERDICTS = ("settled", "hunting", "stuck", "undetermined", "invalid", "failed")
+__all__ = ["MAX_CHUNK", "TARGET_CHUNKS", "Task", "ProgressCallback", "Evaluation",
+           "evaluate_point", "run_chunk", "warm_up", "chunk_size", "evaluate", "point_result",
+           "grid", "verdict_grid"]
 
 #: ``progress(done, total)`` in points.
 ProgressCallback = Callable[[int, int], None]
-
-
-@dataclass(frozen=True)
-class PointResult:
-    """The outcome of one point of a study.
-
-    Attributes
-    ----------
-    index : tuple of int
-        Position in the grid: ``(iy, ix)`` for a map, ``(ix,)`` for a line,
-        ``(sample,)`` for a robustness draw.
-    values : tuple of float
-        The varied values, in the order of the study's paths [SI].
-    isolated : bool
-        Whether the isolated plant was simulated.
-    status : str
-        ``"ok"``, ``"invalid"`` (the spec refused the values) or ``"failed"``
-        (the simulation did not complete or raised).
-    verdict : str
-        ``settled``, ``hunting``, ``stuck`` or ``undetermined`` (the metric's
-        verdict), or ``invalid`` / ``failed``.
-    hunting_cycles : int or None
-        Peaks counted in the window (the paper's metric); None without a metric.
-    amplitude : float or None
-        Peak-to-peak error in the window [m].
-    period : float or None
-        Mean time between counted peaks [s].
-    settling_time : float or None
-        Time after the end of the motion until the error stays in the band [s].
-    final_error : float or None
-        x1 - r at the end [m].
-    message : str
-        Why: the metric's reason, the validation error or the failure.
-    """
-
-    index: tuple[int, ...]
-    values: tuple[float, ...]
-    isolated: bool
-    status: str
-    verdict: str
-    hunting_cycles: int | None
-    amplitude: float | None
-    period: float | None
-    settling_time: float | None
-    final_error: float | None
-    message: str
-
-    @property
-    def hunting(self) -> bool:
-        """Whether the metric counted hunting cycles."""
-        return self.verdict == "hunting"
-
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return to_jsonable({f: getattr(self, f) for f in self.__dataclass_fields__})
 
 
 _OUTCOME_FIELDS = ("status", "verdict", "hunting_cycles", "amplitude", "period", "settling_time",
@@ -194,38 +134,6 @@ def warm_up() -> None:
 
     from .. import kernel, simulation  # noqa: F401  (the kernel compiles at import or loads
     #                                  numba's on-disk cache)
-
-
-@dataclass(frozen=True)
-class RunInfo:
-    """How a study was run (not part of its physics).
-
-    Attributes
-    ----------
-    points : int
-        Points in the study.
-    computed : int
-        Points simulated in this run.
-    cached : int
-        Points taken from the cache.
-    chunks : int
-        Chunks submitted to the executor (or run in-process).
-    executor : str
-        Type name of the executor, ``"serial"`` without one.
-    wall_time : float
-        Time of the whole call [s].
-    """
-
-    points: int
-    computed: int
-    cached: int
-    chunks: int
-    executor: str
-    wall_time: float
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return to_jsonable({f: getattr(self, f) for f in self.__dataclass_fields__})
 
 
 #: Largest number of points in one chunk (bounds the work lost by an interruption).
@@ -369,34 +277,3 @@ def verdict_grid(points: Sequence[PointResult], shape: tuple[int, ...]) -> np.nd
     arr = np.array([p.verdict for p in points], dtype="<U12").reshape(shape)
     arr.flags.writeable = False
     return arr
-
-
-def columns(paths: Sequence[str], points: Sequence[PointResult], prefix: str = "") \
-        -> dict[str, list]:
-    """The points as columns: one per varied path [SI], then the outcome fields."""
-    cols: dict[str, list] = {p: [pt.values[i] for pt in points] for i, p in enumerate(paths)}
-    for name in ("hunting_cycles", "amplitude", "period", "verdict", "status", "message"):
-        cols[prefix + name] = [getattr(pt, name) for pt in points]
-    return cols
-
-
-def csv_text(columns: Mapping[str, list]) -> str:
-    """Columns as CSV text: a header, one row per point, empty cells for no value."""
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    names = list(columns)
-    w.writerow(names)
-    n = len(next(iter(columns.values()))) if columns else 0
-    for i in range(n):
-        w.writerow([_cell(columns[c][i]) for c in names])
-    return buf.getvalue()
-
-
-def _cell(v: Any) -> str:
-    if v is None:
-        return ""
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, float):
-        return repr(v) if math.isfinite(v) else ""
-    return str(v)

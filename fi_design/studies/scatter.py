@@ -14,7 +14,7 @@ import math
 import os
 import time as _time
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -22,43 +22,19 @@ import numpy as np
 from .. import spec as _spec
 from ..errors import ArgumentError, SpecError
 from ..execution import Executor
-from ..results import frozen_array, to_jsonable
+from ..results import frozen_array
+from ..results.studies import (POINT_VERDICTS, HuntingProbability, PointResult, PositionFriction,
+                               RobustnessResult, Scatter)
 from ..specfile import path_unit, with_values
 from .axes import design_value, is_number
-from .cache import PointCache, spec_digest
-from .points import (POINT_VERDICTS, PointResult, ProgressCallback, RunInfo, csv_text, evaluate,
-                     point_result)
+from .cache import PointCache
+from .points import ProgressCallback, evaluate, point_result
 
-__all__ = ["DISTRIBUTIONS", "Scatter", "parse_scatter", "PositionFriction",
-           "parse_position_friction", "wilson_interval", "HuntingProbability",
-           "RobustnessResult", "robustness"]
+__all__ = ["DISTRIBUTIONS", "parse_scatter", "parse_position_friction", "wilson_interval",
+           "robustness"]
 
 #: Distributions of the scatter.
 DISTRIBUTIONS = ("normal", "uniform")
-
-
-@dataclass(frozen=True)
-class Scatter:
-    """How one spec value scatters around its nominal value.
-
-    Attributes
-    ----------
-    path : str
-        Dotted spec path.
-    spread : float
-        Standard deviation (normal) or half-width (uniform): a fraction of the
-        nominal value when ``relative``, else in the path's unit [SI].
-    relative : bool
-        Whether ``spread`` is a fraction of the nominal value.
-    """
-
-    path: str
-    spread: float
-    relative: bool = True
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return {"path": self.path, "spread": self.spread, "relative": self.relative}
 
 
 def parse_scatter(text: str, spec: _spec.Spec | None = None) -> Scatter:
@@ -111,30 +87,6 @@ def parse_scatter(text: str, spec: _spec.Spec | None = None) -> Scatter:
     if not math.isfinite(spread) or spread < 0:
         raise SpecError(f"scatter {word!r}: the spread must be zero or positive", path=path)
     return Scatter(path=path, spread=spread, relative=relative)
-
-
-@dataclass(frozen=True)
-class PositionFriction:
-    """Friction that varies along the rail: the ``position_dependent_friction`` effect.
-
-    Fs and Fc are scaled by 1 + a sin(2 pi x2 / wavelength + phase); every
-    sample draws the phase uniformly in [-pi, pi) (where on the rail the stage
-    happens to work).
-
-    Attributes
-    ----------
-    amplitude : float
-        Relative amplitude a [-].
-    wavelength : float
-        Spatial period [m].
-    """
-
-    amplitude: float
-    wavelength: float
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return {"amplitude": self.amplitude, "wavelength": self.wavelength}
 
 
 def parse_position_friction(text: str) -> PositionFriction:
@@ -205,156 +157,6 @@ def wilson_interval(successes: int, trials: int, confidence: float = 0.95) \
     low = 0.0 if successes <= 0 else max(0.0, centre - half)
     high = 1.0 if successes >= trials else min(1.0, centre + half)
     return low, high
-
-
-@dataclass(frozen=True, eq=False)
-class HuntingProbability:
-    """Probability of hunting over the drawn samples, for one plant.
-
-    Attributes
-    ----------
-    isolated : bool
-        Whether the isolated plant was simulated.
-    samples : int
-        Samples drawn.
-    valid : int
-        Samples that were valid specs and simulated to the end (the trials).
-    hunting : int
-        Valid samples with the verdict ``hunting``.
-    probability : float or None
-        hunting / valid [-]; None without valid samples.
-    low, high : float
-        Wilson confidence interval of the probability [-].
-    confidence : float
-        Confidence level of the interval [-].
-    counts : dict
-        Samples per verdict (``settled``, ``hunting``, ``stuck``,
-        ``undetermined``, ``invalid``, ``failed``).
-    hunting_cycles : ndarray, shape (samples,)
-        Cycles per sample; NaN for invalid or failed samples.
-    verdict : ndarray of str, shape (samples,)
-        Verdict per sample.
-    """
-
-    isolated: bool
-    samples: int
-    valid: int
-    hunting: int
-    probability: float | None
-    low: float
-    high: float
-    confidence: float
-    counts: dict
-    hunting_cycles: np.ndarray
-    verdict: np.ndarray
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return to_jsonable({f: getattr(self, f) for f in self.__dataclass_fields__})
-
-
-@dataclass(frozen=True, eq=False)
-class RobustnessResult:
-    """Probability of hunting under scatter, with and without the isolator.
-
-    Attributes
-    ----------
-    spec : Spec
-        The nominal spec.
-    scatter : tuple of Scatter
-        The scattered values.
-    position_friction : PositionFriction or None
-        Friction varying along the rail, if modelled.
-    distribution : str
-        ``"normal"`` or ``"uniform"``.
-    seed : int
-        Seed of the random generator (``numpy.random.default_rng``).
-    draws : ndarray, shape (samples, len(scatter))
-        Drawn values per sample, in the order of ``scatter`` [SI].
-    phases : ndarray, shape (samples,) or (0,)
-        Drawn phases of the position-dependent friction [rad].
-    isolated : HuntingProbability or None
-        With the isolator (None when the spec has none).
-    not_isolated : HuntingProbability
-        The same samples without the isolator.
-    points : tuple of PointResult
-        Every simulated sample, isolated ones first.
-    run : RunInfo
-        How the study ran.
-    fi_design_version : str
-        Version of fi_design that produced the result.
-    """
-
-    spec: _spec.Spec
-    scatter: tuple[Scatter, ...]
-    position_friction: PositionFriction | None
-    distribution: str
-    seed: int
-    draws: np.ndarray
-    phases: np.ndarray
-    isolated: HuntingProbability | None
-    not_isolated: HuntingProbability
-    points: tuple[PointResult, ...] = field(repr=False)
-    run: RunInfo = field(repr=False)
-    fi_design_version: str = ""
-
-    @property
-    def samples(self) -> int:
-        """Number of samples drawn."""
-        return int(self.draws.shape[0])
-
-    def table(self) -> dict[str, list]:
-        """One row per sample: the drawn values [SI], then the outcome per plant.
-
-        Returns
-        -------
-        dict of str to list
-            Columns ``sample``, each scattered path, ``phase`` (with
-            position-dependent friction), then ``isolated_hunting_cycles``,
-            ``isolated_verdict`` (with an isolator) and
-            ``not_isolated_hunting_cycles``, ``not_isolated_verdict``.
-        """
-        cols: dict[str, list] = {"sample": list(range(self.samples))}
-        for k, sc in enumerate(self.scatter):
-            cols[sc.path] = [float(v) for v in self.draws[:, k]]
-        if self.position_friction is not None:
-            cols["phase"] = [float(v) for v in self.phases]
-        for name, prob in (("isolated", self.isolated), ("not_isolated", self.not_isolated)):
-            if prob is None:
-                continue
-            cols[f"{name}_hunting_cycles"] = [None if math.isnan(c) else int(c)
-                                              for c in prob.hunting_cycles]
-            cols[f"{name}_verdict"] = prob.verdict.tolist()
-        return cols
-
-    def to_csv(self) -> str:
-        """The :meth:`table` as CSV text.
-
-        Returns
-        -------
-        str
-        """
-        return csv_text(self.table())
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return {
-            "fi_design_version": self.fi_design_version,
-            "spec_name": self.spec.name,
-            "spec_sha256": spec_digest(self.spec),
-            "samples": self.samples,
-            "seed": self.seed,
-            "distribution": self.distribution,
-            "scatter": [s.to_dict() for s in self.scatter],
-            "position_friction": self.position_friction.to_dict()
-            if self.position_friction else None,
-            "isolated": self.isolated.to_dict() if self.isolated else None,
-            "not_isolated": self.not_isolated.to_dict(),
-            "draws": to_jsonable(self.draws),
-            "phases": to_jsonable(self.phases),
-            "points": [p.to_dict() for p in self.points],
-            "run": self.run.to_dict(),
-        }
 
 
 _PDF = "position_dependent_friction"

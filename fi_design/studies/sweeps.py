@@ -9,168 +9,20 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Union
+from typing import Union
 
 import numpy as np
 
 from .. import spec as _spec
 from ..errors import ArgumentError, SpecError
 from ..execution import Executor
-from ..results import frozen_array, to_jsonable
-from .axes import Axis, design_value, make_axis
-from .cache import PointCache, spec_digest
-from .points import (POINT_VERDICTS, PointResult, ProgressCallback, RunInfo, columns, csv_text,
-                     evaluate, grid, point_result, verdict_grid)
+from ..results.design import DesignResult
+from ..results.studies import Axis, DesignMap, SweepResult
+from .axes import design_value, make_axis
+from .cache import PointCache
+from .points import ProgressCallback, evaluate, grid, point_result, verdict_grid
 
-if TYPE_CHECKING:  # pragma: no cover
-    from ..guideline import DesignResult
-
-__all__ = ["AxisLike", "SweepResult", "sweep", "DesignMap", "design_map"]
-
-
-@dataclass(frozen=True, eq=False)
-class SweepResult:
-    """A map (or line) of the hunting metric over one or two spec values.
-
-    Attributes
-    ----------
-    spec : Spec
-        The base spec; every point is this spec with the swept values replaced.
-    x : Axis
-        The first swept value (columns of a map).
-    y : Axis or None
-        The second swept value (rows of a map); None for a line.
-    isolated : bool
-        Whether the isolated plant was simulated.
-    points : tuple of PointResult
-        Every point, rows (y) outer, columns (x) inner.
-    hunting_cycles : ndarray, shape (ny, nx) or (nx,)
-        Hunting cycles counted per point; NaN where the point is invalid or
-        failed.
-    amplitude : ndarray, same shape
-        Peak-to-peak error in the counting window [m]; NaN without a metric.
-    period : ndarray, same shape
-        Mean period of the counted cycles [s]; NaN with fewer than two peaks.
-    verdict : ndarray of str, same shape
-        Verdict per point (``settled``, ``hunting``, ``stuck``,
-        ``undetermined``, ``invalid``, ``failed``).
-    design_point : tuple of float or None
-        The spec's own value of x and of y (None when the spec leaves it to a
-        derived default that cannot be computed) [SI].
-    run : RunInfo
-        How the sweep ran (points computed and cached, executor, wall time).
-    fi_design_version : str
-        Version of fi_design that produced the result.
-    """
-
-    spec: _spec.Spec
-    x: Axis
-    y: Axis | None
-    isolated: bool
-    points: tuple[PointResult, ...]
-    hunting_cycles: np.ndarray
-    amplitude: np.ndarray
-    period: np.ndarray
-    verdict: np.ndarray
-    design_point: tuple[float | None, ...]
-    run: RunInfo = field(repr=False)
-    fi_design_version: str = ""
-
-    @property
-    def paths(self) -> tuple[str, ...]:
-        """The swept paths, x first."""
-        return (self.x.path,) if self.y is None else (self.x.path, self.y.path)
-
-    @property
-    def shape(self) -> tuple[int, ...]:
-        """``(ny, nx)`` for a map, ``(nx,)`` for a line."""
-        return self.hunting_cycles.shape
-
-    def counts(self) -> dict[str, int]:
-        """Number of points per verdict (every verdict listed, zeros included).
-
-        Returns
-        -------
-        dict
-            Verdict to count.
-        """
-        return {v: int(np.sum(self.verdict == v)) for v in POINT_VERDICTS}
-
-    def boundary(self, free: str = "above") -> np.ndarray:
-        """Where hunting stops along x, for each row of the map.
-
-        Parameters
-        ----------
-        free : {"above", "below"}
-            ``"above"``: the lowest x from which no point up to the end of the
-            row hunts (for values where more is better, like the crossover);
-            ``"below"``: the highest x up to which no point from the start of
-            the row hunts (like the drive stiffness).
-
-        Returns
-        -------
-        ndarray, shape (ny,) or (1,)
-            The x value [x.unit] per row; NaN when the row's last (first) point
-            hunts or is not a valid, complete simulation. Points that are
-            ``stuck`` or ``undetermined`` do not count as hunting.
-        """
-        if free not in ("above", "below"):
-            raise ArgumentError("free must be 'above' or 'below'")
-        verdicts = self.verdict.reshape(-1, len(self.x.values))
-        xs = self.x.values
-        out = np.full(verdicts.shape[0], np.nan)
-        for r, row in enumerate(verdicts):
-            order = range(len(xs) - 1, -1, -1) if free == "above" else range(len(xs))
-            last = None
-            for i in order:
-                if row[i] in ("hunting", "invalid", "failed"):
-                    break
-                last = i
-            if last is not None:
-                out[r] = xs[last]
-        return frozen_array(out)
-
-    def table(self) -> dict[str, list]:
-        """The points as columns: one per swept path [SI], then the metric.
-
-        Returns
-        -------
-        dict of str to list
-            Columns (in order) named by each swept dotted path, then
-            ``hunting_cycles``, ``amplitude`` [m], ``period`` [s], ``verdict``,
-            ``status`` and ``message``. ``None`` where a point has no value.
-            ``pandas.DataFrame(result.table())`` gives a data frame.
-        """
-        return columns(self.paths, self.points)
-
-    def to_csv(self) -> str:
-        """The :meth:`table` as CSV text (one row per point; empty cells for no value).
-
-        Returns
-        -------
-        str
-        """
-        return csv_text(self.table())
-
-    def to_dict(self) -> dict:
-        """Plain JSON data: axes, metric arrays, points, design point, run info."""
-        return {
-            "fi_design_version": self.fi_design_version,
-            "spec_name": self.spec.name,
-            "spec_sha256": spec_digest(self.spec),
-            "isolated": self.isolated,
-            "x": self.x.to_dict(),
-            "y": self.y.to_dict() if self.y is not None else None,
-            "design_point": to_jsonable(list(self.design_point)),
-            "hunting_cycles": to_jsonable(self.hunting_cycles),
-            "amplitude": to_jsonable(self.amplitude),
-            "period": to_jsonable(self.period),
-            "verdict": self.verdict.tolist(),
-            "counts": self.counts(),
-            "points": [p.to_dict() for p in self.points],
-            "run": self.run.to_dict(),
-        }
+__all__ = ["AxisLike", "sweep", "design_map"]
 
 
 #: An axis as the library takes it: an :class:`~.axes.Axis` or a (dotted path, SI values) pair.
@@ -262,33 +114,6 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
         amplitude=grid(points, shape, "amplitude"), period=grid(points, shape, "period"),
         verdict=verdict_grid(points, shape), design_point=design, run=ev.run,
         fi_design_version=__version__)
-
-
-@dataclass(frozen=True, eq=False)
-class DesignMap:
-    """A crossover x stroke hunting map around a design point (paper Figure 4D).
-
-    Attributes
-    ----------
-    sweep : SweepResult
-        The map: x ``controller.crossover``, y ``isolator.stroke`` (log), the
-        isolated plant, the PID retuned at every crossover.
-    suggested : bool
-        True when the design's spec has no isolator and the map uses the
-        isolator the guideline suggests.
-    stroke : float
-        Stroke of that suggested isolator [m] (the spec's own when not
-        suggested).
-    stiffness : float or None
-        Drive stiffness of the suggested isolator [N/m]; the spec's given
-        stiffness otherwise, None when the spec leaves it to step 3 (it then
-        follows the stroke across the map, k_max / 2).
-    """
-
-    sweep: SweepResult
-    suggested: bool
-    stroke: float
-    stiffness: float | None
 
 
 def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
