@@ -58,6 +58,16 @@ def _status_text(status: Any):
     return Text(name, style=_STYLES.get(name, ""))
 
 
+def _heading(console: "Console", text: str, spec_path: Optional[Path]) -> None:
+    """A summary's bold first line, with the spec file dimmed beside it."""
+    from rich.text import Text
+
+    head = Text(text, style="bold")
+    if spec_path is not None:
+        head.append(f"  ({spec_path})", style="dim")
+    console.print(head)
+
+
 def checks_table(checks, title: str = "Checks"):
     """A rich table of :class:`~fi_design.results.Check` values, status coloured.
 
@@ -143,10 +153,7 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
 
     data = result.to_dict()
     name = _spec_name(result)
-    head = Text(name or "fi-design", style="bold")
-    if spec_path is not None:
-        head.append(f"  ({spec_path})", style="dim")
-    console.print(head)
+    _heading(console, name or "fi-design", spec_path)
 
     gap = data.get("friction_gap") or {}
     if gap:
@@ -533,10 +540,7 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
 
     from .plots import display_unit
 
-    head = Text(f"Sweep of {result.spec.name}", style="bold")
-    if spec_path is not None:
-        head.append(f"  ({spec_path})", style="dim")
-    console.print(head)
+    _heading(console, f"Sweep of {result.spec.name}", spec_path)
     plant = "with isolator" if result.isolated else "without isolator"
     console.print(Text(f"{_axis_values_text(result.x)}; {plant}"))
     if result.y is not None:
@@ -576,10 +580,7 @@ def print_study(console: "Console", result, spec_path: Optional[Path] = None,
     """
     from rich.text import Text
 
-    head = Text(f"Paper study (Figure 4) around {result.spec.name}", style="bold")
-    if spec_path is not None:
-        head.append(f"  ({spec_path})", style="dim")
-    console.print(head)
+    _heading(console, f"Paper study (Figure 4) around {result.spec.name}", spec_path)
     for m in result.maps:
         d = m.definition
         console.print(Text(f"\n{d.key}) {d.title}", style="bold"))
@@ -610,10 +611,7 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
 
     from .plots import display_unit
 
-    head = Text(f"Robustness of {result.spec.name}", style="bold")
-    if spec_path is not None:
-        head.append(f"  ({spec_path})", style="dim")
-    console.print(head)
+    _heading(console, f"Robustness of {result.spec.name}", spec_path)
     for sc in result.scatter:
         unit, f = display_unit("") if sc.relative else display_unit(
             _path_unit(sc.path, result.spec))
