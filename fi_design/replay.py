@@ -23,7 +23,8 @@ import numpy as np
 from .errors import DataError
 from .measured import Measurement
 from .pid import ControlLaw
-from .plant import P_SIGMA2_NEG, PlantParameters, state_index, stribeck
+from .compiled import kernel
+from .plant import P_SIGMA2_NEG, PlantParameters, state_index
 
 #: Span of samples the local velocity estimate fits [s].
 VELOCITY_SPAN = 0.01
@@ -182,11 +183,11 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
     sigma2 = params.sigma2 if sgn > 0 else p[P_SIGMA2_NEG]
     friction = 0.0
     if v1 != 0.0 and not params.switch_model:
-        g, _, _ = stribeck(v1, x1, sgn, p)
+        g, _, _ = kernel().stribeck(v1, x1, sgn, p)
         y0[idx["z"]] = sgn * g / params.sigma0
         friction = sgn * g + sigma2 * v1
     elif v1 != 0.0:
-        friction = sgn * stribeck(v1, x1, sgn, p)[0] + sigma2 * v1
+        friction = sgn * kernel().stribeck(v1, x1, sgn, p)[0] + sigma2 * v1
     if iso:
         d = deflection if deflection is not None else _sliding_deflection(params, friction)
         y0[idx["x2"]] = x1 - d
