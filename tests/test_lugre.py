@@ -1,7 +1,7 @@
 """Invariants of the LuGre friction model, over bounded random parameters (hypothesis).
 
 - Friction is odd in the velocity when it is symmetric: with v, z and the sliding sign
-  reversed, the bristle rate and the friction force reverse (fi_design.plant.lugre), and so
+  reversed, the bristle rate and the friction force reverse (fi_design.equations.lugre), and so
   does the steady-state force g(v) sign(v) + sigma2 v.
 - The bristle deflection stays within Fs / sigma0: at that bound the LuGre bristle equation
   dz/dt = v - sigma0 |v| z / g(v) (with g(v) <= Fs) points inward, and a stage started from
@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from fi_design import plant
+from fi_design import equations
 from fi_design.simulation import plant_parameters, simulate
 
 FRICTION = dict(static=st.floats(0.5, 20.0), ratio=st.floats(0.05, 1.0),
@@ -40,8 +40,8 @@ def test_symmetric_friction_is_odd_in_velocity(paper_spec, v, fraction, static, 
                                                 sigma0, sigma1, sigma2):
     p = _parameters(paper_spec, static, ratio, vs, sigma0, sigma1, sigma2)
     z = fraction * static / sigma0
-    ahead = plant.lugre(v, 0.0, z, 1.0, p)
-    back = plant.lugre(-v, 0.0, -z, -1.0, p)
+    ahead = equations.lugre(v, 0.0, z, 1.0, p)
+    back = equations.lugre(-v, 0.0, -z, -1.0, p)
     zd, force = ahead[0], ahead[1]
     assert back[0] == pytest.approx(-zd, rel=1e-12, abs=1e-15 * v)
     assert back[1] == pytest.approx(-force, rel=1e-12, abs=1e-12 * static)
@@ -55,7 +55,7 @@ def test_steady_state_force_is_the_stribeck_curve(paper_spec, v, static, ratio, 
     p = _parameters(paper_spec, static, ratio, vs, sigma0, sigma1, sigma2)
     g = ratio * static + (static - ratio * static) * math.exp(-(v / vs) ** 2)
     for sign in (1.0, -1.0):
-        zd, force = plant.lugre(sign * v, 0.0, sign * g / sigma0, sign, p)[:2]
+        zd, force = equations.lugre(sign * v, 0.0, sign * g / sigma0, sign, p)[:2]
         assert zd == pytest.approx(0.0, abs=1e-12 * v)
         assert force == pytest.approx(sign * (g + sigma2 * v), rel=1e-12)
 
@@ -67,8 +67,8 @@ def test_bristle_rate_points_inward_at_fs_over_sigma0(paper_spec, v, static, rat
     p = _parameters(paper_spec, static, ratio, vs, sigma0, sigma1, sigma2)
     bound = static / sigma0
     sign = math.copysign(1.0, v)
-    assert plant.lugre(v, 0.0, bound, sign, p)[0] <= 1e-12 * abs(v)
-    assert plant.lugre(v, 0.0, -bound, sign, p)[0] >= -1e-12 * abs(v)
+    assert equations.lugre(v, 0.0, bound, sign, p)[0] <= 1e-12 * abs(v)
+    assert equations.lugre(v, 0.0, -bound, sign, p)[0] >= -1e-12 * abs(v)
 
 
 @settings(max_examples=12, deadline=None)

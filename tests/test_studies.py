@@ -391,7 +391,7 @@ def test_code_digest_covers_existing_modules_and_changes_with_them(tmp_path, mon
     package = Path(cachemod.__file__).resolve().parents[1]
     missing = [n for n in cachemod.CODE_MODULES if not (package / n).is_file()]
     assert not missing
-    assert {"simulation.py", "kernel.py", "plant.py", "trajectory.py",
+    assert {"simulation.py", "kernel.py", "equations.py", "plant.py", "trajectory.py",
             "studies/points.py"} <= set(cachemod.CODE_MODULES)
     monkeypatch.setattr(cachemod, "_CODE_DIGEST", None)
     before = cachemod.code_digest()

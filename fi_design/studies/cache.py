@@ -28,7 +28,7 @@ CACHE_ENV = "FI_DESIGN_CACHE_DIR"
 #: Solver method the studies use (part of the cache key).
 METHOD = "fast"
 #: Source files (in the package) that decide a point's outcome; their digest is in every key.
-CODE_MODULES = ("kernel.py", "plant.py", "simulation.py", "metrics.py", "pid.py",
+CODE_MODULES = ("kernel.py", "equations.py", "plant.py", "simulation.py", "metrics.py", "pid.py",
                 "trajectory.py", "effects.py", "spec.py", "specfile.py", "studies/points.py")
 
 
