@@ -86,4 +86,5 @@ def test_bristle_deflection_from_rest_stays_within_fs_over_sigma0(paper_spec, di
     assert r.success
     bound = static / sigma0
     assert np.max(np.abs(r.bristle)) <= bound * (1 + 1e-6)
-    assert np.max(np.abs(r.bristle)) > 0.5 * bound  # it slid: the bound was approached
+    # it slid: sliding loads the bristles to g(v) / sigma0 >= Fc / sigma0
+    assert np.max(np.abs(r.bristle)) > 0.9 * ratio * bound
