@@ -466,6 +466,7 @@ class IdentificationResult:
     def to_dict(self) -> dict:
         """Plain JSON data: ``parameters``, ``fit`` (DESIGN.md section 8) and the context."""
         from . import __version__
+        from .provenance import current_source
 
         return {
             "parameters": {k: p.to_dict() for k, p in self.parameters.items()},
@@ -478,6 +479,7 @@ class IdentificationResult:
             "notes": list(self.notes),
             "measurement": self.measurement.to_dict(),
             "fi_design_version": __version__,
+            "fi_design_source": current_source().to_dict(),
         }
 
 

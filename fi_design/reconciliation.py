@@ -448,6 +448,9 @@ class ReconcileResult:
 
     def to_dict(self) -> dict:
         """Plain JSON data: the contract keys first, then the details (SI)."""
+        from . import __version__
+        from .provenance import current_source
+
         d = {
             "effect": self.effect,
             "parameters": to_jsonable(self.parameters),
@@ -473,6 +476,8 @@ class ReconcileResult:
             "conclusion": self.conclusion,
             "n_simulations": self.n_simulations,
             "wall_time": self.wall_time,
+            "fi_design_version": __version__,
+            "fi_design_source": current_source().to_dict(),
             "measurement": self.measurement.to_dict(),
         }
         return d

@@ -14,6 +14,7 @@ depend on other values, computed by the functions at the end of this module
 
 from __future__ import annotations
 
+import datetime
 import math
 from typing import Annotated, Any, Literal, Union
 
@@ -367,14 +368,127 @@ class Simulation(StrictModel):
     crossover_scan: CrossoverScan = Field(default_factory=CrossoverScan)
 
 
-class ReportInfo(StrictModel):
-    """Title block of the sign-off report."""
+#: Kinds of report, with the suffix that makes each one's document id (see ReportInfo).
+REPORT_KINDS = {"design": "", "sweep": "SWEEP", "study": "STUDY", "robustness": "ROBUSTNESS",
+                "reconcile": "RECONCILE", "identify": "IDENTIFY"}
 
-    document_id: str = Field("FI-0001", description="Document id.")
-    revision: str = Field("A", description="Revision.")
+
+class Revision(StrictModel):
+    """One entry of the revision history, oldest first."""
+
+    revision: str = Field(min_length=1, description="Revision label, as report.revision.")
+    date: datetime.date | None = Field(None, description="Date of the revision (YYYY-MM-DD). "
+                                                         "Default none.")
+    description: str = Field("", description="What changed. Default empty.")
+    author: str | None = Field(None, description="Who made the change. Default none.")
+
+
+class DocumentIds(StrictModel):
+    """Document ids of the other kinds of report (default: report.document_id with the kind as
+    a suffix, FI-0001-SWEEP, FI-0001-STUDY, FI-0001-ROBUSTNESS, FI-0001-RECONCILE,
+    FI-0001-IDENTIFY)."""
+
+    sweep: str | None = Field(None, min_length=1, description="Document id of a sweep report "
+                                                              "(fi-design sweep). Default "
+                                                              "DOCUMENT_ID-SWEEP.")
+    study: str | None = Field(None, min_length=1, description="Document id of the paper study's "
+                                                              "report. Default DOCUMENT_ID-STUDY.")
+    robustness: str | None = Field(None, min_length=1, description="Document id of a "
+                                                                   "robustness report. Default "
+                                                                   "DOCUMENT_ID-ROBUSTNESS.")
+    reconcile: str | None = Field(None, min_length=1, description="Document id of a "
+                                                                  "reconciliation (gap) report. "
+                                                                  "Default DOCUMENT_ID-RECONCILE.")
+    identify: str | None = Field(None, min_length=1, description="Document id of an "
+                                                                 "identification report. Default "
+                                                                 "DOCUMENT_ID-IDENTIFY.")
+
+
+class ReportInfo(StrictModel):
+    """Title block and document control of the sign-off reports. One document id per kind of
+    report: the design report has document_id, every other kind document_id with the kind as
+    a suffix (FI-0001-SWEEP) unless document_ids names it; the ids must differ."""
+
+    document_id: str = Field("FI-0001", min_length=1,
+                             description="Document id of the design report; the other "
+                                         "reports derive theirs from it (see document_ids).")
+    revision: str = Field("A", min_length=1,
+                          description="Revision. Default the last entry of report.revisions, "
+                                      "else A; with revisions it must be the last entry's.")
     status: str = Field("draft", description="Status (draft unless given).")
     author: str | None = Field(None, description="Prepared by.")
+    checked_by: str | None = Field(None, description="Checked by (name in the signature block).")
+    approved_by: str | None = Field(None, description="Approved by (name in the signature "
+                                                      "block).")
+    revisions: tuple[Revision, ...] = Field((), description="Revision history, oldest first: "
+                                                            "revision, date, description, "
+                                                            "author. Default none.")
+    document_ids: DocumentIds = Field(default_factory=DocumentIds,
+                                      description="Document ids of the other kinds of report "
+                                                  "(default: document_id-KIND).")
     map: bool = Field(False, description="Add a crossover x stroke map around the design point.")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _revision_from_history(cls, data: Any) -> Any:
+        if isinstance(data, dict) and data.get("revision") is None and data.get("revisions"):
+            last = data["revisions"][-1]
+            label = last.get("revision") if isinstance(last, dict) else \
+                getattr(last, "revision", None)
+            if label is not None:
+                data = {**data, "revision": label}
+        return data
+
+    @model_validator(mode="after")
+    def _document_control(self) -> "ReportInfo":
+        if self.revisions:
+            labels = [r.revision for r in self.revisions]
+            dupes = sorted({r for r in labels if labels.count(r) > 1})
+            if dupes:
+                raise ValueError(f"report.revisions: revision {', '.join(dupes)} listed twice")
+            if self.revision != labels[-1]:
+                raise ValueError(f"report.revision: '{self.revision}' is not the last entry of "
+                                 f"report.revisions ('{labels[-1]}'); list the revisions oldest "
+                                 "first and end with the current one, or leave "
+                                 "report.revision out")
+            dates = [r.date for r in self.revisions if r.date is not None]
+            if dates != sorted(dates):
+                raise ValueError("report.revisions: the dates must not decrease (oldest first)")
+        ids: dict[str, str] = {}
+        for kind in REPORT_KINDS:
+            doc = self.id_for(kind)
+            if doc in ids:
+                raise ValueError(f"report.document_ids.{kind}: '{doc}' is already the document "
+                                 f"id of the {ids[doc]} report; every kind of report needs its "
+                                 "own")
+            ids[doc] = kind
+        return self
+
+    def id_for(self, kind: str) -> str:
+        """The document id of a kind of report.
+
+        Parameters
+        ----------
+        kind : str
+            ``design``, ``sweep``, ``study``, ``robustness``, ``reconcile``,
+            ``identify`` (:data:`REPORT_KINDS`), or any other word for a report
+            made with the library (its upper-cased suffix).
+
+        Returns
+        -------
+        str
+            ``document_id`` for the design report; for the others the id given
+            in ``document_ids``, else ``document_id`` and the kind's suffix
+            (``FI-0001-SWEEP``).
+        """
+        if kind == "design":
+            return self.document_id
+        given = getattr(self.document_ids, kind, None)
+        if given:
+            return given
+        suffix = REPORT_KINDS.get(kind) or "".join(c if c.isalnum() else "-"
+                                                   for c in kind.upper())
+        return f"{self.document_id}-{suffix}"
 
 
 # --------------------------------------------------------------------------- effects

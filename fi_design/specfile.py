@@ -42,12 +42,17 @@ class SpecOrigin:
         values from defaults.
     lines : dict
         YAML line (1-based) of every key, by location tuple.
+    text : str or None
+        The file's text exactly as read (comments, layout and line endings
+        kept; ``text.encode("utf-8")`` are the bytes ``sha256`` was computed
+        from); None for a mapping.
     """
 
     path: Path | None
     sha256: str
     raw: dict
     lines: dict = field(default_factory=dict, repr=False)
+    text: str | None = field(default=None, repr=False)
 
 
 def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
@@ -79,7 +84,9 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
     path = Path(source)
     data = read_bytes(path)
     raw, lines = parse_yaml(data, str(path))
-    return _validate(raw, SpecOrigin(path, hashlib.sha256(data).hexdigest(), raw, lines))
+    # parse_yaml decoded the bytes as UTF-8 already: the text encodes back to the same bytes
+    return _validate(raw, SpecOrigin(path, hashlib.sha256(data).hexdigest(), raw, lines,
+                                     data.decode("utf-8")))
 
 
 def origin(spec: Spec) -> SpecOrigin | None:

@@ -232,7 +232,10 @@ def test_design_context_golden(paper_confirmed_design, data_regression):
     ctx = report.build_context(paper_confirmed_design, date=DATE, command=COMMAND,
                                figures=False)
     ctx["meta"]["spec_path"] = Path(ctx["meta"]["spec_path"]).name
-    ctx["meta"]["tool"] = "fi-design VERSION"
+    ctx["meta"]["tool"] = "fi-design VERSION"  # the code's provenance: test_document_control
+    ctx["meta"]["tool_footer"] = "fi-design VERSION, SOURCE"
+    ctx["meta"]["tool_source"] = "SOURCE"
+    ctx["meta"]["code_sha256"] = "CODE-SHA256"
     for row in ctx["appendix"]["solver"]:  # solver statistics: not the report's findings
         if row["quantity"].startswith("steps / rejected / events"):
             row["value"] = "steps / rejected / events"
@@ -611,19 +614,28 @@ def test_templates_ship_in_the_wheel_and_load_from_an_installed_copy(tmp_path):
                           timeout=300)
     assert inst.returncode == 0, inst.stderr[-3000:]
     probe = ("import fi_design, fi_design.report as r\n"
+             "from importlib.resources import files\n"
+             "from fi_design.provenance import current_source\n"
+             "from fi_design.report.meta import title_block\n"
+             "from fi_design.specfile import load_spec\n"
              "print(fi_design.__file__)\n"
              "print(r.template_dir())\n"
+             "spec = load_spec(str(files('fi_design').joinpath('example_spec.yaml')))\n"
+             "meta = title_block(spec, 'design', date='x', command='c')\n"
              "print(len(r.environment().get_template('report.html.jinja').render("
-             "meta={'project': 'p', 'title': 't', 'document_id': 'd', 'revision': 'r', "
-             "'status': 's', 'date': 'x', 'tool': 't', 'spec_path': 's', 'spec_sha256': 'h', "
-             "'command': 'c', 'signatures': [{'role': 'Prepared', 'name': ''}], "
-             "'running': 'r', 'kind': 'design'}, sections=[], body=[], css='')))\n")
+             "meta=meta, sections=[], body=[], css='')))\n"
+             "print(current_source().commit, current_source().code_sha256)\n")
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     env["PYTHONPATH"] = str(site)
     run = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                          cwd=tmp_path, env=env, timeout=120)
     assert run.returncode == 0, run.stderr[-3000:]
-    module, templates, size = run.stdout.split()
+    module, templates, size, commit, digest = run.stdout.split()
     assert Path(module).resolve().is_relative_to(site.resolve())
     assert Path(templates) == (site / "fi_design" / "templates").resolve()
     assert int(size) > 1000
+    # the installed copy is no git checkout: its source is the digest of its code, the same
+    # digest as the source tree it was built from
+    from fi_design.provenance import code_digest
+
+    assert commit == "None" and digest == code_digest()

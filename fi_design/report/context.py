@@ -58,14 +58,15 @@ def build_context(result: Any, *, date: Any = None, command: str | None = None,
     if hasattr(result, "report_sections"):
         return document_context(getattr(result, "report_title", "Report"), result.spec,
                                 result.report_sections(), date=date, command=command,
-                                kind=getattr(result, "report_kind", "report"))
+                                kind=getattr(result, "report_kind", "report"),
+                                source=getattr(result, "fi_design_source", None))
     raise ReportError(f"no report for a {type(result).__name__}; expected a DesignResult, a "
                       "sweep result or an object with report_sections()")
 
 
 def document_context(title: str, spec: Any, sections: Sequence[Section], *, date: Any = None,
                      command: str | None = None, kind: str = "report",
-                     conclusion: str = "") -> dict:
+                     conclusion: str = "", source: Any = None) -> dict:
     """The context of a generic report: title block, :class:`Section` values, appendix.
 
     Parameters
@@ -81,9 +82,12 @@ def document_context(title: str, spec: Any, sections: Sequence[Section], *, date
     command : str, optional
         The command line.
     kind : str, optional
-        Short kind (``"sweep"``, ``"reconcile"``), kept in the metadata.
+        Short kind (``"sweep"``, ``"reconcile"``): it sets the document id
+        (:meth:`fi_design.spec.ReportInfo.id_for`).
     conclusion : str, optional
         A paragraph shown first, under "Summary".
+    source : fi_design.provenance.Source, optional
+        The code that computed the result; default the running package's.
 
     Returns
     -------
@@ -93,7 +97,7 @@ def document_context(title: str, spec: Any, sections: Sequence[Section], *, date
     from markupsafe import Markup
 
     ctx: dict[str, Any] = {"meta": title_block(spec, kind, date=date, command=command,
-                                               title=title)}
+                                               title=title, source=source)}
     entries = []
     if conclusion:
         sections = [Section("summary", "Summary", paragraphs=(conclusion,))] + list(sections)

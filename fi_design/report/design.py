@@ -415,7 +415,8 @@ def design_context(result: DesignResult, *, date: Any = None, command: str | Non
     fig_no = _Numbering()
     ctx: dict[str, Any] = {
         "meta": title_block(spec, "design", date=date, command=command,
-                            sha256=result.spec_sha256, version=result.fi_design_version),
+                            sha256=result.spec_sha256, version=result.fi_design_version,
+                            source=result.fi_design_source),
         "verdict": verdict(result),
         "inputs": spec_inputs(spec),
         "steps": guideline_steps(result, figures),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import datetime
 from typing import Any, Callable
 
 from .meta import spec_file
@@ -94,6 +95,10 @@ def spec_inputs(spec: Any) -> list[dict]:
                     row["source"] = f"derived default: {rule[0]}"
                 except (ValueError, AttributeError):
                     row["source"] = "not given"
+            elif generic.startswith("report.document_ids."):
+                kind = generic.rsplit(".", 1)[1]
+                row["value"] = spec.report.id_for(kind)
+                row["source"] = f"derived default: document_id-{kind.upper()}"
             elif path.endswith(".antiresonance") and isinstance(parent, BaseModel):
                 from ..spec import antiresonance
 
@@ -106,6 +111,10 @@ def spec_inputs(spec: Any) -> list[dict]:
                 row["source"] = "not given"
         if isinstance(value, tuple) and not value:
             row["value"] = "none"
+        if path == "report.revision" and not given and spec.report.revisions:
+            row["source"] = "derived default: the last entry of report.revisions"
+        if isinstance(value, datetime.date):
+            row["value"] = value.isoformat()
         return row
 
     def walk(model: Any, raw_node: Any, prefix: str, rows: list[dict]) -> None:

@@ -75,8 +75,9 @@ def spec_file(spec: Any) -> dict:
     -------
     dict
         ``path`` (as shown), ``sha256`` of the file (of the spec's JSON when
-        given in code) and ``raw``, the mapping as written (None when given in
-        code).
+        given in code), ``raw``, the mapping as written (None when given in
+        code), and ``text``, the file's text as read (None unless read from a
+        file).
     """
     from ..specfile import origin
 
@@ -84,9 +85,9 @@ def spec_file(spec: Any) -> dict:
     if org is None:
         return {"path": "(spec given in code)",
                 "sha256": hashlib.sha256(spec.model_dump_json().encode()).hexdigest(),
-                "raw": None}
+                "raw": None, "text": None}
     path = str(org.path) if org.path is not None else "(spec given as a mapping)"
-    return {"path": path, "sha256": org.sha256, "raw": org.raw}
+    return {"path": path, "sha256": org.sha256, "raw": org.raw, "text": org.text}
 
 
 def _yaml_text(raw: Any) -> str:
@@ -97,7 +98,13 @@ def _yaml_text(raw: Any) -> str:
 
 
 def spec_listing(spec: Any) -> dict:
-    """The spec for an appendix: as read from the file, else as given in code.
+    """The spec for an appendix: the file's own text, else the spec as given in code.
+
+    A spec read from a file is printed verbatim, comments and layout kept, so
+    that the SHA-256 printed beside it can be checked against the printed
+    text: the SHA-256 of the text (UTF-8) is the file's. A spec given as a
+    mapping or in code has no file; it is printed as YAML, and its hash is
+    that of its canonical JSON, not of the printed text.
 
     Parameters
     ----------
@@ -107,22 +114,35 @@ def spec_listing(spec: Any) -> dict:
     Returns
     -------
     dict
-        ``spec_yaml`` (YAML text) and ``spec_note`` (what it is).
+        ``spec_yaml`` (the text), ``spec_note`` (what it is),
+        ``spec_sha256`` (the hash printed beside it) and ``spec_verbatim``
+        (True when the text is the file's and the hash is the text's).
     """
-    raw = spec_file(spec)["raw"]
-    if raw is not None:
-        return {"spec_yaml": _yaml_text(raw),
-                "spec_note": "as read from the file (units as written; comments dropped)"}
+    src = spec_file(spec)
+    if src["text"] is not None:
+        note = ("the spec file exactly as read, comments kept; the SHA-256 of this text "
+                "(UTF-8) is the file's")
+        if "\r" in src["text"]:
+            note += " (the file ends its lines with CR LF; the hash counts them)"
+        if src["text"].startswith("\ufeff"):
+            note += " (the file starts with a byte-order mark, which the hash counts)"
+        return {"spec_yaml": src["text"], "spec_note": note, "spec_sha256": src["sha256"],
+                "spec_verbatim": True}
+    if src["raw"] is not None:
+        return {"spec_yaml": _yaml_text(src["raw"]), "spec_sha256": src["sha256"],
+                "spec_note": "given as a mapping, not a file, printed as YAML; the SHA-256 is "
+                             "that of its canonical JSON", "spec_verbatim": False}
     from ..results import to_jsonable
 
-    return {"spec_yaml": _yaml_text(to_jsonable(spec.model_dump())),
-            "spec_note": "as given in code, in SI units"}
+    return {"spec_yaml": _yaml_text(to_jsonable(spec.model_dump())), "spec_sha256": src["sha256"],
+            "spec_note": "given in code, in SI units, printed as YAML; the SHA-256 is that of "
+                         "its JSON", "spec_verbatim": False}
 
 
 def title_block(spec: Any, kind: str, *, date: Any, command: str | None,
                 sha256: str | None = None, version: str | None = None,
-                title: str | None = None) -> dict:
-    """The title block of a report.
+                title: str | None = None, source: Any = None) -> dict:
+    """The title block of a report: document control, provenance, signatures.
 
     Parameters
     ----------
@@ -130,6 +150,8 @@ def title_block(spec: Any, kind: str, *, date: Any, command: str | None,
         The spec (project name, the ``report`` section, provenance).
     kind : str
         Kind of report (``design``, ``sweep``, ...; a key of :data:`TITLES`).
+        The document id is the spec's id for this kind
+        (:meth:`fi_design.spec.ReportInfo.id_for`).
     date : str, datetime.date or None
         Report date (:func:`report_date`).
     command : str or None
@@ -140,30 +162,43 @@ def title_block(spec: Any, kind: str, *, date: Any, command: str | None,
         fi_design version that computed the result; default this one.
     title : str, optional
         Title; default from :data:`TITLES`.
+    source : fi_design.provenance.Source, optional
+        The code that computed the result (git commit, code digest); default
+        the running package's.
 
     Returns
     -------
     dict
         What ``report.html.jinja`` reads under ``meta``.
     """
-    from .. import __version__
+    from ..provenance import current_source
 
     info = spec.report
     src = spec_file(spec)
-    author = info.author or ""
+    source = source if source is not None else current_source()
+    version = version or source.version
+    document = info.id_for(kind)
     return {
         "kind": kind,
         "title": title or TITLES.get(kind, "Report"),
         "project": spec.name,
-        "document_id": info.document_id,
+        "document_id": document,
         "revision": info.revision,
         "status": info.status,
         "date": report_date(date),
-        "tool": f"fi-design {version or __version__}",
+        "tool": f"fi-design {version}",
+        "tool_footer": f"fi-design {version}, {source.short}",
+        "tool_source": source.revision,
+        "code_sha256": source.code_sha256,
         "spec_path": src["path"],
         "spec_sha256": sha256 or src["sha256"],
         "command": command or "(library call: fi_design.render_report)",
-        "signatures": [{"role": "Prepared", "name": author}, {"role": "Checked", "name": ""},
-                       {"role": "Approved", "name": ""}],
-        "running": f"{info.document_id} rev. {info.revision} ({info.status})",
+        "signatures": [{"role": "Prepared", "name": info.author or ""},
+                       {"role": "Checked", "name": info.checked_by or ""},
+                       {"role": "Approved", "name": info.approved_by or ""}],
+        "revisions": [{"revision": r.revision,
+                       "date": r.date.isoformat() if r.date is not None else "",
+                       "description": r.description, "author": r.author or ""}
+                      for r in info.revisions],
+        "running": f"{document} rev. {info.revision} ({info.status})",
     }

@@ -87,7 +87,7 @@ def sweep_context(result: SweepResult, *, date: Any = None, command: str | None 
     """
     sections = [sweep_section(result, "sweep", "Hunting map", figures=figures)]
     return document_context(TITLES["sweep"], result.spec, sections, date=date, command=command,
-                            kind="sweep")
+                            kind="sweep", source=result.fi_design_source)
 
 
 @build_context.register
@@ -116,7 +116,7 @@ def study_context(result: StudyResult, *, date: Any = None, command: str | None 
                               lead=f"Paper: {m.definition.paper}.", figures=figures)
                 for m in result.maps]
     return document_context(TITLES["study"], result.spec, sections, date=date, command=command,
-                            kind="study")
+                            kind="study", source=result.fi_design_source)
 
 
 @build_context.register
@@ -165,4 +165,4 @@ def robustness_context(result: RobustnessResult, *, date: Any = None,
                                     "drawn around the nominal ones.",),
                         tables=(table,), figures=figs)]
     return document_context(TITLES["robustness"], result.spec, sections, date=date,
-                            command=command, kind="robustness")
+                            command=command, kind="robustness", source=result.fi_design_source)

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..provenance import Source, current_source
 from . import Check, Result, Status, to_jsonable
 from .simulation import HuntingMetrics, SimulationResult
 
@@ -551,6 +552,9 @@ class DesignResult(Result):
     simulation : fi_design.confirm.Confirmation or None
         The nonlinear confirmation; None when it was not run (``confirm=False``),
         and then left out of the JSON.
+    fi_design_source : fi_design.provenance.Source
+        The code that computed it: git commit (from a checkout) and the SHA-256
+        of the package's source files; default the running package's.
     """
 
     spec: Spec = field(repr=False)
@@ -567,6 +571,7 @@ class DesignResult(Result):
     fi_design_version: str
     spec_sha256: str
     simulation: "Confirmation | None" = None
+    fi_design_source: Source = field(default_factory=current_source)
 
     @property
     def passed(self) -> bool:
@@ -583,8 +588,9 @@ class DesignResult(Result):
 
         Keys: ``name``, ``passed``, ``friction_gap``, ``crossover``, ``stiffness``,
         ``flexure``, ``pid``, ``isolator_advice``, ``checks``, ``warnings``,
-        ``conclusion``, ``fi_design_version``, ``spec_sha256`` and, when set,
-        ``simulation``.
+        ``conclusion``, ``fi_design_version``, ``fi_design_source`` (``commit``,
+        ``modified``, ``code_sha256``: :class:`~fi_design.provenance.Source`),
+        ``spec_sha256`` and, when set, ``simulation``.
         """
         out = {
             "name": self.spec.name,
@@ -599,6 +605,7 @@ class DesignResult(Result):
             "warnings": [{"path": p, "message": m} for p, m in self.warnings],
             "conclusion": self.conclusion,
             "fi_design_version": self.fi_design_version,
+            "fi_design_source": self.fi_design_source.to_dict(),
             "spec_sha256": self.spec_sha256,
         }
         if self.simulation is not None:

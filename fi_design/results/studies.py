@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import ArgumentError, SpecError
+from ..provenance import Source, current_source
 from . import Result, frozen_array, to_jsonable
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -181,6 +182,8 @@ class SweepResult(Result):
         How the sweep ran (points computed and cached, executor, wall time).
     fi_design_version : str
         Version of fi_design that produced the result.
+    fi_design_source : fi_design.provenance.Source
+        The code that produced it (git commit, SHA-256 of the source files).
     """
 
     spec: Spec
@@ -195,6 +198,7 @@ class SweepResult(Result):
     design_point: tuple[float | None, ...]
     run: RunInfo = field(repr=False)
     fi_design_version: str = ""
+    fi_design_source: Source = field(default_factory=current_source)
 
     @property
     def paths(self) -> tuple[str, ...]:
@@ -276,6 +280,7 @@ class SweepResult(Result):
         """Plain JSON data: axes, metric arrays, points, design point, run info."""
         return {
             "fi_design_version": self.fi_design_version,
+            "fi_design_source": self.fi_design_source.to_dict(),
             "spec_name": self.spec.name,
             "spec_sha256": spec_digest(self.spec),
             "isolated": self.isolated,
@@ -384,12 +389,15 @@ class StudyResult(Result):
         Points per axis.
     run : RunInfo
         How the whole study ran (all maps together).
+    fi_design_source : fi_design.provenance.Source
+        The code that produced it (git commit, SHA-256 of the source files).
     """
 
     spec: Spec
     maps: tuple[StudyMap, ...]
     resolution: int
     run: RunInfo = field(repr=False)
+    fi_design_source: Source = field(default_factory=current_source)
 
     def map(self, key: str) -> SweepResult:
         """The map ``key`` (``"A"`` to ``"D"``).
@@ -410,7 +418,11 @@ class StudyResult(Result):
 
     def to_dict(self) -> dict:
         """Plain JSON data."""
-        return {"spec_name": self.spec.name, "resolution": self.resolution,
+        from .. import __version__
+
+        return {"fi_design_version": __version__,
+                "fi_design_source": self.fi_design_source.to_dict(),
+                "spec_name": self.spec.name, "resolution": self.resolution,
                 "maps": [m.to_dict() for m in self.maps], "run": self.run.to_dict()}
 
 
@@ -529,6 +541,8 @@ class RobustnessResult(Result):
         How the study ran.
     fi_design_version : str
         Version of fi_design that produced the result.
+    fi_design_source : fi_design.provenance.Source
+        The code that produced it (git commit, SHA-256 of the source files).
     """
 
     spec: Spec
@@ -543,6 +557,7 @@ class RobustnessResult(Result):
     points: tuple[PointResult, ...] = field(repr=False)
     run: RunInfo = field(repr=False)
     fi_design_version: str = ""
+    fi_design_source: Source = field(default_factory=current_source)
 
     @property
     def samples(self) -> int:
@@ -586,6 +601,7 @@ class RobustnessResult(Result):
         """Plain JSON data."""
         return {
             "fi_design_version": self.fi_design_version,
+            "fi_design_source": self.fi_design_source.to_dict(),
             "spec_name": self.spec.name,
             "spec_sha256": spec_digest(self.spec),
             "samples": self.samples,
