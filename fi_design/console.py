@@ -40,14 +40,85 @@ def make_console(stderr: bool = False) -> "Console":
 
 
 def _fmt(value: Any, digits: int = 4) -> str:
-    """A number for a table cell: ``digits`` significant digits, '-' for none."""
+    """A number for a table cell: ``digits`` significant digits, '-' for none.
+
+    Plain notation from 1e-4 to 1e6 (``13333``, ``0.001348``), else a power of
+    ten (``3.2e-08``); integers in full.
+    """
     if value is None:
         return "-"
     if isinstance(value, bool):
         return "yes" if value else "no"
-    if isinstance(value, (int, float)):
-        return f"{value:.{digits}g}"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float) or hasattr(value, "dtype"):
+        x = float(value)
+        if not math.isfinite(x):
+            return "-" if math.isnan(x) else "inf" if x > 0 else "-inf"
+        ax = abs(x)
+        if x == 0 or not 1e-4 <= ax < 1e6:
+            return "0" if x == 0 else f"{x:.{digits}g}"
+        decimals = max(0, digits - 1 - math.floor(math.log10(ax)))
+        text = f"{x:.{decimals}f}"
+        if "." in text:
+            text = text.rstrip("0").rstrip(".")
+        return "0" if text in ("-0", "") else text
     return str(value)
+
+
+def _qty(value: Any, unit: str, digits: int = 4) -> str:
+    """A value with its unit for a table cell, scaled for reading: ``1.37 mm``, ``25.2 µm``.
+
+    Lengths below 0.1 mm are shown in µm, longer ones in mm, speeds in mm/s,
+    stresses with a prefix (the report's rule, :func:`fi_design.report.filters.display_scale`).
+
+    Parameters
+    ----------
+    value : float or None
+        SI value.
+    unit : str
+        Its SI unit.
+    digits : int, optional
+        Significant digits.
+
+    Returns
+    -------
+    str
+        ``-`` for None.
+    """
+    from .report.filters import display_scale
+
+    if value is None or isinstance(value, bool) or not isinstance(value, (int, float)):
+        return _fmt(value)
+    if not math.isfinite(value):
+        return "inf" if value > 0 else "-inf" if value < 0 else "-"
+    if value == 0:
+        return "0"
+    if unit == "m" and 0 < abs(value) < 5e-10:
+        return "< 0.001 \u00b5m"  # below what a position sensor resolves
+    shown, factor = display_scale(unit, value)
+    return f"{_fmt(value * factor, digits)} {shown}".rstrip()
+
+
+def _table(title: str | None = None, **options: Any):
+    """A compact rich table: simple head rule, one space between columns, title on the left."""
+    from rich import box
+    from rich.table import Table
+
+    return Table(title=title, title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False,
+                 collapse_padding=True, **options)
+
+
+def _row_scale(unit: str, values: Any) -> tuple[str, float]:
+    """One display unit for a table row of SI values (µm for micrometre-sized lengths)."""
+    from .report.filters import display_scale, unit_text
+
+    finite = [abs(v) for v in values if isinstance(v, (int, float)) and not isinstance(v, bool)
+              and math.isfinite(v) and v != 0]
+    if unit in ("-", "1", ""):
+        return "-", 1.0
+    shown, factor = display_scale(unit, max(finite) if finite else None)
+    return shown or unit_text(unit), factor
 
 
 def _status_text(status: Any):
@@ -68,10 +139,14 @@ def _heading(console: "Console", text: str, spec_path: Optional[Path]) -> None:
     console.print(head)
 
 
-def checks_table(checks, title: str = "Checks"):
+def checks_table(checks, title: str = "Checks", cases: Any = None):
     """A rich table of :class:`~fi_design.results.Check` values, status coloured.
 
     Checks are grouped by their ``step``: a bold heading row starts each group.
+    Each check's name in words sits above its message in the first column,
+    which wraps, so the table reads at 80 columns as at 200; value and limit
+    share the unit the report shows them in (13.33 N/mm, 31.55 MPa, 47.31°),
+    the limit with the requirement's sense (``≥ 30``).
 
     Parameters
     ----------
@@ -79,31 +154,41 @@ def checks_table(checks, title: str = "Checks"):
         The checks, in report order.
     title : str, optional
         Table title.
+    cases : mapping, optional
+        The design's limit cases by name, which name the case of a margin check
+        (:func:`fi_design.report.check_label`).
 
     Returns
     -------
     rich.table.Table
-        Columns check, status, value, limit, unit, message.
+        Columns check (with its message), status, value, limit, unit.
     """
-    from rich import box
-    from rich.table import Table
     from rich.text import Text
 
-    table = Table(title=title, title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
-    table.add_column("Check", no_wrap=True)
+    from .report.checks import check_row
+
+    table = _table(title)
+    table.add_column("Check", ratio=1, min_width=24, overflow="fold")
     table.add_column("Status", no_wrap=True)
     table.add_column("Value", justify="right", no_wrap=True)
     table.add_column("Limit", justify="right", no_wrap=True)
     table.add_column("Unit", no_wrap=True)
-    table.add_column("Message", ratio=1, min_width=30)
     step = None
     for c in checks:
         if (c.step or "") != step:
             step = c.step or ""
             if step:
-                table.add_row(Text(step, style="bold"))
-        table.add_row(Text(c.name), _status_text(c.status), _fmt(c.value), _fmt(c.limit),
-                      Text(c.unit or ""), Text(c.message or ""))
+                table.add_row(Text(step, style="bold underline"))
+        row = check_row(c, cases)
+        cell = Text(row["label"], style="bold")
+        if row["message"]:
+            cell.append("\n")
+            cell.append(Text(row["message"], style="dim"))
+        limit = _fmt(row["limit"])
+        if row["sense"] and row["limit"] is not None:
+            limit = f"{row['sense']} {limit}"
+        table.add_row(cell, _status_text(c.status), _fmt(row["value"]), limit,
+                      Text(row["unit"] or ""))
     return table
 
 
@@ -163,7 +248,9 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
             f"{_fmt(gap.get('threshold'))} N): "
             + ("hunting is a risk" if risk else "hunting unlikely" if risk is not None else "")))
 
-    console.print(checks_table(result.checks))
+    loop = getattr(result, "loop", None)
+    console.print(checks_table(result.checks,
+                               cases={c.name: c for c in getattr(loop, "cases", ())}))
 
     pid = data.get("pid") or {}
     if pid:
@@ -219,7 +306,8 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
 
     sim = data.get("simulation")
     if isinstance(sim, dict) and "isolated" in sim:
-        console.print(_simulation_table(sim))
+        h = result.spec.requirements.hunting
+        console.print(_simulation_table(sim, (h.window_start, h.window_start + h.window_length)))
 
     conclusion = getattr(result, "conclusion", "") or data.get("conclusion", "")
     if conclusion:
@@ -229,35 +317,72 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
         console.print(Text("warning: ", style="bold yellow").append(Text(_warning_text(w))))
 
 
-def _simulation_table(sim: dict) -> Any:
-    """Table of the simulated verdicts from the confirmation's JSON form."""
-    from rich import box
-    from rich.table import Table
+#: Friction models as the literature names them.
+_MODEL_NAMES = {"lugre": "LuGre", "switch": "switch"}
+
+
+def _simulation_table(sim: dict, window: tuple[float, float] | None = None) -> Any:
+    """Table of the simulated verdicts from the confirmation's JSON form.
+
+    One column per plant, one row per quantity, so it reads at any width;
+    lengths carry their unit (``1.37 mm``, ``25.2 µm``).
+
+    Parameters
+    ----------
+    sim : dict
+        ``DesignResult.to_dict()["simulation"]``.
+    window : tuple of float, optional
+        The counting window [s], named in the cycles row.
+    """
     from rich.text import Text
 
     label = "suggested isolator" if sim.get("suggested_isolator") else "with isolator"
-    t = Table(title="Nonlinear confirmation (LuGre simulation, paper section 2.3)"
-              if sim["isolated"].get("friction_model") == "lugre"
-              else "Nonlinear confirmation (switch friction model)",
-              title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
-    for col, just in (("Plant", "left"), ("Verdict", "left"), ("Cycles", "right"),
-                      ("Amplitude [um]", "right"), ("Period [s]", "right"),
-                      ("Final error [um]", "right"), ("Hunting-free from [Hz]", "right"),
-                      ("Other model", "left")):
-        t.add_column(Text(col), justify=just, no_wrap=True)
-    mins = sim.get("min_hunting_free_crossover") or {}
+    model = sim["isolated"].get("friction_model") or "lugre"
     other = sim.get("cross_check") or {}
-    for key, name in (("isolated", label), ("non_isolated", "without isolator")):
-        v = sim[key]
-        verdict = v.get("verdict", "")
+    other_model = next((v.get("friction_model") for v in other.values() if v),
+                       "switch" if model == "lugre" else "lugre")
+    mins = sim.get("min_hunting_free_crossover") or {}
+    t = _table(f"Nonlinear confirmation ({_MODEL_NAMES.get(model, model)} simulation, paper "
+               "section 2.3)")
+    t.add_column("")
+    plants = (("isolated", label), ("non_isolated", "without isolator"))
+    for _, name in plants:
+        t.add_column(Text(name), justify="right")
+    counted = "in the window" if window is None else \
+        f"in [{_fmt(float(window[0]))} s, {_fmt(float(window[1]))} s)"
+
+    def verdict_text(verdict: str) -> Any:
         style = {"settled": "bold green", "hunting": "bold red"}.get(verdict, "bold yellow")
+        return Text(verdict, style=style)
+
+    def free_from(key: str) -> str:
         m = mins.get(key)
-        t.add_row(name, Text(verdict, style=style), str(v.get("hunting_cycles")),
-                  _fmt(None if v.get("amplitude") is None else 1e6 * v["amplitude"], 3),
-                  _fmt(v.get("period"), 3),
-                  _fmt(None if v.get("final_error") is None else 1e6 * v["final_error"], 3),
-                  "not found" if m is None else f"{m:g} (+-{mins.get('resolution', 0):g})",
-                  (other.get(key) or {}).get("verdict", ""))
+        step = mins.get("resolution")
+        if m is None:
+            return "not in the scan"
+        return f"{m:g} Hz" + (f" (±{step:g})" if step else "")
+
+    def period(v: dict) -> str:
+        return "-" if v.get("period") is None else f"{_fmt(v['period'], 3)} s"
+
+    def settling(v: dict) -> str:
+        st = v.get("settling_time")
+        return "never" if st is None else f"{_fmt(st, 3)} s"
+
+    rows = [
+        ("Verdict", lambda k, v: verdict_text(v.get("verdict", ""))),
+        (f"Hunting cycles {counted}", lambda k, v: str(v.get("hunting_cycles"))),
+        ("Amplitude, peak to peak", lambda k, v: _qty(v.get("amplitude"), "m", 3)),
+        ("Period", lambda k, v: period(v)),
+        ("Settling time after the motion", lambda k, v: settling(v)),
+        ("Final error x1 - r", lambda k, v: _qty(v.get("final_error"), "m", 3)),
+        ("Hunting-free from (scan step)", lambda k, v: free_from(k)),
+    ]
+    if other:
+        rows.append((f"Cross-check, {_MODEL_NAMES.get(other_model, other_model)} model",
+                     lambda k, v: verdict_text((other.get(k) or {}).get("verdict", ""))))
+    for title, cell in rows:
+        t.add_row(Text(title), *[cell(key, sim[key]) for key, _ in plants])
     return t
 
 
@@ -272,35 +397,36 @@ def _warning_text(w: Any) -> str:
     return str(w)
 
 
-#: Columns of the limit-case table: JSON key -> header with unit (others are appended).
+#: Columns of the limit-case table: JSON key -> short header with unit (others are appended).
 CASE_COLUMNS = {
-    "crossover": "Crossover [Hz]",
-    "phase_margin_deg": "Phase margin [deg]",
-    "gain_margin_db": "Gain margin [dB]",
-    "modulus_margin": "Modulus margin [-]",
-    "delay_margin": "Delay margin [s]",
-    "stable": "Stable",
+    "crossover": "fc [Hz]",
+    "phase_margin_deg": "PM [deg]",
+    "gain_margin_db": "GM [dB]",
+    "modulus_margin": "MM [-]",
+    "delay_margin": "DM [s]",
 }
-_CASE_SKIP = {"name", "description", "passed", "failed", "crossovers"}
+#: What the short headers of the limit-case table mean (the table's caption).
+CASE_CAPTION = ("fc: gain crossover; PM, GM, MM, DM: phase, gain, modulus and delay margin "
+                "(inf: no crossing); an unstable case fails with 'stability'")
+_CASE_SKIP = {"name", "description", "passed", "failed", "crossovers", "stable"}
 
 
 def _cases_table(cases: list, numbers: dict) -> Any:
     """Table of the linear limit cases (paper Figure 2) from their JSON form and numbers."""
-    from rich import box
-    from rich.table import Table
     from rich.text import Text
 
     keys = [k for k in CASE_COLUMNS if any(k in c for c in cases)]
     for case in cases:
         keys += [k for k, v in case.items() if k not in keys and k not in _CASE_SKIP
                  and not isinstance(v, (dict, list))]
-    t = Table(title="Linear limit cases at the desired crossover (paper Figure 2)",
-              title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
+    t = _table("Linear limit cases at the desired crossover (paper Figure 2)")
+    t.caption = Text(CASE_CAPTION, style="dim")
+    t.caption_justify = "left"
     t.add_column("#", justify="right", no_wrap=True)
-    t.add_column("Case", no_wrap=True)
+    t.add_column("Limit case", ratio=1, min_width=12)
     for k in keys:
-        t.add_column(Text(CASE_COLUMNS.get(k, _header(k))), justify="right")
-    t.add_column("Status", no_wrap=True)
+        t.add_column(Text(CASE_COLUMNS.get(k, _header(k))), justify="right", no_wrap=True)
+    t.add_column("Status", min_width=6)
     for i, case in enumerate(cases, 1):
         number = str(numbers.get(case.get("name"), i))
         label = case.get("description") or case.get("name") or ""
@@ -368,10 +494,10 @@ def print_simulation(console: "Console", result) -> None:
         rows += [
             ("verdict", m.verdict),
             ("hunting cycles in the window [-]", str(m.hunting_cycles)),
-            ("amplitude (peak to peak) [um]", _fmt(1e6 * m.amplitude, 4)),
+            ("amplitude (peak to peak)", _qty(m.amplitude, "m")),
             ("period [s]", _fmt(m.period, 4)),
             ("settling time [s]", _fmt(m.settling_time, 4)),
-            ("final error [um]", _fmt(1e6 * m.final_error, 4)),
+            ("final error", _qty(m.final_error, "m")),
         ]
     rows += [
         ("integration", "ok" if result.success else result.message),
@@ -422,11 +548,13 @@ class ProgressBar:
 def _axis_values_text(axis) -> str:
     from .plots import display_unit
 
+    from .plots import quantity_name
+
     unit, f = display_unit(axis.unit)
     v = axis.values
     scale = "log" if axis.log else "linear"
-    return (f"{axis.path}: {len(v)} values {_fmt(v[0] * f)} to {_fmt(v[-1] * f)} {unit} "
-            f"({scale})")
+    return (f"{quantity_name(axis.path)} ({axis.path}): {len(v)} values {_fmt(v[0] * f)} to "
+            f"{_fmt(v[-1] * f)} {unit} ({scale})")
 
 
 _CELL = {"settled": ("·", "green"), "stuck": ("s", "yellow"), "undetermined": ("?", "yellow"),
@@ -493,12 +621,11 @@ def grid_caption(result) -> str:
     -------
     str
     """
-    from .plots import display_unit
+    from .plots import axis_label
 
-    text = f"hunting cycles in the window; columns {result.x.path} " \
-           f"[{display_unit(result.x.unit)[0]}]"
+    text = f"hunting cycles in the window; columns: {axis_label(result.x.path, result.x.unit)}"
     if result.y is not None:
-        text += f", rows {result.y.path} [{display_unit(result.y.unit)[0]}]"
+        text += f", rows: {axis_label(result.y.path, result.y.unit)}"
     return text + "; · settled, s stuck, ? undetermined, - invalid, × failed"
 
 
@@ -540,6 +667,8 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
 
     from .plots import display_unit
 
+    from .plots import quantity_name
+
     _heading(console, f"Sweep of {result.spec.name}", spec_path)
     plant = "with isolator" if result.isolated else "without isolator"
     console.print(Text(f"{_axis_values_text(result.x)}; {plant}"))
@@ -551,8 +680,8 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
     above = result.boundary("above")
     if result.y is None:
         if not math.isnan(above[0]):
-            console.print(Text(f"no hunting from {result.x.path} = {_fmt(above[0] * xf)} {xu} "
-                               "upwards"))
+            console.print(Text(f"no hunting from {quantity_name(result.x.path).lower()} = "
+                               f"{_fmt(above[0] * xf)} {xu} upwards"))
     failed = [p for p in result.points if p.status == "failed"]
     for p in failed[:3]:
         console.print(Text(f"failed at {dict(zip(result.paths, p.values))}: {p.message}",
@@ -605,8 +734,6 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
     executor : str, optional
         How the points ran, for the last line.
     """
-    from rich import box
-    from rich.table import Table
     from rich.text import Text
 
     from .plots import display_unit
@@ -623,23 +750,25 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
         console.print(Text(f"position-dependent friction: amplitude {100 * pf.amplitude:.3g} %, "
                            f"wavelength {pf.wavelength * 1e3:.4g} mm, random phase"))
     conf = result.not_isolated.confidence
-    t = Table(title=f"Probability of hunting, {result.samples} samples, seed {result.seed}",
-              title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
-    t.caption = Text(f"P: probability of hunting among the valid samples; CI: {conf:.0%} Wilson "
-                     "interval", style="dim")
+    t = _table(f"Probability of hunting, {result.samples} samples, seed {result.seed}")
+    plants = [(label, p) for label, p in (("with isolator", result.isolated),
+                                          ("without isolator", result.not_isolated))
+              if p is not None]
+    t.add_column("")
+    for label, _ in plants:
+        t.add_column(Text(label), justify="right")
+    rows = [
+        ("Probability of hunting", lambda p: "-" if p.probability is None
+         else f"{100 * p.probability:.1f} %"),
+        (f"{conf:.0%} Wilson interval", lambda p: f"{100 * p.low:.1f} to {100 * p.high:.1f} %"),
+        ("Hunting / valid samples", lambda p: f"{p.hunting} / {p.valid}"),
+    ] + [(f"  {v}", lambda p, v=v: str(p.counts[v]))
+         for v in ("settled", "stuck", "undetermined", "invalid", "failed")]
+    for title, cell in rows:
+        t.add_row(Text(title), *[cell(p) for _, p in plants])
+    t.caption = Text("Probability among the valid samples; the indented rows count every "
+                     "sample by its verdict", style="dim")
     t.caption_justify = "left"
-    for col in ("Plant", "Hunting", "Valid", "P [%]", "CI [%]", "Settled", "Stuck",
-                "Undetermined", "Invalid", "Failed"):
-        t.add_column(Text(col), justify="left" if col == "Plant" else "right", no_wrap=True)
-    for label, p in (("with isolator", result.isolated),
-                     ("without isolator", result.not_isolated)):
-        if p is None:
-            continue
-        prob = "-" if p.probability is None else f"{100 * p.probability:.1f}"
-        c = p.counts
-        t.add_row(label, str(p.hunting), str(p.valid), prob,
-                  f"{100 * p.low:.1f} to {100 * p.high:.1f}", str(c["settled"]), str(c["stuck"]),
-                  str(c["undetermined"]), str(c["invalid"]), str(c["failed"]))
     console.print(t)
     _print_run(console, result.run, executor)
 
@@ -687,31 +816,32 @@ def print_reconcile(console: "Console", result) -> None:
     result : fi_design.reconciliation.ReconcileResult
         The reconciliation.
     """
-    from rich import box
-    from rich.table import Table
     from rich.text import Text
 
     head = Text("Effect: ", style="bold")
     head.append(Text(result.effect, style="bold green" if result.effect != "none" else "bold"))
     console.print(head)
     console.print(Text(result.conclusion))
-    t = Table(title="Candidates (best first)", title_justify="left", box=box.SIMPLE_HEAD,
-              pad_edge=False)
+    t = _table("Candidates (best first)")
+    longest = max((len(c.name) for c in result.candidates), default=6)
     for col, just in (("Effect", "left"), ("Score", "right"), ("Explained", "right"),
-                      ("Fitted parameters (SI)", "left")):
-        t.add_column(col, justify=just)
+                      ("Fitted parameters", "left")):
+        t.add_column(col, justify=just, no_wrap=col != "Fitted parameters",
+                     min_width=longest if col == "Effect" else None,
+                     ratio=1 if col == "Fitted parameters" else None)
     for c in result.candidates:
-        params = ", ".join(f"{k} = {_fmt(v)}" + (f" +- {_fmt(c.uncertainty.get(k), 2)}"
-                                                 if c.uncertainty.get(k) else "")
+        params = ", ".join(_fitted(c.name, k, v, c.uncertainty.get(k))
                            for k, v in c.parameters.items() if v is not None)
         t.add_row(Text(c.name), _fmt(c.score), f"{100 * c.explained:.1f} %", Text(params))
     console.print(t)
-    g = Table(title="Gap before and after", title_justify="left", box=box.SIMPLE_HEAD,
-              pad_edge=False)
+    g = _table("Gap before and after")
     for col in ("Metric", "Unit", "Before", "After", "Noise"):
-        g.add_column(col, justify="left" if col in ("Metric", "Unit") else "right")
+        g.add_column(col, justify="left" if col in ("Metric", "Unit") else "right",
+                     no_wrap=True)
     for m in result.gaps:
-        g.add_row(Text(m.name), Text(m.unit), _fmt(m.before), _fmt(m.after), _fmt(m.noise))
+        unit, factor = _row_scale(m.unit, (m.before, m.after, m.noise))
+        g.add_row(Text(m.name), Text(unit), *[_fmt(None if v is None else v * factor)
+                                              for v in (m.before, m.after, m.noise)])
     console.print(g)
     nz = result.noise
     parts = [f"position {_fmt(nz.position, 3)} m ({nz.source.get('position')})"]
@@ -722,6 +852,21 @@ def print_reconcile(console: "Console", result) -> None:
     console.print(Text("Noise: " + ", ".join(parts)))
     for name, why in result.skipped.items():
         console.print(Text(f"skipped {name}: {why}", style="dim"))
+
+
+def _fitted(effect: str, name: str, value: float, error: Any) -> str:
+    """``wavelength = 5 ± 1.2e-05 mm``: a fitted effect parameter in its display unit."""
+    from .effects import CATALOGUE
+    from .report.filters import display_scale
+
+    units = {p.name: p.unit for p in CATALOGUE[effect].parameters} if effect in CATALOGUE \
+        else {}
+    unit = units.get(name, "")
+    shown, factor = ("", 1.0) if unit in ("", "1") else display_scale(unit, value)
+    text = f"{name} = {_fmt(value * factor)}"
+    if error:
+        text += f" ± {_fmt(error * factor, 2)}"
+    return f"{text} {shown}".rstrip()
 
 
 def print_identification(console: "Console", result) -> None:
@@ -747,8 +892,10 @@ def print_identification(console: "Console", result) -> None:
     for col, just in (("Parameter", "left"), ("Value", "right"), ("Std. error", "right"),
                       ("Unit", "left"), ("Identifiable", "left")):
         t.add_column(col, justify=just, no_wrap=True)
+    from .report.filters import unit_text
+
     for name, p in result.parameters.items():
-        t.add_row(Text(name), _fmt(p.value, 6), _fmt(p.std_error, 3), Text(p.unit),
+        t.add_row(Text(name), _fmt(p.value, 6), _fmt(p.std_error, 3), Text(unit_text(p.unit)),
                   Text("yes" if p.identifiable else "no",
                        style="green" if p.identifiable else "yellow"))
     console.print(t)

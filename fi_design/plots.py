@@ -308,12 +308,39 @@ def _plant_title(v: Any, label: str) -> str:
     return f"{label}: {m.verdict} ({cycles} counted)"
 
 
+def motion_end(time: np.ndarray, reference: np.ndarray) -> float:
+    """When the reference comes to rest for good: the last change of r [s].
+
+    Parameters
+    ----------
+    time, reference : numpy.ndarray, shape (n,)
+        Sample times [s] and reference r [m].
+
+    Returns
+    -------
+    float
+        The first sample time from which r keeps its final value; ``time[0]``
+        for a constant reference.
+    """
+    r = np.asarray(reference, dtype=float)
+    moving = np.nonzero(r != r[-1])[0]
+    return float(time[0]) if not len(moving) else float(time[min(moving[-1] + 1, len(r) - 1)])
+
+
+#: Half-height of the settling panels of :func:`error_figure`, in settle bands.
+SETTLE_ZOOM = 5.0
+
+
 @_styled
 def error_figure(confirmation: Any, spec: Any) -> Any:
     """Position error x1 - r over time with and without the isolator (paper Figure 5).
 
-    Both panels share the axes; the counting window of the hunting metric is
-    shaded, its minimum peak height dashed, the counted peaks circled.
+    One row per plant. Left: the whole error in mm, as the paper's Figure 5;
+    the counting window of the hunting metric is shaded, its minimum peak
+    height dashed, the counted peaks circled. Right: the same error after the
+    motion in µm, zoomed to ``SETTLE_ZOOM`` settle bands either side, where a
+    settling of micrometres shows: the settle band shaded, the settling time
+    dotted. Both plants share each column's scale.
 
     Parameters
     ----------
@@ -327,10 +354,15 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
     matplotlib.figure.Figure
     """
     h = spec.requirements.hunting
-    fig = _report_figure(4.2, top=0.3, hspace=0.45)
-    axes = fig.subplots(2, 1, sharex=True, sharey=True)
+    fig = _report_figure(4.6, top=0.3, hspace=0.55, right=0.1)
+    fig.subplots_adjust(wspace=0.32)
+    axes = fig.subplots(2, 2, sharex="col", sharey="col", width_ratios=(1.55, 1.0))
     label = "suggested isolator" if confirmation.suggested_isolator else "with isolator"
-    for ax, key, name in zip(axes, ("isolated", "non_isolated"), (label, "without isolator")):
+    band = h.settle_band * 1e6
+    zoom = SETTLE_ZOOM * band
+    end = float(confirmation.results["isolated"].time[-1])
+    for (ax, axz), key, name in zip(axes, ("isolated", "non_isolated"),
+                                    (label, "without isolator")):
         res = confirmation.results[key]
         verdict = getattr(confirmation, key)
         m = res.metrics
@@ -342,7 +374,6 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
         if len(m.peak_times):
             ax.plot(m.peak_times, np.asarray(m.peak_heights) * 1e3, "o", mfc="none",
                     mec="navy", ms=6, mew=1.1, label="counted peak")
-            ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), borderaxespad=0.1)
         ax.set_title(_plant_title(verdict, name), loc="left")
         ax.set_ylabel("x1 - r [mm]")
         ax.text(m.window[0], 0.03, " counting window", transform=ax.get_xaxis_transform(),
@@ -350,8 +381,32 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
         ax.text(0.03, h.min_height * 1e3, f"min. peak height {h.min_height * 1e3:g} mm",
                 transform=ax.get_yaxis_transform(), va="bottom", ha="left", fontsize=7,
                 color="0.35", bbox={"facecolor": "white", "alpha": 0.8, "lw": 0, "pad": 0.5})
-    axes[-1].set_xlabel("time [s]")
-    axes[-1].set_xlim(0, float(confirmation.results["isolated"].time[-1]))
+        # the settling, in micrometres, after the motion
+        t0 = motion_end(res.time, res.reference)
+        after = res.time >= t0
+        axz.axhspan(-band, band, color="#dcefe0", lw=0, zorder=0)
+        axz.axhline(0.0, color="0.6", lw=0.6, zorder=1)
+        tz, ez = decimate(res.time[after], res.error[after] * 1e6)
+        axz.plot(tz, np.clip(ez, -1.5 * zoom, 1.5 * zoom), color=PLANT_COLOURS[key], lw=1.0,
+                 zorder=2)
+        if m.settling_time is not None:
+            ts = t0 + m.settling_time
+            axz.axvline(ts, color="0.25", lw=0.9, ls=":", zorder=3)
+            note = f"in the band from t = {ts:.3g} s\n({m.settling_time:.3g} s after the motion)"
+        else:
+            note = "never stays in the band"
+        axz.text(0.98, 0.04, note, transform=axz.transAxes, ha="right", va="bottom",
+                 fontsize=7, color="0.25",
+                 bbox={"facecolor": "white", "alpha": 0.85, "lw": 0, "pad": 0.6})
+        axz.set_title(f"after the motion: \u00b1{band:g} \u00b5m settle band", loc="left",
+                      fontsize=7.5)
+        axz.set_ylabel("x1 - r [\u00b5m]")
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    axes[-1][0].set_xlim(0, end)
+    t0 = min(motion_end(r.time, r.reference) for r in confirmation.results.values())
+    axes[-1][1].set_xlim(t0, end)
+    axes[-1][1].set_ylim(-zoom, zoom)
     return fig
 
 
@@ -531,8 +586,60 @@ def display_unit(unit: str) -> tuple[str, float]:
     return DISPLAY_UNITS.get(unit, (unit, 1.0))
 
 
+#: Names of the values sweeps and studies usually vary, by dotted spec path.
+QUANTITY_NAMES: dict[str, str] = {
+    "controller.crossover": "Crossover frequency",
+    "controller.delay": "Loop delay",
+    "controller.sample_rate": "Sample rate",
+    "controller.force_limit": "Force limit",
+    "controller.derivative_ratio": "Derivative ratio",
+    "controller.integrator_ratio": "Integrator ratio",
+    "isolator.stroke": "Isolator stroke",
+    "isolator.stiffness": "Drive stiffness",
+    "isolator.damping": "Joint damping",
+    "friction.static": "Static friction",
+    "friction.coulomb": "Coulomb friction",
+    "friction.stribeck_velocity": "Stribeck velocity",
+    "friction.viscous": "Viscous friction",
+    "friction.bristle_stiffness": "Bristle stiffness",
+    "friction.bristle_damping": "Bristle damping",
+    "friction.offset": "Load force offset",
+    "stage.mass": "Stage mass",
+    "cart.mass": "Cart mass",
+}
+
+
+def quantity_name(path: str) -> str:
+    """A readable name for the value at a dotted spec path: ``"Isolator stroke"``.
+
+    Parameters
+    ----------
+    path : str
+        Dotted spec path.
+
+    Returns
+    -------
+    str
+        From :data:`QUANTITY_NAMES`, else the first words of the schema's
+        description of the field (``"Extra loop delay"``), else the path.
+    """
+    if path in QUANTITY_NAMES:
+        return QUANTITY_NAMES[path]
+    from .errors import SpecError
+    from .specfile import path_description
+
+    try:
+        text = path_description(path)
+    except SpecError:
+        text = ""
+    for stop in (" [", ";", ". ", " ("):
+        text = text.split(stop)[0]
+    text = text.strip().rstrip(".")
+    return text[:1].upper() + text[1:] if text else path
+
+
 def axis_label(path: str, unit: str) -> str:
-    """Axis label ``"isolator.stroke [mm]"`` for a dotted path and its SI unit.
+    """Axis label with the quantity's name and display unit: ``"Isolator stroke [mm]"``.
 
     Parameters
     ----------
@@ -546,7 +653,16 @@ def axis_label(path: str, unit: str) -> str:
     str
     """
     shown, _ = display_unit(unit)
-    return f"{path} [{shown}]" if shown else path
+    name = quantity_name(path)
+    return f"{name} [{shown}]" if shown else name
+
+
+def _physical_edges(edges: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Cell edges clipped to the physical range: none below zero when every value is >= 0."""
+    out = np.array(edges, dtype=float)
+    if np.all(np.asarray(values, dtype=float) >= 0.0):
+        out[0] = max(out[0], 0.0)
+    return out
 
 
 def _edges(values: np.ndarray, log: bool) -> np.ndarray:
@@ -615,11 +731,15 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
                        label="design point")
             ax.legend(loc="best", fontsize=8, frameon=False)
         ax.set_xlabel(axis_label(x.path, x.unit))
-        ax.set_ylabel("hunting cycles in window [-]")
+        ax.set_ylabel("Hunting cycles in the window [-]")
         if x.log:
             ax.set_xscale("log")
+        else:
+            ex = _physical_edges(_edges(xs, False), xs)
+            ax.set_xlim(ex[0], ex[-1])
         ax.set_ylim(bottom=0)
-        ax.set_title(f"{x.path} ({plant})" if title is None else title, fontsize=10)
+        ax.set_title(f"{quantity_name(x.path)} ({plant})" if title is None else title,
+                     fontsize=10)
         return artist
     y = result.y
     yu, yf = display_unit(y.unit)
@@ -630,9 +750,10 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
                           ).with_extremes(bad="0.8")
     norm = BoundaryNorm(np.arange(-0.5, top + 1.5), cmap.N)
     data = np.ma.masked_invalid(cycles)
-    mesh = ax.pcolormesh(_edges(xs, x.log), _edges(ys, y.log), data, cmap=cmap, norm=norm,
-                         shading="flat")
-    ex, ey = _edges(xs, x.log), _edges(ys, y.log)
+    # half a cell beyond the first value would reach below zero (a negative stroke or
+    # crossover): the cells end at the physical range
+    ex, ey = _physical_edges(_edges(xs, x.log), xs), _physical_edges(_edges(ys, y.log), ys)
+    mesh = ax.pcolormesh(ex, ey, data, cmap=cmap, norm=norm, shading="flat")
     for j, i in zip(*np.nonzero(verdict == "invalid")):
         ax.add_patch(Rectangle((ex[i], ey[j]), ex[i + 1] - ex[i], ey[j + 1] - ey[j], fill=False,
                                hatch="//", edgecolor="0.55", lw=0))
@@ -657,13 +778,16 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
         ax.set_xscale("log")
     if y.log:
         ax.set_yscale("log")
+    ax.set_xlim(ex[0], ex[-1])
+    ax.set_ylim(ey[0], ey[-1])
     ax.set_xlabel(axis_label(x.path, x.unit))
     ax.set_ylabel(axis_label(y.path, y.unit))
-    ax.set_title(f"{y.path} vs {x.path} ({plant})" if title is None else title, fontsize=10)
+    ax.set_title(f"{quantity_name(y.path)} vs {quantity_name(x.path).lower()} ({plant})"
+                 if title is None else title, fontsize=10)
     if colorbar:
         cb = ax.figure.colorbar(mesh, ax=ax, ticks=_ticks(top))
         w0, w1 = _window(result)
-        cb.set_label(f"hunting cycles in [{w0:g} s, {w1:g} s) [-]")
+        cb.set_label(f"Hunting cycles in [{w0:g} s, {w1:g} s) [-]")
     return mesh
 
 

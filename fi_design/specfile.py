@@ -458,6 +458,37 @@ def path_unit(path: str, spec: Spec | None = None) -> str:
     SpecError
         Unknown path, or a path to a section rather than a value.
     """
+    info, ann = _leaf(path, spec)
+    return _unit_of(info) if info is not None else _unit_of_annotation(ann)
+
+
+def path_description(path: str, spec: Spec | None = None) -> str:
+    """The schema's description of the value at a dotted spec path.
+
+    Parameters
+    ----------
+    path : str
+        Dotted path, as for :func:`with_values`.
+    spec : Spec, optional
+        As for :func:`path_unit`.
+
+    Returns
+    -------
+    str
+        The field's description (``"Static friction force Fs [N]."``); ``""``
+        when it has none.
+
+    Raises
+    ------
+    SpecError
+        Unknown path, or a path to a section rather than a value.
+    """
+    info, _ = _leaf(path, spec)
+    return (getattr(info, "description", None) or "") if info is not None else ""
+
+
+def _leaf(path: str, spec: Spec | None = None) -> tuple[Any, Any]:
+    """The field info (None inside a list entry) and annotation of the value at ``path``."""
     model: Any = Spec
     instance: Any = spec
     tokens = _tokens(path)
@@ -497,8 +528,7 @@ def path_unit(path: str, spec: Spec | None = None) -> str:
                                 f"'{done}.{next(iter(sub.model_fields))}'" if sub is not None
                                 else "is a list; name an entry and a value, e.g. "
                                 f"'{done}[0]....'", path=done)
-            unit = _unit_of(info) if info is not None else _unit_of_annotation(ann)
-            return unit
+            return info, ann
         if sub is None:
             raise SpecError(f"'{name}' holds a value, not a section", path=done)
         model = sub

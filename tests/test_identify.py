@@ -378,7 +378,7 @@ def test_cli_on_emps_json_spec_and_report(emps_path, tmp_path):
             "--json", str(out), "--write-spec", str(spec_out), "--report", str(rep)]
     res = runner.invoke(app, args)
     assert res.exit_code == 0, res.output
-    for word in ("mass", "coulomb", "viscous_negative", "Identifiable", "kg", "N*s/m"):
+    for word in ("mass", "coulomb", "viscous_negative", "Identifiable", "kg", "N\u00b7s/m"):
         assert word in res.output
     d = json.loads(out.read_text())
     assert 80 < d["parameters"]["mass"]["value"] < 110

@@ -100,8 +100,12 @@ def test_figures_reproducible_and_inline_ids_prefixed(paper_confirmed_design):
 def test_display_units_and_labels():
     assert plots.display_unit("m") == ("mm", 1e3)
     assert plots.display_unit("Hz") == ("Hz", 1.0)
-    assert plots.axis_label("controller.crossover", "Hz") == "controller.crossover [Hz]"
-    assert plots.axis_label("stage.mass", "kg") == "stage.mass [kg]"
+    assert plots.axis_label("controller.crossover", "Hz") == "Crossover frequency [Hz]"
+    assert plots.axis_label("isolator.stroke", "m") == "Isolator stroke [mm]"
+    assert plots.axis_label("isolator.stiffness", "N/m") == "Drive stiffness [N/mm]"
+    assert plots.axis_label("stage.mass", "kg") == "Stage mass [kg]"
+    # a path without a name of its own takes the schema's description
+    assert plots.axis_label("effects[type=time_delay].delay", "s") == "Extra loop delay [s]"
     assert plots.nice_ticks(0.05, 1.0) == [0.05, 0.1, 0.2, 0.5, 1.0]
     assert plots.plain_tick(0.001) == "0.001" and plots.plain_tick(1000.0) == "1000"
 
@@ -125,3 +129,92 @@ def test_plots_never_use_pyplot():
             "assert 'matplotlib' in sys.modules and 'control' not in sys.modules\n"
             "assert 'matplotlib.pyplot' not in sys.modules, 'pyplot was imported'\n")
     subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT, timeout=120)
+
+
+# --------------------------------------------------------------------------- reading the figures
+
+
+def _hand_made_map(paper_spec):
+    """A 3 x 3 map near zero stroke and crossover, values made up (no simulation needed)."""
+    import numpy as np
+
+    from fi_design.results.studies import RunInfo, SweepResult
+    from fi_design.studies import make_axis
+
+    x = make_axis("controller.crossover", [1.0, 5.0, 9.0])
+    y = make_axis("isolator.stroke", [0.05e-3, 0.3e-3, 0.55e-3])
+    cycles = np.array([[3.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    verdict = np.where(cycles > 0, "hunting", "settled")
+    return SweepResult(spec=paper_spec, x=x, y=y, isolated=True, points=(),
+                       hunting_cycles=cycles, amplitude=np.zeros((3, 3)),
+                       period=np.full((3, 3), np.nan), verdict=verdict,
+                       design_point=(8.0, 0.3e-3), run=RunInfo(9, 9, 0, 1, "serial", 0.0))
+
+
+@pytest.mark.parametrize("draw", ["sweep", "design map"])
+def test_heatmap_axes_stay_physical_and_name_their_quantity(paper_spec, draw):
+    result = _hand_made_map(paper_spec)
+    fig = plots.sweep_figure(result) if draw == "sweep" else plots.design_map_figure(result)
+    ax = next(_data_axes(fig))
+    x0, x1 = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    # half a cell below 1 Hz and 0.05 mm would be -1 Hz and -0.075 mm: the cells stop at zero
+    assert x0 == 0.0 and y0 == 0.0
+    assert x1 == pytest.approx(11.0) and y1 == pytest.approx(0.675)
+    mesh = ax.collections[0]
+    assert mesh.get_coordinates()[..., 0].min() >= 0 and mesh.get_coordinates()[..., 1].min() >= 0
+    assert ax.get_xlabel() == "Crossover frequency [Hz]"
+    assert ax.get_ylabel() == "Isolator stroke [mm]"
+    assert "controller.crossover" not in ax.get_title() + ax.get_xlabel() + ax.get_ylabel()
+
+
+def test_line_sweep_starts_at_zero_not_below(paper_spec):
+    import numpy as np
+
+    from fi_design.results.studies import RunInfo, SweepResult
+    from fi_design.studies import make_axis
+
+    x = make_axis("isolator.stroke", [0.05e-3, 0.3e-3, 0.55e-3])
+    line = SweepResult(spec=paper_spec, x=x, y=None, isolated=True, points=(),
+                       hunting_cycles=np.array([2.0, 0.0, 0.0]), amplitude=np.zeros(3),
+                       period=np.full(3, np.nan),
+                       verdict=np.array(["hunting", "settled", "settled"]),
+                       design_point=(0.3e-3,), run=RunInfo(3, 3, 0, 1, "serial", 0.0))
+    ax = next(_data_axes(plots.sweep_figure(line)))
+    assert ax.get_xlim()[0] == 0.0 and ax.get_xlabel() == "Isolator stroke [mm]"
+
+
+def test_error_figure_shows_the_settling_at_the_band_scale(paper_confirmed_design):
+    import matplotlib.colors as mcolors
+
+    sim = paper_confirmed_design.simulation
+    band = paper_confirmed_design.spec.requirements.hunting.settle_band
+    fig = plots.error_figure(sim, paper_confirmed_design.spec)
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(axes) == 4  # per plant: the whole error (mm) and the settling (um)
+    zooms = [ax for ax in axes if "\u00b5m" in ax.get_ylabel()]
+    full = [ax for ax in axes if "[mm]" in ax.get_ylabel()]
+    assert len(zooms) == 2 and len(full) == 2
+    for ax in zooms:
+        lo, hi = ax.get_ylim()
+        # zoomed to a few settle bands, not to the millimetres of the hunting plant
+        assert lo == pytest.approx(-plots.SETTLE_ZOOM * band * 1e6)
+        assert hi == pytest.approx(plots.SETTLE_ZOOM * band * 1e6)
+        assert "settle band" in ax.get_title(loc="left")
+        bands = [p for p in ax.patches
+                 if mcolors.to_hex(p.get_facecolor()) == "#dcefe0"]
+        assert len(bands) == 1
+        span = bands[0]  # a Rectangle (matplotlib >= 3.9) or a Polygon, y in data units
+        y = [span.get_y(), span.get_y() + span.get_height()] if hasattr(span, "get_height") \
+            else list(span.get_xy()[:, 1])
+        assert min(y) == pytest.approx(-band * 1e6) and max(y) == pytest.approx(band * 1e6)
+        assert ax.get_xlim()[0] > 0  # after the motion
+    for ax in full:
+        assert ax.get_ylim()[1] - ax.get_ylim()[0] > 1.0  # the hunting is visible in mm
+    # the settled plant marks where it enters the band for good; the hunting one never does
+    iso, non = zooms
+    settle = sim.isolated.metrics.settling_time
+    assert settle is not None
+    texts = " ".join(t.get_text() for t in iso.texts)
+    assert "in the band from" in texts
+    assert "never stays in the band" in " ".join(t.get_text() for t in non.texts)

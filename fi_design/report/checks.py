@@ -78,6 +78,8 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
         return flex[tail]
     if head == "pid" and tail == "tuning_mass":
         return "PID tuning mass"
+    if head == "pid" and tail == "integrator":
+        return "Loop without integrator: static error up to Fc / kp"
     return labels.get(head, name.replace("_", " ").capitalize())
 
 

@@ -142,9 +142,11 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
         "scan_range": mins["scan"],
         "error": figure_entry(
             (lambda: plots.error_figure(sim, spec)) if figures else None, "error",
-            "Position error with and without the isolator (as the paper's Figure 5). Grey: the "
-            "counting window; dashed: the minimum peak height; circles: the peaks the metric "
-            "counts.", fig_no()),
+            "Position error with and without the isolator. Left, in mm, as the paper's Figure "
+            "5: grey, the counting window; dashed, the minimum peak height; circles, the peaks "
+            "the metric counts. Right, in \u00b5m after the motion: green, the settle band of "
+            f"\u00b1{num(h.settle_band * 1e6)} \u00b5m; dotted, where the error enters it for "
+            "good (the settling time).", fig_no()),
         "deflection": figure_entry(
             (lambda: plots.deflection_figure(sim, spec)) if figures else None, "deflection",
             "Joint deflection of the isolated stage against the stroke; beyond the dashed lines "
@@ -191,13 +193,14 @@ def _map_section(design_map: DesignMap | None, figures: bool, fig_no: _Numbering
              f"{num(x.values[-1])} Hz, stroke {qty(y.values[0], 'm')} to "
              f"{qty(y.values[-1], 'm')} (log), {held}.")
     counts = result.counts()
+    xname, yname = plots.quantity_name(x.path).lower(), plots.quantity_name(y.path).lower()
     return {
         "intro": (
             f"Hunting cycles of the isolated stage around the design point (red cross) over "
-            f"{x.path} \u00d7 {y.path}, as the paper's Figure 4D: {len(x.values)} \u00d7 "
+            f"{xname} \u00d7 {yname}, as the paper's Figure 4D: {len(x.values)} \u00d7 "
             f"{len(y.values)} simulations with the PID retuned at every crossover. " + note),
         "figure": figure_entry((lambda: plots.design_map_figure(result)) if figures else None,
-                               "map", f"Hunting cycles over {x.path} and {y.path} (isolated). "
+                               "map", f"Hunting cycles over {xname} and {yname} (isolated). "
                                "Marks: s stuck, ? undetermined, \u00d7 failed.", fig_no()),
         "counts": ", ".join(f"{k} {v}" for k, v in counts.items() if v),
     }

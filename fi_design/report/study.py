@@ -14,9 +14,12 @@ __all__ = ["sweep_context", "study_context", "robustness_context", "sweep_sectio
 
 
 def _axis_text(axis: Any) -> str:
+    from ..plots import quantity_name
+
     vals = list(axis.values)
-    return (f"{axis.path}: {len(vals)} values from {qty(vals[0], axis.unit)} to "
-            f"{qty(vals[-1], axis.unit)}{' (log)' if axis.log else ''}")
+    return (f"{quantity_name(axis.path).lower()} ({axis.path}): {len(vals)} values from "
+            f"{qty(vals[0], axis.unit)} to {qty(vals[-1], axis.unit)}"
+            f"{' (log)' if axis.log else ''}")
 
 
 def sweep_section(result: SweepResult, sid: str, title: str, lead: str = "",
@@ -59,8 +62,9 @@ def sweep_section(result: SweepResult, sid: str, title: str, lead: str = "",
 
         with matplotlib.rc_context(plots.REPORT_RC):
             fig = plots.sweep_figure(result, title="")
-        figs = (figure_block(fig, f"Hunting cycles: {' vs '.join(result.paths[::-1])} "
-                                  f"({plant}).", name=sid),)
+        names = [plots.axis_label(a.path, a.unit) for a in (result.y, result.x) if a is not None]
+        figs = (figure_block(fig, f"Hunting cycles ({plant}) over {' and '.join(names)}.",
+                             name=sid),)
     return Section(sid, title, paragraphs=tuple(paras), tables=(table,), figures=figs)
 
 

@@ -1,0 +1,134 @@
+"""The console summaries read at 80 columns as at 120: nothing cut to "…", lengths in the
+unit that reads (1.37 mm, not 1.37e+03 um), every line within the terminal.
+
+The commands run through typer's CliRunner with ``COLUMNS`` fixed, as a terminal of that
+width would set it.
+"""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+from rich.console import Console
+from typer.testing import CliRunner
+
+from fi_design import console as con
+from fi_design.cli import app
+
+from conftest import EXAMPLES
+
+runner = CliRunner()
+
+#: What rich prints where it cuts a cell short.
+ELLIPSIS = ("\u2026", "...")
+
+
+def _run(args: list[str], width: int) -> str:
+    r = runner.invoke(app, args, env={"COLUMNS": str(width), "FI_DESIGN_DEBUG": "1"})
+    assert r.exit_code == 0, r.output
+    return r.output
+
+
+def _readable(text: str, width: int) -> None:
+    for line in text.splitlines():
+        assert len(line.rstrip()) <= width, f"wider than {width}: {line!r}"
+        for mark in ELLIPSIS:
+            assert mark not in line, f"cut short: {line!r}"
+    assert not re.search(r"\d\.?\d*e[+-]0?\d+ [uµ]m", text), "a length in powers of ten of um"
+
+
+@pytest.fixture(scope="module")
+def design_outputs():
+    """The design summary of every example with a stage of its own, at 80 and 120 columns."""
+    out = {}
+    for name in ("paper_setup", "no_isolator", "industrial_axis"):
+        for width in (80, 120):
+            out[name, width] = _run([str(EXAMPLES / f"{name}.yaml")], width)
+    return out
+
+
+@pytest.mark.parametrize("name", ["paper_setup", "no_isolator", "industrial_axis"])
+@pytest.mark.parametrize("width", [80, 120])
+def test_design_summary_reads_at_the_terminal_width(design_outputs, name, width):
+    text = design_outputs[name, width]
+    _readable(text, width)
+    for words in ("Checks", "Status", "Value", "Limit", "Unit", "Limit case", "PM [deg]",
+                  "Nonlinear confirmation", "Verdict", "Hunting cycles in [10 s, 20 s)",
+                  "Amplitude, peak to peak", "Final error", "Hunting-free from", "Conclusion"):
+        assert words in text, (words, text)
+    # the verdicts of both plants and of the cross-check are printed whole
+    row = next(ln for ln in text.splitlines() if ln.strip().startswith("Verdict"))
+    assert re.search(r"(settled|hunting|stuck|undetermined)\s+"
+                     r"(settled|hunting|stuck|undetermined)\s*$", row), row
+
+
+def test_hunting_amplitude_in_millimetres(design_outputs):
+    for width in (80, 120):
+        text = design_outputs["no_isolator", width]
+        row = next(ln for ln in text.splitlines() if "Amplitude, peak to peak" in ln)
+        assert re.search(r"1\.37 mm\s*$", row), row   # 1370 um reads as 1.37 mm
+        assert "1.37e+03" not in text
+        cycles = next(ln for ln in text.splitlines() if "Hunting cycles in" in ln)
+        assert re.search(r"\s0\s+5\s*$", cycles), cycles  # suggested isolator 0, without 5
+
+
+def test_checks_show_scaled_values_with_the_requirement(design_outputs):
+    text = design_outputs["paper_setup", 80]
+    assert re.search(r"Flexure bending stress at full stroke\s+PASS\s+31\.55\s+≤ 300\s+MPa",
+                     text), text
+    assert re.search(r"PASS\s+6667\s+≤ 13333\s+N/m", text)
+
+
+def test_every_check_label_and_message_is_whole_at_80_columns(paper_confirmed_design):
+    rec = Console(width=80, record=True, color_system=None, legacy_windows=False)
+    rec.print(con.checks_table(paper_confirmed_design.checks,
+                               cases={c.name: c for c in paper_confirmed_design.loop.cases}))
+    flat = " ".join(rec.export_text().split())
+    for check in paper_confirmed_design.checks:
+        assert " ".join(check.message.split()) in flat, check.message
+
+
+def test_study_summaries_read_at_80_columns(paper_spec_path, tmp_path):
+    sweep = _run(["sweep", str(paper_spec_path), "--x", "controller.crossover=4 Hz:12 Hz:3",
+                  "--y", "isolator.stroke=0.1 mm:0.3 mm:2", "-j", "1"], 80)
+    _readable(sweep, 80)
+    flat = " ".join(sweep.split())
+    assert "columns: Crossover frequency [Hz], rows: Isolator stroke [mm]" in flat
+    rob = _run(["robustness", str(paper_spec_path), "--samples", "2", "--scatter",
+                "friction.static=10%", "-j", "1"], 80)
+    _readable(rob, 80)
+    for words in ("Probability of hunting", "95% Wilson interval", "undetermined",
+                  "with isolator", "without isolator"):
+        assert words in rob, (words, rob)
+
+
+def test_reconcile_and_identify_summaries_read_at_80_columns():
+    rec = _run(["reconcile", str(EXAMPLES / "measured_stage.yaml"),
+                str(EXAMPLES / "measured_trace.csv")], 80)
+    _readable(rec, 80)
+    assert "position_dependent_friction" in rec
+    assert re.search(r"position_rms_move\s+µm\s", rec), "lengths of the gap table in µm"
+    assert re.search(r"wavelength = 5 ± [\d.e+-]+\s+mm", " ".join(rec.split()))
+    ident = _run(["identify", str(EXAMPLES / "measured_trace.csv"), "--spec",
+                  str(EXAMPLES / "measured_stage.yaml")], 80)
+    _readable(ident, 80)
+    assert "Identifiable" in ident and "N·s/m" in ident
+
+
+@pytest.mark.parametrize("value,unit,text", [
+    (1.366e-3, "m", "1.366 mm"), (2.52e-8, "m", "0.0252 µm"), (1.4e-12, "m", "< 0.001 µm"),
+    (-6.25e-4, "m", "-0.625 mm"), (0.0, "m", "0"), (None, "m", "-"), (3.155e7, "Pa", "31.55 MPa"),
+    (3e-3, "m/s", "3 mm/s"), (2.5, "s", "2.5 s"),
+])
+def test_quantities_in_cells(value, unit, text):
+    assert con._qty(value, unit) == text
+
+
+@pytest.mark.parametrize("value,text", [
+    (13333.33, "13333"), (0.3, "0.3"), (2.0, "2"), (3.2e-8, "3.2e-08"), (1.37e6, "1.37e+06"),
+    (0.00134799, "0.001348"), (float("inf"), "inf"), (float("nan"), "-"), (5, "5"),
+    (None, "-"), (True, "yes"),
+])
+def test_numbers_in_cells(value, text):
+    assert con._fmt(value) == text
