@@ -354,7 +354,7 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
     matplotlib.figure.Figure
     """
     h = spec.requirements.hunting
-    fig = _report_figure(4.6, top=0.3, hspace=0.55, right=0.1)
+    fig = _report_figure(4.3, top=0.3, hspace=0.55, right=0.1)
     fig.subplots_adjust(wspace=0.32)
     axes = fig.subplots(2, 2, sharex="col", sharey="col", width_ratios=(1.55, 1.0))
     label = "suggested isolator" if confirmation.suggested_isolator else "with isolator"
