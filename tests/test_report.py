@@ -409,6 +409,45 @@ def test_pdf_opens_with_page_numbers_and_key_numbers(design_pdf):
                         str(_artifacts() / "report-page")], check=True, timeout=120)
 
 
+def _page_leaves(box, in_heading=False):
+    """(box, inside a heading) for every leaf box of a laid-out page, in document order."""
+    tag = getattr(box, "element_tag", None)
+    here = in_heading or tag in ("h2", "h3")
+    children = getattr(box, "children", None)
+    if not children:
+        yield box, here
+        return
+    for child in children:
+        yield from _page_leaves(child, here)
+
+
+def test_pdf_never_ends_a_page_with_a_heading(design_html):
+    """A heading stays with the first lines of what it heads (report.css), on every page.
+
+    Read from WeasyPrint's own layout of the report: the last thing laid out on a page
+    (text, a figure, an equation) is never part of a section heading.
+    """
+    import logging
+
+    from weasyprint import HTML
+    from weasyprint.formatting_structure.boxes import MarginBox
+
+    logging.getLogger("weasyprint").setLevel(logging.ERROR)
+    document = HTML(string=design_html).render()
+    assert len(document.pages) >= 8
+    headings = 0
+    for n, page in enumerate(document.pages, 1):
+        leaves = [leaf for child in page._page_box.children
+                  if not isinstance(child, MarginBox) for leaf in _page_leaves(child)]
+        headings += sum(1 for _, h in leaves if h)
+        content = [(b, h) for b, h in leaves if getattr(b, "text", None) is None
+                   or b.text.strip()]
+        assert content, f"page {n} is empty"
+        box, in_heading = content[-1]
+        assert not in_heading, f"page {n} ends with a heading ({getattr(box, 'text', box)!r})"
+    assert headings > 15
+
+
 # --------------------------------------------------------------------------- Chromium
 
 
