@@ -24,6 +24,9 @@ REST_BAND = 1e-6
 PRESLIDING_BAND = 50e-6
 #: Fewest events (breakaways, presliding reversals) that count as an excitation.
 MIN_EVENTS = 3
+#: Creeping slower than this fraction of the velocity threshold for DWELL also counts as a rest
+#: (a stuck bearing moves by its presliding displacement, often more than REST_BAND).
+STOP_FRACTION = 0.1
 
 
 @dataclass(frozen=True)
@@ -55,6 +58,9 @@ class Excitation:
     events : tuple of (float, float)
         Per breakaway: the start of the rest and the time the stage slides
         again [s].
+    presliding_segments : tuple of tuple of float
+        Per run of consecutive presliding reversals: the times of its
+        reversals [s] (each pair of neighbours bounds a half cycle).
     """
 
     breakaways: int
@@ -66,6 +72,7 @@ class Excitation:
     rest_band: float
     presliding_band: float
     events: tuple[tuple[float, float], ...] = ()
+    presliding_segments: tuple[tuple[float, ...], ...] = ()
 
     @property
     def breakaway(self) -> bool:
@@ -92,8 +99,11 @@ def excitation(measured: Measurement, proc: Processing, *, spec=None,
     The bearing side (the stage, or the cart x1 - d of an isolated stage with
     a deflection column) is low-passed as for the fit. A *rest* is a stretch
     of at least ``dwell`` in which it moves less than ``rest_band`` (or 10
-    times the position noise, whichever is larger); a *breakaway* is a rest
-    followed by sliding above the velocity threshold. A *reversal* is an
+    times the position noise, whichever is larger) or creeps slower than
+    :data:`STOP_FRACTION` of the velocity threshold (a stuck bearing moves by
+    its presliding displacement); a *breakaway* is a rest, after sliding
+    above the velocity threshold, followed within 20 dwells by motion faster
+    than twice :data:`STOP_FRACTION` of it. A *reversal* is an
     extremum of the position whose prominence exceeds 10 times the noise; a
     *presliding reversal* one whose excursion to the next reversal stays below
     ``presliding_band``.
@@ -131,15 +141,16 @@ def excitation(measured: Measurement, proc: Processing, *, spec=None,
     w = max(2, int(round(dwell * fs)))
     lo = minimum_filter1d(xf, w, mode="nearest")
     hi = maximum_filter1d(xf, w, mode="nearest")
-    rest = (hi - lo) < band
+    rest = ((hi - lo) < band) | (np.abs(v) < STOP_FRACTION * proc.velocity_threshold)
     edge = int(round(proc.edge * fs))
     inner = slice(edge, len(x) - edge) if len(x) > 2 * edge + 1 else slice(None)
     runs = _runs(rest)
     t = np.asarray(measured.time, dtype=float)
     sliding = np.abs(v) > proc.velocity_threshold
+    moving = np.abs(v) > 2.0 * STOP_FRACTION * proc.velocity_threshold
     events = []
     for a, b in runs:
-        later = np.nonzero(sliding[b:])[0]
+        later = np.nonzero(moving[b:])[0]
         if b - a >= w and len(later) and later[0] <= 20 * w and np.any(sliding[:a]):
             events.append((float(t[a]), float(t[b + int(later[0])])))
     breakaways = len(events)
@@ -147,6 +158,19 @@ def excitation(measured: Measurement, proc: Processing, *, spec=None,
     ext = np.sort(np.concatenate([find_peaks(xf, prominence=prom)[0],
                                   find_peaks(-xf, prominence=prom)[0]]))
     excursions = np.abs(np.diff(xf[ext])) if len(ext) > 1 else np.zeros(0)
+    small = [bool(e < presliding_band) and not np.any(sliding[a:b])
+             for e, a, b in zip(excursions, ext[:-1], ext[1:])]
+    segments, run = [], []
+    for k, ok in enumerate(small):
+        if ok:
+            run = run or [float(t[ext[k]])]
+            run.append(float(t[ext[k + 1]]))
+        else:
+            if len(run) > 2:
+                segments.append(tuple(run))
+            run = []
+    if len(run) > 2:
+        segments.append(tuple(run))
     return Excitation(breakaways=breakaways,
                       rest_time=float(sum(b - a for a, b in runs if b - a >= w) / fs),
                       reversals=int(len(ext)),
@@ -154,7 +178,7 @@ def excitation(measured: Measurement, proc: Processing, *, spec=None,
                       low_speed_time=float(np.sum((np.abs(v) < proc.velocity_threshold)[inner]
                                                   & ~rest[inner]) / fs), dwell=float(dwell),
                       rest_band=float(band), presliding_band=float(presliding_band),
-                      events=tuple(events))
+                      events=tuple(events), presliding_segments=tuple(segments))
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:

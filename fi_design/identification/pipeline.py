@@ -119,12 +119,21 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     if measured.disturbance is not None:
         notes.append("force_N is used as the force that acts (the injected disturbance_N "
                      "included); the controller's own output force_N - disturbance_N is not")
-    params.update(dynamic_parameters(exc))
+    say("dynamic parameters", 0.7)
+    dynamic, details = dynamic_parameters(measured, proc, joint, sol, form, exc, spec)
+    for name, p in dynamic.items():
+        if name == "static" and p.value is not None and params["coulomb"].value is not None \
+                and p.value < params["coulomb"].value:
+            p = replace(p, note=p.note + f"; below the Coulomb friction: {IMPLAUSIBLE}")
+            notes.append(f"static = {p.value:.4g} N lies below the Coulomb friction: "
+                         f"{IMPLAUSIBLE}")
+        params[name] = p
     say("done", 1.0)
     return IdentificationResult(
         parameters=MappingProxyType({k: params[k] for k in NAMES}), fit=fit, form=form,
         model=joint.model, masses=masses, processing=proc, excitation=exc,
-        notes=tuple(notes), samples=samples, measurement=measured, spec=spec)
+        notes=tuple(notes), samples=samples, measurement=measured, spec=spec,
+        dynamic=details)
 
 
 def predict_force(result: IdentificationResult, measured: Measurement) -> ForcePrediction:

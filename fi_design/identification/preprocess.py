@@ -287,3 +287,113 @@ def second_difference(x: np.ndarray, dt: float) -> np.ndarray:
     a[1:-1] = np.diff(x, 2) / (dt * dt)
     a[0], a[-1] = a[1], a[-2]
     return a
+
+
+# --------------------------------------------------------------------------- full-rate trace
+
+
+@dataclass
+class Trace:
+    """Filtered full-rate signals of the bearing side, for the dynamic parameters (internal).
+
+    The friction force on the bearing is ``u - sum(theta[name] * inertia[name]) - offset``
+    for the inverse-dynamics estimates ``theta``: see :func:`friction_force`.
+    """
+
+    time: np.ndarray             # [s]
+    x: np.ndarray                # bearing-side position (stage, or cart x1 - d) [m]
+    v: np.ndarray                # its velocity [m/s]
+    u: np.ndarray                # aligned actuator force [N]
+    inertia: dict                # IDIM mass parameter -> its acceleration column [m/s^2]
+    sx: float                    # noise of the filtered position [m]
+    su: float                    # noise of the filtered force [N]
+    sv: float                    # noise of the filtered velocity [m/s]
+    sa: float                    # noise of the filtered acceleration [m/s^2]
+    resolution: float            # the position's resolution: one count or its noise [m]
+    reach: int                   # samples within the zero-phase filter's reach
+    compliance: float            # joint compliance in series with the bearing in x [m/N]
+
+
+#: The zero-phase filter's reach on either side of an event: this many cut-off periods.
+REACH_PERIODS = 2.0
+
+
+def robust_std(x: np.ndarray) -> float:
+    """Standard deviation from the median absolute deviation (robust to transients)."""
+    from scipy.stats import median_abs_deviation
+
+    return float(median_abs_deviation(np.asarray(x, dtype=float), scale="normal"))
+
+
+def resolution(position: np.ndarray) -> float:
+    """One count of a quantized position column [m]: its smallest nonzero step (0 if none)."""
+    d = np.abs(np.diff(np.asarray(position, dtype=float)))
+    scale = float(np.max(np.abs(position))) if len(d) else 0.0
+    d = d[d > 1e-12 * max(scale, 1e-300)]
+    return float(np.min(d)) if len(d) else 0.0
+
+
+def noise_gains(cutoff: float, fs: float) -> tuple[float, float, float]:
+    """RMS gains of white noise through the zero-phase low-pass: value, derivative, second.
+
+    For white noise of standard deviation s sampled at ``fs``, the filtered
+    signal has ``s * g0``, its derivative ``s * g1`` [1/s] and its second
+    derivative ``s * g2`` [1/s^2], from the filter's response
+    (:func:`scipy.signal.sosfreqz`; forwards and backwards: ``|H|^4`` in power).
+    """
+    from scipy.integrate import trapezoid
+    from scipy.signal import butter, sosfreqz
+
+    sos = butter(FILTER_ORDER, cutoff, fs=fs, output="sos")
+    f, h = sosfreqz(sos, worN=4096, fs=fs)
+    p = np.abs(h) ** 4 / (fs / 2.0)
+    w = 2.0 * np.pi * f
+    return (math.sqrt(trapezoid(p, f)), math.sqrt(trapezoid(p * w ** 2, f)),
+            math.sqrt(trapezoid(p * w ** 4, f)))
+
+
+def trace(m: Measurement, proc: Processing, joint: Joint, spec=None) -> Trace:
+    """The filtered full-rate signals of the bearing side and their noise levels.
+
+    Position, force (and deflection) pass the low-pass of the fit, the force
+    is aligned as for the fit (delay, hold); velocity and acceleration are
+    central differences. On a two-mass record the bearing side is the cart,
+    x1 - d, and the inertia has a stage and a cart column. The noise levels
+    are robust estimates (median absolute deviation) of the raw columns'
+    noise, carried through the filter (:func:`noise_gains`); a quantized
+    position adds its count / sqrt(12).
+    """
+    fs = proc.sample_rate
+    fc = proc.cutoff
+    dt = 1.0 / fs
+    t = np.asarray(m.time, dtype=float)
+    pos = np.asarray(m.position, dtype=float)
+    x1 = lowpass(pos, fc, fs)
+    u = lowpass(m.force, fc, fs)
+    if proc.force_delay > 0.0:
+        u = np.interp(t - proc.force_delay, t, u)
+    if proc.force_hold:
+        u = np.concatenate([u[:1], 0.5 * (u[1:] + u[:-1])])
+    a1 = second_difference(x1, dt)
+    raw_x = pos
+    if joint.model == "rigid":
+        x, inertia = x1, {"mass": a1}
+    else:
+        d = lowpass(m.deflection, fc, fs)
+        x = x1 - d
+        raw_x = pos - np.asarray(m.deflection, dtype=float)
+        a2 = a1 - second_difference(d, dt)
+        inertia = ({"stage_mass": a1, "cart_mass": a2} if joint.model == "two_mass" else
+                   {"mass": joint.ratio * a1 + (1.0 - joint.ratio) * a2})
+    count = resolution(raw_x)
+    sx_raw = math.hypot(robust_std(raw_x - lowpass(raw_x, fc, fs)), count / math.sqrt(12))
+    su_raw = robust_std(np.asarray(m.force, dtype=float) - lowpass(m.force, fc, fs))
+    g0, g1, g2 = noise_gains(fc, fs)
+    compliance = 0.0
+    if (joint.model == "rigid" and spec is not None and spec.has_isolator
+            and spec.isolator.stiffness is not None):
+        compliance = 1.0 / spec.isolator.stiffness
+    return Trace(time=t, x=x, v=np.gradient(x, dt), u=u, inertia=inertia, sx=sx_raw * g0,
+                 su=su_raw * g0, sv=sx_raw * g1, sa=sx_raw * g2, resolution=max(count, sx_raw),
+                 reach=max(1, int(round(REACH_PERIODS * fs / fc))),
+                 compliance=compliance)

@@ -21,10 +21,11 @@ from .results import UNITS, Fit, Masses, Parameter, Processing, Samples
 #: Fewest used (decimated, sliding) samples per direction of motion.
 MIN_DIRECTION_SAMPLES = 10
 
+#: Why a mass or friction that comes out negative cannot be right.
 IMPLAUSIBLE = ("physically impossible, so the model (mass, Coulomb and viscous friction "
-                "constant along the travel) does not describe this record; an unmodelled effect "
-                "(friction varying along the rail, a cable force, force ripple) or too little "
-                "sliding can cause it, and fi-design reconcile names such effects")
+               "constant along the travel) does not describe this record; an unmodelled effect "
+               "(friction varying along the rail, a cable force, force ripple) or too little "
+               "sliding can cause it, and fi-design reconcile names such effects")
 
 
 def friction_columns(p: Prepared, form: str) -> dict[str, np.ndarray]:

@@ -215,6 +215,137 @@ class Samples:
         return dataclass_dict(self)
 
 
+@dataclass(frozen=True)
+class BranchFit:
+    """One event of the dynamic parameters: a breakaway's loading branch or a presliding run.
+
+    Attributes
+    ----------
+    kind : str
+        ``"breakaway"`` (the loading branch before a breakaway after a stop)
+        or ``"presliding"`` (a run of small reversals that never slide).
+    time : float
+        The breakaway's onset, or the run's start [s].
+    direction : int
+        +1 or -1: the direction of the breakaway (0 for a presliding run).
+    samples : int
+        Samples fitted.
+    peak_force : float or None
+        Friction force at the onset (drive force minus inertia and offset,
+        in the breakaway's direction) [N]; not the static friction (LuGre's
+        friction there is g(v) at the creep speed, and filtered).
+    creep_velocity : float or None
+        Speed of the bearing at the onset [m/s].
+    span : float
+        Displacement of the bearing over the fitted samples [m].
+    static : float or None
+        The branch's saturation level: its static friction [N].
+    static_std_error : float or None
+        Its standard error from the fit [N] (statistical and propagated).
+    bristle_stiffness : float or None
+        Initial slope of friction against displacement, sigma0 [N/m].
+    bristle_stiffness_std_error : float or None
+        Its standard error from the fit [N/m].
+    bristle_damping : float or None
+        Bristle damping fitted with them, sigma1 [N s/m] (a nuisance parameter:
+        not reported as identified).
+    saturation : float or None
+        The branch's last fitted friction over its level [-].
+    rise : float or None
+        The branch's rise of friction over its level [-].
+    used_for : tuple of str
+        The parameters this event counts for.
+    note : str
+        Why it does not count for a parameter (empty when it counts for all
+        it can).
+    """
+
+    kind: str
+    time: float
+    direction: int
+    samples: int
+    peak_force: float | None
+    creep_velocity: float | None
+    span: float
+    static: float | None
+    static_std_error: float | None
+    bristle_stiffness: float | None
+    bristle_stiffness_std_error: float | None
+    bristle_damping: float | None
+    saturation: float | None
+    rise: float | None
+    used_for: tuple[str, ...]
+    note: str
+
+    def to_dict(self) -> dict:
+        """Plain JSON data."""
+        return dataclass_dict(self)
+
+
+@dataclass(frozen=True)
+class SweepFit:
+    """The fit of the Stribeck curve to steady low-speed sliding.
+
+    Attributes
+    ----------
+    samples : int
+        Samples sliding steadily below the velocity threshold (full rate).
+    effective_samples : float
+        Their effective number after the autocorrelation correction.
+    below, above : int
+        Samples below 0.7 vs and above 1.5 vs.
+    speed_min, speed_max : float
+        Their speed range [m/s].
+    stribeck_velocity : float
+        The fitted Stribeck velocity [m/s].
+    stribeck_velocity_std_error : float
+        Its standard error [m/s].
+    static : float or None
+        Fs fitted with it when no breakaway resolves it [N]; None when fixed.
+    static_std_error : float or None
+        Its standard error [N].
+    rms_residual : float
+        RMS of the weighted residuals [-] (about 1 when the noise model holds).
+    """
+
+    samples: int
+    effective_samples: float
+    below: int
+    above: int
+    speed_min: float
+    speed_max: float
+    stribeck_velocity: float
+    stribeck_velocity_std_error: float
+    static: float | None
+    static_std_error: float | None
+    rms_residual: float
+
+    def to_dict(self) -> dict:
+        """Plain JSON data."""
+        return dataclass_dict(self)
+
+
+@dataclass(frozen=True)
+class Dynamic:
+    """How the dynamic parameters were estimated: the events and the sweep fit.
+
+    Attributes
+    ----------
+    branches : tuple of BranchFit
+        Every breakaway and presliding run examined.
+    sweep : SweepFit or None
+        The Stribeck fit, when the record slides steadily at low speed.
+    """
+
+    branches: tuple[BranchFit, ...] = ()
+    sweep: SweepFit | None = None
+
+    def to_dict(self) -> dict:
+        """Plain JSON data."""
+        return {"branches": [b.to_dict() for b in self.branches],
+                "sweep": None if self.sweep is None else self.sweep.to_dict()}
+
+
 @dataclass(frozen=True, eq=False)
 class IdentificationResult:
     """Friction and mass identified from a measured record (DESIGN.md section 8).
@@ -249,6 +380,9 @@ class IdentificationResult:
         The record.
     spec : fi_design.spec.Spec or None
         The spec, when given.
+    dynamic : Dynamic
+        The events and fits behind ``static``, ``stribeck_velocity`` and
+        ``bristle_stiffness``.
     """
 
     parameters: Mapping[str, Parameter]
@@ -262,6 +396,7 @@ class IdentificationResult:
     samples: Samples = field(repr=False)
     measurement: Measurement = field(repr=False)
     spec: Any = field(default=None, repr=False)
+    dynamic: Dynamic = field(default_factory=Dynamic, repr=False)
 
     def value(self, name: str) -> float | None:
         """The value of parameter ``name`` [SI], or None."""
@@ -279,6 +414,7 @@ class IdentificationResult:
             "masses": self.masses.to_dict(),
             "processing": self.processing.to_dict(),
             "excitation": self.excitation.to_dict(),
+            "dynamic": self.dynamic.to_dict(),
             "notes": list(self.notes),
             "measurement": self.measurement.to_dict(),
             "fi_design_version": __version__,
