@@ -1734,7 +1734,8 @@ def identify_command(
     Inverse-dynamics least squares on the filtered record gives the moving
     mass, Coulomb and viscous friction per direction and the offset, with
     standard errors; static friction, Stribeck velocity and bristle
-    stiffness only where the record holds a breakaway or presliding.
+    stiffness only where the record holds their excitation (breakaways after
+    a stop, a slow velocity sweep through zero, presliding).
     """
     forms = {"symmetric": "symmetric", "per-direction": "per_direction",
              "per_direction": "per_direction"}
@@ -1817,9 +1818,8 @@ def print_identification(console: "Console", result) -> None:
     console.print(Text(f"Masses: stage {_fmt(ms.stage, 5)} kg, cart {_fmt(ms.cart, 5)} kg "
                        f"({ms.source})"))
     for name in ("static", "stribeck_velocity", "bristle_stiffness"):
-        p = result.parameters[name]
-        if not p.identifiable:
-            console.print(Text(f"{name}: {p.note}", style="dim"))
+        p = result.parameters[name]  # how it was estimated, or why not
+        console.print(Text(f"{name}: {p.note}", style=None if p.identifiable else "dim"))
     for note in result.notes:
         console.print(Text(f"note: {note}", style="dim"))
 

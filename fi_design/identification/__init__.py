@@ -78,42 +78,47 @@ equations, ``u = m1 a1 + m2 a2 + F_f(v2) + offset``, is used, with the
 masses in the spec's ratio (the total is identified, its split is not).
 
 LuGre's dynamic parameters (static friction, Stribeck velocity, bristle
-stiffness) need an excitation that sliding data do not hold: a breakaway
-from rest, or a slow velocity sweep through zero (static friction and
-Stribeck velocity), small-amplitude reversals in presliding (bristle
-stiffness). :func:`excitation` detects them in the record. They are never
-estimated here: every one is reported as not identifiable, with no value,
-and a note that says whether the record holds its excitation (and where) and
-which experiment identifies it. A fit of the replayed record
-(:func:`fi_design.simulate` with ``record=``) to the breakaways was built and
-validated on simulated records, and rejected: the replay of a stick-slip
-record is so sensitive to the sliding friction that sub-percent errors in
-it (within their standard errors) moved the static friction and Stribeck
-velocity by many of their own standard errors.
+stiffness) act near zero velocity, where the fit above leaves the samples
+out; :mod:`.dynamic` estimates each from the part of the record that
+carries it, with the estimates above fixed and their errors propagated:
+static friction from the loading branches before breakaways after a stop
+(one value per event), the bristle stiffness from the same branches and
+from presliding cycles, the Stribeck velocity from steady sliding at low
+speed (a slow velocity sweep through zero). Where the record does not hold
+the excitation the parameter is reported ``identifiable: false``, with no
+value and a note naming the experiment that would identify it. (A fit of
+the replayed record, :func:`fi_design.simulate` with ``record=``, to the
+breakaways was built and rejected: the replay of a stick-slip record is so
+sensitive to the sliding friction that sub-percent errors in it, within
+their standard errors, moved the static friction by many of its own,
+unpropagated, standard errors.)
 
 Modules, one job each:
 
 - :mod:`.results`: the result types (:class:`IdentificationResult`,
   :class:`Parameter`, :class:`Fit`, :class:`Processing`, :class:`Masses`,
-  :class:`Samples`, :class:`ForcePrediction`) and the parameter names;
+  :class:`Samples`, :class:`ForcePrediction`, :class:`BranchFit`,
+  :class:`SweepFit`, :class:`Dynamic`) and the parameter names;
 - :mod:`.preprocess`: checks of the record, filter and decimation settings,
   the joint of an isolated stage, the prepared signals (steps 1 to 5);
 - :mod:`.regression`: the inverse-dynamics least squares and its standard
   errors (steps 6 and 7);
-- :mod:`.excitation`: rests, breakaways and reversals in the record;
+- :mod:`.events`: rests, breakaways and reversals in the record (:func:`excitation`);
+- :mod:`.lugrefit`: the least-squares fits of LuGre's presliding curve and
+  Stribeck curve, with the sliding friction's errors propagated;
 - :mod:`.dynamic`: static friction, Stribeck velocity, bristle stiffness;
 - :mod:`.specwrite`: the spec with the identified values (``--write-spec``);
 - :mod:`.pipeline`: :func:`identify`, :func:`predict_force`, :func:`segment`.
 """
 
-from .excitation import Excitation, excitation
+from .events import Excitation, excitation
 from .pipeline import identify, predict_force, segment
 from .preprocess import processing
-from .results import (DYNAMIC, FORMS, NAMES, UNITS, Fit, ForcePrediction, IdentificationResult,
-                      Masses, Parameter, Processing, Samples)
+from .results import (DYNAMIC, FORMS, NAMES, UNITS, BranchFit, Dynamic, Fit, ForcePrediction,
+                      IdentificationResult, Masses, Parameter, Processing, Samples, SweepFit)
 from .specwrite import identified_spec, identified_spec_text, spec_values
 
 __all__ = ["identify", "IdentificationResult", "Parameter", "Fit", "Processing", "Excitation",
            "Masses", "Samples", "ForcePrediction", "predict_force", "processing", "excitation",
            "spec_values", "identified_spec", "identified_spec_text", "segment", "NAMES", "UNITS",
-           "FORMS", "DYNAMIC"]
+           "FORMS", "DYNAMIC", "BranchFit", "SweepFit", "Dynamic"]

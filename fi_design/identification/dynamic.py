@@ -2,61 +2,71 @@
 
 Static friction Fs, the Stribeck velocity vs and the bristle stiffness sigma0
 act near zero velocity, where the inverse-dynamics fit leaves the samples
-out. Each is estimated from its own excitation, with the inverse-dynamics
-estimates (mass, Coulomb and viscous friction, offset) fixed and their
-errors propagated (:mod:`.lugrefit`), or reported ``identifiable: false``
-with a note naming the experiment that would identify it.
+out. Each is estimated from its own excitation with the fits of
+:mod:`.lugrefit`, the inverse-dynamics estimates (mass, Coulomb and viscous
+friction, offset) fixed and their errors propagated, or reported
+``identifiable: false`` with a note naming the experiment that would
+identify it. The events behind every estimate are in
+:class:`~.results.Dynamic` (JSON ``dynamic``).
 
-**Static friction, from breakaways after a stop.** A breakaway event
-(:func:`~.excitation.excitation`: a rest followed by sliding) is read on the
-friction force F = u - m a - offset (the actuator force minus the identified
-inertia and offset) in the direction s of the sliding that follows. Its
-*onset* is the maximum of s F between the rest and the sliding (the force
-that acts when the bearing lets go; there the creep speed v_p is read). The
-*loading branch* runs from the lowest s F since the previous sliding to the
-onset, without the samples within the zero-phase filter's reach of the onset
+**Static friction, from breakaways after a stop.** A breakaway
+(:func:`~.events.excitation`: a rest, or creep slower than a tenth of
+the velocity threshold, after sliding and followed by motion) is read on the
+friction force F = u - m a - offset (the drive force minus the identified
+inertia and offset) in the direction s of the motion that follows. Its
+*onset* is the maximum of s F between the rest and that motion: the force at
+which the bearing lets go, where its creep speed v_p is read. The *loading
+branch* runs from the lowest s F since the previous sliding (after the last
+motion against s beyond three velocity noise levels) to the onset, without
+the samples within the zero-phase filter's reach of the onset
 (:data:`~.preprocess.REACH_PERIODS` cut-off periods: the filter smears the
-drop of friction after the onset into them) and without those creeping faster
-than :data:`CREEP_FRACTION` of v_p (noise-aware: never below three times the
-velocity noise). On the branch the bristles load up to their saturation level
-Fs (:func:`~.lugrefit.fit_branches`), and each event gives one value.
-Why not the force at the onset itself: LuGre's friction peaks where the
-bearing already creeps at v_p, at g(v_p) = Fc + (Fs - Fc) exp(-(v_p/vs)^2)
-below Fs, by 1 % to 10 % of Fs on the records of the tests, and the
-zero-phase filter moves the peak by as much again; the branch's level is read
-where the creep is slow. An event counts when its branch is resolved: at least
-:data:`MIN_BRANCH_SAMPLES` samples, rising by at least :data:`MIN_RISE` of the
-level from its start (a stage that stopped with its bristles already loaded in
-the breakaway's direction shows no branch), up to at least
-:data:`SATURATION` of it. The estimate is the mean over the events; its
-standard error combines the scatter between events (at least their own fit
-errors) with the propagated errors of the sliding friction. With one event
-the scatter is unknown: its fit error is widened by the change of the
-estimate when the bristle damping is left out of the model.
+drop of friction after the onset into them). On it the bristles load up to
+their saturation level Fs; one fit per event (:func:`~.lugrefit.fit_branches`)
+gives one value. The force at the onset itself is not the estimate: LuGre's
+friction peaks where the bearing already creeps, at g(v_p) = Fc + (Fs - Fc)
+exp(-(v_p/vs)^2) < Fs (1 % to 10 % below Fs on the records of the tests), and
+the filter moves the peak by as much again. With vs unknown the branch is
+used only where the creep is slower than :data:`CREEP_FRACTION` of v_p
+(never below three velocity noise levels), where g is Fs to within
+(Fs - Fc)(v / vs)^2; when the record also identifies vs (below) the branches
+are fitted again over their whole length with the level following the
+Stribeck curve at the measured creep speed, vs's error propagated. An event
+counts when its branch holds at least :data:`MIN_BRANCH_SAMPLES` samples and
+rises by at least :data:`MIN_RISE` of the level, up to at least
+:data:`SATURATION` of it (a bearing that stopped with its bristles loaded in
+the breakaway's direction shows no branch). The estimate is the mean over
+the events; its standard error combines the scatter between them (at least
+their own fit errors) with the propagated errors, common to all events.
+With one event the scatter is unknown: its fit error is widened by the
+change of the estimate when the bristle damping is left out of the model.
 
 **Bristle stiffness, from presliding.** The same branch fits give sigma0 per
-breakaway (the slope of friction against displacement where the bristles are
-far from saturation), and so do presliding oscillations (small reversals
-that never slide, e.g. a small-amplitude sine): each run of them is one fit
-with one branch per half cycle, its level fixed at the identified static
-friction (or fitted, when there is none). An event counts when its
-presliding displacement spans at least :data:`MIN_SPAN` position resolutions
-(one encoder count, or the position noise if larger). With an isolator the
-joint's compliance adds in series: on a record with ``deflection_m`` the
-cart's own position is used; without it the spec's joint compliance 1/k is
-removed, and sigma0 is identifiable only if the bristles' own compliance is
-at least :data:`MIN_OWN_COMPLIANCE` of the total.
+breakaway (the slope of friction against displacement where the bristles
+are far from saturation), and so does every full cycle of presliding
+reversals (small reversals that never slide, e.g. a small-amplitude sine;
+one fit per cycle, a branch per half cycle, the level fixed at the
+identified static friction, its error propagated, or fitted when there is
+none). An event counts when its presliding displacement spans at least
+:data:`MIN_SPAN` position resolutions (one encoder count, or the position
+noise if larger). The estimate combines the events as for static friction.
+With an isolator the joint's compliance adds in series: on a record with
+``deflection_m`` the cart's own position x1 - d is used; without it the
+spec's joint compliance 1/k is removed from the displacement, and sigma0 is
+identifiable only if the bristles' own compliance is at least
+:data:`MIN_OWN_COMPLIANCE` of the total (else it would rest on the spec's k).
 
 **Stribeck velocity, from steady low-speed sliding.** Samples sliding in one
 direction between three times the velocity noise and the fit's velocity
-threshold, away from every stop and from the threshold by the filter's reach
-(a slow velocity sweep through zero provides them), are fitted with the
-steady-state Stribeck curve (:func:`~.lugrefit.fit_stribeck`), Fc fixed at
-the identified value and Fs at the breakaway estimate when there is one
-(both errors propagated), else fitted as well. vs is identifiable when at
-least :data:`MIN_STEADY_SAMPLES` samples lie below :data:`STEADY_BELOW` x vs
-and as many above :data:`STEADY_ABOVE` x vs, and its relative standard error
-stays below :data:`MAX_RELATIVE_ERROR`.
+threshold, *steadily* (the speed changing by less than :data:`STEADY_RATE`
+while the bearing travels the bristles' relaxation distance Fs / sigma0,
+identified, or the spec's, said so), with these conditions holding over the
+filter's reach on both sides, are fitted with the steady-state Stribeck
+curve (:func:`~.lugrefit.fit_stribeck`; a slow velocity sweep through zero
+provides them): Fc fixed at the identified value and Fs at the breakaway
+estimate when there is one (both errors propagated), else fitted as well.
+vs is identifiable when at least :data:`MIN_STEADY_SAMPLES` samples lie below
+:data:`STEADY_BELOW` x vs and as many above :data:`STEADY_ABOVE` x vs, and its
+relative standard error stays below :data:`MAX_RELATIVE_ERROR`.
 """
 
 from __future__ import annotations
@@ -66,7 +76,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .excitation import Excitation
+from .events import Excitation
 from .lugrefit import (Branch, LsqFit, Sliding, extended, fit_branches, fit_stribeck,
                        friction_force)
 from .preprocess import Joint, Trace, trace
@@ -212,7 +222,7 @@ def dynamic_parameters(measured, proc: Processing, joint: Joint, sol, form: str,
     vs = None
     for _ in range(2):
         events = [_breakaway(ctx, ev, vs) for ev in exc.events]
-        static, level = _static(ctx, events, form, vs)
+        static, level = _static(ctx, events, form, vs, exc)
         runs = [r for seg in exc.presliding_segments for r in _presliding(ctx, seg, level, vs)]
         stiffness = _stiffness(ctx, events, runs, level, vs, exc)
         sweep, stribeck, vs_new = _stribeck(ctx, level, _relaxation(level, stiffness, spec))
@@ -312,15 +322,17 @@ def _empty(base: dict, why: str):
                      rise=None, used_for=(), note=why)
 
 
-def _static(ctx: _Context, events, form: str, vs: _Fixed | None):
+def _static(ctx: _Context, events, form: str, vs: _Fixed | None, exc: Excitation):
     """(Parameter, _Fixed level or None): static friction from the breakaways."""
     name = "static"
     sliding, n = ctx.sliding, ctx.n
     use = [(bf, ft, br) for bf, ft, br in events if "static" in bf.used_for]
     if not use:
         if not events:
-            why = ("the record holds no breakaway after a stop (a rest of at least the dwell "
-                   "followed by sliding)")
+            why = (f"the record holds no breakaway after a stop (a rest of at least "
+                   f"{exc.dwell * 1e3:.3g} ms after sliding, followed by motion); it moves slower "
+                   f"than the velocity threshold for {exc.low_speed_time:.3g} s in all without "
+                   "stopping, passing through")
         else:
             why = (f"the record holds {len(events)} breakaway(s) after a stop, none with a "
                    "resolved loading branch (" + "; ".join(
@@ -492,16 +504,22 @@ def _steady(tr: Trace, proc: Processing, relax: float) -> np.ndarray:
     """Samples sliding steadily in one direction at low speed, away from stops (indices).
 
     Between three times the velocity noise and the velocity threshold, the
-    speed changing by less than :data:`STEADY_RATE` over the relaxation
-    distance ``relax`` [m] (|a| relax / v^2), the direction the same and the
-    conditions holding within the filter's reach on both sides.
+    speed changing by less than :data:`STEADY_RATE` while the bearing travels
+    the relaxation distance ``relax`` [m] (the velocity compared half that
+    distance before and after: a difference over time rather than the noisy
+    acceleration), the direction the same and the conditions holding within
+    the filter's reach on both sides.
     """
     from scipy.ndimage import binary_erosion
 
     speed = np.abs(tr.v)
-    accel = np.gradient(tr.v, tr.time)
+    n = len(speed)
     band = (speed > 3.0 * tr.sv) & (speed < proc.velocity_threshold)
-    band &= np.abs(accel) * relax < STEADY_RATE * speed ** 2
+    half = np.ceil(0.5 * relax / np.maximum(speed, 1e-300) * proc.sample_rate)
+    half = np.minimum(half, n).astype(int)
+    k = np.arange(n)
+    change = np.abs(tr.v[np.minimum(k + half, n - 1)] - tr.v[np.maximum(k - half, 0)])
+    band &= (change < STEADY_RATE * speed) & (k - half >= 0) & (k + half < n)
     out = np.zeros(len(speed), dtype=bool)
     for s in (1.0, -1.0):
         run = band & (np.sign(tr.v) == s)

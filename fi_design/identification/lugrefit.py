@@ -5,26 +5,26 @@ filtered full-rate signals (:class:`~.preprocess.Trace`) of a record:
 
 **The presliding branch.** While the bearing does not slide, its position x
 and the friction force F = u - m a - offset are tied by LuGre's bristle
-equation. With g the Stribeck curve at the (small) creep speed, taken
-constant (g = Fs while the creep is slow against the Stribeck velocity),
-``dz/dx = 1 - sigma0 z / g`` along a branch of monotonic motion in the
-direction s, so the bristle force Y = s sigma0 z follows, from its value Y_b
-at the branch's first sample (displacement w = s x, Delta = w - w_b)::
-
-    Y(w) = Y_b + (1 - kappa Y_b) sigma0 Delta phi(sigma0 kappa Delta),
-    phi(a) = (1 - exp(-a)) / a,   kappa = 1 / g,
-
-the straight line Y_b + sigma0 Delta of a stiff spring for small
-displacements, bending over to the level g as the bristles saturate. The
-measured friction adds bristle damping and viscous friction,
-``y = s F - sigma2_s s v = Y + sigma1 s v (1 - kappa Y)`` (LuGre's sigma1
-dz/dt, exactly, with dz/dt = v (1 - kappa Y)). kappa, sigma0 and sigma1 are
-fitted, Y_b per branch; sigma1 is a nuisance (its effect, a lead of
-sigma1 / sigma0 in time, would otherwise bias the level). Both variables carry
-noise: the residuals are weighted by the effective variance
-``s_y^2 + (dY/dw s_x)^2`` (errors in variables), with the noise levels of
-the trace. A joint compliance c in series (an isolated stage without a
-deflection column) is removed from the displacement, w = s x - c y.
+equation: along a branch of monotonic motion in the direction s, with the
+displacement w = s x and the bristle force Y = s sigma0 z,
+``dY/dw = sigma0 (1 - Y / g(v))`` (:func:`bristle_force`, exact for g
+constant over each sample interval). From Y_b at the branch's first sample
+it rises as the straight line Y_b + sigma0 (w - w_b) of a stiff spring for
+small displacements and bends over to the level g as the bristles saturate.
+g is the Stribeck curve at the creep speed: Fs where the creep is slow
+against the Stribeck velocity (the level fitted, kappa = 1 / Fs), or
+``Fc + (Fs - Fc) exp(-(v / vs)^2)`` with vs known. The measured friction
+adds bristle damping and viscous friction,
+``y = s F - sigma2_s s v = Y + sigma1 s v (1 - Y / g)`` (LuGre's
+sigma1 dz/dt, exactly). kappa, sigma0 and sigma1 are fitted, Y_b per branch;
+sigma1 is a nuisance (left out, its effect, a lead of sigma1 / sigma0 in
+time, would bias the level). Every variable carries noise: the residuals
+are weighted by the effective variance
+``s_y^2 + (dy/dw s_x)^2 + (dy/dv s_v)^2`` (errors in variables, consistent
+where an unweighted fit is not: noise in the measured velocity otherwise
+shrinks sigma1 and inflates sigma0), with the noise levels of the trace. A
+joint compliance c in series (an isolated stage without a deflection
+column) is removed from the displacement, w = s x - c y.
 
 **The Stribeck curve.** Sliding steadily at speed |v| in direction s, LuGre's
 friction is ``s F - sigma2_s |v| = Fc + (Fs - Fc) exp(-(v / vs)^2)``; vs (and

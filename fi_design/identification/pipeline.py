@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import DataError
 from ..measured import Measurement, measurement_from_arrays
 from .dynamic import dynamic_parameters
-from .excitation import excitation
+from .events import excitation
 from .preprocess import JITTER, check_record, joint_model, prepare, processing
 from .regression import (IMPLAUSIBLE, Solution, check_directions, equations, fit_statistics,
                          force_rss, form_note, rigid_parameters, split_masses, solve, threshold_note)

@@ -5,7 +5,7 @@
 statistics of the inverse-dynamics fit (:class:`Fit`), the processing
 settings (:class:`Processing`), the stage and cart mass (:class:`Masses`),
 what the record holds for LuGre's dynamic parameters
-(:class:`~fi_design.identification.excitation.Excitation`) and the fitted
+(:class:`~fi_design.identification.events.Excitation`) and the fitted
 samples (:class:`Samples`); ``to_dict()`` is the JSON of ``--json``.
 """
 
@@ -21,7 +21,7 @@ from ..measured import Measurement
 from ..results import dataclass_dict
 
 if TYPE_CHECKING:
-    from .excitation import Excitation
+    from .events import Excitation
 
 #: Parameters of an identification, in the order of DESIGN.md section 8.
 NAMES = ("mass", "coulomb", "coulomb_negative", "viscous", "viscous_negative", "offset",

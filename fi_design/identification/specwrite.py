@@ -7,8 +7,11 @@ spec's own YAML text with the values replaced in place and commented.
 
 from __future__ import annotations
 
+import math
+
 from .regression import IMPLAUSIBLE
 from .results import DYNAMIC, IdentificationResult
+
 
 def spec_values(result: IdentificationResult) -> dict[str, float]:
     """The spec values the identification fills in, by dotted path (SI).
@@ -19,10 +22,13 @@ def spec_values(result: IdentificationResult) -> dict[str, float]:
     ``friction.viscous``, ``friction.viscous_negative``, ``friction.offset``
     (0 in the per-direction form, which absorbs it), ``stage.mass`` and
     ``cart.mass`` (identified, or the total split in the spec's ratio), and
-    the dynamic parameters that were identified. Where static friction is
-    not identified, ``friction.static`` keeps the spec's friction gap
-    Fs - Fc on the identified Coulomb friction: the gap (guideline step 1)
-    stays the user's assumption, not a value derived from the record.
+    the dynamic parameters that were identified (``friction.static``,
+    ``friction.stribeck_velocity``, ``friction.bristle_stiffness``). Where
+    static friction is not identified, ``friction.static`` keeps the spec's
+    friction gap Fs - Fc on the identified Coulomb friction: the gap
+    (guideline step 1) stays the user's assumption, not a value derived from
+    the record; the Stribeck velocity and bristle stiffness not identified
+    keep the spec's own values.
 
     Parameters
     ----------
@@ -74,6 +80,10 @@ def identified_spec(spec, params, masses, form):
     if bad:
         raise SpecError(f"the identified value {values[bad[0]]:.4g} {_SPEC_UNITS[bad[0]]} is "
                         f"not positive, which a spec cannot hold: {IMPLAUSIBLE}", path=bad[0])
+    if values.get("friction.static", math.inf) < values["friction.coulomb"]:
+        raise SpecError(f"the identified static friction {values['friction.static']:.4g} N lies "
+                        f"below the Coulomb friction {values['friction.coulomb']:.4g} N, which a "
+                        f"spec cannot hold: {IMPLAUSIBLE}", path="friction.static")
     return with_values(spec, {k: float(x) for k, x in values.items()})
 
 
@@ -181,6 +191,10 @@ def _header(result: IdentificationResult) -> str:
             kept = ("keeps the spec's friction gap Fs - Fc" if name == "static" else
                     "is the spec's own value")
             lines.append(f"# friction.{name} {kept}: not identifiable from this record.")
+    if (result.parameters["bristle_stiffness"].identifiable and result.spec is not None
+            and result.spec.friction.bristle_damping is None):
+        lines.append("# friction.bristle_damping is not identified: its default, sqrt(sigma0 "
+                     "(m1 + m2)), follows the identified bristle stiffness.")
     return "\n".join(lines)
 
 
