@@ -72,7 +72,7 @@ relative standard error stays below :data:`MAX_RELATIVE_ERROR`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -231,6 +231,12 @@ def dynamic_parameters(measured, proc: Processing, joint: Joint, sol, form: str,
         vs = vs_new
     details = Dynamic(branches=tuple(e[0] for e in events + runs), sweep=sweep)
     out = {"static": static, "stribeck_velocity": stribeck, "bristle_stiffness": stiffness}
+    if ctx.tr.compliance > 0.0:  # an isolated stage recorded without its deflection
+        why = ("; the record has no deflection_m column, so the stage's motion holds the joint's "
+               f"deflection (its compliance 1/k = {ctx.tr.compliance:.3g} m/N from the spec is "
+               "removed from the displacement, but the speeds are the stage's): a record with "
+               "deflection_m measures the cart's own motion")
+        out = {k: p if p.identifiable else replace(p, note=p.note + why) for k, p in out.items()}
     return {k: out[k] for k in DYNAMIC}, details
 
 
