@@ -36,10 +36,11 @@ class Excitation:
     Attributes
     ----------
     breakaways : int
-        Rests of at least ``dwell`` (the bearing side moves less than
-        ``rest_band``) followed by sliding above the velocity threshold.
+        Rests of at least ``dwell`` after sliding (the bearing side moves less
+        than ``rest_band``, or creeps slower than :data:`STOP_FRACTION` of the
+        velocity threshold), followed by motion: see :func:`excitation`.
     rest_time : float
-        Total time at rest [s].
+        Total time at rest (or creeping) [s].
     reversals : int
         Reversals of the direction of motion (resolved above the noise).
     presliding_reversals : int
@@ -56,7 +57,7 @@ class Excitation:
     presliding_band : float
         Largest excursion of a presliding reversal [m].
     events : tuple of (float, float)
-        Per breakaway: the start of the rest and the time the stage slides
+        Per breakaway: the start of the rest and the time the bearing moves
         again [s].
     presliding_segments : tuple of tuple of float
         Per run of consecutive presliding reversals: the times of its

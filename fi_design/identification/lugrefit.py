@@ -105,6 +105,14 @@ class Sliding:
         return sum(self.value(n) for n in self.names if n.endswith("mass"))
 
 
+def _force_noise(tr: Trace, mass: float) -> float:
+    """Noise of the measured friction force [N]: force and mass times acceleration noise.
+
+    Never zero (a noise-free record): at least 1e-9 of the largest force.
+    """
+    return max(math.hypot(tr.su, mass * tr.sa), 1e-9 * float(np.max(np.abs(tr.u))), 1e-12)
+
+
 def friction_force(tr: Trace, names: tuple[str, ...], p: np.ndarray) -> np.ndarray:
     """Friction on the bearing, u - inertia - offset, for the estimates ``p`` by ``names`` [N]."""
     F = tr.u.copy()
@@ -295,7 +303,7 @@ def fit_branches(tr: Trace, sliding: Sliding, branches: list[Branch], *,
     if cov_p is not None:
         C = np.asarray(cov_p, dtype=float)
     m = sliding.mass()
-    sy = math.hypot(tr.su, m * tr.sa)
+    sy = _force_noise(tr, m)
     data = [(tr.x[b.idx], tr.v[b.idx], tr.u[b.idx],
              {k: c[b.idx] for k, c in tr.inertia.items()}, b.s) for b in branches]
     k_fixed = "kappa" in fixed
@@ -392,7 +400,7 @@ def fit_stribeck(tr: Trace, sliding: Sliding, idx: np.ndarray, *, static: float 
         ``x`` is ``[vs]`` or ``[vs, Fs]``.
     """
     names = sliding.names
-    sy = math.hypot(tr.su, sliding.mass() * tr.sa)
+    sy = _force_noise(tr, sliding.mass())
     v = tr.v[idx]
     s = np.sign(v)
     speed = np.abs(v)
