@@ -292,50 +292,6 @@ REFERENCES = (
 )
 
 
-#: The paper and the standard works it builds on.
-REFERENCES = (
-    ("Fix2024", "J. A. Fix et al., \u201cMitigating friction induced limit cycles by an "
-                "intermediate flexure stage\u201d (the paper this tool implements; design "
-                "guideline in \u00a74)."),
-    ("Fix2023", "J. A. Fix, A Linearized Parameter Study of a Friction Isolator System: "
-                "Towards a Frequency Domain Design Guideline, MSc thesis, University of Twente, "
-                "2023."),
-    ("Canudas1995", "C. Canudas de Wit, H. Olsson, K. J. \u00c5str\u00f6m and P. Lischinsky, "
-                    "\u201cA new model for control of systems with friction\u201d, IEEE "
-                    "Transactions on Automatic Control 40(3), 1995 (the LuGre model)."),
-    ("Astrom2008", "K. J. \u00c5str\u00f6m and C. Canudas-de-Wit, \u201cRevisiting the LuGre "
-                   "friction model\u201d, IEEE Control Systems Magazine 28(6), 2008."),
-    ("Hensen2003", "R. H. A. Hensen, M. J. G. van de Molengraft and M. Steinbuch, \u201cFriction "
-                   "induced hunting limit cycles: a comparison between the LuGre and switch "
-                   "friction model\u201d, Automatica 39(12), 2003."),
-    ("Hensen2002", "R. H. A. Hensen and M. J. G. van de Molengraft, \u201cFriction induced "
-                   "hunting limit cycles: an event mapping approach\u201d, Proc. American "
-                   "Control Conference, 2002."),
-    ("Karnopp1985", "D. Karnopp, \u201cComputer simulation of stick-slip friction in mechanical "
-                    "dynamic systems\u201d, ASME J. Dynamic Systems, Measurement and Control "
-                    "107(1), 1985 (the switch model)."),
-    ("Hairer1996", "E. Hairer and G. Wanner, Solving Ordinary Differential Equations II: Stiff "
-                   "and Differential-Algebraic Problems, 2nd ed., Springer, 1996 (RODAS4)."),
-    ("Dong2018", "X. Dong and C. E. Okwudire, \u201cAn experimental investigation of the effects "
-                 "of the compliant joint method on feedback compensation of pre-sliding/"
-                 "pre-rolling friction\u201d, Precision Engineering 54, 2018."),
-    ("Dong2020", "X. Dong and C. E. Okwudire, \u201cInfluence of design parameters on the "
-                 "effectiveness of friction isolators in mitigating pre-motion friction in "
-                 "mechanical bearings\u201d, Mechatronics 71, 2020."),
-    ("Wang2022", "J. Wang, X. Dong, O. R. Barry and C. Okwudire, \u201cFriction-induced "
-                 "instability and vibration in a precision motion stage with a friction "
-                 "isolator\u201d, Journal of Vibration and Control 28(15-16), 2022."),
-    ("AlBender2008", "F. Al-Bender and J. Swevers, \u201cCharacterization of friction force "
-                     "dynamics\u201d, IEEE Control Systems Magazine 28(6), 2008."),
-    ("Maeda2013", "Y. Maeda and M. Iwasaki, \u201cRolling friction model-based analyses and "
-                  "compensation for slow settling response in precise positioning\u201d, IEEE "
-                  "Transactions on Industrial Electronics 60(12), 2013 (PID from mass and "
-                  "crossover)."),
-    ("Skogestad2005", "S. Skogestad and I. Postlethwaite, Multivariable Feedback Control, 2nd "
-                      "ed., Wiley, 2005 (margins and sensitivity)."),
-)
-
-
 def _appendix(result: Any) -> dict:
     spec = result.spec
     sim = spec.simulation
