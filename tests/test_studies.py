@@ -379,7 +379,7 @@ def test_figures(paper_spec, kernel):
     line = sw.sweep(paper_spec, ("isolator.stroke", [1e-4, 3e-4]))
     png = plots.figure_bytes(plots.sweep_figure(line), "png")
     assert png.startswith(b"\x89PNG")
-    assert plots.axis_label("isolator.stroke", "m") == "isolator.stroke [mm]"
+    assert plots.axis_label("isolator.stroke", "m") == "Isolator stroke [mm]"
     assert plots.display_unit("N/m") == ("N/mm", 1e-3)
 
 
