@@ -191,10 +191,6 @@ def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
                         results={"isolated": res_iso, "non_isolated": res_non})
 
 
-def _fmt_f(f: float | None) -> str:
-    return "not found" if f is None else f"{f:g} Hz"
-
-
 def _plant_text(v: PlantVerdict, label: str, fc: float) -> str:
     m = v.metrics
     if v.outcome == "static_error":
@@ -229,8 +225,11 @@ def _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested) 
     for key in ("isolated", "non_isolated"):
         m = mins[key]
         judged = key == own_key
-        text = (f"{labels[key]}: hunting-free from {_fmt_f(m)} (scan resolution {res:g} Hz); "
-                f"design crossover {fc:g} Hz")
+        scan = (f"scan {mins['scan'][0]:g} to {mins['scan'][1]:g} Hz" if m is None
+                else f"scan resolution {res:g} Hz")
+        text = (f"{labels[key]}: " + ("hunting-free nowhere in the scan" if m is None
+                                      else f"hunting-free from {m:g} Hz")
+                + f" ({scan}); design crossover {fc:g} Hz")
         if not judged:
             out.append(Check(f"min_crossover_{key}", None, m, None, "Hz", text, step))
         elif not integrates:

@@ -440,25 +440,28 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
         left = r.counts["invalid"] + r.counts["failed"]
         kinds = ("stuck", "undetermined") if _spec_integrates(spec) else ("undetermined",)
         others = {k: r.counts[k] for k in kinds if r.counts[k]}
-        notes = [", ".join(f"{n} {k}" for k, n in others.items())] if others else []
+        notes = []
+        if others:
+            notes.append(" and ".join(f"{n} {k}" for k, n in others.items()) + " sample(s) do "
+                         "not settle either")
         if left:
-            notes.append(f"{left} sample(s) left out: a draw the spec refuses (Fs below Fc) or "
-                         "a failed simulation")
-        if notes:
-            what += " (besides: " + "; ".join(notes) + ")"
+            notes.append(f"{left} sample(s) are left out (a draw the spec refuses, Fs below Fc, "
+                         "or a failed simulation)")
+        tail = "".join(f" {n[0].upper()}{n[1:]}." for n in notes)
         if r.status == "FAIL":
-            text = f"{what}, above the {_pct(r.limit)} limit."
+            text = f"{what}, above the {_pct(r.limit)} limit.{tail}"
         elif r.status == "WARN" and r.hunting_probability is None:
             text = "No scatter sample simulated to the end: the robustness is unknown."
         elif r.status == "WARN" and r.interval[1] > r.limit:
             text = (f"{what}: at or below the {_pct(r.limit)} limit, but the interval reaches "
                     f"above it; more samples (requirements.robustness.samples) would show "
-                    "whether the limit holds.")
+                    f"whether the limit holds.{tail}")
         elif r.status == "WARN":
-            text = (f"{what}: few hunt, but more than {_pct(r.limit)} of the samples do not "
-                    "settle either, so the limit is not shown to hold.")
+            text = (f"{what}, within the {_pct(r.limit)} limit; but more than "
+                    f"{_pct(r.limit)} of the samples do not settle, so the stage is not shown "
+                    f"to be robust.{tail}")
         else:
-            text = f"{what}, within the {_pct(r.limit)} limit."
+            text = f"{what}, within the {_pct(r.limit)} limit.{tail}"
         reasons.append(Reason(r.status, "robustness", text))
     elif simulation is not None:
         reasons.append(Reason("WARN", "robustness",
@@ -494,13 +497,23 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
     reasons.sort(key=lambda r: order[r.severity])
     status = ("FAIL" if any(r.severity == "FAIL" for r in reasons) else
               "PASS_WITH_WARNINGS" if any(r.severity == "WARN" for r in reasons) else "PASS")
-    nfail = sum(r.severity == "FAIL" for r in reasons)
     nwarn = sum(r.severity == "WARN" for r in reasons)
     what = (f"{label} {_BEHAVIOUR.get(behaviour, behaviour)} at {fc:.4g} Hz"
             if behaviour is not None else f"{label} was not simulated")
-    tail = {"FAIL": f"{nfail} reason(s) to fail"
-            + (f", {nwarn} warning(s)" if nwarn else ""),
-            "PASS_WITH_WARNINGS": f"nothing fails; {nwarn} warning(s) to review",
-            "PASS": "nothing fails, nothing to review"}[status]
+    on = []
+    for r in reasons:
+        word = _SOURCES.get(r.source, r.source.replace("_", " "))
+        if r.severity == "FAIL" and word not in on:
+            on.append(word)
+    warned = f"{nwarn} warning{'s' if nwarn != 1 else ''} to review"
+    listed = ", ".join(on[:-1]) + " and on " + on[-1] if len(on) > 1 else "".join(on)
+    tail = {"FAIL": f"It fails on {listed}" + (f"; {warned}" if nwarn else ""),
+            "PASS_WITH_WARNINGS": f"Nothing fails; {warned}",
+            "PASS": "Nothing fails, nothing to review"}[status]
     return Verdict(status=status, reasons=tuple(reasons), plant=own, behaviour=behaviour,
-                   headline=f"{what}: {tail}.")
+                   headline=f"{what}. {tail}.")
+
+
+#: Sources of reasons in the headline's words (others: the check's name).
+_SOURCES = {"simulation": "the simulation at the design crossover",
+            "robustness": "friction scatter", "confirmation": "the missing simulation"}
