@@ -320,6 +320,10 @@ def recommend(spec: _spec.Spec, crossover: CrossoverResult, simulation: Confirma
             iso_info["interval"] = c["interval"]
             text += (f", hunting in {_pct(c['hunting_probability'])} of the scatter samples "
                      f"({_pct(c['interval'][0])} to {_pct(c['interval'][1])})")
+            if c["hunting_probability"] is not None and \
+                    c["hunting_probability"] > robustness.limit:
+                text += (f", above the {_pct(robustness.limit)} limit: as it stands it would "
+                         "not pass the robustness check either")
         parts.append(text + ". Specify it (the isolator section) and run the design again "
                      "to sign it off")
     m_own = simulation.min_hunting_free_crossover[own]

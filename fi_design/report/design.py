@@ -41,7 +41,7 @@ def _cases_table(result: Any) -> list[dict]:
             "gain_margin": c.gain_margin_db, "modulus_margin": c.modulus_margin,
             "delay_margin": None if out_of_band else c.delay_margin,
             "stable": "yes" if c.stable else "no", "status": status, "css": status.lower(),
-            "failed": "no crossing in the loop's band" if out_of_band else ", ".join(c.failed),
+            "failed": "outside the band" if out_of_band else ", ".join(c.failed),
         })
     return rows
 
