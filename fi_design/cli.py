@@ -526,7 +526,8 @@ def identify_command(
     Inverse-dynamics least squares on the filtered record gives the moving
     mass, Coulomb and viscous friction per direction and the offset, with
     standard errors; static friction, Stribeck velocity and bristle
-    stiffness only where the record holds a breakaway or presliding.
+    stiffness only where the record holds their excitation (breakaways after
+    a stop, a slow velocity sweep through zero, presliding).
     """
     forms = {"symmetric": "symmetric", "per-direction": "per_direction",
              "per_direction": "per_direction"}

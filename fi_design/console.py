@@ -831,8 +831,7 @@ def print_identification(console: "Console", result) -> None:
     console.print(Text(f"Masses: stage {_fmt(ms.stage, 5)} kg, cart {_fmt(ms.cart, 5)} kg "
                        f"({ms.source})"))
     for name in ("static", "stribeck_velocity", "bristle_stiffness"):
-        p = result.parameters[name]
-        if not p.identifiable:
-            console.print(Text(f"{name}: {p.note}", style="dim"))
+        p = result.parameters[name]  # how it was estimated, or why not
+        console.print(Text(f"{name}: {p.note}", style=None if p.identifiable else "dim"))
     for note in result.notes:
         console.print(Text(f"note: {note}", style="dim"))

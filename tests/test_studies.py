@@ -295,7 +295,7 @@ def test_interrupted_sweep_resumes(paper_spec, kernel, tmp_path):
 
 def test_default_cache_dir_follows_environment(tmp_path, monkeypatch):
     monkeypatch.setenv(sw.CACHE_ENV, str(tmp_path / "c"))
-    assert sw.PointCache().directory == tmp_path / "c"
+    assert sw.PointCache().directory == tmp_path / "c" / "studies"
 
 
 def test_chunks_interleave():

@@ -18,13 +18,13 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..cachedir import CACHE_ENV, cache_dir
 from ..errors import CacheError
 
 __all__ = ["CACHE_ENV", "METHOD", "CODE_MODULES", "PointCache", "default_cache_dir",
            "open_cache", "code_digest", "point_key"]
 
 #: Environment variable naming the cache directory (tests and CI point it at a temporary one).
-CACHE_ENV = "FI_DESIGN_CACHE_DIR"
 #: Solver method the studies use (part of the cache key).
 METHOD = "fast"
 #: Source files (in the package) that decide a point's outcome; their digest is in every key.
@@ -33,20 +33,15 @@ CODE_MODULES = ("kernel.py", "equations.py", "plant.py", "simulation.py", "metri
 
 
 def default_cache_dir() -> Path:
-    """The cache directory: ``$FI_DESIGN_CACHE_DIR``, else the user cache directory.
+    """The cache directory of the studies: :func:`fi_design.cachedir.cache_dir` ``("studies")``.
 
     Returns
     -------
     pathlib.Path
-        ``platformdirs.user_cache_dir("fi_design") / "studies"`` unless the
-        environment variable names another directory.
+        ``$FI_DESIGN_CACHE_DIR/studies`` when the variable is set, else
+        ``platformdirs.user_cache_dir("fi_design") / "studies"``.
     """
-    env = os.environ.get(CACHE_ENV, "").strip()
-    if env:
-        return Path(env).expanduser()
-    from platformdirs import user_cache_dir
-
-    return Path(user_cache_dir("fi_design")) / "studies"
+    return cache_dir("studies")
 
 
 class PointCache:
