@@ -195,7 +195,10 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     if xo:
         line = (f"Crossover: desired {_fmt(xo.get('desired'))} Hz, achievable "
                 f"{_fmt(xo.get('achievable'))} Hz")
-        if xo.get("limited_by"):
+        if xo.get("limit_kind") == "scan_limit":   # the search cap: a bound, not a result
+            line = (f"Crossover: desired {_fmt(xo.get('desired'))} Hz; the linear model limits "
+                    f"it nowhere below {_fmt(xo.get('achievable'))} Hz (the search cap)")
+        elif xo.get("limited_by"):
             line += f", limited by {xo['limited_by']}"
         console.print(Text(line))
         cases = xo.get("cases") or []
