@@ -206,8 +206,10 @@ def key_figures(result: Any) -> list[dict]:
             note = f"final error {qty(met.final_error, 'm')}"
         need = ("settles" if p.static_error_bound is None
                 else f"settles, or rests within {qty(p.static_error_bound, 'm')}")
+        short = {"stuck": "sticks", "static_error": "static error"}.get(p.outcome,
+                                                                       BEHAVIOUR[p.outcome][1])
         rows.append(_figure(f"Simulated at the design crossover ({qty(fc, 'Hz')})",
-                            BEHAVIOUR[p.outcome][1], "", need, note, css))
+                            short, "", need, note, css))
     if rob is not None:
         css = {"PASS": "pass", "WARN": "warn", "FAIL": "fail"}[rob.status]
         note = (f"{num(100 * rob.confidence, 3)} % interval {_pct(rob.interval[0])} \u2013 "
