@@ -13,6 +13,9 @@ library raises; :class:`~fi_design.cliparts.DefaultCommandGroup` translates:
   nothing written;
 - exit 1: internal error -- a bug; ``--debug`` or ``FI_DESIGN_DEBUG=1`` shows
   the traceback;
+- exit 3: the design verdict is at or below the level of ``--fail-on``
+  (``fail``: FAIL; ``warn``: FAIL or PASS_WITH_WARNINGS), for scripts and CI;
+  the outputs are written first;
 - exit 130: a parameter study interrupted with Ctrl-C.
 
 ``fi-design SPEC.yaml`` runs the default command ``design`` through
@@ -34,7 +37,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from .cliparts import (DEFAULT_COMMAND, ExecutorKind, Force, Jobs, JsonOut, NoCache, NoIsolator,
+from .cliparts import (DEFAULT_COMMAND, EXIT_VERDICT, ExecutorKind, Force, Jobs, JsonOut,
+                       NoCache, NoIsolator,
                        Scheduler, SpecArg, app, check_outputs, check_spec_path, command_line,
                        json_text, load, output_option, run_study, study_pool, write_outputs,
                        write_report, write_study)
@@ -64,15 +68,28 @@ def design_command(
         "--map", help="Add a crossover x stroke hunting map around the design point to the "
                       "report (about 50 more simulations; also `report: {map: true}` in the "
                       "spec).")] = False,
+    fail_on: Annotated[Optional[str], typer.Option(
+        "--fail-on", metavar="fail|warn",
+        help="Exit with code 3 (after writing the outputs) when the verdict is at or below "
+             "this level: 'fail' on FAIL, 'warn' on FAIL or PASS_WITH_WARNINGS; for scripts "
+             "and CI.")] = None,
     force: Force = False,
 ) -> None:
     """Run the four-step guideline on a spec and confirm it by simulation (the default command).
 
     Prints the checks (PASS / FAIL / WARN / INFO), the PID gains, the crossover
     of the four linear limit cases, the simulated verdicts with and without the
-    isolator, the lowest hunting-free crossovers and the conclusion; writes
-    JSON and the sign-off report (HTML or PDF) on request.
+    isolator, the lowest hunting-free crossovers, the conclusion and the
+    verdict on the hardware as specified (PASS, PASS_WITH_WARNINGS or FAIL,
+    with its reasons, the hunting probability under friction scatter, the
+    margins and any recommendation); writes JSON and the sign-off report
+    (HTML or PDF) on request. With --fail-on, exits 3 when the verdict is at
+    or below that level.
     """
+    levels = {"fail": "FAIL", "warn": "PASS_WITH_WARNINGS"}
+    if fail_on is not None and fail_on not in levels:
+        raise typer.BadParameter(f"expected 'fail' or 'warn', got {fail_on!r}",
+                                 param_hint="--fail-on")
     if with_map and report_out is None:
         raise typer.BadParameter("the map is part of the report; add --report OUT.html or "
                                  "--report OUT.pdf", param_hint="--map")
@@ -103,6 +120,8 @@ def design_command(
             design_map = make_map(result, progress=lambda done, total: status(
                 f"hunting map: {done}/{total} simulations"))
     write_report(console, outs["report"], result, design_map=design_map)
+    if fail_on is not None and result.verdict.at_or_below(levels[fail_on]):
+        raise typer.Exit(EXIT_VERDICT)
 
 
 # --------------------------------------------------------------------------- simulate, schema, init

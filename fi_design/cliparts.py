@@ -36,6 +36,8 @@ DEFAULT_COMMAND = "design"
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_BAD_INPUT = 2
+#: Exit code of a design whose verdict is at or below the level of ``--fail-on``.
+EXIT_VERDICT = 3
 #: Exit code of a study interrupted with Ctrl-C (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
 
@@ -129,7 +131,7 @@ app = typer.Typer(
          "guideline (friction gap, crossover, drive stiffness, PID gains) with a "
          "nonlinear LuGre simulation confirming the verdict.\n\n"
          "fi-design SPEC.yaml runs the default command 'design'. Exit codes: 0 done, "
-         "2 bad input, 1 internal error.",
+         "2 bad input, 1 internal error, 3 a design verdict at or below --fail-on.",
 )
 
 

@@ -19,7 +19,17 @@ stage with friction, with and without the isolator, at the design crossover
 
 A spec without an isolator is confirmed against the isolator step 3 suggests
 (:func:`fi_design.guideline.isolator_advice`), so the comparison is always
-"with" against "without".
+"with" against "without". Only the spec's own plant is judged (its checks
+PASS or FAIL): the isolated one when the spec has an isolator, else the stage
+without. The other plant is information, and for a spec without isolator a
+recommendation (:class:`~fi_design.results.design.Recommendation`), never a
+reason to pass.
+
+A loop without integrator (``controller.gains.ki: 0`` or
+``integrator_ratio: .inf``) cannot hunt by the paper's mechanism: it comes to
+rest with a static error of up to (Fc + |offset|) / kp. At rest within that
+error its outcome is ``static_error``, not ``stuck``
+(:class:`~fi_design.results.design.PlantVerdict`).
 """
 
 from __future__ import annotations
@@ -98,6 +108,29 @@ def with_isolator(spec: _spec.Spec, stroke: float, stiffness: float) -> _spec.Sp
     return spec.model_copy(update={"isolator": iso})
 
 
+def static_error_bound(spec: _spec.Spec) -> float | None:
+    """The static error a loop without integrator may leave against friction [m].
+
+    ``(max(Fc, Fc_negative) + |offset|) / kp``: the cart comes to rest once the
+    loop's force no longer overcomes the sliding friction (and the load
+    offset); None when the loop integrates.
+
+    Parameters
+    ----------
+    spec : Spec
+        The design spec.
+
+    Returns
+    -------
+    float or None
+    """
+    from .pid import control_law
+
+    f = spec.friction
+    fc = max(f.coulomb, f.coulomb_negative if f.coulomb_negative is not None else f.coulomb)
+    return control_law(spec).static_error(fc + abs(f.offset))
+
+
 def _other_model(spec: _spec.Spec) -> _spec.Spec:
     other = "switch" if spec.friction.model == "lugre" else "lugre"
     return spec.model_copy(update={"friction": spec.friction.model_copy(update={"model": other})})
@@ -133,10 +166,11 @@ def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
             progress(text)
 
     say("simulating the stage with and without the isolator ...")
+    bound = static_error_bound(spec)
     res_iso = simulate(spec_iso, isolated=True)
     res_non = simulate(spec, isolated=False)
-    iso = PlantVerdict.of("isolated", res_iso)
-    non = PlantVerdict.of("non_isolated", res_non)
+    iso = PlantVerdict.of("isolated", res_iso, bound)
+    non = PlantVerdict.of("non_isolated", res_non, bound)
     scans = {"isolated": scan_crossover(spec_iso, True, progress=progress),
              "non_isolated": scan_crossover(spec, False, progress=progress)}
     cfg = spec.simulation.crossover_scan
@@ -144,8 +178,10 @@ def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
             "resolution": cfg.step, "scan": [cfg.start, cfg.stop]}
     land = landing(spec_iso, res_iso)
     say("cross-checking with the other friction model ...")
-    other_iso = PlantVerdict.of("isolated", simulate(_other_model(spec_iso), isolated=True))
-    other_non = PlantVerdict.of("non_isolated", simulate(_other_model(spec), isolated=False))
+    other_iso = PlantVerdict.of("isolated", simulate(_other_model(spec_iso), isolated=True),
+                                bound)
+    other_non = PlantVerdict.of("non_isolated", simulate(_other_model(spec), isolated=False),
+                                bound)
     agree = _hunts(other_iso) == _hunts(iso) and _hunts(other_non) == _hunts(non)
     checks = _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested)
     return Confirmation(isolated=iso, non_isolated=non, min_hunting_free_crossover=mins,
@@ -155,47 +191,82 @@ def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
                         results={"isolated": res_iso, "non_isolated": res_non})
 
 
-def _fmt_f(f: float | None) -> str:
-    return "not found" if f is None else f"{f:g} Hz"
+def _plant_text(v: PlantVerdict, label: str, fc: float) -> str:
+    m = v.metrics
+    if v.outcome == "static_error":
+        return (f"{label} at {fc:g} Hz: at rest {abs(m.final_error) * 1e6:.3g} um from its "
+                f"target, within the static error (Fc + |offset|) / kp = "
+                f"{v.static_error_bound * 1e6:.3g} um of a loop without integrator (not stuck)")
+    return f"{label} at {fc:g} Hz: {m.verdict} ({m.reason})"
 
 
 def _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested) -> list[Check]:
+    """The confirmation's checks: the spec's own plant judged, the other one information."""
     fc = _spec.design_crossover(spec)
     step = "simulation (paper section 2.3)"
-    label = "suggested isolator" if suggested else "isolated design"
-    mi, mn = iso.metrics, non.metrics
-    out = [
-        Check("simulation_isolated", mi.verdict == "settled", float(mi.hunting_cycles), 0.0,
-              "cycles", f"{label} at {fc:g} Hz: {mi.verdict} ({mi.reason})", step),
-        Check("simulation_non_isolated", None, float(mn.hunting_cycles), None, "cycles",
-              f"without isolator at {fc:g} Hz: {mn.verdict} ({mn.reason})", step),
-    ]
-    m_iso, m_non = mins["isolated"], mins["non_isolated"]
+    integrates = iso.static_error_bound is None
+    if suggested:
+        own_key, labels = "non_isolated", {
+            "non_isolated": "the stage as specified (without isolator)",
+            "isolated": "with the suggested isolator (a recommendation, not the hardware)"}
+    else:
+        own_key, labels = "isolated", {
+            "isolated": "the isolated design as specified",
+            "non_isolated": "without the isolator (for comparison)"}
+    plants = {"isolated": iso, "non_isolated": non}
+    out = []
+    for key in ("isolated", "non_isolated"):
+        v = plants[key]
+        judged = key == own_key
+        out.append(Check(f"simulation_{key}", v.acceptable if judged else None,
+                         float(v.metrics.hunting_cycles), 0.0 if judged else None, "cycles",
+                         _plant_text(v, labels[key], fc), step))
     res = mins["resolution"]
-    out.append(Check(
-        "min_crossover_isolated", None if m_iso is None else fc >= m_iso, m_iso, fc, "Hz",
-        f"{label} stays hunting-free from {_fmt_f(m_iso)} (scan resolution {res:g} Hz); "
-        f"design crossover {fc:g} Hz", step))
-    out.append(Check(
-        "min_crossover_non_isolated", None, m_non, None, "Hz",
-        f"without isolator hunting-free from {_fmt_f(m_non)} (scan resolution {res:g} Hz)",
-        step))
+    for key in ("isolated", "non_isolated"):
+        m = mins[key]
+        judged = key == own_key
+        scan = (f"scan {mins['scan'][0]:g} to {mins['scan'][1]:g} Hz" if m is None
+                else f"scan resolution {res:g} Hz")
+        text = (f"{labels[key]}: " + ("hunting-free nowhere in the scan" if m is None
+                                      else f"hunting-free from {m:g} Hz")
+                + f" ({scan}); design crossover {fc:g} Hz")
+        if not judged:
+            out.append(Check(f"min_crossover_{key}", None, m, None, "Hz", text, step))
+        elif not integrates:
+            out.append(Check(f"min_crossover_{key}", None, m, fc, "Hz", text + (
+                "; the loop has no integrator, so below that crossover it rests with a static "
+                "error rather than hunting"), step))
+        elif m is None:
+            out.append(Check(f"min_crossover_{key}", False, m, fc, "Hz", text + (
+                ": it does not settle even at the top of the scan"), step, status=Status.WARN))
+        elif fc >= m:
+            out.append(Check(f"min_crossover_{key}", True, m, fc, "Hz", text, step))
+        else:
+            out.append(Check(f"min_crossover_{key}", False, m, fc, "Hz", text + (
+                ": the design crossover lies below the boundary, where hunting comes and goes"),
+                step, status=Status.WARN))
+    mn = non.metrics
     if mn.verdict != "hunting":
         out.append(Check("isolator_needed", None, None, None, "-",
                          f"the stage without isolator does not hunt at {fc:g} Hz "
-                         f"({mn.verdict}): the isolator is not needed at this crossover", step))
+                         f"({non.outcome.replace('_', ' ')}): the isolator is not needed at "
+                         "this crossover", step))
     if land is not None:
         ok = (not land.on_limiter) and land.force < land.static_friction
+        where = "the suggested isolator's cart" if suggested else "the cart"
         out.append(Check(
-            "landing_force", ok, land.force, land.static_friction, "N",
-            f"the cart lands at {land.deflection * 1e6:.3g} um joint deflection "
+            "landing_force", None if suggested else ok, land.force, land.static_friction, "N",
+            f"{where} lands at {land.deflection * 1e6:.3g} um joint deflection "
             f"({'on the limiter' if land.on_limiter else 'inside the stroke'}): flexure force "
             f"k min(|d|, s) = {land.force:.3g} N against Fs = {land.static_friction:.3g} N "
             f"(the rule's bound k s = {land.rule_force:.3g} N)", "step 3 refinement: landing"))
     if not agree:
+        other = {"isolated": other_iso, "non_isolated": other_non}
+        own_differs = _hunts(other[own_key]) != _hunts(plants[own_key])
         out.append(Check(
             "friction_model_cross_check", None, None, None, "-",
             f"the {other_iso.friction_model} model disagrees: isolated "
-            f"{other_iso.metrics.verdict}, without isolator {other_non.metrics.verdict}", step,
-            status=Status.WARN))
+            f"{other_iso.metrics.verdict}, without isolator {other_non.metrics.verdict}"
+            + ("" if own_differs else " (not on the stage as specified)"), step,
+            status=Status.WARN if own_differs else Status.INFO))
     return out

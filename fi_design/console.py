@@ -282,7 +282,10 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     if xo:
         line = (f"Crossover: desired {_fmt(xo.get('desired'))} Hz, achievable "
                 f"{_fmt(xo.get('achievable'))} Hz")
-        if xo.get("limited_by"):
+        if xo.get("limit_kind") == "scan_limit":   # the search cap: a bound, not a result
+            line = (f"Crossover: desired {_fmt(xo.get('desired'))} Hz; the linear model limits "
+                    f"it nowhere below {_fmt(xo.get('achievable'))} Hz (the search cap)")
+        elif xo.get("limited_by"):
             line += f", limited by {xo['limited_by']}"
         console.print(Text(line))
         cases = xo.get("cases") or []
@@ -313,8 +316,77 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     if conclusion:
         console.print(Text("Conclusion: ", style="bold").append(Text(str(conclusion),
                                                                         style="")))
+    if getattr(result, "verdict", None) is not None:
+        print_verdict(console, result)   # the input warnings are among its reasons
+        return
     for w in getattr(result, "warnings", ()) or ():
         console.print(Text("warning: ", style="bold yellow").append(Text(_warning_text(w))))
+
+
+#: Border and title style of the verdict box per status; a stage that does not settle gets a
+#: heavy frame, so the box differs in shape too (monochrome terminals, logs).
+_VERDICT_LOOK = {"PASS": ("green", "ROUNDED"), "PASS_WITH_WARNINGS": ("yellow", "ROUNDED"),
+                 "FAIL": ("red", "HEAVY")}
+
+
+def print_verdict(console: "Console", result) -> None:
+    """Print the sign-off verdict of a design as a framed box: status, reasons, figures.
+
+    The box names what the stage as specified does (settles, hunts, ...), lists
+    the reasons (FAIL, WARN, PASS), then the robustness under friction scatter,
+    the margins with units and the recommendation. A green rounded frame for
+    PASS, yellow for PASS_WITH_WARNINGS, a heavy red one for FAIL.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to print.
+    result : fi_design.results.design.DesignResult
+        The design, with its verdict.
+    """
+    from rich import box
+    from rich.panel import Panel
+    from rich.table import Table
+    from rich.text import Text
+
+    v = result.verdict
+    colour, frame = _VERDICT_LOOK[v.status]
+    body = Table.grid(padding=(0, 1))
+    body.add_column(no_wrap=True)
+    body.add_column(ratio=1)
+    body.add_row("", Text(v.headline, style="bold"))
+    for r in v.reasons:
+        body.add_row(_status_text(r.severity), Text(r.text))
+    rob, mar = result.robustness, result.margins
+    if rob is not None:
+        p = "-" if rob.hunting_probability is None else f"{100 * rob.hunting_probability:.3g} %"
+        body.add_row(Text("Scatter", style="bold"), Text(
+            f"hunting in {p} of {rob.valid} samples ({100 * rob.interval[0]:.2g}-"
+            f"{100 * rob.interval[1]:.3g} % at {100 * rob.confidence:.3g} %), limit "
+            f"{100 * rob.limit:.3g} %"))
+    if mar is not None:
+        items = []
+        if mar.crossover_factor is not None:
+            items.append(f"crossover {'>= ' if mar.crossover_factor_bound else ''}"
+                         f"{mar.crossover_factor:.3g}x the hunting-free "
+                         f"{mar.hunting_free_crossover:g} Hz")
+        if mar.end_stop_clearance is not None:
+            items.append(f"end stop {_qty(mar.end_stop_clearance, 'm', 3)} away at rest")
+        if mar.stiffness_factor is not None:
+            items.append(f"k_max / k = {mar.stiffness_factor:.3g}")
+        if mar.stiffness_range is not None:
+            lo, hi = mar.stiffness_range
+            items.append(f"k {lo:.4g}-{hi:.4g} N/m for t = {1e3 * mar.thickness:.3g} \u00b1 "
+                         f"{1e3 * mar.thickness_tolerance:.2g} mm")
+        if mar.static_error is not None:
+            items.append(f"static error {_qty(mar.static_error, 'm', 3)} of "
+                         f"{_qty(mar.static_error_bound, 'm', 3)} (Fc + |offset|) / kp")
+        if items:
+            body.add_row(Text("Margins", style="bold"), Text("; ".join(items)))
+    if result.recommendation is not None:
+        body.add_row(Text("Advice", style="bold"), Text(result.recommendation.text))
+    console.print(Panel(body, title=Text(f"Verdict: {v.status}", style=f"bold {colour}"),
+                        title_align="left", border_style=colour, box=getattr(box, frame)))
 
 
 #: Friction models as the literature names them.
@@ -408,7 +480,7 @@ CASE_COLUMNS = {
 #: What the short headers of the limit-case table mean (the table's caption).
 CASE_CAPTION = ("fc: gain crossover; PM, GM, MM, DM: phase, gain, modulus and delay margin "
                 "(inf: no crossing); an unstable case fails with 'stability'")
-_CASE_SKIP = {"name", "description", "passed", "failed", "crossovers", "stable"}
+_CASE_SKIP = {"name", "description", "passed", "failed", "crossovers", "stable", "in_band"}
 
 
 def _cases_table(cases: list, numbers: dict) -> Any:
@@ -432,7 +504,8 @@ def _cases_table(cases: list, numbers: dict) -> Any:
         label = case.get("description") or case.get("name") or ""
         cells = [Text("inf" if case.get(k) is None and "margin" in k else _fmt(case.get(k)))
                  for k in keys]
-        passed = case.get("passed")
+        passed = case.get("passed") if case.get("in_band", True) or not case.get("passed") \
+            else None  # no crossing in the loop's band: its margins are not a pass
         status = _status_text("INFO" if passed is None else "PASS" if passed else "FAIL")
         if case.get("failed"):
             status.append(" " + ", ".join(map(str, case["failed"])))
@@ -481,10 +554,10 @@ def print_simulation(console: "Console", result) -> None:
     fit = result.replay
     if fit is not None:
         rows += [
-            ("position, model - measured, rms [um]", _fmt(1e6 * fit.position_rms, 4)),
-            ("position, model - measured, max [um]", _fmt(1e6 * fit.position_max, 4)),
-            ("tracking error r - x1 rms, model [um]", _fmt(1e6 * fit.tracking_rms_model, 4)),
-            ("tracking error r - x1 rms, measured [um]",
+            ("position, model - measured, rms [\u00b5m]", _fmt(1e6 * fit.position_rms, 4)),
+            ("position, model - measured, max [\u00b5m]", _fmt(1e6 * fit.position_max, 4)),
+            ("tracking error r - x1 rms, model [\u00b5m]", _fmt(1e6 * fit.tracking_rms_model, 4)),
+            ("tracking error r - x1 rms, measured [\u00b5m]",
              _fmt(1e6 * fit.tracking_rms_measured, 4)),
             ("commanded force, model - measured, rms [N]", _fmt(fit.force_rms, 4)),
         ]

@@ -28,6 +28,14 @@ support frequency at or above the required one (the width enters the drive and
 support stiffness linearly and nothing else). Among the designs that meet every
 constraint it keeps those within 1 % of the closest stiffness and picks the one
 with the largest smallest margin (stress, support frequency, leaf frequency).
+
+Thickness comes from stock: the grid holds only multiples of
+``flexure.thickness_step`` (0.05 mm by default) within the bounds, so the
+sized leaf can be bought, while length and width, which are machined, stay
+continuous. The stock's thickness tolerance +-dt moves the drive stiffness
+with t^3: :func:`stiffness_range` gives ``k (1 -+ dt / t)^3``, the range the
+built isolator may have (``null`` ``thickness_step`` sizes an unrounded
+thickness, for studies).
 """
 
 from __future__ import annotations
@@ -40,7 +48,8 @@ from .results.design import FlexureResult
 
 __all__ = [
     "CLAMPED_GUIDED_ROOT", "FlexureResult", "drive_stiffness", "support_stiffness",
-    "bending_stress", "stroke_limit", "support_frequency", "bending_frequency", "size_flexure",
+    "bending_stress", "stroke_limit", "support_frequency", "bending_frequency",
+    "stock_thicknesses", "stiffness_range", "size_flexure",
 ]
 
 #: First root of tan(x) + tanh(x) = 0: the clamped-guided beam's first mode, lambda [-].
@@ -178,6 +187,66 @@ def bending_frequency(youngs_modulus, density, thickness, length):
         * np.sqrt(youngs_modulus / (12.0 * density))
 
 
+def stock_thicknesses(bounds: tuple[float, float], step: float | None,
+                      points: int = GRID_POINTS) -> np.ndarray:
+    """Leaf thicknesses the sizing may use [m].
+
+    Parameters
+    ----------
+    bounds : (float, float)
+        Smallest and largest thickness [m].
+    step : float or None
+        Stock step [m]: the multiples of it within the bounds; None gives
+        ``points`` log-spaced thicknesses (an unrounded sizing).
+    points : int, optional
+        Grid points without a step.
+
+    Returns
+    -------
+    numpy.ndarray
+        Thicknesses [m], ascending; empty when no multiple of ``step`` lies
+        within the bounds.
+
+    Examples
+    --------
+    >>> [round(t * 1e3, 2) for t in stock_thicknesses((0.12e-3, 0.3e-3), 0.05e-3)]
+    [0.15, 0.2, 0.25, 0.3]
+    """
+    t0, t1 = bounds
+    if step is None:
+        return np.geomspace(t0, t1, points)
+    lo = math.ceil(t0 / step - 1e-9)
+    hi = math.floor(t1 / step + 1e-9)
+    return np.array([float(f"{i * step:.12g}") for i in range(lo, hi + 1)])  # 0.45e-3, not ...04
+
+
+def stiffness_range(stiffness: float, thickness: float, tolerance: float) -> tuple[float, float]:
+    """Drive stiffness of leaves at the thickness tolerance: ``k (1 -+ dt / t)^3`` [N/m].
+
+    Parameters
+    ----------
+    stiffness : float
+        Drive stiffness at the nominal thickness [N/m].
+    thickness : float
+        Nominal leaf thickness t [m].
+    tolerance : float
+        Thickness tolerance +-dt [m], below t.
+
+    Returns
+    -------
+    (float, float)
+        Lowest and highest drive stiffness [N/m] (k goes with t^3, width and
+        length as drawn).
+
+    Examples
+    --------
+    >>> [round(k) for k in stiffness_range(1000.0, 0.4e-3, 0.01e-3)]
+    [927, 1077]
+    """
+    r = tolerance / thickness
+    return stiffness * (1.0 - r) ** 3, stiffness * (1.0 + r) ** 3
+
+
 # --------------------------------------------------------------------------- result
 
 
@@ -221,11 +290,22 @@ def size_flexure(flexure, *, target_stiffness: float, maximum_stiffness: float, 
     (L0, L1), (b0, b1), (t0, t1) = flexure.length, flexure.width, flexure.thickness
     kt, kmax = float(target_stiffness), float(maximum_stiffness)
     w_req = 2.0 * math.pi * required_frequency
+    step, tol = flexure.thickness_step, flexure.thickness_tolerance
     empty = dict(leaves=n, target_stiffness=kt, maximum_stiffness=kmax, stroke=stroke,
-                 allowed_stress=sa, required_frequency=required_frequency)
+                 allowed_stress=sa, required_frequency=required_frequency,
+                 thickness_step=step, thickness_tolerance=tol)
+    stock = stock_thicknesses((t0, t1), step, points)
+    none = dict(length=None, width=None, thickness=None, drive_stiffness=None,
+                support_stiffness=None, stroke_limit=None, stress=None, stress_margin=None,
+                support_frequency=None, bending_frequency=None, frequency_margin=None,
+                leaf_mass=None, stiffness_range=None)
+    if stock.size == 0:
+        return FlexureResult(feasible=False, reason=(
+            f"stock: no multiple of the {_mm(step)} thickness step lies within the thickness "
+            f"bounds {_mm(t0)} to {_mm(t1)}"), **none, **empty)
 
     L = np.geomspace(L0, L1, points)[:, None]
-    t = np.geomspace(t0, t1, points)[None, :]
+    t = stock[None, :]
     per_width = n * E * t ** 3 / L ** 3             # drive stiffness per metre of width
     b_target = kt / per_width
     b_kmax = kmax / per_width
@@ -243,11 +323,7 @@ def size_flexure(flexure, *, target_stiffness: float, maximum_stiffness: float, 
     if not ok.any():
         return FlexureResult(feasible=False, reason=_why(
             flexure, E, sa, rho, n, kmax, stroke, stage_mass, required_frequency, L, t,
-            ok_stress, ok_stiff, per_width, f_bend),
-            length=None, width=None, thickness=None, drive_stiffness=None,
-            support_stiffness=None, stroke_limit=None, stress=None, stress_margin=None,
-            support_frequency=None, bending_frequency=None, frequency_margin=None,
-            leaf_mass=None, **empty)
+            ok_stress, ok_stiff, per_width, f_bend), **none, **empty)
 
     b = np.clip(b_target, b_lo, b_hi)
     k = per_width * b
@@ -267,7 +343,7 @@ def size_flexure(flexure, *, target_stiffness: float, maximum_stiffness: float, 
         support_stiffness=ks, stroke_limit=float(stroke_limit(sa, E, tx, Lx)), stress=sx,
         stress_margin=sa / sx, support_frequency=fs, bending_frequency=fb,
         frequency_margin=min(fs, fb) / required_frequency, leaf_mass=n * rho * Lx * bx * tx,
-        **empty)
+        stiffness_range=stiffness_range(kx, tx, tol), **empty)
 
 
 def _why(flexure, E, sa, rho, n, kmax, stroke, m1, f_req, L, t, ok_stress, ok_stiff,

@@ -88,21 +88,33 @@ def step1_friction_gap(spec: Spec) -> FrictionGapResult:
     -------
     FrictionGapResult
         The gap [N], the threshold [N] and whether hunting is a risk. The
-        check is PASS below the threshold and WARN (a risk, not a design
-        error) at or above it.
+        check is PASS below the threshold. At or above it, it is WARN (a
+        risk, not a design error) for an integrating loop on a stage without
+        isolator, and INFO where the spec answers the risk: with an isolator
+        (what it is there for; the simulation confirms it) or with a loop
+        without integrator (no hunting by the paper's mechanism).
     """
     f = spec.friction
     gap = f.static - f.coulomb
     thr = spec.requirements.friction_gap
     risk = gap >= thr
+    status = Status.PASS
     if risk:
         msg = (f"Fs - Fc = {gap:.3g} N is at or above the {thr:.3g} N threshold: stick-slip "
                "can make an integrating controller hunt")
+        if not control_law(spec).integrator:
+            status = Status.INFO
+            msg += "; this loop has no integrator"
+        elif spec.isolator is not None:
+            status = Status.INFO
+            msg += "; the isolator is there to prevent it (the simulation checks it)"
+        else:
+            status = Status.WARN
     else:
         msg = (f"Fs - Fc = {gap:.3g} N is below the {thr:.3g} N threshold: stick-slip, and so "
                "hunting, is unlikely")
-    check = Check("friction_gap", not risk, gap, thr, "N", msg, step="step 1 friction gap",
-                  status=Status.WARN if risk else Status.PASS)
+    check = Check("friction_gap", not risk if status != Status.INFO else None, gap, thr, "N",
+                  msg, step="step 1 friction gap", status=status)
     return FrictionGapResult(static=f.static, coulomb=f.coulomb, gap=gap, threshold=thr,
                              hunting_risk=risk, checks=(check,))
 
@@ -141,6 +153,10 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
     reach = ach.frequency is not None and fc <= ach.frequency * (1 + 1e-9)
     if ach.frequency is None:
         msg = f"no crossover is achievable: {ach.limited_by}"
+    elif ach.kind == "scan_limit":
+        msg = (f"the desired crossover {fc:.4g} Hz: the linear model limits the crossover "
+               f"nowhere below {ach.frequency:.4g} Hz, the search cap (a bound, not a result; "
+               "the hardware's sampling, delay and parasitic modes set the real limit)")
     elif reach:
         msg = (f"the desired crossover {fc:.4g} Hz is at or below the achievable "
                f"{ach.frequency:.4g} Hz (limited by {ach.limited_by})")
@@ -152,13 +168,19 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
     for c in at.cases:
         where = f"case {linear.CASE_NUMBERS[c.name]} ({c.description})"
         at_f = f" at {c.crossover:.3g} Hz" if c.crossover is not None else ""
-        if c.stable:
-            msg = f"{where}: phase margin {c.phase_margin_deg:.3g} deg{at_f}"
-        else:
+        ok = c.stable and c.phase_margin_deg >= req.phase_margin
+        if not c.stable:
             msg = f"{where}: the closed loop is unstable"
-        checks.append(Check(f"phase_margin.{c.name}", c.stable and
-                            c.phase_margin_deg >= req.phase_margin, c.phase_margin_deg,
-                            req.phase_margin, "deg", msg, step=step))
+        elif not c.in_band:
+            msg = (f"{where}: " + (f"the loop crosses 0 dB only at {c.crossover:.3g} Hz, more "
+                                   f"than {linear.BAND_FACTOR:g}x below the {fc:.4g} Hz "
+                                   "crossover (the integrator against a stiff support)"
+                                   if c.crossover is not None else "the loop never crosses "
+                                   "0 dB") + ": no phase margin in the loop's band")
+        else:
+            msg = f"{where}: phase margin {c.phase_margin_deg:.3g} deg{at_f}"
+        checks.append(Check(f"phase_margin.{c.name}", ok if c.in_band or not ok else None,
+                            c.phase_margin_deg, req.phase_margin, "deg", msg, step=step))
         gm = c.gain_margin_db
         if math.isinf(gm):
             msg = f"{where}: the phase never crosses -180 deg, unlimited gain margin"
@@ -501,11 +523,12 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         compiled). Default True; CAD loops that only need the linear steps pass
         False.
     executor : concurrent.futures-style executor, optional
-        Runs the confirmation (``submit`` returning a future with ``result``
-        and ``cancel``) while this process does the linear analysis: with a
-        process pool the two overlap (and a first run compiles the simulation
-        kernel there). None runs it here, after the linear steps. The library
-        creates no pool.
+        Runs the confirmation and the robustness study, as two tasks
+        (``submit`` returning a future with ``result`` and ``cancel``), while
+        this process does the linear analysis: with a process pool of two
+        workers the three overlap (and a first run compiles the simulation
+        kernel there). None runs them here, after the linear steps. The
+        library creates no pool.
     progress : callable, optional
         ``progress(text)`` with a short message as the work proceeds (the
         confirmation's own messages too when it runs here).
@@ -513,7 +536,12 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     Returns
     -------
     DesignResult
-        Steps 1 to 4, the confirmation, all checks, warnings and a conclusion.
+        Steps 1 to 4, the confirmation, all checks, warnings, a conclusion
+        and the sign-off: ``verdict`` on the hardware as specified,
+        ``robustness`` under the friction scatter of
+        ``requirements.robustness`` (simulated on ``executor`` beside the
+        confirmation; about 200 simulations of a few ms by default),
+        ``margins`` and a ``recommendation`` (:mod:`fi_design.verdict`).
 
     Raises
     ------
@@ -521,6 +549,7 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         When ``spec`` is a path or mapping that does not validate.
     """
     from . import __version__
+    from . import verdict as _verdict
     from .confirm import confirm as run_confirmation
 
     if not isinstance(spec, Spec):
@@ -528,9 +557,12 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
 
         spec = load_spec(spec)
     suggestion = suggested_isolator(spec) if spec.isolator is None else None
-    pending = None
+    robust = confirm and spec.requirements.robustness.samples > 0
+    pending = []
     if confirm and executor is not None:
-        pending = executor.submit(run_confirmation, spec, suggestion)
+        pending.append(executor.submit(run_confirmation, spec, suggestion))
+        if robust:
+            pending.append(executor.submit(_verdict.run_robustness, spec, suggestion))
     try:
         gap = step1_friction_gap(spec)
         xo = step2_crossover(spec)
@@ -538,8 +570,8 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         fx = step3_flexure(spec, st)
         pid = step4_pid(spec)
     except BaseException:
-        if pending is not None:
-            pending.cancel()
+        for fut in pending:
+            fut.cancel()
         raise
     advice = isolator_advice(spec, gap, xo) if spec.isolator is None else None
     checks = gap.checks + xo.checks + st.checks + _flexure_checks(fx) + pid.checks
@@ -549,33 +581,53 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         warnings=tuple(warnings_for(spec)),
         conclusion=_conclusion(spec, gap, xo, st, fx, pid, advice, checks),
         fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None)
+    sim = study = None
     if confirm:
         if progress is not None:
             progress("simulating with and without the isolator (the first run on a machine "
                      "compiles the kernel, about 10 s) ...")
-        sim = pending.result() if pending is not None else \
+        sim = pending[0].result() if pending else \
             run_confirmation(spec, suggestion, progress=progress)
+        if robust:
+            if progress is not None:
+                progress("simulating the friction scatter of requirements.robustness ...")
+            study = pending[1].result() if pending else _verdict.run_robustness(
+                spec, suggestion, None if progress is None else
+                (lambda done, total: progress(f"friction scatter: {done}/{total} simulations")))
         result = replace(result, simulation=sim, checks=result.checks + sim.checks,
                          conclusion=result.conclusion + _simulation_sentence(spec, sim))
-    log.info("design of %r: %d checks, %d failed", spec.name, len(result.checks),
-             len(result.failed_checks))
+    rob = None if study is None else _verdict.robustness_check(spec, study)
+    margins = _verdict.margins(spec, xo, st, fx, pid, sim)
+    result = replace(
+        result, robustness=rob, margins=margins,
+        recommendation=_verdict.recommend(spec, xo, sim, rob),
+        verdict=_verdict.judge(spec, result.checks, result.warnings, sim, rob, margins))
+    log.info("design of %r: %s, %d checks, %d failed", spec.name, result.verdict.status,
+             len(result.checks), len(result.failed_checks))
     return result
 
 
 def _simulation_sentence(spec: Spec, sim: Confirmation) -> str:
-    """The conclusion's sentence on the simulated verdicts."""
-    iso, non = sim.isolated.metrics, sim.non_isolated.metrics
+    """The conclusion's sentence on the simulated verdicts (the spec's own plant first)."""
+    iso, non = sim.isolated, sim.non_isolated
     mins = sim.min_hunting_free_crossover
-    label = "the suggested isolator" if sim.suggested_isolator else "the isolator"
     fc = design_crossover(spec)
 
     def f(x):
         return "beyond the scan" if x is None else f"from {x:g} Hz"
 
-    text = (f" The LuGre simulation at {fc:g} Hz gives: with {label} {iso.verdict}"
-            f" ({iso.hunting_cycles} cycles), without it {non.verdict}"
-            f" ({non.hunting_cycles} cycles); hunting-free {f(mins['isolated'])} with {label} "
-            f"and {f(mins['non_isolated'])} without (resolution {mins['resolution']:g} Hz).")
+    def o(v):
+        return f"{v.outcome.replace('_', ' ')} ({v.metrics.hunting_cycles} cycles)"
+
+    if sim.suggested_isolator:
+        text = (f" The LuGre simulation at {fc:g} Hz gives: the stage as specified, without "
+                f"isolator, {o(non)}, hunting-free {f(mins['non_isolated'])}; with the "
+                f"suggested isolator (a recommendation, not the hardware) it would be {o(iso)}, "
+                f"hunting-free {f(mins['isolated'])} (resolution {mins['resolution']:g} Hz).")
+    else:
+        text = (f" The LuGre simulation at {fc:g} Hz gives: with the isolator {o(iso)}, "
+                f"without it {o(non)}; hunting-free {f(mins['isolated'])} with the isolator "
+                f"and {f(mins['non_isolated'])} without (resolution {mins['resolution']:g} Hz).")
     model = sim.isolated.friction_model
     if model != "lugre":
         text = text.replace("The LuGre simulation", f"The {model} simulation")
@@ -606,7 +658,7 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
                         else "."))
     n = len(xo.cases)
     bad = [c for c in xo.cases if not c.passed]
-    pms = [c.phase_margin_deg for c in xo.cases]
+    pms = [c.phase_margin_deg for c in xo.cases if c.in_band] or [math.inf]
     gms = [abs(c.gain_margin_db) for c in xo.cases]
     margins = (f"phase margins of at least {min(pms):.3g} deg and gain margins of at least "
                f"{min(gms):.3g} dB" if all(math.isfinite(x) for x in gms)

@@ -70,7 +70,7 @@ from .spec import (Spec, antiresonance, bristle_damping, design_crossover, drive
 
 __all__ = [
     "ISOLATED_CASES", "RIGID_CASES", "CASE_DESCRIPTIONS", "CASE_NUMBERS", "SCAN_LIMIT",
-    "SCAN_START",
+    "SCAN_START", "BAND_FACTOR",
     "LimitCase", "CaseMargins", "LoopAnalysis", "AchievableCrossover",
     "limit_cases", "mode_factor", "delay_time", "delay_polynomials", "controller_polynomials",
     "controller_tf", "delay_tf", "loop_polynomials", "loop_transfer_function", "sensitivity",
@@ -103,6 +103,9 @@ SCAN_LIMIT = 1000.0
 SCAN_START = 0.1
 #: Scan points per decade before bisection.
 SCAN_POINTS_PER_DECADE = 10
+#: A gain crossover more than this factor below the controller's crossover lies outside the
+#: loop's band (:attr:`CaseMargins.in_band`) [-].
+BAND_FACTOR = 10.0
 
 
 # --------------------------------------------------------------------------- plants
@@ -546,6 +549,12 @@ class CaseMargins:
     failed : tuple of str
         The requirements not met: ``stability``, ``phase margin``,
         ``gain margin``, ``modulus margin``.
+    in_band : bool
+        Whether a gain crossover lies within the loop's band, at or above
+        :data:`BAND_FACTOR` below the controller's crossover. A case that
+        crosses 0 dB only far below (the integrator against the stiff
+        bristles of a stuck cart crosses at millihertz) or never has no phase
+        or delay margin worth reporting; its gain margin still counts.
     """
 
     name: str
@@ -559,6 +568,7 @@ class CaseMargins:
     crossovers: tuple[float, ...] = ()
     passed: bool = True
     failed: tuple[str, ...] = ()
+    in_band: bool = True
 
     def to_dict(self) -> dict:
         """Plain JSON data; infinite margins become null."""
@@ -710,9 +720,11 @@ def _margins(spec: Spec, law: ControlLaw, lcs: Sequence[LimitCase],
     ln, ld = np.polymul(cn, dn), np.polymul(cd, dd)
     wc = 2.0 * math.pi * law.crossover
     out = []
+    low = law.crossover / BAND_FACTOR
     for lc in lcs:
         m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den), scale=wc,
                                 name=lc.name, description=lc.description), spec)
+        m = replace(m, in_band=any(f >= low for f in m.crossovers))
         out.append(m)
         if first_fail and not m.passed:
             break

@@ -4,8 +4,9 @@ The library never creates pools or clusters (:func:`fi_design.design`,
 :func:`fi_design.sweep` and the other workflows take an ``executor``); the
 CLI makes them here, as context managers that close them again:
 
-- :func:`confirmation_pool`: one forked worker process that runs a design's
-  nonlinear confirmation while the calling process does the linear analysis;
+- :func:`confirmation_pool`: up to two forked worker processes that run a
+  design's nonlinear confirmation and its robustness study while the calling
+  process does the linear analysis;
 - :class:`StudyPool`: the executor of a parameter study, a local process pool
   or a dask.distributed client.
 """
@@ -36,10 +37,12 @@ def _fork_context() -> Any:
 
 @contextlib.contextmanager
 def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
-    """One worker process for a design's confirmation, or None (run in this process).
+    """Worker processes for a design's confirmation and robustness, or None (run here).
 
-    On a multi-core machine the confirmation's simulations (and, on a first
-    run, the compilation of the kernel) then overlap the linear analysis.
+    Two workers where the machine has two cores or more (one otherwise): the
+    confirmation's simulations and the robustness study (and, on a first run,
+    the compilation of the kernel) then overlap each other and the linear
+    analysis.
     When the work fails or is interrupted, the worker is stopped at once
     rather than waited for.
 
@@ -59,7 +62,7 @@ def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
         return
     from concurrent.futures import ProcessPoolExecutor
 
-    pool = ProcessPoolExecutor(max_workers=1, mp_context=ctx)
+    pool = ProcessPoolExecutor(max_workers=min(2, os.cpu_count() or 1), mp_context=ctx)
     try:
         yield pool
     except BaseException:

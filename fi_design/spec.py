@@ -157,6 +157,14 @@ class Flexure(StrictModel):
     width: Bounds = Field((2e-3, 50e-3), description="Leaf width range [m]. Default 2 mm to 50 mm.")
     thickness: Bounds = Field((0.05e-3, 2e-3), description="Leaf thickness range [m]. Default "
                                                            "0.05 mm to 2 mm.")
+    thickness_step: OptQ("m") = Field(0.05e-3, gt=0, description="Stock thicknesses: the leaves "
+                                                                 "are sized in multiples of this "
+                                                                 "[m]; null sizes an unrounded "
+                                                                 "thickness. Default 0.05 mm.")
+    thickness_tolerance: Q("m") = Field(0.01e-3, ge=0, description="Thickness tolerance of the "
+                                                                   "stock, +- [m]: the drive "
+                                                                   "stiffness goes with t^3. "
+                                                                   "Default 0.01 mm.")
 
     @model_validator(mode="after")
     def _ordered(self) -> "Flexure":
@@ -164,6 +172,8 @@ class Flexure(StrictModel):
             lo, hi = getattr(self, name)
             if not 0 < lo <= hi:
                 raise ValueError(f"{name} must be [min, max] with 0 < min <= max")
+        if self.thickness_tolerance >= self.thickness[0]:
+            raise ValueError("thickness_tolerance must be below the smallest thickness")
         return self
 
 
@@ -314,6 +324,49 @@ class Hunting(StrictModel):
                                                         "settling time [m]. Default 10 um.")
 
 
+class Ripple(StrictModel):
+    """Friction that varies along the rail: Fs and Fc times 1 + a sin(2 pi x2 / wavelength + phase)."""
+
+    amplitude: Q("1") = Field(gt=0, lt=1, description="Relative amplitude a of Fs and Fc along "
+                                                      "the rail [-] (e.g. 10 %).")
+    wavelength: Q("m") = Field(gt=0, description="Spatial period of the variation [m].")
+
+
+class Robustness(StrictModel):
+    """Friction scatter under which the design must stay hunting-free (part of the verdict).
+
+    The design command draws ``samples`` variants of the spec with static and
+    Coulomb friction scattered (and, optionally, a ripple along the rail with
+    a random phase per sample), simulates the stage as specified in each, and
+    compares the probability of hunting with ``hunting_probability``.
+    """
+
+    static: Q("1") = Field(0.2, ge=0, lt=1, description="Scatter of static friction Fs, a "
+                                                        "fraction of its value [-]: the standard "
+                                                        "deviation of a normal draw, the "
+                                                        "half-width of a uniform one. Default "
+                                                        "20 %.")
+    coulomb: Q("1") = Field(0.2, ge=0, lt=1, description="Scatter of Coulomb friction Fc, a "
+                                                         "fraction of its value [-]. Default "
+                                                         "20 %.")
+    distribution: Literal["normal", "uniform"] = Field(
+        "normal", description="Distribution of the scatter: 'normal' (default) or 'uniform'.")
+    ripple: Ripple | None = Field(None, description="Optional friction ripple along the rail "
+                                                    "(every sample draws its phase); null: "
+                                                    "none.")
+    samples: int = Field(100, ge=0, le=100_000, description="Samples drawn (each simulated with "
+                                                            "and without the isolator, a few ms "
+                                                            "each); 0 skips the robustness check. "
+                                                            "Default 100.")
+    seed: int = Field(0, ge=0, description="Seed of the draws: the same seed gives the same "
+                                           "samples. Default 0.")
+    hunting_probability: Q("1") = Field(0.05, ge=0, le=1, description="Largest acceptable "
+                                                                      "probability of hunting "
+                                                                      "[-]. Default 5 %.")
+    confidence: float = Field(0.95, gt=0, lt=1, description="Level of the Wilson interval of the "
+                                                            "probability [-]. Default 0.95.")
+
+
 class Requirements(StrictModel):
     """Design requirements and metric settings."""
 
@@ -331,6 +384,7 @@ class Requirements(StrictModel):
     stiffness_safety: float = Field(1.0, ge=1, description="k_max = Fs / (safety * stroke). "
                                                            "Default 1 (the paper's rule).")
     hunting: Hunting = Field(default_factory=Hunting)
+    robustness: Robustness = Field(default_factory=Robustness)
 
 
 class Measurement(StrictModel):
@@ -702,21 +756,30 @@ def antiresonance(mode: ParasiticMode) -> float:
 def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     """Suspicious but legal input, as ``(path, message)`` pairs.
 
-    Checks the LuGre dissipativity condition sigma1 < sigma2 Fc / (Fs - Fc), a
-    hunting window that starts before the last move ends, a stroke smaller than
-    the presliding range and effects with neutral values.
+    A warning fires on the user's own values, and on a default only where the
+    default is a poor fit for this spec (and then says so): a bristle damping
+    the user gave that breaks the LuGre dissipativity condition sigma1 < sigma2
+    Fc / (Fs - Fc) (the default sqrt(sigma0 (m1 + m2)), damping ratio 0.5 of
+    the presliding mode, breaks it too, deliberately: a bristle damping low
+    enough to meet it rings in presliding; a value written out equal to the
+    default to four digits counts as the default), a stroke within five
+    presliding ranges, a hunting window that starts before the last move
+    ends, and a loop without the hardware's sampling and delay (a continuous
+    controller without delay: the margins and the hunting depend on both).
     """
     out: list[tuple[str, str]] = []
     f = spec.friction
     gap = f.static - f.coulomb
-    if f.model == "lugre" and gap > 0:
-        s1 = bristle_damping(spec)
+    if f.model == "lugre" and gap > 0 and f.bristle_damping is not None:
+        s1 = f.bristle_damping
+        default = math.sqrt(f.bristle_stiffness * spec.total_mass)
         bound = f.viscous * f.coulomb / gap
-        if s1 >= bound:
+        if s1 >= bound and abs(s1 / default - 1.0) > 5e-4:
             out.append(("friction.bristle_damping",
-                        f"sigma1 = {s1:.4g} N s/m exceeds sigma2 Fc / (Fs - Fc) = {bound:.4g} N s/m: "
-                        "the LuGre model is not guaranteed dissipative (Barabanov and Ortega); "
-                        "common in practice, but watch for unphysical presliding oscillation"))
+                        f"sigma1 = {s1:.4g} N s/m (given) exceeds sigma2 Fc / (Fs - Fc) = "
+                        f"{bound:.4g} N s/m: the LuGre model is not guaranteed dissipative "
+                        f"(Barabanov and Ortega); the default sqrt(sigma0 (m1 + m2)) = "
+                        f"{default:.4g} N s/m damps the presliding mode at a ratio of 0.5"))
     if spec.isolator is not None:
         presl = f.static / f.bristle_stiffness
         if spec.isolator.stroke < 5 * presl:
@@ -724,10 +787,22 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
                         f"stroke {spec.isolator.stroke * 1e3:.3g} mm is within 5x the presliding "
                         f"range Fs/sigma0 = {presl * 1e6:.3g} um: the joint can hardly isolate"))
     t_end = spec.motion.end_time
-    if t_end > spec.requirements.hunting.window_start:
+    h = spec.requirements.hunting
+    if t_end > h.window_start:
+        whose = ("" if "window_start" in h.model_fields_set
+                 else " (the default window start: set requirements.hunting.window_start and "
+                      "motion.duration for this motion)")
         out.append(("requirements.hunting.window_start",
-                    f"the last move ends at {t_end:.3g} s, inside the hunting window that starts at "
-                    f"{spec.requirements.hunting.window_start:g} s"))
+                    f"the last move ends at {t_end:.3g} s, inside the hunting window that starts "
+                    f"at {h.window_start:g} s{whose}"))
+    ctl = spec.controller
+    delayed = any(e.type == "time_delay" for e in spec.effects)
+    if ctl.sample_rate is None and ctl.delay == 0 and not delayed:
+        out.append(("controller.sample_rate",
+                    "the loop is continuous-time without delay: the hardware samples and "
+                    "computes with a delay, which takes phase margin and moves the crossover "
+                    "where hunting stops; give controller.sample_rate and controller.delay of "
+                    "the hardware to judge the loop it has"))
     return out
 
 

@@ -180,7 +180,7 @@ def test_cli_simulate_record(tmp_path, emps_path, emps_identification):
     res = CliRunner().invoke(app, ["simulate", str(spec), "--record", str(emps_path),
                                    "--csv", str(out), "--json", str(tmp_path / "r.json")])
     assert res.exit_code == 0, res.output
-    assert "model - measured, rms [um]" in res.output and "hunting cycles" not in res.output
+    assert "model - measured, rms [µm]" in res.output and "hunting cycles" not in res.output
     back = load_measurement(out)
     assert back.n == 24841 and back.columns[:4] == ("time_s", "reference_m", "position_m",
                                                     "force_N")

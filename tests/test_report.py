@@ -263,9 +263,10 @@ def test_context_numbers(paper_confirmed_design):
     rows = {r["name"]: r for g in ctx["verdict"]["groups"] for r in g["rows"]}
     assert rows["drive_stiffness"]["value"] == pytest.approx(6667.0)
     assert rows["drive_stiffness"]["limit"] == pytest.approx(4.0 / 0.3e-3)
-    assert rows["friction_gap"]["status"] == "WARN"
+    assert rows["friction_gap"]["status"] == "INFO"   # the isolator answers the risk
     assert len(rows) == len(paper_confirmed_design.checks)
-    assert ctx["verdict"]["overall"] == "PASS with warnings"
+    # settles at 8 Hz, but hunts in 6 of the 100 default scatter samples, above the 5 % limit
+    assert ctx["verdict"]["overall"] == "FAIL" and ctx["verdict"]["behaviour"] == "settles"
     inputs = {r["path"]: r for g in ctx["inputs"] for r in g["rows"]}
     assert inputs["friction.static"]["source"] == "given"
     assert inputs["friction.static"]["written"] == "4 N"
@@ -416,7 +417,7 @@ def test_pdf_opens_with_page_numbers_and_key_numbers(design_pdf):
         assert f"Page {n} of {pages}" in text
     assert text.count("FI-0001 rev. A (draft)") >= pages  # the running header
     for number in ("13 333", "6667", "11.82", "2190", "8467", "100.5", "5.5 Hz", "20 Hz",
-                   "PASS with warnings", "Conclusion", "k_max", DATE):
+                   "FAIL", "SETTLES", "Conclusion", "k_max", DATE):
         assert number in text, number
     if shutil.which("pdftoppm"):
         subprocess.run(["pdftoppm", "-r", "50", "-png", str(design_pdf),

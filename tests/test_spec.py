@@ -87,15 +87,30 @@ def test_file_and_mapping_give_the_same_spec(paper_spec, paper_spec_path):
     assert origin(again).path is None and origin(again).raw == org.raw
 
 
-def test_warnings_for_suspicious_input(paper_spec):
-    paths = [p for p, _ in sp.warnings_for(paper_spec)]
-    assert paths == ["friction.bristle_damping"]  # sigma1 above the dissipativity bound
-    calm = variant(paper_spec, **{"friction.bristle_damping": "5 N*s/m",
-                                  "isolator.stroke": "3 um", "motion.moves": [
-                                      {"distance": "10 mm", "velocity": "1 mm/s",
-                                       "acceleration": "1 m/s^2"}]})
-    paths = [p for p, _ in sp.warnings_for(calm)]
-    assert paths == ["isolator.stroke", "requirements.hunting.window_start"]
+def test_warnings_fire_on_the_users_own_values(paper_spec):
+    # sigma1 = 1414 N s/m in the file is the default sqrt(sigma0 (m1 + m2)) written out: no
+    # warning; the loop is continuous without delay: a warning on what the spec leaves out
+    assert [p for p, _ in sp.warnings_for(paper_spec)] == ["controller.sample_rate"]
+    hardware = variant(paper_spec, **{"controller.sample_rate": "2 kHz"})
+    assert sp.warnings_for(hardware) == []
+    assert sp.warnings_for(variant(paper_spec, **{"controller.delay": "1 ms"})) == []
+    assert sp.warnings_for(variant(paper_spec, effects=[{"type": "time_delay",
+                                                         "delay": "1 ms"}])) == []
+    omitted = variant(hardware, **{"friction.bristle_damping": None})
+    assert sp.warnings_for(omitted) == []     # the default, chosen on purpose (docstring)
+    own = variant(hardware, **{"friction.bristle_damping": "500 N*s/m"})
+    [(path, message)] = sp.warnings_for(own)
+    assert path == "friction.bristle_damping"
+    assert "(given)" in message and "1414 N s/m" in message   # the user's value, and the default
+    calm = variant(hardware, **{"friction.bristle_damping": "5 N*s/m",
+                                "isolator.stroke": "3 um", "motion.moves": [
+                                    {"distance": "10 mm", "velocity": "1 mm/s",
+                                     "acceleration": "1 m/s^2"}]})
+    found = dict(sp.warnings_for(calm))
+    assert list(found) == ["isolator.stroke", "requirements.hunting.window_start"]
+    assert "the default window start" in found["requirements.hunting.window_start"]
+    given = variant(calm, **{"requirements.hunting": {"window_start": "10 s"}})
+    assert "default" not in dict(sp.warnings_for(given))["requirements.hunting.window_start"]
 
 
 def test_motion_spans_and_end_time(paper_spec):

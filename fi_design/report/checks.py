@@ -1,4 +1,13 @@
-"""The verdict of a design report: every check as a row, grouped by guideline step."""
+"""The verdict of a design report: the verdict box, its key figures, every check by step.
+
+The verdict box reads the design's :class:`~fi_design.results.design.Verdict`
+(the hardware as specified), so a stage that settles and one that hunts look
+different: ``behaviour_css`` (``settles``, ``hunts``, ``stuck``,
+``undetermined``, ``static-error``, ``not-simulated``) styles the frame and the
+stamp. The key figures are the robustness under friction scatter and the
+margins, each only where it means something; the notes say why one is
+missing or only a bound.
+"""
 
 from __future__ import annotations
 
@@ -6,9 +15,23 @@ from collections.abc import Mapping
 from typing import Any
 
 from ..results import Status
-from .filters import display_scale
+from .filters import display_scale, num, qty
 
-__all__ = ["STEP_SOURCES", "SENSE", "check_label", "check_row", "verdict"]
+__all__ = ["STEP_SOURCES", "SENSE", "STATUS_TEXT", "BEHAVIOUR", "check_label", "check_row",
+           "key_figures", "verdict"]
+
+#: The verdict's status as printed.
+STATUS_TEXT = {"PASS": "PASS", "PASS_WITH_WARNINGS": "PASS with warnings", "FAIL": "FAIL"}
+
+#: The judged plant's behaviour: (css class, stamp) by outcome; None: not simulated.
+BEHAVIOUR = {
+    "settled": ("settles", "settles"),
+    "hunting": ("hunts", "hunts"),
+    "stuck": ("stuck", "sticks away from its target"),
+    "undetermined": ("undetermined", "cannot be judged"),
+    "static_error": ("static-error", "rests within its static error"),
+    None: ("not-simulated", "not simulated"),
+}
 
 
 #: Where each guideline step comes from in the paper, for the checks' "source" column.
@@ -29,6 +52,7 @@ SENSE = {
     "drive_stiffness": "\u2264", "flexure.stiffness": "\u2264", "flexure.stress": "\u2264",
     "flexure.support_frequency": "\u2265", "flexure.bending_frequency": "\u2265",
     "simulation_isolated": "=", "min_crossover_isolated": "\u2264", "landing_force": "<",
+    "simulation_non_isolated": "=", "min_crossover_non_isolated": "\u2264",
 }
 
 
@@ -132,47 +156,162 @@ def check_row(check: Any, cases: Mapping[str, Any] | None = None) -> dict:
     }
 
 
-def verdict(result: Any) -> dict:
-    """The verdict section: overall status, counts per status, the checks grouped by step.
+def _figure(label: str, value: Any, unit: str, requirement: str = "", note: str = "",
+            css: str = "info", digits: int = 4) -> dict:
+    """One key figure: the value scaled for reading with its shown unit."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        shown, factor = display_scale(unit, value)
+        value = num(value * factor, digits)
+    else:
+        shown = unit
+    if shown in ("1", "-"):
+        shown = ""
+    return {"label": label, "value": value, "unit": shown or "\u2013",
+            "requirement": requirement, "note": note, "css": css}
+
+
+def _pct(x: float | None) -> str:
+    return num(None if x is None else 100.0 * x, 3)
+
+
+def key_figures(result: Any) -> list[dict]:
+    """The verdict's figures: behaviour, robustness and the margins that mean something.
 
     Parameters
     ----------
     result : fi_design.results.design.DesignResult
-        The design.
+        The design, with its verdict.
+
+    Returns
+    -------
+    list of dict
+        ``label``, ``value`` (text, scaled), ``unit`` (shown), ``requirement``,
+        ``note`` and ``css`` (pass, warn, fail, info) per row.
+    """
+    rows = []
+    v, rob, m = result.verdict, result.robustness, result.margins
+    spec = result.spec
+    sim = result.simulation
+    fc = result.crossover.desired
+    if sim is not None:
+        p = getattr(sim, v.plant)
+        met = p.metrics
+        css = "pass" if p.acceptable else "fail"
+        if p.outcome == "hunting":
+            note = (f"{met.hunting_cycles} cycles of {qty(met.amplitude, 'm')} peak to peak"
+                    + (f", period {qty(met.period, 's')}" if met.period is not None else ""))
+        elif p.outcome == "settled":
+            note = (f"within {qty(met.settle_band, 'm')} "
+                    + (f"{qty(met.settling_time, 's')} after the move"
+                       if met.settling_time is not None else "at the end"))
+        else:
+            note = f"final error {qty(met.final_error, 'm')}"
+        need = ("settles" if p.static_error_bound is None
+                else f"settles, or rests within {qty(p.static_error_bound, 'm')}")
+        short = {"stuck": "sticks", "static_error": "static error"}.get(p.outcome,
+                                                                       BEHAVIOUR[p.outcome][1])
+        rows.append(_figure(f"Simulated at the design crossover ({qty(fc, 'Hz')})",
+                            short, "", need, note, css))
+    if rob is not None:
+        css = {"PASS": "pass", "WARN": "warn", "FAIL": "fail"}[rob.status]
+        note = (f"{num(100 * rob.confidence, 3)} % interval {_pct(rob.interval[0])} \u2013 "
+                f"{_pct(rob.interval[1])} %; {rob.hunting} of {rob.valid} valid samples")
+        if rob.comparison is not None and rob.comparison["hunting_probability"] is not None:
+            other = ("without the isolator" if rob.comparison["plant"] == "non_isolated"
+                     else "with the suggested isolator")
+            note += f"; {other}: {_pct(rob.comparison['hunting_probability'])} %"
+        rows.append(_figure("Hunting probability under friction scatter",
+                            _pct(rob.hunting_probability), "%", f"\u2264 {_pct(rob.limit)}",
+                            note, css))
+    if m is None:
+        return rows
+    if m.crossover_factor is not None:
+        css = "pass" if m.crossover_factor >= 1 else "warn"
+        rows.append(_figure(
+            "Crossover factor: design / lowest hunting-free",
+            ("\u2265 " if m.crossover_factor_bound else "") + num(m.crossover_factor, 3), "1",
+            "> 1", f"hunting-free from {qty(m.hunting_free_crossover, 'Hz')} in the scan "
+                   f"(step {qty(spec.simulation.crossover_scan.step, 'Hz')})", css))
+    if m.achievable_factor is not None:
+        rows.append(_figure("Achievable / desired crossover (linear, step 2)",
+                            num(m.achievable_factor, 3), "1", "\u2265 1",
+                            f"achievable {qty(result.crossover.achievable, 'Hz')}",
+                            "pass" if m.achievable_factor >= 1 else "fail"))
+    elif m.achievable_crossover_bound is not None:
+        rows.append(_figure("Achievable crossover (linear, step 2)",
+                            f"\u2265 {num(m.achievable_crossover_bound)}", "Hz", "",
+                            "not limited below the search cap: a bound, not a result", "info"))
+    if m.end_stop_clearance is not None:
+        css = "fail" if m.end_stop_clearance <= 0 else "info"
+        if any(r.source == "end_stop_clearance" for r in v.reasons):
+            css = "warn"
+        rows.append(_figure("End-stop clearance at rest", m.end_stop_clearance, "m", "> 0",
+                            f"joint deflection {qty(m.resting_deflection, 'm')} of the "
+                            f"\u00b1{qty(spec.isolator.stroke, 'm')} stroke", css, 3))
+    if m.stiffness_factor is not None:
+        rows.append(_figure("k_max / k", num(m.stiffness_factor, 3), "1", "\u2265 1",
+                            f"k = {qty(result.stiffness.chosen, 'N/m')}, k_max = "
+                            f"{qty(result.stiffness.maximum, 'N/m')}",
+                            "pass" if m.stiffness_factor >= 1 else "fail"))
+    if m.stiffness_range is not None:
+        lo, hi = m.stiffness_range
+        rows.append(_figure(
+            f"Drive stiffness of the flexure, t = {qty(m.thickness, 'm')} \u00b1 "
+            f"{qty(m.thickness_tolerance, 'm')}", f"{num(lo)} \u2013 {num(hi)}", "N/m",
+            f"\u2264 {num(result.stiffness.maximum)}",
+            f"k (1 \u2213 \u0394t/t)\u00b3; k_max / k \u2265 {num(m.stiffness_factor_worst, 3)}",
+            "pass" if m.stiffness_factor_worst >= 1 else "fail"))
+    if m.static_error is not None:
+        ok = m.static_error <= m.static_error_bound + spec.requirements.hunting.settle_band
+        rows.append(_figure("Static error at rest (loop without integrator)", m.static_error,
+                            "m", f"\u2264 {qty(m.static_error_bound, 'm')}",
+                            "(Fc + |offset|) / kp", "pass" if ok else "fail", 3))
+    return rows
+
+
+def verdict(result: Any) -> dict:
+    """The verdict section: the verdict box, key figures, recommendation, the checks by step.
+
+    Parameters
+    ----------
+    result : fi_design.results.design.DesignResult
+        The design, with its :class:`~fi_design.results.design.Verdict`.
 
     Returns
     -------
     dict
-        ``overall``, ``css``, ``headline``, ``counts``, ``total``, ``groups``
-        (``step``, ``title``, ``rows`` of :func:`check_row`), ``conclusion``
-        and ``warnings``.
+        ``status`` (``PASS``, ``PASS_WITH_WARNINGS``, ``FAIL``), ``overall``
+        (as printed), ``css`` (pass, warn, fail), ``behaviour`` (the stamp),
+        ``behaviour_css``, ``headline``, ``reasons`` (``severity``, ``css``,
+        ``text``), ``figures`` (:func:`key_figures`), ``notes`` (margins not
+        reported, and why), ``recommendation`` (text or None), ``counts`` and
+        ``total`` of the checks, ``groups`` (``step``, ``title``, ``rows`` of
+        :func:`check_row`) and ``conclusion``.
     """
+    v = result.verdict
     cases = {c.name: c for c in result.loop.cases}
     rows = [check_row(c, cases) for c in result.checks]
     counts = {s.value: sum(1 for r in rows if r["status"] == s.value) for s in Status}
-    if counts["FAIL"]:
-        overall, css = "FAIL", "fail"
-        headline = (f"{counts['FAIL']} of {len(rows)} checks fail: the design does not meet "
-                    "its requirements as specified.")
-    elif counts["WARN"]:
-        overall, css = "PASS with warnings", "warn"
-        headline = (f"No check fails; {counts['WARN']} warning"
-                    f"{'s' if counts['WARN'] != 1 else ''} to review.")
-    else:
-        overall, css = "PASS", "pass"
-        headline = "Every check passes."
     groups: list[dict] = []
     for row, check in zip(rows, result.checks):
         if not groups or groups[-1]["step"] != check.step:
             groups.append({"step": check.step, "title": _step_title(check.step), "rows": []})
         groups[-1]["rows"].append(row)
+    css = {"PASS": "pass", "PASS_WITH_WARNINGS": "warn", "FAIL": "fail"}[v.status]
+    behaviour_css, stamp = BEHAVIOUR[v.behaviour]
     return {
-        "overall": overall, "css": css, "headline": headline,
+        "status": v.status, "overall": STATUS_TEXT[v.status], "css": css,
+        "behaviour": stamp, "behaviour_css": behaviour_css, "headline": v.headline,
+        "reasons": [{"severity": r.severity, "css": r.severity.lower(), "text": r.text}
+                    for r in v.reasons],
+        "figures": key_figures(result),
+        "notes": list(result.margins.notes) if result.margins is not None else [],
+        "recommendation": None if result.recommendation is None
+        else result.recommendation.text,
         "counts": [{"status": s, "count": n, "css": s.lower()} for s, n in counts.items()],
         "total": len(rows),
         "groups": groups,
         "conclusion": result.conclusion,
-        "warnings": [{"path": p, "message": m} for p, m in result.warnings],
     }
 
 

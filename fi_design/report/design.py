@@ -25,17 +25,23 @@ __all__ = ["design_context", "REFERENCES"]
 
 
 def _cases_table(result: Any) -> list[dict]:
+    """Rows of the margins table; a case without a crossing in the loop's band shows no
+    phase or delay margin (INFO): they are not margins to pass."""
     numbers = {c.name: c.number for c in result.loop.cases}
     rows = []
     for c in result.crossover.cases:
         status = "PASS" if c.passed else "FAIL"
+        out_of_band = c.passed and not c.in_band
+        if out_of_band:
+            status = "INFO"
         rows.append({
             "number": numbers.get(c.name, ""), "description": c.description,
             "crossover": c.crossover, "crossovers": len(c.crossovers),
-            "phase_margin": c.phase_margin_deg, "gain_margin": c.gain_margin_db,
-            "modulus_margin": c.modulus_margin, "delay_margin": c.delay_margin,
+            "phase_margin": None if out_of_band else c.phase_margin_deg,
+            "gain_margin": c.gain_margin_db, "modulus_margin": c.modulus_margin,
+            "delay_margin": None if out_of_band else c.delay_margin,
             "stable": "yes" if c.stable else "no", "status": status, "css": status.lower(),
-            "failed": ", ".join(c.failed),
+            "failed": "outside the band" if out_of_band else ", ".join(c.failed),
         })
     return rows
 
@@ -86,7 +92,10 @@ def _linear(result: Any, figures: bool, fig_no: _Numbering) -> dict:
         "note": ("A negative gain margin marks a lower gain margin: the integrator on a free mass "
                  "starts the phase below -180\u00b0, and the loop goes unstable if the gain "
                  "falls by that much. An infinite gain margin means the phase never crosses "
-                 "-180\u00b0."),
+                 "-180\u00b0. A case whose loop crosses 0 dB only more than a decade below the "
+                 f"{qty(xo.desired, 'Hz')} crossover (the integrator against the bristles of a "
+                 "stuck cart), or never, has no phase or delay margin in the loop's band: "
+                 "shown as \u2013 (INFO), its gain margin still counts."),
     }
 
 
@@ -96,19 +105,29 @@ _MODEL_NAMES = {"lugre": "LuGre", "switch": "switch (Karnopp-type)"}
 
 def _plant_rows(sim: Any) -> list[dict]:
     mins = sim.min_hunting_free_crossover
-    label = "suggested isolator" if sim.suggested_isolator else "with isolator"
+    if sim.suggested_isolator:
+        names = {"isolated": "suggested isolator (recommendation)",
+                 "non_isolated": "without isolator (as specified)"}
+    else:
+        names = {"isolated": "with isolator (as specified)",
+                 "non_isolated": "without isolator (comparison)"}
     rows = []
-    for key, name in (("isolated", label), ("non_isolated", "without isolator")):
-        m = getattr(sim, key).metrics
+    for key, name in names.items():
+        v = getattr(sim, key)
+        m = v.metrics
         other = sim.cross_check.get(key)
         rows.append({
-            "plant": name, "verdict": m.verdict,
-            "css": {"settled": "pass", "hunting": "fail"}.get(m.verdict, "warn"),
+            "plant": name, "verdict": v.outcome.replace("_", " "),
+            "css": {"settled": "pass", "static_error": "pass",
+                    "hunting": "fail"}.get(v.outcome, "warn"),
             "cycles": m.hunting_cycles, "amplitude": m.amplitude, "period": m.period,
             "settling_time": m.settling_time, "final_error": m.final_error,
-            "minimum": mins.get(key), "other": other.metrics.verdict if other is not None else "",
+            "minimum": mins.get(key), "other": other.outcome.replace("_", " ") if other is not None else "",
             "other_model": other.friction_model if other is not None else "",
-            "reason": m.reason,
+            "reason": m.reason if v.outcome != "static_error" else (
+                f"at rest {qty(abs(m.final_error), 'm')} from the target, within the static "
+                f"error (Fc + |offset|) / kp = {qty(v.static_error_bound, 'm')} of a loop "
+                "without integrator"),
         })
     return rows
 
@@ -222,6 +241,7 @@ def _assumptions(result: Any) -> dict:
             "number of cycles is an indication, not a prediction.",
             "The PID is continuous-time unless a sample rate is given; actuator and sensor are "
             "ideal apart from the effects listed in the spec.",
+            _robustness_assumption(spec),
             "The linear analysis linearises friction in four limit cases (cart sliding or stuck, "
             "joint free or on its limiter, paper Figure 2): the margins hold near each case, not "
             "during transitions between them.",
@@ -246,6 +266,23 @@ def _assumptions(result: Any) -> dict:
             "crossover settles, within one scan step.",
         ],
     }
+
+
+def _robustness_assumption(spec: Any) -> str:
+    r = spec.requirements.robustness
+    if r.samples == 0:
+        return ("No robustness check (requirements.robustness.samples: 0): friction is "
+                "simulated at its nominal values only.")
+    ripple = ("" if r.ripple is None else
+              f", and a {num(100 * r.ripple.amplitude, 3)} % ripple with a "
+              f"{qty(r.ripple.wavelength, 'm')} wavelength along the rail at a random phase")
+    return (f"Robustness: {r.samples} samples with static and Coulomb friction drawn "
+            f"independently ({r.distribution}, spread {num(100 * r.static, 3)} % and "
+            f"{num(100 * r.coulomb, 3)} % of the nominal values{ripple}; seed {r.seed}); a "
+            "draw with Fs below Fc is left out. Independent draws overstate the scatter of the "
+            "gap Fs \u2212 Fc where both follow the same lubrication and preload. The hunting "
+            "probability carries a Wilson interval at "
+            f"{num(100 * r.confidence, 3)} % confidence.")
 
 
 #: The paper and the standard works it builds on.

@@ -24,7 +24,9 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["FrictionGapResult", "ModeSeparation", "CrossoverResult", "StiffnessResult",
            "FlexureResult", "PidResult", "CaseResponse", "LoopResponses", "IsolatorAdvice",
-           "PlantVerdict", "CrossoverScan", "Landing", "Confirmation", "DesignResult"]
+           "PlantVerdict", "CrossoverScan", "Landing", "Confirmation", "VERDICT_STATUSES",
+           "Reason", "Verdict", "RobustnessCheck", "Margins", "Recommendation",
+           "DesignResult"]
 
 
 @dataclass(frozen=True)
@@ -205,6 +207,13 @@ class FlexureResult(Result):
         min(support, bending frequency) / required_frequency [-].
     leaf_mass : float or None
         Mass of all leaves [kg].
+    thickness_step : float or None
+        Stock step the thickness was chosen from [m]; None: unrounded.
+    thickness_tolerance : float
+        Thickness tolerance of the stock, +- [m].
+    stiffness_range : tuple of float or None
+        Drive stiffness at the thickness tolerance, ``k (1 -+ dt / t)^3``
+        (lowest, highest) [N/m]; None when infeasible.
     """
 
     feasible: bool
@@ -227,6 +236,9 @@ class FlexureResult(Result):
     required_frequency: float
     frequency_margin: float | None
     leaf_mass: float | None
+    thickness_step: float | None = None
+    thickness_tolerance: float = 0.0
+    stiffness_range: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -360,6 +372,15 @@ class PlantVerdict(Result):
         Whether the integration completed.
     message : str
         Failure description, empty on success.
+    static_error_bound : float or None
+        For a loop without integrator: the static error it may leave against
+        friction, (Fc + |offset|) / kp with the larger Coulomb friction of the
+        two directions [m]; None when the loop integrates.
+    outcome : str
+        What the stage does, with the loop in mind: the metric's verdict,
+        except that a loop without integrator resting within
+        ``static_error_bound`` (plus the settle band) is ``static_error``,
+        not ``stuck``.
     """
 
     plant: str
@@ -368,13 +389,24 @@ class PlantVerdict(Result):
     metrics: HuntingMetrics
     success: bool
     message: str
+    static_error_bound: float | None = None
+    outcome: str = ""
 
     #: Fields of the metrics in the verdict's JSON (the counted peaks stay out).
     JSON_METRICS = ("hunting_cycles", "amplitude", "period", "settled", "settling_time",
                     "final_error", "verdict", "reason")
 
+    def __post_init__(self) -> None:
+        if not self.outcome:
+            m = self.metrics
+            bound = self.static_error_bound
+            rests = (m.verdict == "stuck" and bound is not None
+                     and abs(m.final_error) <= bound + m.settle_band)
+            object.__setattr__(self, "outcome", "static_error" if rests else m.verdict)
+
     @classmethod
-    def of(cls, plant: str, result: SimulationResult) -> "PlantVerdict":
+    def of(cls, plant: str, result: SimulationResult,
+           static_error_bound: float | None = None) -> "PlantVerdict":
         """The verdict of a simulation result.
 
         Parameters
@@ -383,21 +415,31 @@ class PlantVerdict(Result):
             ``"isolated"`` or ``"non_isolated"``.
         result : SimulationResult
             The simulation.
+        static_error_bound : float, optional
+            The static error a loop without integrator may leave [m].
 
         Returns
         -------
         PlantVerdict
         """
         return cls(plant=plant, friction_model=result.friction_model, crossover=result.crossover,
-                   metrics=result.metrics, success=result.success, message=result.message)
+                   metrics=result.metrics, success=result.success, message=result.message,
+                   static_error_bound=static_error_bound)
+
+    @property
+    def acceptable(self) -> bool:
+        """Settled, or at rest within the static error of a loop without integrator."""
+        return self.outcome in ("settled", "static_error")
 
     def to_dict(self) -> dict:
-        """Flat JSON: plant, model and crossover, the metric's figures and verdict, the solver's
-        outcome (SI)."""
+        """Flat JSON: plant, model and crossover, the metric's figures and verdict, the
+        outcome with the loop in mind, the solver's outcome (SI)."""
         m = self.metrics
         return {"plant": self.plant, "friction_model": self.friction_model,
                 "crossover": to_jsonable(self.crossover),
                 **{k: to_jsonable(getattr(m, k)) for k in self.JSON_METRICS},
+                "outcome": self.outcome,
+                "static_error_bound": to_jsonable(self.static_error_bound),
                 "success": self.success, "message": self.message}
 
 
@@ -515,6 +557,242 @@ class Confirmation(Result):
     results: dict = field(repr=False)  # traces for plots; not in the JSON
 
 
+#: Statuses of a design verdict, from best to worst.
+VERDICT_STATUSES = ("PASS", "PASS_WITH_WARNINGS", "FAIL")
+
+
+@dataclass(frozen=True)
+class Reason(Result):
+    """One reason behind a verdict.
+
+    Attributes
+    ----------
+    severity : str
+        ``"FAIL"`` (the design does not pass because of it), ``"WARN"`` (to
+        review before sign-off) or ``"PASS"`` (a requirement shown to hold).
+    source : str
+        Where it comes from: a check's name, ``"simulation"``,
+        ``"robustness"``, ``"input"`` (a warning on a spec value) or
+        ``"confirmation"``.
+    text : str
+        One sentence a reviewer can read.
+    """
+
+    severity: str
+    source: str
+    text: str
+
+
+@dataclass(frozen=True)
+class Verdict(Result):
+    """The sign-off verdict on the hardware as specified.
+
+    Attributes
+    ----------
+    status : str
+        ``"PASS"``, ``"PASS_WITH_WARNINGS"`` or ``"FAIL"``
+        (:data:`VERDICT_STATUSES`). FAIL when a check fails, when the
+        spec's own plant hunts, sticks away from its target or cannot be
+        determined at the design crossover, or when it hunts under friction
+        scatter more often than ``requirements.robustness.hunting_probability``;
+        PASS_WITH_WARNINGS when nothing fails but something needs review.
+    reasons : tuple of Reason
+        Why: failures first, then warnings, then what holds.
+    plant : str
+        The plant judged, the spec's own: ``"isolated"`` when the spec has an
+        isolator, else ``"non_isolated"``. An isolator the spec does not have
+        is a :class:`Recommendation`, never part of the verdict.
+    behaviour : str or None
+        The judged plant's outcome at the design crossover: ``settled``,
+        ``hunting``, ``stuck``, ``undetermined`` or ``static_error`` (a loop
+        without integrator at rest within its expected static error); None
+        without simulation.
+    headline : str
+        One sentence: what the stage does and the status.
+    """
+
+    status: str
+    reasons: tuple[Reason, ...]
+    plant: str
+    behaviour: str | None
+    headline: str
+
+    @property
+    def passed(self) -> bool:
+        """Whether the status is PASS or PASS_WITH_WARNINGS."""
+        return self.status != "FAIL"
+
+    def at_or_below(self, level: str) -> bool:
+        """Whether the status is ``level`` or worse.
+
+        Parameters
+        ----------
+        level : {"PASS", "PASS_WITH_WARNINGS", "FAIL"}
+
+        Returns
+        -------
+        bool
+        """
+        return VERDICT_STATUSES.index(self.status) >= VERDICT_STATUSES.index(level)
+
+    def to_dict(self) -> dict:
+        """JSON: ``status``, ``reasons`` (their texts), ``findings`` (severity, source and
+        text of each), ``plant``, ``behaviour``, ``headline``."""
+        return {"status": self.status, "reasons": [r.text for r in self.reasons],
+                "findings": [r.to_dict() for r in self.reasons], "plant": self.plant,
+                "behaviour": self.behaviour, "headline": self.headline}
+
+
+@dataclass(frozen=True, eq=False)
+class RobustnessCheck(Result):
+    """The probability that the stage as specified hunts under friction scatter.
+
+    Attributes
+    ----------
+    plant : str
+        The plant judged (the spec's own).
+    samples : int
+        Samples drawn.
+    valid : int
+        Samples simulated to the end (the trials).
+    hunting : int
+        Valid samples that hunt.
+    hunting_probability : float or None
+        hunting / valid [-]; None without valid samples.
+    interval : tuple of float
+        Wilson confidence interval of the probability (low, high) [-].
+    confidence : float
+        Level of the interval [-].
+    limit : float
+        ``requirements.robustness.hunting_probability`` [-].
+    status : str
+        ``"FAIL"`` when the estimate exceeds the limit, ``"WARN"`` when it
+        does not but the interval reaches above it (not demonstrated with
+        these samples), ``"PASS"`` when the whole interval lies at or below.
+    scatter : dict
+        Scattered spec path to its spread, a fraction of the nominal value [-].
+    distribution : str
+        ``"normal"`` (spread = standard deviation) or ``"uniform"`` (half-width).
+    ripple : dict or None
+        ``{"amplitude": -, "wavelength": m}`` of the friction ripple along the
+        rail, or None.
+    seed : int
+        Seed of the draws.
+    counts : dict
+        Samples per verdict of the judged plant.
+    comparison : dict or None
+        The same samples on the other plant (without the isolator, or with
+        the suggested one): ``plant``, ``hunting_probability``, ``interval``.
+    study : fi_design.studies.RobustnessResult
+        The full study (samples, draws; not in the JSON).
+    """
+
+    plant: str
+    samples: int
+    valid: int
+    hunting: int
+    hunting_probability: float | None
+    interval: tuple[float, float]
+    confidence: float
+    limit: float
+    status: str
+    scatter: dict
+    distribution: str
+    ripple: dict | None
+    seed: int
+    counts: dict
+    comparison: dict | None
+    study: Any = field(repr=False)
+
+
+@dataclass(frozen=True)
+class Margins(Result):
+    """How far the design is from its limits, where the figure means something.
+
+    Attributes
+    ----------
+    crossover_factor : float or None
+        Design crossover / lowest hunting-free crossover of the spec's own
+        plant (from the simulated scan) [-]; above 1 the design lies above the
+        hunting boundary. None without simulation, for a loop without
+        integrator (it cannot hunt by the paper's mechanism) and when the
+        plant hunts up to the top of the scan.
+    crossover_factor_bound : bool
+        True when the plant settles over the whole scan: the factor is then a
+        lower bound (design crossover / the scan's lowest crossover).
+    hunting_free_crossover : float or None
+        The lowest hunting-free crossover used [Hz] (within one scan step).
+    achievable_factor : float or None
+        Achievable / desired crossover of step 2 [-]; None when the
+        achievable crossover is only a bound (the search cap) or none.
+    achievable_crossover_bound : float or None
+        The search cap [Hz] when the linear model limits the crossover
+        nowhere below it ("not limited below"); None otherwise.
+    end_stop_clearance : float or None
+        Stroke minus the joint deflection at rest, s - |d| [m], of the spec's
+        own isolator; None without isolator or simulation.
+    resting_deflection : float or None
+        Joint deflection at rest d [m].
+    stiffness_factor : float or None
+        k_max / k [-]; None without isolator.
+    stiffness_range : tuple of float or None
+        Drive stiffness of the sized flexure at its thickness tolerance,
+        ``k (1 -+ dt / t)^3`` [N/m]; None without a sized flexure.
+    stiffness_factor_worst : float or None
+        k_max / the highest stiffness of that range [-].
+    thickness : float or None
+        Stock thickness of the sized leaves [m].
+    thickness_tolerance : float or None
+        Its tolerance +- [m].
+    static_error : float or None
+        Resting error |x1 - r| of a loop without integrator [m].
+    static_error_bound : float or None
+        The static error it may leave, (Fc + |offset|) / kp [m].
+    notes : tuple of str
+        Why a margin is left out or is a bound.
+    """
+
+    crossover_factor: float | None = None
+    crossover_factor_bound: bool = False
+    hunting_free_crossover: float | None = None
+    achievable_factor: float | None = None
+    achievable_crossover_bound: float | None = None
+    end_stop_clearance: float | None = None
+    resting_deflection: float | None = None
+    stiffness_factor: float | None = None
+    stiffness_range: tuple[float, float] | None = None
+    stiffness_factor_worst: float | None = None
+    thickness: float | None = None
+    thickness_tolerance: float | None = None
+    static_error: float | None = None
+    static_error_bound: float | None = None
+    notes: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Recommendation(Result):
+    """What would make the stage pass, apart from the verdict on it.
+
+    Attributes
+    ----------
+    text : str
+        The recommendation in words.
+    isolator : dict or None
+        For a stage without isolator, the suggested one and what the
+        simulation says it would do: ``stroke`` [m], ``stiffness`` [N/m],
+        ``outcome`` at the design crossover, ``hunting_cycles``,
+        ``hunting_free_from`` [Hz], ``end_stop_clearance`` [m] and, when the
+        robustness check ran, ``hunting_probability`` [-] and ``interval``.
+    crossover : float or None
+        The lowest hunting-free crossover of the stage as specified [Hz], when
+        raising the crossover to it would help and the loop can reach it.
+    """
+
+    text: str
+    isolator: dict | None = None
+    crossover: float | None = None
+
+
 @dataclass(frozen=True)
 class DesignResult(Result):
     """The four guideline steps for one spec.
@@ -555,6 +833,17 @@ class DesignResult(Result):
     fi_design_source : fi_design.provenance.Source
         The code that computed it: git commit (from a checkout) and the SHA-256
         of the package's source files; default the running package's.
+    verdict : Verdict or None
+        The sign-off verdict on the hardware as specified (None only while
+        :func:`fi_design.guideline.design` assembles the result).
+    robustness : RobustnessCheck or None
+        Hunting under friction scatter; None when not run
+        (``confirm=False`` or ``requirements.robustness.samples: 0``).
+    margins : Margins or None
+        Distances to the limits.
+    recommendation : Recommendation or None
+        What would make the stage pass (a suggested isolator, a higher
+        crossover); None when there is nothing to add.
     """
 
     spec: Spec = field(repr=False)
@@ -571,11 +860,17 @@ class DesignResult(Result):
     fi_design_version: str
     spec_sha256: str
     simulation: "Confirmation | None" = None
+    verdict: Verdict | None = None
+    robustness: RobustnessCheck | None = None
+    margins: Margins | None = None
+    recommendation: Recommendation | None = None
     fi_design_source: Source = field(default_factory=current_source)
 
     @property
     def passed(self) -> bool:
-        """No check failed (warnings and information do not count)."""
+        """The verdict is PASS or PASS_WITH_WARNINGS (before it is set: no check failed)."""
+        if self.verdict is not None:
+            return self.verdict.passed
         return not any(c.status == Status.FAIL for c in self.checks)
 
     @property
@@ -586,15 +881,20 @@ class DesignResult(Result):
     def to_dict(self) -> dict:
         """The JSON contract: SI values, infinite margins as null.
 
-        Keys: ``name``, ``passed``, ``friction_gap``, ``crossover``, ``stiffness``,
-        ``flexure``, ``pid``, ``isolator_advice``, ``checks``, ``warnings``,
-        ``conclusion``, ``fi_design_version``, ``fi_design_source`` (``commit``,
+        Keys: ``name``, ``passed``, ``verdict``, ``recommendation``, ``robustness``,
+        ``margins``, ``friction_gap``, ``crossover``, ``stiffness``, ``flexure``,
+        ``pid``, ``isolator_advice``, ``checks``, ``warnings``, ``conclusion``,
+        ``fi_design_version``, ``fi_design_source`` (``commit``,
         ``modified``, ``code_sha256``: :class:`~fi_design.provenance.Source`),
         ``spec_sha256`` and, when set, ``simulation``.
         """
         out = {
             "name": self.spec.name,
             "passed": self.passed,
+            "verdict": None if self.verdict is None else self.verdict.to_dict(),
+            "recommendation": to_jsonable(self.recommendation),
+            "robustness": to_jsonable(self.robustness),
+            "margins": to_jsonable(self.margins),
             "friction_gap": self.friction_gap.to_dict(),
             "crossover": self.crossover.to_dict(),
             "stiffness": self.stiffness.to_dict(),

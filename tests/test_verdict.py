@@ -1,0 +1,308 @@
+"""The sign-off verdict (issue 13a): the hardware as specified, robustness, margins, --fail-on.
+
+The verdict cases each get a golden verdict context (pytest-regressions, under
+tests/test_verdict/): a settling isolated stage, examples/no_isolator.yaml (hunts:
+FAIL, with the suggested isolator as a recommendation), a stuck stage, a PD loop at
+rest within Fc / kp and a robustness failure (the paper setup as shipped). The
+robustness sample counts are kept small where the case does not need more.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from fi_design import report
+from fi_design.cli import app
+from fi_design.flexure import drive_stiffness
+from fi_design.guideline import design
+from fi_design.specfile import load_spec
+from fi_design.studies import wilson_interval
+
+from conftest import EXAMPLES, variant
+
+runner = CliRunner()
+
+
+def _samples(n: int) -> dict:
+    return {"requirements.robustness": {"samples": n}}
+
+
+@pytest.fixture(scope="module")
+def no_isolator_spec():
+    return load_spec(EXAMPLES / "no_isolator.yaml")
+
+
+@pytest.fixture(scope="module")
+def cases(paper_spec, no_isolator_spec, paper_confirmed_design):
+    """The five verdict cases, designed once per module."""
+    return {
+        # the paper stage at 11 Hz on a 5 N/mm flexure: settles, and no scatter sample hunts
+        "settling_isolated": design(variant(paper_spec, **{
+            "controller.crossover": "11 Hz", "isolator.stiffness": "5 N/mm", **_samples(80)})),
+        "no_isolator": design(variant(no_isolator_spec, **_samples(20))),
+        # an integrator 300 times slower than the crossover cannot break the cart loose in time
+        "stuck": design(variant(no_isolator_spec, **{"controller.integrator_ratio": 300,
+                                                     **_samples(10)})),
+        # a PD rule (integrator_ratio: .inf): at rest within (Fc + |offset|) / kp
+        "pd_static_error": design(variant(no_isolator_spec, **{
+            "controller.integrator_ratio": math.inf, **_samples(10)})),
+        # the paper setup as shipped: settles, but hunts in 6 of 100 scatter samples
+        "robustness_failure": paper_confirmed_design,
+    }
+
+
+def _rounded(obj):
+    """Floats to 4 significant digits (the golden files compare the rest exactly)."""
+    if isinstance(obj, dict):
+        return {k: _rounded(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_rounded(v) for v in obj]
+    if isinstance(obj, float):
+        return str(obj) if not math.isfinite(obj) else float(f"{obj:.4g}")
+    return obj
+
+
+EXPECTED = {
+    "settling_isolated": ("PASS_WITH_WARNINGS", "settled", "settles"),
+    "no_isolator": ("FAIL", "hunting", "hunts"),
+    "stuck": ("FAIL", "stuck", "stuck"),
+    "pd_static_error": ("PASS_WITH_WARNINGS", "static_error", "static-error"),
+    "robustness_failure": ("FAIL", "settled", "settles"),
+}
+
+
+@pytest.mark.parametrize("case", list(EXPECTED))
+def test_verdict_context_golden(cases, case, data_regression):
+    r = cases[case]
+    status, behaviour, css = EXPECTED[case]
+    assert (r.verdict.status, r.verdict.behaviour) == (status, behaviour)
+    ctx = report.build_context(r, date="2026-01-01", figures=False)["verdict"]
+    assert ctx["behaviour_css"] == css and ctx["status"] == status
+    data_regression.check(_rounded({k: v for k, v in ctx.items()
+                                    if k not in ("groups", "conclusion")}))
+
+
+def test_the_box_looks_different_for_a_stage_that_settles_and_one_that_hunts(cases):
+    def box(r):
+        html = report.render_html(report.build_context(r, date="2026-01-01", figures=False))
+        opening = html.split('id="verdict-box"')[0].rsplit("<div", 1)[1]
+        return opening, html
+
+    settles, html_s = box(cases["settling_isolated"])
+    hunts, html_h = box(cases["no_isolator"])
+    assert 'class="verdict-box warn settles"' in settles
+    assert 'class="verdict-box fail hunts"' in hunts
+    assert '<span class="verdict-stamp">settles</span>' in html_s
+    assert '<span class="verdict-stamp">hunts</span>' in html_h
+    css = (report.template_dir() / "report.css").read_text(encoding="utf-8")
+    rule = css.split(".verdict-box.hunts {")[1].split("}")[0]
+    assert "double" in rule        # a different frame, not only a different colour
+    assert ".verdict-box.hunts .verdict-head { background: repeating-linear-gradient" in css
+
+
+# --------------------------------------------------------------------------- the verdict's logic
+
+
+def test_no_isolator_fails_on_its_own_plant_and_recommends_the_isolator(cases):
+    r = cases["no_isolator"]
+    v = r.verdict
+    assert v.plant == "non_isolated" and not r.passed
+    assert v.reasons[0].severity == "FAIL" and "hunts at 8 Hz" in v.reasons[0].text
+    checks = {c.name: c for c in r.checks}
+    assert checks["simulation_non_isolated"].status.value == "FAIL"
+    assert checks["simulation_isolated"].status.value == "INFO"     # the suggestion: not judged
+    assert checks["landing_force"].status.value == "INFO"
+    rec = r.recommendation
+    assert rec.isolator["outcome"] == "settled" and rec.isolator["stroke"] == 0.3e-3
+    assert rec.isolator["stiffness"] == pytest.approx(4.0 / (2 * 0.3e-3))
+    assert "suggests a 0.3 mm stroke" in rec.text
+    assert rec.crossover == r.simulation.min_hunting_free_crossover["non_isolated"] == 20.0
+    # the suggested isolator is no reason to pass: no PASS reason mentions it
+    assert not any("isolator" in x.text for x in v.reasons if x.severity == "PASS")
+
+
+def test_pd_loop_at_rest_within_its_static_error_is_not_stuck(cases):
+    r = cases["pd_static_error"]
+    plant = r.simulation.non_isolated
+    assert plant.metrics.verdict == "stuck"                 # the metric alone would say so
+    law = r.pid.controller
+    assert not law.integrator
+    bound = r.spec.friction.coulomb / law.kp                # no offset, symmetric friction
+    assert plant.static_error_bound == pytest.approx(bound, rel=1e-12)
+    assert abs(plant.metrics.final_error) <= bound
+    assert plant.outcome == "static_error" and r.passed
+    assert r.margins.static_error == pytest.approx(abs(plant.metrics.final_error))
+    assert r.margins.crossover_factor is None               # cannot hunt: no boundary to keep
+    assert any("no integrator" in n for n in r.margins.notes)
+
+
+def test_stuck_stage_fails(cases):
+    r = cases["stuck"]
+    m = r.simulation.non_isolated.metrics
+    assert m.verdict == "stuck" and m.hunting_cycles == 0
+    assert abs(m.final_error) > r.spec.requirements.hunting.settle_band
+    assert not r.passed and "sticks" in r.verdict.reasons[0].text
+
+
+def test_robustness_failure_and_its_figures(cases):
+    r = cases["robustness_failure"]
+    rob = r.robustness
+    assert r.verdict.behaviour == "settled" and r.verdict.status == "FAIL"
+    assert [x.source for x in r.verdict.reasons if x.severity == "FAIL"] == ["robustness"]
+    assert rob.samples == 100 and rob.limit == 0.05
+    assert rob.hunting_probability == rob.hunting / rob.valid > rob.limit
+    assert rob.interval == pytest.approx(wilson_interval(rob.hunting, rob.valid, 0.95))
+    assert rob.scatter == {"friction.static": 0.2, "friction.coulomb": 0.2}
+    # the samples are the study's: the isolated plant's verdicts, the other plant beside them
+    study = rob.study
+    assert sum(study.isolated.verdict == "hunting") == rob.hunting
+    assert rob.comparison["plant"] == "non_isolated"
+    assert rob.comparison["hunting_probability"] > 0.9
+
+
+def test_warnings_only_pass_with_warnings(cases):
+    r = cases["settling_isolated"]
+    warns = [x for x in r.verdict.reasons if x.severity == "WARN"]
+    assert r.passed and [x.source for x in warns] == ["input"]
+    assert "controller.sample_rate" in warns[0].text     # no sampling and delay: say so
+    assert r.verdict.at_or_below("PASS_WITH_WARNINGS") and not r.verdict.at_or_below("FAIL")
+
+
+def test_without_simulation_the_verdict_cannot_pass(paper_spec):
+    r = design(paper_spec, confirm=False)
+    assert r.verdict.behaviour is None and r.robustness is None
+    assert r.verdict.status == "PASS_WITH_WARNINGS"
+    assert any(x.source == "confirmation" for x in r.verdict.reasons)
+
+
+# --------------------------------------------------------------------------- margins
+
+
+def test_end_stop_clearance_is_stroke_minus_resting_deflection(cases):
+    r = cases["robustness_failure"]
+    d = float(r.simulation.results["isolated"].deflection[-1])   # the trace at rest
+    s = r.spec.isolator.stroke
+    assert r.margins.end_stop_clearance == pytest.approx(s - abs(d), rel=1e-12)
+    assert r.margins.resting_deflection == d
+    assert r.margins.end_stop_clearance == pytest.approx(22e-6, abs=1e-6)   # the issue's 22 um
+
+
+def test_stiffness_range_follows_thickness_cubed(cases):
+    r = cases["robustness_failure"]
+    fx, m = r.flexure, r.margins
+    E = r.spec.isolator.flexure.material.youngs_modulus
+    t, dt = fx.thickness, fx.thickness_tolerance
+    assert t == pytest.approx(0.45e-3, abs=1e-15)     # stock: a multiple of 0.05 mm
+    assert dt == 0.01e-3
+    lo, hi = m.stiffness_range
+    # the leaf formula at t -+ dt, width and length as drawn
+    assert lo == pytest.approx(drive_stiffness(fx.leaves, E, fx.width, t - dt, fx.length),
+                               rel=1e-12)
+    assert hi == pytest.approx(drive_stiffness(fx.leaves, E, fx.width, t + dt, fx.length),
+                               rel=1e-12)
+    k = fx.drive_stiffness
+    assert (lo, hi) == pytest.approx((k * (1 - dt / t) ** 3, k * (1 + dt / t) ** 3), rel=1e-12)
+    assert m.stiffness_factor == pytest.approx(r.stiffness.maximum / r.stiffness.chosen)
+    assert m.stiffness_factor_worst == pytest.approx(r.stiffness.maximum / hi)
+
+
+def test_crossover_factor_and_the_bounds_that_are_not_results(cases):
+    paper = cases["robustness_failure"].margins
+    assert paper.crossover_factor == pytest.approx(8.0 / 5.5) and not paper.crossover_factor_bound
+    assert paper.achievable_factor == pytest.approx(
+        cases["robustness_failure"].crossover.achievable / 8.0)
+    no_iso = cases["no_isolator"]
+    assert no_iso.margins.achievable_factor is None                 # 1000 Hz is the search cap
+    assert no_iso.margins.achievable_crossover_bound == 1000.0
+    assert no_iso.margins.end_stop_clearance is None and no_iso.margins.stiffness_factor is None
+    # case 4 crosses at millihertz: no phase margin to pass, no delay margin to report
+    case4 = next(c for c in cases["robustness_failure"].crossover.cases
+                 if c.name == "stuck_limited")
+    assert not case4.in_band and case4.crossover < 0.01
+    check = next(c for c in cases["robustness_failure"].checks
+                 if c.name == "phase_margin.stuck_limited")
+    assert check.status.value == "INFO" and "band" in check.message
+    ctx = report.build_context(cases["robustness_failure"], date="2026-01-01", figures=False)
+    row = next(c for c in ctx["linear"]["cases"] if c["number"] == 4)
+    assert row["status"] == "INFO" and row["delay_margin"] is None and row["phase_margin"] is None
+
+
+def test_settling_over_the_whole_scan_gives_a_bound(paper_spec):
+    spec = variant(paper_spec, **{"controller.crossover": "12 Hz", **_samples(0),
+                                  "simulation.crossover_scan": {"start": "9 Hz", "stop": "13 Hz",
+                                                                "step": "1 Hz"}})
+    r = design(spec)
+    assert r.margins.crossover_factor_bound and r.margins.crossover_factor == pytest.approx(12 / 9)
+    assert r.robustness is None and any(x.source == "robustness" and x.severity == "WARN"
+                                        for x in r.verdict.reasons)
+
+
+# --------------------------------------------------------------------------- JSON
+
+
+def test_json_fields(cases):
+    for r in cases.values():
+        d = json.loads(json.dumps(r.to_dict(), allow_nan=False))
+        assert d["passed"] is (d["verdict"]["status"] != "FAIL")
+        assert d["verdict"]["status"] in ("PASS", "PASS_WITH_WARNINGS", "FAIL")
+        assert d["verdict"]["reasons"] and all(isinstance(x, str) for x in d["verdict"]["reasons"])
+        assert [f["text"] for f in d["verdict"]["findings"]] == d["verdict"]["reasons"]
+        assert set(d["margins"]) >= {"crossover_factor", "end_stop_clearance", "stiffness_factor"}
+        rob = d["robustness"]
+        assert set(rob) >= {"samples", "hunting_probability", "interval", "scatter"}
+        lo, hi = rob["interval"]
+        assert lo <= rob["hunting_probability"] <= hi
+        assert rob["scatter"] == {"friction.static": 0.2, "friction.coulomb": 0.2}
+    d = cases["no_isolator"].to_dict()
+    assert d["verdict"]["plant"] == "non_isolated" and d["verdict"]["behaviour"] == "hunting"
+    assert d["recommendation"]["isolator"]["outcome"] == "settled"
+    assert d["simulation"]["non_isolated"]["outcome"] == "hunting"
+    d = cases["robustness_failure"].to_dict()
+    assert d["margins"]["end_stop_clearance"] == pytest.approx(22e-6, abs=1e-6)
+    assert d["margins"]["stiffness_range"][0] < 6667 < d["margins"]["stiffness_range"][1]
+    assert d["recommendation"]["isolator"] is None
+    assert [c["in_band"] for c in d["crossover"]["cases"]] == [True, True, True, False]
+
+
+# --------------------------------------------------------------------------- --fail-on
+
+
+@pytest.fixture(scope="module")
+def quick_specs(tmp_path_factory):
+    """The small-gap and no-isolator examples with 10 scatter samples, as files."""
+    out = {}
+    folder = tmp_path_factory.mktemp("fail_on")
+    for name in ("small_gap", "no_isolator"):
+        raw = yaml.safe_load((EXAMPLES / f"{name}.yaml").read_text(encoding="utf-8"))
+        raw.setdefault("requirements", {})["robustness"] = {"samples": 10}
+        path = folder / f"{name}.yaml"
+        path.write_text(yaml.safe_dump(raw), encoding="utf-8")
+        out[name] = path
+    return out
+
+
+@pytest.mark.parametrize("name,option,code", [
+    ("small_gap", [], 0),                      # PASS_WITH_WARNINGS, no --fail-on
+    ("small_gap", ["--fail-on", "fail"], 0),
+    ("small_gap", ["--fail-on", "warn"], 3),
+    ("no_isolator", [], 0),                    # FAIL, but nobody asked
+    ("no_isolator", ["--fail-on", "fail"], 3),
+    ("no_isolator", ["--fail-on", "warn"], 3),
+])
+def test_fail_on_exit_codes(quick_specs, tmp_path, name, option, code):
+    out = tmp_path / "r.json"
+    r = runner.invoke(app, [str(quick_specs[name]), "--json", str(out), *option])
+    assert r.exit_code == code, r.output
+    assert json.loads(out.read_text())["verdict"]["status"] == \
+        {"small_gap": "PASS_WITH_WARNINGS", "no_isolator": "FAIL"}[name]   # written first
+    assert "Verdict: " in r.output
+
+
+def test_fail_on_refuses_other_levels_before_any_work(quick_specs):
+    r = runner.invoke(app, [str(quick_specs["small_gap"]), "--fail-on", "info"])
+    assert r.exit_code == 2 and "--fail-on" in r.output
