@@ -30,6 +30,11 @@ VELOCITY_SPAN = 0.02
 #: Fewest samples the local velocity estimate needs.
 MIN_FIT_SAMPLES = 5
 
+#: Standard errors the velocity estimate must exceed for the stage to count as moving: about
+#: the two-sided 99.9 % quantile of Student's t for the 8 degrees of freedom of a one-sided
+#: 20 ms fit at 1 kHz (a stage at rest is then taken as moving once in a thousand records).
+MOVING_T = 5.0
+
 #: Drives of a replay: the model's controller closes the loop, or the measured force drives it.
 DRIVES = ("closed", "force")
 
@@ -45,15 +50,50 @@ class RecordState:
     time : float
         Sample time [s].
     position : float
-        Measured stage position x1 [m].
+        Stage position x1 at the sample from the local quadratic fit [m]
+        (one sample's sensor noise would otherwise offset the whole replay).
     velocity : float
         Stage velocity from a local quadratic fit of the position [m/s].
+    velocity_error : float
+        Standard error of ``velocity`` from the fit's residuals [m/s] (0 for
+        an exact fit).
+
+    The stage counts as moving when ``velocity`` exceeds :data:`MOVING_T`
+    standard errors (:attr:`moving`); below that the record starts at rest and a noisy
+    velocity estimate must not start the friction model sliding.
     """
 
     index: int
     time: float
     position: float
     velocity: float
+    velocity_error: float = 0.0
+
+    @property
+    def moving(self) -> bool:
+        """Whether the velocity differs from zero by more than :data:`MOVING_T` standard errors."""
+        return abs(self.velocity) > MOVING_T * self.velocity_error
+
+
+def _local_fit(record: Measurement, values: np.ndarray, index: int, span: float):
+    """Quadratic least-squares fit of ``values`` within ``span`` around sample ``index``.
+
+    One-sided at the ends of the record, at least :data:`MIN_FIT_SAMPLES`
+    samples. Returns the coefficients (value, first and second derivative
+    over 1, 1 and 2 at the sample) and their covariance from the residuals.
+    """
+    t = record.time
+    n = len(t)
+    half = max(span / 2.0, 0.5 * (MIN_FIT_SAMPLES - 1) * record.sample_period)
+    lo = int(np.searchsorted(t, t[index] - half, side="left"))
+    hi = int(np.searchsorted(t, t[index] + half, side="right"))
+    if hi - lo < MIN_FIT_SAMPLES:  # at an end: extend to the other side
+        lo, hi = max(0, min(lo, n - MIN_FIT_SAMPLES)), min(n, max(hi, MIN_FIT_SAMPLES))
+    A = np.vander(t[lo:hi] - t[index], 3, increasing=True)
+    coef, ssr, _, _ = np.linalg.lstsq(A, np.asarray(values[lo:hi], dtype=float), rcond=None)
+    dof = hi - lo - 3
+    s2 = float(ssr[0]) / dof if len(ssr) and dof > 0 else 0.0
+    return coef, s2 * np.linalg.pinv(A.T @ A)
 
 
 def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPAN) -> RecordState:
@@ -61,8 +101,8 @@ def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPA
 
     A quadratic fitted by least squares to the positions within ``span``
     around the sample (one-sided at the ends of the record) gives the
-    velocity at the sample: robust to encoder counts and sensor noise, and
-    right while the stage accelerates.
+    position and velocity at the sample: robust to encoder counts and sensor
+    noise, and right while the stage accelerates.
 
     Parameters
     ----------
@@ -79,20 +119,43 @@ def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPA
     DataError
         The record has too few samples to estimate a velocity.
     """
-    t = record.time
-    n = len(t)
+    n = record.n
     if n < MIN_FIT_SAMPLES:
         raise DataError(f"too short to estimate the initial velocity: {n} sample(s), at least "
                         f"{MIN_FIT_SAMPLES} needed", column="position_m", source=record.source)
-    half = max(span / 2.0, 0.5 * (MIN_FIT_SAMPLES - 1) * record.sample_period)
-    lo = int(np.searchsorted(t, t[index] - half, side="left"))
-    hi = int(np.searchsorted(t, t[index] + half, side="right"))
-    if hi - lo < MIN_FIT_SAMPLES:  # at an end: extend to the other side
-        lo, hi = max(0, min(lo, n - MIN_FIT_SAMPLES)), min(n, max(hi, MIN_FIT_SAMPLES))
-    tau = t[lo:hi] - t[index]
-    coef = np.polynomial.polynomial.polyfit(tau, record.position[lo:hi], 2)
-    return RecordState(index=int(index), time=float(t[index]),
-                       position=float(record.position[index]), velocity=float(coef[1]))
+    coef, cov = _local_fit(record, record.position, index, span)
+    return RecordState(index=int(index), time=float(record.time[index]),
+                       position=float(coef[0]), velocity=float(coef[1]),
+                       velocity_error=float(np.sqrt(max(cov[1, 1], 0.0))))
+
+
+def reference_state(record: Measurement, index: int = 0,
+                    span: float = VELOCITY_SPAN) -> tuple[float, float, float]:
+    """Reference position, velocity and acceleration at sample ``index``, from the samples.
+
+    The same local quadratic fit as :func:`record_state`, on ``reference_m``:
+    a reference that starts accelerating at the first sample has zero
+    velocity there, which an interpolating spline's end condition would not
+    give (and the controller's state would carry the difference).
+
+    Returns
+    -------
+    (r, r', r'') : tuple of float
+        [m, m/s, m/s^2].
+    """
+    coef, _ = _local_fit(record, record.reference, index, span)
+    return float(record.reference[index]), float(coef[1]), float(2.0 * coef[2])
+
+
+def command_state(record: Measurement, index: int = 0) -> float | None:
+    """The controller's own output at sample ``index`` [N]: force_N less disturbance_N.
+
+    None without a ``force_N`` column.
+    """
+    if record.force is None:
+        return None
+    dist = 0.0 if record.disturbance is None else float(record.disturbance[index])
+    return float(record.force[index]) - dist
 
 
 def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, *,
@@ -107,7 +170,10 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
     law : ControlLaw
         The loop's controller.
     state : RecordState
-        Stage position and velocity from the data.
+        Stage position and velocity from the data. A stage that is not
+        :attr:`RecordState.moving` starts at rest, its bristles carrying the
+        static load (the first command less the offset, within the
+        breakaway force).
     deflection : float or None
         Measured joint deflection x1 - x2 [m]; None: the deflection of steady
         sliding (the joint force carrying the friction), within the stroke.
@@ -130,7 +196,8 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
     iso = bool(params.isolated)
     idx = state_index(iso)
     p = params.to_array()
-    x1, v1 = state.position, state.velocity
+    x1 = state.position
+    v1 = state.velocity if state.moving else 0.0
     sgn = 1.0 if v1 >= 0.0 else -1.0
     y0 = np.zeros(params.n_states)
     y0[idx["x1"]] = x1
@@ -143,6 +210,15 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
         friction = sgn * g + sigma2 * v1
     elif v1 != 0.0:
         friction = sgn * stribeck(v1, x1, sgn, p)[0] + sigma2 * v1
+    elif command is not None:
+        # at rest: the bristles carry the static load, up to the breakaway force
+        load = command - params.offset
+        if iso and deflection is not None:
+            load = params.k * deflection
+        breakaway = stribeck(0.0, x1, 1.0 if load >= 0.0 else -1.0, p)[0]
+        friction = max(-breakaway, min(breakaway, load))
+        if not params.switch_model:
+            y0[idx["z"]] = friction / params.sigma0
     if iso:
         d = deflection if deflection is not None else _sliding_deflection(params, friction)
         y0[idx["x2"]] = x1 - d
