@@ -83,8 +83,10 @@ def gap_sections(result: Any, figures: bool = True) -> list:
     if noise.deflection is not None:
         nrows.append(("deflection", qty(noise.deflection, "m"),
                       noise.source.get("deflection", "")))
-    if noise.resolution is not None:
-        nrows.append(("position step (staircase)", qty(noise.resolution, "m"), "estimated"))
+    lat = result.lattice
+    if lat.found:
+        nrows.append(("position lattice step", qty(lat.step, "m"),
+                      f"read from the data ({100 * lat.fraction:.0f} % of tested samples on it)"))
     notes = []
     if result.ambiguous:
         notes.append("Not decisively worse than the chosen effect: "

@@ -365,8 +365,10 @@ def decimate(t: np.ndarray, y: np.ndarray, buckets: int = 700) -> tuple[np.ndarr
     keep = [0, n - 1]
     for a, b in zip(edges[:-1], edges[1:]):
         seg = y[a:b]
-        if len(seg):
+        if len(seg) and np.any(np.isfinite(seg)):
             keep += [a + int(np.nanargmin(seg)), a + int(np.nanargmax(seg))]
+        elif len(seg):  # no value here (a failed run): keep one NaN so the line breaks
+            keep.append(a)
     idx = np.unique(np.array(keep))
     return t[idx], y[idx]
 

@@ -1,4 +1,4 @@
-"""Replaying a record that starts at rest (fi_design.replay): noise must not start the model sliding.
+"""Replaying a record from rest (fi_design.replay): noise must not start the model sliding.
 
 A record taken from rest holds sensor noise in its first samples. A velocity
 estimate within its own noise is zero, the bristles then carry the static load
