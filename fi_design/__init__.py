@@ -15,6 +15,7 @@ The public API (imported lazily, so ``import fi_design`` stays fast):
 - :func:`simulate` -- one nonlinear simulation;
 - :func:`sweep`, :func:`robustness` -- parameter studies;
 - :func:`load_measurement`, :func:`reconcile` -- compare with measured data;
+- :func:`identify` -- mass and friction from a measured record (guideline step 1);
 - :func:`render_report` -- HTML or PDF report.
 
 All values are SI floats; units are stated in the docstrings.
@@ -41,6 +42,8 @@ _API = {
     "robustness": "fi_design.studies",
     "load_measurement": "fi_design.measured",
     "reconcile": "fi_design.reconciliation",
+    "identify": "fi_design.identification",
+    "IdentificationResult": "fi_design.identification",
     "render_report": "fi_design.report",
     "FiDesignError": "fi_design.errors",
     "SpecError": "fi_design.errors",

@@ -469,13 +469,29 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
 
     pid = data.get("pid") or {}
     if pid:
-        t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
-                  pad_edge=False)
-        for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]", "tuning mass [kg]"):
-            t.add_column(Text(col), justify="right", no_wrap=True)
-        t.add_row(_fmt(pid.get("kp")), _fmt(pid.get("ki")), _fmt(pid.get("kd")),
-                  _fmt(pid.get("wt")), _fmt(pid.get("tuning_mass")))
-        console.print(t)
+        if pid.get("source") == "gains":
+            # the hardware's loop beside the rule's gains in the same form
+            hw, rule = pid["controller"], pid["rule_in_hardware_form"]
+            t = Table(title="PID gains (step 4): the hardware's, and the rule's at the same "
+                            "crossover", title_justify="left", box=box.SIMPLE_HEAD,
+                      pad_edge=False)
+            t.add_column("")
+            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "D roll-off [Hz]"):
+                t.add_column(Text(col), justify="right", no_wrap=True)
+            for label, g in (("hardware", hw), ("rule", rule)):
+                wf = g.get("roll_off")
+                t.add_row(label, _fmt(g.get("kp")), _fmt(g.get("ki")), _fmt(g.get("kd")),
+                          "none" if wf is None else _fmt(wf / (2 * 3.141592653589793)))
+            console.print(t)
+        else:
+            t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
+                      pad_edge=False)
+            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]",
+                        "tuning mass [kg]"):
+                t.add_column(Text(col), justify="right", no_wrap=True)
+            t.add_row(_fmt(pid.get("kp")), _fmt(pid.get("ki")), _fmt(pid.get("kd")),
+                      _fmt(pid.get("wt")), _fmt(pid.get("tuning_mass")))
+            console.print(t)
 
     xo = data.get("crossover") or {}
     if xo:
@@ -631,16 +647,44 @@ def simulate_command(
     reference: Annotated[bool, typer.Option(
         "--reference", help="Integrate with scipy's solve_ivp (Radau, tight tolerance) instead "
                             "of the fast kernel: slow, for checks.")] = False,
+    record: Annotated[Optional[Path], typer.Option(
+        "--record", metavar="MEASURED.csv", help="Replay this measured record instead of the "
+                                                 "spec's motion: the model starts from the "
+                                                 "state in the data and is driven by its "
+                                                 "reference_m (and disturbance_N).",
+        show_default=False)] = None,
+    drive: Annotated[str, typer.Option(
+        "--drive", metavar="closed|force", help="With --record: 'closed' (the model's "
+                                                "controller closes the loop) or 'force' (the "
+                                                "plant driven open loop by the measured "
+                                                "force_N, re-anchored every --window)."
+                                                )] = "closed",
+    window: Annotated[float, typer.Option(
+        "--window", metavar="SECONDS", help="With --drive force: length of the windows after "
+                                            "which the model is re-anchored to the "
+                                            "measurement [s].")] = 0.1,
     force: Annotated[bool, typer.Option(
         "--force", "-f", help="Overwrite existing output files.")] = False,
 ) -> None:
-    """Simulate the stage once and print the hunting metric.
+    """Simulate the stage once, or replay a measured record, and print the result.
 
     The CSV has the columns of measured data (DESIGN.md section 4): time_s,
     reference_m, position_m, force_N (the commanded force) and, with the
-    isolator, deflection_m; overlay it on your measurements.
+    isolator, deflection_m; overlay it on your measurements. An open-loop
+    replay (--drive force) adds a column ``window`` numbering the re-anchored
+    windows.
     """
     from .output import check_output, write_atomic
+
+    if drive not in ("closed", "force"):
+        raise typer.BadParameter(f"expected 'closed' or 'force', got {drive!r}",
+                                 param_hint="--drive")
+    if drive == "force" and record is None:
+        raise typer.BadParameter("--drive force replays a record: give --record MEASURED.csv",
+                                 param_hint="--drive")
+    if not window > 0:
+        raise typer.BadParameter(f"must be a positive time in seconds, got {window!r}",
+                                 param_hint="--window")
 
     csv_path = check_output(csv_out, force=force, protect=(spec,),
                             extensions=(".csv",)) if csv_out else None
@@ -653,6 +697,11 @@ def simulate_command(
     from .specfile import load_spec
 
     spec_obj = load_spec(spec)
+    measured = None
+    if record is not None:
+        from .measured import load_measurement
+
+        measured = load_measurement(record)
     isolated = False if no_isolator else None
     if not no_isolator and spec_obj.isolator is None:
         isolated = False
@@ -660,9 +709,10 @@ def simulate_command(
     from .simulation import simulate
 
     err = _console(stderr=True)
-    with _status(err, "simulating ..."):
+    with _status(err, "replaying the record ..." if measured is not None else "simulating ..."):
         result = simulate(spec_obj, isolated=isolated,
-                          method="reference" if reference else "fast")
+                          method="reference" if reference else "fast", record=measured,
+                          drive=drive, window=window)
     console = _console()
     _print_simulation(console, result)
     if csv_path is not None:
@@ -684,18 +734,36 @@ def _print_simulation(console: "Console", result) -> None:
 
     m = result.metrics
     plant = "with isolator" if result.isolated else "without isolator"
-    t = Table(title=f"Simulation {plant} at {result.crossover:g} Hz ({result.friction_model}, "
+    loop = "closed loop" if result.drive == "closed" else "open loop, measured force"
+    what = "Simulation" if result.replay is None else f"Replay of {result.record} ({loop})"
+    t = Table(title=f"{what} {plant} at {result.crossover:.4g} Hz ({result.friction_model}, "
                     f"{result.method} solver)", title_justify="left", box=box.SIMPLE_HEAD,
               pad_edge=False)
     t.add_column("Quantity")
     t.add_column("Value", justify="right")
-    rows = [
-        ("verdict", m.verdict),
-        ("hunting cycles in the window [-]", str(m.hunting_cycles)),
-        ("amplitude (peak to peak) [um]", _fmt(1e6 * m.amplitude, 4)),
-        ("period [s]", _fmt(m.period, 4)),
-        ("settling time [s]", _fmt(m.settling_time, 4)),
-        ("final error [um]", _fmt(1e6 * m.final_error, 4)),
+    rows = []
+    fit = result.replay
+    if fit is not None:
+        rows += [
+            ("position, model - measured, rms [um]", _fmt(1e6 * fit.position_rms, 4)),
+            ("position, model - measured, max [um]", _fmt(1e6 * fit.position_max, 4)),
+            ("tracking error r - x1 rms, model [um]", _fmt(1e6 * fit.tracking_rms_model, 4)),
+            ("tracking error r - x1 rms, measured [um]",
+             _fmt(1e6 * fit.tracking_rms_measured, 4)),
+            ("commanded force, model - measured, rms [N]", _fmt(fit.force_rms, 4)),
+        ]
+        if result.window is not None:
+            rows.append(("re-anchored windows [-]", str(int(result.window.max()) + 1)))
+    else:  # the hunting metric judges a settling stage, not a record in motion
+        rows += [
+            ("verdict", m.verdict),
+            ("hunting cycles in the window [-]", str(m.hunting_cycles)),
+            ("amplitude (peak to peak) [um]", _fmt(1e6 * m.amplitude, 4)),
+            ("period [s]", _fmt(m.period, 4)),
+            ("settling time [s]", _fmt(m.settling_time, 4)),
+            ("final error [um]", _fmt(1e6 * m.final_error, 4)),
+        ]
+    rows += [
         ("integration", "ok" if result.success else result.message),
         ("steps / rejected / events [-]", f"{result.n_steps} / {result.n_rejected} / "
                                           f"{result.n_events}"),
@@ -704,7 +772,8 @@ def _print_simulation(console: "Console", result) -> None:
     for k, v in rows:
         t.add_row(Text(k), Text(str(v)))
     console.print(t)
-    console.print(Text(m.reason))
+    if result.replay is None:
+        console.print(Text(m.reason))
 
 
 @app.command("schema")
@@ -1626,6 +1695,133 @@ def print_reconcile(console: "Console", result) -> None:
     console.print(Text("Noise: " + ", ".join(parts)))
     for name, why in result.skipped.items():
         console.print(Text(f"skipped {name}: {why}", style="dim"))
+
+
+# --------------------------------------------------------------------------- identify
+# (friction and mass from a measured record: fi_design.identification, fi_design.identreport)
+
+
+@app.command("identify")
+def identify_command(
+    measured: Annotated[Path, typer.Argument(
+        metavar="MEASURED.csv", help="The measured record: time_s, reference_m, position_m, "
+                                     "force_N (optional deflection_m, disturbance_N).",
+        show_default=False)],
+    spec: Annotated[Optional[Path], typer.Option(
+        "--spec", metavar="SPEC.yaml", help="The stage's spec: its loop sets the filter, its "
+                                            "isolator gives the flexure force, its masses the "
+                                            "split; needed for --write-spec and --report.",
+        show_default=False)] = None,
+    json_out: Annotated[Optional[Path], typer.Option(
+        "--json", metavar="OUT.json", help="Write the identification as JSON.",
+        show_default=False)] = None,
+    write_spec: Annotated[Optional[Path], typer.Option(
+        "--write-spec", metavar="OUT.yaml", help="Write the spec with the identified friction "
+                                                 "and masses filled in (never the input).",
+        show_default=False)] = None,
+    report_out: Annotated[Optional[Path], typer.Option(
+        "--report", metavar="IDENT.html", help="Write the report: force-velocity map, force "
+                                               "residual, fit statistics (HTML, or PDF for a "
+                                               ".pdf name).", show_default=False)] = None,
+    form: Annotated[str, typer.Option(
+        "--form", help="symmetric: one Coulomb friction and an offset; per-direction: Coulomb "
+                       "friction per direction, no offset.")] = "symmetric",
+    force: Annotated[bool, typer.Option(
+        "--force", "-f", help="Overwrite existing output files.")] = False,
+) -> None:
+    """Identify mass, friction and force offset from a measured record (guideline step 1).
+
+    Inverse-dynamics least squares on the filtered record gives the moving
+    mass, Coulomb and viscous friction per direction and the offset, with
+    standard errors; static friction, Stribeck velocity and bristle
+    stiffness only where the record holds a breakaway or presliding.
+    """
+    forms = {"symmetric": "symmetric", "per-direction": "per_direction",
+             "per_direction": "per_direction"}
+    if form not in forms:
+        raise typer.BadParameter("must be 'symmetric' or 'per-direction'", param_hint="--form")
+    if spec is None and (write_spec is not None or report_out is not None):
+        raise typer.BadParameter("--write-spec and --report need the stage's spec",
+                                 param_hint="--spec")
+    from .output import check_output
+
+    outs, seen = {}, []
+    for key, path, exts in (("json", json_out, (".json",)), ("spec", write_spec, (".yaml", ".yml")),
+                            ("report", report_out, (".html", ".pdf"))):
+        outs[key] = None if path is None else check_output(
+            path, force=force, protect=(spec, measured, *seen), extensions=exts)
+        if outs[key] is not None:
+            seen.append(outs[key])
+    from .identification import identified_spec_text, identify
+    from .measured import load_measurement
+    from .specfile import load_spec
+
+    spec_obj = load_spec(spec) if spec is not None else None
+    data = load_measurement(measured)
+    with _FractionBar(_console(stderr=True), "identifying") as bar:
+        result = identify(data, spec_obj, form=forms[form], progress=bar)
+    console = _console()
+    print_identification(console, result)
+    text = identified_spec_text(result) if outs["spec"] is not None else None
+    import json
+
+    from .output import write_atomic
+
+    if outs["json"] is not None:
+        write_atomic(outs["json"], json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n")
+        console.print(f"wrote {outs['json']}", markup=False, highlight=False)
+    if outs["spec"] is not None:
+        write_atomic(outs["spec"], text)
+        console.print(f"wrote {outs['spec']}", markup=False, highlight=False)
+    if outs["report"] is not None:
+        from .identreport import render_identification_report
+
+        render_identification_report(result, outs["report"], command=_command_line())
+        console.print(f"wrote {outs['report']}", markup=False, highlight=False)
+
+
+def print_identification(console: "Console", result) -> None:
+    """Print an :class:`~fi_design.identification.IdentificationResult`: table, fit, notes.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to print.
+    result : fi_design.identification.IdentificationResult
+        The identification.
+    """
+    from rich import box
+    from rich.table import Table
+    from rich.text import Text
+
+    m = result.measurement
+    console.print(Text(f"Identification from {m.source or 'the record'}: {m.n} samples, "
+                       f"{result.form.replace('_', '-')} form, {result.model.replace('_', ' ')} "
+                       "model", style="bold"))
+    t = Table(title="Parameters (SI; standard error one sigma)", title_justify="left",
+              box=box.SIMPLE_HEAD, pad_edge=False)
+    for col, just in (("Parameter", "left"), ("Value", "right"), ("Std. error", "right"),
+                      ("Unit", "left"), ("Identifiable", "left")):
+        t.add_column(col, justify=just, no_wrap=True)
+    for name, p in result.parameters.items():
+        t.add_row(Text(name), _fmt(p.value, 6), _fmt(p.std_error, 3), Text(p.unit),
+                  Text("yes" if p.identifiable else "no",
+                       style="green" if p.identifiable else "yellow"))
+    console.print(t)
+    f = result.fit
+    console.print(Text(f"Fit: RMS force residual {_fmt(f.force_rms_residual, 3)} N, relative "
+                       f"error {_fmt(f.relative_error, 3)}, condition number "
+                       f"{_fmt(f.condition_number, 3)}, {f.samples_used} samples used "
+                       f"({_fmt(f.effective_samples, 3)} effective)"))
+    ms = result.masses
+    console.print(Text(f"Masses: stage {_fmt(ms.stage, 5)} kg, cart {_fmt(ms.cart, 5)} kg "
+                       f"({ms.source})"))
+    for name in ("static", "stribeck_velocity", "bristle_stiffness"):
+        p = result.parameters[name]
+        if not p.identifiable:
+            console.print(Text(f"{name}: {p.note}", style="dim"))
+    for note in result.notes:
+        console.print(Text(f"note: {note}", style="dim"))
 
 
 def main() -> None:

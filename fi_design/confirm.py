@@ -347,7 +347,7 @@ def _fmt_f(f: float | None) -> str:
 
 
 def _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested) -> list[Check]:
-    fc = spec.controller.crossover
+    fc = _spec.design_crossover(spec)
     step = "simulation (paper section 2.3)"
     label = "suggested isolator" if suggested else "isolated design"
     out = [

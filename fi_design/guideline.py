@@ -38,9 +38,10 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from .flexure import FlexureResult, size_flexure
-from .pid import PidGains, tune_pid
+from .pid import ControlLaw, PidGains, control_law
 from .results import Check, Status, dataclass_dict, to_jsonable
-from .spec import Spec, drive_stiffness, proposed_stiffness, stiffness_limit, warnings_for
+from .spec import (Spec, design_crossover, drive_stiffness, proposed_stiffness, stiffness_limit,
+                   warnings_for)
 
 __all__ = [
     "SUGGESTED_STROKE", "FrictionGapResult", "ModeSeparation", "CrossoverResult",
@@ -229,7 +230,7 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
     from . import linear
 
     req = spec.requirements
-    fc = spec.controller.crossover
+    fc = design_crossover(spec)
     cases = linear.limit_cases(spec)
     at = linear.analyse(spec, fc, cases=cases)
     ach = linear.achievable_crossover(spec)
@@ -413,7 +414,7 @@ def step3_flexure(spec: Spec, stiffness: StiffnessResult | None = None) -> Flexu
                         maximum_stiffness=st.maximum, stroke=st.stroke,
                         stage_mass=spec.stage.mass,
                         required_frequency=spec.requirements.parasitic_separation
-                        * spec.controller.crossover)
+                        * design_crossover(spec))
 
 
 def _flexure_checks(fx: FlexureResult | None) -> tuple[Check, ...]:
@@ -450,18 +451,25 @@ def _flexure_checks(fx: FlexureResult | None) -> tuple[Check, ...]:
 
 @dataclass(frozen=True)
 class PidResult:
-    """Step 4: the PID gains.
+    """Step 4: the PID gains, and the loop's controller.
 
     Attributes
     ----------
     gains : fi_design.pid.PidGains
-        The gains (JSON: flattened into the ``pid`` object).
+        The rule's gains at the loop's crossover (JSON: flattened into the
+        ``pid`` object); with explicit hardware gains, the recommendation.
     tuning_rule : str
         ``total`` (m1 + m2, the paper's choice) or ``stage`` (m1).
     derivative_ratio : float
         wd = wc / ratio, wt = ratio x wc [-].
     integrator_ratio : float
         wi = wc / ratio [-].
+    controller : fi_design.pid.ControlLaw
+        The loop's controller: the rule's, or the hardware's own gains
+        (``source``), as the analysis and the simulation use it.
+    static_error : float or None
+        Static position error of a loop without integrator against Coulomb
+        friction, Fc / kp [m]; None when the loop integrates.
     checks : tuple of Check
         The step's checks.
     """
@@ -470,17 +478,40 @@ class PidResult:
     tuning_rule: str
     derivative_ratio: float
     integrator_ratio: float
+    controller: ControlLaw
+    static_error: float | None
     checks: tuple[Check, ...] = field(default=(), repr=False)
 
     def to_dict(self) -> dict:
-        """Flat JSON: the gains' fields plus the rule and ratios."""
-        return {**self.gains.to_dict(), "tuning_rule": self.tuning_rule,
-                "derivative_ratio": self.derivative_ratio,
-                "integrator_ratio": self.integrator_ratio}
+        """Flat JSON: the rule's gains plus the rule, its ratios and the loop's controller."""
+        out = {**self.gains.to_dict(), "tuning_rule": self.tuning_rule,
+               "derivative_ratio": self.derivative_ratio,
+               "integrator_ratio": to_jsonable(self.integrator_ratio),
+               "source": self.controller.source, "integrator": self.controller.integrator,
+               "static_error": self.static_error, "controller": self.controller.to_dict()}
+        if self.controller.source == "gains":
+            out["rule_in_hardware_form"] = to_jsonable(self.controller.rule_in_this_form())
+        return out
+
+
+def _controller_words(c: ControlLaw) -> str:
+    """The structure of a controller in words (D input, roll-off, sampling)."""
+    parts = [f"D on the {c.derivative_on}",
+             "ideal D" if math.isinf(c.roll_off) else
+             f"D roll-off {c.roll_off / (2 * math.pi):.4g} Hz"]
+    parts.append("continuous" if c.sample_period == 0 else
+                 f"sampled at {1.0 / c.sample_period:.4g} Hz")
+    if c.delay > 0:
+        parts.append(f"delay {c.delay * 1e3:.3g} ms")
+    return ", ".join(parts)
 
 
 def step4_pid(spec: Spec) -> PidResult:
     """Guideline step 4: PID gains from the moving mass and the desired crossover.
+
+    With the hardware's own gains (``controller.gains``) the loop uses them;
+    the rule's gains at the crossover the hardware achieves are shown beside
+    them, in the same form, as the recommendation.
 
     Parameters
     ----------
@@ -490,16 +521,34 @@ def step4_pid(spec: Spec) -> PidResult:
     Returns
     -------
     PidResult
-        The gains (:func:`fi_design.pid.tune_pid`) and an informational check;
+        The gains and the loop's controller, with an informational check;
         tuning on the stage mass alone gives a WARN (the paper found the
-        maximum moving mass best).
+        maximum moving mass best); a loop without integrator an INFO with its
+        static error Fc / kp (no hunting by the paper's mechanism).
     """
     ctl = spec.controller
-    g = tune_pid(spec)
+    law = control_law(spec)
+    g = law.rule
     step = "step 4 PID"
-    msg = (f"tuned at {g.crossover:.4g} Hz on {g.tuning_mass:.4g} kg: kp = {g.kp:.4g} N/m, "
-           f"ki = {g.ki:.4g} N/(m s), kd = {g.kd:.4g} N s/m, wt = {g.wt:.4g} rad/s")
-    checks = [Check("pid", None, g.kp, None, "N/m", msg, step=step)]
+    if law.source == "rule":
+        msg = (f"tuned at {g.crossover:.4g} Hz on {g.tuning_mass:.4g} kg: kp = {g.kp:.4g} N/m, "
+               f"ki = {g.ki:.4g} N/(m s), kd = {g.kd:.4g} N s/m, wt = {g.wt:.4g} rad/s")
+        checks = [Check("pid", None, g.kp, None, "N/m", msg, step=step)]
+    else:
+        r = law.rule_in_this_form()
+        msg = (f"the hardware's gains kp = {law.kp:.4g} N/m, ki = {law.ki:.4g} N/(m s), "
+               f"kd = {law.kd:.4g} N s/m ({_controller_words(law)}) cross over at "
+               f"{law.crossover:.4g} Hz on {law.tuning_mass:.4g} kg; the rule there would give "
+               f"kp = {r['kp']:.4g} N/m, ki = {r['ki']:.4g} N/(m s), kd = {r['kd']:.4g} N s/m "
+               f"with a D roll-off of {r['roll_off'] / (2 * math.pi):.4g} Hz")
+        checks = [Check("pid", None, law.kp, g.kp, "N/m", msg, step=step)]
+    static = law.static_error(spec.friction.coulomb)
+    if static is not None:
+        checks.append(Check(
+            "pid.integrator", None, static, None, "m",
+            f"the loop has no integrator: no hunting by the paper's mechanism (integral action "
+            f"building up through stiction), a static error instead of up to Fc / kp = "
+            f"{static * 1e6:.3g} um against the Coulomb friction", step=step))
     if ctl.tuning_mass == "stage" and spec.isolator is not None:
         checks.append(Check(
             "pid.tuning_mass", None, g.tuning_mass, spec.total_mass, "kg",
@@ -507,7 +556,8 @@ def step4_pid(spec: Spec) -> PidResult:
             "crosses over lower (the paper tunes on the maximum moving mass)", step=step,
             status=Status.WARN))
     return PidResult(gains=g, tuning_rule=ctl.tuning_mass, derivative_ratio=ctl.derivative_ratio,
-                     integrator_ratio=ctl.integrator_ratio, checks=tuple(checks))
+                     integrator_ratio=ctl.integrator_ratio, controller=law, static_error=static,
+                     checks=tuple(checks))
 
 
 # --------------------------------------------------------------------------- no isolator
@@ -775,7 +825,7 @@ def _simulation_sentence(spec: Spec, sim: Any) -> str:
         return ""
     mins = sim.min_hunting_free_crossover
     label = "the suggested isolator" if sim.suggested_isolator else "the isolator"
-    fc = spec.controller.crossover
+    fc = design_crossover(spec)
 
     def f(x):
         return "beyond the scan" if x is None else f"from {x:g} Hz"
@@ -797,7 +847,12 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
     from .linear import CASE_NUMBERS
 
     parts = []
-    if gap.hunting_risk:
+    if gap.hunting_risk and not pid.controller.integrator:
+        parts.append(f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, at or above "
+                     f"the {gap.threshold:.3g} N threshold, but the loop has no integrator to "
+                     "push the cart through stiction, so it cannot hunt by the paper's "
+                     "mechanism.")
+    elif gap.hunting_risk:
         parts.append(f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, at or above "
                      f"the {gap.threshold:.3g} N threshold, so stick-slip can make the "
                      "integrating controller hunt.")
@@ -820,14 +875,16 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
                f"{xo.achievable:.4g} Hz")
     else:
         ach = f"the achievable crossover is {xo.achievable:.3g} Hz, limited by {xo.limited_by}"
+    at = ("the desired crossover" if pid.controller.source == "rule"
+          else "the hardware's crossover")
     if not bad:
         every = "both" if n == 2 else f"all {n}"
-        parts.append(f"At the desired crossover of {xo.desired:.3g} Hz {every} linear limit "
+        parts.append(f"At {at} of {xo.desired:.3g} Hz {every} linear limit "
                      f"cases are stable with {margins}; {ach}.")
     else:
         which = ", ".join(f"case {CASE_NUMBERS[c.name]} ({c.description}: "
                           f"{', '.join(c.failed)})" for c in bad)
-        parts.append(f"At the desired crossover of {xo.desired:.3g} Hz the margins fail in "
+        parts.append(f"At {at} of {xo.desired:.3g} Hz the margins fail in "
                      f"{which}; {ach}.")
     if spec.isolator is not None:
         ok = st.chosen <= st.maximum * (1 + 1e-12)
@@ -849,8 +906,19 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
     elif advice is not None:
         parts.append(advice.reason[0].upper() + advice.reason[1:] + ".")
     g = pid.gains
-    parts.append(f"The PID tuned on {g.tuning_mass:.3g} kg has kp = {g.kp:.4g} N/m, "
-                 f"ki = {g.ki:.4g} N/(m s) and kd = {g.kd:.4g} N s/m.")
+    law = pid.controller
+    if law.source == "rule":
+        parts.append(f"The PID tuned on {g.tuning_mass:.3g} kg has kp = {g.kp:.4g} N/m, "
+                     f"ki = {g.ki:.4g} N/(m s) and kd = {g.kd:.4g} N s/m.")
+    else:
+        parts.append(f"The hardware's controller (kp = {law.kp:.4g} N/m, ki = {law.ki:.4g} "
+                     f"N/(m s), kd = {law.kd:.4g} N s/m; {_controller_words(law)}) crosses over "
+                     f"at {law.crossover:.3g} Hz on {law.tuning_mass:.3g} kg; the rule would tune "
+                     f"kp = {g.kp:.4g} N/m, ki = {g.ki:.4g} N/(m s), kd = {g.kd:.4g} N s/m there.")
+    if pid.static_error is not None:
+        parts.append(f"The loop has no integrator, so it cannot hunt by the paper's mechanism; "
+                     f"it leaves a static error of up to Fc / kp = "
+                     f"{pid.static_error * 1e6:.3g} um instead.")
     failed = [c.name for c in checks if c.status == Status.FAIL]
     if failed:
         parts.append(f"{len(failed)} check(s) fail ({', '.join(failed)}): revise the design "

@@ -589,15 +589,17 @@ def stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold, hist, head,
     return u + F, du + dF, ok
 
 
-@njit((i8, f8, A1, A1, I1, A1, A2, A1, A1, I1, f8, A2, i8, i8, A2, A1, A1, A1), cache=True,
+@njit((i8, f8, A1, A1, I1, A1, A2, A1, A1, I1, f8, A2, i8, i8, b1, A2, A1, A1, A1), cache=True,
       error_model="numpy", _nrt=False)
 def write_output(i, tq, yq, p, modes, breaks, coeffs, in_t, in_f, hints, fa_hold, hist, head,
-                 count, out_y, out_r, out_fa, out_cmd):
+                 count, need_cmd, out_y, out_r, out_fa, out_cmd):
     """Store the state ``yq`` at output time ``tq`` as output row ``i``, with r and the forces.
 
     ``out_cmd`` gets the commanded force (controller output plus feedforward
     plus input force, before delay and saturation), ``out_fa`` the force
-    applied to the stage.
+    applied to the stage. ``need_cmd`` false (a continuous controller without
+    delay, feedforward or input force) takes the short way: the command is
+    the controller's output.
     """
     n = yq.shape[0]
     iu = n - 1
@@ -607,6 +609,11 @@ def write_output(i, tq, yq, p, modes, breaks, coeffs, in_t, in_f, hints, fa_hold
     rr, rdr, _, _, kout = reference_at(tq, breaks, coeffs, hints[H_OUT])
     hints[H_OUT] = kout
     out_r[i] = rr
+    if not need_cmd:
+        uc = controller_output(yq, p, modes, rr, rdr, ii, iu)
+        out_cmd[i] = uc
+        out_fa[i], _ = actuator(uc, p)
+        return
     discrete = p[P_TS] > 0.0
     fa, _, _ = stage_command(tq, p, breaks, coeffs, in_t, in_f, hints, fa_hold, hist, head,
                              count)
@@ -698,7 +705,10 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     has_ff = p[P_FF_M] != 0.0 or p[P_FF_C] != 0.0 or p[P_FF_F] != 0.0
     n_in = in_t.shape[0]
     # the command needs computing at every stage unless it is the bare controller state
+    # or (``held``) the discrete controller's held output; calls with many array
+    # arguments cost about 0.2 us each, so the common cases stay inline
     need_cmd = (not fa_state) or has_ff or n_in > 0
+    held = discrete and n_in == 0
     m_acc = p[P_M1] if iso else p[P_M1] + p[P_M2]
     if cont_delay and h_max > delay:
         h_max = delay
@@ -817,7 +827,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
         # ---------------------------------------------------- outputs at t
         while i_out < m_out and t_out[i_out] <= t + 1e-12 * max(1.0, t):
             write_output(i_out, t_out[i_out], y, p, modes, breaks, coeffs, in_t, in_f, hints,
-                         fa_hold, hist, head, count, out_y, out_r, out_fa, out_cmd)
+                         fa_hold, hist, head, count, need_cmd, out_y, out_r, out_fa, out_cmd)
             i_out += 1
 
         if t >= t_end * (1.0 - 1e-14):
@@ -837,8 +847,9 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             t_land = t_sample
         if f_count > 0 and fifo_t[f_head] < t_land:
             t_land = fifo_t[f_head]
-        if n_in > 0:
-            while i_in < n_in and in_t[i_in] + delay <= t + 1e-12 * max(1.0, t):
+        if n_in > 0:  # the input's next change (an unchanged sample is no event)
+            while i_in < n_in and (in_t[i_in] + delay <= t + 1e-12 * max(1.0, t)
+                                   or (i_in > 0 and in_f[i_in] == in_f[i_in - 1])):
                 i_in += 1
             if i_in < n_in and in_t[i_in] + delay < t_land:
                 t_land = in_t[i_in] + delay
@@ -925,7 +936,9 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             ts = t + C2 * h
             rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
             fas = 0.0
-            if need_cmd:
+            if held:
+                fas = fa_hold
+            elif need_cmd:
                 fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
                                           hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
@@ -937,7 +950,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 ytmp[j] = y[j] + A31 * k1[j] + A32 * k2[j]
             ts = t + C3 * h
             rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
-            if need_cmd:
+            if need_cmd and not held:
                 fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
                                           hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
@@ -949,7 +962,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 ytmp[j] = y[j] + A41 * k1[j] + A42 * k2[j] + A43 * k3[j]
             ts = t + C4 * h
             rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
-            if need_cmd:
+            if need_cmd and not held:
                 fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
                                           hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
@@ -961,7 +974,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 ytmp[j] = y[j] + A51 * k1[j] + A52 * k2[j] + A53 * k3[j] + A54 * k4[j]
             ts = t + h
             rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
-            if need_cmd:
+            if need_cmd and not held:
                 fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
                                           hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
@@ -1046,14 +1059,30 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             # ------------------------------------------------ accept
             n_steps += 1
             t_new = t_land if landing else t + h
-            # outputs inside (t, t_new]
-            while i_out < m_out and t_out[i_out] <= t_new + 1e-12 * max(1.0, t_new):
+            # outputs inside (t, t_new); those at t_new follow its time events (a
+            # controller sample there shows its new output, as a drive records it)
+            while i_out < m_out and t_out[i_out] < t_new - 1e-12 * max(1.0, t_new):
                 th = (t_out[i_out] - t) / h
                 if th > 1.0:
                     th = 1.0
                 dense(y, ynew, cd2, cd3, th, ybuf)
-                write_output(i_out, t_out[i_out], ybuf, p, modes, breaks, coeffs, in_t, in_f,
-                             hints, fa_hold, hist, head, count, out_y, out_r, out_fa, out_cmd)
+                if need_cmd and not held:
+                    write_output(i_out, t_out[i_out], ybuf, p, modes, breaks, coeffs, in_t, in_f,
+                                 hints, fa_hold, hist, head, count, need_cmd, out_y, out_r,
+                                 out_fa, out_cmd)
+                else:  # the common cases inline (see ``held``): as write_output would
+                    for j in range(n):
+                        out_y[i_out, j] = ybuf[j]
+                    rr, rdr, _, _, kref = reference_at(t_out[i_out], breaks, coeffs, kref)
+                    out_r[i_out] = rr
+                    if held:
+                        out_cmd[i_out] = ybuf[iu]
+                        out_fa[i_out], _ = actuator(fa_hold, p)
+                    else:
+                        uc = ybuf[iu] if not algebraic else controller_output(
+                            ybuf, p, modes, rr, rdr, ii, iu)
+                        out_cmd[i_out] = uc
+                        out_fa[i_out], _ = actuator(uc, p)
                 i_out += 1
             # predictive step control (Gustafsson)
             if n_steps > 1:

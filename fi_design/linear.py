@@ -495,18 +495,13 @@ def complementary_sensitivity(spec: Spec, case, crossover: float | None = None,
     closed = np.polyadd(den, num)
     if isinstance(ctl, PidGains) or ctl.derivative_on == "error":
         return control.tf(num, closed)
-    # reference path C_r D P over the same closed-loop denominator: scale by C_r / C
+    # reference path: C_r D P (1 + L)^-1 = rn dn pn (cd / rd) / closed, where rd divides cd
+    lc = _case(spec, case, stiffness)
     cn, cd = controller_polynomials(ctl)
     rn, rd = reference_polynomials(ctl)
-    return control.tf(*_trim(np.polymul(np.polymul(num, rn), cd),
-                             np.polymul(np.polymul(closed, rd), cn)))
-
-
-def _trim(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Cancel the common roots at the origin of num and den (trailing zero coefficients)."""
-    while len(num) > 1 and len(den) > 1 and num[-1] == 0.0 and den[-1] == 0.0:
-        num, den = num[:-1], den[:-1]
-    return num, den
+    dn, _ = delay_polynomials(spec)
+    q, _ = np.polydiv(cd, rd)
+    return control.tf(np.polymul(np.polymul(rn, dn), np.polymul(lc.num, q)), closed)
 
 
 # --------------------------------------------------------------------------- margins

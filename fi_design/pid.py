@@ -29,7 +29,7 @@ The same controller in parallel form, as the simulation uses it::
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 from .errors import SpecError
 
@@ -230,7 +230,7 @@ class ControlLaw:
     tuning_mass: float
     derivative_ratio: float
     integrator_ratio: float
-    rule: PidGains
+    rule: PidGains = field(repr=False)
 
     @property
     def integrator(self) -> bool:
@@ -309,8 +309,18 @@ class ControlLaw:
         """
         return None if self.integrator else force / self.kp
 
+    def rule_in_this_form(self) -> dict[str, float]:
+        """The rule's gains at this crossover in this controller's form, to set beside it.
+
+        ``kp``, ``ki``, ``kd`` [N/m, N/(m s), N s/m] of ``kp + ki/s + kd s/(1 + s/wt)``
+        with the rule's roll-off ``roll_off`` = wt [rad/s]: gains a drive
+        with a filtered D term can take as they are.
+        """
+        kp, ki, kd = _filtered_d(self.rule)
+        return dict(kp=kp, ki=ki, kd=kd, roll_off=self.rule.wt)
+
     def to_dict(self) -> dict:
-        """Plain JSON data (SI; rad/s for ``roll_off``, infinities as null)."""
+        """Plain JSON data (SI; rad/s for ``roll_off``, infinities as null; without ``rule``)."""
         from .results import dataclass_dict
 
         return dataclass_dict(self)

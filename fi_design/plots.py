@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from . import spec as _spec
+
 # --------------------------------------------------------------------------- design report
 # (fi_design.report: the linear analysis and the nonlinear confirmation of a DesignResult)
 
@@ -507,7 +509,7 @@ def scan_figure(confirmation: Any, spec: Any) -> Any:
             ax.text(scan.minimum, 0.97 if key == "isolated" else 0.87,
                     f" hunting-free from {scan.minimum:g} Hz", color=col, fontsize=7,
                     transform=ax.get_xaxis_transform(), va="top", ha="left")
-    fc = spec.controller.crossover
+    fc = _spec.design_crossover(spec)
     ax.axvline(fc, color="0.3", lw=0.9, ls="--")
     ax.text(fc, 0.77, f" design {fc:g} Hz", color="0.3", fontsize=7,
             transform=ax.get_xaxis_transform(), va="top", ha="left")

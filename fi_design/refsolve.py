@@ -79,6 +79,8 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
     s = params.s
     in_t = np.zeros(0) if input_time is None else np.asarray(input_time, dtype=float)
     in_f = np.zeros(0) if input_force is None else np.asarray(input_force, dtype=float)
+    # times at which the delayed input changes value
+    changes = (in_t[np.r_[True, np.diff(in_f) != 0]] + delay) if len(in_t) else in_t
 
     t_out = np.asarray(t_out, dtype=float)
     out_y = np.full((len(t_out), n), np.nan)
@@ -171,8 +173,11 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
         return [e[0] for e in evs], funcs
 
     def write_outputs(t0, t1, sol):
+        """Outputs in [t0, t1) from ``sol`` (at t0 only, from the state, when ``sol`` is None):
+        those at t1 follow its time events."""
         lo = bisect.bisect_left(t_out, t0 - 1e-12)
-        hi = bisect.bisect_right(t_out, t1 + 1e-12)
+        hi = bisect.bisect_left(t_out, t1 - 1e-12) if sol is not None else \
+            bisect.bisect_right(t_out, t0 + 1e-12)
         for i in range(lo, hi):
             if not np.isnan(out_r[i]):
                 continue
@@ -227,9 +232,9 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
             t_next = min(t_next, fifo[0][0])
         if cont_delay:
             t_next = min(t_next, t + delay)
-        k = bisect.bisect_right(in_t + delay, t + 1e-12 * max(1.0, t))
-        if k < len(in_t):
-            t_next = min(t_next, in_t[k] + delay)
+        k = bisect.bisect_right(changes, t + 1e-12 * max(1.0, t))
+        if k < len(changes):
+            t_next = min(t_next, changes[k])
         names, funcs = events()
         if zero_run > 2:
             # grazing: the state sits on a switching surface (a cart at rest has
@@ -263,6 +268,8 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
         if abs(y[0]) > x_bound or not np.all(np.isfinite(y)):
             code, status = 4, "solution diverged"
             break
+    if code == 0:
+        write_outputs(t, t, None)
     return Integration(code=code, status=status, states=out_y, reference=out_r,
                        applied_force=out_fa, command=out_cmd, n_steps=n_steps, n_rejected=n_rej,
                        n_events=n_ev, t_reached=t)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -26,14 +27,13 @@ from .pid import ControlLaw
 from .plant import P_SIGMA2_NEG, PlantParameters, state_index, stribeck
 
 #: Span of samples the local velocity estimate fits [s].
-VELOCITY_SPAN = 0.02
+VELOCITY_SPAN = 0.01
 #: Fewest samples the local velocity estimate needs.
 MIN_FIT_SAMPLES = 5
 
-#: Standard errors the velocity estimate must exceed for the stage to count as moving: about
-#: the two-sided 99.9 % quantile of Student's t for the 8 degrees of freedom of a one-sided
-#: 20 ms fit at 1 kHz (a stage at rest is then taken as moving once in a thousand records).
-MOVING_T = 5.0
+#: Two-sided probability that a stage at rest is taken as moving: the velocity estimate must
+#: exceed this quantile of Student's t (with the fit's degrees of freedom) in standard errors.
+MOVING_P = 1e-3
 
 #: Drives of a replay: the model's controller closes the loop, or the measured force drives it.
 DRIVES = ("closed", "force")
@@ -50,17 +50,18 @@ class RecordState:
     time : float
         Sample time [s].
     position : float
-        Stage position x1 at the sample from the local quadratic fit [m]
-        (one sample's sensor noise would otherwise offset the whole replay).
+        Measured stage position x1 at the sample [m].
     velocity : float
         Stage velocity from a local quadratic fit of the position [m/s].
     velocity_error : float
         Standard error of ``velocity`` from the fit's residuals [m/s] (0 for
         an exact fit).
+    dof : int
+        Degrees of freedom of the fit's residuals.
 
-    The stage counts as moving when ``velocity`` exceeds :data:`MOVING_T`
-    standard errors (:attr:`moving`); below that the record starts at rest and a noisy
-    velocity estimate must not start the friction model sliding.
+    The stage counts as moving when a t-test rejects zero velocity at
+    :data:`MOVING_P` (:attr:`moving`); otherwise the record starts at rest and a
+    noisy velocity estimate must not start the friction model sliding.
     """
 
     index: int
@@ -68,14 +69,28 @@ class RecordState:
     position: float
     velocity: float
     velocity_error: float = 0.0
+    dof: int = 0
 
     @property
     def moving(self) -> bool:
-        """Whether the velocity differs from zero by more than :data:`MOVING_T` standard errors."""
-        return abs(self.velocity) > MOVING_T * self.velocity_error
+        """Whether a t-test rejects zero velocity (two-sided, :data:`MOVING_P`)."""
+        if self.velocity_error <= 0.0 or self.dof < 1:
+            return self.velocity != 0.0
+        from scipy.special import stdtrit
+
+        limit = float(stdtrit(self.dof, 1.0 - MOVING_P / 2.0))
+        return abs(self.velocity) > limit * self.velocity_error
 
 
-def _local_fit(record: Measurement, values: np.ndarray, index: int, span: float):
+class LocalFit(NamedTuple):
+    """A local quadratic: coefficients (value, slope, half curvature), covariance, dof."""
+
+    coef: np.ndarray
+    cov: np.ndarray
+    dof: int
+
+
+def _local_fit(record: Measurement, values: np.ndarray, index: int, span: float) -> LocalFit:
     """Quadratic least-squares fit of ``values`` within ``span`` around sample ``index``.
 
     One-sided at the ends of the record, at least :data:`MIN_FIT_SAMPLES`
@@ -93,7 +108,51 @@ def _local_fit(record: Measurement, values: np.ndarray, index: int, span: float)
     coef, ssr, _, _ = np.linalg.lstsq(A, np.asarray(values[lo:hi], dtype=float), rcond=None)
     dof = hi - lo - 3
     s2 = float(ssr[0]) / dof if len(ssr) and dof > 0 else 0.0
-    return coef, s2 * np.linalg.pinv(A.T @ A)
+    return LocalFit(coef, s2 * np.linalg.pinv(A.T @ A), int(dof))
+
+
+@dataclass(frozen=True)
+class ReplayFit:
+    """How a replay agrees with the record it replays.
+
+    Attributes
+    ----------
+    samples : int
+        Samples compared (those the replay reached).
+    position_rms : float
+        RMS of model minus measured stage position [m].
+    position_max : float
+        Largest absolute position difference [m].
+    tracking_rms_model : float
+        RMS tracking error r - x1 of the model [m].
+    tracking_rms_measured : float
+        RMS tracking error r - x1 of the measurement [m].
+    force_rms : float or None
+        RMS of model minus measured commanded force [N]; None without ``force_N``.
+    """
+
+    samples: int
+    position_rms: float
+    position_max: float
+    tracking_rms_model: float
+    tracking_rms_measured: float
+    force_rms: float | None
+
+
+def replay_fit(record: Measurement, position: np.ndarray, force: np.ndarray) -> ReplayFit:
+    """Compare a replay's position [m] and commanded force [N] with the record."""
+    ok = np.isfinite(position)
+
+    def rms(x):
+        return float(np.sqrt(np.mean(x[ok] ** 2))) if ok.any() else math.nan
+
+    dx = position - record.position
+    return ReplayFit(
+        samples=int(ok.sum()), position_rms=rms(dx),
+        position_max=float(np.max(np.abs(dx[ok]))) if ok.any() else math.nan,
+        tracking_rms_model=rms(record.reference - position),
+        tracking_rms_measured=rms(record.reference - record.position),
+        force_rms=None if record.force is None else rms(force - record.force))
 
 
 def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPAN) -> RecordState:
@@ -101,7 +160,7 @@ def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPA
 
     A quadratic fitted by least squares to the positions within ``span``
     around the sample (one-sided at the ends of the record) gives the
-    position and velocity at the sample: robust to encoder counts and sensor
+    velocity at the sample: robust to encoder counts and sensor
     noise, and right while the stage accelerates.
 
     Parameters
@@ -123,10 +182,10 @@ def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPA
     if n < MIN_FIT_SAMPLES:
         raise DataError(f"too short to estimate the initial velocity: {n} sample(s), at least "
                         f"{MIN_FIT_SAMPLES} needed", column="position_m", source=record.source)
-    coef, cov = _local_fit(record, record.position, index, span)
+    fit = _local_fit(record, record.position, index, span)
     return RecordState(index=int(index), time=float(record.time[index]),
-                       position=float(coef[0]), velocity=float(coef[1]),
-                       velocity_error=float(np.sqrt(max(cov[1, 1], 0.0))))
+                       position=float(record.position[index]), velocity=float(fit.coef[1]),
+                       velocity_error=float(np.sqrt(max(fit.cov[1, 1], 0.0))), dof=fit.dof)
 
 
 def reference_state(record: Measurement, index: int = 0,
@@ -143,7 +202,7 @@ def reference_state(record: Measurement, index: int = 0,
     (r, r', r'') : tuple of float
         [m, m/s, m/s^2].
     """
-    coef, _ = _local_fit(record, record.reference, index, span)
+    coef = _local_fit(record, record.reference, index, span).coef
     return float(record.reference[index]), float(coef[1]), float(2.0 * coef[2])
 
 
@@ -234,10 +293,10 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
         kf = law.kernel_form()
         v_wo_i = kf["kp"] * e + kf["kd"] * (rd - v1) - kf["kdm"] * v1
         target = v_wo_i if command is None else command - feedforward
-        if law.integrator:
+        if law.integrator:  # the integrator takes what P and D leave of the first sample
             y0[idx["I"]] = target - v_wo_i
-        if not math.isinf(kf["wt"]):
-            y0[idx["u"]] = target if law.integrator else v_wo_i
+        if not math.isinf(kf["wt"]):  # the filter state is the output itself
+            y0[idx["u"]] = target
     if command is not None:
         changes["u_initial"] = command
     return y0, replace(params, **changes)
@@ -257,14 +316,18 @@ def _discrete_state(params: PlantParameters, law: ControlLaw, e: float, xm: floa
 
     The D term is taken in steady state for the present rate of its input
     (``ed`` = e' or ``-xd``), which both the Tustin and the backward-difference
-    form reproduce exactly; the integrator takes what the first force sample
-    needs beyond P and D (only when the loop has one).
+    form reproduce exactly. What the first force sample needs beyond P and
+    that D goes to the integrator when the loop has one, else to the D term
+    (whose state is then the one the drive really had).
     """
     on_meas = law.derivative_on == "measurement"
     d_in, d_rate = (-xm, -xd) if on_meas else (e, ed)
     D0 = law.kd * d_rate
-    dx2 = D0 - params.db * d_in
     dx1 = 0.0
-    if law.integrator and command is not None:
-        dx1 = command - feedforward - params.dp * e - params.dc * e - D0
-    return dict(dx1=dx1, dx2=dx2)
+    if command is not None:
+        rest = command - feedforward - params.dp * e - params.dc * e - D0
+        if law.integrator:
+            dx1 = rest
+        else:
+            D0 += rest
+    return dict(dx1=dx1, dx2=D0 - params.db * d_in)

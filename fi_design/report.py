@@ -76,6 +76,7 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from .errors import OutputError
+from . import spec as _spec
 from .results import Status
 
 __all__ = [
@@ -1753,7 +1754,7 @@ def design_map(result: Any, *, resolution: tuple[int, int] = (8, 6), progress: A
         spec = with_isolator(spec, adv.stroke, adv.stiffness)
         note = (f"The spec has no isolator: the map uses the suggested one "
                 f"({qty(adv.stroke, 'm')} stroke, {qty(adv.stiffness, 'N/m')}). ")
-    fc = spec.controller.crossover
+    fc = _spec.design_crossover(spec)
     s = spec.isolator.stroke
     nx, ny = resolution
     xs = np.linspace(0.125 * fc, 2.5 * fc, nx)

@@ -26,14 +26,15 @@ from .errors import SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from .pid import ControlLaw, control_law
 from .plant import PlantParameters, state_index
-from .replay import DRIVES, command_state, initial_state, record_state, reference_state
+from .replay import (DRIVES, ReplayFit, command_state, initial_state, record_state,
+                     reference_state, replay_fit)
 from .results import frozen_array, to_jsonable
 from .trajectory import Trajectory, from_moves, from_samples
 
 METHODS = ("fast", "reference")
 
 #: Default length of the re-anchored windows of an open-loop replay [s].
-WINDOW = 0.25
+WINDOW = 0.1
 
 
 @dataclass(frozen=True, eq=False)
@@ -99,6 +100,8 @@ class SimulationResult:
         Open-loop replay: the number of the re-anchored window of each
         sample (the state is reset to the measurement at each window's
         start); None otherwise.
+    replay : ReplayFit or None
+        How a record's replay agrees with the measurement; None otherwise.
     """
 
     isolated: bool
@@ -128,6 +131,7 @@ class SimulationResult:
     drive: str = "closed"
     record: str | None = None
     window: np.ndarray | None = None
+    replay: ReplayFit | None = None
 
     @property
     def error(self) -> np.ndarray:
@@ -369,6 +373,7 @@ def _integrate(spec, method, params, y0, ref, t_end, t_out, rtol, input_time=Non
 
 def _result(spec, iso, method, law, params, out, t_out, wall, effects, *, move_end,
             time_offset=0.0, drive="closed", record=None, window=None) -> SimulationResult:
+    """The result of an integration; ``record`` (a Measurement) for a replay."""
     success = out.code == 0
     message = "" if success else _failure_message(out.status, out.t_reached, params, iso)
     Y, R = out.states, out.reference
@@ -385,8 +390,10 @@ def _result(spec, iso, method, law, params, out, t_out, wall, effects, *, move_e
         applied_force=frozen_array(out.applied_force), bristle=frozen_array(Y[:, idx["z"]]),
         success=success, status=out.status, message=message, t_reached=out.t_reached + time_offset,
         n_steps=out.n_steps, n_rejected=out.n_rejected, n_events=out.n_events, wall_time=wall,
-        metrics=metrics, parameters=params, drive=drive, record=record,
-        window=None if window is None else frozen_array(window, dtype=int))
+        metrics=metrics, parameters=params, drive=drive,
+        record=None if record is None else (record.source or "record"),
+        window=None if window is None else frozen_array(window, dtype=int),
+        replay=None if record is None else replay_fit(record, Y[:, idx["x1"]], out.command))
 
 
 def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects,
@@ -395,7 +402,6 @@ def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects
     t0 = float(record.time[0])
     t_out = np.asarray(record.time, dtype=float) - t0
     ref = from_samples(t_out, record.reference)
-    source = record.source or "record"
     if drive == "closed":
         dist = record.disturbance
         command = command_state(record, 0) if initial_command is None else float(initial_command)
@@ -403,7 +409,7 @@ def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects
         out, wall = _integrate(spec, method, p0, y0, ref, float(t_out[-1]), t_out, rtol,
                                None if dist is None else t_out, dist)
         return _result(spec, iso, method, law, p0, out, t_out, wall, effects, move_end=0.0,
-                       time_offset=t0, record=source)
+                       time_offset=t0, record=record)
     if record.force is None:
         raise SimulationError("an open-loop replay (drive='force') needs the record's force_N "
                               "column")
@@ -428,7 +434,7 @@ def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects
             break
     merged, labels = _merge(pieces, t_out)
     return _result(spec, iso, method, law, open_loop, merged, t_out, wall, effects, move_end=0.0,
-                   time_offset=t0, drive="force", record=source, window=labels)
+                   time_offset=t0, drive="force", record=record, window=labels)
 
 
 def _anchor(law, params, record, index, ref, command):

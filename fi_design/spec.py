@@ -514,11 +514,13 @@ def gains_crossover(spec: Spec) -> float:
 
 
 def design_crossover(spec: Spec) -> float:
-    """The loop's crossover [Hz]: ``controller.crossover`` for the rule, else the gains' own."""
+    """The loop's crossover [Hz]: ``controller.crossover`` for the rule, else the gains' own.
+
+    With explicit gains a given crossover only has to agree with theirs
+    (:data:`CROSSOVER_AGREEMENT`); the loop crosses over where the gains do.
+    """
     ctl = spec.controller
-    if ctl.gains is None:
-        return ctl.crossover
-    return ctl.crossover if ctl.crossover is not None else gains_crossover(spec)
+    return ctl.crossover if ctl.gains is None else gains_crossover(spec)
 
 
 
