@@ -36,6 +36,8 @@ MAX_POINTS = 3000
 FAIL_FACTOR = 10.0
 #: A run whose position error exceeds this many times the largest measured error has run away.
 RUNAWAY_FACTOR = 10.0
+#: Tolerance factor of the check of a finding's numerical accuracy (one run this much tighter).
+ACCURACY_CHECK = 1e-3
 #: Range the initial command is fitted in, in force-noise standard deviations either side.
 INITIAL_COMMAND_RANGE = 4.0
 
@@ -110,8 +112,8 @@ class Comparison:
 
     # ---- model runs
 
-    def run(self, entries, quantize: float | None = None,
-            command_correction: float = 0.0) -> ModelRun:
+    def run(self, entries, quantize: float | None = None, command_correction: float = 0.0,
+            rtol: float | None = None) -> ModelRun:
         """Simulate with effect entries (model objects) on the record.
 
         Parameters
@@ -125,10 +127,13 @@ class Comparison:
         command_correction : float
             Added to the initial command [N] (the nuisance, see
             :attr:`command_width`).
+        rtol : float, optional
+            Relative tolerance; default :func:`model_tolerance`.
         """
         self.n_sims += 1
         u0 = None if self.initial_command is None else self.initial_command + command_correction
-        res = simulate(self.spec, self.iso, effects=list(entries), rtol=self.rtol,
+        res = simulate(self.spec, self.iso, effects=list(entries),
+                       rtol=self.rtol if rtol is None else rtol,
                        record=self.meas, drive=self.drive, initial_command=u0)
         x = np.asarray(res.position, dtype=float)
         u = np.asarray(res.force, dtype=float)

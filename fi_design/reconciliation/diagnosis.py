@@ -6,7 +6,7 @@ catalogue is "the" answer: the model's structure does not match the record.
 The nominal residual (force when recorded, else position) then points at
 likely causes, each with the share of the residual that points there:
 
-- **controller**: power at and above a third of the loop's crossover, where
+- **controller**: energy at and above a third of the loop's crossover, where
   the controller shapes the response (gains, the derivative's filter and
   input, sample rate, delay);
 - **initial state**: residual concentrated at the start of the record (the
@@ -59,7 +59,7 @@ def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
     r = np.where(np.isfinite(model), meas - model, 0.0)
     crossover = control_law(cmp.spec).crossover
     spec = _spectrum(r, cmp.t)
-    causes = sorted(_causes(cmp, r, spec, crossover, use_force), key=lambda c: -c.share)
+    causes = sorted(_causes(cmp, r, crossover, use_force), key=lambda c: -c.share)
     mismatch = misfit >= STRUCTURE_MISFIT and best_explained < EXPLAINED_MIN
     message = ""
     if mismatch:
@@ -99,56 +99,66 @@ def _spectrum(r: np.ndarray, t: np.ndarray) -> Spectrum:
     return Spectrum(f, np.sqrt(p))
 
 
-def _causes(cmp: Comparison, r: np.ndarray, spec: Spectrum, crossover: float,
-            use_force: bool) -> list[Cause]:
+def _band(r: np.ndarray, t: np.ndarray, low: float | None, high: float | None) -> np.ndarray:
+    """Zero-phase Butterworth filtering of a residual: low-pass below ``high``, high-pass above ``low`` [Hz]."""
+    from scipy.signal import butter, sosfiltfilt
+
+    fs = 1.0 / float(np.median(np.diff(t)))
+    nyq = fs / 2.0
+    out = np.asarray(r, dtype=float)
+    if high is not None and high < nyq:
+        out = sosfiltfilt(butter(2, high, btype="lowpass", fs=fs, output="sos"), out)
+    if low is not None:
+        if low >= nyq:
+            return np.zeros_like(out)
+        out = sosfiltfilt(butter(2, low, btype="highpass", fs=fs, output="sos"), out)
+    return out
+
+
+def _causes(cmp: Comparison, r: np.ndarray, crossover: float, use_force: bool) -> list[Cause]:
+    """Shares of the residual's energy (its mean included) that point at each cause."""
     unit = "N" if use_force else "m"
+    t = cmp.t
+    total = float(r @ r) or 1e-300
     out = []
-    freq = spec.frequency
-    power = spec.density ** 2
-    total = float(np.sum(power[1:])) or 1e-300
-    high = float(np.sum(power[freq >= crossover / 3.0])) / total
-    out.append(Cause("controller", high,
-                     f"{100 * high:.0f} % of the residual's power lies at or above a third of the "
-                     f"loop's crossover ({crossover:.3g} Hz), where the controller shapes the "
+    fast = _band(r, t, crossover / 3.0, None)
+    high = float(fast @ fast) / total
+    out.append(Cause("controller", min(high, 1.0),
+                     f"{100 * high:.0f} % of the residual's energy lies at or above a third of "
+                     f"the loop's crossover ({crossover:.3g} Hz), where the controller shapes the "
                      "response: check the controller description (gains, the derivative's input "
                      "and filter, sample rate, delay)."))
-    t = cmp.t
     window = max(START_SHARE * cmp.duration, cmp.settle_window)
     first = t <= t[0] + window
     frac_t = float(np.mean(first))
-    ss = float(np.sum(r ** 2)) or 1e-300
-    frac_ss = float(np.sum(r[first] ** 2)) / ss
+    frac_ss = float(r[first] @ r[first]) / total
     start = max(0.0, (frac_ss - frac_t) / (1.0 - frac_t)) if frac_t < 1.0 else 0.0
     out.append(Cause("initial_state", start,
                      f"{100 * frac_ss:.0f} % of the residual's energy lies in the first "
                      f"{window:.3g} s ({100 * frac_t:.0f} % of the record): check the state "
                      "the replay starts from (position, velocity, the controller's integrator)."))
     moving = cmp.kind != "hold"
-    a = cmp.a_ref
-    mass = 0.0
-    slope = 0.0
+    a, v = cmp.a_ref, cmp.v_ref
+    mass, slope = 0.0, 0.0
     if moving.sum() > 10 and np.ptp(a[moving]) > 0:
         A = np.column_stack([np.ones(moving.sum()), a[moving]])
         coef, *_ = np.linalg.lstsq(A, r[moving], rcond=None)
-        fit = A @ coef
         var = float(np.var(r[moving])) or 1e-300
-        mass = max(0.0, 1.0 - float(np.var(r[moving] - fit)) / var)
+        mass = max(0.0, 1.0 - float(np.var(r[moving] - A @ coef)) / var)
         slope = float(coef[1])
     out.append(Cause("mass", mass,
                      f"the residual follows the reference acceleration (R^2 {mass:.2f}, slope "
                      f"{slope:.3g} {unit} s^2/m"
                      + (": the moving mass or the feedforward is off by about that many kg)."
                         if use_force else ")")))
-    v = cmp.v_ref
-    X = np.column_stack([np.ones_like(v), v, np.sign(v), a])
+    # what velocity, direction and acceleration terms (friction, mass: the catalogue's) leave
+    X = np.column_stack([v, np.sign(v), a])
     coef, *_ = np.linalg.lstsq(X, r, rcond=None)
-    rest = r - X @ coef
-    low = _spectrum(rest, t)
-    band = (low.frequency > 0) & (low.frequency <= crossover / 30.0)
-    slow = float(np.sum(low.density[band] ** 2)) / total
-    slow = min(slow, 1.0)
+    slow_part = _band(r - X @ coef, t, None, crossover / 30.0)
+    slow = min(float(slow_part @ slow_part) / total, 1.0)
     out.append(Cause("disturbance", slow,
-                     f"{100 * slow:.0f} % of the residual's power is slow (below "
-                     f"{crossover / 30.0:.3g} Hz) and not a velocity, direction or acceleration "
-                     "term: a force the model lacks (a cable, a drift, a load)."))
+                     f"{100 * slow:.0f} % of the residual's energy is slow (below "
+                     f"{crossover / 30.0:.3g} Hz, a constant included) and not a velocity, "
+                     "direction or acceleration term: a force the model lacks (a load, a "
+                     "cable, a drift)."))
     return out

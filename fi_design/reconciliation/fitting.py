@@ -58,6 +58,10 @@ class FitOutcome:
         (J^T J)^+ of the effect's own coordinates, marginal over the
         nuisance (and over effects refitted with it), unscaled; None for an
         effect read from the data or a failed fit.
+    jacobian : ndarray, shape (n, m), or None
+        d(residual)/du at the optimum over every fitted coordinate.
+    columns : slice
+        The effect's own columns of ``jacobian``.
     run : ModelRun
         The simulation at the best point.
     entries : list
@@ -70,6 +74,8 @@ class FitOutcome:
         Parameters on a search bound or physical limit at the end.
     n_simulations : int
         Simulations used.
+    n_failed : int
+        Of those, the ones that failed or ran away (an unstable loop).
     note : str
         What happened (a failed local fit, a bound).
     """
@@ -80,12 +86,15 @@ class FitOutcome:
     residual: np.ndarray
     chi2: float
     covariance: np.ndarray | None
+    jacobian: np.ndarray | None
+    columns: slice
     run: ModelRun
     entries: list
     command: float
     widened: int
     at_bound: tuple
     n_simulations: int
+    n_failed: int = 0
     note: str = ""
 
 
@@ -183,6 +192,7 @@ class Objective:
         self.k = len(space.coords)
         self.cache: dict[tuple, Evaluation] = {}
         self.n_sims = 0
+        self.n_failed = 0
 
     def values(self, u: np.ndarray) -> dict:
         """The effect's parameters at u, SI."""
@@ -226,6 +236,7 @@ class Objective:
             self.n_sims += 1
             run = self.cmp.run(self.entries(u), quantize=self.space.quantize,
                                command_correction=self.command(u))
+            self.n_failed += int(not run.ok)
             hit = Evaluation(self.cmp.residuals(run), run)
             self.cache[key] = hit
         return hit
@@ -286,12 +297,12 @@ def fit(cmp: Comparison, space: Space, base: list, command: float = 0.0) -> FitO
         u = np.zeros(0)
         ev = ob.evaluate(u)
         return FitOutcome(space, u, ob.values(u), ev.residual, float(ev.residual @ ev.residual),
-                          None, ev.run, ob.entries(u), 0.0, 0, (), ob.n_sims,
-                          "read from the data")
+                          None, None, slice(0, 0), ev.run, ob.entries(u), 0.0, 0, (), ob.n_sims,
+                          ob.n_failed, "read from the data")
     starts = [_with_command(ob, u, command) for u in space.starts] or \
         [_with_command(ob, np.zeros(0), command)]
     local = _local_fit(ob, starts)
-    n_sims = ob.n_sims
+    n_sims, n_failed = ob.n_sims, ob.n_failed
     widened = 0
     while widened < MAX_WIDEN and local.u is not None:
         coords = list(space.coords if widened == 0 else ob.space.coords)
@@ -312,13 +323,15 @@ def fit(cmp: Comparison, space: Space, base: list, command: float = 0.0) -> FitO
         u0 = _with_command(ob, np.array([c.u_of(value[c.name]) for c in coords]), cmd)
         local = _local_fit(ob, [u0])
         n_sims += ob.n_sims
+        n_failed += ob.n_failed
         widened += 1
     if local.u is None:
         u = local.fallback
         ev = ob.evaluate(u)
         return FitOutcome(ob.space, u, ob.values(u), ev.residual,
-                          float(ev.residual @ ev.residual), None, ev.run, ob.entries(u),
-                          ob.command(u), widened, (), n_sims,
+                          float(ev.residual @ ev.residual), None, None, slice(0, ob.k), ev.run,
+                          ob.entries(u),
+                          ob.command(u), widened, (), n_sims, n_failed,
                           "the local fit failed; the best starting point is reported")
     ev = ob.evaluate(local.u)
     at = _at_bound(ob.space, local.u[:ob.k])
@@ -328,8 +341,10 @@ def fit(cmp: Comparison, space: Space, base: list, command: float = 0.0) -> FitO
                 + ": " + ", ".join(at))
     return FitOutcome(ob.space, local.u, ob.values(local.u), ev.residual,
                       float(ev.residual @ ev.residual),
-                      marginal_covariance(local.jacobian, slice(0, ob.k)), ev.run,
-                      ob.entries(local.u), ob.command(local.u), widened, at, n_sims, note)
+                      marginal_covariance(local.jacobian, slice(0, ob.k)), local.jacobian,
+                      slice(0, ob.k), ev.run,
+                      ob.entries(local.u), ob.command(local.u), widened, at, n_sims, n_failed,
+                      note)
 
 
 def _at_bound(space: Space, u: np.ndarray) -> tuple:
@@ -535,11 +550,19 @@ def polish_jointly(cmp: Comparison, earlier: list, outcome: FitOutcome,
     """
     spaces = [o.space for o in earlier] + [outcome.space]
     jo = JointObjective(cmp, spaces, base)
-    parts = [o.u[:len(o.space.coords)] for o in earlier] + \
-        [outcome.u[:len(outcome.space.coords)]]
-    if jo.nuisance is not None:
-        parts.append([jo.nuisance.u_of(outcome.command)])
-    jf = joint_fit(jo, np.concatenate(parts))
+    k = len(outcome.space.coords)
+    own = [outcome.u[:k]]
+    if outcome.at_bound or not outcome.chi2 < earlier[-1].chi2:
+        # alone it found nothing: the joint fit also starts from the middle of its range
+        own.append(np.full(k, 0.5))
+    jf = None
+    for start in own:
+        parts = [o.u[:len(o.space.coords)] for o in earlier] + [start]
+        if jo.nuisance is not None:
+            parts.append([jo.nuisance.u_of(earlier[-1].command)])
+        trial = joint_fit(jo, np.concatenate(parts))
+        if jf is None or trial.chi2 < jf.chi2:
+            jf = trial
     if not jf.chi2 < outcome.chi2:
         return outcome
     ev = jo.evaluate(jf.u)
@@ -552,6 +575,7 @@ def polish_jointly(cmp: Comparison, earlier: list, outcome: FitOutcome,
         note += "; on the search bound: " + ", ".join(at)
     return replace(outcome, u=np.concatenate([u, jf.u[len(jf.u) - (1 if jo.nuisance else 0):]]),
                    values=ob.values(u), residual=ev.residual, chi2=jf.chi2,
-                   covariance=marginal_covariance(jf.jacobian, sl), run=ev.run,
+                   covariance=marginal_covariance(jf.jacobian, sl), jacobian=jf.jacobian,
+                   columns=sl, run=ev.run,
                    entries=jo.entries(jf.u), command=jo.command(jf.u), at_bound=at,
                    n_simulations=outcome.n_simulations + jo.n_sims, note=note)

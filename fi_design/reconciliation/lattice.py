@@ -23,11 +23,13 @@ steps), so its relative error is about the noise over the travel; the
 largest step that passes is the lattice (every divisor of the step passes
 too). The jitter, the spread around the lattice points, is the sensor noise
 apart from the quantization. The lattice is *coarser than the noise
-explains* when its quantization error ``q / sqrt(12)`` exceeds
-:data:`COARSE_FACTOR` times the position noise estimated from the data as
-for any record (:func:`~.noise.estimate_noise`): an encoder whose counts are
-the only noise (the noise estimate is then about ``q / sqrt(12)`` itself)
-has a lattice, but no quantization effect beyond its noise.
+explains* when the counts, not a noise under them, make the record's
+scatter: under noise, when the quantization error ``q / sqrt(12)`` exceeds
+:data:`COARSE_FACTOR` times the jitter; for whole counts (the noise before
+the rounding is not in the record), when the record's noise estimate
+(:func:`~.noise.estimate_noise`) is at most :data:`COARSE_FACTOR` times
+``q / sqrt(12)`` (a logger rounding a much noisier signal onto a fine grid
+has a lattice, but no coarse one).
 """
 
 from __future__ import annotations
@@ -57,7 +59,7 @@ SMOOTH_ORDER = 3
 GRID_PER_DECADE = 250
 #: Smallest step tried [m].
 MIN_STEP = 1e-9
-#: How many times the position noise the quantization error q / sqrt(12) must exceed.
+#: Margin between the quantization error q / sqrt(12) and the noise for a coarse lattice.
 COARSE_FACTOR = 1.5
 
 
@@ -83,8 +85,9 @@ def find_lattice(position: np.ndarray, noise: float) -> Lattice:
     position : ndarray, shape (n,)
         Measured positions in time order [m].
     noise : float
-        Position noise estimated from the data [m] (the lattice is coarse when
-        q / sqrt(12) exceeds :data:`COARSE_FACTOR` times it).
+        Position noise estimated from the data as for any record [m] (whole
+        counts are a coarse lattice when it is at most :data:`COARSE_FACTOR`
+        times q / sqrt(12)).
 
     Returns
     -------
@@ -101,11 +104,18 @@ def find_lattice(position: np.ndarray, noise: float) -> Lattice:
     if found is None:
         found = _noisy_lattice(x, span)
     if found.found:
-        coarse = found.step / math.sqrt(12.0) > COARSE_FACTOR * noise
-        found = replace(found, coarse=coarse, detail=found.detail + (
-            f"; its quantization error, {found.step / math.sqrt(12.0):.3g} m, is "
-            + ("coarser than" if coarse else "within")
-            + f" the position noise ({noise:.3g} m)"))
+        qe = found.step / math.sqrt(12.0)
+        if found.exact:
+            coarse = noise <= COARSE_FACTOR * qe
+            why = (f"the record's noise ({noise:.3g} m) is "
+                   + ("no more than" if coarse else "well above")
+                   + f" its quantization error ({qe:.3g} m)")
+        else:
+            coarse = qe > COARSE_FACTOR * found.jitter
+            why = (f"its quantization error ({qe:.3g} m) is "
+                   + ("coarser than" if coarse else "within")
+                   + f" the noise around it ({found.jitter:.3g} m)")
+        found = replace(found, coarse=coarse, detail=found.detail + "; " + why)
     return found
 
 
@@ -129,6 +139,8 @@ def _exact_lattice(x: np.ndarray, span: float) -> Lattice | None:
     if np.mean(np.abs(ratio - np.round(ratio)) <= EXACT_TOLERANCE) < EXACT_FRACTION:
         return None
     est = refine_step(x, q)
+    # whole counts: the step is known to the number formatting of the record (ten digits)
+    est = est._replace(error=max(est.error, 1e-10 * est.step))
     q = est.step
     x0 = _offset(x, q)
     e = _wrapped(x, x0, q)

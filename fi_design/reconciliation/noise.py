@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from ..measured import Measurement
-from .results import NoiseLevels
+from .results import Lattice, NoiseLevels
 
 #: Model-accuracy floor of the noise per channel (position and deflection in m, force in N).
 NOISE_FLOOR = {"position": 1e-9, "deflection": 1e-10, "force": 1e-5}
@@ -48,11 +48,14 @@ def estimate_noise(values: np.ndarray) -> float:
     return 1.4826 * mad / math.sqrt(20.0)
 
 
-def noise_levels(spec, measured: Measurement, isolated: bool,
+def noise_levels(spec, measured: Measurement, isolated: bool, lattice: Lattice,
                  force_is_input: bool = False) -> NoiseLevels:
     """Noise per channel: the spec's ``measurement`` section, else estimated from the data.
 
-    No level falls below :data:`NOISE_FLOOR`.
+    A position recorded on a lattice of step q differs from any unquantized
+    position by up to q / 2: the resolution's q / sqrt(12) is added in
+    quadrature to the estimate (whose third differences miss it wherever
+    the stage rests on one count). No level falls below :data:`NOISE_FLOOR`.
 
     Parameters
     ----------
@@ -62,6 +65,8 @@ def noise_levels(spec, measured: Measurement, isolated: bool,
         The record.
     isolated : bool
         Whether the deflection channel takes part.
+    lattice : Lattice
+        The lattice of the measured positions.
     force_is_input : bool
         The measured force drives the model (open-loop replay): it is not
         compared, and has no noise level.
@@ -69,20 +74,23 @@ def noise_levels(spec, measured: Measurement, isolated: bool,
     given = spec.measurement
     source: dict[str, str] = {}
 
-    def level(channel: str, values, spec_value):
+    def level(channel: str, values, spec_value, resolution=None):
         if values is None:
             return None
         if spec_value is not None and spec_value > 0:
             source[channel] = "spec"
             return float(spec_value)
         est = estimate_noise(values)
+        if resolution:
+            est = math.hypot(est, resolution / math.sqrt(12.0))
         if est < NOISE_FLOOR[channel]:
             source[channel] = "floor"
             return NOISE_FLOOR[channel]
         source[channel] = "estimated"
         return float(est)
 
-    pos = level("position", measured.position, given.position_noise if given else None)
+    pos = level("position", measured.position, given.position_noise if given else None,
+                lattice.step if lattice.found else None)
     force = level("force", None if force_is_input else measured.force,
                   given.force_noise if given else None)
     defl = level("deflection", measured.deflection if isolated else None,

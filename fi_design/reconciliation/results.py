@@ -45,10 +45,10 @@ class Lattice:
         Whether every sample is a whole number of steps (up to the file's
         number formatting).
     coarse : bool
-        Whether the lattice is coarser than the noise explains: its
-        quantization error q / sqrt(12) exceeds 1.5 times the position
-        noise estimated from the data. Only then is ``quantization`` a
-        candidate (with this step).
+        Whether the lattice is coarser than the noise explains (the counts,
+        not a noise under them, make the record's scatter; see
+        :mod:`fi_design.reconciliation.lattice`). Only then is
+        ``quantization`` a candidate, with this step.
     detail : str
         One sentence for the report.
     """
@@ -266,6 +266,9 @@ class Candidate:
         Why it could not be named (empty when eligible).
     n_simulations : int
         Simulations the fit used (refit included).
+    n_failed : int
+        Simulations of the fit that failed or ran away (an unstable loop):
+        they counted ten times the nominal misfit and could never win.
     wall_time : float
         Time the fit took [s].
     message : str
@@ -293,6 +296,7 @@ class Candidate:
     eligible: bool
     reasons: tuple
     n_simulations: int
+    n_failed: int
     wall_time: float
     message: str = ""
 

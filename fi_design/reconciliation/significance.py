@@ -71,6 +71,11 @@ Z_MIN = 3.0
 NULL_FACTOR = 3.0
 #: Seed of the noise-only records (reproducible results).
 NULL_SEED = 20240611
+#: Contiguous time blocks of the block jackknife of a finding's uncertainty.
+JACKKNIFE_BLOCKS = 4
+#: Function evaluations of each jackknife refit (it starts at the full fit's optimum).
+JACKKNIFE_NFEV = 10
+
 #: Effects that contain another as a special case: a cable force of zero stiffness is a
 #: force offset (its preload the offset).
 NESTED = {"cable_force": "force_offset"}
@@ -135,7 +140,8 @@ def statistic(cmp: Comparison, outcome: FitOutcome, baseline: Baseline) -> Stati
 
 
 def judge(cmp: Comparison, outcome: FitOutcome, baseline: Baseline, threshold: float,
-          wall_time: float, null: NullRefit | None = None) -> Candidate:
+          wall_time: float, null: NullRefit | None = None,
+          jackknife: dict | None = None, numerical: dict | None = None) -> Candidate:
     """The candidate as a result value: parameters, honest uncertainty, score and verdict.
 
     Parameters
@@ -152,6 +158,10 @@ def judge(cmp: Comparison, outcome: FitOutcome, baseline: Baseline, threshold: f
         Time the fit took [s].
     null : NullRefit, optional
         The noise-only refit, when one ran.
+    jackknife : dict, optional
+        Block-jackknife standard error per parameter (:func:`block_jackknife`).
+    numerical : dict, optional
+        Numerical error per parameter (:func:`numerical_error`).
     """
     sp = outcome.space
     n = len(outcome.residual)
@@ -161,7 +171,7 @@ def judge(cmp: Comparison, outcome: FitOutcome, baseline: Baseline, threshold: f
     excess = baseline.chi2 - n
     explained = float(min(max(st.delta_chi2 / excess, 0.0), 1.0)) if excess > 0 else 0.0
     effect_size = float(math.sqrt(np.mean((outcome.residual - baseline.residual) ** 2)))
-    sigma = _uncertainty(cmp, outcome, st, null)
+    sigma = _uncertainty(cmp, outcome, st, null, jackknife or {}, numerical or {})
     values = outcome.values
     refs = {p: sp.references.get(p) for p in values}
     distance = {}
@@ -180,7 +190,7 @@ def judge(cmp: Comparison, outcome: FitOutcome, baseline: Baseline, threshold: f
         n_parameters=len(sp.coords), widened=outcome.widened, at_bound=outcome.at_bound,
         status=status, from_data=sp.from_data, eligible=not reasons, reasons=tuple(reasons),
         n_simulations=outcome.n_simulations + (null.n_simulations if null else 0),
-        wall_time=float(wall_time), message=message)
+        n_failed=outcome.n_failed, wall_time=float(wall_time), message=message)
 
 
 def prefer_simpler(candidates: dict) -> dict:
@@ -257,12 +267,14 @@ def _ran_away(message: str) -> bool:
     return "runaway" in m or "diverged" in m or "nan" in m or "infinite" in m
 
 
-def _uncertainty(cmp, outcome: FitOutcome, st: Statistic, null: NullRefit | None) -> dict:
+def _uncertainty(cmp, outcome: FitOutcome, st: Statistic, null: NullRefit | None,
+                 jackknife: dict, numerical: dict) -> dict:
     """One standard deviation per parameter, SI.
 
     The Jacobian's covariance (the initial-command nuisance included, so its
     correlation with the effect counts) scaled by s2 and tau (effective
-    samples), with the noise-only refit's error added in quadrature.
+    samples), or the block jackknife's error where larger, with the
+    noise-only refit's error and the numerical error added in quadrature.
     """
     names = list(outcome.values)
     out: dict[str, float | None] = {p: None for p in names}
@@ -271,9 +283,13 @@ def _uncertainty(cmp, outcome: FitOutcome, st: Statistic, null: NullRefit | None
         var = np.diag(G @ (outcome.covariance * st.s2 * st.tau) @ G.T)
         for p, v in zip(names, var):
             out[p] = float(math.sqrt(v)) if v > 0 and math.isfinite(v) else None
-    for p, err in outcome.space.data_error.items():
-        if p in out and err is not None and math.isfinite(err):
-            out[p] = math.hypot(out[p] or 0.0, err) or None
+    for p, err in jackknife.items():
+        if p in out and err is not None and math.isfinite(err) and err > (out[p] or 0.0):
+            out[p] = err
+    for more in (outcome.space.data_error, numerical):
+        for p, err in more.items():
+            if p in out and err is not None and math.isfinite(err):
+                out[p] = math.hypot(out[p] or 0.0, err) or None
     if null is not None:
         for p, dev in null.deviation.items():
             if dev is None or p not in out:
@@ -331,3 +347,87 @@ def noise_only_refit(cmp: Comparison, space: Space, baseline: Baseline, max_poin
         deviation[p] = None if ref is None or v is None or absent else float(v - ref)
     return NullRefit(statistic=st.value, deviation=deviation,
                      n_simulations=outcome.n_simulations + null_cmp.n_sims)
+
+
+def block_jackknife(cmp: Comparison, outcome: FitOutcome,
+                    blocks: int = JACKKNIFE_BLOCKS) -> dict:
+    """Standard error of each parameter from refits that leave out one time block each.
+
+    The record is cut into ``blocks`` contiguous stretches; each refit (from
+    the full fit's optimum, :data:`JACKKNIFE_NFEV` evaluations) drops one.
+    The spread of the refitted values, ``(B - 1) / B`` times their sum of
+    squared deviations, is the jackknife's variance: it holds the residual's
+    autocorrelation and a mismatch between model and record that differs
+    along the record (an implementation difference rarely biases every
+    stretch alike), which the Jacobian does not.
+
+    Parameters
+    ----------
+    cmp : Comparison
+        The comparison.
+    outcome : FitOutcome
+        The full fit.
+    blocks : int
+        Number of blocks.
+
+    Returns
+    -------
+    dict of str to float
+        Standard error per parameter, SI ({} for an effect read from the data).
+    """
+    from scipy.optimize import least_squares
+
+    sp = outcome.space
+    if not sp.coords or outcome.covariance is None:
+        return {}
+    base = [e for e in outcome.entries if e.type != sp.name]
+    ob = Objective(cmp, sp, base)
+    m = len(cmp.idx)
+    channels = len(cmp.channel_blocks(outcome.residual))
+    n = len(outcome.residual)
+    values = []
+    for part in np.array_split(np.arange(m), blocks):
+        keep = np.ones(n, bool)
+        for j in range(channels):
+            keep[j * m + part] = False
+        u0 = np.clip(outcome.u, 1e-9, 1 - 1e-9)
+        try:
+            sol = least_squares(lambda u: ob(u)[keep], u0, jac=lambda u: ob.jac(u)[keep],
+                                bounds=(np.zeros(len(u0)), np.ones(len(u0))), method="trf",
+                                max_nfev=JACKKNIFE_NFEV, ftol=1e-8, xtol=1e-8, gtol=1e-10)
+        except (ValueError, np.linalg.LinAlgError):
+            continue
+        values.append(ob.values(sol.x))
+    if len(values) < 2:
+        return {}
+    out = {}
+    for p in outcome.values:
+        v = np.array([x[p] for x in values], dtype=float)
+        d = v - v.mean()
+        if p == "phase":
+            d = (d + math.pi) % (2 * math.pi) - math.pi
+        out[p] = float(math.sqrt((len(v) - 1) / len(v) * float(d @ d)))
+    return out
+
+
+def numerical_error(cmp: Comparison, outcome: FitOutcome) -> dict:
+    """How far each parameter moves when the model is integrated much more accurately, SI.
+
+    One run at :data:`~.comparison.ACCURACY_CHECK` times the tolerance; its
+    residual change, mapped through the fit's Jacobian (linearised, no
+    refit), is the parameter's share of the integrator's error: a precise
+    fit must not quote an uncertainty below its own numerical accuracy.
+    """
+    from .comparison import ACCURACY_CHECK
+
+    J = outcome.jacobian
+    if J is None or not outcome.run.ok or outcome.columns.stop == outcome.columns.start:
+        return {}
+    run = cmp.run(outcome.entries, quantize=outcome.space.quantize,
+                  command_correction=outcome.command, rtol=cmp.rtol * ACCURACY_CHECK)
+    if not run.ok:
+        return {}
+    du = -np.linalg.lstsq(J, cmp.residuals(run) - outcome.residual, rcond=None)[0]
+    ob = Objective(cmp, outcome.space, [])
+    dp = ob.value_jacobian(outcome.u) @ du[outcome.columns]
+    return {p: float(abs(v)) for p, v in zip(outcome.values, dp) if math.isfinite(v)}

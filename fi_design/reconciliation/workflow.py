@@ -31,8 +31,8 @@ from .lattice import find_lattice
 from .noise import channels_autocorrelation_time, estimate_noise, noise_levels
 from .results import Candidate, EffectStep, ReconcileResult, SearchRound
 from .signatures import Evidence, scan
-from .significance import (NESTED, NULL_SEED, THRESHOLD, judge, noise_only_refit, passes_primary,
-                           prefer_simpler)
+from .significance import (NESTED, NULL_SEED, THRESHOLD, block_jackknife, judge,
+                           noise_only_refit, numerical_error, passes_primary, prefer_simpler)
 from .spaces import Space, candidate_spaces
 from .specout import make_entry
 
@@ -107,8 +107,8 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     args = _check_arguments(spec, measured, isolated, candidates, max_effects, drive)
     iso = args.isolated
     say("reading the record", 0.0)
-    noise = noise_levels(spec, measured, iso, force_is_input=drive == "force")
     lattice = find_lattice(measured.position, estimate_noise(measured.position))
+    noise = noise_levels(spec, measured, iso, lattice, force_is_input=drive == "force")
     cmp = Comparison(spec, measured, iso, noise, lattice, settle_window, drive)
     say("nominal model", 0.02)
     nominal = _nominal(cmp, list(spec.effects), max_points)
@@ -222,8 +222,9 @@ def _search(cmp, evidence: Evidence, names, nominal: Baseline, max_effects: int,
     n_sims = 0
     for index in range(max_effects):
         remaining = [nm for nm in names if nm not in {c.candidate.name for c in chosen}]
-        hints = evidence if index == 0 else replace(evidence, guesses={})
         params = plant_parameters(cmp.spec, cmp.iso, effects=baseline.entries)
+        # later passes start from the signatures of the gap the earlier effects leave
+        hints = evidence if index == 0 else scan(cmp, baseline.run, cmp.lattice, params)
         spaces = candidate_spaces(cmp, hints, remaining, cmp.lattice, params)
         if index == 0:
             skipped.update(spaces.skipped)
@@ -252,7 +253,7 @@ class RoundResult:
 
 def _rank(c: Candidate) -> tuple:
     """Sort key: eligible first, an effect read from the data before fitted ones, then score."""
-    return (not c.eligible, not c.from_data, not c.success, -c.score)
+    return (not c.eligible, not (c.eligible and c.from_data), not c.success, -c.score)
 
 
 def _search_round(cmp, spaces, baseline: Baseline, earlier: list, base: list, threshold,
@@ -264,9 +265,8 @@ def _search_round(cmp, spaces, baseline: Baseline, earlier: list, base: list, th
         say(f"fitting {sp.name}", 0.05 + 0.9 * (index + j / max(len(spaces), 1)) / max_effects)
         t0 = _time.perf_counter()
         outcome = fit(cmp, sp, baseline.entries, baseline.command)
-        k = max(len(sp.coords), 1)
-        if earlier and baseline.chi2 - outcome.chi2 > k * math.log(n):
-            # a promising later effect: refit it with the effects named before it
+        if earlier and outcome.run.ok and sp.coords:
+            # an earlier effect may have absorbed part of this one: refit them together
             outcome = polish_jointly(cmp, earlier, outcome, base)
         outcomes[sp.name] = outcome
         judged[sp.name] = judge(cmp, outcome, baseline, threshold, _time.perf_counter() - t0)
@@ -291,6 +291,12 @@ def _search_round(cmp, spaces, baseline: Baseline, earlier: list, base: list, th
         n_sims += null.n_simulations
         judged[c.name] = judge(cmp, outcomes[c.name], baseline, threshold,
                                c.wall_time + _time.perf_counter() - t0, null)
+        if judged[c.name].eligible:
+            # a finding: its uncertainty from the block jackknife and its numerical accuracy too
+            jack = block_jackknife(cmp, outcomes[c.name])
+            num = numerical_error(cmp, outcomes[c.name])
+            judged[c.name] = judge(cmp, outcomes[c.name], baseline, threshold,
+                                   c.wall_time + _time.perf_counter() - t0, null, jack, num)
         if judged[c.name].eligible and named is None:
             named = judged[c.name]
     ranked = sorted(prefer_simpler(judged).values(), key=_rank)
