@@ -100,7 +100,7 @@ def _spectrum(r: np.ndarray, t: np.ndarray) -> Spectrum:
 
 
 def _band(r: np.ndarray, t: np.ndarray, low: float | None, high: float | None) -> np.ndarray:
-    """Zero-phase Butterworth filtering of a residual: low-pass below ``high``, high-pass above ``low`` [Hz]."""
+    """Zero-phase Butterworth filter: low-pass below ``high``, high-pass above ``low`` [Hz]."""
     from scipy.signal import butter, sosfiltfilt
 
     fs = 1.0 / float(np.median(np.diff(t)))
