@@ -24,7 +24,7 @@ import pytest
 
 from fi_design.reconciliation import reconcile
 
-from hidden_effect import Case, base_spec, measure, parameter_error
+from hidden_effect import Case, base_spec, measure, parameter_error, spec_mapping
 
 #: Back-and-forth moves at a speed well above the Stribeck velocity (3 mm/s): the
 #: stage slides smoothly over several periods of a position-periodic effect.
@@ -265,3 +265,23 @@ def test_progress_callback_and_no_printing(capsys):
     assert all(0.0 <= f <= 1.0 for _, f in seen)
     out = capsys.readouterr()
     assert out.out == "" and out.err == ""
+
+
+def test_a_nominal_model_that_fails_is_reported_not_raised(tmp_path):
+    """A spec whose own loop is unstable on the record: what failed, and a report of the traces."""
+    from fi_design.gapreport import render_gap_report
+
+    case = Case("unstable", False, None, {}, duration=2.0, seed=101)
+    data = measure(case)
+    raw = spec_mapping(case)
+    raw["effects"] = [{"type": "time_delay", "delay": "30 ms"}]  # the loop diverges at 1.2 s
+    from fi_design.specfile import load_spec
+
+    spec = load_spec(raw)
+    result = reconcile(spec, data, candidates=["viscous_friction"])
+    assert result.effect == "none" and result.entries == ()
+    assert not result.nominal.success
+    assert "fails on this record" in result.conclusion
+    assert result.diagnosis.mismatch
+    html = render_gap_report(result, tmp_path / "gap.html").read_text()
+    assert 'id="finding"' in html and "failed" in html

@@ -243,3 +243,13 @@ def test_two_effects_found_in_order_each_with_its_gap():
     assert second.misfit_after < 1.2
     assert abs(first.parameters["stiffness"] - 60.0) <= 3 * first.uncertainty["stiffness"]
     assert abs(second.parameters["delay"] - 2e-3) <= 3 * second.uncertainty["delay"]
+
+
+def test_report_of_a_structural_gap_says_so_first(diverging, tmp_path):
+    from fi_design.gapreport import render_gap_report
+
+    html = render_gap_report(diverging, tmp_path / "gap.html").read_text()
+    assert html.index('id="structure"') < html.index('id="finding"')
+    assert "disturbance" in html and "<svg" in html
+    # every candidate row says why it was not named
+    assert diverging.candidates[0].reasons[0].split(" ")[0] in html
