@@ -47,7 +47,7 @@ def best(fn, repeat: int) -> float:
 
 def kernel_only(spec, isolated: bool):
     """Time only the compiled integrator (the same call simulate() makes)."""
-    from fi_design.kernel import run
+    from fi_design.compiled import run
     from fi_design.trajectory import from_moves
     from fi_design.simulation import plant_parameters, tolerances
 
@@ -69,7 +69,7 @@ def plain_solve_ivp(spec, isolated: bool, t_end: float, method: str):
     """The same equations in a plain solve_ivp call: modes from the state, no events."""
     from scipy.integrate import solve_ivp
 
-    from fi_design import plant
+    from fi_design import equations as plant
     from fi_design.trajectory import from_moves
     from fi_design.simulation import plant_parameters, tolerances
 
@@ -104,7 +104,7 @@ def python_control_run(spec, isolated: bool, t_end: float):
     """The same equations through control.input_output_response (LSODA, modes from the state)."""
     import control
 
-    from fi_design import plant
+    from fi_design import equations as plant
     from fi_design.trajectory import from_moves
     from fi_design.simulation import plant_parameters, tolerances
 

@@ -39,11 +39,14 @@ Failures (step budget exhausted, step-size underflow, NaN, divergence,
 history overflow) end the run with a status code and the time reached; the
 caller reports them, never silent garbage.
 
-Compilation: every function has an explicit signature, so it compiles once,
-at import, and numba caches it on disk (``cache=True``). The cache lives in
-the package's ``__pycache__``; when the package folder is read-only (a
-system-wide install) numba itself falls back to a user-wide cache directory
-(``~/.cache/numba`` or ``$NUMBA_CACHE_DIR``). A cold compile takes about
+Compilation: this module is the kernel's source. Installing the package
+compiles it ahead of time into an extension module (:mod:`fi_design.aot`),
+which :mod:`fi_design.compiled` runs; this module is then never imported.
+Where that build is missing or older than the source, numba compiles it
+here instead: every function has an explicit signature, so it compiles once,
+at import, and numba caches it on disk (``cache=True``) in the package's
+``__pycache__`` (or, in a read-only install, the user-wide
+``~/.cache/numba`` or ``$NUMBA_CACHE_DIR``). A cold compile takes about
 10-15 s on a 2-core machine, loading from the cache about 0.5 s.
 """
 
@@ -52,38 +55,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from .plant import A1, A2, I1, Integration, b1, f8, i8  # signature types, result
-from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, N_CORE_ISO, N_CORE_RIGID,
-                    P_DA, P_DB, P_DC, P_DELAY, P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F,
-                    P_FF_M, P_ISO, P_KD, P_KDM, P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH,
-                    P_TS, P_U0, P_WT, actuator, control_law, controller_output, drive_force,
-                    feedforward, jacobian, measured_position, natural_modes, rhs,
-                    static_friction)
-
-# Status codes of :func:`integrate`.
-OK = 0
-TOO_MANY_STEPS = 1
-STEP_UNDERFLOW = 2
-NOT_FINITE = 3
-DIVERGED = 4
-HISTORY_OVERFLOW = 5
-SINGULAR = 6
-
-STATUS_TEXT = {
-    OK: "ok",
-    TOO_MANY_STEPS: "step budget exhausted",
-    STEP_UNDERFLOW: "step size underflow",
-    NOT_FINITE: "state became NaN or infinite",
-    DIVERGED: "solution diverged",
-    HISTORY_OVERFLOW: "delay history overflow",
-    SINGULAR: "singular iteration matrix",
-}
-
-# Layout of the statistics array returned by :func:`integrate`.
-ST_STEPS, ST_REJECTED, ST_EVENTS, ST_T, ST_H, ST_OUT, ST_ZERO_EVENTS, ST_LIMIT_EVENTS = range(8)
-N_STATS = 8
+from ._jit import A1, A2, I1, b1, f8, i8, kernel_function
+from .equations import (actuator, control_law, controller_output, drive_force, feedforward,
+                        jacobian, measured_position, natural_modes, rhs, static_friction)
+from .plant import (DIVERGED, HISTORY_OVERFLOW, MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK,
+                    N_CORE_ISO, N_CORE_RIGID, N_STATS, NOT_FINITE, OK, P_DA, P_DB, P_DC, P_DELAY,
+                    P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F, P_FF_M, P_ISO, P_KD, P_KDM, P_KI,
+                    P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT, ST_EVENTS, ST_H,
+                    ST_LIMIT_EVENTS, ST_OUT, ST_REJECTED, ST_STEPS, ST_T, ST_ZERO_EVENTS,
+                    STEP_UNDERFLOW, TOO_MANY_STEPS)
 
 # Event kinds.
 EV_NONE, EV_SIGN, EV_LIMIT, EV_LEVEL, EV_UNSTICK = 0, 1, 2, 3, 4
@@ -126,7 +107,7 @@ FAC_MAX = 6.0  # hnew / h <= 6
 # --------------------------------------------------------------------------- small helpers
 
 
-@njit((f8, A1, A2, i8), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((f8, A1, A2, i8))
 def reference_at(t, breaks, coeffs, k):
     """Reference position, velocity, acceleration and jerk at ``t``, and the segment index.
 
@@ -155,7 +136,7 @@ def reference_at(t, breaks, coeffs, k):
     return r, rd, rdd, 6.0 * c3, k
 
 
-@njit((f8, A1, A1, i8), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((f8, A1, A1, i8))
 def input_at(t, in_t, in_f, j):
     """Known input force at ``t`` [N], held from sample to sample, and the sample index.
 
@@ -175,7 +156,7 @@ def input_at(t, in_t, in_f, j):
     return in_f[j], j
 
 
-@njit((f8, A1, A1, A2, i8, A1, A1, i8, b1), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((f8, A1, A1, A2, i8, A1, A1, i8, b1))
 def extra_at(tq, p, breaks, coeffs, kref, in_t, in_f, j, with_ff):
     """The command's parts beyond the feedback at ``tq``: feedforward and input force.
 
@@ -194,7 +175,7 @@ def extra_at(tq, p, breaks, coeffs, kref, in_t, in_f, j, with_ff):
     return F, dF, kref, j
 
 
-@njit((A1, A1, I1, f8, f8, f8, A1, i8), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((A1, A1, I1, f8, f8, f8, A1, i8))
 def law_rate(y, p, modes, r, rd, rdd, f, ii):
     """Time derivative of the unfiltered continuous controller output v [N/s].
 
@@ -207,7 +188,7 @@ def law_rate(y, p, modes, r, rd, rdd, f, ii):
     return p[P_KI] * e + p[P_KP] * (rd - xd) + p[P_KD] * (rdd - xdd) - p[P_KDM] * xdd
 
 
-@njit((A2, I1), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((A2, I1))
 def lu_factor(A, piv):
     """In-place LU decomposition with partial pivoting; returns False if singular."""
     n = A.shape[0]
@@ -236,7 +217,7 @@ def lu_factor(A, piv):
     return True
 
 
-@njit((A2, f8, A2, I1, A2), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((A2, f8, A2, I1, A2))
 def struct_factor(J, sigma, M, piv, w):
     """Factor E = sigma I - J using the plant's structure.
 
@@ -273,7 +254,7 @@ def struct_factor(J, sigma, M, piv, w):
     return lu_factor(M, piv)
 
 
-@njit((A2, A2, I1, A2, A1, A1), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((A2, A2, I1, A2, A1, A1))
 def struct_solve(J, M, piv, w, b, tmp):
     """Solve (sigma I - J) x = b in place with the factors of :func:`struct_factor`."""
     n = J.shape[0]
@@ -317,7 +298,7 @@ def struct_solve(J, M, piv, w, b, tmp):
     b[iz] = yz
 
 
-@njit((A1, A1, A1, A1, f8, A1), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((A1, A1, A1, A1, f8, A1))
 def dense(y0, y1, k2, k3, theta, out):
     """RODAS4 continuous extension at ``theta`` in [0, 1] into ``out``."""
     s1 = 1.0 - theta
@@ -325,14 +306,14 @@ def dense(y0, y1, k2, k3, theta, out):
         out[i] = y0[i] * s1 + theta * (y1[i] + s1 * (k2[i] + theta * k3[i]))
 
 
-@njit((A1, A1, A1, A1, f8, i8), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((A1, A1, A1, A1, f8, i8))
 def dense_component(y0, y1, k2, k3, theta, i):
     """One component of :func:`dense`."""
     s1 = 1.0 - theta
     return y0[i] * s1 + theta * (y1[i] + s1 * (k2[i] + theta * k3[i]))
 
 
-@njit((f8, A2, i8, i8, f8), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((f8, A2, i8, i8, f8))
 def history_at(tq, hist, head, count, u_before):
     """Delayed controller output u(tq) and its rate from the history ring.
 
@@ -379,7 +360,7 @@ def history_at(tq, hist, head, count, u_before):
 # --------------------------------------------------------------------------- events
 
 
-@njit((f8, f8), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((f8, f8))
 def _limit_mode(d, s):
     if d > s:
         return 1
@@ -388,14 +369,13 @@ def _limit_mode(d, s):
     return 0
 
 
-@njit((f8, A1), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((f8, A1))
 def breakaway(F, p):
     """Switch model: > 0 once the drive force ``F`` [N] exceeds static friction its way [N]."""
     return max(F - static_friction(1.0, p), -F - static_friction(-1.0, p))
 
 
-@njit((f8, f8, A1, A1, A1, A1, i8, i8, i8, f8, A1, I1, f8, f8, f8, b1, A1), cache=True,
-      error_model="numpy", _nrt=False)
+@kernel_function((f8, f8, A1, A1, A1, A1, i8, i8, i8, f8, A1, I1, f8, f8, f8, b1, A1))
 def _root(g0, g1, y0, y1, k2, k3, kind, idx, idx2, offset, p, modes, r, rd, fa, fa_state, ybuf):
     """Locate the zero of a switching function on the dense output, theta in [0, 1].
 
@@ -437,8 +417,7 @@ def _root(g0, g1, y0, y1, k2, k3, kind, idx, idx2, offset, p, modes, r, rd, fa, 
     return b
 
 
-@njit((A1, A1, A1, A1, A1, I1, i8, f8, f8, f8, b1, A1, i8), cache=True, error_model="numpy",
-      _nrt=False)
+@kernel_function((A1, A1, A1, A1, A1, I1, i8, f8, f8, f8, b1, A1, i8))
 def find_event(y0, y1, k2, k3, p, modes, iv2, r, rd, fa, fa_state, ybuf, skip):
     """Earliest mode change within a trial step.
 
@@ -514,7 +493,7 @@ def find_event(y0, y1, k2, k3, p, modes, iv2, r, rd, fa, fa_state, ybuf, skip):
     return best, tbest
 
 
-@njit((i8, A1, A1, I1, i8, i8, f8, f8, f8, b1, A1), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((i8, A1, A1, I1, i8, i8, f8, f8, f8, b1, A1))
 def apply_event(kind, y, p, modes, iv2, iu, r, rd, fa, fa_state, y_trial):
     """Switch the mode for event ``kind`` at the current state (jumps included).
 
@@ -558,7 +537,7 @@ def apply_event(kind, y, p, modes, iv2, iu, r, rd, fa, fa_state, y_trial):
 # --------------------------------------------------------------------------- commands
 
 
-@njit((f8, A1, A1, A2, A1, A1, I1, f8, A2, i8, i8), cache=True, error_model="numpy", _nrt=False)
+@kernel_function((f8, A1, A1, A2, A1, A1, I1, f8, A2, i8, i8))
 def stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold, hist, head, count):
     """The ``fa`` argument of :func:`fi_design.plant.rhs` at time ``ts``, and its rate.
 
@@ -589,8 +568,7 @@ def stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold, hist, head,
     return u + F, du + dF, ok
 
 
-@njit((i8, f8, A1, A1, I1, A1, A2, A1, A1, I1, f8, A2, i8, i8, b1, A2, A1, A1, A1), cache=True,
-      error_model="numpy", _nrt=False)
+@kernel_function((i8, f8, A1, A1, I1, A1, A2, A1, A1, I1, f8, A2, i8, i8, b1, A2, A1, A1, A1))
 def write_output(i, tq, yq, p, modes, breaks, coeffs, in_t, in_f, hints, fa_hold, hist, head,
                  count, need_cmd, out_y, out_r, out_fa, out_cmd):
     """Store the state ``yq`` at output time ``tq`` as output row ``i``, with r and the forces.
@@ -638,8 +616,8 @@ def write_output(i, tq, yq, p, modes, breaks, coeffs, in_t, in_f, hints, fa_hold
 # --------------------------------------------------------------------------- the integrator
 
 
-@njit((A1, A1, A1, A2, b1, f8, A1, f8, A1, f8, i8, f8, A1, A1, A2, A1, A1, A1, A1), cache=True,
-      error_model="numpy")
+@kernel_function((A1, A1, A1, A2, b1, f8, A1, f8, A1, f8, i8, f8, A1, A1, A2, A1, A1, A1, A1),
+                 refcounted=True)
 def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_steps, x_bound,
               in_t, in_f, out_y, out_r, out_fa, out_cmd, stats):
     """Integrate the plant from ``y0`` at t = 0 to ``t_end``.
@@ -1140,36 +1118,3 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     stats[ST_OUT] = i_out
     stats[ST_ZERO_EVENTS] = n_zero
     return status
-
-
-def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
-        max_steps=2_000_000, x_bound=10.0, input_time=None, input_force=None):
-    """Allocate outputs and call :func:`integrate`.
-
-    Returns a :class:`fi_design.plant.Integration`; see :func:`integrate` for
-    the arguments (``input_time``, ``input_force``: the known input force's
-    samples [s, N], None for none). This thin wrapper is the kernel's only
-    Python-level entry point; :mod:`fi_design.simulation` wraps it in a result.
-    """
-    # fresh writable copies: numba types read-only arrays differently
-    p = np.array(params, dtype=np.float64)
-    y = np.array(y0, dtype=np.float64)
-    t_out = np.array(t_out, dtype=np.float64)
-    in_t = np.zeros(0) if input_time is None else np.array(input_time, dtype=np.float64)
-    in_f = np.zeros(0) if input_force is None else np.array(input_force, dtype=np.float64)
-    n = y.shape[0]
-    m = t_out.shape[0]
-    out_y = np.full((m, n), np.nan)
-    out_r = np.full(m, np.nan)
-    out_fa = np.full(m, np.nan)
-    out_cmd = np.full(m, np.nan)
-    stats = np.zeros(N_STATS)
-    status = integrate(p, y, np.array(breaks, dtype=np.float64),
-                       np.array(coeffs, dtype=np.float64, order="C"), bool(land), float(t_end),
-                       t_out, float(rtol), np.array(atol, dtype=np.float64),
-                       float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r,
-                       out_fa, out_cmd, stats)
-    return Integration(code=int(status), status=STATUS_TEXT[int(status)], states=out_y,
-                       reference=out_r, applied_force=out_fa, command=out_cmd,
-                       n_steps=int(stats[ST_STEPS]), n_rejected=int(stats[ST_REJECTED]),
-                       n_events=int(stats[ST_EVENTS]), t_reached=float(stats[ST_T]))

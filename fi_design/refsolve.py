@@ -1,7 +1,7 @@
 """Reference solution with scipy's solve_ivp on the same equations.
 
 A deliberately plain path for tests and benchmarks: the right-hand side and
-Jacobian are those of :mod:`fi_design.plant`; mode changes (sliding direction,
+Jacobian are those of :mod:`fi_design.equations`; mode changes (sliding direction,
 limiter contact, quantization level, switch-model sticking) are located by
 solve_ivp's own event finder and handled by the Python code below, written
 independently of the kernel's event logic; time events (reference
@@ -20,9 +20,9 @@ import math
 
 import numpy as np
 
+from .compiled import kernel
 from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, Integration, PlantParameters,
-                    actuator, controller_output, drive_force, feedforward, jacobian,
-                    natural_modes, rhs, static_friction, state_index)
+                    state_index)
 from .trajectory import Trajectory
 
 
@@ -49,7 +49,8 @@ class _History:
 
 def _breakaway(F: float, p) -> float:
     """Switch model: > 0 once the drive force exceeds static friction in its direction [N]."""
-    return max(F - static_friction(1.0, p), -F - static_friction(-1.0, p))
+    k = kernel()
+    return max(F - k.static_friction(1.0, p), -F - k.static_friction(-1.0, p))
 
 
 def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, t_out,
@@ -64,6 +65,9 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
     """
     from scipy.integrate import solve_ivp
 
+    k = kernel()  # the compiled equations
+    actuator, controller_output, drive_force = k.actuator, k.controller_output, k.drive_force
+    feedforward, jacobian, natural_modes, rhs = k.feedforward, k.jacobian, k.natural_modes, k.rhs
     p = params.to_array()
     n = len(y0)
     iso = bool(params.isolated)
@@ -277,6 +281,7 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
 
 def _switch(name, y, p, modes, params, iv2, iu, r, rd, fa, fa_state) -> None:
     """Mode change at an event located by solve_ivp."""
+    drive_force = kernel().drive_force
     if name == "sign":
         if params.switch_model:
             y[iv2] = 0.0

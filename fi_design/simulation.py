@@ -7,7 +7,7 @@ guideline rule, effects applied), integrates with the fast RODAS4 kernel
 traces at the output rate and the hunting metrics.
 
 The two methods share the right-hand side and Jacobian of
-:mod:`fi_design.plant` and the mode logic of :mod:`fi_design.kernel`
+:mod:`fi_design.equations` and the mode logic of :mod:`fi_design.kernel`
 (the reference locates mode changes with solve_ivp's own event finder), so
 the comparison tests the integrator, not a second transcription of the model.
 """
@@ -357,8 +357,9 @@ def _integrate(spec, method, params, y0, ref, t_end, t_out, rtol, input_time=Non
     x_bound = 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(y0[0]))
     start = _time.perf_counter()
     if method == "fast":
-        from .kernel import run  # compiles or loads the kernel on first use
+        from .compiled import kernel, run
 
+        kernel()  # loads the built kernel (or compiles it) before the clock starts
         start = _time.perf_counter()
         out = run(params.to_array(), y0, ref.breaks, ref.coeffs, ref.land, t_end, t_out, tol,
                   tolerances(params, tol), 0.05, spec.simulation.max_steps, x_bound,
@@ -439,11 +440,11 @@ def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects
 
 def _anchor(law, params, record, index, ref, command):
     """Initial state and parameters for a replay starting at sample ``index``."""
-    from .plant import feedforward
+    from .compiled import kernel
 
     st = record_state(record, index)
     r, rd, rdd = reference_state(record, index)
-    ff = feedforward(rd, rdd, 0.0, params.to_array())[0]
+    ff = kernel().feedforward(rd, rdd, 0.0, params.to_array())[0]
     defl = None if record.deflection is None or not params.isolated else \
         float(record.deflection[index])
     return initial_state(params, law, st, deflection=defl, command=command,

@@ -13,7 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fi_design import kernel
-from fi_design.plant import MODE_SIGN, jacobian
+from fi_design.equations import jacobian
+from fi_design.plant import MODE_SIGN
 from fi_design.trajectory import from_moves
 from fi_design.simulation import plant_parameters
 
@@ -105,3 +106,48 @@ def test_cache_falls_back_to_a_user_directory(tmp_path):
     subprocess.run([sys.executable, "-c", "import fi_design.kernel"], check=True, env=env,
                    cwd=tmp_path)
     assert list(cache.rglob("kernel.integrate-*.nbi"))
+
+
+def test_the_installed_kernel_is_the_ahead_of_time_build_of_these_sources():
+    """An install compiles the kernel ahead of time (hatch_build.py); CI must get that build."""
+    from fi_design import compiled
+
+    k = compiled.kernel()
+    if k.backend != "aot":
+        if os.environ.get("CI"):
+            pytest.fail(f"the kernel runs on numba's JIT in CI: {k.reason}")
+        pytest.skip(f"the ahead-of-time kernel is not in use here: {k.reason}")
+    from fi_design import _kernel_aot
+
+    assert _kernel_aot.source_digest() == compiled.source_digest()
+    # the simulation path runs without loading numba at all
+    out = subprocess.run([sys.executable, "-c",
+                          "import sys; from fi_design.specfile import load_spec; "
+                          "from fi_design.simulation import simulate; "
+                          "r = simulate(load_spec(sys.argv[1]), isolated=False); "
+                          "print(r.metrics.hunting_cycles, 'numba' in sys.modules)",
+                          str(os.path.join(os.path.dirname(__file__), "..", "examples",
+                                           "paper_setup.yaml"))],
+                         check=True, capture_output=True, text=True)
+    assert out.stdout.split() == ["5", "False"]
+
+
+def test_the_jit_build_of_the_same_source_agrees(paper_spec, tmp_path):
+    """FI_DESIGN_KERNEL=jit compiles the source with numba: the same trajectories as the
+    build in use (to rounding; the hunting plant amplifies it by its stick-slip events)."""
+    from fi_design.simulation import simulate
+
+    code = ("import sys, numpy as np; from fi_design.specfile import load_spec; "
+            "from fi_design.simulation import simulate; from fi_design import compiled; "
+            "s = load_spec(sys.argv[1]); "
+            "np.save(sys.argv[2], np.array([simulate(s, isolated=i).position for i in (True, "
+            "False)])); print(compiled.backend())")
+    env = dict(os.environ, FI_DESIGN_KERNEL="jit")
+    out = subprocess.run([sys.executable, "-c", code, str(os.path.join(
+        os.path.dirname(__file__), "..", "examples", "paper_setup.yaml")),
+        str(tmp_path / "jit.npy")], env=env, check=True, capture_output=True, text=True)
+    assert out.stdout.strip() == "jit"
+    jit = np.load(tmp_path / "jit.npy")
+    here = [simulate(paper_spec, isolated=i).position for i in (True, False)]
+    assert np.max(np.abs(jit[0] - here[0])) < 1e-9
+    assert np.max(np.abs(jit[1] - here[1])) < 1e-6

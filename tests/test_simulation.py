@@ -16,7 +16,7 @@ import pytest
 import yaml
 from scipy.integrate import solve_ivp
 
-from fi_design import plant
+from fi_design import equations as plant
 from fi_design.errors import SimulationError
 from fi_design.plant import MODE_SIGN, PlantParameters
 from fi_design.simulation import simulate

@@ -1,0 +1,416 @@
+"""The nonlinear plant's equations: right-hand side and Jacobian (DESIGN.md sections 2, 8).
+
+Plain functions on floats, compiled with numba and shared by the fast
+integrator (:mod:`fi_design.kernel`) and the scipy reference path
+(:mod:`fi_design.refsolve`), so both integrate the same equations. The
+parameter array, the states and the modes are laid out in
+:mod:`fi_design.plant`, whose module docstring gives the equations in words.
+
+Every function has an explicit signature: numba compiles it once, at import,
+and caches it on disk; the ahead-of-time build (:mod:`fi_design.aot`)
+compiles the same source into an extension module instead.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ._jit import A1, A2, I1, b1, f8, i8, kernel_function
+from .plant import (
+    MODE_SIGN, MODE_LIMIT, MODE_LEVEL, MODE_STICK, N_CORE_ISO, N_CORE_RIGID, TWO_PI, P_C,
+    P_CABLE_F0, P_CABLE_K, P_CSTOP, P_FC, P_FC_NEG, P_FF_C, P_FF_F, P_FF_M, P_FLIMIT, P_FS,
+    P_ISO, P_K, P_KD, P_KDM, P_KI, P_KP, P_KSTOP, P_M1, P_M2, P_OFFSET, P_PDF_A, P_PDF_L,
+    P_PDF_PHI, P_QUANT, P_RIP_A, P_RIP_P, P_RIP_PHI, P_S, P_SIGMA0, P_SIGMA1, P_SIGMA2,
+    P_SIGMA2_NEG, P_SWITCH, P_TS, P_VS, P_WT, P_X10)
+
+
+# --------------------------------------------------------------------------- pieces
+
+
+@kernel_function((f8, f8, f8, A1))
+def stribeck(v, x2, sgn, p):
+    """g(v) of the sliding direction ``sgn``, scaled by position-dependent friction.
+
+    Returns ``(g, dg/dv, dg/dx2)`` [N, N s/m, N/m] with
+    g = (1 + a sin(2 pi x2 / lambda + phi)) (Fc + (Fs - Fc) exp(-(v / vs)^2)),
+    where for ``sgn < 0`` Fc is ``Fc_neg`` and Fs scales with it (Fs Fc_neg / Fc).
+    """
+    Fs = p[P_FS]
+    Fc = p[P_FC]
+    if sgn < 0.0:
+        Fs = Fs * p[P_FC_NEG] / Fc
+        Fc = p[P_FC_NEG]
+    vs = p[P_VS]
+    w = v / vs
+    ex = (Fs - Fc) * math.exp(-w * w)
+    g0 = Fc + ex
+    dg0 = ex * (-2.0 * w / vs)
+    a = p[P_PDF_A]
+    if a == 0.0:
+        return g0, dg0, 0.0
+    kx = TWO_PI / p[P_PDF_L]
+    arg = kx * x2 + p[P_PDF_PHI]
+    sc = 1.0 + a * math.sin(arg)
+    return sc * g0, sc * dg0, a * kx * math.cos(arg) * g0
+
+
+@kernel_function((f8, A1))
+def static_friction(direction, p):
+    """Static friction Fs of a sliding direction (+1 or -1) [N] (the switch model's breakaway)."""
+    if direction < 0.0:
+        return p[P_FS] * p[P_FC_NEG] / p[P_FC]
+    return p[P_FS]
+
+
+@kernel_function((f8, A1))
+def external_force(x1, p):
+    """Force ripple, cable force and load offset on the stage, and the x1-derivative [N, N/m]."""
+    F = -p[P_OFFSET]
+    dF = 0.0
+    A = p[P_RIP_A]
+    if A != 0.0:
+        kx = TWO_PI / p[P_RIP_P]
+        arg = kx * x1 + p[P_RIP_PHI]
+        F += A * math.sin(arg)
+        dF += A * kx * math.cos(arg)
+    kc = p[P_CABLE_K]
+    F0 = p[P_CABLE_F0]
+    if kc != 0.0 or F0 != 0.0:
+        F += -kc * (x1 - p[P_X10]) - F0
+        dF += -kc
+    return F, dF
+
+
+@kernel_function((f8, A1))
+def actuator(fa, p):
+    """Saturated actuator force and its derivative wrt the command [N, -]."""
+    lim = p[P_FLIMIT]
+    if fa > lim:
+        return lim, 0.0
+    if fa < -lim:
+        return -lim, 0.0
+    return fa, 1.0
+
+
+@kernel_function((f8, f8, f8, f8, A1))
+def lugre(v, x2, z, sgn, p):
+    """LuGre bristle rate and friction force with partials (sliding sign frozen).
+
+    Returns ``(zd, Ff, dzd_dx2, dzd_dv, dzd_dz, dFf_dx2, dFf_dv, dFf_dz)``:
+    dz/dt = v - sigma0 |v| z / g(v), F = sigma0 z + sigma1 dz/dt + sigma2 v,
+    with |v| = sgn * v and g, sigma2 those of the direction ``sgn``.
+    """
+    s0 = p[P_SIGMA0]
+    s1 = p[P_SIGMA1]
+    s2 = p[P_SIGMA2] if sgn > 0.0 else p[P_SIGMA2_NEG]
+    g, dg_dv, dg_dx = stribeck(v, x2, sgn, p)
+    av = sgn * v
+    q = s0 * z / g
+    zd = v - av * q
+    dzd_dv = 1.0 - sgn * q + av * q * dg_dv / g
+    dzd_dz = -s0 * av / g
+    dzd_dx = av * q * dg_dx / g
+    Ff = s0 * z + s1 * zd + s2 * v
+    return zd, Ff, dzd_dx, dzd_dv, dzd_dz, s1 * dzd_dx, s1 * dzd_dv + s2, s0 + s1 * dzd_dz
+
+
+@kernel_function((f8, A1, i8))
+def measured_position(x1, p, level):
+    """Position the controller sees [m]: x1, or level * q when quantized."""
+    q = p[P_QUANT]
+    if q > 0.0:
+        return level * q
+    return x1
+
+
+@kernel_function((f8, f8, f8, A1))
+def feedforward(rd, rdd, r3, p):
+    """Feedforward force and its time derivative [N, N/s].
+
+    ``ff_mass r'' + ff_viscous r' + ff_coulomb sign(r')`` from the reference's
+    velocity ``rd``, acceleration ``rdd`` and jerk ``r3``.
+    """
+    F = p[P_FF_M] * rdd + p[P_FF_C] * rd
+    Fc = p[P_FF_F]
+    if Fc != 0.0:
+        if rd > 0.0:
+            F += Fc
+        elif rd < 0.0:
+            F -= Fc
+    return F, p[P_FF_M] * r3 + p[P_FF_C] * rdd
+
+
+@kernel_function((A1, A1, I1, f8, f8, i8))
+def control_law(y, p, modes, r, rd, ii):
+    """The continuous controller's unfiltered output v and its partials.
+
+    Returns ``(v, dv_dx1, dv_dv1, e)``: v = kp e + I + kd e' - kdm x' [N] with
+    e = r - x and x the measured position (x' = v1, or 0 between quantization
+    levels), its derivatives with respect to x1 and v1 [N/m, N s/m] (dv/dI = 1),
+    and the error e [m].
+    """
+    quant = p[P_QUANT] > 0.0
+    x1 = y[0]
+    xm = measured_position(x1, p, modes[MODE_LEVEL])
+    xd = 0.0 if quant else y[1]
+    e = r - xm
+    kd = p[P_KD]
+    kdm = p[P_KDM]
+    v = p[P_KP] * e + y[ii] + kd * (rd - xd) - kdm * xd
+    if quant:
+        return v, 0.0, 0.0, e
+    return v, -p[P_KP], -(kd + kdm), e
+
+
+@kernel_function((A1, A1, I1, f8, f8, i8, i8))
+def controller_output(y, p, modes, r, rd, ii, iu):
+    """Output u of the continuous controller [N]: the filter state, or v without a filter."""
+    if math.isinf(p[P_WT]):
+        v, _, _, _ = control_law(y, p, modes, r, rd, ii)
+        return v
+    return y[iu]
+
+
+@kernel_function((A1, A1, I1, f8, f8, f8, b1))
+def drive_force(y, p, modes, r, rd, fa, fa_state):
+    """Force that drives the cart apart from friction [N] (the switch model's stick test).
+
+    Isolated: the joint and limiter force. Rigid: actuator plus external force,
+    with the command ``fa`` or, when ``fa_state`` is true, the continuous
+    controller's output (at reference ``r`` [m], ``rd`` [m/s]) plus ``fa``, as
+    in :func:`rhs`.
+    """
+    if p[P_ISO] != 0.0:
+        d = y[0] - y[2]
+        dv = y[1] - y[3]
+        F = p[P_K] * d + p[P_C] * dv
+        s = p[P_S]
+        if d > s:
+            F += p[P_KSTOP] * (d - s) + p[P_CSTOP] * dv
+        elif d < -s:
+            F += p[P_KSTOP] * (d + s) + p[P_CSTOP] * dv
+        return F
+    if fa_state:
+        ii = N_CORE_RIGID + 1
+        fa = fa + controller_output(y, p, modes, r, rd, ii, ii + 1)
+    Fa, _ = actuator(fa, p)
+    Fe, _ = external_force(y[0], p)
+    return Fa + Fe
+
+
+# --------------------------------------------------------------------------- rhs + jacobian
+
+
+@kernel_function((f8, A1, A1, I1, f8, f8, f8, b1, A1))
+def rhs(t, y, p, modes, r, rd, fa, fa_state, f):
+    """Right-hand side dy/dt for frozen modes, written into ``f``.
+
+    Parameters
+    ----------
+    t : float
+        Time [s] (the model is autonomous apart from ``r``, ``rd`` and ``fa``).
+    y : ndarray
+        State (7 isolated, 5 rigid).
+    p : ndarray
+        Parameter array (:class:`PlantParameters`).
+    modes : ndarray of int64
+        Frozen modes (``MODE_*``).
+    r, rd : float
+        Reference position [m] and velocity [m/s] at ``t``.
+    fa : float
+        With ``fa_state`` false: the actuator command [N] (delayed or held).
+        With ``fa_state`` true: the part of the command that is not the
+        controller's output (feedforward plus a known input force) [N].
+    fa_state : bool
+        True: the command is the continuous controller's output u plus ``fa``
+        (continuous controller, no delay).
+    f : ndarray
+        Output, same shape as ``y``.
+    """
+    iso = p[P_ISO] != 0.0
+    if iso:
+        iz, ii, iu = N_CORE_ISO, N_CORE_ISO + 1, N_CORE_ISO + 2
+        x1, v1, x2, v2 = y[0], y[1], y[2], y[3]
+    else:
+        iz, ii, iu = N_CORE_RIGID, N_CORE_RIGID + 1, N_CORE_RIGID + 2
+        x1, v1 = y[0], y[1]
+        x2, v2 = x1, v1
+    z = y[iz]
+    discrete = p[P_TS] > 0.0
+    wt = p[P_WT]
+    v = 0.0
+    e = 0.0
+    if not discrete:
+        v, _, _, e = control_law(y, p, modes, r, rd, ii)
+    if fa_state:
+        u = v if math.isinf(wt) else y[iu]
+        Fa, _ = actuator(u + fa, p)
+    else:
+        Fa, _ = actuator(fa, p)
+    Fe, _ = external_force(x1, p)
+    stick = p[P_SWITCH] != 0.0 and modes[MODE_STICK] == 1
+    sgn = float(modes[MODE_SIGN])
+    if p[P_SWITCH] != 0.0:
+        zd = 0.0
+        if stick:
+            Ff = 0.0
+        else:
+            g, _, _ = stribeck(v2, x2, sgn, p)
+            s2 = p[P_SIGMA2] if sgn > 0.0 else p[P_SIGMA2_NEG]
+            Ff = sgn * g + s2 * v2
+    else:
+        zd, Ff, _, _, _, _, _, _ = lugre(v2, x2, z, sgn, p)
+    if iso:
+        d = x1 - x2
+        dv = v1 - v2
+        lim = modes[MODE_LIMIT]
+        Fj = p[P_K] * d + p[P_C] * dv
+        if lim > 0:
+            Fj += p[P_KSTOP] * (d - p[P_S]) + p[P_CSTOP] * dv
+        elif lim < 0:
+            Fj += p[P_KSTOP] * (d + p[P_S]) + p[P_CSTOP] * dv
+        f[0] = v1
+        f[1] = (Fa - Fj + Fe) / p[P_M1]
+        if stick:
+            f[2] = 0.0
+            f[3] = 0.0
+        else:
+            f[2] = v2
+            f[3] = (Fj - Ff) / p[P_M2]
+    else:
+        if stick:
+            f[0] = 0.0
+            f[1] = 0.0
+        else:
+            f[0] = v1
+            f[1] = (Fa + Fe - Ff) / (p[P_M1] + p[P_M2])
+    f[iz] = zd
+    if discrete:
+        f[ii] = 0.0
+        f[iu] = 0.0
+    else:
+        f[ii] = p[P_KI] * e
+        f[iu] = 0.0 if math.isinf(wt) else wt * (v - y[iu])
+
+
+@kernel_function((f8, A1, A1, I1, f8, f8, f8, b1, A2))
+def jacobian(t, y, p, modes, r, rd, fa, fa_state, J):
+    """Analytic Jacobian d(rhs)/dy for frozen modes, written into ``J`` (n x n)."""
+    n = y.shape[0]
+    for i in range(n):
+        for j in range(n):
+            J[i, j] = 0.0
+    iso = p[P_ISO] != 0.0
+    if iso:
+        iz, ii, iu = N_CORE_ISO, N_CORE_ISO + 1, N_CORE_ISO + 2
+        x1, x2, v2 = y[0], y[2], y[3]
+    else:
+        iz, ii, iu = N_CORE_RIGID, N_CORE_RIGID + 1, N_CORE_RIGID + 2
+        x1 = y[0]
+        x2, v2 = x1, y[1]
+    z = y[iz]
+    discrete = p[P_TS] > 0.0
+    algebraic = math.isinf(p[P_WT])
+    v = 0.0
+    dv_dx = 0.0
+    dv_dv = 0.0
+    if not discrete:
+        v, dv_dx, dv_dv, _ = control_law(y, p, modes, r, rd, ii)
+    dFa = 0.0
+    if fa_state:
+        _, dFa = actuator((v if algebraic else y[iu]) + fa, p)
+    _, dFe = external_force(x1, p)
+    stick = p[P_SWITCH] != 0.0 and modes[MODE_STICK] == 1
+    sgn = float(modes[MODE_SIGN])
+    dzd_dx = 0.0
+    dzd_dv = 0.0
+    dzd_dz = 0.0
+    dF_dx = 0.0
+    dF_dv = 0.0
+    dF_dz = 0.0
+    if p[P_SWITCH] != 0.0:
+        if not stick:
+            _, dg_dv, dg_dx = stribeck(v2, x2, sgn, p)
+            dF_dv = sgn * dg_dv + (p[P_SIGMA2] if sgn > 0.0 else p[P_SIGMA2_NEG])
+            dF_dx = sgn * dg_dx
+    else:
+        _, _, dzd_dx, dzd_dv, dzd_dz, dF_dx, dF_dv, dF_dz = lugre(v2, x2, z, sgn, p)
+    # the actuator force's dependence on the states, through u (filtered) or v (algebraic)
+    if algebraic:
+        dA_dx = dFa * dv_dx
+        dA_dv = dFa * dv_dv
+        dA_dI = dFa
+        dA_du = 0.0
+    else:
+        dA_dx = 0.0
+        dA_dv = 0.0
+        dA_dI = 0.0
+        dA_du = dFa
+    if iso:
+        m1 = p[P_M1]
+        m2 = p[P_M2]
+        lim = modes[MODE_LIMIT]
+        kk = p[P_K]
+        cc = p[P_C]
+        if lim != 0:
+            kk += p[P_KSTOP]
+            cc += p[P_CSTOP]
+        J[0, 1] = 1.0
+        J[1, 0] = (-kk + dFe + dA_dx) / m1
+        J[1, 1] = (-cc + dA_dv) / m1
+        J[1, 2] = kk / m1
+        J[1, 3] = cc / m1
+        J[1, ii] = dA_dI / m1
+        J[1, iu] = dA_du / m1
+        if not stick:
+            J[2, 3] = 1.0
+            J[3, 0] = kk / m2
+            J[3, 1] = cc / m2
+            J[3, 2] = (-kk - dF_dx) / m2
+            J[3, 3] = (-cc - dF_dv) / m2
+            J[3, iz] = -dF_dz / m2
+        J[iz, 2] = dzd_dx
+        J[iz, 3] = dzd_dv
+        J[iz, iz] = dzd_dz
+    else:
+        m = p[P_M1] + p[P_M2]
+        if not stick:
+            J[0, 1] = 1.0
+            J[1, 0] = (dFe - dF_dx + dA_dx) / m
+            J[1, 1] = (-dF_dv + dA_dv) / m
+            J[1, iz] = -dF_dz / m
+            J[1, ii] = dA_dI / m
+            J[1, iu] = dA_du / m
+        J[iz, 0] = dzd_dx
+        J[iz, 1] = dzd_dv
+        J[iz, iz] = dzd_dz
+    if not discrete:
+        J[ii, 0] = 0.0 if p[P_QUANT] > 0.0 else -p[P_KI]
+        if not algebraic:
+            wt = p[P_WT]
+            J[iu, 0] = wt * dv_dx
+            J[iu, 1] = wt * dv_dv
+            J[iu, ii] = wt
+            J[iu, iu] = -wt
+
+
+@kernel_function((A1, A1, I1))
+def natural_modes(y, p, modes):
+    """Modes implied by the state alone (sliding sign kept when the velocity is 0).
+
+    Used to start a simulation and by the reference path, which does not
+    freeze modes. The stick flag is left as given.
+    """
+    iso = p[P_ISO] != 0.0
+    v2 = y[3] if iso else y[1]
+    if v2 > 0.0:
+        modes[MODE_SIGN] = 1
+    elif v2 < 0.0:
+        modes[MODE_SIGN] = -1
+    if iso:
+        d = y[0] - y[2]
+        s = p[P_S]
+        modes[MODE_LIMIT] = 1 if d > s else (-1 if d < -s else 0)
+    q = p[P_QUANT]
+    if q > 0.0:
+        modes[MODE_LEVEL] = int(math.floor(y[0] / q + 0.5))
