@@ -1716,6 +1716,133 @@ def print_reconcile(console: "Console", result) -> None:
         console.print(Text(f"skipped {name}: {why}", style="dim"))
 
 
+# --------------------------------------------------------------------------- identify
+# (friction and mass from a measured record: fi_design.identification, fi_design.identreport)
+
+
+@app.command("identify")
+def identify_command(
+    measured: Annotated[Path, typer.Argument(
+        metavar="MEASURED.csv", help="The measured record: time_s, reference_m, position_m, "
+                                     "force_N (optional deflection_m, disturbance_N).",
+        show_default=False)],
+    spec: Annotated[Optional[Path], typer.Option(
+        "--spec", metavar="SPEC.yaml", help="The stage's spec: its loop sets the filter, its "
+                                            "isolator gives the flexure force, its masses the "
+                                            "split; needed for --write-spec and --report.",
+        show_default=False)] = None,
+    json_out: Annotated[Optional[Path], typer.Option(
+        "--json", metavar="OUT.json", help="Write the identification as JSON.",
+        show_default=False)] = None,
+    write_spec: Annotated[Optional[Path], typer.Option(
+        "--write-spec", metavar="OUT.yaml", help="Write the spec with the identified friction "
+                                                 "and masses filled in (never the input).",
+        show_default=False)] = None,
+    report_out: Annotated[Optional[Path], typer.Option(
+        "--report", metavar="IDENT.html", help="Write the report: force-velocity map, force "
+                                               "residual, fit statistics (HTML, or PDF for a "
+                                               ".pdf name).", show_default=False)] = None,
+    form: Annotated[str, typer.Option(
+        "--form", help="symmetric: one Coulomb friction and an offset; per-direction: Coulomb "
+                       "friction per direction, no offset.")] = "symmetric",
+    force: Annotated[bool, typer.Option(
+        "--force", "-f", help="Overwrite existing output files.")] = False,
+) -> None:
+    """Identify mass, friction and force offset from a measured record (guideline step 1).
+
+    Inverse-dynamics least squares on the filtered record gives the moving
+    mass, Coulomb and viscous friction per direction and the offset, with
+    standard errors; static friction, Stribeck velocity and bristle
+    stiffness only where the record holds a breakaway or presliding.
+    """
+    forms = {"symmetric": "symmetric", "per-direction": "per_direction",
+             "per_direction": "per_direction"}
+    if form not in forms:
+        raise typer.BadParameter("must be 'symmetric' or 'per-direction'", param_hint="--form")
+    if spec is None and (write_spec is not None or report_out is not None):
+        raise typer.BadParameter("--write-spec and --report need the stage's spec",
+                                 param_hint="--spec")
+    from .output import check_output
+
+    outs, seen = {}, []
+    for key, path, exts in (("json", json_out, (".json",)), ("spec", write_spec, (".yaml", ".yml")),
+                            ("report", report_out, (".html", ".pdf"))):
+        outs[key] = None if path is None else check_output(
+            path, force=force, protect=(spec, measured, *seen), extensions=exts)
+        if outs[key] is not None:
+            seen.append(outs[key])
+    from .identification import identified_spec_text, identify
+    from .measured import load_measurement
+    from .specfile import load_spec
+
+    spec_obj = load_spec(spec) if spec is not None else None
+    data = load_measurement(measured)
+    with _FractionBar(_console(stderr=True), "identifying") as bar:
+        result = identify(data, spec_obj, form=forms[form], progress=bar)
+    console = _console()
+    print_identification(console, result)
+    text = identified_spec_text(result) if outs["spec"] is not None else None
+    import json
+
+    from .output import write_atomic
+
+    if outs["json"] is not None:
+        write_atomic(outs["json"], json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n")
+        console.print(f"wrote {outs['json']}", markup=False, highlight=False)
+    if outs["spec"] is not None:
+        write_atomic(outs["spec"], text)
+        console.print(f"wrote {outs['spec']}", markup=False, highlight=False)
+    if outs["report"] is not None:
+        from .identreport import render_identification_report
+
+        render_identification_report(result, outs["report"], command=_command_line())
+        console.print(f"wrote {outs['report']}", markup=False, highlight=False)
+
+
+def print_identification(console: "Console", result) -> None:
+    """Print an :class:`~fi_design.identification.IdentificationResult`: table, fit, notes.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to print.
+    result : fi_design.identification.IdentificationResult
+        The identification.
+    """
+    from rich import box
+    from rich.table import Table
+    from rich.text import Text
+
+    m = result.measurement
+    console.print(Text(f"Identification from {m.source or 'the record'}: {m.n} samples, "
+                       f"{result.form.replace('_', '-')} form, {result.model.replace('_', ' ')} "
+                       "model", style="bold"))
+    t = Table(title="Parameters (SI; standard error one sigma)", title_justify="left",
+              box=box.SIMPLE_HEAD, pad_edge=False)
+    for col, just in (("Parameter", "left"), ("Value", "right"), ("Std. error", "right"),
+                      ("Unit", "left"), ("Identifiable", "left")):
+        t.add_column(col, justify=just, no_wrap=True)
+    for name, p in result.parameters.items():
+        t.add_row(Text(name), _fmt(p.value, 6), _fmt(p.std_error, 3), Text(p.unit),
+                  Text("yes" if p.identifiable else "no",
+                       style="green" if p.identifiable else "yellow"))
+    console.print(t)
+    f = result.fit
+    console.print(Text(f"Fit: RMS force residual {_fmt(f.force_rms_residual, 3)} N, relative "
+                       f"error {_fmt(f.relative_error, 3)}, condition number "
+                       f"{_fmt(f.condition_number, 3)}, {f.samples_used} samples used "
+                       f"({_fmt(f.effective_samples, 3)} effective)"))
+    ms = result.masses
+    console.print(Text(f"Masses: stage {_fmt(ms.stage, 5)} kg, cart {_fmt(ms.cart, 5)} kg "
+                       f"({ms.source})"))
+    for name in ("static", "stribeck_velocity", "bristle_stiffness"):
+        p = result.parameters[name]
+        if not p.identifiable:
+            console.print(Text(f"{name}: {p.note}", style="dim"))
+    for note in result.notes:
+        console.print(Text(f"note: {note}", style="dim"))
+
+
 def main() -> None:
     """Console-script entry point (``fi-design``, ``python -m fi_design``)."""
     app(prog_name="fi-design")

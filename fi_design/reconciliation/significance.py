@@ -55,7 +55,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..measured import measurement_from_arrays
-from .comparison import Comparison, ModelRun
+from .comparison import Comparison
 from .fitting import Baseline, FitOutcome, Objective, fit, fit_baseline
 from .noise import channels_autocorrelation_time
 from .results import Candidate, Lattice

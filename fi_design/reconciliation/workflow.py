@@ -34,7 +34,6 @@ from .signatures import Evidence, scan
 from .significance import (NESTED, NULL_SEED, THRESHOLD, block_jackknife, judge,
                            noise_only_refit, numerical_error, passes_primary, prefer_simpler)
 from .spaces import Space, candidate_spaces
-from .specout import make_entry
 
 ProgressCallback = Callable[[str, float], None]
 
