@@ -178,26 +178,26 @@ class Comparison:
         vmax = float(np.max(np.abs(v))) if len(v) else 0.0
         moving = np.abs(v) > 1e-3 * vmax if vmax > 0 else np.zeros(self.n, bool)
         merged: list[list[int]] = []
-        for i0, i1 in runs(moving):
-            if merged and t[i0] - t[merged[-1][1] - 1] < 0.02:
-                merged[-1][1] = i1
+        for run in runs(moving):
+            if merged and t[run.start] - t[merged[-1][1] - 1] < 0.02:
+                merged[-1][1] = run.stop
             else:
-                merged.append([i0, i1])
-        self.moves = [(i0, i1) for i0, i1 in merged if i1 - i0 >= 2]
+                merged.append([run.start, run.stop])
+        self.moves = [range(i0, i1) for i0, i1 in merged if i1 - i0 >= 2]
         if settle_window is None:
             law = control_law(self.spec)
             tau = law.kp / law.ki if law.ki > 0 else 1.0 / (2.0 * math.pi * law.crossover)
             settle_window = 5.0 * tau
         self.settle_window = float(settle_window)
         kind = np.full(self.n, "hold", dtype=object)
-        for k, (i0, i1) in enumerate(self.moves):
-            kind[i0:i1] = "move"
-            nxt = self.moves[k + 1][0] if k + 1 < len(self.moves) else self.n
-            j = int(np.searchsorted(t, t[i1 - 1] + self.settle_window, side="right"))
-            kind[i1:min(j, nxt)] = "settle"
+        for k, move in enumerate(self.moves):
+            kind[move.start:move.stop] = "move"
+            nxt = self.moves[k + 1].start if k + 1 < len(self.moves) else self.n
+            j = int(np.searchsorted(t, t[move.stop - 1] + self.settle_window, side="right"))
+            kind[move.stop:min(j, nxt)] = "settle"
         self.kind = kind
         self.holds = runs(kind == "hold")
-        self.last_move_end = float(t[self.moves[-1][1] - 1]) if self.moves else 0.0
+        self.last_move_end = float(t[self.moves[-1].stop - 1]) if self.moves else 0.0
         r = self.meas.reference
         self.travel_center = float(0.5 * (np.max(r) + np.min(r)))
 
@@ -209,13 +209,14 @@ class Comparison:
         e_meas = self.meas.position - self.meas.reference
         e_nom = nominal.position - self.meas.reference
         coherent = np.ones(self.n, bool)
-        self.feature_segments: list[tuple[int, int]] = []
-        for i0, i1 in self.holds:
+        self.feature_segments: list[range] = []
+        for hold in self.holds:
+            i0, i1 = hold.start, hold.stop
             if i1 - i0 < 20:
                 continue
             if reversals(e_meas[i0:i1], self.band) >= 3 or reversals(e_nom[i0:i1], self.band) >= 3:
                 coherent[i0:i1] = False
-                self.feature_segments.append((i0, i1))
+                self.feature_segments.append(hold)
         self.coherent = coherent
         idx = np.nonzero(coherent)[0]
         stride = max(1, int(math.ceil(len(idx) / max_points)))
@@ -227,7 +228,8 @@ class Comparison:
         self.feat_meas = []
         self.feat_sigma = []
         m = self.meas
-        for i0, i1 in self.feature_segments:
+        for seg in self.feature_segments:
+            i0, i1 = seg.start, seg.stop
             f = self._features(m.position, m.force, m.deflection, i0, i1)
             chunks = np.array_split(np.arange(i0, i1), 4)
             fc = np.array([self._features(m.position, m.force, m.deflection, c[0], c[-1] + 1)
@@ -284,9 +286,9 @@ class Comparison:
             parts.append((run.force[i] - self.meas.force[i]) / self.noise.force)
         if self.has_defl:
             parts.append((run.deflection[i] - self.meas.deflection[i]) / self.noise.deflection)
-        for (i0, i1), fm, fs in zip(self.feature_segments, self.feat_meas, self.feat_sigma):
-            parts.append((self._features(run.position, run.force, run.deflection, i0, i1) - fm)
-                         / fs)
+        for seg, fm, fs in zip(self.feature_segments, self.feat_meas, self.feat_sigma):
+            parts.append((self._features(run.position, run.force, run.deflection, seg.start,
+                                         seg.stop) - fm) / fs)
         r = np.concatenate(parts)
         if not np.all(np.isfinite(r)):
             return np.full(self.n_points, self.fail_level)
@@ -301,9 +303,10 @@ class Comparison:
     def segment_list(self) -> tuple[Segment, ...]:
         """The segments as result values."""
         out = []
-        for i0, i1 in label_runs(self.kind):
-            out.append(Segment(kind=str(self.kind[i0]), start=float(self.t[i0]),
-                               end=float(self.t[i1 - 1]), coherent=bool(self.coherent[i0])))
+        for seg in label_runs(self.kind):
+            out.append(Segment(kind=str(self.kind[seg.start]), start=float(self.t[seg.start]),
+                               end=float(self.t[seg.stop - 1]),
+                               coherent=bool(self.coherent[seg.start])))
         return tuple(out)
 
     def model_trace(self, run: ModelRun) -> ModelTrace:
@@ -335,20 +338,20 @@ def model_tolerance(spec, noise: NoiseLevels) -> float:
     return float(min(spec.simulation.tolerance, max(1e-9, sig / 100.0 / 1e-3)))
 
 
-def runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """Half-open index ranges where ``mask`` is true."""
+def runs(mask: np.ndarray) -> list[range]:
+    """Index ranges where ``mask`` is true."""
     m = np.concatenate([[False], np.asarray(mask, bool), [False]])
     d = np.diff(m.astype(int))
-    return [(int(a), int(b)) for a, b in zip(np.nonzero(d == 1)[0], np.nonzero(d == -1)[0])]
+    return [range(int(a), int(b)) for a, b in zip(np.nonzero(d == 1)[0], np.nonzero(d == -1)[0])]
 
 
-def label_runs(labels: np.ndarray) -> list[tuple[int, int]]:
-    """Half-open index ranges of equal consecutive labels."""
+def label_runs(labels: np.ndarray) -> list[range]:
+    """Index ranges of equal consecutive labels."""
     out = []
     i0 = 0
     for i in range(1, len(labels) + 1):
         if i == len(labels) or labels[i] != labels[i0]:
-            out.append((i0, i))
+            out.append(range(i0, i))
             i0 = i
     return out
 
