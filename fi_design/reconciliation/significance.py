@@ -79,8 +79,8 @@ JACKKNIFE_NFEV = 10
 #: Effects that contain another as a special case: a cable force of zero stiffness is a
 #: force offset (its preload the offset).
 NESTED = {"cable_force": "force_offset"}
-#: Share of the gap above noise the larger of two nested effects must remove beyond the
-#: smaller one to be named instead of it.
+#: Share of what the smaller of two nested effects leaves above noise that the larger must
+#: remove to be named instead of it.
 NESTED_MARGIN = 0.1
 
 
@@ -197,10 +197,10 @@ def prefer_simpler(candidates: dict) -> dict:
     """Candidates with a larger nested effect made ineligible where the smaller one suffices.
 
     When both effects of a :data:`NESTED` pair can be named and the larger
-    removes less than :data:`NESTED_MARGIN` more of the gap above noise, its
-    extra parameters buy nothing a reader should act on: the smaller one is
-    the finding. (Its likelihood ratio alone would favour the larger one on
-    any record the model misses by more than noise.)
+    removes less than :data:`NESTED_MARGIN` of what the smaller leaves above
+    noise, its extra parameters buy nothing a reader should act on: the
+    smaller one is the finding. (Its likelihood ratio alone would favour the
+    larger one on any record the model misses by more than noise.)
 
     Parameters
     ----------
@@ -212,11 +212,12 @@ def prefer_simpler(candidates: dict) -> dict:
         b, s = out.get(big), out.get(small)
         if b is None or s is None or not (b.eligible and s.eligible):
             continue
-        if b.explained - s.explained < NESTED_MARGIN:
+        left = 1.0 - s.explained
+        extra = (b.explained - s.explained) / left if left > 0 else 0.0
+        if extra < NESTED_MARGIN:
             out[big] = replace(b, eligible=False, reasons=(
-                f"contains {small} as a special case and removes only "
-                f"{100 * (b.explained - s.explained):.1f} % more of the gap than it "
-                f"(needs {100 * NESTED_MARGIN:.0f} %)",))
+                f"contains {small} as a special case and removes only {100 * extra:.1f} % of "
+                f"the gap {small} leaves (needs {100 * NESTED_MARGIN:.0f} %)",))
     return out
 
 
@@ -342,8 +343,9 @@ def noise_only_refit(cmp: Comparison, space: Space, baseline: Baseline, max_poin
     deviation = {}
     for p, v in outcome.values.items():
         ref = space.references.get(p)
-        # a refit that ends on the bound standing for "absent" has found the truth
-        absent = p in outcome.at_bound
+        # a refit that ends on the bound standing for "absent", or finds nothing better than
+        # the truth it was made from, has found the truth
+        absent = p in outcome.at_bound or st.delta_chi2 <= 0.0
         deviation[p] = None if ref is None or v is None or absent else float(v - ref)
     return NullRefit(statistic=st.value, deviation=deviation,
                      n_simulations=outcome.n_simulations + null_cmp.n_sims)
@@ -353,8 +355,12 @@ def block_jackknife(cmp: Comparison, outcome: FitOutcome,
                     blocks: int = JACKKNIFE_BLOCKS) -> dict:
     """Standard error of each parameter from refits that leave out one time block each.
 
-    The record is cut into ``blocks`` contiguous stretches; each refit (from
-    the full fit's optimum, :data:`JACKKNIFE_NFEV` evaluations) drops one.
+    The record is cut into ``blocks`` contiguous stretches that each hold an
+    equal share of the fit's information about the effect (the squared
+    Jacobian of its coordinates, summed over the channels: an effect seen in
+    one short move gets short blocks around it, so that no deletion leaves
+    it unidentifiable); each refit (from the full fit's optimum,
+    :data:`JACKKNIFE_NFEV` evaluations) drops one.
     The spread of the refitted values, ``(B - 1) / B`` times their sum of
     squared deviations, is the jackknife's variance: it holds the residual's
     autocorrelation and a mismatch between model and record that differs
@@ -385,8 +391,15 @@ def block_jackknife(cmp: Comparison, outcome: FitOutcome,
     m = len(cmp.idx)
     channels = len(cmp.channel_blocks(outcome.residual))
     n = len(outcome.residual)
+    J = outcome.jacobian[:, outcome.columns]
+    J = J / np.maximum(np.sqrt(np.sum(J ** 2, axis=0)), 1e-300)
+    info = np.sum(J[:channels * m] ** 2, axis=1).reshape(channels, m).sum(axis=0)
+    share = np.cumsum(info) / max(float(info.sum()), 1e-300)
+    cuts = np.searchsorted(share, np.arange(1, blocks) / blocks)
     values = []
-    for part in np.array_split(np.arange(m), blocks):
+    for part in np.split(np.arange(m), cuts):
+        if len(part) == 0:
+            continue
         keep = np.ones(n, bool)
         for j in range(channels):
             keep[j * m + part] = False
