@@ -71,9 +71,10 @@ def main() -> None:
 
     t0 = time.perf_counter()
     from fi_design.specfile import load_spec
-    from fi_design.studies import PointCache, sweep, warm_up
+    from fi_design.studies import PointCache, parse_axis, sweep, warm_up
 
     spec = load_spec(SPEC)
+    ax, ay = parse_axis(X, spec=spec), parse_axis(Y, spec=spec)
     warm_up()
     t_import = time.perf_counter() - t0
     rows: list[tuple[str, str, str]] = []
@@ -81,12 +82,12 @@ def main() -> None:
 
     def pooled():
         with pool() as ex:
-            return sweep(spec, X, Y, executor=ex)
+            return sweep(spec, ax, ay, executor=ex)
 
     # serial and pool alternate, so that both see the same share of a busy machine
     t_serial = t_pool = math.inf
     for _ in range(args.repeat):
-        t, ref = best(lambda: sweep(spec, X, Y), 1)
+        t, ref = best(lambda: sweep(spec, ax, ay), 1)
         t_serial = min(t_serial, t)
         t, res = best(pooled, 1)
         t_pool = min(t_pool, t)
@@ -124,7 +125,7 @@ def main() -> None:
             cluster, client = start()
             t_start = min(t_start, time.perf_counter() - t)
             try:
-                t, res = best(lambda: sweep(spec, X, Y, executor=client), 1)
+                t, res = best(lambda: sweep(spec, ax, ay, executor=client), 1)
                 t_dask = min(t_dask, t)
             finally:
                 client.close()
@@ -141,9 +142,9 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         cache = PointCache(tmp)
         t = time.perf_counter()
-        first = sweep(spec, X, Y, cache=cache)
+        first = sweep(spec, ax, ay, cache=cache)
         t_first = time.perf_counter() - t
-        t_hit, again = best(lambda: sweep(spec, X, Y, cache=cache), args.repeat)
+        t_hit, again = best(lambda: sweep(spec, ax, ay, cache=cache), args.repeat)
         assert again.run.cached == 400 and again.points == first.points
         cache.close()
     rows.append(("cache: first run (serial, writing the cache)", f"{t_first:.2f} s", ""))

@@ -24,207 +24,20 @@ A spec without an isolator is confirmed against the isolator step 3 suggests
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from . import spec as _spec
-from .metrics import HuntingMetrics
-from .results import Check, Status, dataclass_dict, frozen_array
-from .simulation import SimulationResult, simulate
+from .errors import ArgumentError
+from .results import Check, Status, frozen_array
+from .results.design import Confirmation, CrossoverScan, Landing, PlantVerdict
+from .results.simulation import SimulationResult
+from .simulation import simulate
 
 PLANTS = ("isolated", "non_isolated")
 
 
-@dataclass(frozen=True, eq=False)
-class PlantVerdict:
-    """Summary of one simulated plant at the design crossover.
-
-    Attributes
-    ----------
-    plant : str
-        ``"isolated"`` or ``"non_isolated"``.
-    friction_model : str
-        Friction model that produced the verdict (``lugre`` or ``switch``).
-    crossover : float
-        Crossover simulated [Hz].
-    hunting_cycles : int
-        Peaks counted by the paper's metric.
-    amplitude : float
-        Peak-to-peak error in the counting window [m].
-    period : float or None
-        Mean period of the counted cycles [s].
-    settled : bool
-        Whether the error stays within the settle band at the window's end.
-    settling_time : float or None
-        Time after the move until the error stays within the band [s].
-    final_error : float
-        Error x1 - r at the end [m].
-    verdict : str
-        ``settled``, ``hunting``, ``stuck`` or ``undetermined``.
-    reason : str
-        The verdict in one sentence.
-    success : bool
-        Whether the integration completed.
-    message : str
-        Failure description, empty on success.
-    """
-
-    plant: str
-    friction_model: str
-    crossover: float
-    hunting_cycles: int
-    amplitude: float
-    period: float | None
-    settled: bool
-    settling_time: float | None
-    final_error: float
-    verdict: str
-    reason: str
-    success: bool
-    message: str
-
-    @classmethod
-    def of(cls, plant: str, result: SimulationResult) -> "PlantVerdict":
-        """Summarise a simulation result."""
-        m: HuntingMetrics = result.metrics
-        return cls(plant=plant, friction_model=result.friction_model, crossover=result.crossover,
-                   hunting_cycles=m.hunting_cycles, amplitude=m.amplitude, period=m.period,
-                   settled=m.settled, settling_time=m.settling_time, final_error=m.final_error,
-                   verdict=m.verdict, reason=m.reason, success=result.success,
-                   message=result.message)
-
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
-
-@dataclass(frozen=True, eq=False)
-class CrossoverScan:
-    """Verdicts down a crossover grid and the lowest hunting-free crossover.
-
-    The scan runs from the top of the grid downwards and stops at the first
-    crossover that does not settle: everything above it settles, so the
-    minimum is found with the fewest simulations. Hunting that comes and goes
-    below that boundary (the paper saw it at 9.5 Hz) is a matter for a map
-    (``fi-design sweep``), not for this scan.
-
-    Attributes
-    ----------
-    plant : str
-        ``"isolated"`` or ``"non_isolated"``.
-    crossovers : ndarray, shape (n,)
-        Scanned crossovers, ascending [Hz].
-    verdicts : tuple of str
-        Verdict at each scanned crossover.
-    hunting_cycles : ndarray of int, shape (n,)
-        Counted cycles at each scanned crossover.
-    minimum : float or None
-        Lowest grid crossover from which every higher one settles [Hz]; None
-        if the top of the grid does not settle.
-    resolution : float
-        Grid step [Hz]: the boundary lies within one step below ``minimum``.
-    grid : tuple of float
-        The whole grid (start, stop, step) [Hz].
-    """
-
-    plant: str
-    crossovers: np.ndarray
-    verdicts: tuple[str, ...]
-    hunting_cycles: np.ndarray
-    minimum: float | None
-    resolution: float
-    grid: tuple[float, float, float]
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return dataclass_dict(self)
-
-
-@dataclass(frozen=True)
-class Landing:
-    """Where the cart comes to rest after the move (isolated plant).
-
-    Attributes
-    ----------
-    deflection : float
-        Joint deflection x1 - x2 at the end of the simulation [m].
-    stroke : float
-        One-sided stroke [m].
-    stiffness : float
-        Drive stiffness k [N/m].
-    force : float
-        Force the flexure exerts on the resting cart, k * min(|deflection|,
-        stroke) [N].
-    static_friction : float
-        Fs [N].
-    on_limiter : bool
-        Whether the landing deflection reaches the stroke (the limiter then
-        locks the joint and the controller feels the friction again).
-    rule_force : float
-        The paper's conservative bound k * stroke [N].
-    """
-
-    deflection: float
-    stroke: float
-    stiffness: float
-    force: float
-    static_friction: float
-    on_limiter: bool
-    rule_force: float
-
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
-
-@dataclass(frozen=True, eq=False)
-class Confirmation:
-    """The simulated confirmation of a design.
-
-    Attributes
-    ----------
-    isolated, non_isolated : PlantVerdict
-        The two plants at the design crossover.
-    min_hunting_free_crossover : dict
-        ``{"isolated": Hz or None, "non_isolated": Hz or None, "resolution":
-        Hz, "scan": [start, stop]}``.
-    scans : dict of CrossoverScan
-        The scans behind the minimum crossovers, by plant.
-    landing : Landing or None
-        Landing of the isolated cart.
-    cross_check : dict of PlantVerdict
-        The same plants with the other friction model, by plant.
-    models_agree : bool
-        Whether both friction models give the same hunting/no-hunting call
-        for both plants.
-    suggested_isolator : bool
-        True when the spec has no isolator and the isolated plant uses the
-        isolator suggested by the guideline.
-    checks : tuple of Check
-        The simulation's checks for the design summary.
-    results : dict of SimulationResult
-        The two full simulations (traces for plots; not in the JSON).
-    """
-
-    isolated: PlantVerdict
-    non_isolated: PlantVerdict
-    min_hunting_free_crossover: dict
-    scans: dict
-    landing: Landing | None
-    cross_check: dict
-    models_agree: bool
-    suggested_isolator: bool
-    checks: tuple[Check, ...]
-    results: dict = field(repr=False)  # traces for plots; not in the JSON
-
-    def to_dict(self) -> dict:
-        """Plain JSON data: the verdicts, scans and checks (no traces)."""
-        return dataclass_dict(self)
-
-
 def _hunts(v: PlantVerdict) -> bool:
-    return v.verdict == "hunting"
+    return v.metrics.verdict == "hunting"
 
 
 def scan_crossover(spec: _spec.Spec, isolated: bool, start: float | None = None,
@@ -311,7 +124,7 @@ def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
     suggested = spec.isolator is None
     if suggested:
         if suggestion is None:
-            raise ValueError("a spec without isolator needs a suggested (stroke, stiffness)")
+            raise ArgumentError("a spec without isolator needs a suggested (stroke, stiffness)")
         spec_iso = with_isolator(spec, *suggestion)
     else:
         spec_iso = spec
@@ -350,11 +163,12 @@ def _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested) 
     fc = _spec.design_crossover(spec)
     step = "simulation (paper section 2.3)"
     label = "suggested isolator" if suggested else "isolated design"
+    mi, mn = iso.metrics, non.metrics
     out = [
-        Check("simulation_isolated", iso.verdict == "settled", float(iso.hunting_cycles), 0.0,
-              "cycles", f"{label} at {fc:g} Hz: {iso.verdict} ({iso.reason})", step),
-        Check("simulation_non_isolated", None, float(non.hunting_cycles), None, "cycles",
-              f"without isolator at {fc:g} Hz: {non.verdict} ({non.reason})", step),
+        Check("simulation_isolated", mi.verdict == "settled", float(mi.hunting_cycles), 0.0,
+              "cycles", f"{label} at {fc:g} Hz: {mi.verdict} ({mi.reason})", step),
+        Check("simulation_non_isolated", None, float(mn.hunting_cycles), None, "cycles",
+              f"without isolator at {fc:g} Hz: {mn.verdict} ({mn.reason})", step),
     ]
     m_iso, m_non = mins["isolated"], mins["non_isolated"]
     res = mins["resolution"]
@@ -366,10 +180,10 @@ def _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested) 
         "min_crossover_non_isolated", None, m_non, None, "Hz",
         f"without isolator hunting-free from {_fmt_f(m_non)} (scan resolution {res:g} Hz)",
         step))
-    if non.verdict != "hunting":
+    if mn.verdict != "hunting":
         out.append(Check("isolator_needed", None, None, None, "-",
                          f"the stage without isolator does not hunt at {fc:g} Hz "
-                         f"({non.verdict}): the isolator is not needed at this crossover", step))
+                         f"({mn.verdict}): the isolator is not needed at this crossover", step))
     if land is not None:
         ok = (not land.on_limiter) and land.force < land.static_friction
         out.append(Check(
@@ -381,6 +195,7 @@ def _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested) 
     if not agree:
         out.append(Check(
             "friction_model_cross_check", None, None, None, "-",
-            f"the {other_iso.friction_model} model disagrees: isolated {other_iso.verdict}, "
-            f"without isolator {other_non.verdict}", step, status=Status.WARN))
+            f"the {other_iso.friction_model} model disagrees: isolated "
+            f"{other_iso.metrics.verdict}, without isolator {other_non.metrics.verdict}", step,
+            status=Status.WARN))
     return out

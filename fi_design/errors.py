@@ -86,8 +86,21 @@ class DataError(FiDesignError, ValueError):
         super().__init__(": ".join(parts + [message]) if parts else message)
 
 
+class ArgumentError(FiDesignError, ValueError):
+    """A library function was called with an argument it refuses (a value outside the spec:
+    a chunk size, a resolution, a method name)."""
+
+
+class ReportError(FiDesignError, TypeError):
+    """There is no report for this kind of result."""
+
+
 class OutputError(FiDesignError, OSError):
     """An output path is refused (exists without --force, equals the spec, bad extension)."""
+
+
+class CacheError(FiDesignError, OSError):
+    """The result cache of the parameter studies cannot be opened, read or written."""
 
 
 class SimulationError(FiDesignError, RuntimeError):

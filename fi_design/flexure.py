@@ -33,11 +33,10 @@ with the largest smallest margin (stress, support frequency, leaf frequency).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
-from .results import dataclass_dict
+from .results.design import FlexureResult
 
 __all__ = [
     "CLAMPED_GUIDED_ROOT", "FlexureResult", "drive_stiffness", "support_stiffness",
@@ -180,76 +179,6 @@ def bending_frequency(youngs_modulus, density, thickness, length):
 
 
 # --------------------------------------------------------------------------- result
-
-
-@dataclass(frozen=True)
-class FlexureResult:
-    """A sized parallel leaf-spring guide, or why none fits.
-
-    Attributes
-    ----------
-    feasible : bool
-        A design within the bounds meets every constraint.
-    reason : str
-        Empty when feasible; else the binding constraint in words.
-    leaves : int
-        Number of leaves n.
-    length, width, thickness : float or None
-        Leaf dimensions L, b, t [m]; None when infeasible.
-    drive_stiffness : float or None
-        Drive stiffness of the design [N/m].
-    target_stiffness : float
-        Stiffness aimed at (step 3's chosen stiffness) [N/m].
-    maximum_stiffness : float
-        k_max the drive stiffness must not exceed [N/m].
-    support_stiffness : float or None
-        Undeflected support stiffness [N/m].
-    stroke : float
-        Required one-sided stroke [m].
-    stroke_limit : float or None
-        Largest stroke within the allowed stress [m].
-    stress : float or None
-        Peak bending stress at full stroke [Pa].
-    allowed_stress : float
-        Allowed stress of the material [Pa].
-    stress_margin : float or None
-        allowed_stress / stress [-]; above 1 is within the limit.
-    support_frequency : float or None
-        First parasitic (support-direction) frequency with the stage mass [Hz].
-    bending_frequency : float or None
-        Leaf's own first bending resonance, clamped-guided (conservative) [Hz].
-    required_frequency : float
-        Parasitic frequencies must reach this: separation x crossover [Hz].
-    frequency_margin : float or None
-        min(support, bending frequency) / required_frequency [-].
-    leaf_mass : float or None
-        Mass of all leaves [kg].
-    """
-
-    feasible: bool
-    reason: str
-    leaves: int
-    length: float | None
-    width: float | None
-    thickness: float | None
-    drive_stiffness: float | None
-    target_stiffness: float
-    maximum_stiffness: float
-    support_stiffness: float | None
-    stroke: float
-    stroke_limit: float | None
-    stress: float | None
-    allowed_stress: float
-    stress_margin: float | None
-    support_frequency: float | None
-    bending_frequency: float | None
-    required_frequency: float
-    frequency_margin: float | None
-    leaf_mass: float | None
-
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
 
 
 # --------------------------------------------------------------------------- sizing

@@ -19,10 +19,10 @@ checks (:class:`~fi_design.results.Check`):
 an isolator in the spec, :func:`isolator_advice` says whether one looks needed
 and which stroke and stiffness to start from.
 
-The nonlinear confirmation is not part of this module: a simulation result is
-attached with ``design(spec, simulation=...)`` or
-:meth:`DesignResult.with_simulation`, and appears in JSON under ``simulation``
-only when set.
+:func:`design` also runs the nonlinear confirmation
+(:func:`fi_design.confirm.confirm`) on the executor the caller passes, so that
+its simulations overlap the linear analysis; it appears in JSON under
+``simulation`` when it ran.
 
 The linear analysis (python-control) is imported inside the step functions,
 so importing this module stays fast.
@@ -33,15 +33,23 @@ from __future__ import annotations
 import hashlib
 import logging
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
-from .flexure import FlexureResult, size_flexure
-from .pid import ControlLaw, PidGains, control_law
-from .results import Check, Status, dataclass_dict, to_jsonable
+import numpy as np
+
+from .flexure import size_flexure
+from .pid import ControlLaw, control_law
+from .results import Check, Status, frozen_array
+from .results.design import (CaseResponse, Confirmation, CrossoverResult, DesignResult,
+                             FlexureResult, FrictionGapResult, IsolatorAdvice, LoopResponses,
+                             ModeSeparation, PidResult, StiffnessResult)
 from .spec import (Spec, design_crossover, drive_stiffness, proposed_stiffness, stiffness_limit,
                    warnings_for)
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .execution import Executor
 
 __all__ = [
     "SUGGESTED_STROKE", "FrictionGapResult", "ModeSeparation", "CrossoverResult",
@@ -66,38 +74,6 @@ def _g(x: float | None, digits: int = 4) -> str:
 
 
 # --------------------------------------------------------------------------- step 1
-
-
-@dataclass(frozen=True)
-class FrictionGapResult:
-    """Step 1: the gap between static and Coulomb friction.
-
-    Attributes
-    ----------
-    static : float
-        Static friction Fs [N].
-    coulomb : float
-        Coulomb friction Fc [N].
-    gap : float
-        Fs - Fc [N].
-    threshold : float
-        ``requirements.friction_gap`` [N]: above it hunting is a risk.
-    hunting_risk : bool
-        ``gap >= threshold``.
-    checks : tuple of Check
-        The step's checks (also in :attr:`DesignResult.checks`).
-    """
-
-    static: float
-    coulomb: float
-    gap: float
-    threshold: float
-    hunting_risk: bool
-    checks: tuple[Check, ...] = field(default=(), repr=False)
-
-    def to_dict(self) -> dict:
-        """Plain JSON data (checks are listed once, in the design's ``checks``)."""
-        return dataclass_dict(self)
 
 
 def step1_friction_gap(spec: Spec) -> FrictionGapResult:
@@ -132,80 +108,6 @@ def step1_friction_gap(spec: Spec) -> FrictionGapResult:
 
 
 # --------------------------------------------------------------------------- step 2
-
-
-@dataclass(frozen=True)
-class ModeSeparation:
-    """A parasitic mode against the crossover.
-
-    Attributes
-    ----------
-    name : str
-        The mode's label.
-    frequency : float
-        Its frequency [Hz].
-    required : float
-        ``parasitic_separation`` x desired crossover [Hz].
-    collocated : bool
-        Collocated (antiresonance first) or not.
-    passed : bool
-        ``frequency >= required``.
-    """
-
-    name: str
-    frequency: float
-    required: float
-    collocated: bool
-    passed: bool
-
-
-@dataclass(frozen=True)
-class CrossoverResult:
-    """Step 2: desired and achievable crossover, margins per limit case.
-
-    Attributes
-    ----------
-    desired : float
-        ``controller.crossover`` [Hz].
-    achievable : float or None
-        Highest crossover meeting all requirements [Hz]; None if none does.
-    limited_by : str
-        What limits the achievable crossover, in words.
-    limit_kind : str
-        ``margin``, ``mode``, ``scan_limit`` or ``infeasible``
-        (see :class:`fi_design.linear.AchievableCrossover`).
-    limiting_case : str or None
-        Case name when a margin limits.
-    feasible_ranges : tuple of tuple of float
-        Feasible crossover stretches of the scan [Hz].
-    delay : float
-        Loop delay in the linear analysis [s] (computational plus half a
-        sample period).
-    stiffness : float or None
-        Joint stiffness the cases use [N/m]; None without isolator.
-    cases : tuple of fi_design.linear.CaseMargins
-        Margins of each limit case with the PID tuned at the desired crossover.
-    parasitic_modes : tuple of ModeSeparation
-        Each parasitic mode against ``parasitic_separation`` x desired crossover.
-    checks : tuple of Check
-        The step's checks.
-    """
-
-    desired: float
-    achievable: float | None
-    limited_by: str
-    limit_kind: str
-    limiting_case: str | None
-    feasible_ranges: tuple[tuple[float, float], ...]
-    delay: float
-    stiffness: float | None
-    cases: tuple[Any, ...]
-    parasitic_modes: tuple[ModeSeparation, ...]
-    checks: tuple[Check, ...] = field(default=(), repr=False)
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return dataclass_dict(self)
 
 
 def step2_crossover(spec: Spec) -> CrossoverResult:
@@ -293,49 +195,50 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
         checks=tuple(checks))
 
 
-# --------------------------------------------------------------------------- step 3
+# --------------------------------------------------------------------------- loop responses
 
 
-@dataclass(frozen=True)
-class StiffnessResult:
-    """Step 3: the maximum and the chosen drive stiffness.
+def loop_responses(spec: Spec, crossover: CrossoverResult, points: int = 500) -> LoopResponses:
+    """The loop of every limit case over a frequency grid that holds every crossover and mode.
 
-    Attributes
+    The loop is the one whose margins step 2 reports: the spec's controller at
+    the desired crossover, the joint stiffness of the cases.
+
+    Parameters
     ----------
-    maximum : float
-        k_max = Fs / (stiffness_safety x stroke) [N/m].
-    chosen : float
-        The spec's stiffness, else the proposed k_max / 2 [N/m]. Without an
-        isolator: the stiffness suggested to start from.
-    source : str
-        Where ``chosen`` comes from, in words.
-    stroke : float
-        One-sided stroke [m] (the suggested one without isolator).
-    static : float
-        Static friction Fs [N].
-    safety : float
-        ``requirements.stiffness_safety`` [-].
-    force_at_stroke : float
-        Flexure force at full stroke, chosen x stroke [N]; stays below Fs.
-    suggested : bool
-        True when the spec has no isolator and the values are a suggestion.
-    checks : tuple of Check
-        The step's checks.
+    spec : fi_design.spec.Spec
+        The design spec.
+    crossover : CrossoverResult
+        Step 2 (desired crossover, the gain crossovers of each case, the
+        joint stiffness the cases use).
+    points : int, optional
+        Number of frequencies.
+
+    Returns
+    -------
+    LoopResponses
     """
+    from . import linear
 
-    maximum: float
-    chosen: float
-    source: str
-    stroke: float
-    static: float
-    safety: float
-    force_at_stroke: float
-    suggested: bool
-    checks: tuple[Check, ...] = field(default=(), repr=False)
+    fc = crossover.desired
+    lows = [fc / 30.0] + [c / 3.0 for case in crossover.cases for c in case.crossovers
+                          if c and c > 0]
+    modes = spec.isolator.parasitic_modes if spec.isolator is not None else ()
+    highs = [30.0 * fc] + [2.0 * m.frequency for m in modes]
+    lo = 10.0 ** math.floor(math.log10(min(lows)))
+    hi = 10.0 ** math.ceil(math.log10(max(highs)))
+    f = np.geomspace(lo, hi, points)
+    s = 2j * math.pi * f
+    cases = []
+    for lc in linear.limit_cases(spec, crossover.stiffness):
+        num, den = linear.loop_polynomials(spec, lc)
+        cases.append(CaseResponse(name=lc.name, number=lc.number, description=lc.description,
+                                  loop=frozen_array(np.polyval(num, s) / np.polyval(den, s),
+                                                    dtype=complex)))
+    return LoopResponses(frequency=frozen_array(f), cases=tuple(cases))
 
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return dataclass_dict(self)
+
+# --------------------------------------------------------------------------- step 3
 
 
 def step3_stiffness(spec: Spec) -> StiffnessResult:
@@ -449,51 +352,6 @@ def _flexure_checks(fx: FlexureResult | None) -> tuple[Check, ...]:
 # --------------------------------------------------------------------------- step 4
 
 
-@dataclass(frozen=True)
-class PidResult:
-    """Step 4: the PID gains, and the loop's controller.
-
-    Attributes
-    ----------
-    gains : fi_design.pid.PidGains
-        The rule's gains at the loop's crossover (JSON: flattened into the
-        ``pid`` object); with explicit hardware gains, the recommendation.
-    tuning_rule : str
-        ``total`` (m1 + m2, the paper's choice) or ``stage`` (m1).
-    derivative_ratio : float
-        wd = wc / ratio, wt = ratio x wc [-].
-    integrator_ratio : float
-        wi = wc / ratio [-].
-    controller : fi_design.pid.ControlLaw
-        The loop's controller: the rule's, or the hardware's own gains
-        (``source``), as the analysis and the simulation use it.
-    static_error : float or None
-        Static position error of a loop without integrator against Coulomb
-        friction, Fc / kp [m]; None when the loop integrates.
-    checks : tuple of Check
-        The step's checks.
-    """
-
-    gains: PidGains
-    tuning_rule: str
-    derivative_ratio: float
-    integrator_ratio: float
-    controller: ControlLaw
-    static_error: float | None
-    checks: tuple[Check, ...] = field(default=(), repr=False)
-
-    def to_dict(self) -> dict:
-        """Flat JSON: the rule's gains plus the rule, its ratios and the loop's controller."""
-        out = {**self.gains.to_dict(), "tuning_rule": self.tuning_rule,
-               "derivative_ratio": self.derivative_ratio,
-               "integrator_ratio": to_jsonable(self.integrator_ratio),
-               "source": self.controller.source, "integrator": self.controller.integrator,
-               "static_error": self.static_error, "controller": self.controller.to_dict()}
-        if self.controller.source == "gains":
-            out["rule_in_hardware_form"] = to_jsonable(self.controller.rule_in_this_form())
-        return out
-
-
 def _controller_words(c: ControlLaw) -> str:
     """The structure of a controller in words (D input, roll-off, sampling)."""
     parts = [f"D on the {c.derivative_on}",
@@ -563,32 +421,6 @@ def step4_pid(spec: Spec) -> PidResult:
 # --------------------------------------------------------------------------- no isolator
 
 
-@dataclass(frozen=True)
-class IsolatorAdvice:
-    """Whether a stage without isolator looks like it needs one.
-
-    Attributes
-    ----------
-    needed : bool or None
-        True: an isolator is recommended; False: not needed; None: it depends
-        on whether a higher crossover removes hunting (simulate to decide).
-    reason : str
-        Why, in words.
-    stroke : float
-        Stroke to start from [m] (the paper's 0.3 mm).
-    stiffness : float
-        Stiffness to start from, Fs / (2 x safety x stroke) [N/m].
-    maximum_stiffness : float
-        k_max for that stroke [N/m].
-    """
-
-    needed: bool | None
-    reason: str
-    stroke: float
-    stiffness: float
-    maximum_stiffness: float
-
-
 def suggested_isolator(spec: Spec) -> tuple[float, float]:
     """Stroke [m] and drive stiffness [N/m] to start from when the spec has no isolator.
 
@@ -642,111 +474,6 @@ def isolator_advice(spec: Spec, gap: FrictionGapResult, crossover: CrossoverResu
 # --------------------------------------------------------------------------- the design
 
 
-@dataclass(frozen=True)
-class DesignResult:
-    """The four guideline steps for one spec.
-
-    Attributes
-    ----------
-    spec : fi_design.spec.Spec
-        The spec that produced the result (not in JSON; see ``spec_sha256``).
-    friction_gap : FrictionGapResult
-        Step 1.
-    crossover : CrossoverResult
-        Step 2.
-    stiffness : StiffnessResult
-        Step 3 (a suggestion without isolator).
-    flexure : fi_design.flexure.FlexureResult or None
-        Step 3 leaf-spring sizing; None without ``isolator.flexure``.
-    pid : PidResult
-        Step 4.
-    isolator_advice : IsolatorAdvice or None
-        Only for a spec without isolator.
-    checks : tuple of Check
-        All checks of the four steps, in step order.
-    warnings : tuple of (str, str)
-        ``(path, message)`` of suspicious spec values
-        (:func:`fi_design.spec.warnings_for`).
-    conclusion : str
-        One paragraph in plain words.
-    fi_design_version : str
-        Version of fi_design that computed it.
-    spec_sha256 : str
-        SHA-256 of the spec file (of the spec's JSON when not read from a file).
-    simulation : object or None
-        The nonlinear confirmation, when attached (:meth:`with_simulation`);
-        emitted in JSON only when set.
-    """
-
-    spec: Spec = field(repr=False)
-    friction_gap: FrictionGapResult
-    crossover: CrossoverResult
-    stiffness: StiffnessResult
-    flexure: FlexureResult | None
-    pid: PidResult
-    isolator_advice: IsolatorAdvice | None
-    checks: tuple[Check, ...]
-    warnings: tuple[tuple[str, str], ...]
-    conclusion: str
-    fi_design_version: str
-    spec_sha256: str
-    simulation: Any = None
-
-    @property
-    def passed(self) -> bool:
-        """No check failed (warnings and information do not count)."""
-        return not any(c.status == Status.FAIL for c in self.checks)
-
-    @property
-    def failed_checks(self) -> tuple[Check, ...]:
-        """The checks with status FAIL."""
-        return tuple(c for c in self.checks if c.status == Status.FAIL)
-
-    def with_simulation(self, simulation: Any, conclusion: str | None = None) -> "DesignResult":
-        """A copy with the nonlinear confirmation attached.
-
-        Parameters
-        ----------
-        simulation : fi_design.confirm.Confirmation or object
-            The confirmation; its ``checks`` (if any) join the design's checks.
-        conclusion : str, optional
-            The conclusion; default: the linear one followed by a sentence on
-            the simulated verdicts.
-        """
-        extra = tuple(getattr(simulation, "checks", ()))
-        if conclusion is None:
-            conclusion = self.conclusion + _simulation_sentence(self.spec, simulation)
-        return replace(self, simulation=simulation, checks=self.checks + extra,
-                       conclusion=conclusion)
-
-    def to_dict(self) -> dict:
-        """The JSON contract: SI values, infinite margins as null.
-
-        Keys: ``name``, ``passed``, ``friction_gap``, ``crossover``, ``stiffness``,
-        ``flexure``, ``pid``, ``isolator_advice``, ``checks``, ``warnings``,
-        ``conclusion``, ``fi_design_version``, ``spec_sha256`` and, when set,
-        ``simulation``.
-        """
-        out = {
-            "name": self.spec.name,
-            "passed": self.passed,
-            "friction_gap": self.friction_gap.to_dict(),
-            "crossover": self.crossover.to_dict(),
-            "stiffness": self.stiffness.to_dict(),
-            "flexure": None if self.flexure is None else self.flexure.to_dict(),
-            "pid": self.pid.to_dict(),
-            "isolator_advice": to_jsonable(self.isolator_advice),
-            "checks": [to_jsonable(c) for c in self.checks],
-            "warnings": [{"path": p, "message": m} for p, m in self.warnings],
-            "conclusion": self.conclusion,
-            "fi_design_version": self.fi_design_version,
-            "spec_sha256": self.spec_sha256,
-        }
-        if self.simulation is not None:
-            out["simulation"] = to_jsonable(self.simulation)
-        return out
-
-
 def _sha256(spec: Spec) -> str:
     from .specfile import origin
 
@@ -757,7 +484,8 @@ def _sha256(spec: Spec) -> str:
 
 
 def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
-           simulation: Any = None, progress: Any = None) -> DesignResult:
+           executor: Executor | None = None,
+           progress: Callable[[str], None] | None = None) -> DesignResult:
     """Run the four guideline steps on a spec and confirm them by simulation.
 
     Parameters
@@ -772,10 +500,15 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         (:func:`fi_design.confirm.confirm`, about a second once the kernel is
         compiled). Default True; CAD loops that only need the linear steps pass
         False.
-    simulation : fi_design.confirm.Confirmation, optional
-        A confirmation computed elsewhere, attached instead of simulating.
+    executor : concurrent.futures-style executor, optional
+        Runs the confirmation (``submit`` returning a future with ``result``
+        and ``cancel``) while this process does the linear analysis: with a
+        process pool the two overlap (and a first run compiles the simulation
+        kernel there). None runs it here, after the linear steps. The library
+        creates no pool.
     progress : callable, optional
-        Called with a short message as the confirmation proceeds.
+        ``progress(text)`` with a short message as the work proceeds (the
+        confirmation's own messages too when it runs here).
 
     Returns
     -------
@@ -788,41 +521,50 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         When ``spec`` is a path or mapping that does not validate.
     """
     from . import __version__
+    from .confirm import confirm as run_confirmation
 
     if not isinstance(spec, Spec):
         from .specfile import load_spec
 
         spec = load_spec(spec)
-    gap = step1_friction_gap(spec)
-    xo = step2_crossover(spec)
-    st = step3_stiffness(spec)
-    fx = step3_flexure(spec, st)
-    pid = step4_pid(spec)
+    suggestion = suggested_isolator(spec) if spec.isolator is None else None
+    pending = None
+    if confirm and executor is not None:
+        pending = executor.submit(run_confirmation, spec, suggestion)
+    try:
+        gap = step1_friction_gap(spec)
+        xo = step2_crossover(spec)
+        st = step3_stiffness(spec)
+        fx = step3_flexure(spec, st)
+        pid = step4_pid(spec)
+    except BaseException:
+        if pending is not None:
+            pending.cancel()
+        raise
     advice = isolator_advice(spec, gap, xo) if spec.isolator is None else None
     checks = gap.checks + xo.checks + st.checks + _flexure_checks(fx) + pid.checks
     result = DesignResult(
         spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,
-        isolator_advice=advice, checks=checks, warnings=tuple(warnings_for(spec)),
+        loop=loop_responses(spec, xo), isolator_advice=advice, checks=checks,
+        warnings=tuple(warnings_for(spec)),
         conclusion=_conclusion(spec, gap, xo, st, fx, pid, advice, checks),
         fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None)
-    if simulation is None and confirm:
-        from .confirm import confirm as _confirm
-
-        suggestion = suggested_isolator(spec) if spec.isolator is None else None
-        simulation = _confirm(spec, suggestion, progress=progress)
-    if simulation is not None:
-        result = result.with_simulation(simulation)
+    if confirm:
+        if progress is not None:
+            progress("simulating with and without the isolator (the first run on a machine "
+                     "compiles the kernel, about 10 s) ...")
+        sim = pending.result() if pending is not None else \
+            run_confirmation(spec, suggestion, progress=progress)
+        result = replace(result, simulation=sim, checks=result.checks + sim.checks,
+                         conclusion=result.conclusion + _simulation_sentence(spec, sim))
     log.info("design of %r: %d checks, %d failed", spec.name, len(result.checks),
              len(result.failed_checks))
     return result
 
 
-def _simulation_sentence(spec: Spec, sim: Any) -> str:
+def _simulation_sentence(spec: Spec, sim: Confirmation) -> str:
     """The conclusion's sentence on the simulated verdicts."""
-    iso = getattr(sim, "isolated", None)
-    non = getattr(sim, "non_isolated", None)
-    if iso is None or non is None:
-        return ""
+    iso, non = sim.isolated.metrics, sim.non_isolated.metrics
     mins = sim.min_hunting_free_crossover
     label = "the suggested isolator" if sim.suggested_isolator else "the isolator"
     fc = design_crossover(spec)
@@ -834,8 +576,9 @@ def _simulation_sentence(spec: Spec, sim: Any) -> str:
             f" ({iso.hunting_cycles} cycles), without it {non.verdict}"
             f" ({non.hunting_cycles} cycles); hunting-free {f(mins['isolated'])} with {label} "
             f"and {f(mins['non_isolated'])} without (resolution {mins['resolution']:g} Hz).")
-    if iso.friction_model != "lugre":
-        text = text.replace("The LuGre simulation", f"The {iso.friction_model} simulation")
+    model = sim.isolated.friction_model
+    if model != "lugre":
+        text = text.replace("The LuGre simulation", f"The {model} simulation")
     if not sim.models_agree:
         text += " The other friction model disagrees on the verdict (see the checks)."
     return text

@@ -62,10 +62,13 @@ def _styled(draw):
 
 
 def friction_curve(result: Any, velocity: np.ndarray) -> np.ndarray:
-    """The identified sliding friction plus offset at ``velocity`` [N].
+    """The identified steady-state friction plus offset at ``velocity`` [N].
 
     Coulomb plus viscous friction per direction and the offset, in the
-    identification's form; zero velocity gets the mean of the two sides.
+    identification's form; where static friction and the Stribeck velocity
+    are both identified, the Stribeck term (Fs - Fc) exp(-(v/vs)^2) on top
+    (the negative direction's scaled by its Coulomb ratio). Zero velocity
+    gets the mean of the two sides.
 
     Parameters
     ----------
@@ -73,14 +76,27 @@ def friction_curve(result: Any, velocity: np.ndarray) -> np.ndarray:
         The identification.
     velocity : ndarray
         Velocities [m/s].
+
+    Returns
+    -------
+    ndarray
+        Force [N], the shape of ``velocity``.
     """
     v = np.asarray(velocity, dtype=float)
     p = {k: (x.value if x.value is not None else 0.0) for k, x in result.parameters.items()}
-    fc_pos = p["coulomb"] + p["offset"]
-    fc_neg = (p["coulomb"] - p["offset"]) if result.form == "symmetric" else p["coulomb_negative"]
+    symmetric = result.form == "symmetric"
+    fc_pos = p["coulomb"] + (p["offset"] if symmetric else 0.0)
+    fc_neg = (p["coulomb"] - p["offset"]) if symmetric else p["coulomb_negative"]
     pos = fc_pos + p["viscous"] * v
     neg = -fc_neg + p["viscous_negative"] * v
-    return np.where(v > 0, pos, np.where(v < 0, neg, 0.5 * (fc_pos - fc_neg)))
+    par = result.parameters
+    if par["static"].identifiable and par["stribeck_velocity"].identifiable:
+        gap = p["static"] - p["coulomb"]  # the form's positive direction, offset aside
+        e = np.exp(-(v / p["stribeck_velocity"]) ** 2)
+        ratio = 1.0 if symmetric else p["coulomb_negative"] / p["coulomb"]
+        pos = pos + gap * e
+        neg = neg - gap * ratio * e
+    return np.where(v > 0, pos, np.where(v < 0, neg, 0.5 * (pos + neg)))
 
 
 @_styled
@@ -109,7 +125,8 @@ def force_velocity_figure(result: Any) -> Any:
     ax.plot(v[inn], f[inn], ".", ms=2, color=COLOURS["used"], label="used in the fit")
     top = float(np.max(np.abs(v))) if len(v) else 1.0
     for side in (-1.0, 1.0):
-        vv = np.linspace(side * 1e-9, side * top, 200)
+        vv = side * np.unique(np.concatenate([np.linspace(1e-9, top, 200),
+                                              np.geomspace(1e-4 * top, top, 200)]))
         ax.plot(vv, friction_curve(result, vv / 1e3), color=COLOURS["fit"], lw=1.4,
                 label="identified friction + offset" if side > 0 else None)
     ax.axhline(0.0, color="0.5", lw=0.6)
@@ -209,7 +226,8 @@ def identification_sections(result: Any, figures: bool = True) -> list:
         paragraphs=("The measured actuator force minus the identified inertial force, against "
                     "the velocity of the bearing side: the friction the record shows, offset "
                     "included. The curve is the identified Coulomb plus viscous friction of "
-                    "each direction.",),
+                    "each direction, with the Stribeck term where static friction and the "
+                    "Stribeck velocity are identified.",),
         figures=(fig(force_velocity_figure, "Measured friction (points; grey: left out of the "
                                             "fit) and the identified friction curve of both "
                                             "directions (red). Shaded: the velocity band left "
@@ -227,7 +245,7 @@ def identification_sections(result: Any, figures: bool = True) -> list:
         figures=(fig(residual_figure, "Measured minus modelled actuator force at the used "
                                       "samples (filtered, decimated).", "ident-residual"),))
     e = result.excitation
-    exc_rows = (("breakaways from rest", str(e.breakaways)),
+    exc_rows = (("breakaways after a stop", str(e.breakaways)),
                 ("time at rest", qty(e.rest_time, "s")),
                 ("reversals", str(e.reversals)),
                 ("presliding reversals", str(e.presliding_reversals)),
@@ -238,15 +256,39 @@ def identification_sections(result: Any, figures: bool = True) -> list:
     notes = [f"{name}: {result.parameters[name].note}"
              for name in ("static", "stribeck_velocity", "bristle_stiffness")]
     notes += list(result.notes)
+    tables = [Table(("Excitation", "Value"), exc_rows, caption="Excitation in the record")]
+    dyn = getattr(result, "dynamic", None)
+    if dyn is not None and dyn.branches:
+        tables.append(Table(
+            ("Event", "Time [s]", "Samples", "Static friction [N]", "Bristle stiffness [N/m]",
+             "Force at onset [N]", "Creep at onset [mm/s]", "Counts for", "Why not"),
+            tuple(_event_row(b) for b in dyn.branches),
+            caption="Breakaways and presliding cycles (value ± standard error of each fit)",
+            numeric=(False, True, True, True, True, True, True, False, False)))
+    if dyn is not None and dyn.sweep is not None:
+        w = dyn.sweep
+        tables.append(Table(("Steady low-speed sliding", "Value"), (
+            ("samples (effective)", f"{w.samples} ({num(w.effective_samples, 3)})"),
+            ("speed range", f"{qty(w.speed_min, 'm/s', 3)} – {qty(w.speed_max, 'm/s', 3)}"),
+            ("below 0.7 vs / above 1.5 vs", f"{w.below} / {w.above}"),
+            ("Stribeck velocity", f"{qty(w.stribeck_velocity, 'm/s')} ± "
+                                  f"{qty(w.stribeck_velocity_std_error, 'm/s', 2)}"),
+            ("RMS weighted residual", num(w.rms_residual, 3))),
+            caption="Fit of the Stribeck curve", numeric=(False, True)))
     s4 = Section(
         "identifiability", "What is and is not identifiable",
         paragraphs=("Static friction, Stribeck velocity and bristle stiffness act only near "
-                    "zero velocity, where this record's samples are left out; they need a "
-                    "breakaway from rest, a slow velocity sweep through zero or presliding "
-                    "reversals, and a dedicated fit. They are not estimated here, never "
-                    "guessed: the table says what the record holds.",),
-        tables=(Table(("Excitation", "Value"), exc_rows, caption="Excitation in the record"),),
-        notes=tuple(notes))
+                    "zero velocity, where the inverse-dynamics fit leaves the samples out. Each "
+                    "is estimated from the part of the record that carries it, with the sliding "
+                    "friction above fixed and its errors propagated: static friction from the "
+                    "loading branch before each breakaway after a stop (the level the bristles "
+                    "saturate at, LuGre's presliding curve fitted to friction against "
+                    "displacement), the bristle stiffness from the same branches and from "
+                    "presliding cycles, the Stribeck velocity from steady sliding at low speed "
+                    "(a slow velocity sweep through zero). Where the record lacks the "
+                    "excitation the parameter is not identifiable and the note names the "
+                    "experiment that would identify it: never a guessed number.",),
+        tables=tuple(tables), notes=tuple(notes))
     p = result.processing
     proc_rows = (("sample rate", qty(p.sample_rate, "Hz")),
                  ("low-pass cut-off", f"{qty(p.cutoff, 'Hz')} ({p.cutoff_rule})"),
@@ -262,6 +304,24 @@ def identification_sections(result: Any, figures: bool = True) -> list:
                  tables=(Table(("Setting", "Value"), proc_rows, caption="Settings",
                                numeric=(False, False)),))
     return [s1, s2, s3, s4, s5]
+
+
+def _event_row(b: Any) -> tuple:
+    """A row of the events table."""
+    from .report import num
+
+    def pm(value, se, digits=4):
+        if value is None:
+            return "–"
+        return num(value, digits) + ("" if se is None else f" ± {num(se, 2)}")
+
+    what = {"breakaway": "breakaway " + ("+" if b.direction > 0 else "−"),
+            "presliding": "presliding cycle"}[b.kind]
+    return (what, num(b.time, 4), str(b.samples), pm(b.static, b.static_std_error),
+            pm(b.bristle_stiffness, b.bristle_stiffness_std_error),
+            num(b.peak_force, 4),
+            "–" if b.creep_velocity is None else num(b.creep_velocity * 1e3, 3),
+            ", ".join(b.used_for) or "–", b.note or "–")
 
 
 def conclusion(result: Any) -> str:

@@ -1043,14 +1043,16 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 th = (t_out[i_out] - t) / h
                 if th > 1.0:
                     th = 1.0
-                dense(y, ynew, cd2, cd3, th, ybuf)
                 if need_cmd and not held:
+                    dense(y, ynew, cd2, cd3, th, ybuf)
                     write_output(i_out, t_out[i_out], ybuf, p, modes, breaks, coeffs, in_t, in_f,
                                  hints, fa_hold, hist, head, count, need_cmd, out_y, out_r,
                                  out_fa, out_cmd)
                 else:  # the common cases inline (see ``held``): as write_output would
-                    for j in range(n):
-                        out_y[i_out, j] = ybuf[j]
+                    s1 = 1.0 - th
+                    for j in range(n):  # the dense output, as dense() computes it
+                        out_y[i_out, j] = y[j] * s1 + th * (ynew[j] + s1 * (cd2[j] + th * cd3[j]))
+                        ybuf[j] = out_y[i_out, j]
                     rr, rdr, _, _, kref = reference_at(t_out[i_out], breaks, coeffs, kref)
                     out_r[i_out] = rr
                     if held:

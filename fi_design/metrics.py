@@ -17,65 +17,12 @@ window is ``settled``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from .results import dataclass_dict, frozen_array
+from .results import frozen_array
+from .results.simulation import VERDICTS, HuntingMetrics
 
-VERDICTS = ("settled", "hunting", "stuck", "undetermined")
-
-
-@dataclass(frozen=True, eq=False)
-class HuntingMetrics:
-    """Hunting metric and settling figures of one trace.
-
-    Attributes
-    ----------
-    hunting_cycles : int
-        Peaks of x1 - r counted in the window (the paper's metric).
-    peak_times : ndarray, shape (hunting_cycles,)
-        Times of the counted peaks [s].
-    peak_heights : ndarray, shape (hunting_cycles,)
-        Error at the counted peaks [m].
-    amplitude : float
-        Peak-to-peak error in the window [m].
-    period : float or None
-        Mean time between counted peaks [s]; None with fewer than two.
-    settled : bool
-        Whether |x1 - r| stays within the settle band over the last quarter of
-        the window.
-    settling_time : float or None
-        Time after the end of the motion until |x1 - r| stays within the
-        settle band to the end of the trace [s]; None if it never does.
-    final_error : float
-        x1 - r at the last sample [m].
-    verdict : str
-        ``settled``, ``hunting``, ``stuck`` or ``undetermined``.
-    reason : str
-        Why, in one sentence.
-    window : tuple of float
-        The counting window (start, end) [s].
-    settle_band : float
-        The band used for ``settled`` and the settling time [m].
-    """
-
-    hunting_cycles: int
-    peak_times: np.ndarray
-    peak_heights: np.ndarray
-    amplitude: float
-    period: float | None
-    settled: bool
-    settling_time: float | None
-    final_error: float
-    verdict: str
-    reason: str
-    window: tuple[float, float]
-    settle_band: float
-
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
+__all__ = ["VERDICTS", "HuntingMetrics", "hunting_metrics"]
 
 
 def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_length: float = 10.0,

@@ -3,7 +3,8 @@
 Every command that writes a file (JSON, report, CSV, a fixed spec) does two
 things with it:
 
-1. :func:`check_output` before any long computation, so a run never spends a
+1. :func:`check_output` (:func:`check_outputs` for several, :func:`check_output_dir`
+   for a directory of them) before any long computation, so a run never spends a
    minute and then fails on a path it could have refused at once. It refuses
    an existing file without ``force``, the spec itself (even with ``force``, and
    also when reached through a symlink or a hard link), a wrong extension, a
@@ -82,6 +83,82 @@ def check_output(path: str | os.PathLike, *, force: bool = False,
         if out.exists() and not out.is_file():
             raise OutputError(f"{out}: exists and is not a regular file")
     return out
+
+
+def check_outputs(inputs: Iterable[str | os.PathLike], *, force: bool = False,
+                  **paths: tuple[str | os.PathLike | None, tuple[str, ...]]) -> dict:
+    """Refuse several output paths of one run before the work starts.
+
+    Parameters
+    ----------
+    inputs : iterable of path
+        The run's input files: never overwritten (see :func:`check_output`).
+    force : bool, optional
+        Allow overwriting existing files.
+    **paths : (path or None, extensions)
+        Each output by name, with its allowed extensions; None when not asked.
+
+    Returns
+    -------
+    dict
+        Name to the checked :class:`~pathlib.Path` (None for outputs not asked).
+
+    Raises
+    ------
+    OutputError
+        A path is refused, or two outputs name the same file.
+    """
+    out: dict = {}
+    seen: list[Path] = []
+    protect = tuple(inputs)
+    for name, (path, exts) in paths.items():
+        if path is None:
+            out[name] = None
+            continue
+        out[name] = check_output(path, force=force, protect=(*protect, *seen), extensions=exts)
+        seen.append(out[name])
+    return out
+
+
+def check_output_dir(directory: str | os.PathLike, names: Iterable[str], *,
+                     force: bool = False,
+                     protect: Iterable[str | os.PathLike | None] = ()) -> dict:
+    """Refuse a directory of outputs before the work starts (it may not exist yet).
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        Where the files go; created by the caller when missing (its parent
+        must exist).
+    names : iterable of str
+        The file names inside it.
+    force : bool, optional
+        Allow overwriting existing files.
+    protect : iterable of path, optional
+        Files never overwritten.
+
+    Returns
+    -------
+    dict
+        File name to its :class:`~pathlib.Path` in ``directory``.
+
+    Raises
+    ------
+    OutputError
+        ``directory`` is a file, its parent is missing, or a file is refused.
+    """
+    out = Path(directory)
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"{out}: exists and is not a directory")
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir():
+        raise OutputError(f"{out}: directory {parent} does not exist")
+    targets = {}
+    for name in names:
+        if out.is_dir():
+            check_output(out / name, force=force, protect=protect)
+        targets[name] = out / name
+    return targets
 
 
 def _same_file(a: Path, b: Path) -> bool:

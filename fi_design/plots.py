@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from . import spec as _spec
+from .errors import ArgumentError
 
 # --------------------------------------------------------------------------- design report
 # (fi_design.report: the linear analysis and the nonlinear confirmation of a DesignResult)
@@ -74,71 +75,14 @@ def case_label(case: Any) -> str:
 
     Parameters
     ----------
-    case : fi_design.linear.CaseMargins or LimitCase
-        The case (``name`` and ``description``).
+    case : fi_design.guideline.CaseResponse
+        The case (``number`` and ``description``).
 
     Returns
     -------
     str
     """
-    from .linear import CASE_NUMBERS
-
-    return f"{CASE_NUMBERS.get(case.name, '')} {case.description}".strip()
-
-
-def frequency_grid(result: Any, points: int = 500) -> np.ndarray:
-    """Frequencies [Hz] for the loop plots of a design: every crossover and mode inside.
-
-    From a third of the lowest gain crossover of any case (and a thirtieth of
-    the desired crossover) to thirty times the desired crossover or twice the
-    highest parasitic mode, log-spaced.
-
-    Parameters
-    ----------
-    result : fi_design.guideline.DesignResult
-        The design.
-    points : int, optional
-        Number of frequencies.
-
-    Returns
-    -------
-    numpy.ndarray, shape (points,)
-    """
-    fc = result.crossover.desired
-    lows = [fc / 30.0] + [c / 3.0 for case in result.crossover.cases
-                          for c in case.crossovers if c and c > 0]
-    spec = result.spec
-    modes = spec.isolator.parasitic_modes if spec.isolator is not None else ()
-    highs = [30.0 * fc] + [2.0 * m.frequency for m in modes]
-    lo = 10.0 ** math.floor(math.log10(min(lows)))
-    hi = 10.0 ** math.ceil(math.log10(max(highs)))
-    return np.geomspace(lo, hi, points)
-
-
-def loop_responses(result: Any, frequency: np.ndarray) -> list[tuple[Any, np.ndarray]]:
-    """The loop L(j 2 pi f) of every limit case of a design, as the margins used it.
-
-    Parameters
-    ----------
-    result : fi_design.guideline.DesignResult
-        The design (spec, PID and the cases of step 2).
-    frequency : numpy.ndarray
-        Frequencies [Hz].
-
-    Returns
-    -------
-    list of (fi_design.linear.LimitCase, numpy.ndarray)
-        Each case with its complex, dimensionless L at ``frequency``.
-    """
-    from . import linear
-
-    spec = result.spec
-    s = 2j * math.pi * np.asarray(frequency, dtype=float)
-    out = []
-    for lc in linear.limit_cases(spec, result.crossover.stiffness):
-        num, den = linear.loop_polynomials(spec, lc, gains=result.pid.gains)
-        out.append((lc, np.polyval(num, s) / np.polyval(den, s)))
-    return out
+    return f"{case.number} {case.description}".strip()
 
 
 def plain_tick(value: float, _pos: Any = None) -> str:
@@ -185,28 +129,24 @@ def _phase_deg(L: np.ndarray, f: np.ndarray, near: float) -> np.ndarray:
 
 
 @_styled
-def bode_figure(result: Any, responses: list | None = None,
-                frequency: np.ndarray | None = None) -> Any:
+def bode_figure(result: Any) -> Any:
     """Open-loop Bode plot of the four limit cases (paper Figure 2) in one figure.
 
-    Magnitude and phase of L = C D P for every case, the desired crossover
+    Magnitude and phase of L = C D P for every case (the design's
+    :class:`~fi_design.guideline.LoopResponses`), the desired crossover
     (dashed), 0 dB and -180 deg, and each case's gain crossovers (dots).
 
     Parameters
     ----------
     result : fi_design.guideline.DesignResult
         The design.
-    responses : list, optional
-        :func:`loop_responses` on ``frequency`` (computed when omitted).
-    frequency : numpy.ndarray, optional
-        Frequencies [Hz]; default :func:`frequency_grid`.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    f = frequency_grid(result) if frequency is None else frequency
-    responses = loop_responses(result, f) if responses is None else responses
+    f = result.loop.frequency
+    responses = [(c, c.loop) for c in result.loop.cases]
     fc = result.crossover.desired
     fig = _report_figure(4.3, top=0.62, right=0.3, hspace=0.1)
     mag, pha = fig.subplots(2, 1, sharex=True, height_ratios=(1.1, 1.0))
@@ -253,8 +193,7 @@ def bode_figure(result: Any, responses: list | None = None,
 
 
 @_styled
-def nyquist_figure(result: Any, responses: list | None = None,
-                   frequency: np.ndarray | None = None) -> Any:
+def nyquist_figure(result: Any) -> Any:
     """Nyquist plot of the limit cases (positive frequencies), zoomed on the critical point -1.
 
     Colours and line styles as in :func:`bode_figure`; the circle
@@ -265,17 +204,12 @@ def nyquist_figure(result: Any, responses: list | None = None,
     ----------
     result : fi_design.guideline.DesignResult
         The design.
-    responses : list, optional
-        :func:`loop_responses` on ``frequency``.
-    frequency : numpy.ndarray, optional
-        Frequencies [Hz]; default :func:`frequency_grid`.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    f = frequency_grid(result) if frequency is None else frequency
-    responses = loop_responses(result, f) if responses is None else responses
+    responses = [(c, c.loop) for c in result.loop.cases]
     fig = _report_figure(3.0, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
     ax = fig.add_subplot()
     for lc, L in responses:
@@ -299,25 +233,20 @@ def nyquist_figure(result: Any, responses: list | None = None,
 
 
 @_styled
-def sensitivity_figure(result: Any, responses: list | None = None,
-                       frequency: np.ndarray | None = None) -> Any:
+def sensitivity_figure(result: Any) -> Any:
     """Sensitivity |S| = |1 / (1 + L)| of the limit cases, peaks marked.
 
     Parameters
     ----------
     result : fi_design.guideline.DesignResult
         The design.
-    responses : list, optional
-        :func:`loop_responses` on ``frequency``.
-    frequency : numpy.ndarray, optional
-        Frequencies [Hz]; default :func:`frequency_grid`.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    f = frequency_grid(result) if frequency is None else frequency
-    responses = loop_responses(result, f) if responses is None else responses
+    f = result.loop.frequency
+    responses = [(c, c.loop) for c in result.loop.cases]
     fig = _report_figure(3.0, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
     ax = fig.add_subplot()
     for lc, L in responses:
@@ -376,8 +305,9 @@ def decimate(t: np.ndarray, y: np.ndarray, buckets: int = 700) -> tuple[np.ndarr
 
 
 def _plant_title(v: Any, label: str) -> str:
-    cycles = f"{v.hunting_cycles} cycle{'s' if v.hunting_cycles != 1 else ''}"
-    return f"{label}: {v.verdict} ({cycles} counted)"
+    m = v.metrics
+    cycles = f"{m.hunting_cycles} cycle{'s' if m.hunting_cycles != 1 else ''}"
+    return f"{label}: {m.verdict} ({cycles} counted)"
 
 
 @_styled
@@ -527,7 +457,7 @@ def scan_figure(confirmation: Any, spec: Any) -> Any:
     return fig
 
 
-def figure_svg(fig: Any, prefix: str) -> str:
+def figure_svg(fig: Any, prefix: str, text_as_paths: bool = False) -> str:
     """A figure as SVG text for inlining in HTML: no XML prolog, unique ids, scalable.
 
     Parameters
@@ -537,21 +467,26 @@ def figure_svg(fig: Any, prefix: str) -> str:
     prefix : str
         Prepended to every ``id`` (and the references to it), so several
         figures can share one HTML page; letters, digits and ``-`` only.
+    text_as_paths : bool, optional
+        Draw text as glyph outlines (equations: exact, with any font);
+        default False.
 
     Returns
     -------
     str
         An ``<svg>`` element with a ``viewBox`` (CSS sizes it), reproducible
-        (fixed id salt, no date). Text stays text (``svg.fonttype: none``):
-        searchable, and about twice as fast for WeasyPrint to draw as glyph
-        outlines; viewers draw it with their own sans-serif font.
+        (fixed id salt, no date). By default text stays text
+        (``svg.fonttype: none``): searchable, and about twice as fast for
+        WeasyPrint to draw as glyph outlines; viewers draw it with their own
+        sans-serif font.
     """
     import re
 
     import matplotlib
 
     buf = io.BytesIO()
-    with matplotlib.rc_context({"svg.hashsalt": "fi_design", "svg.fonttype": "none"}):
+    with matplotlib.rc_context({"svg.hashsalt": "fi_design",
+                                "svg.fonttype": "path" if text_as_paths else "none"}):
         fig.savefig(buf, format="svg", metadata={"Date": None})
     text = buf.getvalue().decode("utf-8")
     text = text[text.index("<svg"):]
@@ -773,6 +708,58 @@ def sweep_figure(result: Any, *, title: str | None = None) -> Any:
     return fig
 
 
+def design_map_figure(result: Any) -> Any:
+    """The hunting map around a design point, sized for the design report.
+
+    Parameters
+    ----------
+    result : fi_design.studies.SweepResult
+        The crossover x stroke map (:class:`~fi_design.studies.DesignMap`'s ``sweep``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Log axes labelled with plain 1-2-5 numbers, not mathtext powers.
+    """
+    import matplotlib
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    with matplotlib.rc_context(REPORT_RC):
+        fig = Figure(figsize=(REPORT_WIDTH, 3.8), layout="constrained")
+        ax = fig.add_subplot()
+        draw_sweep(ax, result, title="")
+        for axis, swept in ((ax.xaxis, result.x), (ax.yaxis, result.y)):
+            if swept is not None and swept.log:
+                _, factor = display_unit(swept.unit)
+                axis.set_major_formatter(FuncFormatter(plain_tick))
+                axis.set_minor_formatter(NullFormatter())
+                lo, hi = min(swept.values) * factor, max(swept.values) * factor
+                axis.set_ticks(nice_ticks(lo, hi))
+    return fig
+
+
+def nice_ticks(lo: float, hi: float) -> list[float]:
+    """1-2-5 ticks between ``lo`` and ``hi`` (for log axes).
+
+    Parameters
+    ----------
+    lo, hi : float
+        The axis range (above zero).
+
+    Returns
+    -------
+    list of float
+    """
+    out = []
+    for exp in range(math.floor(math.log10(lo)) - 1, math.ceil(math.log10(hi)) + 1):
+        for m in (1.0, 2.0, 5.0):
+            v = m * 10.0 ** exp
+            if lo * 0.999 <= v <= hi * 1.001:
+                out.append(float(f"{v:.6g}"))
+    return out
+
+
 def _legend_text(result: Any) -> str:
     marks = ", ".join(f"{m} {v}" for v, m in VERDICT_MARKS.items()
                       if np.any(np.asarray(result.verdict) == v))
@@ -872,7 +859,7 @@ def figure_bytes(fig: Any, fmt: str = "svg") -> bytes:
 
     fmt = fmt.lower().lstrip(".")
     if fmt not in ("svg", "png"):
-        raise ValueError(f"unsupported figure format {fmt!r}; use svg or png")
+        raise ArgumentError(f"unsupported figure format {fmt!r}; use svg or png")
     buf = io.BytesIO()
     meta = {"Date": None} if fmt == "svg" else {"Software": None}
     with matplotlib.rc_context({"svg.hashsalt": "fi_design", "svg.fonttype": "path"}):
@@ -902,7 +889,7 @@ def gap_overlay_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
 
     Returns
@@ -948,7 +935,7 @@ def gap_residual_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
 
     Returns
@@ -983,7 +970,7 @@ def candidate_scores_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
 
     Returns
@@ -1002,7 +989,7 @@ def candidate_scores_figure(result: Any) -> Any:
     ax.axvline(thr, color="C3", lw=0.9, ls="--")
     ax.text(thr, 1.0, " threshold", transform=ax.get_xaxis_transform(), va="bottom",
             fontsize=7, color="C3")
-    ax.set_xlabel("score: sign(s) log10(1 + |s|), s = BIC difference")
+    ax.set_xlabel("score: sign(s) log10(1 + |s|), s = BIC difference [-]")
     return fig
 
 
@@ -1018,7 +1005,7 @@ def structure_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
 
     Returns

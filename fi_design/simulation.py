@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import time as _time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
@@ -26,143 +26,16 @@ from .errors import SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from .pid import ControlLaw, control_law
 from .plant import PlantParameters, state_index
-from .replay import (DRIVES, ReplayFit, command_state, initial_state, record_state,
-                     reference_state, replay_fit)
-from .results import frozen_array, to_jsonable
+from .replay import (DRIVES, command_state, initial_state, record_state, reference_state,
+                     replay_fit)
+from .results import frozen_array
+from .results.simulation import SimulationResult
 from .trajectory import Trajectory, from_moves, from_samples
 
 METHODS = ("fast", "reference")
 
 #: Default length of the re-anchored windows of an open-loop replay [s].
 WINDOW = 0.1
-
-
-@dataclass(frozen=True, eq=False)
-class SimulationResult:
-    """Traces and metrics of one simulation.
-
-    Attributes
-    ----------
-    isolated : bool
-        Whether the isolated (two-mass) plant was simulated.
-    method : str
-        ``"fast"`` (RODAS4 kernel) or ``"reference"`` (solve_ivp).
-    friction_model : str
-        ``"lugre"`` or ``"switch"``.
-    crossover : float
-        Crossover of the controller [Hz] (the rule's, or the hardware gains').
-    effects : tuple of str
-        Names of the effects in the model.
-    time : ndarray, shape (n,)
-        Sample times [s] at the output rate.
-    reference : ndarray, shape (n,)
-        Reference r [m].
-    position : ndarray, shape (n,)
-        Stage position x1 [m] (the measured position).
-    cart_position : ndarray, shape (n,)
-        Cart position x2 [m] (equal to x1 without isolator).
-    velocity : ndarray, shape (n,)
-        Stage velocity v1 [m/s].
-    cart_velocity : ndarray, shape (n,)
-        Cart velocity v2 [m/s].
-    force : ndarray, shape (n,)
-        Commanded actuator force [N], before delay and saturation: the
-        controller's output plus feedforward plus a known input force (a
-        record's disturbance; in an open-loop replay the measured force).
-    applied_force : ndarray, shape (n,)
-        Force acting on the stage [N], after delay and saturation.
-    bristle : ndarray, shape (n,)
-        LuGre bristle deflection z [m] (zero for the switch model).
-    success : bool
-        Whether the integration reached the end time.
-    status : str
-        ``"ok"`` or the failure kind.
-    message : str
-        Failure description with the time reached and a likely cause.
-    t_reached : float
-        Last time integrated [s].
-    n_steps, n_rejected, n_events : int
-        Accepted steps, discarded trial steps (rejected by the error test or
-        redone to end at a mode change) and mode switches.
-    wall_time : float
-        Integration time [s] (excluding JIT compilation on first use only if
-        the kernel was already compiled).
-    metrics : HuntingMetrics
-        Hunting metric and verdict of this trace.
-    parameters : PlantParameters
-        The kernel parameters used.
-    drive : str
-        ``"closed"`` (the model's controller closes the loop) or ``"force"``
-        (open-loop replay of a record's measured force).
-    record : str or None
-        Source of the replayed record; None for the spec's own motion.
-    window : ndarray of int, shape (n,), or None
-        Open-loop replay: the number of the re-anchored window of each
-        sample (the state is reset to the measurement at each window's
-        start); None otherwise.
-    replay : ReplayFit or None
-        How a record's replay agrees with the measurement; None otherwise.
-    """
-
-    isolated: bool
-    method: str
-    friction_model: str
-    crossover: float
-    effects: tuple[str, ...]
-    time: np.ndarray
-    reference: np.ndarray
-    position: np.ndarray
-    cart_position: np.ndarray
-    velocity: np.ndarray
-    cart_velocity: np.ndarray
-    force: np.ndarray
-    applied_force: np.ndarray
-    bristle: np.ndarray
-    success: bool
-    status: str
-    message: str
-    t_reached: float
-    n_steps: int
-    n_rejected: int
-    n_events: int
-    wall_time: float
-    metrics: HuntingMetrics
-    parameters: PlantParameters
-    drive: str = "closed"
-    record: str | None = None
-    window: np.ndarray | None = None
-    replay: ReplayFit | None = None
-
-    @property
-    def error(self) -> np.ndarray:
-        """Position error x1 - r [m]."""
-        return self.position - self.reference
-
-    @property
-    def deflection(self) -> np.ndarray | None:
-        """Joint deflection x1 - x2 [m]; None without isolator."""
-        return self.position - self.cart_position if self.isolated else None
-
-    def traces(self) -> dict[str, np.ndarray]:
-        """Columns in the measured-data layout (DESIGN.md section 4).
-
-        ``time_s``, ``reference_m``, ``position_m``, ``force_N`` and, for the
-        isolated plant, ``deflection_m``.
-        """
-        cols = {"time_s": self.time, "reference_m": self.reference, "position_m": self.position,
-                "force_N": self.force}
-        if self.isolated:
-            cols["deflection_m"] = self.deflection
-        if self.window is not None:
-            cols["window"] = self.window
-        return cols
-
-    def to_dict(self, traces: bool = False) -> dict:
-        """Plain JSON data: metadata and metrics; the traces only when asked."""
-        from dataclasses import fields
-
-        return {f.name: to_jsonable(getattr(self, f.name)) for f in fields(self)
-                if traces or not isinstance(getattr(self, f.name), np.ndarray)}
 
 
 # --------------------------------------------------------------------------- parameters
@@ -382,7 +255,7 @@ def _result(spec, iso, method, law, params, out, t_out, wall, effects, *, move_e
     t = t_out + time_offset
     metrics = _metrics(spec, t, Y[:, idx["x1"]] - R, success, message, move_end)
     return SimulationResult(
-        isolated=iso, method=method, friction_model=spec.friction.model,
+        spec=spec, isolated=iso, method=method, friction_model=spec.friction.model,
         crossover=law.crossover,
         effects=tuple(e.type for e in (spec.effects if effects is None else effects)),
         time=frozen_array(t), reference=frozen_array(R), position=frozen_array(Y[:, idx["x1"]]),

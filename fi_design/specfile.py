@@ -122,7 +122,12 @@ def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, dict]:
     if not text.strip() or all(ln.strip().startswith("#") or not ln.strip()
                                for ln in text.splitlines()):
         raise SpecError("the spec file is empty", source=source)
-    loader = yaml.SafeLoader(text)
+    try:
+        loader = yaml.SafeLoader(text)
+    except yaml.reader.ReaderError as exc:  # a NUL or other control character
+        line = text.count("\n", 0, exc.position) + 1
+        raise SpecError(f"control character U+{exc.character:04X} is not allowed in a YAML "
+                        "spec: the file is not plain text", line=line, source=source) from None
     try:
         node = loader.get_single_node()
         if node is None:

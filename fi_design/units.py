@@ -23,7 +23,7 @@ import math
 import re
 from functools import lru_cache
 
-from .errors import UnitError
+from .errors import ArgumentError, UnitError
 
 #: Target units understood by :func:`to_si`, with the dimension users see in messages.
 KNOWN_UNITS = {
@@ -99,7 +99,7 @@ def to_si(value, unit: str, path: str | None = None) -> float:
         unit is required (angles, decibels).
     """
     if unit not in KNOWN_UNITS:  # programming error, not user input
-        raise ValueError(f"unknown target unit {unit!r}")
+        raise ArgumentError(f"unknown target unit {unit!r}")
     if _is_number(value):
         if unit == "deg":
             raise UnitError(f"a bare number is ambiguous for an angle; write e.g. '{value} deg'",

@@ -80,7 +80,7 @@ def emps_record(emps_path):
 
 @pytest.fixture(autouse=True, scope="session")
 def _private_result_cache(tmp_path_factory):
-    """Point the sweep result cache (FI_DESIGN_CACHE_DIR) at a temporary directory.
+    """Point the caches (FI_DESIGN_CACHE_DIR: sweep results, drawn equations) at a temporary directory.
 
     No test ever reads or writes the user's cache; tests that need an empty
     cache of their own pass ``cache=tmp_path`` or set the variable again.

@@ -163,6 +163,19 @@ def test_binary_file(tmp_path):
     _assert_refused(result, out, tmp_path, ["not a text file"])
 
 
+@pytest.mark.parametrize("char", ["\x00", "\x07", "\x1b"])
+def test_control_character_in_the_spec(tmp_path, char):
+    """A NUL (or other control character) is bad input naming file and line, not a bug."""
+    text = edit("static: 4 N", f"static: 4{char} N")
+    spec = tmp_path / "ctrl.yaml"
+    spec.write_bytes(text.encode("utf-8"))
+    result, out = _run(str(spec), tmp_path)
+    n = line_of(text, "static: 4")
+    _assert_refused(result, out, tmp_path, [f"{spec}:{n}:", f"U+{ord(char):04X}",
+                                            "not plain text"])
+    assert "internal error" not in result.stderr
+
+
 def test_several_problems_listed(tmp_path):
     text = edit("static: 4 N", "statc: 4 N").replace("stage: {mass: 1.6 kg}", "stage: {mass: -1}")
     spec = tmp_path / "two.yaml"

@@ -127,9 +127,6 @@ def test_internal_error_exit_1_without_traceback(paper_spec_path, monkeypatch):
         raise RuntimeError("kaboom")
 
     monkeypatch.setattr(fi_design.guideline, "design", boom)
-    import fi_design.cli
-
-    monkeypatch.setattr(fi_design.cli, "_Job", _FakeJob)
     monkeypatch.delenv("FI_DESIGN_DEBUG", raising=False)
     r = runner.invoke(app, [str(paper_spec_path)])
     assert r.exit_code == 1
@@ -260,19 +257,6 @@ class _FakeResult:
     def to_dict(self):
         return {"fi_design_version": __version__}
 
-    def with_simulation(self, simulation):
-        return self
-
-
-class _FakeJob:
-    def __init__(self, spec):
-        pass
-
-    def result(self):
-        return None
-
-    def cancel(self):
-        pass
 
 
 def _fake_design(monkeypatch, calls):
@@ -285,4 +269,3 @@ def _fake_design(monkeypatch, calls):
         return _FakeResult()
 
     monkeypatch.setattr(fi_design.guideline, "design", fake)
-    monkeypatch.setattr(fi_design.cli, "_Job", _FakeJob)

@@ -24,7 +24,7 @@ def paper_confirmation(paper_spec):
 def test_paper_headline_isolator_needs_far_less_bandwidth(paper_confirmation):
     """Paper: hunting-free at 5 Hz with the isolator, 14-20 Hz needed without."""
     c = paper_confirmation
-    assert c.isolated.verdict == "settled" and c.non_isolated.verdict == "hunting"
+    assert c.isolated.metrics.verdict == "settled" and c.non_isolated.metrics.verdict == "hunting"
     m = c.min_hunting_free_crossover
     assert m["resolution"] == 0.5
     assert 4.0 <= m["isolated"] <= 7.0
@@ -66,11 +66,11 @@ def test_landing_refinement(paper_confirmation, paper_spec):
 def test_friction_models_agree_on_the_paper_setup(paper_confirmation):
     assert paper_confirmation.models_agree
     assert paper_confirmation.cross_check["non_isolated"].friction_model == "switch"
-    assert paper_confirmation.cross_check["non_isolated"].verdict == "hunting"
+    assert paper_confirmation.cross_check["non_isolated"].metrics.verdict == "hunting"
 
 
-def test_design_json_contract_simulation(paper_spec, paper_confirmation):
-    d = design(paper_spec, simulation=paper_confirmation).to_dict()
+def test_design_json_contract_simulation(paper_confirmed_design):
+    d = paper_confirmed_design.to_dict()
     sim = d["simulation"]
     for plant in ("isolated", "non_isolated"):
         v = sim[plant]
@@ -88,13 +88,42 @@ def test_design_json_contract_simulation(paper_spec, paper_confirmation):
     json.dumps(d, allow_nan=False)
 
 
+class _RecordingExecutor:
+    """A thread pool that records what it was given (the library creates no pool)."""
+
+    def __init__(self):
+        from concurrent.futures import ThreadPoolExecutor
+
+        self.pool = ThreadPoolExecutor(max_workers=1)
+        self.submitted = []
+
+    def submit(self, fn, *args):
+        self.submitted.append(fn.__name__)
+        return self.pool.submit(fn, *args)
+
+
+def test_design_runs_the_confirmation_on_the_given_executor(paper_spec, paper_confirmed_design):
+    ex = _RecordingExecutor()
+    try:
+        r = design(paper_spec, executor=ex)
+    finally:
+        ex.pool.shutdown()
+    assert ex.submitted == ["confirm"]
+    d, ref = r.to_dict(), paper_confirmed_design.to_dict()
+    assert d["simulation"] == ref["simulation"] and d["checks"] == ref["checks"]
+    assert r.conclusion == paper_confirmed_design.conclusion
+    messages = []
+    design(paper_spec, confirm=False, executor=ex, progress=messages.append)
+    assert ex.submitted == ["confirm"] and messages == []  # nothing to confirm, nothing sent
+
+
 def test_spec_without_isolator_is_confirmed_against_the_suggestion(repo_root):
     spec = load_spec(repo_root / "examples" / "no_isolator.yaml")
     r = design(spec)
     sim = r.simulation
     assert sim.suggested_isolator
-    assert sim.non_isolated.verdict == "hunting"
-    assert sim.isolated.verdict == "settled"
+    assert sim.non_isolated.metrics.verdict == "hunting"
+    assert sim.isolated.metrics.verdict == "settled"
     assert "suggested isolator" in r.conclusion
 
 

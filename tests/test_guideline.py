@@ -193,17 +193,14 @@ def test_without_isolator_advises_on_the_need(paper_spec):
 # --------------------------------------------------------------------------- simulation, hashes
 
 
-def test_simulation_is_attached_only_when_given(paper_spec, paper_design):
-    @dataclasses.dataclass(frozen=True)
-    class FakeSimulation:
-        hunting_cycles: int
-
-    with_sim = paper_design.with_simulation(FakeSimulation(0), conclusion="confirmed")
-    assert with_sim.checks == paper_design.checks  # the fake carries no checks
-    assert with_sim.to_dict()["simulation"] == {"hunting_cycles": 0}
-    assert with_sim.conclusion == "confirmed" and paper_design.simulation is None
-    assert gl.design(paper_spec, simulation=FakeSimulation(3)).to_dict()["simulation"] == \
-        {"hunting_cycles": 3}
+def test_simulation_appears_only_when_confirmed(paper_design, paper_confirmed_design):
+    assert paper_design.simulation is None and "simulation" not in paper_design.to_dict()
+    confirmed = paper_confirmed_design
+    assert confirmed.checks[:len(paper_design.checks)] == paper_design.checks
+    assert confirmed.checks[len(paper_design.checks):] == confirmed.simulation.checks
+    assert confirmed.conclusion.startswith(paper_design.conclusion)
+    assert "LuGre simulation" in confirmed.conclusion[len(paper_design.conclusion):]
+    assert confirmed.to_dict()["simulation"]["isolated"]["verdict"] == "settled"
 
 
 def test_spec_hash_without_origin(paper_spec):

@@ -269,7 +269,7 @@ def test_progress_callback_and_no_printing(capsys):
 
 def test_a_nominal_model_that_fails_is_reported_not_raised(tmp_path):
     """A spec whose own loop is unstable on the record: what failed, and a report of the traces."""
-    from fi_design.gapreport import render_gap_report
+    from fi_design.report.gap import render_gap_report
 
     case = Case("unstable", False, None, {}, duration=2.0, seed=101)
     data = measure(case)

@@ -246,7 +246,7 @@ def test_two_effects_found_in_order_each_with_its_gap():
 
 
 def test_report_of_a_structural_gap_says_so_first(diverging, tmp_path):
-    from fi_design.gapreport import render_gap_report
+    from fi_design.report.gap import render_gap_report
 
     html = render_gap_report(diverging, tmp_path / "gap.html").read_text()
     assert html.index('id="structure"') < html.index('id="finding"')

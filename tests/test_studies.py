@@ -17,7 +17,10 @@ import numpy as np
 import pytest
 
 from fi_design import studies as sw
-from fi_design.errors import SpecError
+from fi_design.errors import ArgumentError, SpecError
+from fi_design.execution import chunks
+from fi_design.results.studies import spec_digest
+from fi_design.studies import cache as cachemod, points
 from fi_design.specfile import with_values
 
 
@@ -103,7 +106,7 @@ def test_invalid_and_failed_points_are_recorded(paper_spec, kernel):
 def test_result_is_frozen_and_json_ready(paper_spec, kernel):
     import json
 
-    res = sw.sweep(paper_spec, "controller.crossover=4:12:2")
+    res = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=4:12:2"))
     with pytest.raises(ValueError):
         res.hunting_cycles[0] = 3
     with pytest.raises(AttributeError):
@@ -122,8 +125,8 @@ def test_design_point_resolves_derived_stiffness(paper_spec):
 
 def test_library_is_silent_and_reports_progress(paper_spec, kernel, capsys):
     calls = []
-    sw.sweep(paper_spec, "controller.crossover=4:12:5", progress=lambda d, n: calls.append((d, n)),
-             chunksize=2)
+    sw.sweep(paper_spec, sw.parse_axis("controller.crossover=4:12:5"),
+             progress=lambda d, n: calls.append((d, n)), chunksize=2)
     out = capsys.readouterr()
     assert out.out == "" and out.err == ""
     assert calls[0] == (0, 5) and calls[-1] == (5, 5)
@@ -133,7 +136,7 @@ def test_library_is_silent_and_reports_progress(paper_spec, kernel, capsys):
 def test_sweep_of_isolated_plant_needs_an_isolator(paper_spec):
     bare = with_values(paper_spec, {"isolator": None})
     with pytest.raises(SpecError, match="no isolator"):
-        sw.sweep(bare, "controller.crossover=4:12:2", isolated=True)
+        sw.sweep(bare, sw.parse_axis("controller.crossover=4:12:2"), isolated=True)
 
 
 def test_fi_design_sweep_callable_after_module_import(paper_spec, kernel):
@@ -149,8 +152,9 @@ def test_fi_design_sweep_callable_after_module_import(paper_spec, kernel):
 
 def test_map_a_friction_gap(paper_spec, kernel):
     """Without isolator: hunting only from a friction gap Fs - Fc of about 1 N."""
-    res = sw.sweep(paper_spec, "friction.coulomb=0.5,1,1.5,2",
-                   "friction.static=1.25,1.75,2.25,2.75,3.25,3.75,4.25", isolated=False)
+    res = sw.sweep(paper_spec, sw.parse_axis("friction.coulomb=0.5,1,1.5,2"),
+                   sw.parse_axis("friction.static=1.25,1.75,2.25,2.75,3.25,3.75,4.25"),
+                   isolated=False)
     for pt in res.points:
         fc, fs = pt.values
         gap = fs - fc
@@ -169,20 +173,20 @@ def test_map_a_friction_gap(paper_spec, kernel):
 def test_map_b_crossover_without_isolator(paper_spec, kernel):
     """Without isolator: hunting stops above a crossover of about 18 to 20 Hz at 1.6 kg;
     a heavier stage stops hunting at a lower crossover."""
-    res = sw.sweep(paper_spec, "controller.crossover=6,12,24,30", "stage.mass=0.8,1.6,3.2",
-                   isolated=False)
+    res = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=6,12,24,30"),
+                   sw.parse_axis("stage.mass=0.8,1.6,3.2"), isolated=False)
     assert cycles_at(res, 12, 1.6)[0] == "hunting"
     assert cycles_at(res, 24, 1.6)[0] == "settled"
     free = res.boundary("above")  # lowest crossover from which no point hunts, per mass
     assert free[1] == 24.0 and free[2] == 12.0 and free[0] >= 30.0
-    line = sw.sweep(paper_spec, "controller.crossover=10,15,20,25", isolated=False)
+    line = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=10,15,20,25"), isolated=False)
     assert list(line.verdict) == ["hunting", "hunting", "settled", "settled"]
 
 
 def test_map_c_stroke_and_stiffness(paper_spec, kernel):
     """With isolator: a limited stiffness and a stroke above about 0.2 mm are hunting-free."""
-    res = sw.sweep(paper_spec, "isolator.stroke=0.05 mm,0.3 mm,1 mm",
-                   "isolator.stiffness=2000,6667,40000")
+    res = sw.sweep(paper_spec, sw.parse_axis("isolator.stroke=0.05 mm,0.3 mm,1 mm"),
+                   sw.parse_axis("isolator.stiffness=2000,6667,40000"))
     v = res.verdict
     assert all(v[j, 0] == "hunting" for j in range(3))  # 0.05 mm: no stiffness helps
     assert v[0, 1] == v[1, 1] == v[0, 2] == v[1, 2] == "settled"
@@ -192,8 +196,8 @@ def test_map_c_stroke_and_stiffness(paper_spec, kernel):
 def test_map_d_crossover_with_isolator(paper_spec, pool):
     """With isolator: 0.3 mm stroke hunting-free from about 5 Hz; a 0.05 mm stroke hunts like
     the stage without isolator."""
-    res = sw.sweep(paper_spec, "controller.crossover=2,4,6,8,12",
-                   "isolator.stroke=0.05 mm,0.3 mm,1 mm", executor=pool)
+    res = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=2,4,6,8,12"),
+                   sw.parse_axis("isolator.stroke=0.05 mm,0.3 mm,1 mm"), executor=pool)
     assert [str(v) for v in res.verdict[1]] == ["hunting", "hunting", "settled", "settled",
                                                 "settled"]
     assert res.boundary("above")[1] == 6.0 and res.boundary("above")[2] == 6.0
@@ -226,7 +230,8 @@ def _same(a, b) -> bool:
 
 
 def test_process_pool_serial_and_dask_identical(paper_spec, pool):
-    x, y = "controller.crossover=3,6,12", "isolator.stroke=0.1 mm,0.3 mm"
+    x = sw.parse_axis("controller.crossover=3,6,12")
+    y = sw.parse_axis("isolator.stroke=0.1 mm,0.3 mm")
     serial = sw.sweep(paper_spec, x, y)
     pooled = sw.sweep(paper_spec, x, y, executor=pool, chunksize=1)
     assert _same(serial, pooled)
@@ -244,29 +249,32 @@ def test_process_pool_serial_and_dask_identical(paper_spec, pool):
 
 def test_cache_skips_finished_points(paper_spec, kernel, tmp_path):
     cache = sw.PointCache(tmp_path)
-    first = sw.sweep(paper_spec, "controller.crossover=4:12:4", cache=cache)
+    first = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=4:12:4"), cache=cache)
     assert first.run.computed == 4 and first.run.cached == 0 and len(cache) == 4
-    again = sw.sweep(paper_spec, "controller.crossover=4:12:4", cache=cache)
+    again = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=4:12:4"), cache=cache)
     assert again.run.computed == 0 and again.run.cached == 4
     assert _same(first, again)
     # another plant, another spec value: other keys
-    other = sw.sweep(paper_spec, "controller.crossover=4:12:4", isolated=False, cache=cache)
+    x = sw.parse_axis("controller.crossover=4:12:4")
+    other = sw.sweep(paper_spec, x, isolated=False, cache=cache)
     assert other.run.computed == 4
     moved = with_values(paper_spec, {"friction.static": 4.5})
-    assert sw.sweep(moved, "controller.crossover=4:12:4", cache=cache).run.computed == 4
+    assert sw.sweep(moved, x, cache=cache).run.computed == 4
 
 
 def test_cache_key_covers_version_and_code(paper_spec, monkeypatch):
-    h = sw.spec_digest(paper_spec)
-    key = sw.point_key(h, (("controller.crossover", 8.0),), True)
-    assert key == sw.point_key(h, (("controller.crossover", 8.0),), True)
-    assert key != sw.point_key(h, (("controller.crossover", 8.000000001),), True)
+    h = spec_digest(paper_spec)
+    key = cachemod.point_key(h, (("controller.crossover", 8.0),), True)
+    assert key == cachemod.point_key(h, (("controller.crossover", 8.0),), True)
+    assert key != cachemod.point_key(h, (("controller.crossover", 8.000000001),), True)
     import fi_design
 
     monkeypatch.setattr(fi_design, "__version__", "99.0")
-    assert key != sw.point_key(h, (("controller.crossover", 8.0),), True)
-    monkeypatch.setattr(sw, "_CODE_DIGEST", "edited")
-    monkeypatch.setattr(fi_design, "__version__", fi_design.__version__)
+    assert key != cachemod.point_key(h, (("controller.crossover", 8.0),), True)
+    monkeypatch.undo()
+    assert key == cachemod.point_key(h, (("controller.crossover", 8.0),), True)
+    monkeypatch.setattr(cachemod, "_CODE_DIGEST", "edited")  # as if the model's source changed
+    assert key != cachemod.point_key(h, (("controller.crossover", 8.0),), True)
 
 
 def test_interrupted_sweep_resumes(paper_spec, kernel, tmp_path):
@@ -277,7 +285,7 @@ def test_interrupted_sweep_resumes(paper_spec, kernel, tmp_path):
         if done >= 4:
             raise Interrupt
 
-    x = "controller.crossover=3:15:7"
+    x = sw.parse_axis("controller.crossover=3:15:7")
     with pytest.raises(Interrupt):
         sw.sweep(paper_spec, x, cache=tmp_path, chunksize=2, progress=stop_after_two_chunks)
     resumed = sw.sweep(paper_spec, x, cache=tmp_path, chunksize=2)
@@ -287,13 +295,22 @@ def test_interrupted_sweep_resumes(paper_spec, kernel, tmp_path):
 
 def test_default_cache_dir_follows_environment(tmp_path, monkeypatch):
     monkeypatch.setenv(sw.CACHE_ENV, str(tmp_path / "c"))
-    assert sw.PointCache().directory == tmp_path / "c"
+    assert sw.PointCache().directory == tmp_path / "c" / "studies"
 
 
 def test_chunks_interleave():
-    assert sw._chunks(7, 3) == [[0, 3, 6], [1, 4], [2, 5]]
-    assert sorted(i for c in sw._chunks(1000, None) for i in c) == list(range(1000))
-    assert max(len(c) for c in sw._chunks(100_000, None)) <= sw.MAX_CHUNK
+    assert chunks(7, 3) == [[0, 3, 6], [1, 4], [2, 5]]
+    assert chunks(0, 5) == []
+    size = points.chunk_size(1000)
+    assert size == 63 and sorted(i for c in chunks(1000, size) for i in c) == list(range(1000))
+    assert points.chunk_size(100_000) == points.MAX_CHUNK and points.chunk_size(5, 2) == 2
+    with pytest.raises(ArgumentError):
+        points.chunk_size(5, 0)
+
+
+def test_sweep_takes_typed_axes_only(paper_spec):
+    with pytest.raises(ArgumentError, match="parse_axis"):
+        sw.sweep(paper_spec, "controller.crossover=4:12:2")  # type: ignore[arg-type]
 
 
 # --------------------------------------------------------------------------- robustness
@@ -319,7 +336,7 @@ def test_parse_scatter():
 
 def test_robustness_is_reproducible(paper_spec, pool):
     kw = dict(samples=6, seed=3, position_friction=sw.PositionFriction(0.1, 0.02))
-    scatter = ["friction.static=10%", "friction.coulomb=10%"]
+    scatter = [sw.parse_scatter(t) for t in ("friction.static=10%", "friction.coulomb=10%")]
     a = sw.robustness(paper_spec, scatter, executor=pool, **kw)
     b = sw.robustness(paper_spec, scatter, **kw)
     assert np.array_equal(a.draws, b.draws) and np.array_equal(a.phases, b.phases)
@@ -345,7 +362,7 @@ def test_robustness_invalid_draws_and_errors(paper_spec, kernel):
     with pytest.raises(SpecError, match="nothing scatters"):
         sw.robustness(paper_spec, [])
     with pytest.raises(SpecError, match="distribution"):
-        sw.robustness(paper_spec, ["friction.static=10%"], distribution="cauchy")
+        sw.robustness(paper_spec, [sw.Scatter("friction.static", 0.1)], distribution="cauchy")
 
 
 # --------------------------------------------------------------------------- figures
@@ -359,8 +376,8 @@ def test_figures(paper_spec, kernel):
     svg = plots.figure_bytes(plots.sweep_figure(res), "svg")
     assert svg.startswith(b"<?xml") and b"<text" not in svg  # text drawn as paths
     assert svg == plots.figure_bytes(plots.sweep_figure(res), "svg")  # reproducible
-    png = plots.figure_bytes(plots.sweep_figure(sw.sweep(paper_spec, "isolator.stroke=1e-4,3e-4")),
-                             "png")
+    line = sw.sweep(paper_spec, ("isolator.stroke", [1e-4, 3e-4]))
+    png = plots.figure_bytes(plots.sweep_figure(line), "png")
     assert png.startswith(b"\x89PNG")
     assert plots.axis_label("isolator.stroke", "m") == "isolator.stroke [mm]"
     assert plots.display_unit("N/m") == ("N/mm", 1e-3)
@@ -371,17 +388,17 @@ def test_code_digest_covers_existing_modules_and_changes_with_them(tmp_path, mon
     module must not silently drop out of it) and changes when one of them changes."""
     from pathlib import Path
 
-    import fi_design.studies as st
-
-    here = Path(st.__file__).resolve().parent
-    missing = [n for n in st._CODE_MODULES if not (here / f"{n}.py").is_file()]
+    package = Path(cachemod.__file__).resolve().parents[1]
+    missing = [n for n in cachemod.CODE_MODULES if not (package / n).is_file()]
     assert not missing
-    assert {"simulation", "kernel", "plant", "trajectory"} <= set(st._CODE_MODULES)
-    monkeypatch.setattr(st, "_CODE_DIGEST", None)
-    before = st.code_digest()
-    for n in st._CODE_MODULES:
-        (tmp_path / f"{n}.py").write_bytes((here / f"{n}.py").read_bytes())
-    (tmp_path / "simulation.py").write_bytes(b"# edited\n" + (here / "simulation.py").read_bytes())
-    monkeypatch.setattr(st, "__file__", str(tmp_path / "studies.py"))
-    monkeypatch.setattr(st, "_CODE_DIGEST", None)
-    assert st.code_digest() != before
+    assert {"simulation.py", "kernel.py", "equations.py", "plant.py", "trajectory.py",
+            "studies/points.py"} <= set(cachemod.CODE_MODULES)
+    monkeypatch.setattr(cachemod, "_CODE_DIGEST", None)
+    before = cachemod.code_digest()
+    for n in cachemod.CODE_MODULES:
+        (tmp_path / n).parent.mkdir(exist_ok=True)
+        (tmp_path / n).write_bytes((package / n).read_bytes())
+    (tmp_path / "simulation.py").write_bytes(b"# edited\n" + (package / "simulation.py").read_bytes())
+    monkeypatch.setattr(cachemod, "__file__", str(tmp_path / "studies" / "cache.py"))
+    monkeypatch.setattr(cachemod, "_CODE_DIGEST", None)
+    assert cachemod.code_digest() != before

@@ -22,7 +22,7 @@ module             job
 ``significance``   honest uncertainties and the tests a finding must pass
 ``gaps``           gap metrics before and after
 ``diagnosis``      structure diagnosis when no effect explains the gap
-``results``        the result values
+``results``        (in :mod:`fi_design.results.reconciliation`) the result values
 ``specout``        spec entries and the corrected spec file
 ``workflow``       :func:`reconcile`, stringing the steps together
 =================  ==========================================================
@@ -32,8 +32,9 @@ The library never prints; pass ``progress`` to follow the work.
 
 from .comparison import MAX_POINTS
 from .noise import NOISE_FLOOR, estimate_noise
-from .results import (Candidate, Cause, Diagnosis, EffectStep, GapMetric, Lattice, ModelTrace,
-                      NoiseLevels, ReconcileResult, SearchRound, Segment, Signature)
+from ..results.reconciliation import (Candidate, Cause, Diagnosis, EffectStep, GapMetric,
+                                      Lattice, ModelTrace, NoiseLevels, ReconcileResult,
+                                      SearchRound, Segment, Signature)
 from .significance import THRESHOLD
 from .specout import entry_input, fixed_spec_text, make_entry, spec_with_entries
 from .workflow import reconcile

@@ -28,7 +28,7 @@ from ..pid import control_law
 from ..replay import command_state
 from ..simulation import simulate
 from ..trajectory import from_samples
-from .results import Lattice, ModelTrace, NoiseLevels, Segment
+from ..results.reconciliation import Lattice, ModelTrace, NoiseLevels, Segment
 
 #: Default largest number of sample-wise residuals per channel.
 MAX_POINTS = 3000

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..pid import control_law
 from .comparison import Comparison, ModelRun
-from .results import Cause, Diagnosis
+from ..results.reconciliation import Cause, Diagnosis
 from .significance import EXPLAINED_MIN
 
 #: RMS misfit of the nominal model [noise units] from which a gap counts as structural.

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..metrics import hunting_metrics
 from .comparison import Comparison, ModelRun
-from .results import GapMetric
+from ..results.reconciliation import GapMetric
 
 
 def play(values: np.ndarray, half_width: float) -> np.ndarray:

@@ -40,7 +40,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .results import Lattice
+from ..results.reconciliation import Lattice
 
 #: Tolerance of an exact lattice, as a fraction of the step (the file's number formatting).
 EXACT_TOLERANCE = 0.01

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from ..measured import Measurement
-from .results import Lattice, NoiseLevels
+from ..results.reconciliation import Lattice, NoiseLevels
 
 #: Model-accuracy floor of the noise per channel (position and deflection in m, force in N).
 NOISE_FLOOR = {"position": 1e-9, "deflection": 1e-10, "force": 1e-5}

@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .comparison import Comparison, ModelRun
-from .results import Lattice, Signature
+from ..results.reconciliation import Lattice, Signature
 
 
 class Line(NamedTuple):

@@ -58,7 +58,7 @@ from ..measured import measurement_from_arrays
 from .comparison import Comparison
 from .fitting import Baseline, FitOutcome, Objective, fit, fit_baseline
 from .noise import channels_autocorrelation_time
-from .results import Candidate, Lattice
+from ..results.reconciliation import Candidate, Lattice
 from .spaces import Space
 
 #: Default significance threshold on the score.

@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import effects as _effects
 from .comparison import Comparison
-from .results import Lattice
+from ..results.reconciliation import Lattice
 from .signatures import Evidence
 
 #: Factor a logarithmic search bound moves by when widened.

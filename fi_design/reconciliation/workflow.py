@@ -29,11 +29,13 @@ from .fitting import (Baseline, FitOutcome, JointObjective, fit, fit_baseline, j
 from .gaps import gap_metrics
 from .lattice import find_lattice
 from .noise import channels_autocorrelation_time, estimate_noise, noise_levels
-from .results import Candidate, EffectStep, ReconcileResult, SearchRound
+from ..results.reconciliation import (Candidate, Diagnosis, EffectStep, ReconcileResult,
+                                      SearchRound)
 from .signatures import Evidence, scan
 from .significance import (NESTED, NULL_SEED, THRESHOLD, block_jackknife, judge,
                            noise_only_refit, numerical_error, passes_primary, prefer_simpler)
 from .spaces import Space, candidate_spaces
+from .specout import make_entry
 
 ProgressCallback = Callable[[str, float], None]
 
@@ -140,7 +142,9 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
         chi2_nominal=nominal.chi2, chi2_corrected=final.chi2,
         conclusion=conclusion, n_simulations=cmp.n_sims + search.n_simulations,
         wall_time=_time.perf_counter() - started, measurement=measured,
-        nominal=cmp.model_trace(nominal.run), corrected=cmp.model_trace(final.run), spec=spec)
+        nominal=cmp.model_trace(nominal.run), corrected=cmp.model_trace(final.run), spec=spec,
+        effect_entries=tuple(make_entry(e["type"], {k: v for k, v in e.items() if k != "type"})
+                             for e in final.entries))
 
 
 def _silent(message: str, fraction: float) -> None:
@@ -415,8 +419,6 @@ def _refine_jointly(cmp: Comparison, chosen: list[Chosen], nominal: Baseline) ->
 def _failed_nominal(cmp: Comparison, nominal: Baseline, started: float,
                     threshold: float) -> ReconcileResult:
     """The result when the nominal model cannot be replayed: what failed, and the traces."""
-    from .results import Diagnosis
-
     run = nominal.run
     diagnosis = Diagnosis(
         mismatch=True, misfit=math.inf, misfit_limit=0.0, best_explained=0.0,

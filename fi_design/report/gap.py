@@ -1,11 +1,11 @@
 """The reconciliation report: which effect the model misses, and the gap before and after.
 
-Built from :class:`fi_design.reconciliation.ReconcileResult` as generic report
-sections (:class:`fi_design.report.Section`) and rendered with the report
-engineer's templates through :func:`fi_design.report.render_document`: the
-same title block, layout, escaping and appendix as the design report. All
-wording and number formatting happens here, in Python; the templates only
-place it.
+Built from :class:`fi_design.results.reconciliation.ReconcileResult` as generic report
+sections (:class:`~fi_design.report.blocks.Section`, :func:`gap_sections`) and
+rendered like every other report (:func:`gap_context`,
+:func:`render_gap_report`): the same title block, layout, escaping and
+appendix as the design report. All wording and number formatting happens
+here, in Python; the templates only place it.
 """
 
 from __future__ import annotations
@@ -14,7 +14,15 @@ import os
 from pathlib import Path
 from typing import Any
 
-from . import effects as _effects
+from .. import effects as _effects
+from .blocks import FigureBlock, Section, Table, figure_block
+from .context import document_context
+from .filters import num, qty
+
+__all__ = ["gap_sections", "gap_context", "render_gap_report", "TITLE"]
+
+#: Title of the reconciliation report.
+TITLE = "Model-measurement reconciliation"
 
 
 def _param_unit(effect: str, name: str) -> str:
@@ -25,8 +33,6 @@ def _param_unit(effect: str, name: str) -> str:
 
 
 def _params_text(effect: str, values: dict, unc: dict | None = None) -> str:
-    from .report import qty
-
     parts = []
     for k, v in values.items():
         if v is None:
@@ -52,7 +58,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
     figures : bool, optional
         Draw the figures (False: captions only, for golden tests).
@@ -64,8 +70,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
         effects one by one, gap before and after, candidates, signatures,
         segments.
     """
-    from . import plots
-    from .report import FigureBlock, Section, Table, figure_block, num, qty
+    from .. import plots
 
     def fig(make, caption, name):
         if not figures:
@@ -221,13 +226,37 @@ def gap_sections(result: Any, figures: bool = True) -> list:
     return sections
 
 
+def gap_context(result: Any, *, date: Any = None, command: str | None = None,
+                figures: bool = True) -> dict:
+    """The report context of a reconciliation.
+
+    Parameters
+    ----------
+    result : fi_design.results.reconciliation.ReconcileResult
+        The reconciliation.
+    date : str or datetime.date, optional
+        Report date (default today).
+    command : str, optional
+        The command line, shown in the title block.
+    figures : bool, optional
+        Draw the figures (default).
+
+    Returns
+    -------
+    dict
+        For :func:`~fi_design.report.render.render_html`.
+    """
+    return document_context(TITLE, result.spec, gap_sections(result, figures), date=date,
+                            command=command, kind="reconcile")
+
+
 def render_gap_report(result: Any, path: str | os.PathLike, *, date: Any = None,
                       command: str | None = None) -> Path:
     """Write the reconciliation report (HTML or PDF).
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
     path : str or os.PathLike
         ``.html`` or ``.pdf``.
@@ -241,8 +270,8 @@ def render_gap_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     pathlib.Path
         The written file.
     """
-    from .report import render_document
+    from .render import output_format, render_html, write_document
 
-    return render_document(path, title="Model-measurement reconciliation", spec=result.spec,
-                           sections=gap_sections(result), date=date, command=command,
-                           kind="reconcile")
+    out = Path(path)
+    output_format(out)  # refuse a wrong extension before any work
+    return write_document(render_html(gap_context(result, date=date, command=command)), out)

@@ -1,23 +1,29 @@
-"""Result values of the reconciliation (frozen dataclasses, SI, one docstring per field).
+"""Results of the reconciliation of a model with a measured record.
 
-Everything :func:`fi_design.reconciliation.reconcile` returns is defined here
-and imports nothing but data modules, so that presentation (console, report,
-plots) can read a result without importing the analysis that made it.
+Produced by :func:`fi_design.reconciliation.reconcile`: the named effect (or
+``none``) with its honest uncertainty, the candidates and the tests each
+passed, the gaps before and after, the lattice of the measured positions and
+the structure diagnosis, with the model traces at the measured times.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..measured import Measurement
-from ..results import dataclass_dict, to_jsonable
+from . import Result, to_jsonable
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..measured import Measurement
+
+__all__ = ["Lattice", "NoiseLevels", "Segment", "Signature", "GapMetric", "Candidate",
+           "SearchRound", "EffectStep", "Cause", "Diagnosis", "ModelTrace", "ReconcileResult"]
 
 
 @dataclass(frozen=True)
-class Lattice:
+class Lattice(Result):
     """The lattice the measured positions lie on (a quantizing sensor), read from the data.
 
     Attributes
@@ -70,13 +76,9 @@ class Lattice:
         """Whether the positions lie on a lattice."""
         return self.step is not None
 
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
 
 @dataclass(frozen=True)
-class NoiseLevels:
+class NoiseLevels(Result):
     """Sensor noise used to judge every gap.
 
     Attributes
@@ -100,13 +102,9 @@ class NoiseLevels:
     deflection: float | None
     source: dict
 
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
 
 @dataclass(frozen=True)
-class Segment:
+class Segment(Result):
     """A stretch of the trace compared one way.
 
     Attributes
@@ -125,13 +123,9 @@ class Segment:
     end: float
     coherent: bool = True
 
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
 
 @dataclass(frozen=True)
-class Signature:
+class Signature(Result):
     """Evidence in the nominal residual that points at effects.
 
     Attributes
@@ -157,13 +151,9 @@ class Signature:
     unit: str
     detail: str
 
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
 
 @dataclass(frozen=True)
-class GapMetric:
+class GapMetric(Result):
     """One measure of disagreement, before and after the correction.
 
     Attributes
@@ -198,13 +188,9 @@ class GapMetric:
     significant_before: bool | None
     significant_after: bool | None
 
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
 
 @dataclass(frozen=True)
-class Candidate:
+class Candidate(Result):
     """One catalogue effect fitted to the measurement, and how it was judged.
 
     Attributes
@@ -306,14 +292,14 @@ class Candidate:
         return self.status not in ("failed", "diverged")
 
     def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        d = dataclass_dict(self)
+        """Plain JSON data (SI), with ``success``."""
+        d = super().to_dict()
         d["success"] = self.success
         return d
 
 
 @dataclass(frozen=True)
-class SearchRound:
+class SearchRound(Result):
     """One pass over the catalogue (``max_effects`` > 1 runs several).
 
     Attributes
@@ -333,13 +319,9 @@ class SearchRound:
     candidates: tuple
     selected: str | None
 
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
 
 @dataclass(frozen=True)
-class EffectStep:
+class EffectStep(Result):
     """One named effect and the gap it closes, in the order they were found.
 
     Attributes
@@ -368,13 +350,9 @@ class EffectStep:
     force_rms_before: float | None
     force_rms_after: float | None
 
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
 
 @dataclass(frozen=True)
-class Cause:
+class Cause(Result):
     """A likely cause of a gap the catalogue cannot explain.
 
     Attributes
@@ -391,13 +369,9 @@ class Cause:
     share: float
     detail: str
 
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
 
 @dataclass(frozen=True, eq=False)
-class Diagnosis:
+class Diagnosis(Result):
     """Whether the model's structure, rather than a missing effect, is the problem.
 
     Attributes
@@ -437,13 +411,10 @@ class Diagnosis:
     spectrum: np.ndarray = field(repr=False)
     crossover: float = 0.0
 
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI), without the spectrum."""
-        return dataclass_dict(self)
 
 
 @dataclass(frozen=True, eq=False)
-class ModelTrace:
+class ModelTrace(Result):
     """A model run sampled at the measured times.
 
     Attributes
@@ -471,13 +442,9 @@ class ModelTrace:
     success: bool
     message: str = ""
 
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI)."""
-        return dataclass_dict(self)
-
 
 @dataclass(frozen=True, eq=False)
-class ReconcileResult:
+class ReconcileResult(Result):
     """What :func:`fi_design.reconciliation.reconcile` found.
 
     Attributes
@@ -544,6 +511,8 @@ class ReconcileResult:
         The two models at the measured times.
     spec : Spec
         The spec reconciled (without the new effects).
+    effect_entries : tuple
+        The spec ``effects`` entries of :attr:`entries`, validated.
     """
 
     effect: str
@@ -576,6 +545,7 @@ class ReconcileResult:
     nominal: ModelTrace = field(repr=False)
     corrected: ModelTrace = field(repr=False)
     spec: Any = field(repr=False)
+    effect_entries: tuple = field(default=(), repr=False)
 
     @property
     def gap_before(self) -> dict:
@@ -588,10 +558,13 @@ class ReconcileResult:
         return {g.name: g.after for g in self.gaps}
 
     def corrected_spec(self):
-        """The spec with the chosen effects in its ``effects`` list (a new Spec)."""
-        from .specout import spec_with_entries
+        """The spec with the chosen effects in its ``effects`` list (a new Spec).
 
-        return spec_with_entries(self.spec, self.entries)
+        An entry of a type the spec already lists replaces it.
+        """
+        names = {e.type for e in self.effect_entries}
+        kept = [e for e in self.spec.effects if e.type not in names]
+        return self.spec.model_copy(update={"effects": tuple(kept + list(self.effect_entries))})
 
     def to_dict(self) -> dict:
         """Plain JSON data: the contract keys first, then the details (SI)."""

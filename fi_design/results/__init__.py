@@ -1,9 +1,17 @@
-"""Result values shared by the analyses: checks and the one path to JSON.
+"""The results layer: the values every workflow returns, and the one path to JSON.
 
-Results are frozen dataclasses with a docstring per field (unit and shape).
-Array fields use ``eq=False`` dataclasses and are copied and made read-only by
-:func:`frozen_array`. :func:`to_jsonable` turns any result into plain JSON
-data: dataclasses to dicts, arrays to lists, infinities and NaN to ``None``.
+Results are frozen dataclasses derived from :class:`Result`, with a docstring
+per field (unit and shape). Array fields use ``eq=False`` dataclasses and are
+copied and made read-only by :func:`frozen_array`. ``to_dict()`` turns a
+result into plain JSON data (:func:`to_jsonable`: dataclasses to dicts, arrays
+to lists, infinities and NaN to ``None``).
+
+The result types live here, below the analyses that produce them, so that
+presentation (report, plots, console) reads and dispatches on them without
+importing an analysis: :mod:`.design` (the guideline and its confirmation),
+:mod:`.simulation` (one simulation and its hunting metric) and :mod:`.studies`
+(sweeps, the paper's maps, robustness). This module holds what they share:
+:class:`Result`, :class:`Check` and the JSON helpers.
 """
 
 from __future__ import annotations
@@ -17,6 +25,28 @@ from typing import Any
 import numpy as np
 
 
+class Result:
+    """Base of the result values: ``to_dict()`` is the one path to JSON.
+
+    Subclasses are frozen dataclasses. ``to_dict()`` gives every field,
+    converted by :func:`to_jsonable`, except those declared with
+    ``field(repr=False)``: the spec and other inputs a result keeps, traces
+    and cross-references that are not part of its JSON. A result whose JSON
+    has another shape overrides ``to_dict``.
+    """
+
+    __slots__ = ()
+
+    def to_dict(self) -> dict:
+        """Plain JSON data (SI): every field shown in the repr.
+
+        Returns
+        -------
+        dict
+        """
+        return dataclass_dict(self)
+
+
 class Status(str, enum.Enum):
     """Outcome of a check."""
 
@@ -27,7 +57,7 @@ class Status(str, enum.Enum):
 
 
 @dataclass(frozen=True)
-class Check:
+class Check(Result):
     """One guideline check: data, not prose.
 
     Attributes
@@ -106,7 +136,8 @@ def to_jsonable(obj: Any) -> Any:
 def dataclass_dict(obj: Any) -> dict:
     """Field-by-field :func:`to_jsonable` of a dataclass.
 
-    A result's own ``to_dict`` builds on this (calling :func:`to_jsonable` on
-    itself would recurse). Fields declared with ``repr=False`` are left out.
+    :meth:`Result.to_dict` is this; a result's own ``to_dict`` builds on it
+    (calling :func:`to_jsonable` on itself would recurse). Fields declared
+    with ``repr=False`` are left out.
     """
     return {f.name: to_jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj) if f.repr}

@@ -1,0 +1,357 @@
+"""The shell of the command line: the application and what its commands share.
+
+- ``app``, a typer application of class :class:`DefaultCommandGroup`:
+  ``fi-design SPEC.yaml`` runs the default command, and every command's
+  errors become exit codes in one place; ``--version`` and ``--debug``;
+- the options several commands take (``SpecArg``, ``Force``, the study
+  executor's ``Jobs`` ... ``NoCache``, :func:`output_option`);
+- the steps of a command around its one library call: :func:`check_outputs`
+  before any work, :func:`load`, :func:`write_outputs` and :func:`write_report`
+  after it, and for the studies :func:`study_pool` and :func:`run_study`
+  (executor, progress bar, Ctrl-C).
+
+The commands themselves are in :mod:`fi_design.cli`.
+"""
+
+from __future__ import annotations
+
+import difflib
+import os
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, Optional
+
+import typer
+from typer.core import TyperGroup
+
+from .errors import FiDesignError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from rich.console import Console
+
+DEBUG_ENV = "FI_DESIGN_DEBUG"
+#: Command run when the first argument is not a command name.
+DEFAULT_COMMAND = "design"
+
+EXIT_OK = 0
+EXIT_INTERNAL = 1
+EXIT_BAD_INPUT = 2
+#: Exit code of a study interrupted with Ctrl-C (128 + SIGINT, as shells report it).
+EXIT_INTERRUPTED = 130
+
+
+def _debug_requested(ctx: typer.Context | None = None) -> bool:
+    if os.environ.get(DEBUG_ENV, "").strip().lower() not in ("", "0", "false", "no"):
+        return True
+    return bool(ctx is not None and ctx.params.get("debug"))
+
+
+class DefaultCommandGroup(TyperGroup):
+    """A command group that runs :data:`DEFAULT_COMMAND` when no command is named.
+
+    ``fi-design SPEC.yaml --json out.json`` is read as ``fi-design design
+    SPEC.yaml --json out.json``; ``fi-design schema`` still runs ``schema``.
+    The group's own flags (``--version``, ``--debug``, ``--help``) may come
+    first; ``--debug`` is also accepted anywhere before ``--``. A spec file
+    whose name equals a command name can be given as ``./NAME``.
+
+    The group also translates errors for every command: a
+    :class:`~fi_design.errors.FiDesignError` exits 2 with its message, any
+    other exception exits 1 with a short "internal error" note (the traceback
+    with ``--debug`` or ``FI_DESIGN_DEBUG=1``).
+    """
+
+    default_command = DEFAULT_COMMAND
+
+    def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
+        args = list(args)
+        end = args.index("--") if "--" in args else len(args)
+        if "--debug" in args[1:end]:
+            head = [a for a in args[:end] if a != "--debug"]
+            args = ["--debug"] + head + args[end:]
+        i = self._skip_group_options(ctx, args)
+        if i < len(args) and args[i] != "--" and args[i] not in self.commands:
+            args.insert(i, self.default_command)
+        return super().parse_args(ctx, args)
+
+    def _skip_group_options(self, ctx: Any, args: list[str]) -> int:
+        """Index of the first argument that is not one of the group's own options."""
+        flags: set[str] = set()
+        valued: set[str] = set()
+        for param in self.get_params(ctx):
+            names = list(getattr(param, "opts", [])) + list(getattr(param, "secondary_opts", []))
+            if getattr(param, "is_flag", False) or getattr(param, "count", False):
+                flags.update(names)
+            else:
+                valued.update(n for n in names if n.startswith("-"))
+        i = 0
+        while i < len(args):
+            name = args[i].split("=", 1)[0]
+            if name in flags:
+                i += 1
+            elif name in valued:
+                i += 1 if "=" in args[i] else 2
+            else:
+                break
+        return i
+
+    def invoke(self, ctx: Any) -> Any:
+        try:
+            return super().invoke(ctx)
+        except (typer.Exit, typer.Abort, typer.TyperException, BrokenPipeError):
+            raise  # usage errors, explicit exits, `fi-design ... | head`
+        except Exception as exc:  # noqa: BLE001 -- the one place that turns errors into codes
+            debug = _debug_requested(ctx)
+            if debug:
+                import traceback
+
+                traceback.print_exc(file=sys.stderr)
+            if isinstance(exc, FiDesignError):
+                typer.echo(f"error: {exc}", err=True)
+                raise typer.Exit(EXIT_BAD_INPUT) from None
+            note = "" if debug else (
+                f"\nThis is a bug in fi-design, not in your input. Run again with --debug (or "
+                f"set {DEBUG_ENV}=1) to see the traceback, and please report it with the spec "
+                "file.")
+            typer.echo(f"internal error: {type(exc).__name__}: {exc}{note}", err=True)
+            raise typer.Exit(EXIT_INTERNAL) from None
+
+
+app = typer.Typer(
+    cls=DefaultCommandGroup,
+    name="fi-design",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    subcommand_metavar="SPEC.yaml | COMMAND [ARGS]...",
+    context_settings={"help_option_names": ["-h", "--help"]},
+    help="Design friction isolators for precision stages: the paper's four-step "
+         "guideline (friction gap, crossover, drive stiffness, PID gains) with a "
+         "nonlinear LuGre simulation confirming the verdict.\n\n"
+         "fi-design SPEC.yaml runs the default command 'design'. Exit codes: 0 done, "
+         "2 bad input, 1 internal error.",
+)
+
+
+def _show_version(value: bool) -> None:
+    if value:
+        from . import __version__
+
+        typer.echo(f"fi-design {__version__}")
+        raise typer.Exit(EXIT_OK)
+
+
+@app.callback()
+def _root(
+    version: Annotated[bool, typer.Option(
+        "--version", callback=_show_version, is_eager=True,
+        help="Print the version and exit.")] = False,
+    debug: Annotated[bool, typer.Option(
+        "--debug", help=f"Show the traceback of internal errors (also: {DEBUG_ENV}=1).")] = False,
+) -> None:
+    """Group options; the work happens in the commands."""
+
+
+def app_commands() -> list[str]:
+    """Names of all registered commands, in definition order."""
+    return [c.name or c.callback.__name__.replace("_", "-") for c in app.registered_commands]
+
+
+# --------------------------------------------------------------------------- options
+
+SpecArg = Annotated[Path, typer.Argument(metavar="SPEC.yaml", help="The design spec (YAML).",
+                                         show_default=False)]
+Force = Annotated[bool, typer.Option("--force", "-f", help="Overwrite existing output files.")]
+NoIsolator = Annotated[bool, typer.Option(
+    "--no-isolator", help="Simulate the stage without the isolator (one rigid mass on the "
+                          "bearing).")]
+
+
+def output_option(flag: str, metavar: str, text: str) -> Any:
+    """An optional output file option (default None)."""
+    return typer.Option(None, flag, metavar=metavar, help=text, show_default=False)
+
+
+JsonOut = Annotated[Optional[Path], typer.Option(
+    "--json", metavar="OUT.json", help="Write the full result as JSON.", show_default=False)]
+Jobs = Annotated[int, typer.Option(
+    "--jobs", "-j", min=0, metavar="N",
+    help="Worker processes (local executor) or local dask workers; 0 = all cores, "
+         "1 = serial in this process.")]
+ExecutorKind = Annotated[str, typer.Option(
+    "--executor", metavar="local|dask",
+    help="local: a process pool on this machine (default); dask: a dask.distributed "
+         "cluster (--scheduler ADDRESS, or a local cluster).")]
+Scheduler = Annotated[Optional[str], typer.Option(
+    "--scheduler", metavar="ADDRESS",
+    help="Address of a running dask scheduler, e.g. tcp://10.0.0.5:8786 (with --executor "
+         "dask). Without it, a local cluster is started.", show_default=False)]
+NoCache = Annotated[bool, typer.Option(
+    "--no-cache", help="Neither read nor write the result cache (FI_DESIGN_CACHE_DIR, else the "
+                       "user cache directory).")]
+
+
+# --------------------------------------------------------------------------- steps of a command
+
+
+def check_spec_path(spec: Path) -> None:
+    """Turn a mistyped command name into a hint instead of 'no such file'.
+
+    Parameters
+    ----------
+    spec : pathlib.Path
+        The SPEC.yaml argument as given.
+    """
+    if spec.exists() or spec.suffix or os.sep in str(spec):
+        return
+    close = difflib.get_close_matches(str(spec), [c for c in app_commands()
+                                                  if c != DEFAULT_COMMAND], n=1)
+    if close:
+        from .errors import SpecFileError
+
+        raise SpecFileError(f"{spec}: no such spec file, and not a command; "
+                            f"did you mean 'fi-design {close[0]}'?")
+
+
+def check_outputs(inputs: tuple[Path, ...], force: bool, **paths: Any) -> dict:
+    """Every output path of a command checked before any work (:func:`fi_design.output.check_outputs`).
+
+    Parameters
+    ----------
+    inputs : tuple of pathlib.Path
+        The command's input files, never overwritten.
+    force : bool
+        ``--force``.
+    **paths : (path or None, extensions)
+        The outputs by name.
+
+    Returns
+    -------
+    dict
+        Name to checked path (None where not asked).
+    """
+    from .output import check_outputs as check
+
+    return check(inputs, force=force, **paths)
+
+
+def load(spec: Path) -> Any:
+    """The spec of a command, read after its output paths were checked.
+
+    Parameters
+    ----------
+    spec : pathlib.Path
+        SPEC.yaml.
+
+    Returns
+    -------
+    fi_design.spec.Spec
+    """
+    from .specfile import load_spec
+
+    check_spec_path(spec)
+    return load_spec(spec)
+
+
+def json_text(result: Any) -> str:
+    """A result's ``to_dict()`` as the JSON text of ``--json``."""
+    import json
+
+    return json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n"
+
+
+def write_outputs(console: "Console", outs: dict, payloads: dict) -> None:
+    """Write each payload (text or bytes) to its checked path, atomically, and say so.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to say so.
+    outs : dict
+        Checked paths by name (:func:`check_outputs`).
+    payloads : dict
+        Content by the same names.
+    """
+    from .output import write_atomic
+
+    for name, data in payloads.items():
+        write_atomic(outs[name], data)
+        console.print(f"wrote {outs[name]}", markup=False)
+
+
+def write_report(console: "Console", path: Optional[Path], result: Any, **options: Any) -> None:
+    """The report of a result (:func:`fi_design.report.render_report`), written atomically.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to say so.
+    path : pathlib.Path or None
+        The checked report path; None: no report.
+    result : object
+        The result.
+    **options
+        Passed on (``design_map`` of a design report).
+    """
+    if path is None:
+        return
+    from .console import Status, make_console
+    from .report import render_report
+
+    with Status(make_console(stderr=True), "writing the report ...") as status:
+        render_report(result, path, command=command_line(), progress=status, **options)
+    console.print(f"wrote {path}", markup=False)
+
+
+def command_line() -> str:
+    """The command as typed, for a report's title block."""
+    import shlex
+
+    return "fi-design " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+
+
+def study_pool(kind: str, jobs: int, scheduler: Optional[str]) -> Any:
+    """The executor of a study command (:class:`fi_design.pools.StudyPool`), options checked."""
+    from .pools import EXECUTORS, StudyPool
+
+    if kind not in EXECUTORS:
+        raise typer.BadParameter(f"'{kind}' is not one of {', '.join(EXECUTORS)}",
+                                 param_hint="--executor")
+    if scheduler and kind != "dask":
+        raise typer.BadParameter("--scheduler needs --executor dask", param_hint="--scheduler")
+    return StudyPool(kind, jobs, scheduler)
+
+
+def run_study(label: str, pool: Any, no_cache: bool, work: Any) -> Any:
+    """Run ``work(executor, progress, cache)`` with a progress bar; Ctrl-C exits 130.
+
+    An interruption writes no output; the finished points stay in the cache.
+    """
+    from .console import ProgressBar, make_console
+    from .studies import PointCache
+
+    err = make_console(stderr=True)
+    try:
+        with pool as ex, ProgressBar(err, label) as bar:
+            return work(ex, bar, None if no_cache else PointCache())
+    except KeyboardInterrupt:
+        err.print("interrupted; nothing was kept (--no-cache) and no output was written"
+                  if no_cache else "interrupted; the finished points are in the result cache: "
+                  "run the same command again to resume. No output was written",
+                  markup=False, highlight=False)
+        raise typer.Exit(EXIT_INTERRUPTED) from None
+
+
+def write_study(console: "Console", outs: dict, result: Any, figure: Any) -> None:
+    """The CSV, JSON, ``figure(result)`` and report of a sweep or robustness study, as asked."""
+    payloads: dict = {}
+    if outs["csv"] is not None:
+        payloads["csv"] = result.to_csv()
+    if outs["json"] is not None:
+        payloads["json"] = json_text(result)
+    if outs["figure"] is not None:
+        from .plots import figure_bytes
+
+        payloads["figure"] = figure_bytes(figure(result), outs["figure"].suffix)
+    write_outputs(console, outs, payloads)
+    write_report(console, outs["report"], result)

@@ -1,0 +1,216 @@
+"""The identification as one call: :func:`identify`, and its use on other records.
+
+:func:`identify` runs the steps of the package docstring in order: checks,
+processing, the inverse-dynamics fit (with the force read as held or sampled,
+whichever fits better), the excitation and the dynamic parameters.
+:func:`predict_force` applies an identification to another record
+(cross-validation); :func:`segment` cuts a record.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from types import MappingProxyType
+from typing import Callable
+
+import numpy as np
+
+from ..errors import DataError
+from ..measured import Measurement, measurement_from_arrays
+from .dynamic import dynamic_parameters
+from .events import excitation
+from .preprocess import JITTER, check_record, joint_model, prepare, processing
+from .regression import (IMPLAUSIBLE, Solution, check_directions, equations, fit_statistics,
+                         force_rss, form_note, rigid_parameters, split_masses, solve, threshold_note)
+from .results import FORMS, NAMES, ForcePrediction, IdentificationResult
+
+ProgressCallback = Callable[[str, float], None]
+
+
+def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
+             progress: ProgressCallback | None = None, cutoff: float | None = None,
+             decimation: int | None = None,
+             velocity_threshold: float | None = None) -> IdentificationResult:
+    """Identify mass, friction and force offset from a measured record (guideline step 1).
+
+    Parameters
+    ----------
+    measured : Measurement
+        The record: ``time_s``, ``position_m`` and ``force_N`` (the force that
+        acts, an injected disturbance included), uniformly sampled; with
+        ``deflection_m`` and a spec with an isolator, the two-mass equations.
+    spec : fi_design.spec.Spec, optional
+        The stage: its loop's crossover sets the filter, its isolator's
+        stiffness and damping give the flexure force, its mass ratio splits
+        the total mass, its Stribeck velocity bounds the velocity threshold
+        from below. Without it: one rigid mass.
+    form : {"symmetric", "per_direction"}
+        ``"symmetric"``: one Coulomb friction (``coulomb``) and an ``offset``;
+        ``"per_direction"``: ``coulomb`` (positive direction) and
+        ``coulomb_negative``, no offset. Viscous friction is per direction in
+        both. The two fit the data identically (see the module docstring).
+    progress : callable, optional
+        Called as ``progress(message, fraction)`` with fraction in [0, 1].
+    cutoff : float, optional
+        Low-pass cut-off [Hz]; default from the spec's crossover or the sample
+        rate (:func:`processing`).
+    decimation : int, optional
+        Decimation factor; default from the cut-off.
+    velocity_threshold : float, optional
+        Slowest speed used [m/s]; default 10 % of the peak speed, with a spec
+        at least three times its Stribeck velocity. It must lie well above the
+        Stribeck velocity, where friction is Coulomb plus viscous.
+
+    Returns
+    -------
+    IdentificationResult
+        ``to_dict()`` is the JSON of DESIGN.md section 8.
+
+    Raises
+    ------
+    DataError
+        No ``force_N`` column, too few samples, a constant position, sampling
+        the filter cannot take, motion in one direction only, too few sliding
+        samples; the message names the column and what is needed.
+    ValueError
+        An unknown ``form``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fi_design.measured import measurement_from_arrays
+    >>> t = np.arange(0.0, 4.0, 1e-3)
+    >>> x = 0.01 * np.sin(2 * np.pi * 0.5 * t)
+    >>> v = np.gradient(x, t); a = np.gradient(v, t)
+    >>> u = 2.0 * a + 3.0 * np.sign(v) + 40.0 * v + 0.5
+    >>> m = measurement_from_arrays(t, x, x, force_N=u)
+    >>> r = identify(m)
+    >>> round(r.value("mass"), 1), round(r.value("coulomb"), 1), round(r.value("offset"), 1)
+    (2.0, 3.0, 0.5)
+    """
+    if form not in FORMS:
+        raise ValueError(f"form must be one of {FORMS}, got {form!r}")
+    say = progress or (lambda message, fraction: None)
+    check_record(measured)
+    say("filtering", 0.0)
+    proc = processing(measured, spec, cutoff=cutoff, decimation=decimation,
+                      velocity_threshold=velocity_threshold)
+    joint = joint_model(measured, spec)
+    say("least squares", 0.3)
+    fits = []
+    for hold in (True, False):  # the force as a held command, or as a sampled force
+        p = replace(proc, force_hold=hold)
+        prep = prepare(measured, p, joint)
+        check_directions(prep, p, measured.source)
+        sol = solve(equations(prep, form, joint), prep.used)
+        fits.append((force_rss(prep, sol, joint), p, prep, sol))
+    _, proc, prep, sol = min(fits, key=lambda f: f[0])
+    samples, fit = fit_statistics(prep, sol, joint)
+    say("excitation", 0.5)
+    exc = excitation(measured, proc, spec=spec)
+    params = rigid_parameters(sol, form, joint)
+    masses = split_masses(sol, joint, spec, params["mass"])
+    notes = list(joint.notes) + [form_note(form), threshold_note(proc)]
+    for name, p in list(params.items()):
+        if p.value is not None and p.value <= 0.0 and name != "offset":
+            params[name] = replace(p, note=p.note + "; " + IMPLAUSIBLE)
+            notes.append(f"{name} = {p.value:.4g} {p.unit} is not positive: {IMPLAUSIBLE}")
+    if measured.disturbance is not None:
+        notes.append("force_N is used as the force that acts (the injected disturbance_N "
+                     "included); the controller's own output force_N - disturbance_N is not")
+    say("dynamic parameters", 0.7)
+    dynamic, details = dynamic_parameters(measured, proc, joint, sol, form, exc, spec)
+    for name, p in dynamic.items():
+        if name == "static" and p.value is not None and params["coulomb"].value is not None \
+                and p.value < params["coulomb"].value:
+            p = replace(p, note=p.note + f"; below the Coulomb friction: {IMPLAUSIBLE}")
+            notes.append(f"static = {p.value:.4g} N lies below the Coulomb friction: "
+                         f"{IMPLAUSIBLE}")
+        params[name] = p
+    say("done", 1.0)
+    return IdentificationResult(
+        parameters=MappingProxyType({k: params[k] for k in NAMES}), fit=fit, form=form,
+        model=joint.model, masses=masses, processing=proc, excitation=exc,
+        notes=tuple(notes), samples=samples, measurement=measured, spec=spec,
+        dynamic=details)
+
+
+def predict_force(result: IdentificationResult, measured: Measurement) -> ForcePrediction:
+    """The identified model's actuator force on a record, processed as the identification was.
+
+    For cross-validation: identify on one record (or part of one), predict
+    the force on another. The record is filtered, aligned, decimated and
+    selected with ``result.processing`` (same cut-off, decimation and velocity
+    threshold), and the inverse-dynamics model with the identified mass,
+    friction and offset gives the force.
+
+    Parameters
+    ----------
+    result : IdentificationResult
+        The identification.
+    measured : Measurement
+        The record to predict (same sample rate).
+
+    Returns
+    -------
+    ForcePrediction
+
+    Raises
+    ------
+    DataError
+        The record cannot be processed (see :func:`identify`) or has another
+        sample rate.
+    """
+    check_record(measured)
+    proc = result.processing
+    fs = 1.0 / measured.sample_period
+    if abs(fs / proc.sample_rate - 1.0) > JITTER:
+        raise DataError(f"sampled at {fs:g} Hz, the identification at {proc.sample_rate:g} Hz",
+                        column="time_s", source=measured.source)
+    joint = joint_model(measured, result.spec)
+    if joint.model != result.model:
+        raise DataError(f"a {joint.model} record cannot be predicted by a {result.model} "
+                        "identification", column="deflection_m", source=measured.source)
+    prep = prepare(measured, proc, joint)
+    th = {n: p.value for n, p in result.parameters.items() if p.value is not None}
+    if result.model == "two_mass":
+        th["stage_mass"], th["cart_mass"] = result.masses.stage, result.masses.cart
+    sol = Solution(names=list(th), theta=np.array(list(th.values())),
+                    cov=np.zeros((len(th), len(th))), cond=math.nan,
+                    n_used=int(prep.used.sum()), n_eff=math.nan)
+    samples, fit = fit_statistics(prep, sol, joint)
+    return ForcePrediction(samples=samples, force_rms_residual=fit.force_rms_residual,
+                           relative_error=fit.relative_error, samples_used=fit.samples_used)
+
+
+def segment(measured: Measurement, start: float | None = None,
+            stop: float | None = None) -> Measurement:
+    """The samples of a record with ``start <= time < stop`` [s] (for cross-validation).
+
+    Parameters
+    ----------
+    measured : Measurement
+        The record.
+    start, stop : float, optional
+        Time span [s]; None: from the first or to the last sample.
+
+    Returns
+    -------
+    Measurement
+        A new record with the same columns; its source names the span.
+    """
+    t = np.asarray(measured.time)
+    a = 0 if start is None else int(np.searchsorted(t, start, side="left"))
+    b = len(t) if stop is None else int(np.searchsorted(t, stop, side="left"))
+
+    def col(values):
+        return None if values is None else np.asarray(values)[a:b]
+
+    span = f"{'' if start is None else f'{start:g} s '}to{'' if stop is None else f' {stop:g} s'}"
+    return measurement_from_arrays(
+        col(measured.time), col(measured.reference), col(measured.position),
+        force_N=col(measured.force), deflection_m=col(measured.deflection),
+        disturbance_N=col(measured.disturbance),
+        source=f"{measured.source or 'record'} ({span.strip()})")
+

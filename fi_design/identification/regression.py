@@ -1,0 +1,238 @@
+"""The inverse-dynamics least squares (IDIM-LS, steps 6 and 7 of the package docstring).
+
+The equations of motion as linear regressions on the prepared signals
+(:func:`equations`), their weighted least-squares solution with the
+autocorrelation-corrected covariance (:func:`solve`), the fit statistics and
+the parameters of the sliding friction and the masses.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DataError
+from ..results import frozen_array
+from .preprocess import Joint, Prepared
+from .results import UNITS, Fit, Masses, Parameter, Processing, Samples
+
+#: Fewest used (decimated, sliding) samples per direction of motion.
+MIN_DIRECTION_SAMPLES = 10
+
+#: Why a mass or friction that comes out negative cannot be right.
+IMPLAUSIBLE = ("physically impossible, so the model (mass, Coulomb and viscous friction "
+               "constant along the travel) does not describe this record; an unmodelled effect "
+               "(friction varying along the rail, a cable force, force ripple) or too little "
+               "sliding can cause it, and fi-design reconcile names such effects")
+
+
+def friction_columns(p: Prepared, form: str) -> dict[str, np.ndarray]:
+    c = p.cols
+    if form == "symmetric":
+        return {"coulomb": c["sign"], "viscous": c["vpos"], "viscous_negative": c["vneg"]}
+    return {"coulomb": c["pos"], "coulomb_negative": -c["neg"], "viscous": c["vpos"],
+            "viscous_negative": c["vneg"]}
+
+
+def equations(p: Prepared, form: str, joint: Joint) -> list[tuple[np.ndarray, dict]]:
+    """The equations as (left-hand side, {parameter: column}), all on every sample."""
+    fric = friction_columns(p, form)
+    off = {"offset": p.cols["one"]} if form == "symmetric" else {}
+    if joint.model == "two_mass":
+        stage = (p.force - p.joint, {"stage_mass": p.a1, **off})
+        cart = (p.joint, {"cart_mass": p.a2, **fric})
+        return [stage, cart]
+    if joint.model == "two_mass_sum":
+        a = joint.ratio * p.a1 + (1.0 - joint.ratio) * p.a2
+    else:
+        a = p.a1
+    return [(p.force, {"mass": a, **fric, **off})]
+
+
+@dataclass
+class Solution:
+    names: list
+    theta: np.ndarray
+    cov: np.ndarray
+    cond: float
+    n_used: int
+    n_eff: float
+
+
+def solve(equations: list, used: np.ndarray) -> Solution:
+    """Weighted least squares over the equations, with the autocorrelation-corrected covariance."""
+    from scipy.linalg import lstsq, svdvals
+
+    names: list[str] = []
+    for _, cols in equations:
+        names += [n for n in cols if n not in names]
+    blocks = []
+    for y, cols in equations:
+        A = np.column_stack([cols[n][used] if n in cols else np.zeros(int(used.sum()))
+                             for n in names])
+        blocks.append((A, y[used]))
+    A_all = np.vstack([b[0] for b in blocks])
+    scale = np.linalg.norm(A_all, axis=0)
+    scale[scale == 0.0] = 1.0
+    weights = [1.0] * len(blocks)
+    for _ in range(2 if len(blocks) > 1 else 1):  # OLS, then WLS with per-equation variances
+        Aw = np.vstack([w * A for w, (A, _) in zip(weights, blocks)]) / scale
+        yw = np.concatenate([w * y for w, (_, y) in zip(weights, blocks)])
+        sol, _, rank, _ = lstsq(Aw, yw)
+        theta = sol / scale
+        res = [y - A @ theta for A, y in blocks]
+        weights = [1.0 / max(float(np.std(r)), 1e-300) for r in res]
+    if rank < len(names):
+        raise DataError("the record does not excite every parameter (the regressor is rank "
+                        f"deficient: rank {rank} of {len(names)} for {', '.join(names)}); it "
+                        "needs acceleration and sliding at varied speeds in both directions",
+                        column="position_m")
+    Aw = np.vstack([w * A for w, (A, _) in zip(weights, blocks)])
+    rw = np.concatenate([w * r for w, r in zip(weights, res)])
+    n, k = Aw.shape
+    s2 = float(rw @ rw) / max(n - k, 1)
+    from scipy.linalg import pinvh
+
+    cov = s2 * pinvh(Aw.T @ Aw)
+    n_eff = sum(len(r) / effective_fraction(w * r) for w, r in zip(weights, res))
+    inflation = n / n_eff
+    sv = svdvals(Aw / np.linalg.norm(Aw, axis=0))
+    return Solution(names=names, theta=theta, cov=cov * inflation, cond=float(sv[0] / sv[-1]),
+                     n_used=int(used.sum()), n_eff=n / inflation)
+
+
+def effective_fraction(r: np.ndarray) -> float:
+    """n / n_eff = 1 + 2 sum of the residual autocorrelations up to the first non-positive one."""
+    from scipy.signal import correlate
+
+    r = np.asarray(r, dtype=float) - float(np.mean(r))
+    if len(r) < 3 or not np.any(r):
+        return 1.0
+    ac = correlate(r, r, mode="full", method="fft")[len(r) - 1:]
+    ac = ac / ac[0]
+    total = 0.0
+    for rho in ac[1:len(r) // 2]:
+        if rho <= 0.0:
+            break
+        total += float(rho)
+    return 1.0 + 2.0 * total
+
+
+def force_rss(prep: Prepared, sol: Solution, joint: Joint) -> float:
+    """Residual sum of squares of the actuator force per used sample [N^2]."""
+    _, fit = fit_statistics(prep, sol, joint)
+    return fit.force_rms_residual ** 2
+
+
+def check_directions(prep: Prepared, proc: Processing, source: str | None) -> None:
+    used = prep.used
+    pos = int(np.sum(used & (prep.v > 0)))
+    neg = int(np.sum(used & (prep.v < 0)))
+    if min(pos, neg) < MIN_DIRECTION_SAMPLES:
+        raise DataError(
+            f"too little sliding: {pos} usable samples moving in the positive direction and "
+            f"{neg} in the negative one faster than {proc.velocity_threshold:.3g} m/s (at least "
+            f"{MIN_DIRECTION_SAMPLES} each after decimation by {proc.decimation}); identification "
+            "needs sliding in both directions (otherwise Coulomb friction and the offset are "
+            "indistinguishable)", column="position_m", source=source)
+
+
+def fit_statistics(prep: Prepared, sol: Solution, joint: Joint) -> tuple[Samples, Fit]:
+    th = dict(zip(sol.names, sol.theta))
+    fric = sum(th.get(n, 0.0) * c for n, c in friction_columns(
+        prep, "per_direction" if "coulomb_negative" in th else "symmetric").items())
+    fric = fric + th.get("offset", 0.0) * prep.cols["one"]
+    if joint.model == "two_mass":
+        inertia = th["stage_mass"] * prep.a1 + th["cart_mass"] * prep.a2
+    elif joint.model == "two_mass_sum":
+        inertia = th["mass"] * (joint.ratio * prep.a1 + (1.0 - joint.ratio) * prep.a2)
+    else:
+        inertia = th["mass"] * prep.a1
+    model = inertia + fric
+    u = prep.force[prep.used]
+    r = u - model[prep.used]
+    samples = Samples(time=frozen_array(prep.time), velocity=frozen_array(prep.v),
+                      force=frozen_array(prep.force), model=frozen_array(model),
+                      inertia=frozen_array(inertia), used=frozen_array(prep.used, dtype=bool))
+    fit = Fit(force_rms_residual=float(np.sqrt(np.mean(r ** 2))),
+              relative_error=float(np.linalg.norm(r) / np.linalg.norm(u)),
+              condition_number=sol.cond, samples_used=sol.n_used, effective_samples=sol.n_eff,
+              error_method="residual variance, scaled by n / n_eff for the autocorrelation of "
+                           "the residuals (effective sample count, initial positive sequence)")
+    return samples, fit
+
+
+def rigid_parameters(sol: Solution, form: str, joint: Joint) -> dict[str, Parameter]:
+    idx = {n: i for i, n in enumerate(sol.names)}
+    se = np.sqrt(np.clip(np.diag(sol.cov), 0.0, None))
+
+    def est(name: str, note: str) -> Parameter:
+        i = idx[name]
+        return Parameter(float(sol.theta[i]), float(se[i]), UNITS[name], True, note)
+
+    out: dict[str, Parameter] = {}
+    if joint.model == "two_mass":
+        i, j = idx["stage_mass"], idx["cart_mass"]
+        var = sol.cov[i, i] + sol.cov[j, j] + 2.0 * sol.cov[i, j]
+        out["mass"] = Parameter(float(sol.theta[i] + sol.theta[j]), float(math.sqrt(max(var, 0))),
+                                "kg", True, "total moving mass m1 + m2, the sum of the stage "
+                                            "and cart masses identified separately")
+    else:
+        out["mass"] = est("mass", "total moving mass" + (
+            "" if joint.model == "rigid" else " (stage and cart accelerations in the spec's "
+                                              "mass ratio)"))
+    if form == "symmetric":
+        out["coulomb"] = est("coulomb", "Coulomb friction, both directions (symmetric form)")
+        out["coulomb_negative"] = Parameter(
+            None, None, "N", False,
+            "symmetric form: taken equal to coulomb; per direction it is collinear with the "
+            "offset on sliding data (sign(v) per direction sums to a constant): "
+            "form='per_direction' estimates it, without an offset")
+        out["offset"] = est("offset", "constant force on the stage (sign of a friction force: "
+                                      "u = offset holds the stage)")
+    else:
+        out["coulomb"] = est("coulomb", "Coulomb friction sliding in the positive direction "
+                                        "(per-direction form, the offset absorbed)")
+        out["coulomb_negative"] = est("coulomb_negative", "Coulomb friction sliding in the "
+                                                          "negative direction (per-direction "
+                                                          "form, the offset absorbed)")
+        out["offset"] = Parameter(
+            None, None, "N", False,
+            "per-direction form: absorbed into coulomb and coulomb_negative (collinear on "
+            "sliding data: Fc+ = Fc + offset, Fc- = Fc - offset); form='symmetric' estimates it")
+    out["viscous"] = est("viscous", "viscous friction sliding in the positive direction")
+    out["viscous_negative"] = est("viscous_negative", "viscous friction sliding in the negative "
+                                                      "direction")
+    return out
+
+
+def split_masses(sol: Solution, joint: Joint, spec, total: Parameter) -> Masses:
+    if joint.model == "two_mass":
+        i, j = sol.names.index("stage_mass"), sol.names.index("cart_mass")
+        return Masses(stage=float(sol.theta[i]), cart=float(sol.theta[j]),
+                      stage_std_error=float(math.sqrt(max(sol.cov[i, i], 0.0))),
+                      cart_std_error=float(math.sqrt(max(sol.cov[j, j], 0.0))),
+                      source="identified")
+    r = joint.ratio
+    return Masses(stage=total.value * r, cart=total.value * (1.0 - r), stage_std_error=None,
+                  cart_std_error=None,
+                  source="split in the spec's ratio" if spec is not None else
+                  "no spec: all on the stage")
+
+
+def form_note(form: str) -> str:
+    if form == "symmetric":
+        return ("symmetric form: one Coulomb friction for both directions and a force offset "
+                "(the default); the per-direction form (form='per_direction') fits the data "
+                "identically with Fc+ = coulomb + offset and Fc- = coulomb - offset")
+    return ("per-direction form: Coulomb friction per direction and no offset; the symmetric "
+            "form fits the data identically with coulomb = (Fc+ + Fc-) / 2 and offset = "
+            "(Fc+ - Fc-) / 2")
+
+
+def threshold_note(proc: Processing) -> str:
+    return (f"samples slower than {proc.velocity_threshold:.4g} m/s are not used: near zero "
+            "velocity friction is not Coulomb plus viscous (Stribeck effect, presliding, "
+            "sticking)")

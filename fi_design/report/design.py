@@ -1,0 +1,390 @@
+"""The design report: the context of a :class:`~fi_design.guideline.DesignResult`.
+
+Sections in order: verdict, inputs, the four guideline steps, the linear
+analysis, the nonlinear confirmation, a hunting map around the design point
+(when the caller passes one), assumptions and limitations, references and an
+appendix. All wording and arithmetic happen here; the templates only place
+it.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..results.design import DesignResult
+from ..results.studies import DesignMap
+from .blocks import figure_entry
+from .checks import verdict
+from .context import build_context
+from .filters import num, qty
+from .inputs import spec_inputs
+from .meta import spec_listing, title_block, versions
+from .steps import guideline_steps
+
+__all__ = ["design_context", "REFERENCES"]
+
+
+def _cases_table(result: Any) -> list[dict]:
+    numbers = {c.name: c.number for c in result.loop.cases}
+    rows = []
+    for c in result.crossover.cases:
+        status = "PASS" if c.passed else "FAIL"
+        rows.append({
+            "number": numbers.get(c.name, ""), "description": c.description,
+            "crossover": c.crossover, "crossovers": len(c.crossovers),
+            "phase_margin": c.phase_margin_deg, "gain_margin": c.gain_margin_db,
+            "modulus_margin": c.modulus_margin, "delay_margin": c.delay_margin,
+            "stable": "yes" if c.stable else "no", "status": status, "css": status.lower(),
+            "failed": ", ".join(c.failed),
+        })
+    return rows
+
+
+class _Numbering:
+    """Figure numbers in order of appearance."""
+
+    def __init__(self) -> None:
+        self.n = 0
+
+    def __call__(self) -> int:
+        self.n += 1
+        return self.n
+
+
+def _linear(result: Any, figures: bool, fig_no: _Numbering) -> dict:
+    from .. import plots
+
+    req = result.spec.requirements
+    xo = result.crossover
+    n = len(xo.cases)
+    m = req.modulus_margin if req.modulus_margin is not None else 0.5
+    return {
+        "intro": (
+            f"The loop L = C D P of each of the {n} linear limit cases (paper Figure 2) with the "
+            f"PID of step 4 at the desired crossover of {qty(xo.desired, 'Hz')}"
+            + (f" and a Pad\u00e9 model of the {qty(xo.delay, 's')} loop delay"
+               if xo.delay > 0 else "")
+            + ". Margins come from python-control's stability_margins; closed-loop stability "
+            "from the roots of the characteristic polynomial. A case can cross 0 dB more than "
+            "once; the table gives the crossing with the smallest phase margin and the "
+            "number of crossings."),
+        "bode": figure_entry(
+            (lambda: plots.bode_figure(result)) if figures else None, "bode",
+            f"Open-loop Bode plot of the {n} limit cases. Dots: gain crossovers; dashed: the "
+            "desired crossover.", fig_no()),
+        "nyquist": figure_entry(
+            (lambda: plots.nyquist_figure(result)) if figures else None, "nyquist",
+            f"Nyquist plot near the critical point -1 (+). Dotted: |1 + L| = {num(m)}. Colours "
+            "and line styles as in the Bode plot.", fig_no(), "half"),
+        "sensitivity": figure_entry(
+            (lambda: plots.sensitivity_figure(result)) if figures else None, "sensitivity",
+            "Sensitivity |S| = |1/(1 + L)|; dots mark each peak (1 / modulus margin).",
+            fig_no(), "half"),
+        "cases": _cases_table(result),
+        "requirements": {"phase_margin": req.phase_margin, "gain_margin": req.gain_margin,
+                         "modulus_margin": req.modulus_margin},
+        "note": ("A negative gain margin marks a lower gain margin: the integrator on a free mass "
+                 "starts the phase below -180\u00b0, and the loop goes unstable if the gain "
+                 "falls by that much. An infinite gain margin means the phase never crosses "
+                 "-180\u00b0."),
+    }
+
+
+#: Friction models as the literature names them.
+_MODEL_NAMES = {"lugre": "LuGre", "switch": "switch (Karnopp-type)"}
+
+
+def _plant_rows(sim: Any) -> list[dict]:
+    mins = sim.min_hunting_free_crossover
+    label = "suggested isolator" if sim.suggested_isolator else "with isolator"
+    rows = []
+    for key, name in (("isolated", label), ("non_isolated", "without isolator")):
+        m = getattr(sim, key).metrics
+        other = sim.cross_check.get(key)
+        rows.append({
+            "plant": name, "verdict": m.verdict,
+            "css": {"settled": "pass", "hunting": "fail"}.get(m.verdict, "warn"),
+            "cycles": m.hunting_cycles, "amplitude": m.amplitude, "period": m.period,
+            "settling_time": m.settling_time, "final_error": m.final_error,
+            "minimum": mins.get(key), "other": other.metrics.verdict if other is not None else "",
+            "other_model": other.friction_model if other is not None else "",
+            "reason": m.reason,
+        })
+    return rows
+
+
+def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
+    from .. import plots
+
+    sim = result.simulation
+    if sim is None:
+        return None
+    spec = result.spec
+    h = spec.requirements.hunting
+    mins = sim.min_hunting_free_crossover
+    iso = sim.results["isolated"]
+    label = "the suggested isolator" if sim.suggested_isolator else "the isolator"
+    land = sim.landing
+    scan = sim.scans["isolated"]
+    out = {
+        "intro": (
+            f"The stage is simulated with and without {label} at the design crossover, with "
+            f"{_MODEL_NAMES.get(sim.isolated.friction_model, sim.isolated.friction_model)} "
+            "friction, through the spec's moves and then at "
+            "rest. The paper's hunting metric (section 2.3) counts the peaks of the position "
+            f"error x1 - r of at least {qty(h.min_height, 'm')}, at least "
+            f"{qty(h.min_distance, 's')} apart, in the window [{num(h.window_start)} s, "
+            f"{num(h.window_start + h.window_length)} s); one peak is one hunting cycle. The "
+            "verdict also names a stage that is stuck away from its target or moves too slowly to "
+            "judge, which the count alone cannot see."),
+        "plants": _plant_rows(sim),
+        "resolution": mins["resolution"],
+        "scan_range": mins["scan"],
+        "error": figure_entry(
+            (lambda: plots.error_figure(sim, spec)) if figures else None, "error",
+            "Position error with and without the isolator (as the paper's Figure 5). Grey: the "
+            "counting window; dashed: the minimum peak height; circles: the peaks the metric "
+            "counts.", fig_no()),
+        "deflection": figure_entry(
+            (lambda: plots.deflection_figure(sim, spec)) if figures else None, "deflection",
+            "Joint deflection of the isolated stage against the stroke; beyond the dashed lines "
+            "the limiter carries the cart.", fig_no()),
+        "scan": figure_entry(
+            (lambda: plots.scan_figure(sim, spec)) if figures else None, "scan",
+            f"Hunting cycles down the crossover scan (grid {num(scan.grid[0])} to "
+            f"{num(scan.grid[1])} Hz in steps of {num(scan.grid[2])} Hz), both plants. The scan "
+            "runs from the top down and stops at the first crossover that does not settle; "
+            "dotted: the lowest hunting-free crossover, dashed: the design crossover.",
+            fig_no()),
+        "landing": None if land is None else {
+            "deflection": land.deflection, "stroke": land.stroke, "force": land.force,
+            "static_friction": land.static_friction, "rule_force": land.rule_force,
+            "on_limiter": "yes" if land.on_limiter else "no",
+        },
+        "models_agree": sim.models_agree,
+        "cross_check": (
+            "Cross-check with the "
+            f"{_MODEL_NAMES.get(sim.cross_check['isolated'].friction_model, '')} friction model: "
+            + ("both models give the same hunting / no-hunting call for both plants."
+               if sim.models_agree else
+               "the models disagree on the verdict (see the checks); treat the margin to hunting "
+               "as small.")),
+        "solver": {"steps": iso.n_steps, "rejected": iso.n_rejected, "events": iso.n_events},
+    }
+    return out
+
+
+def _map_section(design_map: DesignMap | None, figures: bool, fig_no: _Numbering) -> dict | None:
+    if design_map is None:
+        return None
+    from .. import plots
+
+    result = design_map.sweep
+    x, y = result.x, result.y
+    note = ""
+    if design_map.suggested:
+        note = (f"The spec has no isolator: the map uses the suggested one "
+                f"({qty(design_map.stroke, 'm')} stroke, {qty(design_map.stiffness, 'N/m')}). ")
+    held = ("the drive stiffness held at the design value" if design_map.stiffness is not None
+            else "the drive stiffness following the stroke (k_max / 2: the spec gives none)")
+    note += (f"Computed with fi_design.studies.sweep: crossover {num(x.values[0])} to "
+             f"{num(x.values[-1])} Hz, stroke {qty(y.values[0], 'm')} to "
+             f"{qty(y.values[-1], 'm')} (log), {held}.")
+    counts = result.counts()
+    return {
+        "intro": (
+            f"Hunting cycles of the isolated stage around the design point (red cross) over "
+            f"{x.path} \u00d7 {y.path}, as the paper's Figure 4D: {len(x.values)} \u00d7 "
+            f"{len(y.values)} simulations with the PID retuned at every crossover. " + note),
+        "figure": figure_entry((lambda: plots.design_map_figure(result)) if figures else None,
+                               "map", f"Hunting cycles over {x.path} and {y.path} (isolated). "
+                               "Marks: s stuck, ? undetermined, \u00d7 failed.", fig_no()),
+        "counts": ", ".join(f"{k} {v}" for k, v in counts.items() if v),
+    }
+
+
+def _assumptions(result: Any) -> dict:
+    spec = result.spec
+    sim = spec.simulation
+    h = spec.requirements.hunting
+    return {
+        "model": [
+            "Two rigid masses (stage m1, cart m2) joined by a linear spring-damper (k, c) with "
+            "compliant end stops at \u00b1s; without the isolator one rigid mass m1 + m2. Motion "
+            "along one axis only: tilt, yaw and support compliance enter only as the parasitic "
+            "modes of the linear analysis.",
+            "LuGre friction (Canudas de Wit et al. 1995) with constant parameters along the "
+            "rail; the switch (Karnopp-type) model serves as a cross-check. Real friction varies "
+            "with position, time, temperature and wear (paper \u00a73.2), so the simulated "
+            "number of cycles is an indication, not a prediction.",
+            "The PID is continuous-time unless a sample rate is given; actuator and sensor are "
+            "ideal apart from the effects listed in the spec.",
+            "The linear analysis linearises friction in four limit cases (cart sliding or stuck, "
+            "joint free or on its limiter, paper Figure 2): the margins hold near each case, not "
+            "during transitions between them.",
+        ],
+        "solver": [
+            f"Fast path: a linearly implicit Rosenbrock method of order 4 (RODAS4, Hairer and "
+            f"Wanner) with step-size control at relative tolerance {num(sim.tolerance)}, mode "
+            "switches of limiter and stick-slip located as events; traces sampled at "
+            f"{qty(sim.output_rate, 'Hz')}.",
+            "The fast integrator is tested against scipy's solve_ivp (Radau) at a tolerance "
+            "10\u2074 times tighter on the same equations.",
+        ],
+        "metric": [
+            f"The metric counts peaks above +{qty(h.min_height, 'm')} only: a cycle with a "
+            "smaller amplitude, or one offset below the target, counts as none.",
+            f"A cycle slower than the {qty(h.window_length, 's')} window shows no peak; the "
+            "verdict then says 'undetermined', not 'settled'.",
+            "A stage resting away from its target (stuck) shows no peaks either; the verdict "
+            f"calls it 'stuck' unless it lies within the settle band of {qty(h.settle_band, 'm')}.",
+            "Hunting can come and go with the crossover (the paper saw a hunting-free run at "
+            "9.5 Hz): the lowest hunting-free crossover is the one above which every scanned "
+            "crossover settles, within one scan step.",
+        ],
+    }
+
+
+#: The paper and the standard works it builds on.
+REFERENCES = (
+    ("Fix2024", "J. A. Fix et al., \u201cMitigating friction induced limit cycles by an "
+                "intermediate flexure stage\u201d (the paper this tool implements; design "
+                "guideline in \u00a74)."),
+    ("Fix2023", "J. A. Fix, A Linearized Parameter Study of a Friction Isolator System: "
+                "Towards a Frequency Domain Design Guideline, MSc thesis, University of Twente, "
+                "2023."),
+    ("Canudas1995", "C. Canudas de Wit, H. Olsson, K. J. \u00c5str\u00f6m and P. Lischinsky, "
+                    "\u201cA new model for control of systems with friction\u201d, IEEE "
+                    "Transactions on Automatic Control 40(3), 1995 (the LuGre model)."),
+    ("Astrom2008", "K. J. \u00c5str\u00f6m and C. Canudas-de-Wit, \u201cRevisiting the LuGre "
+                   "friction model\u201d, IEEE Control Systems Magazine 28(6), 2008."),
+    ("Hensen2003", "R. H. A. Hensen, M. J. G. van de Molengraft and M. Steinbuch, \u201cFriction "
+                   "induced hunting limit cycles: a comparison between the LuGre and switch "
+                   "friction model\u201d, Automatica 39(12), 2003."),
+    ("Hensen2002", "R. H. A. Hensen and M. J. G. van de Molengraft, \u201cFriction induced "
+                   "hunting limit cycles: an event mapping approach\u201d, Proc. American "
+                   "Control Conference, 2002."),
+    ("Karnopp1985", "D. Karnopp, \u201cComputer simulation of stick-slip friction in mechanical "
+                    "dynamic systems\u201d, ASME J. Dynamic Systems, Measurement and Control "
+                    "107(1), 1985 (the switch model)."),
+    ("Hairer1996", "E. Hairer and G. Wanner, Solving Ordinary Differential Equations II: Stiff "
+                   "and Differential-Algebraic Problems, 2nd ed., Springer, 1996 (RODAS4)."),
+    ("Dong2018", "X. Dong and C. E. Okwudire, \u201cAn experimental investigation of the effects "
+                 "of the compliant joint method on feedback compensation of pre-sliding/"
+                 "pre-rolling friction\u201d, Precision Engineering 54, 2018."),
+    ("Dong2020", "X. Dong and C. E. Okwudire, \u201cInfluence of design parameters on the "
+                 "effectiveness of friction isolators in mitigating pre-motion friction in "
+                 "mechanical bearings\u201d, Mechatronics 71, 2020."),
+    ("Wang2022", "J. Wang, X. Dong, O. R. Barry and C. Okwudire, \u201cFriction-induced "
+                 "instability and vibration in a precision motion stage with a friction "
+                 "isolator\u201d, Journal of Vibration and Control 28(15-16), 2022."),
+    ("AlBender2008", "F. Al-Bender and J. Swevers, \u201cCharacterization of friction force "
+                     "dynamics\u201d, IEEE Control Systems Magazine 28(6), 2008."),
+    ("Maeda2013", "Y. Maeda and M. Iwasaki, \u201cRolling friction model-based analyses and "
+                  "compensation for slow settling response in precise positioning\u201d, IEEE "
+                  "Transactions on Industrial Electronics 60(12), 2013 (PID from mass and "
+                  "crossover)."),
+    ("Skogestad2005", "S. Skogestad and I. Postlethwaite, Multivariable Feedback Control, 2nd "
+                      "ed., Wiley, 2005 (margins and sensitivity)."),
+)
+
+
+def _appendix(result: Any) -> dict:
+    spec = result.spec
+    sim = spec.simulation
+    scan = sim.crossover_scan
+    solver = [
+        {"quantity": "integrator", "value": "RODAS4 (fast kernel, numba)", "unit": ""},
+        {"quantity": "relative tolerance", "value": sim.tolerance, "unit": "1"},
+        {"quantity": "output rate", "value": sim.output_rate, "unit": "Hz"},
+        {"quantity": "step budget per simulation", "value": sim.max_steps, "unit": "1"},
+        {"quantity": "simulated time", "value": spec.motion.duration, "unit": "s"},
+        {"quantity": "crossover scan", "value": [scan.start, scan.stop], "unit": "Hz"},
+        {"quantity": "crossover scan step", "value": scan.step, "unit": "Hz"},
+        {"quantity": "friction model", "value": spec.friction.model, "unit": ""},
+        {"quantity": "loop delay (linear analysis, Pad\u00e9 order "
+                     f"{spec.controller.pade_order})", "value": result.crossover.delay,
+         "unit": "s"},
+    ]
+    sim_res = result.simulation
+    if sim_res is not None:
+        for key, res in sim_res.results.items():
+            solver.append({"quantity": f"steps / rejected / events ({key.replace('_', '-')})",
+                           "value": f"{res.n_steps} / {res.n_rejected} / {res.n_events}",
+                           "unit": ""})
+    return {**spec_listing(spec), "solver": solver, "versions": versions()}
+
+
+def _design_sections(ctx: dict) -> list[dict]:
+    sections = [
+        {"id": "verdict", "title": "Verdict", "template": "verdict.html.jinja"},
+        {"id": "inputs", "title": "Inputs", "template": "inputs.html.jinja"},
+        {"id": "steps", "title": "The four guideline steps", "template": "steps.html.jinja"},
+        {"id": "linear", "title": "Linear analysis", "template": "linear.html.jinja"},
+        {"id": "nonlinear", "title": "Nonlinear confirmation", "template": "nonlinear.html.jinja"},
+    ]
+    if ctx.get("map") is not None:
+        sections.append({"id": "map", "title": "Hunting map around the design point",
+                         "template": "map.html.jinja"})
+    sections += [
+        {"id": "assumptions", "title": "Assumptions and limitations",
+         "template": "assumptions.html.jinja"},
+        {"id": "references", "title": "References", "template": "references.html.jinja"},
+        {"id": "appendix", "title": "Appendix: spec, solver and software",
+         "template": "appendix.html.jinja"},
+    ]
+    for i, s in enumerate(sections, 1):
+        s["number"] = i
+    return sections
+
+
+@build_context.register
+def design_context(result: DesignResult, *, date: Any = None, command: str | None = None,
+                   figures: bool = True, design_map: DesignMap | None = None) -> dict:
+    """Everything a design report shows, as plain data.
+
+    Parameters
+    ----------
+    result : fi_design.guideline.DesignResult
+        The design (with its simulated confirmation, if any).
+    date : str or datetime.date, optional
+        The report date; default :func:`~fi_design.report.meta.report_date` (today).
+    command : str, optional
+        The command line that made the report (shown in the title block).
+    figures : bool, optional
+        Render figures and equations to SVG (default). False leaves ``svg``
+        None everywhere: the golden tests compare the rest.
+    design_map : fi_design.studies.DesignMap, optional
+        A crossover x stroke map around the design point
+        (:func:`fi_design.studies.design_map`) for its own section.
+
+    Returns
+    -------
+    dict
+        Keys ``meta`` (title block), ``sections`` (the contents, in order),
+        ``verdict``, ``inputs``, ``steps``, ``linear``, ``nonlinear`` (None
+        without simulation), ``map`` (None without map), ``assumptions``,
+        ``references``, ``appendix``. Numbers are SI floats with a ``unit`` key
+        beside them (the templates format them with the ``qty`` filter), or text.
+    """
+    spec = result.spec
+    fig_no = _Numbering()
+    ctx: dict[str, Any] = {
+        "meta": title_block(spec, "design", date=date, command=command,
+                            sha256=result.spec_sha256, version=result.fi_design_version),
+        "verdict": verdict(result),
+        "inputs": spec_inputs(spec),
+        "steps": guideline_steps(result, figures),
+        "linear": _linear(result, figures, fig_no),
+        "nonlinear": _nonlinear(result, figures, fig_no),
+    }
+    if ctx["nonlinear"] is None:
+        ctx["nonlinear_missing"] = ("The nonlinear confirmation was not run (fi-design "
+                                    "--no-simulation, or design(spec, confirm=False)): the "
+                                    "verdict rests on the linear steps alone.")
+    ctx["map"] = _map_section(design_map, figures, fig_no)
+    ctx["assumptions"] = _assumptions(result)
+    ctx["references"] = [{"key": k, "text": t} for k, t in REFERENCES]
+    ctx["appendix"] = _appendix(result)
+    ctx["sections"] = _design_sections(ctx)
+    return ctx

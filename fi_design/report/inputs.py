@@ -1,0 +1,158 @@
+"""The inputs section of a design report: every spec value, given or defaulted."""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+from .meta import spec_file
+
+__all__ = ["spec_inputs"]
+
+
+#: Derived defaults: path -> (rule in words, function of the spec).
+def _derived_rules() -> dict[str, tuple[str, Callable[[Any], float]]]:
+    from .. import spec as s
+
+    return {
+        "friction.bristle_damping": ("sqrt(sigma0 (m1 + m2))", s.bristle_damping),
+        "isolator.stiffness": ("k_max / 2 (step 3)", s.drive_stiffness),
+        "isolator.damping": ("2 \u00b7 0.05 \u00b7 sqrt(k m1 m2 / (m1 + m2))", s.joint_damping),
+        "isolator.limiter.damping": ("2 \u00b7 0.2 \u00b7 sqrt(k_stop m1)", s.limiter_damping),
+    }
+
+
+_MISSING = object()
+
+
+def _raw_at(raw: Any, key: Any) -> Any:
+    if isinstance(raw, dict):
+        return raw.get(key, _MISSING)
+    if isinstance(raw, (list, tuple)) and isinstance(key, int) and key < len(raw):
+        return raw[key]
+    return _MISSING
+
+
+def _as_written(value: Any) -> str:
+    if value is _MISSING:
+        return ""
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_as_written(v) for v in value) + "]"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if value is None:
+        return "null"
+    if isinstance(value, float):
+        return f"{value:g}"
+    return str(value)
+
+
+def _first_sentence(text: str) -> str:
+    text = (text or "").split(" [")[0].split(". Default")[0].strip()
+    return text.rstrip(".")
+
+
+def spec_inputs(spec: Any) -> list[dict]:
+    """Every value of a spec, grouped by section, with unit and whether it was given.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The spec (its origin tells given values from defaults).
+
+    Returns
+    -------
+    list of dict
+        One group per top-level section: ``title`` and ``rows``, each row with
+        ``path``, ``description``, ``value`` (SI), ``unit`` (SI), ``written``
+        (as in the file) and ``source`` (``given``, ``default``, ``derived
+        default: RULE`` or ``not given``).
+    """
+    from pydantic import BaseModel
+
+    from ..specfile import path_unit
+
+    src = spec_file(spec)
+    raw = src["raw"] if src["raw"] is not None else {}
+    rules = _derived_rules()
+    groups: list[dict] = []
+
+    def leaf(path: str, value: Any, written: Any, info: Any, parent: Any) -> dict:
+        given = written is not _MISSING
+        try:
+            unit = path_unit(path, spec)
+        except Exception:  # noqa: BLE001 -- a unit we cannot name is shown without one
+            unit = ""
+        row = {"path": path, "description": _first_sentence(getattr(info, "description", "")),
+               "value": value, "unit": unit, "written": _as_written(written),
+               "source": "given" if given else "default"}
+        generic = path.split("[")[0] + ("" if "[" not in path else "")
+        if value is None and not given:
+            rule = rules.get(generic)
+            if rule is not None:
+                try:
+                    row["value"] = float(rule[1](spec))
+                    row["source"] = f"derived default: {rule[0]}"
+                except (ValueError, AttributeError):
+                    row["source"] = "not given"
+            elif path.endswith(".antiresonance") and isinstance(parent, BaseModel):
+                from ..spec import antiresonance
+
+                if getattr(parent, "collocated", False):
+                    row["value"] = antiresonance(parent)
+                    row["source"] = "derived default: frequency / sqrt(2)"
+                else:
+                    row["source"] = "not used (mode not collocated)"
+            else:
+                row["source"] = "not given"
+        if isinstance(value, tuple) and not value:
+            row["value"] = "none"
+        return row
+
+    def walk(model: Any, raw_node: Any, prefix: str, rows: list[dict]) -> None:
+        for name, info in type(model).model_fields.items():
+            value = getattr(model, name)
+            path = f"{prefix}{name}"
+            written = _raw_at(raw_node, name)
+            if isinstance(value, BaseModel):
+                walk(value, written if written is not _MISSING else {}, path + ".", rows)
+            elif isinstance(value, tuple) and value and all(isinstance(v, BaseModel)
+                                                            for v in value):
+                for i, item in enumerate(value):
+                    item_raw = _raw_at(written, i) if written is not _MISSING else _MISSING
+                    walk(item, item_raw if item_raw is not _MISSING else {}, f"{path}[{i}].",
+                         rows)
+            elif value is None and info.annotation is not None and _is_section(info):
+                rows.append({"path": path, "description": _first_sentence(info.description or ""),
+                             "value": "none", "unit": "", "written": "",
+                             "source": "not given (section omitted)"})
+            else:
+                rows.append(leaf(path, value, written, info, model))
+
+    for name, info in type(spec).model_fields.items():
+        value = getattr(spec, name)
+        written = _raw_at(raw, name)
+        rows: list[dict] = []
+        if isinstance(value, BaseModel):
+            walk(value, written if written is not _MISSING else {}, name + ".", rows)
+        elif isinstance(value, tuple) and value and all(isinstance(v, BaseModel) for v in value):
+            for i, item in enumerate(value):
+                item_raw = _raw_at(written, i) if written is not _MISSING else _MISSING
+                walk(item, item_raw if item_raw is not _MISSING else {}, f"{name}[{i}].", rows)
+        elif value is None or (isinstance(value, tuple) and not value):
+            rows.append({"path": name, "description": _first_sentence(info.description or ""),
+                         "value": "none", "unit": "", "written": _as_written(written),
+                         "source": "given" if written is not _MISSING else "not given"})
+        else:
+            rows.append(leaf(name, value, written, info, spec))
+        groups.append({"title": name, "rows": rows})
+    return groups
+
+
+def _is_section(info: Any) -> bool:
+    from pydantic import BaseModel
+
+    ann = info.annotation
+    for arg in getattr(ann, "__args__", ()) or (ann,):
+        if isinstance(arg, type) and issubclass(arg, BaseModel):
+            return True
+    return False

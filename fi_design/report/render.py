@@ -1,0 +1,262 @@
+"""Rendering: one jinja environment, HTML from a context, PDF from the HTML (WeasyPrint).
+
+The templates live in the repository's top-level ``templates/`` folder; the
+wheel carries them as ``fi_design/templates`` (:func:`template_dir` finds
+either). Every section template extends ``section.html.jinja`` and uses only
+``extends``, ``block``, ``for`` and ``if``; numbers are formatted by the
+filters of :mod:`fi_design.report.filters`. Files are written atomically
+(:mod:`fi_design.output`).
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from pathlib import Path
+from typing import Any, Callable
+
+from ..errors import OutputError
+from .context import build_context
+from .filters import FILTERS
+
+__all__ = ["FORMATS", "template_dir", "environment", "render_html", "output_format",
+           "write_document", "render_report", "render_document"]
+
+#: Output formats by file extension.
+FORMATS = {".html": "html", ".pdf": "pdf"}
+
+
+def template_dir() -> Path:
+    """The folder holding the report templates.
+
+    An installed wheel carries them as ``fi_design/templates``; a source tree
+    (an editable install) keeps them in the repository's top-level
+    ``templates/`` folder, next to the package.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    FileNotFoundError
+        Neither place holds ``report.html.jinja`` (a broken installation).
+    """
+    package = Path(__file__).resolve().parents[1]
+    for candidate in (package / "templates", package.parent / "templates"):
+        if (candidate / "report.html.jinja").is_file():
+            return candidate
+    raise FileNotFoundError(f"fi_design: report templates not found in {package / 'templates'} "
+                            f"or {package.parent / 'templates'}; reinstall the package")
+
+
+@functools.lru_cache(maxsize=1)
+def environment() -> Any:
+    """The one jinja environment of the reports: autoescape, ``StrictUndefined``, filters.
+
+    Returns
+    -------
+    jinja2.Environment
+        Loads from :func:`template_dir`; the filters ``num``, ``qty`` and
+        ``unit`` (:data:`fi_design.report.filters.FILTERS`).
+    """
+    import jinja2
+
+    env = jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(template_dir())),
+        autoescape=jinja2.select_autoescape(default=True, default_for_string=True),
+        undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
+        keep_trailing_newline=True)
+    env.filters.update(FILTERS)
+    return env
+
+
+def render_html(context: dict) -> str:
+    """Render a report context (from :func:`~fi_design.report.context.build_context`) to HTML.
+
+    Parameters
+    ----------
+    context : dict
+        ``meta``, ``sections`` (each with ``id``, ``number``, ``title`` and
+        ``template``) and the data each section's template reads under its
+        ``id``.
+
+    Returns
+    -------
+    str
+        One self-contained HTML document (inline CSS and SVG, no script).
+    """
+    from markupsafe import Markup
+
+    env = environment()
+    body = [Markup(env.get_template(section["template"]).render(
+        section=section, data=context.get(section["id"]), meta=context["meta"],
+        context=context)) for section in context["sections"]]
+    css = Markup((template_dir() / "report.css").read_text(encoding="utf-8"))
+    return env.get_template("report.html.jinja").render(
+        meta=context["meta"], sections=context["sections"], body=body, css=css)
+
+
+def output_format(path: str | os.PathLike) -> str:
+    """The format of a report file, from its extension.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The report's file name.
+
+    Returns
+    -------
+    str
+        ``"html"`` or ``"pdf"``.
+
+    Raises
+    ------
+    fi_design.errors.OutputError
+        Any other extension.
+    """
+    ext = Path(path).suffix.lower()
+    if ext not in FORMATS:
+        raise OutputError(f"{path}: a report must end with .html or .pdf")
+    return FORMATS[ext]
+
+
+def write_document(html: str, path: str | os.PathLike) -> Path:
+    """Write a rendered report as HTML, or as a PDF (A4, WeasyPrint) made from it, atomically.
+
+    Parameters
+    ----------
+    html : str
+        The document (:func:`render_html`).
+    path : str or os.PathLike
+        ``.html`` or ``.pdf``; an existing file is replaced.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+
+    Raises
+    ------
+    fi_design.errors.OutputError
+        Wrong extension, or the file cannot be written.
+    """
+    from ..output import atomic_path, write_atomic
+
+    out = Path(path)
+    if output_format(out) == "html":
+        return write_atomic(out, html)
+    import logging
+
+    # WeasyPrint logs every CSS property it does not know at WARNING; the report's
+    # screen-only rules are expected to be skipped.
+    logging.getLogger("weasyprint").setLevel(logging.ERROR)
+    logging.getLogger("fontTools").setLevel(logging.ERROR)
+    from weasyprint import HTML
+
+    document = HTML(string=html, base_url=None, url_fetcher=_no_fetch).render()
+    with atomic_path(out) as tmp:
+        document.write_pdf(str(tmp))
+    return out
+
+
+def _no_fetch(url: str, *args: Any, **kwargs: Any) -> dict:
+    """URL fetcher that refuses everything: the report is self-contained by design."""
+    raise ValueError(f"the report makes no external requests (refused {url!r})")
+
+
+def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
+                  command: str | None = None, design_map: Any = None,
+                  progress: Callable[[str], None] | None = None) -> Path:
+    """Write the report of a result as HTML or PDF (chosen by the extension).
+
+    Presentation only: every number comes from ``result`` (and
+    ``design_map``); nothing is simulated here.
+
+    Parameters
+    ----------
+    result : DesignResult, SweepResult, StudyResult, RobustnessResult or object
+        What to report (:func:`~fi_design.report.context.build_context`). An
+        object with ``report_sections()`` and ``report_title`` is rendered as
+        a generic document.
+    path : str or os.PathLike
+        Output file, ``.html`` or ``.pdf``; an existing file is replaced
+        (atomically). Any other extension raises before any work.
+    date : str or datetime.date, optional
+        Report date; default today (or ``SOURCE_DATE_EPOCH``).
+    command : str, optional
+        The command line, shown in the title block.
+    design_map : fi_design.studies.DesignMap, optional
+        Design reports: a crossover x stroke hunting map around the design
+        point (:func:`fi_design.studies.design_map`), shown in its own section.
+    progress : callable, optional
+        ``progress(text)`` with a short message as the work proceeds.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+
+    Raises
+    ------
+    fi_design.errors.OutputError
+        The extension is not .html or .pdf, or the file cannot be written.
+    fi_design.errors.ReportError
+        ``result`` is of a kind there is no report for (a ``TypeError`` too).
+    """
+    out = Path(path)
+    fmt = output_format(out)
+    if progress is not None:
+        progress("drawing the report's figures ...")
+    options = {} if design_map is None else {"design_map": design_map}
+    html = render_html(build_context(result, date=date, command=command, **options))
+    if progress is not None:
+        progress("writing the PDF ..." if fmt == "pdf" else "writing the HTML ...")
+    return write_document(html, out)
+
+
+def render_document(path: str | os.PathLike, *, title: str, spec: Any, sections: Any,
+                    date: Any = None, command: str | None = None, kind: str = "report",
+                    conclusion: str = "") -> Path:
+    """Write a generic report (HTML or PDF) from :class:`~fi_design.report.blocks.Section` values.
+
+    The other commands' reports use this: the same title block, page layout,
+    running header and appendix as the design report, with their own
+    sections.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.html`` or ``.pdf``.
+    title : str
+        Report title.
+    spec : fi_design.spec.Spec
+        The spec the work started from.
+    sections : sequence of Section
+        The content.
+    date : str or datetime.date, optional
+        Report date (default today).
+    command : str, optional
+        The command line.
+    kind : str, optional
+        Short kind of report.
+    conclusion : str, optional
+        A summary paragraph shown first.
+
+    Returns
+    -------
+    pathlib.Path
+        The written file.
+
+    Raises
+    ------
+    fi_design.errors.OutputError
+        Wrong extension or the file cannot be written.
+    """
+    from .context import document_context
+
+    out = Path(path)
+    output_format(out)
+    ctx = document_context(title, spec, sections, date=date, command=command, kind=kind,
+                           conclusion=conclusion)
+    return write_document(render_html(ctx), out)

@@ -1,0 +1,231 @@
+"""The four guideline steps of a design report, with their equations."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Any
+
+from .equations import equation
+from .filters import num, qty, tex_num, tex_qty
+
+__all__ = ["guideline_steps"]
+
+
+def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
+    """The four guideline steps: equations in symbols and with numbers, results, explanation.
+
+    Parameters
+    ----------
+    result : fi_design.guideline.DesignResult
+        The design (and its simulated landing, when confirmed).
+    figures : bool, optional
+        Draw the equations (default); False leaves their ``svg`` None.
+
+    Returns
+    -------
+    list of dict
+        One per step: ``number``, ``title``, ``source``, ``equations``
+        (:func:`~fi_design.report.equations.equation`), ``results`` (quantity,
+        SI value, unit) and ``explanation``.
+    """
+    numbers = itertools.count(1)
+
+    def eq(tex: str) -> dict:
+        return equation(tex, f"eq-{next(numbers)}", figures)
+
+    spec = result.spec
+    gap = result.friction_gap
+    xo = result.crossover
+    st = result.stiffness
+    g = result.pid.gains
+    req = spec.requirements
+    steps = []
+
+    # step 1
+    rel = "\\geq" if gap.hunting_risk else "<"
+    steps.append({
+        "number": 1, "title": "Friction gap", "source": "paper \u00a74 step 1; Figure 4A",
+        "equations": [
+            eq(f"\\Delta F = F_s - F_c = {tex_qty(gap.static, 'N')} - "
+                      f"{tex_qty(gap.coulomb, 'N')} = {tex_qty(gap.gap, 'N')}"),
+            eq(f"\\Delta F = {tex_qty(gap.gap, 'N')} \\ {rel}\\ \\Delta F_\\mathrm{{lim}}"
+                      f" = {tex_qty(gap.threshold, 'N')}"),
+        ],
+        "results": [
+            {"quantity": "friction gap Fs \u2212 Fc", "value": gap.gap, "unit": "N"},
+            {"quantity": "threshold (requirements.friction_gap)", "value": gap.threshold,
+             "unit": "N"},
+            {"quantity": "hunting risk", "value": "yes" if gap.hunting_risk else "no",
+             "unit": ""},
+        ],
+        "explanation": (
+            "Hunting needs stick-slip: the integrator builds up force until the bearing breaks "
+            "loose at static friction, the cart slips past the target because sliding friction "
+            "is lower, and sticks again. The larger the gap between static and Coulomb friction, "
+            "the larger the overshoot (paper Figure 4A: hunting appears above a gap of about "
+            f"1 N). Here the gap is {qty(gap.gap, 'N')}, "
+            + ("at or above the threshold: hunting is a risk and the next steps decide how to "
+               "avoid it." if gap.hunting_risk else
+               "below the threshold: stick-slip, and so hunting, is unlikely.")),
+    })
+
+    # step 2
+    sep = req.parasitic_separation
+    need = sep * xo.desired
+    eqs = [eq(f"\\omega_c = 2\\pi f_c = 2\\pi \\times {tex_qty(xo.desired, 'Hz')} = "
+                     f"{tex_qty(2 * math.pi * xo.desired, 'rad/s')}")]
+    if xo.achievable is not None:
+        ok = xo.desired <= xo.achievable * (1 + 1e-9)
+        rel = "\\leq" if ok else ">"
+        eqs.append(eq(
+            f"f_c = {tex_qty(xo.desired, 'Hz')}\\ {rel}\\ "
+            f"f_{{c,\\mathrm{{ach}}}} = {tex_qty(xo.achievable, 'Hz')}"))
+    eqs.append(eq(f"f_\\mathrm{{par}} \\geq n_\\mathrm{{sep}}\\, f_c = {tex_num(sep)} "
+                         f"\\times {tex_qty(xo.desired, 'Hz')} = {tex_qty(need, 'Hz')}"))
+    pms = [c.phase_margin_deg for c in xo.cases]
+    gms = [abs(c.gain_margin_db) for c in xo.cases]
+    results = [
+        {"quantity": "desired crossover fc", "value": xo.desired, "unit": "Hz"},
+        {"quantity": "achievable crossover", "value": xo.achievable, "unit": "Hz"},
+        {"quantity": "limited by", "value": xo.limited_by, "unit": ""},
+        {"quantity": "smallest phase margin at fc (all cases)", "value": min(pms),
+         "unit": "deg"},
+        {"quantity": "smallest gain margin at fc (all cases)", "value": min(gms), "unit": "dB"},
+        {"quantity": "loop delay in the analysis", "value": xo.delay, "unit": "s"},
+        {"quantity": "lowest allowed parasitic frequency", "value": need, "unit": "Hz"},
+    ]
+    for m in xo.parasitic_modes:
+        results.append({"quantity": f"parasitic mode \u2018{m.name}\u2019"
+                                    f" ({'collocated' if m.collocated else 'non-collocated'})",
+                        "value": m.frequency, "unit": "Hz"})
+    steps.append({
+        "number": 2, "title": "Desired and achievable crossover",
+        "source": "paper \u00a72.2 and \u00a74 step 2; Figure 2",
+        "equations": eqs, "results": results,
+        "explanation": (
+            "One PID must be stable, with the required margins "
+            f"({qty(req.phase_margin, 'deg')} phase, {qty(req.gain_margin, 'dB')} gain), in every "
+            "linear limit case the stage switches between near standstill (paper Figure 2). The "
+            "achievable crossover is the highest at which all cases keep these margins and every "
+            f"parasitic flexure mode stays {num(sep)} times above the crossover. A limited "
+            "achievable crossover makes an isolator useful; a high one may avoid hunting by "
+            "control alone. The margins of each case are in the linear analysis below."),
+    })
+
+    # step 3
+    eqs = []
+    results = []
+    if spec.isolator is not None or st.suggested:
+        gamma = st.safety
+        eqs.append(eq(
+            f"k_\\max = \\frac{{F_s}}{{\\gamma\\, s}} = \\frac{{{tex_qty(st.static, 'N')}}}"
+            f"{{{tex_num(gamma)} \\times {tex_qty(st.stroke, 'm')}}} = "
+            f"{tex_qty(st.maximum, 'N/m')}"))
+        ok = st.chosen <= st.maximum * (1 + 1e-12)
+        rel = "<" if st.force_at_stroke < st.static else "\\geq"
+        eqs.append(eq(
+            f"F_k = k\\, s = {tex_qty(st.chosen, 'N/m')} \\times {tex_qty(st.stroke, 'm')} = "
+            f"{tex_qty(st.force_at_stroke, 'N')}\\ {rel}\\ F_s = {tex_qty(st.static, 'N')}"))
+        results += [
+            {"quantity": "stroke s", "value": st.stroke, "unit": "m"},
+            {"quantity": "safety factor \u03b3 (requirements.stiffness_safety)",
+             "value": st.safety, "unit": "1"},
+            {"quantity": "maximum drive stiffness k_max", "value": st.maximum, "unit": "N/m"},
+            {"quantity": "chosen drive stiffness k", "value": st.chosen, "unit": "N/m"},
+            {"quantity": "source of k", "value": st.source, "unit": ""},
+            {"quantity": "flexure force at full stroke k s", "value": st.force_at_stroke,
+             "unit": "N"},
+            {"quantity": "k within k_max", "value": "yes" if ok else "no", "unit": ""},
+        ]
+    fx = result.flexure
+    if fx is not None and fx.feasible:
+        E = spec.isolator.flexure.material.youngs_modulus
+        eqs.append(eq(
+            f"k = \\frac{{n E b t^3}}{{L^3}} = \\frac{{{fx.leaves} \\times {tex_qty(E, 'Pa')} "
+            f"\\times {tex_qty(fx.width, 'm')} \\times ({tex_qty(fx.thickness, 'm')})^3}}"
+            f"{{({tex_qty(fx.length, 'm')})^3}} = {tex_qty(fx.drive_stiffness, 'N/m')}"))
+        rel = "\\leq" if fx.stress <= fx.allowed_stress else ">"
+        eqs.append(eq(
+            f"\\sigma = \\frac{{3 E t s}}{{L^2}} = {tex_qty(fx.stress, 'Pa')}\\ "
+            f"{rel}\\ \\sigma_\\mathrm{{allow}} = "
+            f"{tex_qty(fx.allowed_stress, 'Pa')}"))
+        results += [
+            {"quantity": "leaves n", "value": fx.leaves, "unit": "1"},
+            {"quantity": "leaf length L", "value": fx.length, "unit": "m"},
+            {"quantity": "leaf width b", "value": fx.width, "unit": "m"},
+            {"quantity": "leaf thickness t", "value": fx.thickness, "unit": "m"},
+            {"quantity": "bending stress at full stroke", "value": fx.stress, "unit": "Pa"},
+            {"quantity": "stress margin allowed / actual", "value": fx.stress_margin, "unit": "1"},
+            {"quantity": "support-direction frequency (with m1)", "value": fx.support_frequency,
+             "unit": "Hz"},
+            {"quantity": "leaf bending resonance (clamped-guided)", "value": fx.bending_frequency,
+             "unit": "Hz"},
+            {"quantity": "required parasitic frequency", "value": fx.required_frequency,
+             "unit": "Hz"},
+        ]
+    elif fx is not None:
+        results.append({"quantity": "leaf-spring flexure", "value": f"none fits: {fx.reason}",
+                        "unit": ""})
+    sim = result.simulation
+    land = getattr(sim, "landing", None) if sim is not None else None
+    if land is not None:
+        eqs.append(eq(
+            f"F_\\mathrm{{rest}} = k \\min(|d|, s) = {tex_qty(land.stiffness, 'N/m')} \\times "
+            f"{tex_qty(min(abs(land.deflection), land.stroke), 'm')} = {tex_qty(land.force, 'N')}"))
+        results.append({"quantity": "simulated deflection at rest d", "value": land.deflection,
+                        "unit": "m"})
+        results.append({"quantity": "flexure force on the resting cart", "value": land.force,
+                        "unit": "N"})
+    if st.suggested:
+        lead = ("The spec has no isolator; these are the values to start a design from, for the "
+                "paper's 0.3 mm stroke. ")
+    else:
+        lead = ""
+    steps.append({
+        "number": 3, "title": "Maximum drive stiffness", "source": "paper \u00a74 step 3; "
+                                                                    "Figure 4C",
+        "equations": eqs, "results": results,
+        "explanation": lead + (
+            "At full stroke the flexure must push the cart with less than static friction, or it "
+            "drags the cart along while the stage settles and the controller feels the friction "
+            "again: k_max = Fs / (\u03b3 s). Lower stiffness mitigates hunting better (paper "
+            "Figure 4C); the flexure's parasitic modes and support stiffness bound how low it can "
+            "go. The simulated force on the resting cart refines the rule: the cart sees "
+            "k min(|d|, s), not k s."),
+    })
+
+    # step 4
+    m_text = ("m_1 + m_2" if spec.controller.tuning_mass == "total" else "m_1")
+    eqs = [
+        eq(f"m = {m_text} = {tex_qty(g.tuning_mass, 'kg')}"),
+        eq("C(s) = k_s \\left(1 + \\frac{\\omega_i}{s}\\right)"
+                  "\\frac{1 + s/\\omega_d}{1 + s/\\omega_t}"),
+        eq(f"k_s = \\frac{{m\\, \\omega_c^2}}{{r}} = \\frac{{{tex_qty(g.tuning_mass, 'kg')}"
+                  f" \\times ({tex_qty(g.wc, 'rad/s')})^2}}{{{tex_num(result.pid.derivative_ratio)}"
+                  f"}} = {tex_qty(g.ks, 'N/m')}"),
+        eq(f"\\omega_d = \\omega_c / r = {tex_qty(g.wd, 'rad/s')},\\quad \\omega_t = "
+                  f"r\\, \\omega_c = {tex_qty(g.wt, 'rad/s')},\\quad \\omega_i = \\omega_c / r_i = "
+                  f"{tex_qty(g.wi, 'rad/s')}"),
+        eq(f"k_p = k_s (1 + \\omega_i/\\omega_d) = {tex_qty(g.kp, 'N/m')},\\quad "
+                  f"k_i = k_s \\omega_i = {tex_qty(g.ki, 'N/(m s)')},\\quad "
+                  f"k_d = k_s / \\omega_d = {tex_qty(g.kd, 'N s/m')}"),
+    ]
+    steps.append({
+        "number": 4, "title": "PID gains", "source": "paper \u00a72.2 and \u00a74 step 4",
+        "equations": eqs,
+        "results": [
+            {"quantity": "tuning mass m", "value": g.tuning_mass, "unit": "kg"},
+            {"quantity": "proportional gain kp", "value": g.kp, "unit": "N/m"},
+            {"quantity": "integral gain ki", "value": g.ki, "unit": "N/(m s)"},
+            {"quantity": "derivative gain kd", "value": g.kd, "unit": "N s/m"},
+            {"quantity": "roll-off \u03c9t", "value": g.wt, "unit": "rad/s"},
+        ],
+        "explanation": (
+            "The gains follow from the moving mass and the crossover: the lead-lag part has its "
+            "phase maximum at \u03c9c, and k_s puts |C(j\u03c9c)| = m \u03c9c\u00b2, so a free "
+            "mass m crosses over at \u03c9c. The paper tunes on the maximum moving mass m1 + m2 "
+            "(the limiter engaged), which it found best. The simulation uses the parallel form "
+            "(kp + ki/s + kd s) / (1 + s/\u03c9t)."),
+    })
+    return steps

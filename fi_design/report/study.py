@@ -1,0 +1,168 @@
+"""Reports of the parameter studies: a sweep, the paper's four maps, robustness."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..results.studies import RobustnessResult, StudyResult, SweepResult
+from .blocks import FigureBlock, Section, Table, figure_block
+from .context import build_context, document_context
+from .filters import num, qty
+from .meta import TITLES
+
+__all__ = ["sweep_context", "study_context", "robustness_context", "sweep_section"]
+
+
+def _axis_text(axis: Any) -> str:
+    vals = list(axis.values)
+    return (f"{axis.path}: {len(vals)} values from {qty(vals[0], axis.unit)} to "
+            f"{qty(vals[-1], axis.unit)}{' (log)' if axis.log else ''}")
+
+
+def sweep_section(result: SweepResult, sid: str, title: str, lead: str = "",
+                  figures: bool = True) -> Section:
+    """One map of hunting cycles as a report section: axes, design point, counts, figure.
+
+    Parameters
+    ----------
+    result : fi_design.studies.SweepResult
+        The map (or line).
+    sid : str
+        Section id.
+    title : str
+        Section title.
+    lead : str, optional
+        A first paragraph.
+    figures : bool, optional
+        Draw the figure (default).
+
+    Returns
+    -------
+    Section
+    """
+    from .. import plots
+
+    counts = result.counts()
+    plant = "with isolator" if result.isolated else "without isolator"
+    paras = [p for p in (lead,) if p]
+    axes = [_axis_text(result.x)] + ([_axis_text(result.y)] if result.y is not None else [])
+    paras.append(f"Simulated {plant}; " + "; ".join(axes) + ". Design point: "
+                 + ", ".join(qty(v, a.unit) if v is not None else "n/a"
+                             for v, a in zip(result.design_point,
+                                             [result.x] + ([result.y] if result.y else [])))
+                 + ".")
+    rows = tuple((k, num(v)) for k, v in counts.items())
+    table = Table(("Verdict", "Points"), rows, caption="Points per verdict")
+    figs: tuple[FigureBlock, ...] = ()
+    if figures:
+        import matplotlib
+
+        with matplotlib.rc_context(plots.REPORT_RC):
+            fig = plots.sweep_figure(result, title="")
+        figs = (figure_block(fig, f"Hunting cycles: {' vs '.join(result.paths[::-1])} "
+                                  f"({plant}).", name=sid),)
+    return Section(sid, title, paragraphs=tuple(paras), tables=(table,), figures=figs)
+
+
+@build_context.register
+def sweep_context(result: SweepResult, *, date: Any = None, command: str | None = None,
+                  figures: bool = True) -> dict:
+    """The report context of a sweep.
+
+    Parameters
+    ----------
+    result : fi_design.studies.SweepResult
+        The sweep.
+    date : str or datetime.date, optional
+        Report date.
+    command : str, optional
+        The command line.
+    figures : bool, optional
+        Render the figures (default).
+
+    Returns
+    -------
+    dict
+        For :func:`~fi_design.report.render.render_html`.
+    """
+    sections = [sweep_section(result, "sweep", "Hunting map", figures=figures)]
+    return document_context(TITLES["sweep"], result.spec, sections, date=date, command=command,
+                            kind="sweep")
+
+
+@build_context.register
+def study_context(result: StudyResult, *, date: Any = None, command: str | None = None,
+                  figures: bool = True) -> dict:
+    """The report context of the paper's study: one section per map.
+
+    Parameters
+    ----------
+    result : fi_design.studies.StudyResult
+        The study.
+    date : str or datetime.date, optional
+        Report date.
+    command : str, optional
+        The command line.
+    figures : bool, optional
+        Render the figures (default).
+
+    Returns
+    -------
+    dict
+        For :func:`~fi_design.report.render.render_html`.
+    """
+    sections = [sweep_section(m.result, f"map-{m.definition.key.lower()}",
+                              f"Map {m.definition.key}: {m.definition.title}",
+                              lead=f"Paper: {m.definition.paper}.", figures=figures)
+                for m in result.maps]
+    return document_context(TITLES["study"], result.spec, sections, date=date, command=command,
+                            kind="study")
+
+
+@build_context.register
+def robustness_context(result: RobustnessResult, *, date: Any = None,
+                       command: str | None = None, figures: bool = True) -> dict:
+    """The report context of a robustness study: probabilities of hunting and their intervals.
+
+    Parameters
+    ----------
+    result : fi_design.studies.RobustnessResult
+        The study.
+    date : str or datetime.date, optional
+        Report date.
+    command : str, optional
+        The command line.
+    figures : bool, optional
+        Render the figures (default).
+
+    Returns
+    -------
+    dict
+        For :func:`~fi_design.report.render.render_html`.
+    """
+    from .. import plots
+
+    rows = []
+    for label, p in (("with isolator", result.isolated), ("without isolator",
+                                                          result.not_isolated)):
+        if p is None:
+            continue
+        rows.append((label, num(p.hunting), num(p.valid),
+                     qty(100 * p.probability, "%") if p.probability is not None else "n/a",
+                     f"{num(100 * p.low, 3)} \u2013 {num(100 * p.high, 3)}\u00a0%"))
+    table = Table(("Plant", "Hunting", "Valid samples", "Probability", "Confidence interval"),
+                  tuple(rows), caption="Probability of hunting under the scatter")
+    figs: tuple[FigureBlock, ...] = ()
+    if figures:
+        import matplotlib
+
+        with matplotlib.rc_context(plots.REPORT_RC):
+            fig = plots.robustness_figure(result, title="")
+        figs = (figure_block(fig, "Probability of hunting with its confidence interval.",
+                             name="robustness", width="half"),)
+    sections = [Section("robustness", "Probability of hunting",
+                        paragraphs=(f"{result.samples} samples of the spec with its values "
+                                    "drawn around the nominal ones.",),
+                        tables=(table,), figures=figs)]
+    return document_context(TITLES["robustness"], result.spec, sections, date=date,
+                            command=command, kind="robustness")

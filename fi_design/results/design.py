@@ -1,0 +1,606 @@
+"""Results of the design workflow: the four guideline steps, the loop, the confirmation.
+
+Produced by :func:`fi_design.guideline.design` (steps 1 to 4, the loop
+responses, the isolator advice), :func:`fi_design.flexure.size_flexure` and
+:func:`fi_design.confirm.confirm` (the simulated confirmation).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from . import Check, Result, Status, to_jsonable
+from .simulation import HuntingMetrics, SimulationResult
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..spec import Spec
+
+# Values from the analyses below (fi_design.linear's CaseMargins, fi_design.pid's PidGains and
+# ControlLaw) are typed Any here: the results layer imports no analysis, not even for a type.
+
+__all__ = ["FrictionGapResult", "ModeSeparation", "CrossoverResult", "StiffnessResult",
+           "FlexureResult", "PidResult", "CaseResponse", "LoopResponses", "IsolatorAdvice",
+           "PlantVerdict", "CrossoverScan", "Landing", "Confirmation", "DesignResult"]
+
+
+@dataclass(frozen=True)
+class FrictionGapResult(Result):
+    """Step 1: the gap between static and Coulomb friction.
+
+    Attributes
+    ----------
+    static : float
+        Static friction Fs [N].
+    coulomb : float
+        Coulomb friction Fc [N].
+    gap : float
+        Fs - Fc [N].
+    threshold : float
+        ``requirements.friction_gap`` [N]: above it hunting is a risk.
+    hunting_risk : bool
+        ``gap >= threshold``.
+    checks : tuple of Check
+        The step's checks (also in :attr:`DesignResult.checks`).
+    """
+
+    static: float
+    coulomb: float
+    gap: float
+    threshold: float
+    hunting_risk: bool
+    checks: tuple[Check, ...] = field(default=(), repr=False)
+
+
+@dataclass(frozen=True)
+class ModeSeparation(Result):
+    """A parasitic mode against the crossover.
+
+    Attributes
+    ----------
+    name : str
+        The mode's label.
+    frequency : float
+        Its frequency [Hz].
+    required : float
+        ``parasitic_separation`` x desired crossover [Hz].
+    collocated : bool
+        Collocated (antiresonance first) or not.
+    passed : bool
+        ``frequency >= required``.
+    """
+
+    name: str
+    frequency: float
+    required: float
+    collocated: bool
+    passed: bool
+
+
+@dataclass(frozen=True)
+class CrossoverResult(Result):
+    """Step 2: desired and achievable crossover, margins per limit case.
+
+    Attributes
+    ----------
+    desired : float
+        ``controller.crossover`` [Hz].
+    achievable : float or None
+        Highest crossover meeting all requirements [Hz]; None if none does.
+    limited_by : str
+        What limits the achievable crossover, in words.
+    limit_kind : str
+        ``margin``, ``mode``, ``scan_limit`` or ``infeasible``
+        (see :class:`fi_design.linear.AchievableCrossover`).
+    limiting_case : str or None
+        Case name when a margin limits.
+    feasible_ranges : tuple of tuple of float
+        Feasible crossover stretches of the scan [Hz].
+    delay : float
+        Loop delay in the linear analysis [s] (computational plus half a
+        sample period).
+    stiffness : float or None
+        Joint stiffness the cases use [N/m]; None without isolator.
+    cases : tuple of fi_design.linear.CaseMargins
+        Margins of each limit case with the PID tuned at the desired crossover.
+    parasitic_modes : tuple of ModeSeparation
+        Each parasitic mode against ``parasitic_separation`` x desired crossover.
+    checks : tuple of Check
+        The step's checks.
+    """
+
+    desired: float
+    achievable: float | None
+    limited_by: str
+    limit_kind: str
+    limiting_case: str | None
+    feasible_ranges: tuple[tuple[float, float], ...]
+    delay: float
+    stiffness: float | None
+    cases: tuple[Any, ...]
+    parasitic_modes: tuple[ModeSeparation, ...]
+    checks: tuple[Check, ...] = field(default=(), repr=False)
+
+
+@dataclass(frozen=True)
+class StiffnessResult(Result):
+    """Step 3: the maximum and the chosen drive stiffness.
+
+    Attributes
+    ----------
+    maximum : float
+        k_max = Fs / (stiffness_safety x stroke) [N/m].
+    chosen : float
+        The spec's stiffness, else the proposed k_max / 2 [N/m]. Without an
+        isolator: the stiffness suggested to start from.
+    source : str
+        Where ``chosen`` comes from, in words.
+    stroke : float
+        One-sided stroke [m] (the suggested one without isolator).
+    static : float
+        Static friction Fs [N].
+    safety : float
+        ``requirements.stiffness_safety`` [-].
+    force_at_stroke : float
+        Flexure force at full stroke, chosen x stroke [N]; stays below Fs.
+    suggested : bool
+        True when the spec has no isolator and the values are a suggestion.
+    checks : tuple of Check
+        The step's checks.
+    """
+
+    maximum: float
+    chosen: float
+    source: str
+    stroke: float
+    static: float
+    safety: float
+    force_at_stroke: float
+    suggested: bool
+    checks: tuple[Check, ...] = field(default=(), repr=False)
+
+
+@dataclass(frozen=True)
+class FlexureResult(Result):
+    """A sized parallel leaf-spring guide, or why none fits.
+
+    Attributes
+    ----------
+    feasible : bool
+        A design within the bounds meets every constraint.
+    reason : str
+        Empty when feasible; else the binding constraint in words.
+    leaves : int
+        Number of leaves n.
+    length, width, thickness : float or None
+        Leaf dimensions L, b, t [m]; None when infeasible.
+    drive_stiffness : float or None
+        Drive stiffness of the design [N/m].
+    target_stiffness : float
+        Stiffness aimed at (step 3's chosen stiffness) [N/m].
+    maximum_stiffness : float
+        k_max the drive stiffness must not exceed [N/m].
+    support_stiffness : float or None
+        Undeflected support stiffness [N/m].
+    stroke : float
+        Required one-sided stroke [m].
+    stroke_limit : float or None
+        Largest stroke within the allowed stress [m].
+    stress : float or None
+        Peak bending stress at full stroke [Pa].
+    allowed_stress : float
+        Allowed stress of the material [Pa].
+    stress_margin : float or None
+        allowed_stress / stress [-]; above 1 is within the limit.
+    support_frequency : float or None
+        First parasitic (support-direction) frequency with the stage mass [Hz].
+    bending_frequency : float or None
+        Leaf's own first bending resonance, clamped-guided (conservative) [Hz].
+    required_frequency : float
+        Parasitic frequencies must reach this: separation x crossover [Hz].
+    frequency_margin : float or None
+        min(support, bending frequency) / required_frequency [-].
+    leaf_mass : float or None
+        Mass of all leaves [kg].
+    """
+
+    feasible: bool
+    reason: str
+    leaves: int
+    length: float | None
+    width: float | None
+    thickness: float | None
+    drive_stiffness: float | None
+    target_stiffness: float
+    maximum_stiffness: float
+    support_stiffness: float | None
+    stroke: float
+    stroke_limit: float | None
+    stress: float | None
+    allowed_stress: float
+    stress_margin: float | None
+    support_frequency: float | None
+    bending_frequency: float | None
+    required_frequency: float
+    frequency_margin: float | None
+    leaf_mass: float | None
+
+
+@dataclass(frozen=True)
+class PidResult(Result):
+    """Step 4: the PID gains, and the loop's controller.
+
+    Attributes
+    ----------
+    gains : fi_design.pid.PidGains
+        The rule's gains at the loop's crossover (JSON: flattened into the
+        ``pid`` object); with explicit hardware gains, the recommendation.
+    tuning_rule : str
+        ``total`` (m1 + m2, the paper's choice) or ``stage`` (m1).
+    derivative_ratio : float
+        wd = wc / ratio, wt = ratio x wc [-].
+    integrator_ratio : float
+        wi = wc / ratio [-].
+    controller : fi_design.pid.ControlLaw
+        The loop's controller: the rule's, or the hardware's own gains
+        (``source``), as the analysis and the simulation use it.
+    static_error : float or None
+        Static position error of a loop without integrator against Coulomb
+        friction, Fc / kp [m]; None when the loop integrates.
+    checks : tuple of Check
+        The step's checks.
+    """
+
+    gains: Any
+    tuning_rule: str
+    derivative_ratio: float
+    integrator_ratio: float
+    controller: Any
+    static_error: float | None
+    checks: tuple[Check, ...] = field(default=(), repr=False)
+
+    def to_dict(self) -> dict:
+        """Flat JSON: the rule's gains plus the rule, its ratios and the loop's controller."""
+        out = {**self.gains.to_dict(), "tuning_rule": self.tuning_rule,
+               "derivative_ratio": self.derivative_ratio,
+               "integrator_ratio": to_jsonable(self.integrator_ratio),
+               "source": self.controller.source, "integrator": self.controller.integrator,
+               "static_error": self.static_error, "controller": self.controller.to_dict()}
+        if self.controller.source == "gains":
+            out["rule_in_hardware_form"] = to_jsonable(self.controller.rule_in_this_form())
+        return out
+
+
+@dataclass(frozen=True, eq=False)
+class CaseResponse(Result):
+    """The open loop of one linear limit case over a frequency grid.
+
+    Attributes
+    ----------
+    name : str
+        Case name (``sliding_free``, ``stuck_free``, ...).
+    number : int
+        1 to 4 in the paper's order (Figure 2).
+    description : str
+        The case in words.
+    loop : ndarray of complex, shape (n,)
+        L(j 2 pi f) = C D P at the grid's frequencies [-].
+    """
+
+    name: str
+    number: int
+    description: str
+    loop: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class LoopResponses(Result):
+    """Frequency responses of the loop in every limit case (for the Bode, Nyquist and
+    sensitivity plots), as the margins of step 2 used it.
+
+    Attributes
+    ----------
+    frequency : ndarray, shape (n,)
+        Log-spaced frequencies [Hz]: from a third of the lowest gain crossover
+        of any case (and a thirtieth of the desired crossover) to thirty times
+        the desired crossover or twice the highest parasitic mode.
+    cases : tuple of CaseResponse
+        One per limit case, in the paper's order.
+    """
+
+    frequency: np.ndarray
+    cases: tuple[CaseResponse, ...]
+
+
+@dataclass(frozen=True)
+class IsolatorAdvice(Result):
+    """Whether a stage without isolator looks like it needs one.
+
+    Attributes
+    ----------
+    needed : bool or None
+        True: an isolator is recommended; False: not needed; None: it depends
+        on whether a higher crossover removes hunting (simulate to decide).
+    reason : str
+        Why, in words.
+    stroke : float
+        Stroke to start from [m] (the paper's 0.3 mm).
+    stiffness : float
+        Stiffness to start from, Fs / (2 x safety x stroke) [N/m].
+    maximum_stiffness : float
+        k_max for that stroke [N/m].
+    """
+
+    needed: bool | None
+    reason: str
+    stroke: float
+    stiffness: float
+    maximum_stiffness: float
+
+
+@dataclass(frozen=True, eq=False)
+class PlantVerdict(Result):
+    """One simulated plant at the design crossover: its hunting metric and verdict.
+
+    Attributes
+    ----------
+    plant : str
+        ``"isolated"`` or ``"non_isolated"``.
+    friction_model : str
+        Friction model that produced the verdict (``lugre`` or ``switch``).
+    crossover : float
+        Crossover simulated [Hz].
+    metrics : HuntingMetrics
+        The paper's hunting metric of the trace and the verdict (``settled``,
+        ``hunting``, ``stuck`` or ``undetermined``) with its reason.
+    success : bool
+        Whether the integration completed.
+    message : str
+        Failure description, empty on success.
+    """
+
+    plant: str
+    friction_model: str
+    crossover: float
+    metrics: HuntingMetrics
+    success: bool
+    message: str
+
+    #: Fields of the metrics in the verdict's JSON (the counted peaks stay out).
+    JSON_METRICS = ("hunting_cycles", "amplitude", "period", "settled", "settling_time",
+                    "final_error", "verdict", "reason")
+
+    @classmethod
+    def of(cls, plant: str, result: SimulationResult) -> "PlantVerdict":
+        """The verdict of a simulation result.
+
+        Parameters
+        ----------
+        plant : str
+            ``"isolated"`` or ``"non_isolated"``.
+        result : SimulationResult
+            The simulation.
+
+        Returns
+        -------
+        PlantVerdict
+        """
+        return cls(plant=plant, friction_model=result.friction_model, crossover=result.crossover,
+                   metrics=result.metrics, success=result.success, message=result.message)
+
+    def to_dict(self) -> dict:
+        """Flat JSON: plant, model and crossover, the metric's figures and verdict, the solver's
+        outcome (SI)."""
+        m = self.metrics
+        return {"plant": self.plant, "friction_model": self.friction_model,
+                "crossover": to_jsonable(self.crossover),
+                **{k: to_jsonable(getattr(m, k)) for k in self.JSON_METRICS},
+                "success": self.success, "message": self.message}
+
+
+@dataclass(frozen=True, eq=False)
+class CrossoverScan(Result):
+    """Verdicts down a crossover grid and the lowest hunting-free crossover.
+
+    The scan runs from the top of the grid downwards and stops at the first
+    crossover that does not settle: everything above it settles, so the
+    minimum is found with the fewest simulations. Hunting that comes and goes
+    below that boundary (the paper saw it at 9.5 Hz) is a matter for a map
+    (``fi-design sweep``), not for this scan.
+
+    Attributes
+    ----------
+    plant : str
+        ``"isolated"`` or ``"non_isolated"``.
+    crossovers : ndarray, shape (n,)
+        Scanned crossovers, ascending [Hz].
+    verdicts : tuple of str
+        Verdict at each scanned crossover.
+    hunting_cycles : ndarray of int, shape (n,)
+        Counted cycles at each scanned crossover.
+    minimum : float or None
+        Lowest grid crossover from which every higher one settles [Hz]; None
+        if the top of the grid does not settle.
+    resolution : float
+        Grid step [Hz]: the boundary lies within one step below ``minimum``.
+    grid : tuple of float
+        The whole grid (start, stop, step) [Hz].
+    """
+
+    plant: str
+    crossovers: np.ndarray
+    verdicts: tuple[str, ...]
+    hunting_cycles: np.ndarray
+    minimum: float | None
+    resolution: float
+    grid: tuple[float, float, float]
+
+
+
+@dataclass(frozen=True)
+class Landing(Result):
+    """Where the cart comes to rest after the move (isolated plant).
+
+    Attributes
+    ----------
+    deflection : float
+        Joint deflection x1 - x2 at the end of the simulation [m].
+    stroke : float
+        One-sided stroke [m].
+    stiffness : float
+        Drive stiffness k [N/m].
+    force : float
+        Force the flexure exerts on the resting cart, k * min(|deflection|,
+        stroke) [N].
+    static_friction : float
+        Fs [N].
+    on_limiter : bool
+        Whether the landing deflection reaches the stroke (the limiter then
+        locks the joint and the controller feels the friction again).
+    rule_force : float
+        The paper's conservative bound k * stroke [N].
+    """
+
+    deflection: float
+    stroke: float
+    stiffness: float
+    force: float
+    static_friction: float
+    on_limiter: bool
+    rule_force: float
+
+
+
+@dataclass(frozen=True, eq=False)
+class Confirmation(Result):
+    """The simulated confirmation of a design.
+
+    Attributes
+    ----------
+    isolated, non_isolated : PlantVerdict
+        The two plants at the design crossover.
+    min_hunting_free_crossover : dict
+        ``{"isolated": Hz or None, "non_isolated": Hz or None, "resolution":
+        Hz, "scan": [start, stop]}``.
+    scans : dict of CrossoverScan
+        The scans behind the minimum crossovers, by plant.
+    landing : Landing or None
+        Landing of the isolated cart.
+    cross_check : dict of PlantVerdict
+        The same plants with the other friction model, by plant.
+    models_agree : bool
+        Whether both friction models give the same hunting/no-hunting call
+        for both plants.
+    suggested_isolator : bool
+        True when the spec has no isolator and the isolated plant uses the
+        isolator suggested by the guideline.
+    checks : tuple of Check
+        The simulation's checks for the design summary.
+    results : dict of SimulationResult
+        The two full simulations (traces for plots; not in the JSON).
+    """
+
+    isolated: PlantVerdict
+    non_isolated: PlantVerdict
+    min_hunting_free_crossover: dict
+    scans: dict
+    landing: Landing | None
+    cross_check: dict
+    models_agree: bool
+    suggested_isolator: bool
+    checks: tuple[Check, ...]
+    results: dict = field(repr=False)  # traces for plots; not in the JSON
+
+
+@dataclass(frozen=True)
+class DesignResult(Result):
+    """The four guideline steps for one spec.
+
+    Attributes
+    ----------
+    spec : fi_design.spec.Spec
+        The spec that produced the result (not in JSON; see ``spec_sha256``).
+    friction_gap : FrictionGapResult
+        Step 1.
+    crossover : CrossoverResult
+        Step 2.
+    stiffness : StiffnessResult
+        Step 3 (a suggestion without isolator).
+    flexure : fi_design.flexure.FlexureResult or None
+        Step 3 leaf-spring sizing; None without ``isolator.flexure``.
+    pid : PidResult
+        Step 4.
+    loop : LoopResponses
+        The loop of every limit case over frequency, for the plots (not in
+        JSON).
+    isolator_advice : IsolatorAdvice or None
+        Only for a spec without isolator.
+    checks : tuple of Check
+        All checks of the four steps, in step order.
+    warnings : tuple of (str, str)
+        ``(path, message)`` of suspicious spec values
+        (:func:`fi_design.spec.warnings_for`).
+    conclusion : str
+        One paragraph in plain words.
+    fi_design_version : str
+        Version of fi_design that computed it.
+    spec_sha256 : str
+        SHA-256 of the spec file (of the spec's JSON when not read from a file).
+    simulation : fi_design.confirm.Confirmation or None
+        The nonlinear confirmation; None when it was not run (``confirm=False``),
+        and then left out of the JSON.
+    """
+
+    spec: Spec = field(repr=False)
+    friction_gap: FrictionGapResult
+    crossover: CrossoverResult
+    stiffness: StiffnessResult
+    flexure: FlexureResult | None
+    pid: PidResult
+    loop: LoopResponses = field(repr=False)
+    isolator_advice: IsolatorAdvice | None
+    checks: tuple[Check, ...]
+    warnings: tuple[tuple[str, str], ...]
+    conclusion: str
+    fi_design_version: str
+    spec_sha256: str
+    simulation: "Confirmation | None" = None
+
+    @property
+    def passed(self) -> bool:
+        """No check failed (warnings and information do not count)."""
+        return not any(c.status == Status.FAIL for c in self.checks)
+
+    @property
+    def failed_checks(self) -> tuple[Check, ...]:
+        """The checks with status FAIL."""
+        return tuple(c for c in self.checks if c.status == Status.FAIL)
+
+    def to_dict(self) -> dict:
+        """The JSON contract: SI values, infinite margins as null.
+
+        Keys: ``name``, ``passed``, ``friction_gap``, ``crossover``, ``stiffness``,
+        ``flexure``, ``pid``, ``isolator_advice``, ``checks``, ``warnings``,
+        ``conclusion``, ``fi_design_version``, ``spec_sha256`` and, when set,
+        ``simulation``.
+        """
+        out = {
+            "name": self.spec.name,
+            "passed": self.passed,
+            "friction_gap": self.friction_gap.to_dict(),
+            "crossover": self.crossover.to_dict(),
+            "stiffness": self.stiffness.to_dict(),
+            "flexure": None if self.flexure is None else self.flexure.to_dict(),
+            "pid": self.pid.to_dict(),
+            "isolator_advice": to_jsonable(self.isolator_advice),
+            "checks": [to_jsonable(c) for c in self.checks],
+            "warnings": [{"path": p, "message": m} for p, m in self.warnings],
+            "conclusion": self.conclusion,
+            "fi_design_version": self.fi_design_version,
+            "spec_sha256": self.spec_sha256,
+        }
+        if self.simulation is not None:
+            out["simulation"] = to_jsonable(self.simulation)
+        return out

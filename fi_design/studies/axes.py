@@ -1,0 +1,169 @@
+"""The axes of a parameter study: spec values at dotted paths, swept over a grid.
+
+:class:`Axis` is one swept value; :func:`make_axis` builds one from values in
+SI, :func:`parse_axis` from the command line's text ``PATH=START:STOP:N``
+(text is read only here, at the boundary). :func:`design_value` is the spec's
+own value at a path, the design point a study is drawn around.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from .. import spec as _spec
+from ..errors import SpecError
+from ..results.studies import Axis
+from ..specfile import path_unit, value_at
+
+__all__ = ["make_axis", "parse_axis", "design_value", "is_number"]
+
+
+def make_axis(path: str, values: Sequence[float], log: bool = False,
+              spec: _spec.Spec | None = None) -> Axis:
+    """An :class:`Axis` for a dotted path, with the unit looked up in the spec schema.
+
+    Parameters
+    ----------
+    path : str
+        Dotted spec path.
+    values : sequence of float
+        Values in the path's SI unit.
+    log : bool, optional
+        Logarithmic spacing (for plots). Default False.
+    spec : Spec, optional
+        Resolves list indices into ``effects``.
+
+    Returns
+    -------
+    Axis
+
+    Raises
+    ------
+    SpecError
+        Unknown path, a path to a section or to a value without a number.
+    """
+    unit = path_unit(path, spec)
+    if unit == "":
+        raise SpecError("is not a numeric value; only numbers can be swept", path=path)
+    return Axis(path=path, values=np.asarray(values, dtype=float), unit=unit, log=log)
+
+
+def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> Axis:
+    """Read an axis written as ``PATH=START:STOP:N`` (or ``PATH=V1,V2,...``).
+
+    Parameters
+    ----------
+    text : str
+        ``"controller.crossover=2 Hz:30 Hz:15"``, ``"isolator.stroke=0.05 mm:1 mm:12"``
+        or ``"stage.mass=1,2,4"``. START and STOP are SI numbers or strings
+        with units; N is the number of values, end points included.
+    log : bool, optional
+        Space the N values logarithmically (START and STOP above zero).
+    spec : Spec, optional
+        Resolves list indices into ``effects``.
+
+    Returns
+    -------
+    Axis
+
+    Raises
+    ------
+    SpecError
+        Unknown path, malformed range, wrong unit, N below 1.
+    """
+    from ..units import to_si
+
+    if "=" not in text:
+        raise SpecError(f"axis {text!r}: expected PATH=START:STOP:N, e.g. "
+                        "'controller.crossover=2 Hz:30 Hz:15'")
+    path, rng = (part.strip() for part in text.split("=", 1))
+    if not path:
+        raise SpecError(f"axis {text!r}: the path before '=' is empty")
+    unit = path_unit(path, spec)
+    if unit == "":
+        raise SpecError("is not a numeric value; only numbers can be swept", path=path)
+
+    def number(word: str, what: str) -> float:
+        word = word.strip()
+        if not word:
+            raise SpecError(f"range {rng!r}: {what} is empty", path=path)
+        try:
+            return to_si(float(word) if is_number(word) else word, unit, path=path)
+        except SpecError as exc:
+            raise SpecError(f"range {rng!r}: {what}: {exc.message}", path=path) from None
+
+    if ":" not in rng and "," in rng:
+        values = [number(w, f"value {i + 1}") for i, w in enumerate(rng.split(","))]
+        return Axis(path=path, values=np.array(values), unit=unit, log=log)
+    parts = rng.split(":")
+    if len(parts) != 3:
+        raise SpecError(f"range {rng!r}: expected START:STOP:N (three parts separated by ':'), "
+                        f"e.g. '0.05 mm:1 mm:12'", path=path)
+    start, stop = number(parts[0], "START"), number(parts[1], "STOP")
+    try:
+        n = int(parts[2].strip())
+    except ValueError:
+        raise SpecError(f"range {rng!r}: N must be a whole number, got {parts[2].strip()!r}",
+                        path=path) from None
+    if n < 1:
+        raise SpecError(f"range {rng!r}: N must be at least 1, got {n}", path=path)
+    if n > 1 and start == stop:
+        raise SpecError(f"range {rng!r}: START equals STOP; give N = 1 or a wider range",
+                        path=path)
+    if log:
+        if start <= 0 or stop <= 0:
+            raise SpecError(f"range {rng!r}: a logarithmic axis needs START and STOP above "
+                            "zero", path=path)
+        values = np.geomspace(start, stop, n)
+    else:
+        values = np.linspace(start, stop, n)
+    return Axis(path=path, values=values, unit=unit, log=log)
+
+
+def is_number(word: str) -> bool:
+    """Whether ``word`` is a plain number (else a string with units)."""
+    try:
+        float(word)
+    except ValueError:
+        return False
+    return True
+
+
+_DERIVED = {
+    "isolator.stiffness": lambda s: _spec.drive_stiffness(s),
+    "isolator.damping": lambda s: _spec.joint_damping(s),
+    "friction.bristle_damping": lambda s: _spec.bristle_damping(s),
+    "isolator.limiter.damping": lambda s: _spec.limiter_damping(s),
+}
+
+
+def design_value(spec: _spec.Spec, path: str) -> float | None:
+    """The spec's own value at a path, derived defaults resolved [SI].
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec.
+    path : str
+        Dotted path.
+
+    Returns
+    -------
+    float or None
+        The value; derived defaults (``isolator.stiffness`` left to step 3,
+        default dampings) are computed; None if the spec has no such value.
+    """
+    try:
+        value = value_at(spec, path)
+    except SpecError:
+        return None
+    if value is None and path in _DERIVED:
+        try:
+            value = _DERIVED[path](spec)
+        except ValueError:
+            return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    return float(value)

@@ -1,0 +1,279 @@
+"""Points of a parameter study: simulate one, run many in chunks, record the outcomes.
+
+Every point is the base spec with some values replaced
+(:func:`fi_design.specfile.with_values`), simulated with the fast kernel and
+judged by the hunting metric (:func:`evaluate_point`). A point whose values the
+spec refuses is ``invalid``, a simulation that does not complete (or raises)
+``failed``: neither stops the study. :func:`evaluate` takes the finished
+points from the cache and runs the rest in chunks on the caller's executor
+(:func:`fi_design.execution.run_chunks`); the outcomes do not depend on where
+they ran.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time as _time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .. import spec as _spec
+from ..errors import ArgumentError, FiDesignError, SpecError
+from ..execution import Executor, chunks, run_chunks
+from ..results import frozen_array
+from ..results.studies import PointResult, RunInfo, spec_digest
+from ..specfile import with_values
+from .cache import METHOD, PointCache, open_cache, point_key
+
+__all__ = ["MAX_CHUNK", "TARGET_CHUNKS", "Task", "ProgressCallback", "Evaluation",
+           "evaluate_point", "run_chunk", "warm_up", "chunk_size", "evaluate", "point_result",
+           "grid", "verdict_grid"]
+
+#: ``progress(done, total)`` in points.
+ProgressCallback = Callable[[int, int], None]
+
+
+_OUTCOME_FIELDS = ("status", "verdict", "hunting_cycles", "amplitude", "period", "settling_time",
+                   "final_error", "message")
+
+
+def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool) -> dict:
+    """Simulate one point and return its outcome as plain data (the cached form).
+
+    Parameters
+    ----------
+    spec : Spec
+        The base spec.
+    values : mapping of str to value
+        Dotted path to value, applied with :func:`~fi_design.specfile.with_values`.
+    isolated : bool
+        Simulate the isolated plant (True) or the stage without isolator.
+
+    Returns
+    -------
+    dict
+        Keys ``status``, ``verdict``, ``hunting_cycles``, ``amplitude``,
+        ``period``, ``settling_time``, ``final_error``, ``message`` and
+        ``cacheable`` (False for outcomes that depend on the machine).
+    """
+    from ..simulation import simulate
+
+    try:
+        point = with_values(spec, values) if values else spec
+    except SpecError as exc:
+        return _outcome("invalid", "invalid", message=str(exc))
+    try:
+        res = simulate(point, isolated, METHOD)
+    except FiDesignError as exc:  # a request the simulation refuses: deterministic
+        return _outcome("failed", "failed", message=str(exc))
+    except Exception as exc:  # noqa: BLE001 -- one bad point must not stop a sweep
+        out = _outcome("failed", "failed", message=f"{type(exc).__name__}: {exc}")
+        out["cacheable"] = False
+        return out
+    m = res.metrics
+    if not res.success:
+        return _outcome("failed", "failed", message=res.message)
+    return _outcome("ok", m.verdict, hunting_cycles=int(m.hunting_cycles),
+                    amplitude=_num(m.amplitude), period=_num(m.period),
+                    settling_time=_num(m.settling_time), final_error=_num(m.final_error),
+                    message=m.reason)
+
+
+def _num(x: Any) -> float | None:
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _outcome(status: str, verdict: str, *, hunting_cycles: int | None = None,
+             amplitude: float | None = None, period: float | None = None,
+             settling_time: float | None = None, final_error: float | None = None,
+             message: str = "") -> dict:
+    return {"status": status, "verdict": verdict, "hunting_cycles": hunting_cycles,
+            "amplitude": amplitude, "period": period, "settling_time": settling_time,
+            "final_error": final_error, "message": message, "cacheable": True}
+
+
+def run_chunk(spec: _spec.Spec, tasks: Sequence[tuple[tuple[tuple[str, Any], ...], bool]]) \
+        -> list[dict]:
+    """Evaluate a chunk of points (the unit of work sent to an executor).
+
+    Parameters
+    ----------
+    spec : Spec
+        The base spec.
+    tasks : sequence of (values, isolated)
+        ``values`` is a tuple of ``(path, value)`` pairs.
+
+    Returns
+    -------
+    list of dict
+        One outcome per task (see :func:`evaluate_point`), in order.
+    """
+    return [evaluate_point(spec, dict(values), isolated) for values, isolated in tasks]
+
+
+def warm_up() -> None:
+    """Compile or load the simulation kernel, and import what a point needs, in this process.
+
+    Call it once in the parent before starting worker processes (numba then
+    writes its on-disk cache, and forked workers inherit the compiled code),
+    and pass it as the pool's ``initializer`` so that spawned workers load the
+    kernel before their first chunk.
+
+    Returns
+    -------
+    None
+    """
+    import scipy.signal  # noqa: F401  (the metric's peak finder, imported on first use)
+
+    from .. import kernel, simulation  # noqa: F401  (the kernel compiles at import or loads
+    #                                  numba's on-disk cache)
+
+
+#: Largest number of points in one chunk (bounds the work lost by an interruption).
+MAX_CHUNK = 64
+#: Chunks per study when the chunk size is chosen automatically.
+TARGET_CHUNKS = 16
+
+#: A point: its ``(path, value)`` pairs and the plant (True: isolated).
+Task = tuple[tuple[tuple[str, float], ...], bool]
+
+
+def chunk_size(n: int, chunksize: int | None = None) -> int:
+    """Points per chunk: as given, else about 1/16 of the points, at most :data:`MAX_CHUNK`.
+
+    Parameters
+    ----------
+    n : int
+        Points to run.
+    chunksize : int, optional
+        A given size (at least 1).
+
+    Returns
+    -------
+    int
+    """
+    if chunksize is not None:
+        if chunksize < 1:
+            raise ArgumentError(f"chunksize must be at least 1, got {chunksize}")
+        return chunksize
+    return min(MAX_CHUNK, max(1, math.ceil(n / TARGET_CHUNKS)))
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """The outcomes of a study's points and how they were obtained.
+
+    Attributes
+    ----------
+    outcomes : tuple of dict
+        One per task, in task order (see :func:`evaluate_point`).
+    run : RunInfo
+        Points computed and cached, chunks, executor, wall time.
+    """
+
+    outcomes: tuple[dict, ...]
+    run: RunInfo
+
+
+def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | None = None,
+             progress: ProgressCallback | None = None,
+             cache: PointCache | str | os.PathLike | bool | None = None,
+             chunksize: int | None = None) -> Evaluation:
+    """The outcomes of all points of a study: from the cache, or simulated in chunks.
+
+    Parameters
+    ----------
+    spec : Spec
+        The base spec.
+    tasks : sequence of (values, isolated)
+        The points: ``(path, value)`` pairs and the plant.
+    executor : Executor, optional
+        Runs the chunks; None runs them here, one after another.
+    progress : callable, optional
+        ``progress(done, total)`` in points, after the cache lookup and after
+        every chunk, in the calling thread.
+    cache : PointCache, path, bool or None, optional
+        Where finished points are looked up and stored (:func:`~.cache.open_cache`).
+    chunksize : int, optional
+        Points per chunk (:func:`chunk_size`).
+
+    Returns
+    -------
+    Evaluation
+    """
+    start = _time.perf_counter()
+    store = open_cache(cache)
+    n = len(tasks)
+    outcomes: list[dict | None] = [None] * n
+    keys: list[str] = []
+    if store is not None:
+        shash = spec_digest(spec)
+        keys = [point_key(shash, values, iso) for values, iso in tasks]
+        hits = store.get_many(keys)
+        for i, k in enumerate(keys):
+            if k in hits:
+                outcomes[i] = hits[k]
+    todo = [i for i in range(n) if outcomes[i] is None]
+    cached = n - len(todo)
+    done = cached
+    if progress is not None:
+        progress(done, n)
+    groups = [[todo[j] for j in chunk]
+              for chunk in chunks(len(todo), chunk_size(len(todo), chunksize))]
+
+    def finish(g: int, results: list[dict]) -> None:
+        nonlocal done
+        fresh = {}
+        for i, out in zip(groups[g], results):
+            outcomes[i] = out
+            if store is not None and out.get("cacheable", True):
+                fresh[keys[i]] = {k: out[k] for k in _OUTCOME_FIELDS}
+        if store is not None:
+            store.put_many(fresh)
+        done += len(groups[g])
+        if progress is not None:
+            progress(done, n)
+
+    def lost(g: int, exc: Exception) -> list[dict]:
+        msg = f"the worker running this point failed: {type(exc).__name__}: {exc}"
+        return [dict(_outcome("failed", "failed", message=msg), cacheable=False)
+                for _ in groups[g]]
+
+    arguments = [(spec, [tasks[i] for i in group]) for group in groups]
+    if executor is None:
+        for g, args in enumerate(arguments):
+            finish(g, run_chunk(*args))
+    elif groups:
+        run_chunks(executor, run_chunk, arguments, finish, lost)
+    run = RunInfo(points=n, computed=len(todo), cached=cached, chunks=len(groups),
+                  executor="serial" if executor is None else type(executor).__name__,
+                  wall_time=_time.perf_counter() - start)
+    return Evaluation(outcomes=tuple(outcomes), run=run)  # type: ignore[arg-type]
+
+
+def point_result(index: tuple[int, ...], values: tuple[float, ...], iso: bool, out: dict) \
+        -> PointResult:
+    """A :class:`PointResult` from a point's place, values, plant and outcome."""
+    return PointResult(index=index, values=values, isolated=iso,
+                       **{k: out.get(k) for k in _OUTCOME_FIELDS})
+
+
+def grid(points: Sequence[PointResult], shape: tuple[int, ...], name: str) -> np.ndarray:
+    """One outcome field of the points as a read-only array of ``shape`` (NaN without value)."""
+    vals = [getattr(p, name) if p.status == "ok" else None for p in points]
+    return frozen_array(np.array([np.nan if v is None else float(v) for v in vals])
+                        .reshape(shape))
+
+
+def verdict_grid(points: Sequence[PointResult], shape: tuple[int, ...]) -> np.ndarray:
+    """The points' verdicts as a read-only string array of ``shape``."""
+    arr = np.array([p.verdict for p in points], dtype="<U12").reshape(shape)
+    arr.flags.writeable = False
+    return arr

@@ -1,0 +1,114 @@
+"""The spec (fi_design.spec) and its file (fi_design.specfile): SI values, derived defaults,
+validation that names the field and line, immutability, provenance."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+
+import pytest
+from pydantic import ValidationError
+
+from fi_design import spec as sp
+from fi_design.errors import SpecError
+from fi_design.specfile import load_spec, origin
+
+from conftest import EXAMPLES, variant
+
+
+def test_values_are_si(paper_spec):
+    s = paper_spec
+    assert (s.stage.mass, s.cart.mass, s.total_mass) == (1.6, 0.4, 2.0)
+    assert s.friction.static == 4.0 and s.friction.coulomb == 1.0
+    assert s.friction.stribeck_velocity == pytest.approx(3e-3)
+    assert s.isolator.stroke == pytest.approx(3e-4) and s.isolator.stiffness == 6667.0
+    assert s.isolator.parasitic_modes[0].frequency == 150.0
+    assert s.isolator.flexure.material.youngs_modulus == pytest.approx(2e11)
+    assert s.isolator.flexure.length == pytest.approx((0.01, 0.06))
+    assert s.controller.crossover == 8.0 and s.motion.moves[0].distance == pytest.approx(0.01)
+    assert s.requirements.phase_margin == 30.0 and s.requirements.gain_margin == 6.0
+    assert s.has_isolator
+
+
+def test_spec_is_immutable(paper_spec):
+    with pytest.raises(ValidationError):
+        paper_spec.friction.static = 5.0
+
+
+def test_derived_defaults(paper_spec):
+    bare = variant(paper_spec, **{"friction.bristle_damping": None, "isolator.stiffness": None,
+                                  "isolator.damping": None})
+    f = bare.friction
+    assert sp.bristle_damping(bare) == pytest.approx(math.sqrt(f.bristle_stiffness * 2.0))
+    assert sp.stiffness_limit(bare) == pytest.approx(4.0 / 3e-4)
+    assert sp.proposed_stiffness(bare) == pytest.approx(0.5 * 4.0 / 3e-4)
+    assert sp.drive_stiffness(bare) == sp.proposed_stiffness(bare)
+    k = sp.drive_stiffness(bare)
+    assert sp.joint_damping(bare) == pytest.approx(2 * 0.05 * math.sqrt(k * 1.6 * 0.4 / 2.0))
+    assert sp.limiter_damping(bare) == pytest.approx(2 * 0.2 * math.sqrt(1e6 * 1.6))
+    # given values win over the rules
+    assert sp.bristle_damping(paper_spec) == 1414.0 and sp.drive_stiffness(paper_spec) == 6667.0
+    mode = paper_spec.isolator.parasitic_modes[0]
+    assert sp.antiresonance(mode) == pytest.approx(150.0 / math.sqrt(2))
+
+
+@pytest.mark.parametrize("paths,where,words", [
+    ({"friction.static": "0.5 N"}, "friction", ["at least the Coulomb"]),
+    ({"stage.mass": "-1 kg"}, "stage.mass", ["greater than 0"]),
+    ({"friction.statc": "4 N"}, "friction.statc", ["unknown"]),
+    ({"motion.duration": "5 s"}, "", ["hunting window ends"]),
+    ({"isolator.stroke": "3 N"}, "isolator.stroke", ["not a length"]),
+])
+def test_validation_errors_name_the_field(paper_spec, paths, where, words):
+    with pytest.raises(SpecError) as err:
+        variant(paper_spec, **paths)
+    assert (err.value.path or "").startswith(where), err.value.path
+    for w in words:
+        assert w in str(err.value), str(err.value)
+
+
+def test_errors_in_a_file_carry_the_line(tmp_path):
+    text = (EXAMPLES / "paper_setup.yaml").read_text().replace("static: 4 N", "static: 4 kg")
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    line = next(i for i, ln in enumerate(text.splitlines(), 1) if "static: 4 kg" in ln)
+    with pytest.raises(SpecError) as err:
+        load_spec(path)
+    assert err.value.line == line and err.value.path == "friction.static"
+    assert str(err.value).startswith(f"{path}:{line}: friction.static:")
+
+
+def test_file_and_mapping_give_the_same_spec(paper_spec, paper_spec_path):
+    org = origin(paper_spec)
+    assert org.path == paper_spec_path
+    assert org.sha256 == hashlib.sha256(paper_spec_path.read_bytes()).hexdigest()
+    again = load_spec(org.raw)
+    assert again.model_dump() == paper_spec.model_dump()
+    assert origin(again).path is None and origin(again).raw == org.raw
+
+
+def test_warnings_for_suspicious_input(paper_spec):
+    paths = [p for p, _ in sp.warnings_for(paper_spec)]
+    assert paths == ["friction.bristle_damping"]  # sigma1 above the dissipativity bound
+    calm = variant(paper_spec, **{"friction.bristle_damping": "5 N*s/m",
+                                  "isolator.stroke": "3 um", "motion.moves": [
+                                      {"distance": "10 mm", "velocity": "1 mm/s",
+                                       "acceleration": "1 m/s^2"}]})
+    paths = [p for p, _ in sp.warnings_for(calm)]
+    assert paths == ["isolator.stroke", "requirements.hunting.window_start"]
+
+
+def test_motion_spans_and_end_time(paper_spec):
+    two = variant(paper_spec, **{"motion.moves": [
+        {"distance": "10 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2"},
+        {"distance": "-10 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2", "start": "5 s"}]})
+    (a0, a1), (b0, b1) = two.motion.spans()
+    one_move = 0.01 / 0.05 + 0.05 / 1.0  # trapezoid: d / v + v / a
+    assert (a0, b0) == (0.0, 5.0)
+    assert a1 == pytest.approx(one_move) and b1 == pytest.approx(5.0 + one_move)
+    assert two.motion.end_time == pytest.approx(b1)
+    with pytest.raises(SpecError, match="before moves"):
+        variant(paper_spec, **{"motion.moves": [
+            {"distance": "10 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2"},
+            {"distance": "5 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2",
+             "start": "0.1 s"}]})

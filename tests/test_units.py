@@ -1,0 +1,65 @@
+"""The unit boundary: strings with units in, SI floats out, wrong dimensions refused by path."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from fi_design.errors import ArgumentError, UnitError
+from fi_design.units import registry, to_si
+
+
+@pytest.mark.parametrize("value,unit,expected", [
+    ("0.3 mm", "m", 3e-4), ("2 N/mm", "N/m", 2000.0), ("5 Hz", "Hz", 5.0),
+    ("10 N*s/m", "N*s/m", 10.0), ("200 GPa", "Pa", 2e11), ("1 um", "m", 1e-6),
+    ("1 m/s**2", "m/s**2", 1.0), ("7.8 g/cm**3", "kg/m**3", 7800.0), ("1.6 kg", "kg", 1.6),
+    ("10 ms", "s", 0.01), ("0.5 rad", "deg", math.degrees(0.5)), ("30 deg", "deg", 30.0),
+    ("6 dB", "dB", 6.0), ("-3.5 dB", "dB", -3.5), ("3", "1", 3.0), ("50 %", "1", 0.5),
+    (0.3, "m", 0.3), (8, "Hz", 8.0),
+])
+def test_conversions(value, unit, expected):
+    assert to_si(value, unit) == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("text,hz", [("62.83185307179586 rad/s", 10.0), ("360 deg/s", 1.0),
+                                     ("60 rpm", 1.0), ("1 kHz", 1000.0), ("2 1/s", 2.0)])
+def test_angular_frequencies_become_hertz(text, hz):
+    """pint treats the radian as dimensionless; without the guard rad/s would read as Hz."""
+    assert to_si(text, "Hz") == pytest.approx(hz, rel=1e-12)
+
+
+def test_the_guard_is_needed():
+    """The hazard the guard removes: pint's own conversion of rad/s to Hz drops the 2 pi."""
+    naive = registry().Quantity("62.83185307179586 rad/s").to("Hz").magnitude
+    assert naive == pytest.approx(62.83185307179586)
+    assert to_si("62.83185307179586 rad/s", "Hz") == pytest.approx(naive / (2 * math.pi))
+
+
+@pytest.mark.parametrize("value,unit,words", [
+    ("3 mm", "N", ["not a force", "mm"]), ("2 kg", "Hz", ["not a frequency"]),
+    ("3 N", "1", ["expected a plain number"]), ("fast", "m/s", ["cannot read"]),
+    ("", "m", ["empty"]), ("inf mm", "m", ["not a finite number"]), (30, "deg", ["ambiguous"]),
+    (6, "dB", ["ambiguous"]), ("6", "dB", ["cannot read"]), ("30", "deg", ["no unit"]),
+    ([1, 2], "m", ["expected a number or a string"]), (float("nan"), "m", ["finite"]),
+])
+def test_bad_values_name_the_path(value, unit, words):
+    with pytest.raises(UnitError) as err:
+        to_si(value, unit, path="friction.static")
+    assert err.value.path == "friction.static"
+    for w in words:
+        assert w in str(err.value), str(err.value)
+
+
+def test_unknown_target_unit_is_a_programming_error():
+    with pytest.raises(ArgumentError, match="unknown target unit"):
+        to_si(1.0, "furlong")
+
+
+@settings(max_examples=50, deadline=None)
+@given(x=st.floats(-1e6, 1e6, allow_nan=False), prefix=st.sampled_from(
+    [("mm", 1e-3), ("um", 1e-6), ("km", 1e3), ("m", 1.0)]))
+def test_lengths_scale_by_their_prefix(x, prefix):
+    unit, factor = prefix
+    assert to_si(f"{x!r} {unit}", "m") == pytest.approx(x * factor, rel=1e-12, abs=1e-300)
