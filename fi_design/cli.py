@@ -37,11 +37,11 @@ from typing import Annotated, Optional
 
 import typer
 
-from .cliparts import (DEFAULT_COMMAND, EXIT_VERDICT, ExecutorKind, Force, Jobs, JsonOut,
-                       NoCache, NoIsolator,
-                       Scheduler, SpecArg, app, check_outputs, check_spec_path, command_line,
-                       json_text, load, output_option, run_study, study_pool, write_outputs,
-                       write_report, write_study)
+from .cliparts import (DEFAULT_COMMAND, EXIT_VERDICT, Drive, ExecutorKind, Force, Jobs,
+                       JsonOut, NoCache, NoIsolator, Scheduler, SpecArg, app, check_drive,
+                       check_outputs, check_spec_path, command_line, json_text, load,
+                       output_option, run_study, study_pool, write_outputs, write_report,
+                       write_study)
 
 __all__ = ["app", "main", "DEFAULT_COMMAND"]
 
@@ -141,12 +141,7 @@ def simulate_command(
     record: Optional[Path] = output_option("--record", "MEASURED.csv",
         "Replay this measured record instead of the spec's motion: the model starts from the "
         "state in the data and is driven by its reference_m (and disturbance_N)."),
-    drive: Annotated[str, typer.Option(
-        "--drive", metavar="closed|force", help="With --record: 'closed' (the model's "
-                                                "controller closes the loop) or 'force' (the "
-                                                "plant driven open loop by the measured "
-                                                "force_N, re-anchored every --window).")] =
-        "closed",
+    drive: Drive = "closed",
     window: Annotated[float, typer.Option(
         "--window", metavar="SECONDS", help="With --drive force: length of the windows after "
                                             "which the model is re-anchored to the "
@@ -161,12 +156,7 @@ def simulate_command(
     replay (--drive force) adds a column ``window`` numbering the re-anchored
     windows.
     """
-    if drive not in ("closed", "force"):
-        raise typer.BadParameter(f"expected 'closed' or 'force', got {drive!r}",
-                                 param_hint="--drive")
-    if drive == "force" and record is None:
-        raise typer.BadParameter("--drive force replays a record: give --record MEASURED.csv",
-                                 param_hint="--drive")
+    check_drive(drive, record)
     if not window > 0:
         raise typer.BadParameter(f"must be a positive time in seconds, got {window!r}",
                                  param_hint="--window")
@@ -460,6 +450,7 @@ def reconcile_command(
     max_effects: Annotated[int, typer.Option(
         "--max-effects", min=1, max=10, metavar="N",
         help="Name up to N effects, each searched on the gap the earlier ones leave.")] = 1,
+    drive: Drive = "closed",
     force: Force = False,
 ) -> None:
     """Find the physical effect the model misses in a measured trace.
@@ -468,7 +459,11 @@ def reconcile_command(
     measurement segment by segment and by hunting features against the sensor
     noise, fits every effect of the catalogue, and names the one that explains
     the gap best (or 'none'), with its fitted size and the gap before and after.
+    With --drive force the plant alone is driven by the measured force in
+    re-anchored windows, so the controller's description drops out of the
+    comparison.
     """
+    check_drive(drive)
     outs = check_outputs((spec, measured), force, report=(report_out, (".html", ".pdf")),
                     json=(json_out, (".json",)), fixed=(write_spec, (".yaml", ".yml")))
     spec_obj = load(spec)
@@ -479,7 +474,8 @@ def reconcile_command(
 
     data = load_measurement(measured)
     with FractionBar(make_console(stderr=True), "reconciling") as bar:
-        result = reconcile(spec_obj, data, max_effects=max_effects, progress=bar)
+        result = reconcile(spec_obj, data, max_effects=max_effects, drive=drive,
+                           progress=bar)
     console = make_console()
     print_reconcile(console, result)
     if outs["json"] is not None:

@@ -176,6 +176,11 @@ def output_option(flag: str, metavar: str, text: str) -> Any:
 
 JsonOut = Annotated[Optional[Path], typer.Option(
     "--json", metavar="OUT.json", help="Write the full result as JSON.", show_default=False)]
+Drive = Annotated[str, typer.Option(
+    "--drive", metavar="closed|force",
+    help="How the model replays the record: 'closed' (its controller closes the loop on the "
+         "measured reference) or 'force' (the plant alone, driven open loop by the measured "
+         "force_N and re-anchored to the measurement in windows).")]
 Jobs = Annotated[int, typer.Option(
     "--jobs", "-j", min=0, metavar="N",
     help="Worker processes (local executor) or local dask workers; 0 = all cores, "
@@ -357,3 +362,13 @@ def write_study(console: "Console", outs: dict, result: Any, figure: Any) -> Non
         payloads["figure"] = figure_bytes(figure(result), outs["figure"].suffix)
     write_outputs(console, outs, payloads)
     write_report(console, outs["report"], result)
+
+
+def check_drive(drive: str, record: object = True) -> None:
+    """Refuse an unknown ``--drive`` or ``--drive force`` without a record (exit 2)."""
+    if drive not in ("closed", "force"):
+        raise typer.BadParameter(f"expected 'closed' or 'force', got {drive!r}",
+                                 param_hint="--drive")
+    if drive == "force" and record is None:
+        raise typer.BadParameter("--drive force replays a record: give --record MEASURED.csv",
+                                 param_hint="--drive")

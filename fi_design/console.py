@@ -880,13 +880,13 @@ class FractionBar:
 
 
 def print_reconcile(console: "Console", result) -> None:
-    """Print the readable summary of a :class:`~fi_design.reconciliation.ReconcileResult`.
+    """Print the readable summary of a :class:`~fi_design.results.reconciliation.ReconcileResult`.
 
     Parameters
     ----------
     console : rich.console.Console
         Where to print.
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
     """
     from rich.text import Text
@@ -895,6 +895,21 @@ def print_reconcile(console: "Console", result) -> None:
     head.append(Text(result.effect, style="bold green" if result.effect != "none" else "bold"))
     console.print(head)
     console.print(Text(result.conclusion))
+    if result.diagnosis.mismatch and result.diagnosis.causes:
+        d = _table("Likely causes of the structural gap")
+        for col, just in (("Cause", "left"), ("Share", "right"), ("What was measured", "left")):
+            d.add_column(col, justify=just, no_wrap=col == "Share",
+                         ratio=1 if col == "What was measured" else None)
+        for c in result.diagnosis.causes:
+            d.add_row(Text(c.name.replace("_", " ")), f"{100 * c.share:.0f} %", Text(c.detail))
+        console.print(d)
+    if len(result.steps) > 1:
+        s = _table("Effects in order")
+        for col in ("Effect", "Misfit before", "Misfit after"):
+            s.add_column(col, justify="left" if col == "Effect" else "right", no_wrap=True)
+        for st in result.steps:
+            s.add_row(Text(st.name), _fmt(st.misfit_before), _fmt(st.misfit_after))
+        console.print(s)
     t = _table("Candidates (best first)")
     longest = max((len(c.name) for c in result.candidates), default=6)
     for col, just in (("Effect", "left"), ("Score", "right"), ("Explained", "right"),
@@ -907,6 +922,9 @@ def print_reconcile(console: "Console", result) -> None:
                            for k, v in c.parameters.items() if v is not None)
         t.add_row(Text(c.name), _fmt(c.score), f"{100 * c.explained:.1f} %", Text(params))
     console.print(t)
+    for c in result.candidates:
+        if c.name not in result.effects and c.reasons:
+            console.print(Text(f"{c.name} not named: {c.reasons[0]}", style="dim"))
     g = _table("Gap before and after")
     for col in ("Metric", "Unit", "Before", "After", "Noise"):
         g.add_column(col, justify="left" if col in ("Metric", "Unit") else "right",
@@ -923,6 +941,7 @@ def print_reconcile(console: "Console", result) -> None:
     if nz.deflection is not None:
         parts.append(f"deflection {_fmt(nz.deflection, 3)} m ({nz.source.get('deflection')})")
     console.print(Text("Noise: " + ", ".join(parts)))
+    console.print(Text("Position lattice: " + result.lattice.detail))
     for name, why in result.skipped.items():
         console.print(Text(f"skipped {name}: {why}", style="dim"))
 

@@ -296,8 +296,10 @@ def decimate(t: np.ndarray, y: np.ndarray, buckets: int = 700) -> tuple[np.ndarr
     keep = [0, n - 1]
     for a, b in zip(edges[:-1], edges[1:]):
         seg = y[a:b]
-        if len(seg):
+        if len(seg) and np.any(np.isfinite(seg)):
             keep += [a + int(np.nanargmin(seg)), a + int(np.nanargmax(seg))]
+        elif len(seg):  # no value here (a failed run): keep one NaN so the line breaks
+            keep.append(a)
     idx = np.unique(np.array(keep))
     return t[idx], y[idx]
 
@@ -1011,7 +1013,7 @@ def gap_overlay_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
 
     Returns
@@ -1057,7 +1059,7 @@ def gap_residual_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
 
     Returns
@@ -1092,7 +1094,7 @@ def candidate_scores_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
 
     Returns
@@ -1112,4 +1114,53 @@ def candidate_scores_figure(result: Any) -> Any:
     ax.text(thr, 1.0, " threshold", transform=ax.get_xaxis_transform(), va="bottom",
             fontsize=7, color="C3")
     ax.set_xlabel("score: sign(s) log10(1 + |s|), s = BIC difference [-]")
+    return fig
+
+
+@_styled
+def structure_figure(result: Any) -> Any:
+    """The nominal model's residual over time and its amplitude spectrum (structure diagnosis).
+
+    Left: measured minus nominal model (force [N] when recorded, else position
+    [µm]) over time. Right: its Welch amplitude spectral density with the
+    loop's crossover and a third of it marked (energy above a third of the
+    crossover points at the controller description, slow energy at a missing
+    disturbance).
+
+    Parameters
+    ----------
+    result : fi_design.results.reconciliation.ReconcileResult
+        The reconciliation.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    d = result.diagnosis
+    meas = result.measurement
+    t = result.nominal.time
+    if d.channel == "force":
+        r = np.asarray(meas.force) - np.asarray(result.nominal.force)
+        scale, label, dens = 1.0, "measured - nominal force [N]", "ASD [N/√Hz]"
+    else:
+        r = np.asarray(meas.position) - np.asarray(result.nominal.position)
+        scale, label, dens = 1e6, "measured - nominal position [µm]", "ASD [µm/√Hz]"
+    fig = _report_figure(2.6, top=0.25)
+    fig.subplots_adjust(wspace=0.4)
+    ax1, ax2 = fig.subplots(1, 2)
+    tt, yy = decimate(t, r * scale)
+    ax1.plot(tt, yy, color=GAP_COLOURS["nominal"], lw=0.8)
+    ax1.set_xlabel("time from the first sample [s]")
+    ax1.set_ylabel(label)
+    f = np.asarray(d.frequency)
+    a = np.asarray(d.spectrum) * scale
+    keep = f > 0
+    ax2.loglog(f[keep], a[keep], color=GAP_COLOURS["nominal"], lw=0.9)
+    for x, text in ((d.crossover, "crossover"), (d.crossover / 3.0, "crossover / 3")):
+        if x > 0:
+            ax2.axvline(x, color="0.5", lw=0.8, ls="--")
+            ax2.text(x, 0.97, text + " ", transform=ax2.get_xaxis_transform(), va="top",
+                     ha="right", fontsize=7, color="0.35", rotation=90)
+    ax2.set_xlabel("frequency [Hz]")
+    ax2.set_ylabel(dens)
     return fig

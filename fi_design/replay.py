@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -30,6 +31,10 @@ from .plant import P_SIGMA2_NEG, PlantParameters, state_index
 VELOCITY_SPAN = 0.01
 #: Fewest samples the local velocity estimate needs.
 MIN_FIT_SAMPLES = 5
+
+#: Two-sided probability that a stage at rest is taken as moving: the velocity estimate must
+#: exceed this quantile of Student's t (with the fit's degrees of freedom) in standard errors.
+MOVING_P = 1e-3
 
 #: Drives of a replay: the model's controller closes the loop, or the measured force drives it.
 DRIVES = ("closed", "force")
@@ -46,15 +51,65 @@ class RecordState:
     time : float
         Sample time [s].
     position : float
-        Measured stage position x1 [m].
+        Measured stage position x1 at the sample [m].
     velocity : float
         Stage velocity from a local quadratic fit of the position [m/s].
+    velocity_error : float
+        Standard error of ``velocity`` from the fit's residuals [m/s] (0 for
+        an exact fit).
+    dof : int
+        Degrees of freedom of the fit's residuals.
+
+    The stage counts as moving when a t-test rejects zero velocity at
+    :data:`MOVING_P` (:attr:`moving`); otherwise the record starts at rest and a
+    noisy velocity estimate must not start the friction model sliding.
     """
 
     index: int
     time: float
     position: float
     velocity: float
+    velocity_error: float = 0.0
+    dof: int = 0
+
+    @property
+    def moving(self) -> bool:
+        """Whether a t-test rejects zero velocity (two-sided, :data:`MOVING_P`)."""
+        if self.velocity_error <= 0.0 or self.dof < 1:
+            return self.velocity != 0.0
+        from scipy.special import stdtrit
+
+        limit = float(stdtrit(self.dof, 1.0 - MOVING_P / 2.0))
+        return abs(self.velocity) > limit * self.velocity_error
+
+
+class LocalFit(NamedTuple):
+    """A local quadratic: coefficients (value, slope, half curvature), covariance, dof."""
+
+    coef: np.ndarray
+    cov: np.ndarray
+    dof: int
+
+
+def _local_fit(record: Measurement, values: np.ndarray, index: int, span: float) -> LocalFit:
+    """Quadratic least-squares fit of ``values`` within ``span`` around sample ``index``.
+
+    One-sided at the ends of the record, at least :data:`MIN_FIT_SAMPLES`
+    samples. Returns the coefficients (value, first and second derivative
+    over 1, 1 and 2 at the sample) and their covariance from the residuals.
+    """
+    t = record.time
+    n = len(t)
+    half = max(span / 2.0, 0.5 * (MIN_FIT_SAMPLES - 1) * record.sample_period)
+    lo = int(np.searchsorted(t, t[index] - half, side="left"))
+    hi = int(np.searchsorted(t, t[index] + half, side="right"))
+    if hi - lo < MIN_FIT_SAMPLES:  # at an end: extend to the other side
+        lo, hi = max(0, min(lo, n - MIN_FIT_SAMPLES)), min(n, max(hi, MIN_FIT_SAMPLES))
+    A = np.vander(t[lo:hi] - t[index], 3, increasing=True)
+    coef, ssr, _, _ = np.linalg.lstsq(A, np.asarray(values[lo:hi], dtype=float), rcond=None)
+    dof = hi - lo - 3
+    s2 = float(ssr[0]) / dof if len(ssr) and dof > 0 else 0.0
+    return LocalFit(coef, s2 * np.linalg.pinv(A.T @ A), int(dof))
 
 
 @dataclass(frozen=True)
@@ -106,8 +161,8 @@ def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPA
 
     A quadratic fitted by least squares to the positions within ``span``
     around the sample (one-sided at the ends of the record) gives the
-    velocity at the sample: robust to encoder counts and sensor noise, and
-    right while the stage accelerates.
+    velocity at the sample: robust to encoder counts and sensor
+    noise, and right while the stage accelerates.
 
     Parameters
     ----------
@@ -124,20 +179,43 @@ def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPA
     DataError
         The record has too few samples to estimate a velocity.
     """
-    t = record.time
-    n = len(t)
+    n = record.n
     if n < MIN_FIT_SAMPLES:
         raise DataError(f"too short to estimate the initial velocity: {n} sample(s), at least "
                         f"{MIN_FIT_SAMPLES} needed", column="position_m", source=record.source)
-    half = max(span / 2.0, 0.5 * (MIN_FIT_SAMPLES - 1) * record.sample_period)
-    lo = int(np.searchsorted(t, t[index] - half, side="left"))
-    hi = int(np.searchsorted(t, t[index] + half, side="right"))
-    if hi - lo < MIN_FIT_SAMPLES:  # at an end: extend to the other side
-        lo, hi = max(0, min(lo, n - MIN_FIT_SAMPLES)), min(n, max(hi, MIN_FIT_SAMPLES))
-    tau = t[lo:hi] - t[index]
-    coef = np.polynomial.polynomial.polyfit(tau, record.position[lo:hi], 2)
-    return RecordState(index=int(index), time=float(t[index]),
-                       position=float(record.position[index]), velocity=float(coef[1]))
+    fit = _local_fit(record, record.position, index, span)
+    return RecordState(index=int(index), time=float(record.time[index]),
+                       position=float(record.position[index]), velocity=float(fit.coef[1]),
+                       velocity_error=float(np.sqrt(max(fit.cov[1, 1], 0.0))), dof=fit.dof)
+
+
+def reference_state(record: Measurement, index: int = 0,
+                    span: float = VELOCITY_SPAN) -> tuple[float, float, float]:
+    """Reference position, velocity and acceleration at sample ``index``, from the samples.
+
+    The same local quadratic fit as :func:`record_state`, on ``reference_m``:
+    a reference that starts accelerating at the first sample has zero
+    velocity there, which an interpolating spline's end condition would not
+    give (and the controller's state would carry the difference).
+
+    Returns
+    -------
+    (r, r', r'') : tuple of float
+        [m, m/s, m/s^2].
+    """
+    coef = _local_fit(record, record.reference, index, span).coef
+    return float(record.reference[index]), float(coef[1]), float(2.0 * coef[2])
+
+
+def command_state(record: Measurement, index: int = 0) -> float | None:
+    """The controller's own output at sample ``index`` [N]: force_N less disturbance_N.
+
+    None without a ``force_N`` column.
+    """
+    if record.force is None:
+        return None
+    dist = 0.0 if record.disturbance is None else float(record.disturbance[index])
+    return float(record.force[index]) - dist
 
 
 def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, *,
@@ -152,7 +230,10 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
     law : ControlLaw
         The loop's controller.
     state : RecordState
-        Stage position and velocity from the data.
+        Stage position and velocity from the data. A stage that is not
+        :attr:`RecordState.moving` starts at rest, its bristles carrying the
+        static load (the first command less the offset, within the
+        breakaway force).
     deflection : float or None
         Measured joint deflection x1 - x2 [m]; None: the deflection of steady
         sliding (the joint force carrying the friction), within the stroke.
@@ -175,7 +256,8 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
     iso = bool(params.isolated)
     idx = state_index(iso)
     p = params.to_array()
-    x1, v1 = state.position, state.velocity
+    x1 = state.position
+    v1 = state.velocity if state.moving else 0.0
     sgn = 1.0 if v1 >= 0.0 else -1.0
     y0 = np.zeros(params.n_states)
     y0[idx["x1"]] = x1
@@ -188,6 +270,15 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
         friction = sgn * g + sigma2 * v1
     elif v1 != 0.0:
         friction = sgn * kernel().stribeck(v1, x1, sgn, p)[0] + sigma2 * v1
+    elif command is not None:
+        # at rest: the bristles carry the static load, up to the breakaway force
+        load = command - params.offset
+        if iso and deflection is not None:
+            load = params.k * deflection
+        breakaway = kernel().stribeck(0.0, x1, 1.0 if load >= 0.0 else -1.0, p)[0]
+        friction = max(-breakaway, min(breakaway, load))
+        if not params.switch_model:
+            y0[idx["z"]] = friction / params.sigma0
     if iso:
         d = deflection if deflection is not None else _sliding_deflection(params, friction)
         y0[idx["x2"]] = x1 - d

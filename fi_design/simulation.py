@@ -26,7 +26,8 @@ from .errors import SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from .pid import ControlLaw, control_law
 from .plant import PlantParameters, state_index
-from .replay import DRIVES, initial_state, record_state, replay_fit
+from .replay import (DRIVES, command_state, initial_state, record_state, reference_state,
+                     replay_fit)
 from .results import frozen_array
 from .results.simulation import SimulationResult
 from .trajectory import Trajectory, from_moves, from_samples
@@ -127,7 +128,7 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
              crossover: float | None = None, reference: Trajectory | None = None,
              initial_position: float = 0.0, duration: float | None = None,
              effects=None, rtol: float | None = None, record=None, drive: str = "closed",
-             window: float = WINDOW) -> SimulationResult:
+             window: float = WINDOW, initial_command: float | None = None) -> SimulationResult:
     """Simulate the stage and evaluate the hunting metric.
 
     Parameters
@@ -167,6 +168,12 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         re-anchored to the measurement every ``window`` seconds.
     window : float
         Length of the re-anchored windows of an open-loop replay [s].
+    initial_command : float, optional
+        Closed-loop replay: the controller's output at the first sample [N]
+        that its initial state is made consistent with; default the record's
+        first ``force_N`` less ``disturbance_N`` sample. A single sample holds
+        the force sensor's noise: a caller that estimated the command better
+        (the reconciliation fits it) passes it here.
 
     Returns
     -------
@@ -188,7 +195,8 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
     law = control_law(spec, crossover)
     params = plant_parameters(spec, iso, effects=effects, law=law)
     if record is not None:
-        return _replay(spec, iso, method, law, params, record, drive, window, rtol, effects)
+        return _replay(spec, iso, method, law, params, record, drive, window, rtol, effects,
+                       initial_command)
     if drive != "closed":
         raise SimulationError("drive='force' replays a record: give record=")
     params = replace(params, x1_initial=float(initial_position))
@@ -262,15 +270,15 @@ def _result(spec, iso, method, law, params, out, t_out, wall, effects, *, move_e
         replay=None if record is None else replay_fit(record, Y[:, idx["x1"]], out.command))
 
 
-def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects):
+def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects,
+            initial_command=None):
     """Replay a measured record, closed loop or open loop in re-anchored windows."""
     t0 = float(record.time[0])
     t_out = np.asarray(record.time, dtype=float) - t0
     ref = from_samples(t_out, record.reference)
     if drive == "closed":
         dist = record.disturbance
-        command = None if record.force is None else float(
-            record.force[0] - (dist[0] if dist is not None else 0.0))
+        command = command_state(record, 0) if initial_command is None else float(initial_command)
         y0, p0 = _anchor(law, params, record, 0, ref, command)
         out, wall = _integrate(spec, method, p0, y0, ref, float(t_out[-1]), t_out, rtol,
                                None if dist is None else t_out, dist)
@@ -308,8 +316,7 @@ def _anchor(law, params, record, index, ref, command):
     from .compiled import kernel
 
     st = record_state(record, index)
-    tau = float(record.time[index] - record.time[0])
-    r, rd, rdd = (float(ref(tau, k)) for k in (0, 1, 2))
+    r, rd, rdd = reference_state(record, index)
     ff = kernel().feedforward(rd, rdd, 0.0, params.to_array())[0]
     defl = None if record.deflection is None or not params.isolated else \
         float(record.deflection[index])

@@ -1,6 +1,6 @@
 """The reconciliation report: which effect the model misses, and the gap before and after.
 
-Built from :class:`fi_design.reconciliation.ReconcileResult` as generic report
+Built from :class:`fi_design.results.reconciliation.ReconcileResult` as generic report
 sections (:class:`~fi_design.report.blocks.Section`, :func:`gap_sections`) and
 rendered like every other report (:func:`gap_context`,
 :func:`render_gap_report`): the same title block, layout, escaping and
@@ -48,12 +48,17 @@ def _params_text(effect: str, values: dict, unc: dict | None = None) -> str:
     return ", ".join(parts)
 
 
+def _short(reasons: tuple) -> str:
+    """The first reason a candidate was not named, for a table cell."""
+    return reasons[0] if reasons else ""
+
+
 def gap_sections(result: Any, figures: bool = True) -> list:
     """Report sections of a reconciliation.
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
     figures : bool, optional
         Draw the figures (False: captions only, for golden tests).
@@ -61,15 +66,42 @@ def gap_sections(result: Any, figures: bool = True) -> list:
     Returns
     -------
     list of fi_design.report.Section
-        Finding, gap before and after, candidates, signatures, method.
+        Structure (when the model's structure misses the record), finding,
+        effects one by one, gap before and after, candidates, signatures,
+        segments.
     """
+    from .. import plots
+
     def fig(make, caption, name):
         if not figures:
             return FigureBlock(None, caption, name)
         return figure_block(make(result), caption, name)
 
-    from .. import plots
+    def cell(v, unit):
+        if v is None:
+            return "-"
+        if unit == "-":
+            return num(v)
+        return qty(v, unit)
 
+    sections = []
+    diag = result.diagnosis
+    if diag.mismatch:
+        crows = tuple((c.name.replace("_", " "), f"{100 * c.share:.0f} %", c.detail)
+                      for c in diag.causes)
+        figs = ()
+        if len(diag.frequency):
+            figs = (fig(plots.structure_figure,
+                        f"The nominal model's {diag.channel} residual over time and its amplitude "
+                        "spectrum, with the loop's crossover and a third of it marked.",
+                        "gap-structure"),)
+        sections.append(Section(
+            "structure", "The model's structure misses the record", paragraphs=(diag.message,),
+            tables=(Table(("Likely cause", "Share of the residual", "What was measured"), crows,
+                          caption="Shares are of the residual's energy (controller, initial "
+                                  "state, disturbance) or its R² (mass)",
+                          numeric=(False, True, False)),) if crows else (),
+            figures=figs))
     meas = result.measurement
     finding = [result.conclusion]
     if result.effect != "none":
@@ -79,7 +111,11 @@ def gap_sections(result: Any, figures: bool = True) -> list:
         f"Measured trace: {meas.source or 'in memory'}, {meas.n} samples over "
         f"{num(meas.duration)} s ({', '.join(meas.columns)}). Model: "
         f"{'isolated (two-mass) plant' if result.isolated else 'stage without isolator'}, "
-        f"driven by the measured reference and started at rest at the first sample.")
+        + ("driven by the measured reference and started from the state in the data"
+           if result.drive == "closed" else
+           "driven open loop by the measured force in windows re-anchored to the data")
+        + (f"; initial command {qty(result.initial_command, 'N')} (fitted within the force "
+           "noise)" if result.initial_command is not None else "") + ".")
     noise = result.noise
     nrows = [("position", qty(noise.position, "m"), noise.source.get("position", ""))]
     if noise.force is not None:
@@ -87,81 +123,107 @@ def gap_sections(result: Any, figures: bool = True) -> list:
     if noise.deflection is not None:
         nrows.append(("deflection", qty(noise.deflection, "m"),
                       noise.source.get("deflection", "")))
-    if noise.resolution is not None:
-        nrows.append(("position step (staircase)", qty(noise.resolution, "m"), "estimated"))
-    notes = []
+    lat = result.lattice
+    if lat.found:
+        nrows.append(("position lattice step", qty(lat.step, "m"),
+                      f"read from the data ({100 * lat.fraction:.1f} % of tested samples on it, "
+                      f"chance {100 * lat.chance:.0f} %)"))
+    notes = [f"Position lattice: {lat.detail}."]
     if result.ambiguous:
         notes.append("Not decisively worse than the chosen effect: "
                      + ", ".join(result.ambiguous) + ".")
     for name, why in result.skipped.items():
         notes.append(f"{name}: {why}.")
-    s1 = Section("finding", "Finding", paragraphs=tuple(finding),
-                 tables=(Table(("Channel", "Noise (std)", "Source"), tuple(nrows),
-                               caption="Noise levels every gap is judged against",
-                               numeric=(False, True, False)),),
-                 figures=(fig(plots.gap_overlay_figure,
-                              "Measured trace (grey), nominal model (red, dashed) and corrected "
-                              "model (blue). Shaded: holds with stick-slip, compared by "
-                              "phase-free features.", "gap-overlay"),
-                          fig(plots.gap_residual_figure,
-                              "Measured minus modelled position; the grey band is two noise "
-                              "standard deviations.", "gap-residual")),
-                 notes=tuple(notes))
-
-    def cell(v, unit):
-        if v is None:
-            return "-"
-        if unit == "-":
-            return num(v)
-        return qty(v, unit)
-
+    if not result.nominal.success:
+        notes.append(f"The nominal model's simulation failed: {result.nominal.message}.")
+    if result.effects and not result.corrected.success:
+        notes.append(f"The corrected model's simulation failed: {result.corrected.message}.")
+    sections.append(Section(
+        "finding", "Finding", paragraphs=tuple(finding),
+        tables=(Table(("Channel", "Noise (std)", "Source"), tuple(nrows),
+                      caption="Noise levels every gap is judged against",
+                      numeric=(False, True, False)),),
+        figures=(fig(plots.gap_overlay_figure,
+                     "Measured trace (grey), nominal model (red, dashed) and corrected "
+                     "model (blue). Shaded: holds with stick-slip, compared by "
+                     "phase-free features. A failed run ends where it failed.", "gap-overlay"),
+                 fig(plots.gap_residual_figure,
+                     "Measured minus modelled position; the grey band is two noise "
+                     "standard deviations.", "gap-residual")),
+        notes=tuple(notes)))
+    if result.steps:
+        srows = []
+        for i, st in enumerate(result.steps, 1):
+            srows.append((str(i), st.name, _params_text(st.name, st.parameters, st.uncertainty),
+                          f"{num(st.misfit_before)} → {num(st.misfit_after)}",
+                          f"{qty(st.position_rms_before, 'm')} → {qty(st.position_rms_after, 'm')}",
+                          "-" if st.force_rms_before is None else
+                          f"{qty(st.force_rms_before, 'N')} → {qty(st.force_rms_after, 'N')}"))
+        sections.append(Section(
+            "effects", "Effects found, in order",
+            paragraphs=("Each effect was searched on the gap the ones before it leave, and "
+                        "refitted with them; each row is the gap it closed.",),
+            tables=(Table(("#", "Effect", "Parameters (SI)", "Misfit", "Position RMS",
+                           "Force RMS"), tuple(srows),
+                          numeric=(True, False, False, True, True, True)),)))
     grows = []
     for g in result.gaps:
         flag = "" if g.significant_after is None else ("yes" if g.significant_after else "no")
         grows.append((g.name, g.unit, cell(g.measured, g.unit), cell(g.nominal, g.unit),
                       cell(g.corrected, g.unit), cell(g.before, g.unit), cell(g.after, g.unit),
                       cell(g.noise, g.unit), flag))
-    s2 = Section("gap", "Gap before and after",
-                 paragraphs=("Sample-wise measures compare the traces point by point in the "
-                             "move, settle and hold segments; the features (hunting cycles, "
-                             "amplitude, period, settling time, final error, error spread) stay "
-                             "meaningful when stick-slip drifts out of phase. 'Beyond noise' "
-                             "says whether the corrected model still misses by more than noise "
-                             "explains.",),
-                 tables=(Table(("Metric", "Unit", "Measured", "Nominal", "Corrected",
-                                "Gap before", "Gap after", "Noise", "Beyond noise"),
-                               tuple(grows), numeric=(False, False) + (True,) * 6 + (False,)),))
+    sections.append(Section(
+        "gap", "Gap before and after",
+        paragraphs=("Sample-wise measures compare the traces point by point in the move, settle "
+                    "and hold segments; the features (hunting cycles, amplitude, period, "
+                    "settling time, final error, error spread) stay meaningful when stick-slip "
+                    "drifts out of phase. 'Beyond noise' says whether the corrected model still "
+                    "misses by more than noise explains.",),
+        tables=(Table(("Metric", "Unit", "Measured", "Nominal", "Corrected", "Gap before",
+                       "Gap after", "Noise", "Beyond noise"), tuple(grows),
+                      numeric=(False, False) + (True,) * 6 + (False,)),)))
     crows = []
     for i, c in enumerate(result.candidates, 1):
-        crows.append((str(i), c.name, num(c.score), f"{100 * c.explained:.1f} %",
-                      _params_text(c.name, c.parameters, c.uncertainty),
-                      str(c.n_simulations), c.message or ""))
-    s3 = Section("candidates", "Candidate effects",
-                 paragraphs=(f"Every catalogue effect was fitted by bounded least squares. Score: "
-                             f"BIC difference against the model without it, with the variance "
-                             f"rescaled by the fit's reduced chi-square; an effect is named when "
-                             f"its score exceeds {num(result.threshold)}. 'Explained' is the "
-                             f"share of the gap above noise that the fit removes.",),
-                 tables=(Table(("#", "Effect", "Score", "Explained", "Fitted parameters (SI)",
-                                "Simulations", "Note"), tuple(crows),
-                               numeric=(True, False, True, True, False, True, False)),),
-                 figures=(fig(plots.candidate_scores_figure,
-                              "Candidate scores (signed log scale); chosen effects in blue.",
-                              "gap-scores"),))
+        dist = ", ".join(f"{k} {v:+.3g}" for k, v in c.distance.items() if v is not None)
+        crows.append((str(i), c.name, "named" if c.name in result.effects else c.status,
+                      num(c.score), f"{100 * c.explained:.1f} %",
+                      _params_text(c.name, c.parameters, c.uncertainty), dist or "-",
+                      f"{c.n_failed} of {c.n_simulations}" if c.n_failed else
+                      str(c.n_simulations), _short(c.reasons)))
+    sections.append(Section(
+        "candidates", "Candidate effects",
+        paragraphs=(f"Every applicable catalogue effect was fitted by bounded least squares "
+                    f"(bounds widened up to twice where a fit ended on one). An effect is named "
+                    f"only when its simulation ran, its fit is off every bound, its score (the "
+                    f"improvement in effective samples less k ln n_eff) exceeds "
+                    f"{num(result.threshold)}, it removes at least half the gap above noise, a "
+                    f"parameter lies three standard errors from the model's own value, and a "
+                    f"refit on a noise-only record improves three times less. Distances are in "
+                    f"those standard errors; runs that failed or ran away (an unstable loop) "
+                    f"scored ten times the nominal misfit and could never win.",),
+        tables=(Table(("#", "Effect", "Status", "Score", "Explained", "Fitted parameters (SI)",
+                       "Distance from the model's value", "Simulations (failed)",
+                       "Why not named"), tuple(crows),
+                      numeric=(True, False, False, True, True, False, False, True, False)),),
+        figures=(fig(plots.candidate_scores_figure,
+                     "Candidate scores (signed log scale); named effects in blue.",
+                     "gap-scores"),)))
     srows = tuple((s.name, ", ".join(s.effects), f"{s.strength:.2f}",
                    "-" if s.value is None else f"{s.value:.4g} {s.unit}", s.detail)
                   for s in result.signatures)
-    s4 = Section("signatures", "Signatures in the nominal residual",
-                 paragraphs=("What the residual of the nominal model looks like, and which "
-                             "effects each pattern points at. Signatures only give the fits "
-                             "their starting values; the scores decide.",),
-                 tables=(Table(("Signature", "Points at", "Strength (R²)", "Value", "Detail"),
-                               srows, numeric=(False, False, True, True, False)),))
+    sections.append(Section(
+        "signatures", "Signatures in the nominal residual",
+        paragraphs=("What the residual of the nominal model looks like, and which effects each "
+                    "pattern points at. Signatures only give the fits their starting values; "
+                    "the tests decide.",),
+        tables=(Table(("Signature", "Points at", "Strength (R²)", "Value", "Detail"), srows,
+                      numeric=(False, False, True, True, False)),)))
     seg_rows = tuple((s.kind, num(s.start), num(s.end),
                       "samples" if s.coherent else "features") for s in result.segments)
-    s5 = Section("segments", "Segments",
-                 tables=(Table(("Segment", "Start [s]", "End [s]", "Compared by"), seg_rows),))
-    return [s1, s2, s3, s4, s5]
+    sections.append(Section("segments", "Segments",
+                            tables=(Table(("Segment", "Start [s]", "End [s]", "Compared by"),
+                                          seg_rows),)))
+    return sections
 
 
 def gap_context(result: Any, *, date: Any = None, command: str | None = None,
@@ -170,7 +232,7 @@ def gap_context(result: Any, *, date: Any = None, command: str | None = None,
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
     date : str or datetime.date, optional
         Report date (default today).
@@ -194,7 +256,7 @@ def render_gap_report(result: Any, path: str | os.PathLike, *, date: Any = None,
 
     Parameters
     ----------
-    result : fi_design.reconciliation.ReconcileResult
+    result : fi_design.results.reconciliation.ReconcileResult
         The reconciliation.
     path : str or os.PathLike
         ``.html`` or ``.pdf``.

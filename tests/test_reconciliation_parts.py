@@ -1,0 +1,117 @@
+"""The reconciliation's parts on signals with a known answer: lattice, noise, effective samples.
+
+- the lattice test reads the step and the share of samples on it from the
+  positions alone (whole counts, counts under noise), finds none in an
+  unquantized signal, and is not fooled by the regular pitch v dt of a
+  constant-velocity move sampled at a fixed rate;
+- the integrated autocorrelation time is 1 for white residuals and
+  (1 + phi) / (1 - phi) for an AR(1) series;
+- a failed run scores far above the nominal misfit (it can never win a fit).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fi_design.reconciliation.lattice import find_lattice
+from fi_design.reconciliation.noise import autocorrelation_time, estimate_noise
+
+RATE = 1000.0
+
+
+def _motion(seconds: float = 4.0) -> np.ndarray:
+    """A smooth back-and-forth motion [m] sampled at 1 kHz (10 mm strokes, slow and fast parts)."""
+    t = np.arange(int(seconds * RATE)) / RATE
+    return 5e-3 * (1.0 - np.cos(2 * np.pi * 0.5 * t)) + 2e-4 * np.sin(2 * np.pi * 3.1 * t)
+
+
+def test_whole_counts_are_an_exact_lattice():
+    q = 5e-8
+    x = np.round(_motion() / q) * q
+    lat = find_lattice(x, estimate_noise(x))
+    assert lat.found and lat.exact
+    assert lat.step == pytest.approx(q, rel=1e-9)
+    assert lat.fraction == 1.0 and lat.chance == pytest.approx(0.02)
+    assert lat.p_value < 1e-9
+    assert lat.step_error > 0
+    # counts are this record's only noise: a coarse lattice
+    assert lat.coarse
+
+
+def test_a_fine_logger_grid_under_a_noisy_signal_is_not_coarse():
+    q = 5e-8
+    rng = np.random.default_rng(8)
+    x = np.round((_motion() + 1e-6 * rng.standard_normal(4000)) / q) * q
+    lat = find_lattice(x, estimate_noise(x))
+    assert lat.found and lat.exact and not lat.coarse
+
+
+def test_counts_with_noise_added_after_them():
+    q, sigma = 2e-6, 0.2e-6
+    rng = np.random.default_rng(3)
+    x = np.round(_motion() / q) * q + sigma * rng.standard_normal(4000)
+    lat = find_lattice(x, estimate_noise(x))
+    assert lat.found and not lat.exact
+    assert lat.step == pytest.approx(q, rel=1e-3)
+    assert abs(lat.step - q) <= 5 * lat.step_error
+    assert lat.jitter == pytest.approx(sigma, rel=0.2)
+    assert lat.fraction > 0.6 and lat.chance == 0.5 and lat.p_value < 1e-9
+    assert lat.coarse  # a 2 um staircase under 0.2 um noise
+
+
+def test_no_lattice_in_an_unquantized_noisy_signal():
+    rng = np.random.default_rng(4)
+    x = _motion() + 0.2e-6 * rng.standard_normal(4000)
+    assert not find_lattice(x, estimate_noise(x)).found
+
+
+def test_a_constant_velocity_pitch_is_no_lattice():
+    """20 um per sample: the raw samples sit on 5 um and 10 um lattices, the sensor does not."""
+    rng = np.random.default_rng(5)
+    t = np.arange(4000) / RATE
+    x = 0.02 * t + 0.05e-6 * rng.standard_normal(4000)
+    assert not find_lattice(x, estimate_noise(x)).found
+
+
+def test_autocorrelation_time_of_white_and_ar1_series():
+    rng = np.random.default_rng(6)
+    white = rng.standard_normal(20000)
+    assert autocorrelation_time(white) == pytest.approx(1.0, abs=0.15)
+    phi = 0.8
+    ar = np.empty(20000)
+    ar[0] = 0.0
+    e = rng.standard_normal(20000)
+    for i in range(1, len(ar)):
+        ar[i] = phi * ar[i - 1] + e[i]
+    assert autocorrelation_time(ar) == pytest.approx((1 + phi) / (1 - phi), rel=0.2)
+
+
+def test_a_failed_run_scores_far_above_the_nominal_misfit(paper_spec):
+    from fi_design.measured import measurement_from_arrays
+    from fi_design.reconciliation.comparison import FAIL_FACTOR, Comparison, ModelRun
+    from fi_design.reconciliation.noise import noise_levels
+    from fi_design.simulation import simulate
+
+    res = simulate(paper_spec, True)
+    rng = np.random.default_rng(7)
+    n = len(res.time)
+    data = measurement_from_arrays(res.time[:3000], res.reference[:3000],
+                                   res.position[:3000] + 1e-6 * rng.standard_normal(3000),
+                                   res.force[:3000] + 1e-3 * rng.standard_normal(3000))
+    lat = find_lattice(data.position, estimate_noise(data.position))
+    cmp = Comparison(paper_spec, data, False, noise_levels(paper_spec, data, False, lat), lat,
+                     None, "closed")
+    nominal = cmp.run([])
+    cmp.finish_setup(nominal, 1000)
+    r = cmp.residuals(nominal)
+    chi2 = float(r @ r)
+    cmp.set_fail_level(chi2)
+    nan = np.full(cmp.n, math.nan)
+    failed = ModelRun(nan, nan, None, ok=False, message="solution diverged")
+    rf = cmp.residuals(failed)
+    assert float(rf @ rf) == pytest.approx(FAIL_FACTOR ** 2 * max(chi2, cmp.n_points))
+    assert float(rf @ rf) > 50 * chi2
+    assert n > 3000
