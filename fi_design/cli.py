@@ -487,11 +487,7 @@ def reconcile_command(
         console.print(f"wrote {outs['fixed']}"
                       + ("" if result.entries else " (no effect found: the spec is unchanged)"),
                       markup=False)
-    if outs["report"] is not None:
-        from .report import render_gap_report
-
-        render_gap_report(result, outs["report"], command=command_line())
-        console.print(f"wrote {outs['report']}", markup=False)
+    write_report(console, outs["report"], result)
 
 
 # --------------------------------------------------------------------------- identify

@@ -9,8 +9,8 @@ How a report is made
    function with one builder per result type: :mod:`.design` (a
    :class:`~fi_design.guideline.DesignResult`, optionally with a
    :class:`~fi_design.studies.DesignMap` computed by the caller), :mod:`.study`
-   (sweeps, the paper's study, robustness). :func:`gap_context` (:mod:`.gap`)
-   builds the reconciliation report. All arithmetic, comparison and wording
+   (sweeps, the paper's study, robustness), :mod:`.gap` (a reconciliation:
+   :func:`gap_context`). All arithmetic, comparison and wording
    happens in these builders; the golden tests compare the contexts (with
    ``figures=False``).
 2. Figures come from :mod:`fi_design.plots` (``matplotlib.figure.Figure``,

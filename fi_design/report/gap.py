@@ -15,8 +15,9 @@ from pathlib import Path
 from typing import Any
 
 from .. import effects as _effects
+from ..results.reconciliation import ReconcileResult
 from .blocks import FigureBlock, Section, Table, figure_block
-from .context import document_context
+from .context import build_context, document_context
 from .filters import num, qty
 
 __all__ = ["gap_sections", "gap_context", "render_gap_report", "TITLE"]
@@ -226,6 +227,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
     return sections
 
 
+@build_context.register(ReconcileResult)
 def gap_context(result: Any, *, date: Any = None, command: str | None = None,
                 figures: bool = True) -> dict:
     """The report context of a reconciliation.
