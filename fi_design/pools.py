@@ -40,9 +40,10 @@ def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
     """Worker processes for a design's confirmation and robustness, or None (run here).
 
     Two workers where the machine has two cores or more (one otherwise): the
-    confirmation's simulations and the robustness study (and, on a first run,
-    the compilation of the kernel) then overlap each other and the linear
-    analysis.
+    confirmation's simulations and the robustness study then overlap each
+    other and the linear analysis. The kernel and scipy.signal are loaded
+    here first (:func:`fi_design.studies.warm_up`), so the forked workers
+    start with them.
     When the work fails or is interrupted, the worker is stopped at once
     rather than waited for.
 
@@ -61,6 +62,13 @@ def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
         yield None
         return
     from concurrent.futures import ProcessPoolExecutor
+
+    from .studies import warm_up
+
+    # scipy.signal (the metric's peak finder; python-control needs it here anyway) is the
+    # larger part of every import the work needs: loaded once before the fork, the workers
+    # inherit it instead of each importing it again on two cores (measured in BENCHMARKS.md)
+    warm_up()
 
     pool = ProcessPoolExecutor(max_workers=min(2, os.cpu_count() or 1), mp_context=ctx)
     try:

@@ -121,8 +121,9 @@ def run_chunk(spec: _spec.Spec, tasks: Sequence[tuple[tuple[tuple[str, Any], ...
 def warm_up() -> None:
     """Compile or load the simulation kernel, and import what a point needs, in this process.
 
-    Call it once in the parent before starting worker processes (numba then
-    writes its on-disk cache, and forked workers inherit the compiled code),
+    Call it once in the parent before starting worker processes (forked
+    workers inherit the loaded kernel; with numba's JIT it writes its on-disk
+    cache first),
     and pass it as the pool's ``initializer`` so that spawned workers load the
     kernel before their first chunk.
 
@@ -132,8 +133,10 @@ def warm_up() -> None:
     """
     import scipy.signal  # noqa: F401  (the metric's peak finder, imported on first use)
 
-    from .. import kernel, simulation  # noqa: F401  (the kernel compiles at import or loads
-    #                                  numba's on-disk cache)
+    from .. import simulation  # noqa: F401
+    from ..compiled import kernel
+
+    kernel()  # the extension built at install, or numba's JIT (compiles or loads its cache)
 
 
 #: Largest number of points in one chunk (bounds the work lost by an interruption).
