@@ -12,9 +12,9 @@ Prints a Markdown section for BENCHMARKS.md:
   state, no events) at the same nominal tolerance, and with python-control's
   ``input_output_response`` on the same right-hand side;
 - the accuracy of each against a tight reference (Radau, rtol 1e-10);
-- the numba compile time with an empty cache and the cache-load time, each
-  in a fresh process;
-- the first-ever and the cached ``fi-design examples/paper_setup.yaml``.
+- the ahead-of-time build (done once at install), the load of the built
+  kernel, and numba's JIT instead (compile with an empty cache, load from
+  it), each in a fresh process.
 
 Ratios are against the fast kernel measured in the same run, so the machine's
 load cancels out as far as it can.
@@ -136,13 +136,6 @@ def fresh(code: str, env: dict) -> float:
     return time.perf_counter() - t0
 
 
-def cli_time(env: dict) -> float:
-    t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "fi_design", str(SPEC)], check=True, env=env, cwd=ROOT,
-                   stdout=subprocess.DEVNULL)
-    return time.perf_counter() - t0
-
-
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=20)
@@ -196,21 +189,23 @@ def main() -> None:
           f"{1e3 * total_lsoda:.0f} ms, ratio {total_lsoda / total_fast:.0f}.\n")
 
     if not args.skip_cold:
+        with tempfile.TemporaryDirectory() as out:
+            build = fresh(f"from fi_design.aot import build; build({out!r})", dict(os.environ))
+        load = fresh("from fi_design.compiled import kernel; assert kernel().backend == 'aot'",
+                     dict(os.environ))
         with tempfile.TemporaryDirectory() as cache:
-            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-            cold = fresh("import fi_design.kernel", env)
-            warm = fresh("import fi_design.kernel", env)
-        with tempfile.TemporaryDirectory() as cache:
-            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-            first = cli_time(env)
-            second = cli_time(env)
-        print("| start-up | time [s] |")
+            env = dict(os.environ, NUMBA_CACHE_DIR=cache, FI_DESIGN_KERNEL="jit")
+            cold = fresh("from fi_design.compiled import kernel; kernel().integrate", env)
+            warm = fresh("from fi_design.compiled import kernel; kernel().integrate", env)
+            base = fresh("import numpy", env)
+        print("| start-up (fresh processes) | time [s] |")
         print("| --- | ---: |")
-        print(f"| kernel compile, empty cache (fresh process) | {cold:.1f} |")
-        print(f"| kernel load from cache (fresh process) | {warm:.2f} |")
-        print(f"| first-ever `fi-design examples/paper_setup.yaml` (empty cache) | {first:.1f} |")
-        print(f"| `fi-design examples/paper_setup.yaml`, cache warm | {second:.1f} |")
-
+        print(f"| `python -c 'import numpy'` (the yardstick) | {base:.2f} |")
+        print(f"| ahead-of-time build of the kernel (once, at install) | {build:.1f} |")
+        print(f"| load the built kernel (the default) | {load:.2f} |")
+        print(f"| numba's JIT instead (FI_DESIGN_KERNEL=jit), empty cache: compile | {cold:.1f} |")
+        print(f"| numba's JIT, cache warm: load | {warm:.2f} |")
+        print("\nThe whole commands' start-up is measured by `benchmarks/bench_startup.py`.")
 
 if __name__ == "__main__":
     main()
