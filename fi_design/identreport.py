@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from .plots import report_figure, styled
+
 #: Colours: used samples, samples left out, the fitted curve.
 COLOURS = {"used": "C0", "unused": "0.75", "fit": "C3"}
 #: Most points drawn per scatter (evenly thinned beyond): keeps the SVG small.
@@ -32,33 +34,9 @@ def _thin(mask: np.ndarray) -> np.ndarray:
     return idx[::step]
 
 
-def _figure(height: float, *, top: float = 0.3, bottom: float = 0.45, left: float = 0.62,
-            right: float = 0.12) -> Any:
-    """A report-width figure with fixed margins [in] (the design report's layout)."""
-    from matplotlib.figure import Figure
-
-    from .plots import REPORT_WIDTH
-
-    w = REPORT_WIDTH
-    fig = Figure(figsize=(w, height))
-    fig.subplots_adjust(left=left / w, right=1.0 - right / w, top=1.0 - top / height,
-                        bottom=bottom / height)
-    return fig
-
-
-def _styled(draw):
-    import functools
-
-    @functools.wraps(draw)
-    def wrapper(*args, **kwargs):
-        import matplotlib
-
-        from .plots import REPORT_RC
-
-        with matplotlib.rc_context(REPORT_RC):
-            return draw(*args, **kwargs)
-
-    return wrapper
+def _figure(height: float) -> Any:
+    """A report-width figure with the design report's fixed margins [in]."""
+    return report_figure(height, top=0.3)
 
 
 def friction_curve(result: Any, velocity: np.ndarray) -> np.ndarray:
@@ -99,7 +77,7 @@ def friction_curve(result: Any, velocity: np.ndarray) -> np.ndarray:
     return np.where(v > 0, pos, np.where(v < 0, neg, 0.5 * (pos + neg)))
 
 
-@_styled
+@styled
 def force_velocity_figure(result: Any) -> Any:
     """The force-velocity map: measured friction (force minus inertia) and the fitted curve.
 
@@ -140,7 +118,7 @@ def force_velocity_figure(result: Any) -> Any:
     return fig
 
 
-@_styled
+@styled
 def residual_figure(result: Any) -> Any:
     """Measured minus modelled actuator force over time, used samples.
 

@@ -39,7 +39,7 @@ REPORT_RC = {
 }
 
 
-def _report_figure(height: float, width: float = REPORT_WIDTH, *, left: float = 0.62,
+def report_figure(height: float, width: float = REPORT_WIDTH, *, left: float = 0.62,
                    right: float = 0.12, top: float = 0.12, bottom: float = 0.45,
                    hspace: float = 0.35) -> Any:
     """A report figure with fixed margins [in].
@@ -56,7 +56,7 @@ def _report_figure(height: float, width: float = REPORT_WIDTH, *, left: float = 
     return fig
 
 
-def _styled(draw):
+def styled(draw):
     """Run a figure function under :data:`REPORT_RC` (fonts are fixed when artists are made)."""
     import functools
 
@@ -128,7 +128,7 @@ def _phase_deg(L: np.ndarray, f: np.ndarray, near: float) -> np.ndarray:
     return ph - 360.0 * math.ceil((ph[i] - 90.0) / 360.0)
 
 
-@_styled
+@styled
 def bode_figure(result: Any) -> Any:
     """Open-loop Bode plot of the four limit cases (paper Figure 2) in one figure.
 
@@ -148,7 +148,7 @@ def bode_figure(result: Any) -> Any:
     f = result.loop.frequency
     responses = [(c, c.loop) for c in result.loop.cases]
     fc = result.crossover.desired
-    fig = _report_figure(4.3, top=0.62, right=0.3, hspace=0.1)
+    fig = report_figure(4.3, top=0.62, right=0.3, hspace=0.1)
     mag, pha = fig.subplots(2, 1, sharex=True, height_ratios=(1.1, 1.0))
     by_name = {c.name: c for c in result.crossover.cases}
     phases = []
@@ -192,7 +192,7 @@ def bode_figure(result: Any) -> Any:
     return fig
 
 
-@_styled
+@styled
 def nyquist_figure(result: Any) -> Any:
     """Nyquist plot of the limit cases (positive frequencies), zoomed on the critical point -1.
 
@@ -210,7 +210,7 @@ def nyquist_figure(result: Any) -> Any:
     matplotlib.figure.Figure
     """
     responses = [(c, c.loop) for c in result.loop.cases]
-    fig = _report_figure(3.0, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
+    fig = report_figure(3.0, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
     ax = fig.add_subplot()
     for lc, L in responses:
         col = CASE_COLOURS.get(lc.name)
@@ -232,7 +232,7 @@ def nyquist_figure(result: Any) -> Any:
     return fig
 
 
-@_styled
+@styled
 def sensitivity_figure(result: Any) -> Any:
     """Sensitivity |S| = |1 / (1 + L)| of the limit cases, peaks marked.
 
@@ -247,7 +247,7 @@ def sensitivity_figure(result: Any) -> Any:
     """
     f = result.loop.frequency
     responses = [(c, c.loop) for c in result.loop.cases]
-    fig = _report_figure(3.0, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
+    fig = report_figure(3.0, 3.3, left=0.55, right=0.1, top=0.1, bottom=0.45)
     ax = fig.add_subplot()
     for lc, L in responses:
         col = CASE_COLOURS.get(lc.name)
@@ -333,7 +333,7 @@ def motion_end(time: np.ndarray, reference: np.ndarray) -> float:
 SETTLE_ZOOM = 5.0
 
 
-@_styled
+@styled
 def error_figure(confirmation: Any, spec: Any) -> Any:
     """Position error x1 - r over time with and without the isolator (paper Figure 5).
 
@@ -356,7 +356,7 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
     matplotlib.figure.Figure
     """
     h = spec.requirements.hunting
-    fig = _report_figure(4.3, top=0.3, hspace=0.55, right=0.1)
+    fig = report_figure(4.3, top=0.3, hspace=0.55, right=0.1)
     fig.subplots_adjust(wspace=0.32)
     axes = fig.subplots(2, 2, sharex="col", sharey="col", width_ratios=(1.55, 1.0))
     label = "suggested isolator" if confirmation.suggested_isolator else "with isolator"
@@ -412,7 +412,7 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
     return fig
 
 
-@_styled
+@styled
 def deflection_figure(confirmation: Any, spec: Any) -> Any:
     """Joint deflection x1 - x2 of the isolated plant over time, against the stroke.
 
@@ -431,7 +431,7 @@ def deflection_figure(confirmation: Any, spec: Any) -> Any:
     res = confirmation.results["isolated"]
     stroke = confirmation.landing.stroke if confirmation.landing is not None else \
         spec.isolator.stroke
-    fig = _report_figure(2.5, top=0.35)
+    fig = report_figure(2.5, top=0.35)
     ax = fig.add_subplot()
     t, d = decimate(res.time, res.deflection * 1e6)
     ax.plot(t, d, color=PLANT_COLOURS["isolated"], lw=1.0, label="deflection x1 - x2")
@@ -451,7 +451,7 @@ def deflection_figure(confirmation: Any, spec: Any) -> Any:
     return fig
 
 
-@_styled
+@styled
 def scan_figure(confirmation: Any, spec: Any) -> Any:
     """Hunting cycles against the crossover for both plants (the crossover scans).
 
@@ -470,7 +470,7 @@ def scan_figure(confirmation: Any, spec: Any) -> Any:
     -------
     matplotlib.figure.Figure
     """
-    fig = _report_figure(2.8, top=0.35)
+    fig = report_figure(2.8, top=0.35)
     ax = fig.add_subplot()
     label = "suggested isolator" if confirmation.suggested_isolator else "with isolator"
     names = {"isolated": label, "non_isolated": "without isolator"}
@@ -1003,7 +1003,7 @@ def _gap_label(result: Any) -> str:
         "corrected (no effect added)"
 
 
-@_styled
+@styled
 def gap_overlay_figure(result: Any) -> Any:
     """Measured trace with the nominal and the corrected model on top.
 
@@ -1028,7 +1028,7 @@ def gap_overlay_figure(result: Any) -> Any:
         panels.append(("force", "force u [N]", 1.0, False))
     if meas.deflection is not None and result.nominal.deflection is not None:
         panels.append(("deflection", "deflection x1 - x2 [µm]", 1e6, False))
-    fig = _report_figure(1.9 * len(panels) + 0.7, top=0.3, hspace=0.3)
+    fig = report_figure(1.9 * len(panels) + 0.7, top=0.3, hspace=0.3)
     axes = np.atleast_1d(fig.subplots(len(panels), 1, sharex=True))
     for ax, (key, label, scale, minus_ref) in zip(axes, panels):
         for seg in result.segments:
@@ -1053,7 +1053,7 @@ def gap_overlay_figure(result: Any) -> Any:
     return fig
 
 
-@_styled
+@styled
 def gap_residual_figure(result: Any) -> Any:
     """Measured minus modelled position, nominal and corrected, against the noise band.
 
@@ -1070,7 +1070,7 @@ def gap_residual_figure(result: Any) -> Any:
     t = result.nominal.time
     x = np.asarray(meas.position)
     sigma = result.noise.position * 1e6
-    fig = _report_figure(2.6, top=0.3)
+    fig = report_figure(2.6, top=0.3)
     ax = fig.subplots()
     ax.axhspan(-2 * sigma, 2 * sigma, color="0.9", lw=0, zorder=0)
     for name, src in (("nominal", result.nominal), ("corrected", result.corrected)):
@@ -1088,7 +1088,7 @@ def gap_residual_figure(result: Any) -> Any:
     return fig
 
 
-@_styled
+@styled
 def candidate_scores_figure(result: Any) -> Any:
     """Score of every fitted candidate effect (horizontal bars), with the threshold.
 
@@ -1102,7 +1102,7 @@ def candidate_scores_figure(result: Any) -> Any:
     matplotlib.figure.Figure
     """
     cands = list(result.candidates)[::-1]
-    fig = _report_figure(0.28 * max(len(cands), 1) + 0.9, left=1.9, top=0.15)
+    fig = report_figure(0.28 * max(len(cands), 1) + 0.9, left=1.9, top=0.15)
     ax = fig.subplots()
     names = [c.name for c in cands]
     # signed log scale: scores span many decades
@@ -1117,7 +1117,7 @@ def candidate_scores_figure(result: Any) -> Any:
     return fig
 
 
-@_styled
+@styled
 def structure_figure(result: Any) -> Any:
     """The nominal model's residual over time and its amplitude spectrum (structure diagnosis).
 
@@ -1145,7 +1145,7 @@ def structure_figure(result: Any) -> Any:
     else:
         r = np.asarray(meas.position) - np.asarray(result.nominal.position)
         scale, label, dens = 1e6, "measured - nominal position [µm]", "ASD [µm/√Hz]"
-    fig = _report_figure(2.6, top=0.25)
+    fig = report_figure(2.6, top=0.25)
     fig.subplots_adjust(wspace=0.4)
     ax1, ax2 = fig.subplots(1, 2)
     tt, yy = decimate(t, r * scale)
