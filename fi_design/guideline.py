@@ -584,8 +584,7 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     sim = study = None
     if confirm:
         if progress is not None:
-            progress("simulating with and without the isolator (the first run on a machine "
-                     "compiles the kernel, about 10 s) ...")
+            progress("simulating with and without the isolator ...")
         sim = pending[0].result() if pending else \
             run_confirmation(spec, suggestion, progress=progress)
         if robust:
