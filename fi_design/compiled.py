@@ -26,7 +26,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from .plant import (N_STATS, ST_EVENTS, ST_REJECTED, ST_STEPS, ST_T, STATUS_TEXT, Integration)
+from .plant import (N_STATS, N_WATCH, ST_CROSSINGS, ST_EVENTS, ST_PERIOD, ST_REJECTED, ST_STEPS,
+                    ST_STOP, ST_T, STATUS_TEXT, STOP_TEXT, W_QUIET, W_START, Integration)
 
 log = logging.getLogger(__name__)
 
@@ -75,13 +76,16 @@ def backend() -> str:
 
 
 def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
-        max_steps=2_000_000, x_bound=10.0, input_time=None, input_force=None) -> Integration:
+        max_steps=2_000_000, x_bound=10.0, input_time=None, input_force=None, watch=None,
+        crossings: int = 0) -> Integration:
     """Allocate outputs and call the integrator (:func:`fi_design.kernel.integrate`).
 
     Returns a :class:`fi_design.plant.Integration`; see ``integrate`` for the
     arguments (``input_time``, ``input_force``: the known input force's
-    samples [s, N], None for none). This thin wrapper is the kernel's only
-    Python-level entry point; :mod:`fi_design.simulation` wraps it in a result.
+    samples [s, N], None for none; ``watch``: the watch array, ``W_*`` in
+    :mod:`fi_design.plant`, None for none; ``crossings``: room for this many
+    section crossings). This thin wrapper is the kernel's only Python-level
+    entry point; :mod:`fi_design.simulation` wraps it in a result.
     """
     # fresh writable copies: compiled code types read-only arrays differently
     p = np.array(params, dtype=np.float64)
@@ -96,12 +100,27 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     out_fa = np.full(m, np.nan)
     out_cmd = np.full(m, np.nan)
     stats = np.zeros(N_STATS)
+    if watch is None:
+        w = np.zeros(N_WATCH)
+        w[W_START] = np.inf
+        w[W_QUIET] = np.inf
+    else:
+        w = np.array(watch, dtype=np.float64)
+    k = max(int(crossings), 1)
+    cross_t = np.full(k, np.nan)
+    cross_y = np.full((k, n), np.nan)
+    cross_e = np.full((k, 2), np.nan)
+    y_end = np.full(n, np.nan)
     status = kernel().integrate(
         p, y, np.array(breaks, dtype=np.float64), np.array(coeffs, dtype=np.float64, order="C"),
         bool(land), float(t_end), t_out, float(rtol), np.array(atol, dtype=np.float64),
         float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r, out_fa, out_cmd,
-        stats)
+        stats, w, cross_t, cross_y, cross_e, y_end)
+    c = int(stats[ST_CROSSINGS])
     return Integration(code=int(status), status=STATUS_TEXT[int(status)], states=out_y,
                        reference=out_r, applied_force=out_fa, command=out_cmd,
                        n_steps=int(stats[ST_STEPS]), n_rejected=int(stats[ST_REJECTED]),
-                       n_events=int(stats[ST_EVENTS]), t_reached=float(stats[ST_T]))
+                       n_events=int(stats[ST_EVENTS]), t_reached=float(stats[ST_T]),
+                       final_state=y_end, stop=STOP_TEXT[int(stats[ST_STOP])],
+                       crossing_times=cross_t[:c], crossing_states=cross_y[:c],
+                       crossing_extremes=cross_e[:c], period_crossings=int(stats[ST_PERIOD]))

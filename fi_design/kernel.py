@@ -59,15 +59,18 @@ import numpy as np
 from ._jit import A1, A2, I1, b1, f8, i8, kernel_function
 from .equations import (actuator, control_law, controller_output, drive_force, feedforward,
                         jacobian, measured_position, natural_modes, rhs, static_friction)
-from .plant import (DIVERGED, HISTORY_OVERFLOW, MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK,
-                    N_CORE_ISO, N_CORE_RIGID, N_STATS, NOT_FINITE, OK, P_DA, P_DB, P_DC, P_DELAY,
-                    P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F, P_FF_M, P_ISO, P_KD, P_KDM, P_KI,
-                    P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT, ST_EVENTS, ST_H,
-                    ST_LIMIT_EVENTS, ST_OUT, ST_REJECTED, ST_STEPS, ST_T, ST_ZERO_EVENTS,
-                    STEP_UNDERFLOW, TOO_MANY_STEPS)
+from .plant import (DIVERGED, HISTORY_OVERFLOW, MAX_PERIOD, MODE_LEVEL, MODE_LIMIT, MODE_SIGN,
+                    MODE_STICK, N_CORE_ISO, N_CORE_RIGID, N_STATS, NOT_FINITE, OK, P_DA, P_DB,
+                    P_DC, P_DELAY, P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F, P_FF_M, P_ISO,
+                    P_KD, P_KDM, P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT,
+                    ST_CROSSINGS, ST_EVENTS, ST_H, ST_LIMIT_EVENTS, ST_OUT, ST_PERIOD,
+                    ST_REJECTED, ST_STEPS, ST_STOP, ST_T, ST_ZERO_EVENTS, STEP_UNDERFLOW,
+                    STOP_CROSSINGS, STOP_END, STOP_QUIET, STOP_REPEAT, TOO_MANY_STEPS, W_ARM,
+                    W_BAND, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_REPEAT, W_REST_ANYWHERE,
+                    W_START)
 
-# Event kinds.
-EV_NONE, EV_SIGN, EV_LIMIT, EV_LEVEL, EV_UNSTICK = 0, 1, 2, 3, 4
+# Event kinds (EV_SECTION: the watch's Poincare section, no mode change).
+EV_NONE, EV_SIGN, EV_LIMIT, EV_LEVEL, EV_UNSTICK, EV_SECTION = 0, 1, 2, 3, 4, 5
 
 HIST = 8192  # delay history ring size
 HT, HU, HDU, HUR, HDUR = range(5)  # rows of the history: time, value and rate in, out
@@ -616,10 +619,11 @@ def write_output(i, tq, yq, p, modes, breaks, coeffs, in_t, in_f, hints, fa_hold
 # --------------------------------------------------------------------------- the integrator
 
 
-@kernel_function((A1, A1, A1, A2, b1, f8, A1, f8, A1, f8, i8, f8, A1, A1, A2, A1, A1, A1, A1),
-                 refcounted=True)
+@kernel_function((A1, A1, A1, A2, b1, f8, A1, f8, A1, f8, i8, f8, A1, A1, A2, A1, A1, A1, A1,
+                  A1, A1, A2, A2, A1), refcounted=True)
 def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_steps, x_bound,
-              in_t, in_f, out_y, out_r, out_fa, out_cmd, stats):
+              in_t, in_f, out_y, out_r, out_fa, out_cmd, stats, watch, cross_t, cross_y,
+              cross_e, y_end):
     """Integrate the plant from ``y0`` at t = 0 to ``t_end``.
 
     Parameters
@@ -661,6 +665,23 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
         feedforward and input force, before delay and saturation).
     stats : ndarray, shape (N_STATS,)
         Output: counters (``ST_*``).
+    watch : ndarray, shape (N_WATCH,)
+        What to watch for once the motion is over (``W_*`` in
+        :mod:`fi_design.plant`): from ``watch[W_START]`` on, the upward
+        crossings of x1 - r = 0 (r = ``watch[W_LEVEL]``, the held reference)
+        are located like mode events (the step is redone to end on them) and
+        recorded, and the run stops early when the stage has come to rest (the
+        quiet rule) or its motion repeats at the section (the repeat rule).
+        ``watch[W_START] = inf`` turns it off.
+    cross_t : ndarray, shape (K,)
+        Output: times of the crossings [s] (the first ``stats[ST_CROSSINGS]``).
+    cross_y : ndarray, shape (K, n)
+        Output: states at the crossings.
+    cross_e : ndarray, shape (K, 2)
+        Output: smallest and largest x1 - r at the step ends since the
+        crossing before (since the watch's start for the first) [m].
+    y_end : ndarray, shape (n,)
+        Output: the state where the run ended.
 
     Returns
     -------
@@ -740,6 +761,23 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
 
     for i in range(N_STATS):
         stats[i] = 0.0
+    # the watch (section crossings, quiet and repeat rules)
+    t_watch = watch[W_START]
+    level = watch[W_LEVEL]
+    band = watch[W_BAND]
+    quiet = watch[W_QUIET]
+    repeat = watch[W_REPEAT]
+    rest_anywhere = watch[W_REST_ANYWHERE] != 0.0
+    arm = watch[W_ARM]
+    max_cross = min(int(watch[W_MAX_CROSSINGS]), cross_t.shape[0])
+    n_cross = 0
+    armed = False
+    quiet_t0 = -1.0
+    quiet_x = 0.0
+    e_lo = math.inf
+    e_hi = -math.inf
+    stop = STOP_END
+    period = 0
     m_out = t_out.shape[0]
     i_out = 0
     kref = 0
@@ -808,7 +846,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                          fa_hold, hist, head, count, need_cmd, out_y, out_r, out_fa, out_cmd)
             i_out += 1
 
-        if t >= t_end * (1.0 - 1e-14):
+        if t >= t_end * (1.0 - 1e-14) or stop != STOP_END:
             break
         if n_steps + n_rej >= max_steps:
             status = TOO_MANY_STEPS
@@ -995,45 +1033,69 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 cd2[j] = DD21 * k1[j] + DD22 * k2[j] + DD23 * k3[j] + DD24 * k4[j] + DD25 * k5[j]
                 cd3[j] = DD31 * k1[j] + DD32 * k2[j] + DD33 * k3[j] + DD34 * k4[j] + DD35 * k5[j]
             # state events
+            kind = EV_NONE
+            theta = 2.0
             if not suppress:
                 kind, theta = find_event(y, ynew, cd2, cd3, p, modes, iv2, r0, rd0, fa0, fa_state,
                                          ybuf, pending)
-                if kind != EV_NONE:
-                    if theta * h < 1e-12 * max(1.0, t) or theta <= 0.0:
-                        # crossing at the start of the step: switch now, no step
-                        for j in range(n):
-                            ybuf[j] = ynew[j]
-                        u_before = 0.0
-                        if cont_delay:
-                            u_before = controller_output(y, p, modes, r0, rd0, ii, iu)
-                        apply_event(kind, y, p, modes, iv2, iu, r0, rd0, fa0, fa_state, ybuf)
-                        if cont_delay:
-                            u_after = controller_output(y, p, modes, r0, rd0, ii, iu)
-                            if u_after != u_before:
-                                jump_pending = True
-                                jump_u = u_before
-                                jump_du = f0[iu]
-                        n_events += 1
-                        n_zero += 1
-                        zero_run += 1
-                        if zero_run > 8:
-                            natural_modes(y, p, modes)
-                            suppress = True
-                            zero_run = 0
-                        restart = True
-                        break
-                    # redo the step so that it ends at the crossing
+            if armed and pending != EV_SECTION and t >= t_watch:
+                g0 = y[0] - level
+                g1 = ynew[0] - level
+                if g0 < 0.0 and g1 >= 0.0:
+                    ths = _root(g0, g1, y, ynew, cd2, cd3, 0, 0, 0, level, p, modes, r0, rd0,
+                                fa0, fa_state, ybuf)
+                    if ths < theta:
+                        if ths * h < 1e-12 * max(1.0, t):
+                            # on the section at the step's start: record the state there
+                            if n_cross < max_cross:
+                                cross_t[n_cross] = t
+                                for j in range(n):
+                                    cross_y[n_cross, j] = y[j]
+                                cross_e[n_cross, 0] = e_lo
+                                cross_e[n_cross, 1] = e_hi
+                                n_cross += 1
+                            armed = False
+                            e_lo = math.inf
+                            e_hi = -math.inf
+                        else:
+                            kind = EV_SECTION
+                            theta = ths
+            if kind != EV_NONE:
+                if theta * h < 1e-12 * max(1.0, t) or theta <= 0.0:
+                    # crossing at the start of the step: switch now, no step
                     for j in range(n):
-                        yev[j] = ynew[j]  # keep the trial end (direction of the crossing)
-                    pending = kind
-                    if theta < 1.0 - 1e-9:
-                        h = theta * h
-                        t_land = t + h
-                        continue
-                    # The crossing is at the very end of this step: accept the step as it
-                    # is and switch after it. (Redoing it with the same h looped forever
-                    # when two events, e.g. a sign change and a limiter contact, fell on
-                    # the same step end: each redo skipped one and found the other.)
+                        ybuf[j] = ynew[j]
+                    u_before = 0.0
+                    if cont_delay:
+                        u_before = controller_output(y, p, modes, r0, rd0, ii, iu)
+                    apply_event(kind, y, p, modes, iv2, iu, r0, rd0, fa0, fa_state, ybuf)
+                    if cont_delay:
+                        u_after = controller_output(y, p, modes, r0, rd0, ii, iu)
+                        if u_after != u_before:
+                            jump_pending = True
+                            jump_u = u_before
+                            jump_du = f0[iu]
+                    n_events += 1
+                    n_zero += 1
+                    zero_run += 1
+                    if zero_run > 8:
+                        natural_modes(y, p, modes)
+                        suppress = True
+                        zero_run = 0
+                    restart = True
+                    break
+                # redo the step so that it ends at the crossing
+                for j in range(n):
+                    yev[j] = ynew[j]  # keep the trial end (direction of the crossing)
+                pending = kind
+                if theta < 1.0 - 1e-9:
+                    h = theta * h
+                    t_land = t + h
+                    continue
+                # The crossing is at the very end of this step: accept the step as it
+                # is and switch after it. (Redoing it with the same h looped forever
+                # when two events, e.g. a sign change and a limiter contact, fell on
+                # the same step end: each redo skipped one and found the other.)
             # ------------------------------------------------ accept
             n_steps += 1
             t_new = t_land if landing else t + h
@@ -1079,6 +1141,49 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 y[j] = ynew[j]
             t = t_new
             suppress = False
+            if pending == EV_SECTION:
+                # the step ended on the section: record the crossing
+                if n_cross < max_cross:
+                    cross_t[n_cross] = t
+                    for j in range(n):
+                        cross_y[n_cross, j] = y[j]
+                    cross_e[n_cross, 0] = e_lo
+                    cross_e[n_cross, 1] = e_hi
+                    n_cross += 1
+                armed = False
+                e_lo = math.inf
+                e_hi = -math.inf
+                pending = EV_NONE
+                if n_cross >= max_cross:
+                    stop = STOP_CROSSINGS
+                elif repeat > 0.0:
+                    c = n_cross - 1
+                    for q in range(1, min(MAX_PERIOD, c) + 1):
+                        worst = 0.0
+                        for j in range(n):
+                            dj = abs(cross_y[c, j] - cross_y[c - q, j]) * rtol / atol[j]
+                            if dj > worst:
+                                worst = dj
+                        if worst <= repeat:
+                            stop = STOP_REPEAT
+                            period = q
+                            break
+            if t >= t_watch:
+                g = y[0] - level
+                if g < -arm:
+                    armed = True
+                if g < e_lo:
+                    e_lo = g
+                if g > e_hi:
+                    e_hi = g
+                if rest_anywhere or abs(g) <= band:
+                    if quiet_t0 < 0.0 or abs(y[0] - quiet_x) > band:
+                        quiet_t0 = t
+                        quiet_x = y[0]
+                    elif t - quiet_t0 >= quiet:
+                        stop = STOP_QUIET
+                else:
+                    quiet_t0 = -1.0
             if pending != EV_NONE:
                 # the step ended at a located crossing: switch the mode
                 if pending == EV_LIMIT:
@@ -1119,4 +1224,9 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     stats[ST_H] = h
     stats[ST_OUT] = i_out
     stats[ST_ZERO_EVENTS] = n_zero
+    stats[ST_CROSSINGS] = n_cross
+    stats[ST_STOP] = stop
+    stats[ST_PERIOD] = period
+    for j in range(n):
+        y_end[j] = y[j]
     return status

@@ -3,7 +3,14 @@
 The paper's metric (section 2.3): count the peaks of the position error
 x1 - r in a window after the expected settling time ([10 s, 20 s) by
 default), with a minimum distance between peaks (0.5 s) and a minimum peak
-height (0.1 mm); one peak per hunting cycle.
+height (0.1 mm); one peak per hunting cycle. A peak must also stand out from
+its surroundings by the minimum height (its prominence), so a stage at rest
+or the plateau of a stick phase is never a cycle, and one period with a main
+and a secondary bump counts once; a cycle that stays below the target counts
+its negative peaks.
+
+The metric judges one trace: whether the *stage* hunts is answered over a
+family of moves and by the cycle itself (:mod:`fi_design.stage`).
 
 The count alone is blind in two ways, and the verdict here is not:
 
@@ -64,12 +71,18 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     w0, w1 = window_start, window_start + window_length
     inside = (t >= w0) & (t < w1) & np.isfinite(e)
     tw, ew = t[inside], e[inside]
+    idx = np.zeros(0, dtype=int)
     if len(tw) > 1:
         dt = float(np.median(np.diff(tw)))
         distance = max(1, int(round(min_distance / dt)))
-        idx, _ = find_peaks(ew, height=min_height, distance=distance)
-    else:
-        idx = np.zeros(0, dtype=int)
+        # a peak must stand out by min_height from its surroundings (prominence), so a
+        # plateau's numerical noise or a secondary bump of one period is no cycle; a cycle
+        # below the target shows its negative peaks: count the side that shows more
+        for side in (1.0, -1.0):
+            found, _ = find_peaks(side * ew, height=min_height, prominence=min_height,
+                                  distance=distance)
+            if len(found) > len(idx):
+                idx = found
     peaks_t, peaks_h = tw[idx], ew[idx]
     cycles = int(len(idx))
     amplitude = float(np.ptp(ew)) if len(ew) else float("nan")

@@ -188,6 +188,22 @@ class Integration:
         Accepted steps, discarded trial steps, mode switches.
     t_reached : float
         Last time integrated [s].
+    final_state : ndarray, shape (n,), optional
+        State at ``t_reached`` (kernel path).
+    stop : str
+        Why the run ended: ``"end"`` (``t_end`` or a failure), or a rule of
+        the watch: ``"quiet"``, ``"repeat"``, ``"crossings"``.
+    crossing_times : ndarray, shape (c,), optional
+        Times of the Poincare section's crossings (x1 - r = 0 upwards, after
+        the watch starts) [s].
+    crossing_states : ndarray, shape (c, n), optional
+        States at those crossings.
+    crossing_extremes : ndarray, shape (c, 2), optional
+        Smallest and largest x1 - r at the step ends since the crossing before
+        [m] (since the watch's start for the first).
+    period_crossings : int
+        With ``stop == "repeat"``: crossings per period of the repeating
+        motion (0 otherwise).
     """
 
     code: int
@@ -200,6 +216,12 @@ class Integration:
     n_rejected: int
     n_events: int
     t_reached: float
+    final_state: np.ndarray | None = None
+    stop: str = "end"
+    crossing_times: np.ndarray | None = None
+    crossing_states: np.ndarray | None = None
+    crossing_extremes: np.ndarray | None = None
+    period_crossings: int = 0
 
 
 #: Kernel parameter index of every :class:`PlantParameters` field, by name.
@@ -273,5 +295,28 @@ STATUS_TEXT = {
 }
 
 # Layout of the kernel's statistics array.
-ST_STEPS, ST_REJECTED, ST_EVENTS, ST_T, ST_H, ST_OUT, ST_ZERO_EVENTS, ST_LIMIT_EVENTS = range(8)
-N_STATS = 8
+(ST_STEPS, ST_REJECTED, ST_EVENTS, ST_T, ST_H, ST_OUT, ST_ZERO_EVENTS, ST_LIMIT_EVENTS,
+ ST_CROSSINGS, ST_STOP, ST_PERIOD) = range(11)
+N_STATS = 11
+
+# --------------------------------------------------------------------------- the watch
+
+# Layout of the kernel's watch array: what a run watches for once the motion is over, and
+# when it stops early (see ``fi_design.kernel.integrate``). Times in s, lengths in m.
+# W_START: time from which the watch is on (inf: off); W_LEVEL: the held reference r, the
+# Poincare section is x1 - r = 0 crossed upwards; W_BAND: band [m] of the quiet rule;
+# W_QUIET: stop once x1 has stayed within W_BAND of one position (and, unless
+# W_REST_ANYWHERE is 1, within W_BAND of r) for this long (inf: never);
+# W_REPEAT: stop once the state at a section crossing repeats the one 1 to
+# MAX_PERIOD crossings before within this fraction of the physical scales atol / rtol (0:
+# never); W_MAX_CROSSINGS: stop after this many crossings (at most the rows of the crossing
+# outputs); W_ARM: x1 - r must fall below -W_ARM between two counted crossings.
+(W_START, W_LEVEL, W_BAND, W_QUIET, W_REPEAT, W_MAX_CROSSINGS, W_REST_ANYWHERE,
+ W_ARM) = range(8)
+N_WATCH = 8
+#: Longest period, in section crossings, the repeat rule compares.
+MAX_PERIOD = 4
+# Why a run stopped (stats[ST_STOP]).
+STOP_END, STOP_QUIET, STOP_REPEAT, STOP_CROSSINGS = range(4)
+STOP_TEXT = {STOP_END: "end", STOP_QUIET: "quiet", STOP_REPEAT: "repeat",
+             STOP_CROSSINGS: "crossings"}

@@ -278,11 +278,45 @@ class Move(StrictModel):
         return self
 
 
+class Family(StrictModel):
+    """The moves the stage must settle after: hunting is judged over all of them.
+
+    Default: ``count`` distances log-spaced from a tenth of the isolator's
+    stroke (0.1 mm without isolator) to five times the spec's largest move, at
+    the velocity, acceleration and jerk of the spec's largest move, in both
+    directions when the friction or the loads are not symmetric. The spec's
+    own motion is always judged as well.
+    """
+
+    distances: Union[tuple[Q("m"), ...], None] = Field(
+        None, description="Signed move distances [m]; null: log-spaced from smallest to largest.")
+    smallest: OptQ("m") = Field(None, gt=0, description="Smallest distance [m]; null: a tenth of "
+                                                        "the isolator's stroke, 0.1 mm without "
+                                                        "isolator.")
+    largest: OptQ("m") = Field(None, gt=0, description="Largest distance [m]; null: five times the "
+                                                       "spec's largest move.")
+    count: int = Field(24, ge=2, le=400, description="Number of log-spaced distances. Default 24.")
+    directions: Literal["auto", "both", "positive"] = Field(
+        "auto", description="Move directions: both, positive only, or auto (both when the "
+                            "friction or the loads are not symmetric). Default auto.")
+
+    @model_validator(mode="after")
+    def _sane(self) -> "Family":
+        if self.distances is not None and any(d == 0 for d in self.distances):
+            raise ValueError("distances must not be zero")
+        if self.smallest is not None and self.largest is not None and \
+                self.largest <= self.smallest:
+            raise ValueError("largest must be above smallest")
+        return self
+
+
 class Motion(StrictModel):
     """Reference motion: moves run one after another, then hold."""
 
     moves: tuple[Move, ...] = Field(min_length=1, description="The moves.")
     duration: Q("s") = Field(20.0, gt=0, description="Simulated time [s]. Default 20 s.")
+    family: Family = Field(default_factory=Family, description="The moves the stage must settle "
+                                                               "after (stage-level hunting).")
 
     @model_validator(mode="after")
     def _in_order(self) -> "Motion":
@@ -322,6 +356,11 @@ class Hunting(StrictModel):
                                                        "Default 0.1 mm.")
     settle_band: Q("m") = Field(1e-5, gt=0, description="Error band for 'settled' and the "
                                                         "settling time [m]. Default 10 um.")
+    horizon: Q("s") = Field(300.0, gt=0, le=1e5,
+                            description="Stage-level hunting: the longest time after a move to "
+                                        "wait for the stage to come to rest or repeat a cycle "
+                                        "[s]; runs stop as soon as either is certain. Default "
+                                        "300 s.")
 
 
 class Ripple(StrictModel):

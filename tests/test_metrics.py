@@ -75,3 +75,31 @@ def test_cycle_count_matches_the_window(period, amp, phase):
     assert abs(m.hunting_cycles - 10.0 / period) <= 1.0
     assert m.verdict == "hunting"
     assert m.amplitude == pytest.approx(2 * amp, rel=0.01)
+
+
+def test_a_stage_at_rest_off_target_is_never_a_cycle():
+    """A PD stage resting 2.85 mm past its target with round-off noise: no peak, stuck."""
+    rng = np.random.default_rng(1)
+    e = 2.85e-3 + 4e-16 * rng.standard_normal(T.shape)
+    m = hunting_metrics(T, e)
+    assert m.hunting_cycles == 0 and m.verdict == "stuck"
+
+
+def test_one_period_with_a_secondary_bump_counts_once():
+    """A stick-slip period: a slip peak, then a plateau with a small bump 1.2 s later."""
+    period = 3.3
+    ph = np.mod(T, period)
+    main = 0.9e-3 * np.exp(-((ph - 0.2) / 0.1) ** 2)
+    bump = 0.4e-3 + 0.02e-3 * np.exp(-((ph - 1.4) / 0.2) ** 2)  # on a 0.4 mm plateau
+    low = 0.9e-3 * np.exp(-((ph - 1.85) / 0.1) ** 2)
+    e = np.where(ph < 0.2, main, np.where(ph < 1.65, np.maximum(main, bump), -np.where(
+        ph < 1.85, low, np.maximum(low, 0.4e-3))))
+    m = hunting_metrics(T, e)
+    assert m.hunting_cycles == 3
+    assert m.period == pytest.approx(period, rel=1e-3)
+
+
+def test_a_cycle_below_the_target_counts_its_negative_peaks():
+    e = -0.6e-3 + 0.4e-3 * np.sin(2 * np.pi * T / 2.0)  # never above -0.2 mm
+    m = hunting_metrics(T, e)
+    assert m.hunting_cycles == 5 and m.verdict == "hunting"

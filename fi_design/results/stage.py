@@ -1,0 +1,272 @@
+"""Results of the stage-level hunting analysis: every move, the cycle itself, the boundary.
+
+Produced by :func:`fi_design.stage.stage_hunting`. Hunting is a property of
+the stage, not of one move: the closed loop with stick-slip friction is
+bistable (a stable rest set beside a stable limit cycle), and which one a run
+ends in depends on where the cart first sticks after the move. The answer per
+plant is therefore taken over a family of moves (:class:`MoveOutcome`), the
+cycle a hunting move enters is converged as a periodic orbit (:class:`Cycle`),
+and the hunting-free crossover is the crossover above which that cycle no
+longer exists (its fold), found by bisection (:class:`StageHunting`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import Result, dataclass_dict, to_jsonable
+
+__all__ = ["MOVE_OUTCOMES", "MoveOutcome", "CycleTrace", "Cycle", "StageHunting"]
+
+#: How a move can end: at rest at the target, in a sustained cycle, at rest
+#: off the target (a loop without integrator: its static error; with an
+#: integrator: stuck), or not judged within the horizon (``undetermined``,
+#: also a failed simulation).
+MOVE_OUTCOMES = ("settles", "hunts", "rests", "stuck", "undetermined")
+
+
+@dataclass(frozen=True)
+class MoveOutcome(Result):
+    """How the stage ends after one move of the family.
+
+    Attributes
+    ----------
+    distance : float
+        Signed move distance [m]; for the spec's own motion, its net travel.
+    label : str
+        ``"family"`` or ``"spec"`` (the spec's own motion, all its moves).
+    outcome : str
+        One of :data:`MOVE_OUTCOMES`.
+    final_error : float
+        x1 - r where the run ended [m] (at a section crossing for a cycle).
+    amplitude : float or None
+        Peak-to-peak x1 - r over the last period of a cycle [m] (at the
+        integrator's step ends); None when the move does not hunt.
+    period : float or None
+        Period of that cycle [s].
+    time : float
+        Time simulated after the motion ended [s].
+    reason : str
+        Why, in one sentence.
+    """
+
+    distance: float
+    label: str
+    outcome: str
+    final_error: float
+    amplitude: float | None
+    period: float | None
+    time: float
+    reason: str
+
+    @property
+    def hunts(self) -> bool:
+        """Whether the move ends in a sustained cycle."""
+        return self.outcome == "hunts"
+
+
+@dataclass(frozen=True, eq=False)
+class CycleTrace(Result):
+    """One period of a cycle, sampled from its section crossing.
+
+    Attributes
+    ----------
+    time : ndarray, shape (m,)
+        Time since the section crossing [s].
+    error : ndarray, shape (m,)
+        Position error x1 - r [m].
+    velocity : ndarray, shape (m,)
+        Stage velocity v1 [m/s].
+    deflection : ndarray, shape (m,) or None
+        Joint deflection x1 - x2 [m] (isolated plant only).
+    cart_velocity : ndarray, shape (m,) or None
+        Cart velocity v2 [m/s] (isolated plant only).
+    """
+
+    time: np.ndarray
+    error: np.ndarray
+    velocity: np.ndarray
+    deflection: np.ndarray | None
+    cart_velocity: np.ndarray | None
+
+
+@dataclass(frozen=True, eq=False)
+class Cycle(Result):
+    """A hunting cycle, converged as a periodic orbit.
+
+    The Poincare section is x1 - r = 0 crossed upwards (always mid-slip). With
+    a continuous-time controller without delay the state is complete and the
+    orbit is converged by Newton's method on the return map (``method
+    "shooting"``), whose Jacobian (finite differences, checked at two
+    perturbation sizes) gives the Floquet multipliers. A sampled or delayed
+    controller has a state the section does not hold: the orbit is then the
+    one a long simulation settles on (``method "simulation"``) and its
+    multiplier is not computed.
+
+    Attributes
+    ----------
+    crossover : float
+        Controller crossover the cycle was computed at [Hz].
+    amplitude : float
+        Peak-to-peak x1 - r over one period [m].
+    period : float
+        Period [s].
+    stable : bool
+        Whether the cycle attracts (largest multiplier below 1; a cycle found
+        by a long simulation attracted it).
+    multiplier : float or None
+        Largest Floquet multiplier in magnitude [-]; None when not computed.
+    multiplier_check : float or None
+        The same from a ten times larger perturbation [-] (they agree when the
+        finite differences are trustworthy).
+    method : str
+        ``"shooting"`` or ``"simulation"``.
+    residual : float
+        Return-map residual of the converged orbit, in units of the state's
+        physical scales (1 mm, 1 cm/s, Fs / sigma0, Fs) [-].
+    crossings : int
+        Section crossings per period.
+    on_limiter : bool or None
+        Whether the joint reaches its stroke limiter during the cycle
+        (isolated plant); None without isolator.
+    deflection_range : tuple of float or None
+        Smallest and largest joint deflection over the cycle [m].
+    section_state : ndarray, shape (n,)
+        The state at the section crossing (the orbit's initial condition).
+    trace : CycleTrace or None
+        One period, for plots.
+    """
+
+    crossover: float
+    amplitude: float
+    period: float
+    stable: bool
+    multiplier: float | None
+    multiplier_check: float | None
+    method: str
+    residual: float
+    crossings: int
+    on_limiter: bool | None
+    deflection_range: tuple[float, float] | None
+    section_state: np.ndarray = field(repr=False)
+    trace: CycleTrace | None = field(default=None, repr=False)
+
+    def to_dict(self) -> dict:
+        """``amplitude``, ``period``, ``stable``, ``multiplier`` and the rest (SI)."""
+        return dataclass_dict(self)
+
+
+@dataclass(frozen=True, eq=False)
+class StageHunting(Result):
+    """Whether a plant hunts for any move of its family, the cycle, and the boundary.
+
+    Attributes
+    ----------
+    plant : str
+        ``"isolated"`` or ``"non_isolated"``.
+    crossover : float
+        Controller crossover of the answer [Hz].
+    moves : tuple of MoveOutcome
+        Every move tried, the spec's own motion first.
+    cycle : Cycle or None
+        The cycle the hunting moves enter (the largest when they enter
+        several), converged; None when no move hunts.
+    other_cycles : tuple of Cycle
+        Further distinct cycles some moves enter.
+    hunting_free_from : float or None
+        Stage-level hunting-free crossover [Hz]: the fold of the cycle, above
+        which it no longer exists (and no move of the family hunts). None
+        when not computed, or when the cycle persists up to the search's top.
+    boundary : dict or None
+        How ``hunting_free_from`` was found: ``{"bracket": [lo, hi] Hz,
+        "resolution": Hz, "kind": "fold" | "bound" | "none", "note": str,
+        "tests": int}``.
+    first_only : bool
+        Whether the family was cut short at the first hunting move (studies).
+    static_error_bound : float or None
+        For a loop without integrator, the static error (Fc + |offset|) / kp
+        it may rest with [m]; None when the loop integrates.
+    settle_band : float
+        The settle band [m].
+    """
+
+    plant: str
+    crossover: float
+    moves: tuple[MoveOutcome, ...]
+    cycle: Cycle | None
+    other_cycles: tuple[Cycle, ...] = ()
+    hunting_free_from: float | None = None
+    boundary: dict | None = None
+    first_only: bool = False
+    static_error_bound: float | None = None
+    settle_band: float = 1e-5
+
+    @property
+    def hunts(self) -> bool:
+        """Whether any move ends in a sustained cycle."""
+        return any(m.hunts for m in self.moves)
+
+    @property
+    def hunting_moves(self) -> tuple[MoveOutcome, ...]:
+        """The moves that end in a cycle."""
+        return tuple(m for m in self.moves if m.hunts)
+
+    @property
+    def entered_by(self) -> tuple[float, ...]:
+        """Distances of the moves that enter a cycle [m], in the order tried."""
+        return tuple(m.distance for m in self.moves if m.hunts)
+
+    def _rests_too_far(self, m: MoveOutcome) -> bool:
+        bound = self.static_error_bound
+        return m.outcome == "rests" and (bound is None
+                                         or abs(m.final_error) > bound + self.settle_band)
+
+    @property
+    def outcome(self) -> str:
+        """The plant in a word: ``hunts`` (some move ends in a cycle), ``stuck`` (some
+        move rests off its target beyond what the loop explains), ``undetermined``,
+        ``static_error`` (a loop without integrator, every move at rest within its
+        static error) or ``settles``."""
+        if any(m.hunts for m in self.moves):
+            return "hunts"
+        if any(m.outcome == "stuck" or self._rests_too_far(m) for m in self.moves):
+            return "stuck"
+        if any(m.outcome == "undetermined" for m in self.moves):
+            return "undetermined"
+        if any(m.outcome == "rests" for m in self.moves):
+            return "static_error"
+        return "settles"
+
+    @property
+    def acceptable(self) -> bool:
+        """Whether every move comes to rest (at its target, or within a PD loop's static
+        error)."""
+        return self.outcome in ("settles", "static_error")
+
+    @property
+    def spec_move(self) -> MoveOutcome | None:
+        """The outcome of the spec's own motion."""
+        return next((m for m in self.moves if m.label == "spec"), None)
+
+    @property
+    def largest_amplitude(self) -> float:
+        """Largest cycle amplitude over the moves [m]; 0 where none hunts."""
+        amps = [c.amplitude for c in (self.cycle, *self.other_cycles) if c is not None]
+        amps += [m.amplitude for m in self.moves if m.hunts and m.amplitude is not None]
+        return float(max(amps)) if amps else 0.0
+
+    def to_dict(self) -> dict:
+        """The contract's form: ``hunts``, ``moves_tried``, ``moves_hunting``,
+        ``entered_by``, ``cycle``, ``hunting_free_from``, plus the moves."""
+        return {
+            "plant": self.plant, "crossover": self.crossover, "hunts": self.hunts,
+            "outcome": self.outcome, "acceptable": self.acceptable,
+            "moves_tried": len(self.moves),
+            "moves_hunting": len(self.hunting_moves), "entered_by": list(self.entered_by),
+            "cycle": None if self.cycle is None else self.cycle.to_dict(),
+            "other_cycles": [c.to_dict() for c in self.other_cycles],
+            "hunting_free_from": to_jsonable(self.hunting_free_from),
+            "boundary": to_jsonable(self.boundary), "first_only": self.first_only,
+            "moves": [m.to_dict() for m in self.moves]}

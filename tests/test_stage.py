@@ -1,0 +1,249 @@
+"""Stage-level hunting: the move family, the cycle as a periodic orbit, the fold.
+
+Checked against what the product did not generate: the independent solve_ivp
+simulator of ``tests/independent.py`` (the cycle's amplitude and period after
+a long run, moves that hunt just below the fold), Canudas de Wit et al.
+(1995)'s unit-mass PID example (a published period and amplitude), and a
+dense move scan for the boundary.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fi_design.stage import (converge_cycle, family_distances, rest_is_final, stage_hunting,
+                             stage_hunts)
+
+#: The paper setup (isolated, 8 Hz): its independent-simulator parameters.
+PAPER = dict(m1=1.6, m2=0.4, friction=dict(Fs=4.0, Fc=1.0, vs=3e-3, sigma0=1e6, sigma1=1414.0,
+                                           sigma2=20.0),
+             isolator=dict(k=6667.0, s=0.3e-3, c=4.62))
+
+
+@pytest.fixture(scope="module")
+def paper_isolated(paper_spec):
+    """The stage-level answer of the paper setup's isolated plant at 8 Hz."""
+    return stage_hunting(paper_spec, True)
+
+
+def _canudas_spec():
+    from fi_design.specfile import load_spec
+
+    return load_spec({
+        "name": "Canudas de Wit et al. 1995, unit mass under PID",
+        "stage": {"mass": "0.5 kg"}, "cart": {"mass": "0.5 kg"},
+        "friction": {"static": "1.5 N", "coulomb": "1 N", "stribeck_velocity": "1 mm/s",
+                     "viscous": "0.4 N*s/m", "bristle_stiffness": "1e5 N/m",
+                     "bristle_damping": f"{math.sqrt(1e5)} N*s/m"},
+        "controller": {"gains": {"kp": "3 N/m", "ki": "4 N/(m*s)", "kd": "6 N*s/m"},
+                       "derivative_on": "measurement"},
+        "motion": {"moves": [{"distance": "1 m", "velocity": "1 m/s",
+                              "acceleration": "10 m/s^2"}], "duration": "20 s"},
+        "requirements": {"hunting": {"horizon": "1000 s"}}})
+
+
+def _upward_crossings(t, e):
+    i = np.nonzero((e[:-1] < 0) & (e[1:] >= 0))[0]
+    return t[i] - e[i] * (t[i + 1] - t[i]) / (e[i + 1] - e[i])
+
+
+# --------------------------------------------------------------------------- the family
+
+
+def test_family_spans_a_tenth_of_the_stroke_to_five_times_the_move(paper_spec):
+    d = family_distances(paper_spec, True)
+    assert len(d) == 24
+    assert d[0] == pytest.approx(0.03e-3) and d[-1] == pytest.approx(50e-3)
+    assert np.all(np.diff(np.log(d)) == pytest.approx(np.log(d[1] / d[0])))
+    assert family_distances(paper_spec, False)[0] == pytest.approx(0.1e-3)
+
+
+def test_asymmetric_friction_tries_both_directions(paper_spec):
+    from conftest import variant
+
+    from fi_design.simulation import plant_parameters
+
+    spec = variant(paper_spec, **{"friction.coulomb_negative": "1.5 N"})
+    d = family_distances(spec, True, plant_parameters(spec, True))
+    assert len(d) == 48 and sum(x < 0 for x in d) == 24
+    sym = family_distances(paper_spec, True, plant_parameters(paper_spec, True))
+    assert all(x > 0 for x in sym)
+
+
+# --------------------------------------------------------------------------- the paper setup
+
+
+def test_paper_setup_hunts_on_its_cycle_but_rests_after_its_own_move(paper_isolated):
+    st = paper_isolated
+    spec_move = st.moves[0]
+    assert spec_move.label == "spec" and spec_move.outcome == "settles"
+    assert st.hunts and st.outcome == "hunts"
+    entered = [round(d * 1e3, 1) for d in st.entered_by]
+    # issue figures: 1, 15, 20 and 30 mm moves hunt (the family's 1.04, 13.8, 19, 26, 36 mm)
+    assert 1.0 in entered and 19.0 in entered and 26.2 in entered
+    c = st.cycle
+    assert c.method == "shooting" and c.stable and c.residual < 1e-6
+    assert c.amplitude == pytest.approx(1.80e-3, rel=2e-3)
+    assert c.on_limiter is True and c.deflection_range[1] >= 0.3e-3
+    # the multiplier is a property of the orbit, not of the finite differences
+    assert c.multiplier == pytest.approx(c.multiplier_check, rel=0.05)
+    assert 0.0 < c.multiplier < 1.0
+    assert all(m.amplitude == pytest.approx(c.amplitude, rel=1e-2) for m in st.hunting_moves)
+
+
+def test_paper_cycle_agrees_with_a_long_independent_simulation(paper_isolated):
+    """A 20 mm move simulated for 30 s by solve_ivp ends on the same cycle."""
+    from independent import generate
+
+    c = paper_isolated.cycle
+    rec = generate(PAPER["m1"], PAPER["m2"], friction=PAPER["friction"],
+                   isolator=PAPER["isolator"], controller=dict(rule=dict(fc=8.0)),
+                   moves=[dict(distance=0.02, velocity=0.05, acceleration=1.0)], t_end=30.0,
+                   rate=2000.0)
+    t, e = rec.time, rec.truth.x1 - rec.reference
+    tc = _upward_crossings(t, e)
+    tc = tc[tc > 15.0]
+    periods = np.diff(tc)
+    # the long run converges on the orbit geometrically: extrapolate its periods (Aitken)
+    p0, p1, p2 = periods[-3:]
+    limit = p2 - (p2 - p1) ** 2 / ((p2 - p1) - (p1 - p0))
+    assert limit == pytest.approx(c.period, rel=2e-4)
+    last = (t >= tc[-2]) & (t <= tc[-1])
+    assert np.ptp(e[last]) == pytest.approx(c.amplitude, rel=1e-3)
+    # the convergence ratio of the periods is the Floquet multiplier
+    assert (p2 - p1) / (p1 - p0) == pytest.approx(c.multiplier, abs=0.05)
+
+
+def test_paper_fold_lies_above_every_hunting_crossover_of_a_dense_scan(paper_spec,
+                                                                     paper_isolated):
+    fold = paper_isolated.hunting_free_from
+    assert paper_isolated.boundary["kind"] == "fold"
+    lo, hi = paper_isolated.boundary["bracket"]
+    assert hi - lo <= 0.011 and fold == hi
+    assert 11.0 < fold < 11.5  # from about 11 Hz no move of 0.1 to 50 mm hunts
+    dense = np.geomspace(1e-5, 0.1, 120)
+    below, _ = stage_hunts(paper_spec, True, crossover=11.0, family=dense)
+    above, _ = stage_hunts(paper_spec, True, crossover=fold * 1.002, family=dense)
+    assert any(m.hunts for m in below)
+    assert not any(m.hunts for m in above)
+
+
+def test_without_isolator_the_cycle_lives_to_its_fold_near_24_5_hz(paper_spec):
+    st = stage_hunting(paper_spec, False)
+    c = st.cycle
+    assert c.period == pytest.approx(2.063, rel=1e-3)
+    assert c.amplitude == pytest.approx(1.357e-3, rel=2e-3)
+    assert c.multiplier == pytest.approx(0.542, abs=0.02)
+    assert st.hunting_free_from == pytest.approx(24.53, abs=0.05)
+    assert len(st.hunting_moves) >= 20
+
+
+# --------------------------------------------------------------------------- published case
+
+
+def test_canudas_de_wit_1995_pid_example_hunts_with_its_published_cycle():
+    """Canudas de Wit et al. (1995), u = 3 e + 4 int e - 6 v on a unit mass: 24.4 s, 127.8 mm."""
+    spec = _canudas_spec()
+    st = stage_hunting(spec, False, family=[1.0], boundary=False)
+    assert all(m.hunts for m in st.moves)
+    c = st.cycle
+    assert c.period == pytest.approx(24.4, abs=0.05)
+    assert c.amplitude == pytest.approx(0.1278, abs=0.0005)
+    assert c.stable
+
+
+# --------------------------------------------------------------------------- rest
+
+
+def test_rest_within_the_band_is_final_only_below_static_friction(paper_spec):
+    """Without isolator the bristles carry sigma0 (z + r - x1) once the loop pulls x1 to r."""
+    from fi_design.plant import state_index
+    from fi_design.simulation import plant_parameters
+
+    p = plant_parameters(paper_spec, False)
+    idx = state_index(False)
+    y = np.zeros(p.n_states)
+    z_limit = p.Fs / p.sigma0  # 4 um of bristle deflection holds 4 N
+    y[idx["x1"]], y[idx["z"]] = -1e-6, 0.5 * z_limit  # 2 N now, 3 N at the target
+    assert rest_is_final(p, y, 0.0)
+    y[idx["x1"]] = -3e-6  # 2 N now, 5 N > Fs at the target: the integrator breaks it loose
+    assert not rest_is_final(p, y, 0.0)
+
+
+def test_isolated_rest_is_final_while_the_flexure_force_stays_below_fs(paper_spec):
+    from fi_design.plant import state_index
+    from fi_design.simulation import plant_parameters
+
+    p = plant_parameters(paper_spec, True)
+    idx = state_index(True)
+    y = np.zeros(p.n_states)
+    y[idx["x2"]] = -0.28e-3  # cart stuck 0.28 mm behind: k d = 1.87 N < 4 N
+    assert rest_is_final(p, y, 0.0)
+    y[idx["x2"]] = -0.35e-3  # the joint on its limiter: k s + k_stop (d - s) = 52 N
+    assert not rest_is_final(p, y, 0.0)
+
+
+def test_orbit_is_found_from_a_rough_guess_and_falls_to_nothing_from_rest(paper_spec,
+                                                                        paper_isolated):
+    from fi_design.simulation import plant_parameters
+
+    p = plant_parameters(paper_spec, True)
+    c = paper_isolated.cycle
+    rough = np.array(c.section_state) * (1 + 0.05)
+    again = converge_cycle(p, 0.0, rough, 1, 8.0, period=c.period, trace=False)
+    assert again.amplitude == pytest.approx(c.amplitude, rel=1e-4)
+    assert again.period == pytest.approx(c.period, rel=1e-5)
+    still = np.zeros(p.n_states)
+    still[1] = 1e-4  # a gentle nudge through the target: it comes to rest
+    assert converge_cycle(p, 0.0, still, 1, 8.0, period=c.period, trace=False) is None
+
+
+@pytest.mark.slow
+def test_moves_hunting_just_below_the_fold_hunt_in_the_independent_simulator(paper_isolated):
+    """At 11.2 Hz (below the fold) the 0.408 mm move hunts, at 11.5 Hz it settles: solve_ivp."""
+    from independent import generate
+
+    assert paper_isolated.hunting_free_from > 11.2
+    ends = {}
+    for fc in (11.2, 11.5):
+        rec = generate(PAPER["m1"], PAPER["m2"], friction=PAPER["friction"],
+                       isolator=PAPER["isolator"], controller=dict(rule=dict(fc=fc)),
+                       moves=[dict(distance=0.408e-3, velocity=0.05, acceleration=1.0)],
+                       t_end=30.0, rate=1000.0)
+        e = rec.truth.x1 - rec.reference
+        ends[fc] = np.ptp(e[rec.time > 20.0])
+    assert ends[11.2] > 1e-3 and ends[11.5] < 1e-5
+
+
+# --------------------------------------------------------------------------- the kernel's watch
+
+
+def test_the_watch_lands_on_the_section_and_leaves_the_trajectory_alone(paper_spec):
+    """Section crossings are stepped to (x1 = r to round-off) and agree with the trace."""
+    from fi_design.compiled import run
+    from fi_design.plant import N_WATCH, W_ARM, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_START
+    from fi_design.simulation import plant_parameters, tolerances
+    from fi_design.stage import _family_reference
+
+    p = plant_parameters(paper_spec, False)
+    ref, end = _family_reference(paper_spec, 0.01, 12.0)
+    t_out = np.arange(0.0, end + 12.0, 1e-4)
+    args = (p.to_array(), np.zeros(p.n_states), ref.breaks, ref.coeffs, True, end + 12.0, t_out,
+            1e-8, tolerances(p, 1e-8), 0.05, 2_000_000, 10.0)
+    w = np.zeros(N_WATCH)
+    w[W_START], w[W_LEVEL], w[W_QUIET], w[W_MAX_CROSSINGS], w[W_ARM] = (end, ref.final,
+                                                                        np.inf, 100, 1e-5)
+    watched = run(*args, watch=w, crossings=100)
+    plain = run(*args)
+    assert watched.stop == "end" and plain.stop == "end"
+    assert len(watched.crossing_times) >= 4
+    assert np.max(np.abs(watched.crossing_states[:, 0] - ref.final)) < 1e-10  # 0.1 nm
+    e = plain.states[:, 0] - plain.reference
+    tc = _upward_crossings(t_out, e)
+    tc = tc[tc >= end]
+    assert np.allclose(watched.crossing_times, tc[:len(watched.crossing_times)], atol=1e-5)
+    # the section only splits steps: the trajectory is the same within the tolerance
+    assert np.nanmax(np.abs(watched.states[:, 0] - plain.states[:, 0])) < 1e-6
