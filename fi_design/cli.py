@@ -38,8 +38,9 @@ from typing import Annotated, Optional
 import typer
 
 from .cliparts import (DEFAULT_COMMAND, EXIT_VERDICT, Drive, ExecutorKind, Force, Jobs,
-                       JsonOut, NoCache, NoIsolator, Scheduler, SpecArg, app, check_drive,
-                       check_outputs, check_spec_path, command_line, json_text, load,
+                       JsonOut, Measure, NoCache, NoIsolator, Scheduler, SpecArg, app,
+                       check_drive, check_measure, check_outputs, check_spec_path,
+                       command_line, json_text, load,
                        output_option, run_study, study_pool, write_outputs, write_report,
                        write_study)
 
@@ -248,13 +249,14 @@ def sweep_command(
         "Write the heatmap (or line plot)."),
     report_out: Optional[Path] = output_option("--report", "OUT.html",
         "Write the report of the sweep (HTML, or PDF for a .pdf name)."),
+    measure: Measure = "stage",
     jobs: Jobs = 0,
     executor: ExecutorKind = "local",
     scheduler: Scheduler = None,
     no_cache: NoCache = False,
     force: Force = False,
 ) -> None:
-    """Map hunting cycles over one or two spec values (the paper's Figure 4).
+    """Map hunting over one or two spec values (the paper's Figure 4).
 
     Every point is the spec with the swept values replaced and validated; an
     invalid point (say Fs < Fc) or a failed simulation is recorded, and the
@@ -283,8 +285,10 @@ def sweep_command(
     if ay is not None and ay.path == ax.path:
         raise typer.BadParameter("--x and --y sweep the same value", param_hint="--y")
     isolated = False if no_isolator else spec_obj.has_isolator
+    check_measure(measure)
     result = run_study("sweep", pool, no_cache, lambda ex, bar, cache: sweep(
-        spec_obj, ax, ay, isolated=isolated, executor=ex, progress=bar, cache=cache))
+        spec_obj, ax, ay, isolated=isolated, executor=ex, progress=bar, cache=cache,
+        measure=measure))
     console = make_console()
     write_study(console, outs, result, sweep_figure)
     print_sweep(console, result, spec_path=spec, executor=pool.describe())
@@ -309,6 +313,7 @@ def study_command(
         "--maps", metavar="ABCD", help="Which maps: A static vs Coulomb friction, B crossover "
                                        "vs mass (both without isolator), C stroke vs stiffness, "
                                        "D crossover vs stroke (with isolator).")] = "ABCD",
+    measure: Measure = "stage",
     jobs: Jobs = 0,
     executor: ExecutorKind = "local",
     scheduler: Scheduler = None,
@@ -337,6 +342,7 @@ def study_command(
         raise typer.BadParameter("the report would overwrite a file of the study",
                                  param_hint="--report")
     check_spec_path(spec)
+    check_measure(measure)
     pool = study_pool(executor, jobs, scheduler)
     spec_obj = load(spec)
 
@@ -345,7 +351,8 @@ def study_command(
     from .studies import paper_study
 
     result = run_study("paper study", pool, no_cache, lambda ex, bar, cache: paper_study(
-        spec_obj, resolution, maps="".join(letters), executor=ex, progress=bar, cache=cache))
+        spec_obj, resolution, maps="".join(letters), executor=ex, progress=bar, cache=cache,
+        measure=measure))
     console = make_console()
     fig = study_figure(result)
     payloads = {"figure4.svg": figure_bytes(fig, "svg"), "figure4.png": figure_bytes(fig, "png"),
@@ -390,6 +397,7 @@ def robustness_command(
         "Write a bar chart of the probabilities."),
     report_out: Optional[Path] = output_option("--report", "OUT.html",
         "Write the report (HTML, or PDF for a .pdf name)."),
+    measure: Measure = "stage",
     jobs: Jobs = 0,
     executor: ExecutorKind = "local",
     scheduler: Scheduler = None,
@@ -398,9 +406,11 @@ def robustness_command(
 ) -> None:
     """Probability of hunting when friction (or any spec value) scatters.
 
-    Draws the scattered values around the spec's, simulates every sample with
-    and without the isolator, and prints the probability of hunting with its
-    Wilson confidence interval. The same seed gives the same result.
+    Draws the scattered values around the spec's, judges every sample with
+    and without the isolator (by default over every move of its family), and
+    prints the probability of hunting, and of not settling for any reason,
+    with their Wilson confidence intervals. The same seed gives the same
+    result.
     """
     outs = check_outputs((spec,), force, csv=(csv_out, (".csv",)), json=(json_out, (".json",)),
                     figure=(figure_out, (".svg", ".png")),
@@ -413,6 +423,7 @@ def robustness_command(
         raise typer.BadParameter("give at least one --scatter PATH=SPREAD (e.g. "
                                  "--scatter friction.static=10%) or --position-friction",
                                  param_hint="--scatter")
+    check_measure(measure)
     pool = study_pool(executor, jobs, scheduler)
     spec_obj = load(spec)
 
@@ -424,7 +435,7 @@ def robustness_command(
     pf = parse_position_friction(position_friction) if position_friction else None
     result = run_study("robustness", pool, no_cache, lambda ex, bar, cache: robustness(
         spec_obj, items, samples, seed=seed, distribution=distribution, position_friction=pf,
-        confidence=confidence, executor=ex, progress=bar, cache=cache))
+        confidence=confidence, executor=ex, progress=bar, cache=cache, measure=measure))
     console = make_console()
     write_study(console, outs, result, robustness_figure)
     print_robustness(console, result, spec_path=spec, executor=pool.describe())

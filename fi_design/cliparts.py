@@ -193,12 +193,23 @@ Scheduler = Annotated[Optional[str], typer.Option(
     "--scheduler", metavar="ADDRESS",
     help="Address of a running dask scheduler, e.g. tcp://10.0.0.5:8786 (with --executor "
          "dask). Without it, a local cluster is started.", show_default=False)]
+Measure = Annotated[str, typer.Option(
+    "--measure", metavar="stage|move",
+    help="What a point measures: 'stage' (default: does any move of the family end in a "
+         "hunting cycle, and how large is it) or 'move' (the paper's metric: hunting cycles "
+         "counted on the spec's own move).")]
 NoCache = Annotated[bool, typer.Option(
     "--no-cache", help="Neither read nor write the result cache (FI_DESIGN_CACHE_DIR, else the "
                        "user cache directory).")]
 
 
 # --------------------------------------------------------------------------- steps of a command
+
+
+def check_measure(measure: str) -> None:
+    """Refuse a ``--measure`` other than ``stage`` or ``move`` (exit 2)."""
+    if measure not in ("stage", "move"):
+        raise typer.BadParameter(f"'{measure}' is not stage or move", param_hint="--measure")
 
 
 def check_spec_path(spec: Path) -> None:

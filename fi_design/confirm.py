@@ -4,11 +4,13 @@ The guideline's four steps are linear and static. This module simulates the
 stage with friction, with and without the isolator, at the design crossover
 (paper section 2.3 and Figure 5), and adds what a reviewer wants to know:
 
-- the verdict of each plant from the hunting metric (``settled``,
-  ``hunting``, ``stuck`` or ``undetermined``);
-- the lowest crossover at which each plant stops hunting, from a scan with
-  the simulation (the paper's headline: the isolator needs far less
-  bandwidth, 5 Hz against 14-20 Hz);
+- whether each plant hunts as a *stage*: after any move of its family, with
+  the cycle it then enters converged as a periodic orbit
+  (:func:`fi_design.stage.stage_hunting`); the paper's metric on the spec's
+  own move stays beside it, labelled as that move's answer;
+- the lowest crossover from which each plant no longer hunts for any move:
+  the fold of its cycle, found by bisection (the paper's headline: the
+  isolator needs far less bandwidth);
 - where the cart lands: the joint deflection at rest after the move and the
   flexure force there against Fs. The paper's rule k * stroke < Fs is
   sufficient but conservative; the force the cart actually sees at rest is
@@ -39,57 +41,17 @@ import numpy as np
 from . import spec as _spec
 from .errors import ArgumentError
 from .results import Check, Status, frozen_array
-from .results.design import Confirmation, CrossoverScan, Landing, PlantVerdict
+from .results.design import Confirmation, Landing, PlantVerdict
 from .results.simulation import SimulationResult
+from .results.stage import StageHunting
 from .simulation import simulate
+from .stage import length_range, length_text, stage_hunting
 
 PLANTS = ("isolated", "non_isolated")
 
 
 def _hunts(v: PlantVerdict) -> bool:
     return v.metrics.verdict == "hunting"
-
-
-def scan_crossover(spec: _spec.Spec, isolated: bool, start: float | None = None,
-                   stop: float | None = None, step: float | None = None,
-                   progress=None) -> CrossoverScan:
-    """Simulate a crossover grid and find the lowest crossover that stays hunting-free.
-
-    Parameters
-    ----------
-    spec : Spec
-        The design spec (grid from ``spec.simulation.crossover_scan`` unless
-        given).
-    isolated : bool
-        Which plant.
-    start, stop, step : float, optional
-        Grid [Hz].
-    progress : callable, optional
-        Called with a short message before each simulation.
-    """
-    cfg = spec.simulation.crossover_scan
-    start = cfg.start if start is None else start
-    stop = cfg.stop if stop is None else stop
-    step = cfg.step if step is None else step
-    grid = np.arange(start, stop + 0.5 * step, step)
-    done: list[tuple[float, str, int]] = []
-    plant = "with isolator" if isolated else "without isolator"
-    minimum = None
-    for fc in grid[::-1]:
-        if progress is not None:
-            progress(f"scanning the crossover {plant}: {fc:g} Hz")
-        m = simulate(spec, isolated=isolated, crossover=float(fc)).metrics
-        done.append((float(fc), m.verdict, m.hunting_cycles))
-        if m.verdict != "settled":
-            break
-        minimum = float(fc)
-    done.reverse()
-    return CrossoverScan(plant="isolated" if isolated else "non_isolated",
-                         crossovers=frozen_array([d[0] for d in done]),
-                         verdicts=tuple(d[1] for d in done),
-                         hunting_cycles=frozen_array([d[2] for d in done], dtype=int),
-                         minimum=minimum, resolution=float(step),
-                         grid=(float(start), float(stop), float(step)))
 
 
 def landing(spec: _spec.Spec, result: SimulationResult) -> Landing:
@@ -171,11 +133,14 @@ def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
     res_non = simulate(spec, isolated=False)
     iso = PlantVerdict.of("isolated", res_iso, bound)
     non = PlantVerdict.of("non_isolated", res_non, bound)
-    scans = {"isolated": scan_crossover(spec_iso, True, progress=progress),
-             "non_isolated": scan_crossover(spec, False, progress=progress)}
+    stage = {"isolated": stage_hunting(spec_iso, True, progress=progress),
+             "non_isolated": stage_hunting(spec, False, progress=progress)}
     cfg = spec.simulation.crossover_scan
-    mins = {"isolated": scans["isolated"].minimum, "non_isolated": scans["non_isolated"].minimum,
-            "resolution": cfg.step, "scan": [cfg.start, cfg.stop]}
+    widths = [st.boundary["resolution"] for st in stage.values() if st.boundary]
+    mins = {"isolated": stage["isolated"].hunting_free_from,
+            "non_isolated": stage["non_isolated"].hunting_free_from,
+            "resolution": max(widths) if widths else None,
+            "search": [cfg.start, max(cfg.stop, res_iso.crossover)]}
     land = landing(spec_iso, res_iso)
     say("cross-checking with the other friction model ...")
     other_iso = PlantVerdict.of("isolated", simulate(_other_model(spec_iso), isolated=True),
@@ -183,9 +148,9 @@ def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
     other_non = PlantVerdict.of("non_isolated", simulate(_other_model(spec), isolated=False),
                                 bound)
     agree = _hunts(other_iso) == _hunts(iso) and _hunts(other_non) == _hunts(non)
-    checks = _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested)
-    return Confirmation(isolated=iso, non_isolated=non, min_hunting_free_crossover=mins,
-                        scans=scans, landing=land,
+    checks = _checks(spec, iso, non, stage, mins, land, agree, other_iso, other_non, suggested)
+    return Confirmation(isolated=iso, non_isolated=non, stage=stage,
+                        min_hunting_free_crossover=mins, landing=land,
                         cross_check={"isolated": other_iso, "non_isolated": other_non},
                         models_agree=agree, suggested_isolator=suggested, checks=tuple(checks),
                         results={"isolated": res_iso, "non_isolated": res_non})
@@ -200,7 +165,47 @@ def _plant_text(v: PlantVerdict, label: str, fc: float) -> str:
     return f"{label} at {fc:g} Hz: {m.verdict} ({m.reason})"
 
 
-def _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested) -> list[Check]:
+
+def stage_text(st: StageHunting, label: str) -> str:
+    """One sentence on a plant's stage-level answer (for checks, verdict and report)."""
+    fc = st.crossover
+    n = len(st.moves)
+    if st.hunts:
+        h = st.hunting_moves
+        dist = sorted(abs(m.distance) for m in h)
+        c = st.cycle
+        if c is not None:
+            cyc = f"a cycle of {length_text(c.amplitude)} peak to peak, period {c.period:.3g} s"
+            if c.on_limiter:
+                cyc += ", the joint on its limiter"
+        else:
+            m = h[0]
+            cyc = (f"a cycle of {length_text(m.amplitude)} peak to peak" if m.amplitude else "a cycle")
+        moves = (f"the {length_text(dist[0])} move" if len(dist) == 1 else
+                 f"{len(h)} of {n} moves, from {length_range(dist[0], dist[-1])},")
+        sm = st.spec_move
+        own = ("" if sm is None or sm.hunts else
+               f"; after the spec's own motion it {'settles' if sm.outcome == 'settles' else sm.outcome}")
+        return f"{label} hunts at {fc:g} Hz: {moves} end in {cyc}{own}"
+    if st.outcome == "stuck":
+        m = next(m for m in st.moves if m.outcome in ("stuck", "rests"))
+        return (f"{label} sticks at {fc:g} Hz: after the {length_text(abs(m.distance))} move it "
+                f"rests {length_text(abs(m.final_error))} from its target ({m.reason})")
+    if st.outcome == "undetermined":
+        m = next(m for m in st.moves if m.outcome == "undetermined")
+        return (f"{label} cannot be judged at {fc:g} Hz after the {length_text(abs(m.distance))} move: "
+                f"{m.reason}")
+    if st.outcome == "static_error":
+        worst = max(abs(m.final_error) for m in st.moves)
+        return (f"{label} comes to rest at {fc:g} Hz after all {n} moves, at most "
+                f"{length_text(worst)} from the target, within the (Fs + |offset|) / kp = "
+                f"{length_text(st.static_error_bound)} that static friction can hold against a "
+                "loop without integrator")
+    return f"{label} comes to rest at its target at {fc:g} Hz after all {n} moves"
+
+
+def _checks(spec, iso, non, stage, mins, land, agree, other_iso, other_non,
+            suggested) -> list[Check]:
     """The confirmation's checks: the spec's own plant judged, the other one information."""
     fc = _spec.design_crossover(spec)
     step = "simulation (paper section 2.3)"
@@ -216,40 +221,52 @@ def _checks(spec, iso, non, mins, land, agree, other_iso, other_non, suggested) 
     plants = {"isolated": iso, "non_isolated": non}
     out = []
     for key in ("isolated", "non_isolated"):
-        v = plants[key]
+        st = stage[key]
         judged = key == own_key
-        out.append(Check(f"simulation_{key}", v.acceptable if judged else None,
-                         float(v.metrics.hunting_cycles), 0.0 if judged else None, "cycles",
-                         _plant_text(v, labels[key], fc), step))
-    res = mins["resolution"]
+        out.append(Check(f"simulation_{key}", st.acceptable if judged else None,
+                         float(len(st.hunting_moves)), 0.0 if judged else None, "moves",
+                         stage_text(st, labels[key]), step))
     for key in ("isolated", "non_isolated"):
+        v = plants[key]
+        text = "the spec's own motion, the paper's metric: " + _plant_text(v, labels[key], fc)
+        slow = key == own_key and not v.acceptable and stage[key].acceptable
+        if slow:  # every move comes to rest, but the spec's not within the metric's window
+            text += ("; every move comes to rest in the end, but not within the window of the "
+                     "metric: a slow settling to review")
+        out.append(Check(f"spec_move_{key}", None, float(v.metrics.hunting_cycles), None,
+                         "cycles", text, step, status=Status.WARN if slow else None))
+    for key in ("isolated", "non_isolated"):
+        st = stage[key]
         m = mins[key]
         judged = key == own_key
-        scan = (f"scan {mins['scan'][0]:g} to {mins['scan'][1]:g} Hz" if m is None
-                else f"scan resolution {res:g} Hz")
-        text = (f"{labels[key]}: " + ("hunting-free nowhere in the scan" if m is None
-                                      else f"hunting-free from {m:g} Hz")
-                + f" ({scan}); design crossover {fc:g} Hz")
+        b = st.boundary or {}
+        how = (f"the fold of its cycle, bisected to {b['resolution']:.2g} Hz"
+               if b.get("kind") == "fold" else b.get("note", "not computed"))
+        text = (f"{labels[key]}: " + ("no move of the family hunts from "
+                                      f"{m:.4g} Hz up" if m is not None
+                                      else "hunts for some move up to the top of the search")
+                + f" ({how}); design crossover {fc:g} Hz")
         if not judged:
             out.append(Check(f"min_crossover_{key}", None, m, None, "Hz", text, step))
         elif not integrates:
             out.append(Check(f"min_crossover_{key}", None, m, fc, "Hz", text + (
-                "; the loop has no integrator, so below that crossover it rests with a static "
-                "error rather than hunting"), step))
+                "; the loop has no integrator, so it rests with a static error rather than "
+                "hunting"), step))
         elif m is None:
             out.append(Check(f"min_crossover_{key}", False, m, fc, "Hz", text + (
-                ": it does not settle even at the top of the scan"), step, status=Status.WARN))
+                ": a crossover that ends hunting was not found"), step, status=Status.WARN))
         elif fc >= m:
             out.append(Check(f"min_crossover_{key}", True, m, fc, "Hz", text, step))
         else:
             out.append(Check(f"min_crossover_{key}", False, m, fc, "Hz", text + (
-                ": the design crossover lies below the boundary, where hunting comes and goes"),
+                ": the design crossover lies below it, where the cycle exists"
+                + ("" if st.hunts else " although no move of the family enters it")),
                 step, status=Status.WARN))
-    mn = non.metrics
-    if mn.verdict != "hunting":
+    stn = stage["non_isolated"]
+    if not stn.hunts:
         out.append(Check("isolator_needed", None, None, None, "-",
-                         f"the stage without isolator does not hunt at {fc:g} Hz "
-                         f"({non.outcome.replace('_', ' ')}): the isolator is not needed at "
+                         f"the stage without isolator does not hunt after any move at {fc:g} "
+                         f"Hz ({stn.outcome.replace('_', ' ')}): the isolator is not needed at "
                          "this crossover", step))
     if land is not None:
         ok = (not land.on_limiter) and land.force < land.static_friction

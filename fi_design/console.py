@@ -310,7 +310,11 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     sim = data.get("simulation")
     if isinstance(sim, dict) and "isolated" in sim:
         h = result.spec.requirements.hunting
-        console.print(_simulation_table(sim, (h.window_start, h.window_start + h.window_length)))
+        console.print(_simulation_table(sim, (h.window_start, h.window_start + h.window_length),
+                                        data.get("stage_hunting")))
+        for line in moves_strips(data.get("stage_hunting") or {},
+                                 bool(sim.get("suggested_isolator"))):
+            console.print(line)
 
     conclusion = getattr(result, "conclusion", "") or data.get("conclusion", "")
     if conclusion:
@@ -361,7 +365,7 @@ def print_verdict(console: "Console", result) -> None:
     if rob is not None:
         p = "-" if rob.hunting_probability is None else f"{100 * rob.hunting_probability:.3g} %"
         body.add_row(Text("Scatter", style="bold"), Text(
-            f"hunting in {p} of {rob.valid} samples ({100 * rob.interval[0]:.2g}-"
+            f"does not settle in {p} of {rob.valid} samples ({100 * rob.interval[0]:.2g}-"
             f"{100 * rob.interval[1]:.3g} % at {100 * rob.confidence:.3g} %), limit "
             f"{100 * rob.limit:.3g} %"))
     if mar is not None:
@@ -369,7 +373,7 @@ def print_verdict(console: "Console", result) -> None:
         if mar.crossover_factor is not None:
             items.append(f"crossover {'>= ' if mar.crossover_factor_bound else ''}"
                          f"{mar.crossover_factor:.3g}x the hunting-free "
-                         f"{mar.hunting_free_crossover:g} Hz")
+                         f"{_fmt(mar.hunting_free_crossover, 4)} Hz")
         if mar.end_stop_clearance is not None:
             items.append(f"end stop {_qty(mar.end_stop_clearance, 'm', 3)} away at rest")
         if mar.stiffness_factor is not None:
@@ -392,8 +396,60 @@ def print_verdict(console: "Console", result) -> None:
 #: Friction models as the literature names them.
 _MODEL_NAMES = {"lugre": "LuGre", "switch": "switch"}
 
+#: One character per move outcome in :func:`moves_strips`, with its style.
+MOVE_GLYPHS = {"hunts": ("\u25cf", "bold red"), "settles": ("\u00b7", "green"),
+               "rests": ("\u25aa", "green"), "stuck": ("\u25aa", "bold yellow"),
+               "undetermined": ("?", "bold yellow")}
 
-def _simulation_table(sim: dict, window: tuple[float, float] | None = None) -> Any:
+
+def moves_strips(stages: dict, suggested: bool = False) -> list:
+    """The move family at a glance: one character per move, small to large, per plant.
+
+    ``●`` ends in a cycle, ``·`` settles, ``▪`` rests off target (yellow: stuck),
+    ``?`` undetermined; negative moves on a second strip.
+
+    Parameters
+    ----------
+    stages : dict
+        ``DesignResult.to_dict()["stage_hunting"]``.
+    suggested : bool
+        Whether the isolated plant is the suggested isolator.
+
+    Returns
+    -------
+    list of rich.text.Text
+    """
+    from rich.text import Text
+
+    names = {"isolated": "suggested isolator" if suggested else "with isolator",
+             "non_isolated": "without isolator"}
+    out = []
+    for key in ("isolated", "non_isolated"):
+        st = stages.get(key)
+        if not st:
+            continue
+        moves = [m for m in st.get("moves", []) if m.get("label") == "family"]
+        for sign, word in ((1.0, ""), (-1.0, " (negative)")):
+            side = sorted((m for m in moves if m["distance"] * sign > 0),
+                          key=lambda m: abs(m["distance"]))
+            if not side:
+                continue
+            lo, hi = abs(side[0]["distance"]), abs(side[-1]["distance"])
+            unit, f = _row_scale("m", [lo, hi])
+            line = Text(f"Moves {_fmt(lo * f, 3)} to {_fmt(hi * f, 3)} {unit}, "
+                        f"{names[key]}{word}: ")
+            for m in side:
+                glyph, style = MOVE_GLYPHS.get(m["outcome"], ("x", "bold yellow"))
+                line.append(glyph, style=style)
+            out.append(line)
+    if out:
+        out.append(Text("  \u25cf ends in a hunting cycle, \u00b7 settles, \u25aa rests off "
+                        "target, ? not judged", style="dim"))
+    return out
+
+
+def _simulation_table(sim: dict, window: tuple[float, float] | None = None,
+                      stages: dict | None = None) -> Any:
     """Table of the simulated verdicts from the confirmation's JSON form.
 
     One column per plant, one row per quantity, so it reads at any width;
@@ -405,6 +461,8 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None) -> A
         ``DesignResult.to_dict()["simulation"]``.
     window : tuple of float, optional
         The counting window [s], named in the cycles row.
+    stages : dict, optional
+        ``DesignResult.to_dict()["stage_hunting"]``: the stage-level rows.
     """
     from rich.text import Text
 
@@ -416,7 +474,7 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None) -> A
     mins = sim.get("min_hunting_free_crossover") or {}
     t = _table(f"Nonlinear confirmation ({_MODEL_NAMES.get(model, model)} simulation, paper "
                "section 2.3)")
-    t.add_column("")
+    t.add_column("", no_wrap=True)
     plants = (("isolated", label), ("non_isolated", "without isolator"))
     for _, name in plants:
         t.add_column(Text(name), justify="right")
@@ -424,15 +482,48 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None) -> A
         f"in [{_fmt(float(window[0]))} s, {_fmt(float(window[1]))} s)"
 
     def verdict_text(verdict: str) -> Any:
-        style = {"settled": "bold green", "hunting": "bold red"}.get(verdict, "bold yellow")
-        return Text(verdict, style=style)
+        style = {"settled": "bold green", "settles": "bold green", "static_error": "bold green",
+                 "hunting": "bold red", "hunts": "bold red"}.get(verdict, "bold yellow")
+        return Text(verdict.replace("_", " "), style=style)
+
+    stages = stages or {}
+
+    def stage(key: str) -> dict:
+        return stages.get(key) or {}
 
     def free_from(key: str) -> str:
         m = mins.get(key)
-        step = mins.get("resolution")
+        b = stage(key).get("boundary") or {}
         if m is None:
-            return "not in the scan"
-        return f"{m:g} Hz" + (f" (±{step:g})" if step else "")
+            return "above the search" if b.get("kind") == "bound" else "-"
+        return f"{_fmt(m, 4)} Hz" + ("" if b.get("kind") == "fold" else " (bound)")
+
+    def hunting_moves(key: str) -> str:
+        st = stage(key)
+        if not st:
+            return "-"
+        return f"{st.get('moves_hunting')} of {st.get('moves_tried')}"
+
+    def entered(key: str) -> str:
+        d = sorted(abs(x) for x in stage(key).get("entered_by") or [])
+        if not d:
+            return "-"
+        unit, f = _row_scale("m", d)
+        return _qty(d[0], "m", 3) if len(d) == 1 else \
+            f"{_fmt(d[0] * f, 3)} to {_fmt(d[-1] * f, 3)} {unit}"
+
+    def cycle(key: str, name: str, unit: str | None = None) -> Any:
+        c = stage(key).get("cycle")
+        if not c or c.get(name) is None:
+            return "-"
+        value = c[name]
+        if unit == "m":
+            return _qty(value, "m", 3)
+        if unit == "s":
+            return f"{_fmt(value, 3)} s"
+        if isinstance(value, bool):
+            return "yes" if value else "no"
+        return _fmt(value, 3)
 
     def period(v: dict) -> str:
         return "-" if v.get("period") is None else f"{_fmt(v['period'], 3)} s"
@@ -442,13 +533,20 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None) -> A
         return "never" if st is None else f"{_fmt(st, 3)} s"
 
     rows = [
-        ("Verdict", lambda k, v: verdict_text(v.get("verdict", ""))),
+        ("Stage, after every move", lambda k, v: verdict_text(stage(k).get("outcome", ""))),
+        ("Moves ending in a cycle", lambda k, v: hunting_moves(k)),
+        ("Moves that enter it", lambda k, v: entered(k)),
+        ("Cycle, peak to peak", lambda k, v: cycle(k, "amplitude", "m")),
+        ("Cycle period", lambda k, v: cycle(k, "period", "s")),
+        ("Floquet multiplier", lambda k, v: cycle(k, "multiplier")),
+        ("Joint on its limiter", lambda k, v: cycle(k, "on_limiter")),
+        ("No move hunts from", lambda k, v: free_from(k)),
+        ("Spec's motion: verdict", lambda k, v: verdict_text(v.get("verdict", ""))),
         (f"Hunting cycles {counted}", lambda k, v: str(v.get("hunting_cycles"))),
         ("Amplitude, peak to peak", lambda k, v: _qty(v.get("amplitude"), "m", 3)),
         ("Period", lambda k, v: period(v)),
         ("Settling time after the motion", lambda k, v: settling(v)),
         ("Final error x1 - r", lambda k, v: _qty(v.get("final_error"), "m", 3)),
-        ("Hunting-free from (scan step)", lambda k, v: free_from(k)),
     ]
     if other:
         rows.append((f"Cross-check, {_MODEL_NAMES.get(other_model, other_model)} model",
@@ -668,13 +766,15 @@ def sweep_grid_table(result, max_columns: int = 25):
     for v in x.values:
         t.add_column(Text(_fmt(v * xf, 3)), justify="right", no_wrap=True)
     rows = result.verdict.reshape(-1, len(x.values))
-    cycles = result.hunting_cycles.reshape(-1, len(x.values))
+    stage = getattr(result, "measure", "move") == "stage"
+    values = (result.amplitude * 1e3 if stage else result.hunting_cycles).reshape(
+        -1, len(x.values))
     labels = [""] if y is None else [_fmt(v * yf, 3) for v in y.values]
-    for label, vrow, crow in zip(labels, rows, cycles):
+    for label, vrow, crow in zip(labels, rows, values):
         cells = []
         for v, c in zip(vrow, crow):
             if v == "hunting":
-                cells.append(Text(str(int(c)), style="bold red"))
+                cells.append(Text(f"{c:.2g}" if stage else str(int(c)), style="bold red"))
             else:
                 mark, style = _CELL.get(str(v), ("", ""))
                 cells.append(Text(mark, style=style))
@@ -696,7 +796,10 @@ def grid_caption(result) -> str:
     """
     from .plots import axis_label
 
-    text = f"hunting cycles in the window; columns: {axis_label(result.x.path, result.x.unit)}"
+    what = ("peak to peak of the cycle some move ends in [mm]"
+            if getattr(result, "measure", "move") == "stage"
+            else "hunting cycles of the spec's move in the window")
+    text = f"{what}; columns: {axis_label(result.x.path, result.x.unit)}"
     if result.y is not None:
         text += f", rows: {axis_label(result.y.path, result.y.unit)}"
     return text + "; · settled, s stuck, ? undetermined, - invalid, × failed"

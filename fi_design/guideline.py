@@ -523,12 +523,12 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         compiled). Default True; CAD loops that only need the linear steps pass
         False.
     executor : concurrent.futures-style executor, optional
-        Runs the confirmation and the robustness study, as two tasks
-        (``submit`` returning a future with ``result`` and ``cancel``), while
-        this process does the linear analysis: with a process pool of two
-        workers the three overlap (and a first run compiles the simulation
-        kernel there). None runs them here, after the linear steps. The
-        library creates no pool.
+        Runs the confirmation as one task and the robustness samples in
+        chunks (``submit`` returning a future with ``result``, ``cancel`` and
+        ``add_done_callback``), while this process does the linear analysis:
+        with a process pool of two workers they overlap (and a first run
+        compiles the simulation kernel there). None runs them here, after the
+        linear steps. The library creates no pool.
     progress : callable, optional
         ``progress(text)`` with a short message as the work proceeds (the
         confirmation's own messages too when it runs here).
@@ -561,8 +561,6 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     pending = []
     if confirm and executor is not None:
         pending.append(executor.submit(run_confirmation, spec, suggestion))
-        if robust:
-            pending.append(executor.submit(_verdict.run_robustness, spec, suggestion))
     try:
         gap = step1_friction_gap(spec)
         xo = step2_crossover(spec)
@@ -585,17 +583,24 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     if confirm:
         if progress is not None:
             progress("simulating with and without the isolator ...")
-        sim = pending[0].result() if pending else \
-            run_confirmation(spec, suggestion, progress=progress)
         if robust:
+            # the samples go to the executor in chunks, beside the confirmation
             if progress is not None:
                 progress("simulating the friction scatter of requirements.robustness ...")
-            study = pending[1].result() if pending else _verdict.run_robustness(
+            study = _verdict.run_robustness(
                 spec, suggestion, None if progress is None else
-                (lambda done, total: progress(f"friction scatter: {done}/{total} simulations")))
+                (lambda done, total: progress(f"friction scatter: {done}/{total} samples")),
+                executor=executor)
+        sim = pending[0].result() if pending else \
+            run_confirmation(spec, suggestion, progress=progress)
+        own = "isolated" if spec.has_isolator else "non_isolated"
+        text = _conclusion(spec, gap, xo, st, fx, pid, advice, checks,
+                           hunts=sim.stage[own].hunts)
         result = replace(result, simulation=sim, checks=result.checks + sim.checks,
-                         conclusion=result.conclusion + _simulation_sentence(spec, sim))
+                         conclusion=text + _simulation_sentence(spec, sim))
     rob = None if study is None else _verdict.robustness_check(spec, study)
+    if rob is not None:  # a check like the others: the tally counts it
+        result = replace(result, checks=result.checks + (_verdict.robustness_as_check(rob),))
     margins = _verdict.margins(spec, xo, st, fx, pid, sim)
     result = replace(
         result, robustness=rob, margins=margins,
@@ -607,37 +612,36 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
 
 
 def _simulation_sentence(spec: Spec, sim: Confirmation) -> str:
-    """The conclusion's sentence on the simulated verdicts (the spec's own plant first)."""
-    iso, non = sim.isolated, sim.non_isolated
+    """The conclusion's sentences on the simulated stage (the spec's own plant first)."""
+    from .confirm import stage_text
+
     mins = sim.min_hunting_free_crossover
-    fc = design_crossover(spec)
 
     def f(x):
-        return "beyond the scan" if x is None else f"from {x:g} Hz"
-
-    def o(v):
-        return f"{v.outcome.replace('_', ' ')} ({v.metrics.hunting_cycles} cycles)"
+        return "beyond the search" if x is None else f"from {x:.4g} Hz"
 
     if sim.suggested_isolator:
-        text = (f" The LuGre simulation at {fc:g} Hz gives: the stage as specified, without "
-                f"isolator, {o(non)}, hunting-free {f(mins['non_isolated'])}; with the "
-                f"suggested isolator (a recommendation, not the hardware) it would be {o(iso)}, "
-                f"hunting-free {f(mins['isolated'])} (resolution {mins['resolution']:g} Hz).")
+        own, other = "non_isolated", "isolated"
+        labels = ("The stage as specified, without isolator,",
+                  "with the suggested isolator (a recommendation, not the hardware) it")
     else:
-        text = (f" The LuGre simulation at {fc:g} Hz gives: with the isolator {o(iso)}, "
-                f"without it {o(non)}; hunting-free {f(mins['isolated'])} with the isolator "
-                f"and {f(mins['non_isolated'])} without (resolution {mins['resolution']:g} Hz).")
-    model = sim.isolated.friction_model
-    if model != "lugre":
-        text = text.replace("The LuGre simulation", f"The {model} simulation")
+        own, other = "isolated", "non_isolated"
+        labels = ("The isolated stage as specified", "without the isolator it")
+    model = "LuGre" if sim.isolated.friction_model == "lugre" else sim.isolated.friction_model
+    text = (f" Simulated with {model} friction after every move of its family: "
+            + stage_text(sim.stage[own], labels[0]) + "; "
+            + stage_text(sim.stage[other], labels[1]) + ". No move hunts "
+            + f"{f(mins[own])} as specified and {f(mins[other])} "
+            + ("with the suggested isolator" if sim.suggested_isolator else "without the isolator")
+            + " (the folds of the cycles).")
     if not sim.models_agree:
-        text += " The other friction model disagrees on the verdict (see the checks)."
+        text += " The other friction model disagrees on the spec's own move (see the checks)."
     return text
 
 
 def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: StiffnessResult,
                 fx: FlexureResult | None, pid: PidResult, advice: IsolatorAdvice | None,
-                checks: tuple[Check, ...]) -> str:
+                checks: tuple[Check, ...], hunts: bool = False) -> str:
     from .linear import CASE_NUMBERS
 
     parts = []
@@ -650,6 +654,11 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
         parts.append(f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, at or above "
                      f"the {gap.threshold:.3g} N threshold, so stick-slip can make the "
                      "integrating controller hunt.")
+    elif hunts:
+        parts.append(f"Static friction exceeds Coulomb friction by only {gap.gap:.3g} N, below "
+                     f"the {gap.threshold:.3g} N threshold where the guideline expects no "
+                     "hunting; yet the stage's own simulation hunts (below): the threshold is a "
+                     "rule of thumb, the simulation decides.")
     else:
         parts.append(f"Static friction exceeds Coulomb friction by only {gap.gap:.3g} N, below "
                      f"the {gap.threshold:.3g} N threshold, so hunting is unlikely"

@@ -451,64 +451,196 @@ def deflection_figure(confirmation: Any, spec: Any) -> Any:
     return fig
 
 
-@styled
-def scan_figure(confirmation: Any, spec: Any) -> Any:
-    """Hunting cycles against the crossover for both plants (the crossover scans).
+def _plant_names(confirmation: Any) -> dict:
+    label = "suggested isolator" if confirmation.suggested_isolator else "with isolator"
+    return {"isolated": label, "non_isolated": "without isolator"}
 
-    Hunting points filled, settled points open, ``stuck`` squares and
-    ``undetermined`` diamonds; the desired crossover dashed, each plant's lowest
-    hunting-free crossover dotted.
+
+#: Markers of the move outcomes: (marker, filled).
+MOVE_MARKS = {"hunts": ("o", True), "settles": ("o", False), "rests": ("s", False),
+              "stuck": ("s", True), "undetermined": ("D", False)}
+
+
+@styled
+def moves_figure(confirmation: Any) -> Any:
+    """How each plant ends after every move of its family (stage-level hunting).
+
+    x: the move distance (log); y: the peak-to-peak amplitude of the cycle a
+    move ends in, 0 for a move that comes to rest. Filled circles hunt, open
+    circles settle, squares rest off target (open: within a loop's static
+    error; filled: stuck), diamonds could not be judged; a star marks the
+    spec's own motion. Negative moves are drawn at their distance with a
+    lighter colour.
 
     Parameters
     ----------
-    confirmation : fi_design.confirm.Confirmation
-        The simulated confirmation (its ``scans``).
-    spec : fi_design.spec.Spec
-        The design spec (desired crossover).
+    confirmation : fi_design.results.design.Confirmation
+        The simulated confirmation (its ``stage``).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig = report_figure(2.8, top=0.35)
+    fig = report_figure(2.7, top=0.35)
     ax = fig.add_subplot()
-    label = "suggested isolator" if confirmation.suggested_isolator else "with isolator"
-    names = {"isolated": label, "non_isolated": "without isolator"}
-    marks = {"hunting": ("o", True), "settled": ("o", False), "stuck": ("s", False),
-             "undetermined": ("D", False)}
-    offset = {"isolated": -0.08, "non_isolated": 0.08}
-    for key, scan in confirmation.scans.items():
+    names = _plant_names(confirmation)
+    top = 0.0
+    for key in ("isolated", "non_isolated"):
+        st = confirmation.stage[key]
         col = PLANT_COLOURS[key]
-        fx = np.asarray(scan.crossovers, dtype=float)
-        cyc = np.asarray(scan.hunting_cycles, dtype=float) + offset[key]
-        ax.plot(fx, cyc, color=col, lw=0.8, alpha=0.7, drawstyle="steps-mid",
-                label=f"{names[key]}")
-        verdicts = np.asarray(scan.verdicts)
-        for v, (mk, filled) in marks.items():
-            sel = verdicts == v
-            if sel.any():
-                ax.plot(fx[sel], cyc[sel], mk, ms=3.6, color=col, mfc=col if filled else "white",
-                        mew=0.9, ls="none")
-        if scan.minimum is not None:
-            ax.axvline(scan.minimum, color=col, lw=0.9, ls=":")
-            ax.text(scan.minimum, 0.97 if key == "isolated" else 0.87,
-                    f" hunting-free from {scan.minimum:g} Hz", color=col, fontsize=7,
-                    transform=ax.get_xaxis_transform(), va="top", ha="left")
-    fc = _spec.design_crossover(spec)
-    ax.axvline(fc, color="0.3", lw=0.9, ls="--")
-    ax.text(fc, 0.77, f" design {fc:g} Hz", color="0.3", fontsize=7,
-            transform=ax.get_xaxis_transform(), va="top", ha="left")
+        ax.plot([], [], "o", color=col, label=names[key])
+        for m in st.moves:
+            d = abs(m.distance) * 1e3
+            if d <= 0:
+                continue
+            amp = (m.amplitude or 0.0) * 1e3 if m.hunts else 0.0
+            top = max(top, amp)
+            mk, filled = MOVE_MARKS.get(m.outcome, ("x", True))
+            if m.label == "spec":
+                mk, filled = "*", m.hunts
+            alpha = 1.0 if m.distance > 0 else 0.45
+            ax.plot([d], [amp], mk, ms=7 if m.label == "spec" else 4.5, color=col,
+                    mfc=col if filled else "white", mew=1.0, alpha=alpha, ls="none")
+    _log_x(ax)
+    ax.set_xlabel("move distance [mm]")
+    ax.set_ylabel("cycle peak to peak [mm]")
+    ax.set_ylim(-0.08 * max(top, 0.1), 1.15 * max(top, 0.1))
     from matplotlib.lines import Line2D
 
     handles, labels = ax.get_legend_handles_labels()
-    for v, (mk, filled) in marks.items():
-        handles.append(Line2D([], [], marker=mk, ls="none", ms=3.6, color="0.25",
+    for word, (mk, filled) in (("hunts", MOVE_MARKS["hunts"]), ("settles", MOVE_MARKS["settles"]),
+                               ("rests off target", MOVE_MARKS["rests"]),
+                               ("spec's motion", ("*", False))):
+        handles.append(Line2D([], [], marker=mk, ls="none", ms=5, color="0.25",
                               mfc="0.25" if filled else "white", mew=0.9))
-        labels.append(v)
+        labels.append(word)
     fig.legend(handles, labels, loc="upper center", ncols=len(labels), bbox_to_anchor=(0.5, 1.0))
+    return fig
+
+
+@styled
+def cycle_figure(confirmation: Any, spec: Any) -> Any:
+    """The hunting cycles themselves, beside the settling of the spec's own motion.
+
+    Left: phase portrait of each plant's converged cycle, x1 - r [mm] against
+    the stage velocity v1 [mm/s]. Middle: the joint deflection x1 - x2 over
+    one period of the isolated stage's cycle, with its stroke (the limiter
+    beyond). Right: x1 - r of the plant as specified after the spec's own
+    motion [µm], with the settle band: the move the spec names may settle
+    while others hunt.
+
+    Parameters
+    ----------
+    confirmation : fi_design.results.design.Confirmation
+        The simulated confirmation (``stage`` and ``results``).
+    spec : fi_design.spec.Spec
+        The design spec (settle band).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    h = spec.requirements.hunting
+    names = _plant_names(confirmation)
+    fig = report_figure(2.8, top=0.5, right=0.1)
+    fig.subplots_adjust(wspace=0.42)
+    ax_p, ax_d, ax_s = fig.subplots(1, 3, width_ratios=(1.15, 1.0, 1.0))
+    for key in ("isolated", "non_isolated"):
+        c = confirmation.stage[key].cycle
+        if c is None or c.trace is None:
+            continue
+        tr = c.trace
+        ax_p.plot(np.asarray(tr.error) * 1e3, np.asarray(tr.velocity) * 1e3,
+                  color=PLANT_COLOURS[key], lw=1.1,
+                  label=f"{names[key]}: cycle of {c.amplitude * 1e3:.3g} mm, {c.period:.3g} s")
+    ax_p.axvline(0.0, color="0.6", lw=0.6)
+    ax_p.set_xlabel("x1 - r [mm]")
+    ax_p.set_ylabel("v1 [mm/s]")
+    ax_p.set_title("phase portrait", loc="left", fontsize=7.5)
+    if ax_p.get_legend_handles_labels()[0]:
+        fig.legend(*ax_p.get_legend_handles_labels(), loc="upper center", ncols=2,
+                   bbox_to_anchor=(0.5, 1.0))
+    c = confirmation.stage["isolated"].cycle
+    stroke = confirmation.landing.stroke if confirmation.landing is not None else None
+    if c is not None and c.trace is not None and c.trace.deflection is not None:
+        ax_d.plot(c.trace.time, np.asarray(c.trace.deflection) * 1e6,
+                  color=PLANT_COLOURS["isolated"], lw=1.1)
+        ax_d.set_xlim(0, float(c.trace.time[-1]))
+    else:
+        ax_d.text(0.5, 0.5, "no cycle with the isolator", transform=ax_d.transAxes,
+                  ha="center", va="center", fontsize=7.5, color="0.35")
+    if stroke is not None:
+        for sign in (1, -1):
+            ax_d.axhline(sign * stroke * 1e6, color="0.3", lw=0.8, ls="--")
+        ax_d.set_ylim(-1.4 * stroke * 1e6, 1.4 * stroke * 1e6)
+    ax_d.set_xlabel("time in the period [s]")
+    ax_d.set_ylabel("x1 - x2 [µm]")
+    ax_d.set_title("joint deflection, isolated cycle", loc="left", fontsize=7.5)
+    band = h.settle_band * 1e6
+    zoom = SETTLE_ZOOM * band
+    ax_s.axhspan(-band, band, color="#dcefe0", lw=0, zorder=0)
+    own = "non_isolated" if confirmation.suggested_isolator else "isolated"
+    res = confirmation.results[own]
+    t0 = motion_end(res.time, res.reference)
+    after = res.time >= t0
+    tz, ez = decimate(res.time[after], res.error[after] * 1e6)
+    ax_s.plot(tz, np.clip(ez, -1.5 * zoom, 1.5 * zoom), color=PLANT_COLOURS[own], lw=1.0)
+    ax_s.set_ylim(-zoom, zoom)
+    ax_s.set_xlim(t0, float(res.time[-1]))
+    ax_s.set_xlabel("time [s]")
+    ax_s.set_ylabel("x1 - r [µm]")
+    ax_s.set_title(f"spec's motion, ±{band:g} µm band", loc="left", fontsize=7.5)
+    return fig
+
+
+@styled
+def boundary_figure(confirmation: Any, spec: Any) -> Any:
+    """The stage-level boundary on the crossover axis.
+
+    For each plant, the peak-to-peak amplitude of its hunting cycle as the
+    crossover rises (the points the bisection found the cycle at), ending at
+    the cycle's fold: from there on no move of the family hunts (dotted). The
+    design crossover is dashed.
+
+    Parameters
+    ----------
+    confirmation : fi_design.results.design.Confirmation
+        The simulated confirmation (``stage`` and ``min_hunting_free_crossover``).
+    spec : fi_design.spec.Spec
+        The design spec (design crossover).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = report_figure(2.6, top=0.35)
+    ax = fig.add_subplot()
+    names = _plant_names(confirmation)
+    for n, key in enumerate(("isolated", "non_isolated")):
+        st = confirmation.stage[key]
+        col = PLANT_COLOURS[key]
+        b = st.boundary or {}
+        pts = [p for p in b.get("branch") or [] if p[1] is not None]
+        if pts:
+            f, a = np.array([p[0] for p in pts]), np.array([p[1] for p in pts]) * 1e3
+            ax.plot(f, a, "o-", color=col, ms=3, lw=1.1, label=f"{names[key]}: cycle")
+        m = st.hunting_free_from
+        if m is not None and b.get("kind") == "fold":
+            ax.axvline(m, color=col, lw=0.9, ls=":")
+            ax.text(m, 0.62 - 0.1 * n, f"no move hunts from {m:.4g} Hz ", color=col,
+                    fontsize=7, transform=ax.get_xaxis_transform(), va="top", ha="right")
+    fc = _spec.design_crossover(spec)
+    ax.axvline(fc, color="0.3", lw=0.9, ls="--")
+    ax.text(fc, 0.04, f" design {fc:g} Hz", color="0.3", fontsize=7,
+            transform=ax.get_xaxis_transform(), va="bottom", ha="left")
+    folds = [st.hunting_free_from for st in confirmation.stage.values()
+             if st.hunting_free_from is not None]
+    ax.set_xlim(0.0, 1.08 * max(folds + [fc]))
+    ax.set_ylim(bottom=0.0)
     ax.set_xlabel("crossover fc [Hz]")
-    ax.set_ylabel("hunting cycles [-]")
-    ax.set_ylim(bottom=-0.5)
+    ax.set_ylabel("cycle peak to peak [mm]")
+    fig.legend(*ax.get_legend_handles_labels(), loc="upper center", ncols=2,
+               bbox_to_anchor=(0.5, 1.0))
     return fig
 
 
@@ -684,10 +816,12 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
                annotate: bool | None = None, vmax: float | None = None) -> Any:
     """Draw a :class:`~fi_design.studies.SweepResult` into ``ax``.
 
-    A map is a heatmap of hunting cycles (paper Figure 4): white where no
-    cycle was counted, invalid points hatched grey, stuck points marked ``s``,
+    A map is a heatmap (paper Figure 4) of the hunting cycles counted on the
+    spec's move (``measure "move"``), or of the peak-to-peak amplitude of the
+    cycle some move of the family ends in (``measure "stage"``): white where
+    there is none, invalid points hatched grey, stuck points marked ``s``,
     undetermined ``?``, failed ``×``, the design point a red cross. A line is
-    a step plot of the cycles over x.
+    a step plot of the same over x.
 
     Parameters
     ----------
@@ -717,7 +851,13 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
     xu, xf = display_unit(x.unit)
     xs = np.asarray(x.values) * xf
     plant = "with isolator" if result.isolated else "without isolator"
-    cycles = np.asarray(result.hunting_cycles, dtype=float)
+    stage = getattr(result, "measure", "move") == "stage"
+    # the stage's cycle amplitude in mm, or the cycles the metric counts on the spec's move
+    cycles = np.asarray(result.amplitude if stage else result.hunting_cycles, dtype=float)
+    if stage:
+        cycles = cycles * 1e3
+    label = ("Cycle peak to peak, any move [mm]" if stage
+             else "Hunting cycles in the window [-]")
     verdict = np.asarray(result.verdict)
     if result.y is None:
         shown = np.where(np.isnan(cycles), np.nan, cycles)
@@ -733,7 +873,7 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
                        label="design point")
             ax.legend(loc="best", fontsize=8, frameon=False)
         ax.set_xlabel(axis_label(x.path, x.unit))
-        ax.set_ylabel("Hunting cycles in the window [-]")
+        ax.set_ylabel(label)
         if x.log:
             ax.set_xscale("log")
         else:
@@ -746,12 +886,22 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
     y = result.y
     yu, yf = display_unit(y.unit)
     ys = np.asarray(y.values) * yf
-    top = int(np.nanmax(cycles)) if np.any(np.isfinite(cycles)) else 0
-    top = max(top, 1) if vmax is None else max(int(math.ceil(vmax)), 1)
-    cmap = ListedColormap(["white"] + list(colormaps["YlOrRd"](np.linspace(0.15, 1.0, top)))
-                          ).with_extremes(bad="0.8")
-    norm = BoundaryNorm(np.arange(-0.5, top + 1.5), cmap.N)
-    data = np.ma.masked_invalid(cycles)
+    if stage:
+        from matplotlib.colors import Normalize
+
+        top_mm = float(np.nanmax(cycles)) if np.any(np.isfinite(cycles)) else 0.0
+        top_mm = max(top_mm, 1e-3) if vmax is None else max(float(vmax), 1e-3)
+        cmap = colormaps["YlOrRd"].with_extremes(under="white", bad="0.8")
+        norm = Normalize(vmin=0.0, vmax=top_mm)
+        data = np.ma.masked_invalid(np.where(cycles > 0, cycles, -1.0))
+        top = top_mm
+    else:
+        top = int(np.nanmax(cycles)) if np.any(np.isfinite(cycles)) else 0
+        top = max(top, 1) if vmax is None else max(int(math.ceil(vmax)), 1)
+        cmap = ListedColormap(["white"] + list(colormaps["YlOrRd"](np.linspace(0.15, 1.0, top)))
+                              ).with_extremes(bad="0.8")
+        norm = BoundaryNorm(np.arange(-0.5, top + 1.5), cmap.N)
+        data = np.ma.masked_invalid(cycles)
     # half a cell beyond the first value would reach below zero (a negative stroke or
     # crossover): the cells end at the physical range
     ex, ey = _physical_edges(_edges(xs, x.log), xs), _physical_edges(_edges(ys, y.log), ys)
@@ -770,8 +920,8 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
                 ax.text(xs[i], ys[j], mark, ha="center", va="center", fontsize=8,
                         color="0.1")
             elif annotate and np.isfinite(c) and c > 0:
-                ax.text(xs[i], ys[j], f"{int(c)}", ha="center", va="center", fontsize=6,
-                        color="black" if c < 0.6 * top else "white")
+                ax.text(xs[i], ys[j], f"{c:.2g}" if stage else f"{int(c)}", ha="center",
+                        va="center", fontsize=6, color="black" if c < 0.6 * top else "white")
     dx, dy = result.design_point
     if dx is not None and dy is not None:
         ax.plot([dx * xf], [dy * yf], marker="X", color="red", ms=10, mec="white", mew=1.0,
@@ -787,9 +937,13 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
     ax.set_title(f"{quantity_name(y.path)} vs {quantity_name(x.path).lower()} ({plant})"
                  if title is None else title, fontsize=10)
     if colorbar:
-        cb = ax.figure.colorbar(mesh, ax=ax, ticks=_ticks(top))
-        w0, w1 = _window(result)
-        cb.set_label(f"Hunting cycles in [{w0:g} s, {w1:g} s) [-]")
+        if stage:
+            cb = ax.figure.colorbar(mesh, ax=ax, extend="min")
+            cb.set_label("Cycle peak to peak, any move [mm] (white: every move settles)")
+        else:
+            cb = ax.figure.colorbar(mesh, ax=ax, ticks=_ticks(top))
+            w0, w1 = _window(result)
+            cb.set_label(f"Hunting cycles in [{w0:g} s, {w1:g} s) [-]")
     return mesh
 
 

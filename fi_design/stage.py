@@ -38,6 +38,7 @@ cycle is the one a long simulation settles on.
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 from collections.abc import Callable, Sequence
@@ -56,7 +57,7 @@ from .trajectory import Trajectory, from_moves, profile_duration
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Watch", "watch_settings", "family_distances", "rest_is_final", "move_outcome",
+__all__ = ["Watch", "watch_settings", "length_text", "length_range", "family_distances", "rest_is_final", "move_outcome",
            "converge_cycle", "cycle_exists", "cycle_fold", "stage_hunting", "stage_hunts"]
 
 #: Room for section crossings per run (the crossings rule stops a run there).
@@ -95,8 +96,10 @@ class Watch:
     horizon : float
         Longest time after the motion [s] (``requirements.hunting.horizon``).
     rest_anywhere : bool
-        A loop without integrator rests wherever friction holds it (its static
-        error), not only within the band.
+        A rest off the target ends a run too: a loop without integrator rests
+        wherever friction holds it (its static error), and a saturated drive
+        may not push harder than its force limit (stuck for good); an
+        integrating loop with force to spare goes on.
     tolerance : float
         Relative tolerance of the family runs [-] (``simulation.tolerance``).
     max_steps : int
@@ -129,8 +132,8 @@ def watch_settings(spec: _spec.Spec, params: PlantParameters) -> Watch:
     else:
         quiet = 1.0
     return Watch(band=h.settle_band, quiet=quiet, horizon=h.horizon,
-                 rest_anywhere=not integrates, tolerance=spec.simulation.tolerance,
-                 max_steps=spec.simulation.max_steps)
+                 rest_anywhere=not integrates or math.isfinite(params.force_limit),
+                 tolerance=spec.simulation.tolerance, max_steps=spec.simulation.max_steps)
 
 
 def _gains(p: PlantParameters) -> tuple[float, float]:
@@ -291,8 +294,31 @@ def rest_is_final(params: PlantParameters, y: np.ndarray, level: float) -> bool:
         force = p.sigma0 * (z + level - x1)
         x_cart = level
     sign = 1.0 if force >= 0.0 else -1.0
-    g0 = kernel().stribeck(0.0, x_cart, sign, p.to_array())[0]
+    g0 = kernel().stribeck(0.0, x_cart, sign, _kernel_arrays(p, 1.0)[0])[0]
     return abs(force) < g0
+
+
+def length_text(x: float) -> str:
+    """A length [m] in words: in um below a millimetre, in mm from there (3 digits)."""
+    x = float(x)
+    return f"{x * 1e6:.3g} um" if abs(x) < 1e-3 else f"{x * 1e3:.3g} mm"
+
+
+def length_range(lo: float, hi: float) -> str:
+    """Two lengths [m] in one unit, the larger's: ``"0.396 to 50 mm"``."""
+    unit, scale = ("um", 1e6) if max(abs(lo), abs(hi)) < 1e-3 else ("mm", 1e3)
+    return f"{lo * scale:.3g} to {hi * scale:.3g} {unit}"
+
+
+def _rest_ends_run(params: PlantParameters, y: np.ndarray, level: float, band: float) -> bool:
+    """Whether a quiet stop ends the run: at the target for good (:func:`rest_is_final`), or
+    off it with nothing left to move it (no integrator, or a drive at its force limit)."""
+    if abs(y[0] - level) <= band:
+        return rest_is_final(params, y, level)
+    if not _integrates(params):
+        return True
+    iu = state_index(bool(params.isolated))["u"]
+    return abs(y[iu]) >= params.force_limit * (1.0 - 1e-9)
 
 
 # --------------------------------------------------------------------------- one move
@@ -326,11 +352,17 @@ def _x_bound(ref: Trajectory, y0: np.ndarray) -> float:
     return 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(y0[0]))
 
 
+@functools.lru_cache(maxsize=64)
+def _kernel_arrays(params: PlantParameters, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """The kernel's parameter array and absolute tolerances of a plant (made once per plant)."""
+    return params.to_array(), tolerances(params, tol)
+
+
 def _integrate(params, y0, ref, t_end, watch, tol, max_steps, crossings=CROSSINGS,
                t_out=None, h_max=H_MAX):
-    p = params.to_array()
+    p, atol = _kernel_arrays(params, tol)
     return run(p, y0, ref.breaks, ref.coeffs, ref.land, t_end,
-               np.zeros(0) if t_out is None else t_out, tol, tolerances(params, tol), h_max,
+               np.zeros(0) if t_out is None else t_out, tol, atol, h_max,
                max_steps, _x_bound(ref, y0), watch=watch, crossings=crossings)
 
 
@@ -374,9 +406,9 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
         y = out.final_state
         if out.code != 0:
             return _Run(MoveOutcome(distance, label, "undetermined", float(y[0] - level), None,
-                                    None, elapsed, f"the simulation failed: {out.status}"),
-                        None, 0, level)
-        if out.stop == "quiet" and not rest_is_final(params, y, level):
+                                    None, elapsed, f"the simulation failed: {out.status}",
+                                    failed=True), None, 0, level)
+        if out.stop == "quiet" and not _rest_ends_run(params, y, level, w.band):
             # the integrator will break the cart loose again: keep going
             if offset + out.t_reached >= t_end * (1 - 1e-12):
                 break
@@ -391,10 +423,14 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
     e = float(y[0] - level)
     n = len(out.crossing_times)
     if out.stop == "quiet":
-        at_target = abs(e) <= w.band
-        word = "settles" if at_target else "rests"
-        why = (f"at rest {abs(e) * 1e6:.3g} um from the target for good" if at_target else
-               f"at rest {abs(e) * 1e6:.3g} um from the target (no integrator to pull it in)")
+        if abs(e) <= w.band:
+            word, why = "settles", f"at rest {length_text(abs(e))} from the target for good"
+        elif _integrates(params):
+            word, why = "stuck", (f"at rest {length_text(abs(e))} from the target with the drive "
+                                  f"at its {params.force_limit:.3g} N force limit")
+        else:
+            word, why = "rests", (f"at rest {length_text(abs(e))} from the target (no "
+                                  "integrator to pull it in)")
         return _Run(MoveOutcome(distance, label, word, e, None, None, elapsed, why), None, 0,
                     level)
     if out.stop in ("repeat", "crossings") or (out.stop == "end" and n >= 4):
@@ -413,7 +449,7 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
                     np.array(out.crossing_states[-1]), q, level)
     if abs(e) > w.band:
         word = "stuck" if _integrates(params) else "rests"
-        why = (f"{abs(e) * 1e6:.3g} um from the target after {elapsed:.3g} s, neither at rest "
+        why = (f"{length_text(abs(e))} from the target after {elapsed:.3g} s, neither at rest "
                "there for good nor cycling")
         return _Run(MoveOutcome(distance, label, word, e, None, None, elapsed, why), None, 0,
                     level)
@@ -666,7 +702,7 @@ def cycle_exists(params: PlantParameters, level: float, guess: np.ndarray, w: Wa
         if out.code != 0:
             return None
         if out.stop == "quiet":
-            if rest_is_final(params, out.final_state, level):
+            if _rest_ends_run(params, out.final_state, level, w.band):
                 return None
             if not _restartable(params):
                 return _Found(None, 0, None, None)  # cannot continue exactly: not at rest yet
@@ -842,11 +878,13 @@ def stage_hunting(spec: _spec.Spec, isolated: bool | None = None, *,
         free_from = bound.pop("hunting_free_from")
     law = control_law(spec, crossover)
     fr = spec.friction
-    fcmax = max(fr.coulomb, fr.coulomb if fr.coulomb_negative is None else fr.coulomb_negative)
+    neg = 1.0 if fr.coulomb_negative is None or fr.coulomb == 0 else \
+        fr.coulomb_negative / fr.coulomb
+    held = fr.static * max(1.0, neg)  # what static friction can hold against the loop
     return StageHunting(plant=plant, crossover=float(fc), moves=outcomes, cycle=cycle,
                         other_cycles=tuple(others), hunting_free_from=free_from,
                         boundary=bound, first_only=first_only,
-                        static_error_bound=law.static_error(fcmax + abs(fr.offset)),
+                        static_error_bound=law.static_error(held + abs(fr.offset)),
                         settle_band=spec.requirements.hunting.settle_band)
 
 

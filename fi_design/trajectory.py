@@ -75,7 +75,9 @@ class Trajectory:
     @property
     def final(self) -> float:
         """The held end position [m]."""
-        return float(self(self.breaks[-1]))
+        c0, c1, c2, c3 = self.coeffs[-1]
+        tau = self.breaks[-1] - self.breaks[-2]
+        return float(c0 + tau * (c1 + tau * (c2 + tau * c3)))
 
 
 def jerk_profile_times(d: float, v: float, a: float, j: float) -> tuple[float, float, float]:

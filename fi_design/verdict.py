@@ -42,7 +42,8 @@ from .results import Check, Status
 from .results.design import (Confirmation, CrossoverResult, FlexureResult, Margins, PidResult,
                              Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict)
 
-__all__ = ["run_robustness", "robustness_check", "margins", "recommend", "judge"]
+__all__ = ["run_robustness", "robustness_check", "robustness_as_check", "margins", "recommend",
+           "judge"]
 
 #: Plant judged for a spec with / without isolator.
 _OWN = {True: "isolated", False: "non_isolated"}
@@ -62,15 +63,16 @@ def _um(x: float) -> str:
 
 
 def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
-                   progress: Callable[[int, int], None] | None = None) -> Any:
+                   progress: Callable[[int, int], None] | None = None,
+                   executor: Any = None) -> Any:
     """Simulate the samples of ``requirements.robustness`` (the study, not yet judged).
 
     Static and Coulomb friction scatter by the given fractions (and ripple
-    along the rail when set); every sample is simulated with and without the
-    isolator, in this process (:func:`fi_design.guideline.design` submits this
-    function to the caller's executor). A spec without isolator is studied
-    with the suggested isolator added, so the same samples show what it would
-    do; the spec's own plant is the one without.
+    along the rail when set); every sample is judged at the stage level
+    (every move of its family, :mod:`fi_design.stage`), with and without the
+    isolator, in chunks on ``executor`` (or here). A spec without isolator is
+    studied with the suggested isolator added, so the same samples show what
+    it would do; the spec's own plant is the one without.
 
     Parameters
     ----------
@@ -79,7 +81,9 @@ def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = No
     suggestion : (stroke, stiffness), optional
         Isolator to add when the spec has none [m, N/m].
     progress : callable, optional
-        ``progress(done, total)`` in simulations.
+        ``progress(done, total)`` in samples.
+    executor : concurrent.futures-style executor, optional
+        Runs the samples in chunks; None runs them here.
 
     Returns
     -------
@@ -102,7 +106,8 @@ def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = No
         target = with_isolator(spec, *suggestion)
     return robustness(target, scatter, cfg.samples, seed=cfg.seed,
                       distribution=cfg.distribution, position_friction=ripple,
-                      confidence=cfg.confidence, executor=None, progress=progress, cache=None)
+                      confidence=cfg.confidence, executor=executor, progress=progress,
+                      cache=None)
 
 
 def robustness_check(spec: _spec.Spec, study: Any) -> RobustnessCheck:
@@ -127,29 +132,52 @@ def robustness_check(spec: _spec.Spec, study: Any) -> RobustnessCheck:
     own = _OWN[spec.has_isolator]
     mine = study.isolated if own == "isolated" else study.not_isolated
     other = study.not_isolated if own == "isolated" else study.isolated
-    p, limit = mine.probability, cfg.hunting_probability
-    unsettled = mine.counts["undetermined"] + (mine.counts["stuck"] if _spec_integrates(spec)
-                                               else 0)
+    # a sample fails when its stage does not settle, whatever the reason
+    p, limit = mine.unsettled_probability, cfg.hunting_probability
     if p is None:
         status = "WARN"
     elif p > limit:
         status = "FAIL"
-    elif mine.high > limit or unsettled > limit * mine.valid:
+    elif mine.unsettled_high > limit:
         status = "WARN"
     else:
         status = "PASS"
     comparison = None if other is None else {
         "plant": "isolated" if other.isolated else "non_isolated",
-        "hunting_probability": other.probability, "interval": (other.low, other.high)}
+        "hunting_probability": other.unsettled_probability,
+        "interval": (other.unsettled_low, other.unsettled_high)}
     ripple = None if study.position_friction is None else {
         "amplitude": study.position_friction.amplitude,
         "wavelength": study.position_friction.wavelength}
     return RobustnessCheck(
-        plant=own, samples=mine.samples, valid=mine.valid, hunting=mine.hunting,
-        hunting_probability=p, interval=(mine.low, mine.high), confidence=mine.confidence,
+        plant=own, samples=mine.samples, valid=mine.valid, hunting=mine.unsettled,
+        hunting_probability=p, interval=(mine.unsettled_low, mine.unsettled_high),
+        confidence=mine.confidence,
         limit=limit, status=status, scatter={s.path: s.spread for s in study.scatter},
         distribution=study.distribution, ripple=ripple, seed=study.seed,
         counts=dict(mine.counts), comparison=comparison, study=study)
+
+
+def robustness_as_check(r: RobustnessCheck) -> Check:
+    """The robustness check as one of the design's checks (FAIL, WARN or PASS).
+
+    Parameters
+    ----------
+    r : RobustnessCheck
+        From :func:`robustness_check`.
+
+    Returns
+    -------
+    Check
+        Named ``robustness``; value and limit as probabilities [-].
+    """
+    p = "n/a" if r.hunting_probability is None else _pct(r.hunting_probability)
+    text = (f"the stage as specified does not settle after every move in {p} of {r.valid} "
+            f"scatter samples ({100 * r.confidence:.3g} % interval {_pct(r.interval[0])} to "
+            f"{_pct(r.interval[1])}), limit {_pct(r.limit)}")
+    return Check("robustness", None if r.status == "WARN" else r.status == "PASS",
+                 r.hunting_probability, r.limit, "-", text, "robustness under friction scatter",
+                 status=Status(r.status))
 
 
 def _spec_integrates(spec: _spec.Spec) -> bool:
@@ -224,25 +252,27 @@ def margins(spec: _spec.Spec, crossover: CrossoverResult, stiffness: StiffnessRe
     if simulation is None:
         notes.append("no simulation: no hunting boundary, end-stop clearance or static error")
     else:
-        scan = simulation.scans[own]
-        m = scan.minimum
+        st = simulation.stage[own]
+        m = st.hunting_free_from
+        b = st.boundary or {}
         if not pid.controller.integrator:
             notes.append("the loop has no integrator: it cannot hunt by the paper's mechanism, "
                          "so there is no hunting-free crossover to keep a distance from")
         elif m is None:
-            notes.append(f"the stage as specified does not settle even at the top of the "
-                         f"crossover scan ({scan.grid[1]:g} Hz): no crossover factor")
+            notes.append(f"the stage as specified hunts for some move up to the top of the "
+                         f"search ({simulation.min_hunting_free_crossover['search'][1]:g} Hz): "
+                         "no crossover factor")
         else:
             out["hunting_free_crossover"] = m
             out["crossover_factor"] = fc / m
-            if abs(m - scan.grid[0]) < 1e-9 * max(1.0, m):
+            if b.get("kind") == "bound":
                 out["crossover_factor_bound"] = True
-                notes.append(f"the stage settles over the whole crossover scan from "
-                             f"{scan.grid[0]:g} Hz: the crossover factor is a lower bound")
-        v = getattr(simulation, own)
-        if v.static_error_bound is not None and v.outcome in ("static_error", "stuck"):
-            out["static_error"] = abs(v.metrics.final_error)
-            out["static_error_bound"] = v.static_error_bound
+                notes.append(f"no move of the family hunts from {m:g} Hz, the bottom of the "
+                             "search: the crossover factor is a lower bound")
+        if st.static_error_bound is not None and st.outcome in ("static_error", "stuck"):
+            rest = [abs(mv.final_error) for mv in st.moves if mv.outcome in ("rests", "stuck")]
+            out["static_error"] = max(rest) if rest else 0.0
+            out["static_error_bound"] = st.static_error_bound
         land = simulation.landing
         if spec.has_isolator and land is not None:
             out["resting_deflection"] = land.deflection
@@ -293,25 +323,26 @@ def recommend(spec: _spec.Spec, crossover: CrossoverResult, simulation: Confirma
     if simulation is None:
         return None
     own = _OWN[spec.has_isolator]
-    mine = getattr(simulation, own)
+    mine = simulation.stage[own]
     scatter_fails = robustness is not None and robustness.status == "FAIL"
     if mine.acceptable and not scatter_fails:
         return None
     parts: list[str] = []
     iso_info = None
     if not spec.has_isolator:
-        sug = simulation.isolated
+        sug = simulation.stage["isolated"]
         land = simulation.landing
         k = land.stiffness if land is not None else None
         iso_info = {"stroke": land.stroke if land is not None else None, "stiffness": k,
-                    "outcome": sug.outcome, "hunting_cycles": sug.metrics.hunting_cycles,
+                    "outcome": sug.outcome, "moves_hunting": len(sug.hunting_moves),
                     "hunting_free_from": simulation.min_hunting_free_crossover["isolated"],
                     "end_stop_clearance": None if land is None
                     else land.stroke - abs(land.deflection)}
         text = (f"add a friction isolator: the guideline suggests a "
                 f"{land.stroke * 1e3:.3g} mm stroke and k = {k:.4g} N/m; simulated at "
-                f"{crossover.desired:g} Hz the stage would then be "
-                f"{sug.outcome.replace('_', ' ')} ({sug.metrics.hunting_cycles} cycles)")
+                f"{crossover.desired:g} Hz the stage would then "
+                + (f"hunt after {len(sug.hunting_moves)} of {len(sug.moves)} moves"
+                   if sug.hunts else _BEHAVIOUR.get(sug.outcome, sug.outcome)))
         m = iso_info["hunting_free_from"]
         text += ", hunting-free from " + (f"{m:g} Hz" if m is not None else "no scanned crossover")
         if robustness is not None and robustness.comparison is not None:
@@ -339,9 +370,8 @@ def recommend(spec: _spec.Spec, crossover: CrossoverResult, simulation: Confirma
             bound = (" (step 2 sets no limit below its search cap; check it with the "
                      "hardware's sampling and delay)" if crossover.limit_kind == "scan_limit"
                      else f" (step 2: achievable {reach:.3g} Hz)" if reach is not None else "")
-            parts.append(("or " if parts else "") + f"raise the crossover to at least "
-                         f"{m_own:g} Hz, from which the stage as specified settles in the "
-                         f"scan{bound}")
+            parts.append(("or " if parts else "") + f"raise the crossover above "
+                         f"{m_own:.4g} Hz, from which no move of the family hunts{bound}")
     if not parts and scatter_fails:
         parts.append("look for more margin to hunting under scatter: `fi-design robustness` "
                      "studies the scatter, and the hunting map of the report (`--map`) shows "
@@ -357,44 +387,25 @@ def recommend(spec: _spec.Spec, crossover: CrossoverResult, simulation: Confirma
 
 
 _BEHAVIOUR = {
-    "settled": "settles",
-    "hunting": "hunts",
+    "settles": "settles after every move",
+    "hunts": "hunts",
     "stuck": "sticks away from its target",
     "undetermined": "cannot be judged",
-    "static_error": "rests within its static error",
+    "static_error": "rests within its static error after every move",
 }
 
 
-def _behaviour_reason(v: Any, fc: float, label: str) -> Reason:
-    m = v.metrics
-    if v.outcome == "settled":
-        after = (f" {m.settling_time:.3g} s after the move" if m.settling_time is not None
-                 else "")
-        return Reason("PASS", "simulation",
-                      f"{label} settles at {fc:.4g} Hz: |x1 - r| within "
-                      f"{_um(m.settle_band)}{after}, no hunting cycle.")
-    if v.outcome == "static_error":
-        return Reason("PASS", "simulation",
-                      f"{label} comes to rest {_um(abs(m.final_error))} from its target at "
-                      f"{fc:.4g} Hz, within the static error (Fc + |offset|) / kp = "
-                      f"{_um(v.static_error_bound)} of a loop without integrator: not stuck, and "
-                      "no hunting by the paper's mechanism.")
-    if v.outcome == "hunting":
-        period = f", period {m.period:.3g} s" if m.period is not None else ""
-        return Reason("FAIL", "simulation",
-                      f"{label} hunts at {fc:.4g} Hz: {m.hunting_cycles} cycle(s) of "
-                      f"{m.amplitude * 1e3:.3g} mm peak to peak{period}.")
-    if v.outcome == "stuck":
-        extra = ""
-        if v.static_error_bound is not None:
-            extra = (f", beyond the static error (Fc + |offset|) / kp = "
-                     f"{_um(v.static_error_bound)} its loop without integrator explains")
-        return Reason("FAIL", "simulation",
-                      f"{label} sticks {_um(abs(m.final_error))} away from its target at "
-                      f"{fc:.4g} Hz{extra}: no cycles counted, but it does not settle.")
-    return Reason("FAIL", "simulation",
-                  f"Whether {label.lower()} settles cannot be determined at {fc:.4g} Hz: "
-                  f"{m.reason}.")
+def _behaviour_reason(st: Any, label: str) -> Reason:
+    """The verdict's reason on the plant's stage-level answer (every move of its family)."""
+    from .confirm import stage_text
+
+    text = stage_text(st, label) + "."
+    if st.outcome == "settles":
+        return Reason("PASS", "simulation", text + " No move ends in a hunting cycle.")
+    if st.outcome == "static_error":
+        return Reason("PASS", "simulation", text + " Not stuck, and no hunting by the paper's "
+                                                   "mechanism.")
+    return Reason("FAIL", "simulation", text[0].upper() + text[1:])
 
 
 def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[str, str]],
@@ -429,25 +440,24 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
     behaviour = None
     judged_check = f"simulation_{own}"
     if simulation is not None:
-        v = getattr(simulation, own)
-        behaviour = v.outcome
-        reasons.append(_behaviour_reason(v, fc, label))
+        st = simulation.stage[own]
+        behaviour = st.outcome
+        reasons.append(_behaviour_reason(st, label))
     for c in checks:
-        if c.status == Status.FAIL and c.name != judged_check:
+        if c.status == Status.FAIL and c.name not in (judged_check, "robustness"):
             reasons.append(Reason("FAIL", c.name, f"{c.step}: {c.message}."))
     if robustness is not None:
         r = robustness
-        what = (f"Under friction scatter of {_scatter_words(r)} the stage as specified hunts in "
-                f"{_pct(r.hunting_probability)} of {r.valid} valid samples "
-                f"({100 * r.confidence:.3g} % interval {_pct(r.interval[0])} to "
-                f"{_pct(r.interval[1])})")
+        kinds = ("hunting", "stuck", "undetermined") if _spec_integrates(spec) else \
+            ("hunting", "undetermined")
+        why = ", ".join(f"{r.counts[k]} {'hunt' if k == 'hunting' else k}"
+                        for k in kinds if r.counts[k])
+        what = (f"Under friction scatter of {_scatter_words(r)} the stage as specified does not "
+                f"settle after every move in {_pct(r.hunting_probability)} of {r.valid} valid "
+                f"samples ({100 * r.confidence:.3g} % interval {_pct(r.interval[0])} to "
+                f"{_pct(r.interval[1])}" + (f"; {why}" if why else "") + ")")
         left = r.counts["invalid"] + r.counts["failed"]
-        kinds = ("stuck", "undetermined") if _spec_integrates(spec) else ("undetermined",)
-        others = {k: r.counts[k] for k in kinds if r.counts[k]}
         notes = []
-        if others:
-            notes.append(" and ".join(f"{n} {k}" for k, n in others.items()) + " sample(s) do "
-                         "not settle either")
         if left:
             notes.append(f"{left} sample(s) are left out (a draw the spec refuses, Fs below Fc, "
                          "or a failed simulation)")
@@ -460,10 +470,6 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
             text = (f"{what}: at or below the {_pct(r.limit)} limit, but the interval reaches "
                     f"above it; more samples (requirements.robustness.samples) would show "
                     f"whether the limit holds.{tail}")
-        elif r.status == "WARN":
-            text = (f"{what}, within the {_pct(r.limit)} limit; but more than "
-                    f"{_pct(r.limit)} of the samples do not settle, so the stage is not shown "
-                    f"to be robust.{tail}")
         else:
             text = f"{what}, within the {_pct(r.limit)} limit.{tail}"
         reasons.append(Reason(r.status, "robustness", text))
@@ -485,7 +491,7 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
                 f"{100 * rise:.2g} % higher would put it on the limiter, within the "
                 f"+-{100 * spread:.3g} % scatter of Fc."))
     for c in checks:
-        if c.status == Status.WARN:
+        if c.status == Status.WARN and c.name != "robustness":
             reasons.append(Reason("WARN", c.name, f"{c.step}: {c.message}."))
     for path, message in warnings:
         reasons.append(Reason("WARN", "input", f"{path}: {message}."))
@@ -504,6 +510,11 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
     nwarn = sum(r.severity == "WARN" for r in reasons)
     what = (f"{label} {_BEHAVIOUR.get(behaviour, behaviour)} at {fc:.4g} Hz"
             if behaviour is not None else f"{label} was not simulated")
+    if behaviour == "hunts":
+        st = simulation.stage[own]
+        c = st.cycle
+        what += (f" ({len(st.hunting_moves)} of {len(st.moves)} moves"
+                 + (f", a {c.amplitude * 1e3:.3g} mm cycle of {c.period:.3g} s)" if c else ")"))
     on = []
     for r in reasons:
         word = _SOURCES.get(r.source, r.source.replace("_", " "))
@@ -519,5 +530,5 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
 
 
 #: Sources of reasons in the headline's words (others: the check's name).
-_SOURCES = {"simulation": "the simulation at the design crossover",
+_SOURCES = {"simulation": "the simulation of its moves",
             "robustness": "friction scatter", "confirmation": "the missing simulation"}

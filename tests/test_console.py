@@ -55,10 +55,11 @@ def test_design_summary_reads_at_the_terminal_width(design_outputs, name, width)
     _readable(text, width)
     for words in ("Checks", "Status", "Value", "Limit", "Unit", "Limit case", "PM [deg]",
                   "Nonlinear confirmation", "Verdict", "Hunting cycles in [10 s, 20 s)",
-                  "Amplitude, peak to peak", "Final error", "Hunting-free from", "Conclusion"):
+                  "Amplitude, peak to peak", "Final error", "No move hunts from", "Moves ending in",
+                  "Conclusion"):
         assert words in text, (words, text)
     # the verdicts of both plants and of the cross-check are printed whole
-    row = next(ln for ln in text.splitlines() if ln.strip().startswith("Verdict"))
+    row = next(ln for ln in text.splitlines() if ln.strip().startswith("Spec's motion: verdict"))
     assert re.search(r"(settled|hunting|stuck|undetermined)\s+"
                      r"(settled|hunting|stuck|undetermined)\s*$", row), row
 

@@ -217,9 +217,10 @@ def test_simulation_appears_only_when_confirmed(paper_design, paper_confirmed_de
     assert paper_design.simulation is None and "simulation" not in paper_design.to_dict()
     confirmed = paper_confirmed_design
     assert confirmed.checks[:len(paper_design.checks)] == paper_design.checks
-    assert confirmed.checks[len(paper_design.checks):] == confirmed.simulation.checks
+    assert confirmed.checks[len(paper_design.checks):-1] == confirmed.simulation.checks
+    assert confirmed.checks[-1].name == "robustness"   # the scatter is a check like the others
     assert confirmed.conclusion.startswith(paper_design.conclusion)
-    assert "LuGre simulation" in confirmed.conclusion[len(paper_design.conclusion):]
+    assert "Simulated with LuGre friction" in confirmed.conclusion[len(paper_design.conclusion):]
     assert confirmed.to_dict()["simulation"]["isolated"]["verdict"] == "settled"
 
 

@@ -45,7 +45,9 @@ def _figures(design, studies, reconciliation):
     yield "sensitivity", plots.sensitivity_figure(design)
     yield "error", plots.error_figure(sim, design.spec)
     yield "deflection", plots.deflection_figure(sim, design.spec)
-    yield "scan", plots.scan_figure(sim, design.spec)
+    yield "moves", plots.moves_figure(sim)
+    yield "cycle", plots.cycle_figure(sim, design.spec)
+    yield "boundary", plots.boundary_figure(sim, design.spec)
     yield "sweep map", plots.sweep_figure(studies["map"])
     yield "sweep line", plots.sweep_figure(studies["line"])
     yield "design map", plots.design_map_figure(studies["map"])
@@ -85,7 +87,7 @@ def test_every_figure_builds_with_unit_labels(paper_confirmed_design, studies, r
                 any(UNIT.search(o.get_xlabel()) for o in shared), (name, xlabel)
         svg = plots.figure_bytes(fig, "svg")
         assert svg.startswith(b"<?xml") and b"<svg" in svg
-    assert len(seen) == 14
+    assert len(seen) == 16
 
 
 def test_figures_reproducible_and_inline_ids_prefixed(paper_confirmed_design):

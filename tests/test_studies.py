@@ -144,7 +144,11 @@ def test_fi_design_sweep_callable_after_module_import(paper_spec, kernel):
     import fi_design.studies  # noqa: F401  (sets the package attribute to the module)
 
     res = fi_design.sweep(paper_spec, x=("controller.crossover", [8.0]))
-    assert res.verdict[0] == "settled"
+    assert res.measure == "stage" and res.verdict[0] == "hunting"  # some moves hunt at 8 Hz
+    assert res.amplitude[0] == pytest.approx(1.8e-3, rel=0.01)
+    assert math.isnan(res.hunting_cycles[0])
+    one_move = fi_design.sweep(paper_spec, x=("controller.crossover", [8.0]), measure="move")
+    assert one_move.verdict[0] == "settled"                     # the spec's own move does not
 
 
 # --------------------------------------------------------------------------- the paper's trends
@@ -154,7 +158,7 @@ def test_map_a_friction_gap(paper_spec, kernel):
     """Without isolator: hunting only from a friction gap Fs - Fc of about 1 N."""
     res = sw.sweep(paper_spec, sw.parse_axis("friction.coulomb=0.5,1,1.5,2"),
                    sw.parse_axis("friction.static=1.25,1.75,2.25,2.75,3.25,3.75,4.25"),
-                   isolated=False)
+                   isolated=False, measure="move")
     for pt in res.points:
         fc, fs = pt.values
         gap = fs - fc
@@ -174,19 +178,26 @@ def test_map_b_crossover_without_isolator(paper_spec, kernel):
     """Without isolator: hunting stops above a crossover of about 18 to 20 Hz at 1.6 kg;
     a heavier stage stops hunting at a lower crossover."""
     res = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=6,12,24,30"),
-                   sw.parse_axis("stage.mass=0.8,1.6,3.2"), isolated=False)
+                   sw.parse_axis("stage.mass=0.8,1.6,3.2"), isolated=False, measure="move")
     assert cycles_at(res, 12, 1.6)[0] == "hunting"
     assert cycles_at(res, 24, 1.6)[0] == "settled"
     free = res.boundary("above")  # lowest crossover from which no point hunts, per mass
     assert free[1] == 24.0 and free[2] == 12.0 and free[0] >= 30.0
-    line = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=10,15,20,25"), isolated=False)
+    line = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=10,15,20,25"), isolated=False,
+                    measure="move")
     assert list(line.verdict) == ["hunting", "hunting", "settled", "settled"]
+    # the stage as a whole: some move hunts up to the cycle's fold at 24.5 Hz
+    stage = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=10,20,24,25"),
+                     isolated=False)
+    assert list(stage.verdict) == ["hunting", "hunting", "hunting", "settled"]
+    amp = stage.amplitude
+    assert amp[0] > amp[1] > amp[2] > 0 == amp[3]   # the cycle shrinks towards its fold
 
 
 def test_map_c_stroke_and_stiffness(paper_spec, kernel):
     """With isolator: a limited stiffness and a stroke above about 0.2 mm are hunting-free."""
     res = sw.sweep(paper_spec, sw.parse_axis("isolator.stroke=0.05 mm,0.3 mm,1 mm"),
-                   sw.parse_axis("isolator.stiffness=2000,6667,40000"))
+                   sw.parse_axis("isolator.stiffness=2000,6667,40000"), measure="move")
     v = res.verdict
     assert all(v[j, 0] == "hunting" for j in range(3))  # 0.05 mm: no stiffness helps
     assert v[0, 1] == v[1, 1] == v[0, 2] == v[1, 2] == "settled"
@@ -197,7 +208,8 @@ def test_map_d_crossover_with_isolator(paper_spec, pool):
     """With isolator: 0.3 mm stroke hunting-free from about 5 Hz; a 0.05 mm stroke hunts like
     the stage without isolator."""
     res = sw.sweep(paper_spec, sw.parse_axis("controller.crossover=2,4,6,8,12"),
-                   sw.parse_axis("isolator.stroke=0.05 mm,0.3 mm,1 mm"), executor=pool)
+                   sw.parse_axis("isolator.stroke=0.05 mm,0.3 mm,1 mm"), executor=pool,
+                   measure="move")
     assert [str(v) for v in res.verdict[1]] == ["hunting", "hunting", "settled", "settled",
                                                 "settled"]
     assert res.boundary("above")[1] == 6.0 and res.boundary("above")[2] == 6.0
@@ -207,7 +219,7 @@ def test_map_d_crossover_with_isolator(paper_spec, pool):
 @pytest.mark.slow
 def test_paper_study_boundaries(paper_spec, pool, tmp_path):
     """The four maps at resolution 10; boundaries as in docs/paper_reproduction.md."""
-    st = sw.paper_study(paper_spec, 10, executor=pool, cache=tmp_path)
+    st = sw.paper_study(paper_spec, 10, executor=pool, cache=tmp_path, measure="move")
     a, b, c, d = (st.map(k) for k in "ABCD")
     for pt in a.points:
         fs, fc = pt.values
@@ -335,7 +347,8 @@ def test_parse_scatter():
 
 
 def test_robustness_is_reproducible(paper_spec, pool):
-    kw = dict(samples=6, seed=3, position_friction=sw.PositionFriction(0.1, 0.02))
+    kw = dict(samples=6, seed=3, position_friction=sw.PositionFriction(0.1, 0.02),
+              measure="move")
     scatter = [sw.parse_scatter(t) for t in ("friction.static=10%", "friction.coulomb=10%")]
     a = sw.robustness(paper_spec, scatter, executor=pool, **kw)
     b = sw.robustness(paper_spec, scatter, **kw)

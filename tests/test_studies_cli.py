@@ -23,7 +23,13 @@ def test_sweep_writes_csv_json_and_figure(paper_spec_path, tmp_path):
             "--y", "isolator.stroke=0.1 mm:0.3 mm:2", "--csv", out_csv, "--json", out_json,
             "--figure", fig, "--jobs", "1")
     assert r.exit_code == 0, r.output
-    assert "points:" in r.output and "hunting cycles in the window" in r.output
+    assert "points:" in r.output and "peak to peak of the cycle some move ends in" in r.output
+    one = run("sweep", paper_spec_path, "--x", "controller.crossover=3 Hz:9 Hz:3",
+              "--measure", "move", "--jobs", "1")
+    assert one.exit_code == 0 and "hunting cycles of the spec's move in the window" in one.output
+    bad = runner.invoke(app, ["sweep", str(paper_spec_path), "--x", "controller.crossover=3:9:2",
+                              "--measure", "moves"])
+    assert bad.exit_code == 2 and "--measure" in bad.output
     rows = list(csv.DictReader(out_csv.open()))
     assert list(rows[0])[:6] == ["controller.crossover", "isolator.stroke", "hunting_cycles",
                                  "amplitude", "period", "verdict"]

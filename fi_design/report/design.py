@@ -16,7 +16,7 @@ from ..results.studies import DesignMap
 from .blocks import figure_entry
 from .checks import verdict
 from .context import build_context
-from .filters import num, qty
+from .filters import display_scale, num, qty
 from .inputs import spec_inputs
 from .meta import spec_listing, title_block, versions
 from .steps import guideline_steps
@@ -104,7 +104,6 @@ _MODEL_NAMES = {"lugre": "LuGre", "switch": "switch (Karnopp-type)"}
 
 
 def _plant_rows(sim: Any) -> list[dict]:
-    mins = sim.min_hunting_free_crossover
     if sim.suggested_isolator:
         names = {"isolated": "suggested isolator (recommendation)",
                  "non_isolated": "without isolator (as specified)"}
@@ -122,12 +121,53 @@ def _plant_rows(sim: Any) -> list[dict]:
                     "hunting": "fail"}.get(v.outcome, "warn"),
             "cycles": m.hunting_cycles, "amplitude": m.amplitude, "period": m.period,
             "settling_time": m.settling_time, "final_error": m.final_error,
-            "minimum": mins.get(key), "other": other.outcome.replace("_", " ") if other is not None else "",
+            "other": other.outcome.replace("_", " ") if other is not None else "",
             "other_model": other.friction_model if other is not None else "",
             "reason": m.reason if v.outcome != "static_error" else (
                 f"at rest {qty(abs(m.final_error), 'm')} from the target, within the static "
                 f"error (Fc + |offset|) / kp = {qty(v.static_error_bound, 'm')} of a loop "
                 "without integrator"),
+        })
+    return rows
+
+
+def _length_range(lo: float, hi: float) -> str:
+    """Two lengths [m] in the unit of the larger: ``0.396 to 50 mm``."""
+    shown, factor = display_scale("m", hi)
+    return f"{num(lo * factor, 3)} to {num(hi * factor, 3)} {shown}"
+
+
+def _stage_rows(sim: Any) -> list[dict]:
+    """One row per plant of the stage-level answer (every move of its family)."""
+    if sim.suggested_isolator:
+        names = {"isolated": "suggested isolator (recommendation)",
+                 "non_isolated": "without isolator (as specified)"}
+    else:
+        names = {"isolated": "with isolator (as specified)",
+                 "non_isolated": "without isolator (comparison)"}
+    from ..confirm import stage_text
+
+    rows = []
+    for key, name in names.items():
+        st = sim.stage[key]
+        c = st.cycle
+        b = st.boundary or {}
+        dist = sorted(abs(d) for d in st.entered_by)
+        rows.append({
+            "plant": name, "outcome": st.outcome.replace("_", " "),
+            "css": "pass" if st.acceptable else ("fail" if st.hunts else "warn"),
+            "moves": f"{len(st.hunting_moves)} of {len(st.moves)}",
+            "entered": ("" if not dist else qty(dist[0], "m") if len(dist) == 1
+                        else _length_range(dist[0], dist[-1])),
+            "amplitude": None if c is None else c.amplitude,
+            "period": None if c is None else c.period,
+            "multiplier": None if c is None else c.multiplier,
+            "limiter": "" if c is None or c.on_limiter is None else
+            ("yes" if c.on_limiter else "no"),
+            "free_from": st.hunting_free_from,
+            "bracket": (f"fold bisected to {qty(b['resolution'], 'Hz')}"
+                        if b.get("kind") == "fold" else b.get("note", "")),
+            "text": stage_text(st, name[0].upper() + name[1:]),
         })
     return rows
 
@@ -140,43 +180,59 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
         return None
     spec = result.spec
     h = spec.requirements.hunting
-    mins = sim.min_hunting_free_crossover
     iso = sim.results["isolated"]
     label = "the suggested isolator" if sim.suggested_isolator else "the isolator"
     land = sim.landing
-    scan = sim.scans["isolated"]
+    fam = spec.motion.family
     out = {
         "intro": (
-            f"The stage is simulated with and without {label} at the design crossover, with "
+            f"Hunting is a property of the stage, not of one move: with {label} and without it, "
+            "at the design crossover and with "
             f"{_MODEL_NAMES.get(sim.isolated.friction_model, sim.isolated.friction_model)} "
-            "friction, through the spec's moves and then at "
-            "rest. The paper's hunting metric (section 2.3) counts the peaks of the position "
-            f"error x1 - r of at least {qty(h.min_height, 'm')}, at least "
-            f"{qty(h.min_distance, 's')} apart, in the window [{num(h.window_start)} s, "
-            f"{num(h.window_start + h.window_length)} s); one peak is one hunting cycle. The "
-            "verdict also names a stage that is stuck away from its target or moves too slowly to "
-            "judge, which the count alone cannot see."),
+            f"friction, the stage is simulated after every move of a family ({fam.count} "
+            "distances, log-spaced from a tenth of the stroke, 0.1 mm without isolator, to five "
+            "times the spec's largest move, and the spec's own motion). A run stops once the "
+            "stage rests within the settle band for good (the friction force the loop will "
+            "ask of the resting cart stays below its static friction) or once its state repeats "
+            "at the Poincar\u00e9 section x1 - r = 0: a sustained cycle. The cycle is then "
+            "converged as a periodic orbit by Newton's method on the return map, whose Floquet "
+            "multiplier below 1 shows it attracts; the crossover from which no move hunts is "
+            "the cycle's fold, found by bisection."),
+        "stage": _stage_rows(sim),
+        "spec_intro": (
+            "The spec's own motion alone, as the paper judges it (section 2.3): the peaks of "
+            f"the position error x1 - r of at least {qty(h.min_height, 'm')} and standing out "
+            f"by as much, at least {qty(h.min_distance, 's')} apart, in the window "
+            f"[{num(h.window_start)} s, {num(h.window_start + h.window_length)} s); one peak "
+            "is one hunting cycle. This answers for one move only."),
         "plants": _plant_rows(sim),
-        "resolution": mins["resolution"],
-        "scan_range": mins["scan"],
+        "moves": figure_entry(
+            (lambda: plots.moves_figure(sim)) if figures else None, "moves",
+            "How the stage ends after each move of its family: the cycle's peak to peak for a "
+            "move that hunts (filled), 0 for one that comes to rest (open); the star is the "
+            "spec's own motion.", fig_no()),
+        "cycle": figure_entry(
+            (lambda: plots.cycle_figure(sim, spec)) if figures else None, "cycle",
+            "The hunting cycles: phase portraits (left), the isolated stage's joint deflection "
+            "over one period against its stroke (middle), and the settling after the spec's "
+            f"own motion in the \u00b1{num(h.settle_band * 1e6)} \u00b5m settle band (right).",
+            fig_no()),
         "error": figure_entry(
             (lambda: plots.error_figure(sim, spec)) if figures else None, "error",
-            "Position error with and without the isolator. Left, in mm, as the paper's Figure "
-            "5: grey, the counting window; dashed, the minimum peak height; circles, the peaks "
-            "the metric counts. Right, in \u00b5m after the motion: green, the settle band of "
-            f"\u00b1{num(h.settle_band * 1e6)} \u00b5m; dotted, where the error enters it for "
-            "good (the settling time).", fig_no()),
+            "Position error after the spec's own motion, with and without the isolator. Left, "
+            "in mm, as the paper's Figure 5: grey, the counting window; dashed, the minimum "
+            "peak height; circles, the peaks the metric counts. Right, in \u00b5m after the "
+            f"motion: green, the settle band of \u00b1{num(h.settle_band * 1e6)} \u00b5m; "
+            "dotted, where the error enters it for good (the settling time).", fig_no()),
         "deflection": figure_entry(
             (lambda: plots.deflection_figure(sim, spec)) if figures else None, "deflection",
-            "Joint deflection of the isolated stage against the stroke; beyond the dashed lines "
-            "the limiter carries the cart.", fig_no()),
-        "scan": figure_entry(
-            (lambda: plots.scan_figure(sim, spec)) if figures else None, "scan",
-            f"Hunting cycles down the crossover scan (grid {num(scan.grid[0])} to "
-            f"{num(scan.grid[1])} Hz in steps of {num(scan.grid[2])} Hz), both plants. The scan "
-            "runs from the top down and stops at the first crossover that does not settle; "
-            "dotted: the lowest hunting-free crossover, dashed: the design crossover.",
-            fig_no()),
+            "Joint deflection of the isolated stage after the spec's own motion, against the "
+            "stroke; beyond the dashed lines the limiter carries the cart.", fig_no()),
+        "boundary": figure_entry(
+            (lambda: plots.boundary_figure(sim, spec)) if figures else None, "boundary",
+            "The stage-level boundary: the peak to peak of each plant's hunting cycle as the "
+            "crossover rises, up to the cycle's fold (dotted), from which no move of the "
+            "family hunts; dashed, the design crossover.", fig_no()),
         "landing": None if land is None else {
             "deflection": land.deflection, "stroke": land.stroke, "force": land.force,
             "static_friction": land.static_friction, "rule_force": land.rule_force,

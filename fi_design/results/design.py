@@ -24,7 +24,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["FrictionGapResult", "ModeSeparation", "CrossoverResult", "StiffnessResult",
            "FlexureResult", "PidResult", "CaseResponse", "LoopResponses", "IsolatorAdvice",
-           "PlantVerdict", "CrossoverScan", "Landing", "Confirmation", "VERDICT_STATUSES",
+           "PlantVerdict", "Landing", "Confirmation", "VERDICT_STATUSES",
            "Reason", "Verdict", "RobustnessCheck", "Margins", "Recommendation",
            "DesignResult"]
 
@@ -443,45 +443,6 @@ class PlantVerdict(Result):
                 "success": self.success, "message": self.message}
 
 
-@dataclass(frozen=True, eq=False)
-class CrossoverScan(Result):
-    """Verdicts down a crossover grid and the lowest hunting-free crossover.
-
-    The scan runs from the top of the grid downwards and stops at the first
-    crossover that does not settle: everything above it settles, so the
-    minimum is found with the fewest simulations. Hunting that comes and goes
-    below that boundary (the paper saw it at 9.5 Hz) is a matter for a map
-    (``fi-design sweep``), not for this scan.
-
-    Attributes
-    ----------
-    plant : str
-        ``"isolated"`` or ``"non_isolated"``.
-    crossovers : ndarray, shape (n,)
-        Scanned crossovers, ascending [Hz].
-    verdicts : tuple of str
-        Verdict at each scanned crossover.
-    hunting_cycles : ndarray of int, shape (n,)
-        Counted cycles at each scanned crossover.
-    minimum : float or None
-        Lowest grid crossover from which every higher one settles [Hz]; None
-        if the top of the grid does not settle.
-    resolution : float
-        Grid step [Hz]: the boundary lies within one step below ``minimum``.
-    grid : tuple of float
-        The whole grid (start, stop, step) [Hz].
-    """
-
-    plant: str
-    crossovers: np.ndarray
-    verdicts: tuple[str, ...]
-    hunting_cycles: np.ndarray
-    minimum: float | None
-    resolution: float
-    grid: tuple[float, float, float]
-
-
-
 @dataclass(frozen=True)
 class Landing(Result):
     """Where the cart comes to rest after the move (isolated plant).
@@ -523,12 +484,17 @@ class Confirmation(Result):
     Attributes
     ----------
     isolated, non_isolated : PlantVerdict
-        The two plants at the design crossover.
+        The two plants after the spec's own motion at the design crossover
+        (the paper's metric on one move).
+    stage : dict of StageHunting
+        The stage-level answer of each plant, by plant: every move of the
+        family, the cycle, the hunting-free crossover
+        (:class:`~fi_design.results.stage.StageHunting`).
     min_hunting_free_crossover : dict
         ``{"isolated": Hz or None, "non_isolated": Hz or None, "resolution":
-        Hz, "scan": [start, stop]}``.
-    scans : dict of CrossoverScan
-        The scans behind the minimum crossovers, by plant.
+        Hz, "search": [start, stop]}``: the stage-level hunting-free
+        crossovers (the cycles' folds), the widest bisection bracket, and the
+        crossover range searched.
     landing : Landing or None
         Landing of the isolated cart.
     cross_check : dict of PlantVerdict
@@ -547,8 +513,8 @@ class Confirmation(Result):
 
     isolated: PlantVerdict
     non_isolated: PlantVerdict
+    stage: dict = field(repr=False)  # in the JSON as the design's "stage_hunting"
     min_hunting_free_crossover: dict
-    scans: dict
     landing: Landing | None
     cross_check: dict
     models_agree: bool
@@ -645,7 +611,7 @@ class Verdict(Result):
 
 @dataclass(frozen=True, eq=False)
 class RobustnessCheck(Result):
-    """The probability that the stage as specified hunts under friction scatter.
+    """The probability that the stage as specified does not settle under friction scatter.
 
     Attributes
     ----------
@@ -656,9 +622,12 @@ class RobustnessCheck(Result):
     valid : int
         Samples simulated to the end (the trials).
     hunting : int
-        Valid samples that hunt.
+        Valid samples whose stage does not settle after every move of its
+        family, whatever the reason: it hunts, sticks (an integrating loop) or
+        cannot be judged (``counts`` tells which).
     hunting_probability : float or None
-        hunting / valid [-]; None without valid samples.
+        hunting / valid [-]: the probability the sign-off limits; None without
+        valid samples.
     interval : tuple of float
         Wilson confidence interval of the probability (low, high) [-].
     confidence : float
@@ -886,7 +855,9 @@ class DesignResult(Result):
         ``pid``, ``isolator_advice``, ``checks``, ``warnings``, ``conclusion``,
         ``fi_design_version``, ``fi_design_source`` (``commit``,
         ``modified``, ``code_sha256``: :class:`~fi_design.provenance.Source`),
-        ``spec_sha256`` and, when set, ``simulation``.
+        ``spec_sha256`` and, when set, ``simulation`` and ``stage_hunting``
+        (``{"isolated": ..., "non_isolated": ...}``, each
+        :meth:`~fi_design.results.stage.StageHunting.to_dict`).
         """
         out = {
             "name": self.spec.name,
@@ -910,4 +881,5 @@ class DesignResult(Result):
         }
         if self.simulation is not None:
             out["simulation"] = to_jsonable(self.simulation)
+            out["stage_hunting"] = {k: v.to_dict() for k, v in self.simulation.stage.items()}
         return out

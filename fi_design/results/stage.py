@@ -50,6 +50,8 @@ class MoveOutcome(Result):
         Time simulated after the motion ended [s].
     reason : str
         Why, in one sentence.
+    failed : bool
+        The simulation did not complete (the outcome is then ``undetermined``).
     """
 
     distance: float
@@ -60,6 +62,7 @@ class MoveOutcome(Result):
     period: float | None
     time: float
     reason: str
+    failed: bool = False
 
     @property
     def hunts(self) -> bool:
@@ -186,8 +189,9 @@ class StageHunting(Result):
     first_only : bool
         Whether the family was cut short at the first hunting move (studies).
     static_error_bound : float or None
-        For a loop without integrator, the static error (Fc + |offset|) / kp
-        it may rest with [m]; None when the loop integrates.
+        For a loop without integrator, the largest error static friction can
+        hold against it, (Fs + |offset|) / kp [m] (a move too short to break
+        the cart loose never starts); None when the loop integrates.
     settle_band : float
         The settle band [m].
     """

@@ -184,6 +184,11 @@ class SweepResult(Result):
         Version of fi_design that produced the result.
     fi_design_source : fi_design.provenance.Source
         The code that produced it (git commit, SHA-256 of the source files).
+    measure : str
+        ``"stage"``: a point's verdict is the stage's over its move family
+        and ``amplitude`` the peak to peak of the cycle it enters (0 where
+        every move comes to rest), ``hunting_cycles`` NaN; ``"move"``: the
+        paper's metric on the spec's own move.
     """
 
     spec: Spec
@@ -199,6 +204,7 @@ class SweepResult(Result):
     run: RunInfo = field(repr=False)
     fi_design_version: str = ""
     fi_design_source: Source = field(default_factory=current_source)
+    measure: str = "move"
 
     @property
     def paths(self) -> tuple[str, ...]:
@@ -495,6 +501,14 @@ class HuntingProbability(Result):
         Cycles per sample; NaN for invalid or failed samples.
     verdict : ndarray of str, shape (samples,)
         Verdict per sample.
+    unsettled : int
+        Valid samples that do not settle, whatever the reason: ``hunting``,
+        ``stuck`` (with an integrating loop; a loop without integrator rests
+        with its static error) or ``undetermined``.
+    unsettled_probability : float or None
+        unsettled / valid [-]: what a sign-off compares with its limit.
+    unsettled_low, unsettled_high : float
+        Its Wilson interval [-].
     """
 
     isolated: bool
@@ -508,6 +522,10 @@ class HuntingProbability(Result):
     counts: dict
     hunting_cycles: np.ndarray
     verdict: np.ndarray
+    unsettled: int = 0
+    unsettled_probability: float | None = None
+    unsettled_low: float = 0.0
+    unsettled_high: float = 1.0
 
 
 
@@ -543,6 +561,9 @@ class RobustnessResult(Result):
         Version of fi_design that produced the result.
     fi_design_source : fi_design.provenance.Source
         The code that produced it (git commit, SHA-256 of the source files).
+    measure : str
+        ``"stage"`` (a sample hunts when any move of its family ends in a
+        cycle) or ``"move"`` (the paper's metric on the spec's move).
     """
 
     spec: Spec
@@ -558,6 +579,7 @@ class RobustnessResult(Result):
     run: RunInfo = field(repr=False)
     fi_design_version: str = ""
     fi_design_source: Source = field(default_factory=current_source)
+    measure: str = "move"
 
     @property
     def samples(self) -> int:

@@ -29,7 +29,8 @@ __all__ = ["CACHE_ENV", "METHOD", "CODE_MODULES", "PointCache", "default_cache_d
 METHOD = "fast"
 #: Source files (in the package) that decide a point's outcome; their digest is in every key.
 CODE_MODULES = ("kernel.py", "equations.py", "plant.py", "simulation.py", "metrics.py", "pid.py",
-                "trajectory.py", "effects.py", "spec.py", "specfile.py", "studies/points.py")
+                "trajectory.py", "effects.py", "spec.py", "specfile.py", "stage.py",
+                "studies/points.py")
 
 
 def default_cache_dir() -> Path:
@@ -188,7 +189,8 @@ def code_digest() -> str:
     return _CODE_DIGEST
 
 
-def point_key(spec_hash: str, values: Sequence[tuple[str, Any]], isolated: bool) -> str:
+def point_key(spec_hash: str, values: Sequence[tuple[str, Any]], isolated: bool,
+              measure: str = "move") -> str:
     """The cache key of one point.
 
     Parameters
@@ -199,18 +201,21 @@ def point_key(spec_hash: str, values: Sequence[tuple[str, Any]], isolated: bool)
         The point's values.
     isolated : bool
         The plant simulated.
+    measure : {"move", "stage"}
+        What a point measures (the spec's move, or the stage over its moves).
 
     Returns
     -------
     str
         SHA-256 hex digest over the spec, the values (exact float repr), the
-        plant, the fi_design version, :func:`code_digest` and the solver method.
+        plant, the measure, the fi_design version, :func:`code_digest` and the
+        solver method.
     """
     from .. import __version__
 
     payload = json.dumps({"spec": spec_hash, "values": [[p, v] for p, v in values],
                           "isolated": bool(isolated), "version": __version__,
-                          "code": code_digest(), "method": METHOD},
+                          "code": code_digest(), "method": METHOD, "measure": measure},
                          sort_keys=True, default=str)
     return hashlib.sha256(payload.encode()).hexdigest()
 

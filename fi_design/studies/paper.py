@@ -84,7 +84,7 @@ def paper_axes(spec: _spec.Spec, definition: MapDefinition, resolution: int) -> 
 def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
                 executor: Executor | None = None, progress: ProgressCallback | None = None,
                 cache: PointCache | str | os.PathLike | bool | None = None,
-                chunksize: int | None = None) -> StudyResult:
+                chunksize: int | None = None, measure: str = "stage") -> StudyResult:
     """The paper's four maps (Figure 4) around a spec's design point.
 
     A: ``friction.static`` x ``friction.coulomb`` without isolator; B:
@@ -110,6 +110,11 @@ def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
         As for :func:`~.sweeps.sweep`.
     chunksize : int, optional
         As for :func:`~.sweeps.sweep`.
+    measure : {"stage", "move"}, optional
+        ``"stage"`` (default): per point, whether any move of the family ends
+        in a sustained cycle and that cycle's peak-to-peak amplitude
+        (:mod:`fi_design.stage`); ``"move"``: the paper's hunting metric on
+        the spec's own move.
 
     Returns
     -------
@@ -145,7 +150,7 @@ def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
         layouts.append((d, ax, ay, cells, len(tasks)))
         tasks += [(((ax.path, vals[0]), (ay.path, vals[1])), d.isolated) for _, vals in cells]
     ev = evaluate(spec, tasks, executor=executor, progress=progress, cache=cache,
-                  chunksize=chunksize)
+                  chunksize=chunksize, measure=measure)
     info = replace(ev.run, wall_time=_time.perf_counter() - start)
     out_maps = []
     for d, ax, ay, cells, offset in layouts:
@@ -158,6 +163,6 @@ def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
             amplitude=grid(points, shape, "amplitude"), period=grid(points, shape, "period"),
             verdict=verdict_grid(points, shape),
             design_point=(design_value(spec, ax.path), design_value(spec, ay.path)),
-            run=info, fi_design_version=__version__)
+            run=info, fi_design_version=__version__, measure=measure)
         out_maps.append(StudyMap(d, res))
     return StudyResult(spec=spec, maps=tuple(out_maps), resolution=resolution, run=info)

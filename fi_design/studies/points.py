@@ -2,7 +2,10 @@
 
 Every point is the base spec with some values replaced
 (:func:`fi_design.specfile.with_values`), simulated with the fast kernel and
-judged by the hunting metric (:func:`evaluate_point`). A point whose values the
+judged (:func:`evaluate_point`) by one of two measures: ``"stage"`` (the
+default: whether any move of the family ends in a sustained cycle, and that
+cycle's amplitude, :mod:`fi_design.stage`) or ``"move"`` (the paper's hunting
+metric on the spec's own move). A point whose values the
 spec refuses is ``invalid``, a simulation that does not complete (or raises)
 ``failed``: neither stops the study. :func:`evaluate` takes the finished
 points from the cache and runs the rest in chunks on the caller's executor
@@ -29,7 +32,7 @@ from ..results.studies import PointResult, RunInfo, spec_digest
 from ..specfile import with_values
 from .cache import METHOD, PointCache, open_cache, point_key
 
-__all__ = ["MAX_CHUNK", "TARGET_CHUNKS", "Task", "ProgressCallback", "Evaluation",
+__all__ = ["MEASURES", "MAX_CHUNK", "TARGET_CHUNKS", "Task", "ProgressCallback", "Evaluation",
            "evaluate_point", "run_chunk", "warm_up", "chunk_size", "evaluate", "point_result",
            "grid", "verdict_grid"]
 
@@ -40,8 +43,12 @@ ProgressCallback = Callable[[int, int], None]
 _OUTCOME_FIELDS = ("status", "verdict", "hunting_cycles", "amplitude", "period", "settling_time",
                    "final_error", "message")
 
+#: What a point measures: the stage over its move family, or the spec's own move.
+MEASURES = ("stage", "move")
 
-def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool) -> dict:
+
+def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
+                   measure: str = "move") -> dict:
     """Simulate one point and return its outcome as plain data (the cached form).
 
     Parameters
@@ -52,6 +59,14 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool) 
         Dotted path to value, applied with :func:`~fi_design.specfile.with_values`.
     isolated : bool
         Simulate the isolated plant (True) or the stage without isolator.
+    measure : {"move", "stage"}
+        ``"move"``: the paper's hunting metric on the spec's move
+        (``hunting_cycles`` counted in the window, ``amplitude`` its peak to
+        peak). ``"stage"``: the moves of the family are run until one ends in
+        a sustained cycle (verdict ``hunting``, ``amplitude`` the cycle's peak
+        to peak, ``hunting_cycles`` None) or all come to rest (``settled``,
+        amplitude 0); a move that sticks or cannot be judged makes the point
+        ``stuck`` or ``undetermined``.
 
     Returns
     -------
@@ -62,10 +77,14 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool) 
     """
     from ..simulation import simulate
 
+    if measure not in MEASURES:
+        raise ArgumentError(f"measure must be one of {MEASURES}, got {measure!r}")
     try:
         point = with_values(spec, values) if values else spec
     except SpecError as exc:
         return _outcome("invalid", "invalid", message=str(exc))
+    if measure == "stage":
+        return _stage_point(point, isolated)
     try:
         res = simulate(point, isolated, METHOD)
     except FiDesignError as exc:  # a request the simulation refuses: deterministic
@@ -81,6 +100,37 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool) 
                     amplitude=_num(m.amplitude), period=_num(m.period),
                     settling_time=_num(m.settling_time), final_error=_num(m.final_error),
                     message=m.reason)
+
+
+def _stage_point(point: _spec.Spec, isolated: bool) -> dict:
+    """The stage-level outcome of one point (see :func:`evaluate_point`)."""
+    from ..stage import stage_hunts
+
+    try:
+        moves, _ = stage_hunts(point, isolated, first_only=True)
+    except FiDesignError as exc:
+        return _outcome("failed", "failed", message=str(exc))
+    except Exception as exc:  # noqa: BLE001 -- one bad point must not stop a sweep
+        out = _outcome("failed", "failed", message=f"{type(exc).__name__}: {exc}")
+        out["cacheable"] = False
+        return out
+    final = _num(moves[0].final_error)
+    broken = next((m for m in moves if m.failed), None)
+    if broken is not None:
+        return _outcome("failed", "failed", message=f"the {broken.distance * 1e3:.4g} mm move: "
+                                                    f"{broken.reason}")
+    hunt = next((m for m in moves if m.hunts), None)
+    if hunt is not None:
+        return _outcome("ok", "hunting", amplitude=_num(hunt.amplitude),
+                        period=_num(hunt.period), final_error=final,
+                        message=f"the {hunt.distance * 1e3:.4g} mm move ends in {hunt.reason}")
+    for word, verdict in (("stuck", "stuck"), ("undetermined", "undetermined")):
+        bad = next((m for m in moves if m.outcome == word), None)
+        if bad is not None:
+            return _outcome("ok", verdict, amplitude=0.0, final_error=final,
+                            message=f"the {bad.distance * 1e3:.4g} mm move: {bad.reason}")
+    return _outcome("ok", "settled", amplitude=0.0, final_error=final,
+                    message=f"all {len(moves)} moves come to rest")
 
 
 def _num(x: Any) -> float | None:
@@ -99,8 +149,8 @@ def _outcome(status: str, verdict: str, *, hunting_cycles: int | None = None,
             "final_error": final_error, "message": message, "cacheable": True}
 
 
-def run_chunk(spec: _spec.Spec, tasks: Sequence[tuple[tuple[tuple[str, Any], ...], bool]]) \
-        -> list[dict]:
+def run_chunk(spec: _spec.Spec, tasks: Sequence[tuple[tuple[tuple[str, Any], ...], bool]],
+              measure: str = "move") -> list[dict]:
     """Evaluate a chunk of points (the unit of work sent to an executor).
 
     Parameters
@@ -109,13 +159,16 @@ def run_chunk(spec: _spec.Spec, tasks: Sequence[tuple[tuple[tuple[str, Any], ...
         The base spec.
     tasks : sequence of (values, isolated)
         ``values`` is a tuple of ``(path, value)`` pairs.
+    measure : {"move", "stage"}
+        See :func:`evaluate_point`.
 
     Returns
     -------
     list of dict
         One outcome per task (see :func:`evaluate_point`), in order.
     """
-    return [evaluate_point(spec, dict(values), isolated) for values, isolated in tasks]
+    return [evaluate_point(spec, dict(values), isolated, measure)
+            for values, isolated in tasks]
 
 
 def warm_up() -> None:
@@ -188,7 +241,7 @@ class Evaluation:
 def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | None = None,
              progress: ProgressCallback | None = None,
              cache: PointCache | str | os.PathLike | bool | None = None,
-             chunksize: int | None = None) -> Evaluation:
+             chunksize: int | None = None, measure: str = "move") -> Evaluation:
     """The outcomes of all points of a study: from the cache, or simulated in chunks.
 
     Parameters
@@ -206,11 +259,15 @@ def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | No
         Where finished points are looked up and stored (:func:`~.cache.open_cache`).
     chunksize : int, optional
         Points per chunk (:func:`chunk_size`).
+    measure : {"move", "stage"}
+        What a point measures (:func:`evaluate_point`).
 
     Returns
     -------
     Evaluation
     """
+    if measure not in MEASURES:
+        raise ArgumentError(f"measure must be one of {MEASURES}, got {measure!r}")
     start = _time.perf_counter()
     store = open_cache(cache)
     n = len(tasks)
@@ -218,7 +275,7 @@ def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | No
     keys: list[str] = []
     if store is not None:
         shash = spec_digest(spec)
-        keys = [point_key(shash, values, iso) for values, iso in tasks]
+        keys = [point_key(shash, values, iso, measure) for values, iso in tasks]
         hits = store.get_many(keys)
         for i, k in enumerate(keys):
             if k in hits:
@@ -249,7 +306,7 @@ def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | No
         return [dict(_outcome("failed", "failed", message=msg), cacheable=False)
                 for _ in groups[g]]
 
-    arguments = [(spec, [tasks[i] for i in group]) for group in groups]
+    arguments = [(spec, [tasks[i] for i in group], measure) for group in groups]
     if executor is None:
         for g, args in enumerate(arguments):
             finish(g, run_chunk(*args))

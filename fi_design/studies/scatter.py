@@ -167,7 +167,7 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
                position_friction: PositionFriction | None = None, confidence: float = 0.95,
                executor: Executor | None = None, progress: ProgressCallback | None = None,
                cache: PointCache | str | os.PathLike | bool | None = None,
-               chunksize: int | None = None) -> RobustnessResult:
+               chunksize: int | None = None, measure: str = "stage") -> RobustnessResult:
     """Probability of hunting when spec values scatter around the design.
 
     Every sample draws each scattered value independently (normal: nominal
@@ -199,6 +199,11 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
         Level of the Wilson interval, default 0.95.
     executor, progress, cache, chunksize
         As for :func:`~.sweeps.sweep`.
+    measure : {"stage", "move"}, optional
+        ``"stage"`` (default): per point, whether any move of the family ends
+        in a sustained cycle and that cycle's peak-to-peak amplitude
+        (:mod:`fi_design.stage`); ``"move"``: the paper's hunting metric on
+        the spec's own move.
 
     Returns
     -------
@@ -272,27 +277,32 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
         tasks.append(tuple(vals))
     all_tasks = [(vals, iso) for iso in plants for vals in tasks]
     ev = evaluate(base, all_tasks, executor=executor, progress=progress, cache=cache,
-                  chunksize=chunksize)
+                  chunksize=chunksize, measure=measure)
     points = tuple(point_result((n % samples,), sample_values[n % samples], iso, out)
                    for n, ((_, iso), out) in enumerate(zip(all_tasks, ev.outcomes)))
+    from ..pid import control_law
+
+    integrates = control_law(spec).integrator
     probs = {}
     for iso in plants:
         pts = [p for p in points if p.isolated == iso]
-        probs[iso] = _probability(pts, iso, confidence)
+        probs[iso] = _probability(pts, iso, confidence, integrates)
     info = replace(ev.run, wall_time=_time.perf_counter() - start)
     return RobustnessResult(
         spec=spec, scatter=items, position_friction=position_friction, distribution=distribution,
         seed=int(seed), draws=frozen_array(draws), phases=frozen_array(phases),
         isolated=probs.get(True), not_isolated=probs[False], points=points, run=info,
-        fi_design_version=__version__)
+        fi_design_version=__version__, measure=measure)
 
 
-def _probability(points: Sequence[PointResult], iso: bool, confidence: float) \
-        -> HuntingProbability:
+def _probability(points: Sequence[PointResult], iso: bool, confidence: float,
+                 integrates: bool = True) -> HuntingProbability:
     counts = {v: sum(p.verdict == v for p in points) for v in POINT_VERDICTS}
     valid = sum(p.status == "ok" for p in points)
     hunting = counts["hunting"]
     low, high = wilson_interval(hunting, valid, confidence)
+    unsettled = hunting + counts["undetermined"] + (counts["stuck"] if integrates else 0)
+    u_low, u_high = wilson_interval(unsettled, valid, confidence)
     cycles = np.array([np.nan if p.hunting_cycles is None or p.status != "ok"
                        else float(p.hunting_cycles) for p in points])
     verdict = np.array([p.verdict for p in points], dtype="<U12")
@@ -301,4 +311,6 @@ def _probability(points: Sequence[PointResult], iso: bool, confidence: float) \
         isolated=iso, samples=len(points), valid=valid, hunting=hunting,
         probability=hunting / valid if valid else None, low=low, high=high,
         confidence=confidence, counts=counts, hunting_cycles=frozen_array(cycles),
-        verdict=verdict)
+        verdict=verdict, unsettled=unsettled,
+        unsettled_probability=unsettled / valid if valid else None, unsettled_low=u_low,
+        unsettled_high=u_high)

@@ -42,7 +42,7 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
           isolated: bool | None = None, executor: Executor | None = None,
           progress: ProgressCallback | None = None,
           cache: PointCache | str | os.PathLike | bool | None = None,
-          chunksize: int | None = None) -> SweepResult:
+          chunksize: int | None = None, measure: str = "stage") -> SweepResult:
     """Map the hunting metric over one or two spec values.
 
     Parameters
@@ -69,6 +69,11 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
         cache directory); None: no cache.
     chunksize : int, optional
         Points per chunk; default about 1/16 of the points, at most 64.
+    measure : {"stage", "move"}, optional
+        ``"stage"`` (default): per point, whether any move of the family ends
+        in a sustained cycle and that cycle's peak-to-peak amplitude
+        (:mod:`fi_design.stage`); ``"move"``: the paper's hunting metric on
+        the spec's own move.
 
     Returns
     -------
@@ -104,7 +109,7 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
     paths = (ax.path,) if ay is None else (ax.path, ay.path)
     tasks = [(tuple(zip(paths, vals)), iso) for _, vals in cells]
     ev = evaluate(spec, tasks, executor=executor, progress=progress, cache=cache,
-                  chunksize=chunksize)
+                  chunksize=chunksize, measure=measure)
     points = tuple(point_result(idx, vals, iso, out)
                    for (idx, vals), out in zip(cells, ev.outcomes))
     design = tuple(design_value(spec, p) for p in paths)
@@ -113,12 +118,13 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
         hunting_cycles=grid(points, shape, "hunting_cycles"),
         amplitude=grid(points, shape, "amplitude"), period=grid(points, shape, "period"),
         verdict=verdict_grid(points, shape), design_point=design, run=ev.run,
-        fi_design_version=__version__)
+        fi_design_version=__version__, measure=measure)
 
 
 def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
                executor: Executor | None = None, progress: ProgressCallback | None = None,
-               cache: PointCache | str | os.PathLike | bool | None = None) -> DesignMap:
+               cache: PointCache | str | os.PathLike | bool | None = None,
+               measure: str = "stage") -> DesignMap:
     """A small crossover x stroke hunting map around the design point (paper Figure 4D).
 
     Crossover from 0.125 to 2.5 times the design's, stroke from 1/6 to 10/3
@@ -133,7 +139,7 @@ def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
     resolution : (int, int), optional
         Points along the crossover and the stroke (default 8 x 6 = 48
         simulations, a few seconds).
-    executor, progress, cache
+    executor, progress, cache, measure
         As for :func:`sweep`.
 
     Returns
@@ -153,6 +159,7 @@ def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
     x = make_axis("controller.crossover", np.linspace(0.125 * fc, 2.5 * fc, nx), spec=spec)
     y = make_axis("isolator.stroke", np.geomspace(s / 6.0, s * 10.0 / 3.0, ny), log=True,
                   spec=spec)
-    out = sweep(spec, x, y, isolated=True, executor=executor, progress=progress, cache=cache)
+    out = sweep(spec, x, y, isolated=True, executor=executor, progress=progress, cache=cache,
+                measure=measure)
     return DesignMap(sweep=out, suggested=suggested, stroke=s,
                      stiffness=spec.isolator.stiffness)
