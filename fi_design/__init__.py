@@ -11,7 +11,9 @@ reports.
 The public API (imported lazily, so ``import fi_design`` stays fast):
 
 - :func:`load_spec` -- read and validate a YAML spec or a mapping;
-- :func:`design` -- the four guideline steps and the simulated confirmation;
+- :func:`design` -- the four guideline steps, the simulated confirmation and
+  the sign-off verdict, with a recommendation that passes when it fails;
+- :func:`recommend` -- search the isolator and crossover for a design that passes;
 - :func:`simulate` -- one nonlinear simulation;
 - :func:`sweep`, :func:`robustness` -- parameter studies;
 - :func:`load_measurement`, :func:`reconcile` -- compare with measured data;
@@ -34,7 +36,8 @@ except PackageNotFoundError:  # running from a source tree without install
 _API = {
     "load_spec": "fi_design.specfile",
     "Spec": "fi_design.spec",
-    "design": "fi_design.guideline",
+    "design": "fi_design.signoff",
+    "recommend": "fi_design.recommend",
     "DesignResult": "fi_design.results.design",
     "simulate": "fi_design.simulation",
     "SimulationResult": "fi_design.results.simulation",

@@ -74,6 +74,10 @@ def design_command(
         help="Exit with code 3 (after writing the outputs) when the verdict is at or below "
              "this level: 'fail' on FAIL, 'warn' on FAIL or PASS_WITH_WARNINGS; for scripts "
              "and CI.")] = None,
+    no_recommend: Annotated[bool, typer.Option(
+        "--no-recommend", help="On a FAIL verdict, skip the search for a design that passes "
+                               "(it takes seconds to a minute; `fi-design recommend` runs it "
+                               "alone).")] = False,
     force: Force = False,
 ) -> None:
     """Run the four-step guideline on a spec and confirm it by simulation (the default command).
@@ -83,9 +87,9 @@ def design_command(
     isolator, the lowest hunting-free crossovers, the conclusion and the
     verdict on the hardware as specified (PASS, PASS_WITH_WARNINGS or FAIL,
     with its reasons, the hunting probability under friction scatter, the
-    margins and any recommendation); writes JSON and the sign-off report
-    (HTML or PDF) on request. With --fail-on, exits 3 when the verdict is at
-    or below that level.
+    margins and, when it fails, a design that passes, found by search);
+    writes JSON and the sign-off report (HTML or PDF) on request. With
+    --fail-on, exits 3 when the verdict is at or below that level.
     """
     levels = {"fail": "FAIL", "warn": "PASS_WITH_WARNINGS"}
     if fail_on is not None and fail_on not in levels:
@@ -102,13 +106,14 @@ def design_command(
     spec_obj = load(spec)
 
     from .console import Status, make_console, print_design
-    from .guideline import design
     from .pools import confirmation_pool
+    from .signoff import design
 
     console, err = make_console(), make_console(stderr=True)
     with Status(err, "running the design guideline ...") as status, \
             confirmation_pool(not no_simulation) as pool:
-        result = design(spec_obj, confirm=not no_simulation, executor=pool, progress=status)
+        result = design(spec_obj, confirm=not no_simulation, executor=pool, progress=status,
+                        recommend=not no_recommend)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
     print_design(console, result, spec_path=spec)
     write_outputs(console, outs, payloads)
@@ -439,6 +444,45 @@ def robustness_command(
     console = make_console()
     write_study(console, outs, result, robustness_figure)
     print_robustness(console, result, spec_path=spec, executor=pool.describe())
+
+
+# --------------------------------------------------------------------------- recommend
+
+
+@app.command("recommend")
+def recommend_command(
+    spec: SpecArg,
+    json_out: JsonOut = None,
+    report_out: Optional[Path] = output_option("--report", "OUT.html|OUT.pdf",
+        "Write the report of the search (HTML, or PDF for a .pdf name)."),
+    force: Force = False,
+) -> None:
+    """Search the isolator's stroke and stiffness (and the rule's crossover) for a design that passes.
+
+    Every point of a stroke x stiffness grid is judged by the sign-off's own
+    constraints: k_max, the flexure, the loop margins with the parasitic
+    modes, every move of the family, the hunting-free crossover, the end stop
+    and the friction scatter. Prints the design with the most margin, what
+    binds it and the design space; with none feasible, the nearest design,
+    what it violates and what would open the space.
+    """
+    outs = check_outputs((spec,), force, json=(json_out, (".json",)),
+                         report=(report_out, (".html", ".pdf")))
+    check_spec_path(spec)
+    spec_obj = load(spec)
+
+    from .console import Status, make_console, print_recommendation
+    from .pools import confirmation_pool
+    from .recommend import recommend
+
+    console, err = make_console(), make_console(stderr=True)
+    with Status(err, "searching the design space ...") as status, \
+            confirmation_pool(True) as pool:
+        result = recommend(spec_obj, executor=pool, progress=status)
+    payloads = {} if outs["json"] is None else {"json": json_text(result)}
+    print_recommendation(console, result, spec_path=spec)
+    write_outputs(console, outs, payloads)
+    write_report(console, outs["report"], result)
 
 
 # --------------------------------------------------------------------------- reconcile

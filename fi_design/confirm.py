@@ -45,7 +45,7 @@ from .results.design import Confirmation, Landing, PlantVerdict
 from .results.simulation import SimulationResult
 from .results.stage import StageHunting
 from .simulation import simulate
-from .stage import length_range, length_text, stage_hunting
+from .stage import stage_hunting
 
 PLANTS = ("isolated", "non_isolated")
 
@@ -166,44 +166,6 @@ def _plant_text(v: PlantVerdict, label: str, fc: float) -> str:
 
 
 
-def stage_text(st: StageHunting, label: str) -> str:
-    """One sentence on a plant's stage-level answer (for checks, verdict and report)."""
-    fc = st.crossover
-    n = len(st.moves)
-    if st.hunts:
-        h = st.hunting_moves
-        dist = sorted(abs(m.distance) for m in h)
-        c = st.cycle
-        if c is not None:
-            cyc = f"a cycle of {length_text(c.amplitude)} peak to peak, period {c.period:.3g} s"
-            if c.on_limiter:
-                cyc += ", the joint on its limiter"
-        else:
-            m = h[0]
-            cyc = (f"a cycle of {length_text(m.amplitude)} peak to peak" if m.amplitude else "a cycle")
-        moves = (f"the {length_text(dist[0])} move" if len(dist) == 1 else
-                 f"{len(h)} of {n} moves, from {length_range(dist[0], dist[-1])},")
-        sm = st.spec_move
-        own = ("" if sm is None or sm.hunts else
-               f"; after the spec's own motion it {'settles' if sm.outcome == 'settles' else sm.outcome}")
-        return f"{label} hunts at {fc:g} Hz: {moves} end in {cyc}{own}"
-    if st.outcome == "stuck":
-        m = next(m for m in st.moves if m.outcome in ("stuck", "rests"))
-        return (f"{label} sticks at {fc:g} Hz: after the {length_text(abs(m.distance))} move it "
-                f"rests {length_text(abs(m.final_error))} from its target ({m.reason})")
-    if st.outcome == "undetermined":
-        m = next(m for m in st.moves if m.outcome == "undetermined")
-        return (f"{label} cannot be judged at {fc:g} Hz after the {length_text(abs(m.distance))} move: "
-                f"{m.reason}")
-    if st.outcome == "static_error":
-        worst = max(abs(m.final_error) for m in st.moves)
-        return (f"{label} comes to rest at {fc:g} Hz after all {n} moves, at most "
-                f"{length_text(worst)} from the target, within the (Fs + |offset|) / kp = "
-                f"{length_text(st.static_error_bound)} that static friction can hold against a "
-                "loop without integrator")
-    return f"{label} comes to rest at its target at {fc:g} Hz after all {n} moves"
-
-
 def _checks(spec, iso, non, stage, mins, land, agree, other_iso, other_non,
             suggested) -> list[Check]:
     """The confirmation's checks: the spec's own plant judged, the other one information."""
@@ -225,7 +187,7 @@ def _checks(spec, iso, non, stage, mins, land, agree, other_iso, other_non,
         judged = key == own_key
         out.append(Check(f"simulation_{key}", st.acceptable if judged else None,
                          float(len(st.hunting_moves)), 0.0 if judged else None, "moves",
-                         stage_text(st, labels[key]), step))
+                         st.describe(labels[key]), step))
     for key in ("isolated", "non_isolated"):
         v = plants[key]
         text = "the spec's own motion, the paper's metric: " + _plant_text(v, labels[key], fc)

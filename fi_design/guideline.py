@@ -541,7 +541,8 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         ``robustness`` under the friction scatter of
         ``requirements.robustness`` (simulated on ``executor`` beside the
         confirmation; about 200 simulations of a few ms by default),
-        ``margins`` and a ``recommendation`` (:mod:`fi_design.verdict`).
+        ``margins``; no ``recommendation`` (:func:`fi_design.signoff.design`
+        adds the design search's when the verdict fails).
 
     Raises
     ------
@@ -604,8 +605,8 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     margins = _verdict.margins(spec, xo, st, fx, pid, sim)
     result = replace(
         result, robustness=rob, margins=margins,
-        recommendation=_verdict.recommend(spec, xo, sim, rob),
         verdict=_verdict.judge(spec, result.checks, result.warnings, sim, rob, margins))
+
     log.info("design of %r: %s, %d checks, %d failed", spec.name, result.verdict.status,
              len(result.checks), len(result.failed_checks))
     return result
@@ -613,7 +614,6 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
 
 def _simulation_sentence(spec: Spec, sim: Confirmation) -> str:
     """The conclusion's sentences on the simulated stage (the spec's own plant first)."""
-    from .confirm import stage_text
 
     mins = sim.min_hunting_free_crossover
 
@@ -629,8 +629,8 @@ def _simulation_sentence(spec: Spec, sim: Confirmation) -> str:
         labels = ("The isolated stage as specified", "without the isolator it")
     model = "LuGre" if sim.isolated.friction_model == "lugre" else sim.isolated.friction_model
     text = (f" Simulated with {model} friction after every move of its family: "
-            + stage_text(sim.stage[own], labels[0]) + "; "
-            + stage_text(sim.stage[other], labels[1]) + ". No move hunts "
+            + sim.stage[own].describe(labels[0]) + "; "
+            + sim.stage[other].describe(labels[1]) + ". No move hunts "
             + f"{f(mins[own])} as specified and {f(mins[other])} "
             + ("with the suggested isolator" if sim.suggested_isolator else "without the isolator")
             + " (the folds of the cycles).")

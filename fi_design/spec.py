@@ -406,6 +406,27 @@ class Robustness(StrictModel):
                                                             "probability [-]. Default 0.95.")
 
 
+class RecommendBounds(StrictModel):
+    """Bounds of the recommendation's search (``fi-design recommend``); null: the default range."""
+
+    stroke: Union[tuple[Q("m"), Q("m")], None] = Field(
+        None, description="[min, max] stroke [m], e.g. the travel the mechanism allows; default "
+                          "a third to three times the spec's stroke (0.1 to 1 mm without one).")
+    stiffness: Union[tuple[Q("N/m"), Q("N/m")], None] = Field(
+        None, description="[min, max] drive stiffness [N/m]; default up to k_max.")
+    crossover: Union[tuple[Q("Hz"), Q("Hz")], None] = Field(
+        None, description="[min, max] controller crossover [Hz] (a spec tuned by the rule); "
+                          "default up to the achievable crossover.")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "RecommendBounds":
+        for name in ("stroke", "stiffness", "crossover"):
+            pair = getattr(self, name)
+            if pair is not None and not 0 < pair[0] <= pair[1]:
+                raise ValueError(f"{name} must be [min, max] with 0 < min <= max")
+        return self
+
+
 class Requirements(StrictModel):
     """Design requirements and metric settings."""
 
@@ -424,6 +445,8 @@ class Requirements(StrictModel):
                                                            "Default 1 (the paper's rule).")
     hunting: Hunting = Field(default_factory=Hunting)
     robustness: Robustness = Field(default_factory=Robustness)
+    recommend: RecommendBounds = Field(default_factory=RecommendBounds,
+                                       description="Bounds of the recommendation's search.")
 
 
 class Measurement(StrictModel):
@@ -463,7 +486,7 @@ class Simulation(StrictModel):
 
 #: Kinds of report, with the suffix that makes each one's document id (see ReportInfo).
 REPORT_KINDS = {"design": "", "sweep": "SWEEP", "study": "STUDY", "robustness": "ROBUSTNESS",
-                "reconcile": "RECONCILE", "identify": "IDENTIFY"}
+                "reconcile": "RECONCILE", "identify": "IDENTIFY", "recommend": "RECOMMEND"}
 
 
 class Revision(StrictModel):
@@ -479,7 +502,7 @@ class Revision(StrictModel):
 class DocumentIds(StrictModel):
     """Document ids of the other kinds of report (default: report.document_id with the kind as
     a suffix, FI-0001-SWEEP, FI-0001-STUDY, FI-0001-ROBUSTNESS, FI-0001-RECONCILE,
-    FI-0001-IDENTIFY)."""
+    FI-0001-IDENTIFY, FI-0001-RECOMMEND)."""
 
     sweep: str | None = Field(None, min_length=1, description="Document id of a sweep report "
                                                               "(fi-design sweep). Default "
@@ -495,6 +518,10 @@ class DocumentIds(StrictModel):
     identify: str | None = Field(None, min_length=1, description="Document id of an "
                                                                  "identification report. Default "
                                                                  "DOCUMENT_ID-IDENTIFY.")
+    recommend: str | None = Field(None, min_length=1, description="Document id of a "
+                                                                  "recommendation report "
+                                                                  "(fi-design recommend). "
+                                                                  "Default DOCUMENT_ID-RECOMMEND.")
 
 
 class ReportInfo(StrictModel):

@@ -51,13 +51,13 @@ from .compiled import kernel, run
 from .errors import ArgumentError
 from .plant import (N_WATCH, W_ARM, W_BAND, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_REPEAT,
                     W_REST_ANYWHERE, W_START, PlantParameters, state_index)
-from .results.stage import Cycle, CycleTrace, MoveOutcome, StageHunting
+from .results.stage import Cycle, CycleTrace, MoveOutcome, StageHunting, length_text
 from .simulation import plant_parameters, tolerances
 from .trajectory import Trajectory, from_moves, profile_duration
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Watch", "watch_settings", "length_text", "length_range", "family_distances", "rest_is_final", "move_outcome",
+__all__ = ["Watch", "watch_settings", "family_distances", "rest_is_final", "move_outcome",
            "converge_cycle", "cycle_exists", "cycle_fold", "stage_hunting", "stage_hunts"]
 
 #: Room for section crossings per run (the crossings rule stops a run there).
@@ -296,18 +296,6 @@ def rest_is_final(params: PlantParameters, y: np.ndarray, level: float) -> bool:
     sign = 1.0 if force >= 0.0 else -1.0
     g0 = kernel().stribeck(0.0, x_cart, sign, _kernel_arrays(p, 1.0)[0])[0]
     return abs(force) < g0
-
-
-def length_text(x: float) -> str:
-    """A length [m] in words: in um below a millimetre, in mm from there (3 digits)."""
-    x = float(x)
-    return f"{x * 1e6:.3g} um" if abs(x) < 1e-3 else f"{x * 1e3:.3g} mm"
-
-
-def length_range(lo: float, hi: float) -> str:
-    """Two lengths [m] in one unit, the larger's: ``"0.396 to 50 mm"``."""
-    unit, scale = ("um", 1e6) if max(abs(lo), abs(hi)) < 1e-3 else ("mm", 1e3)
-    return f"{lo * scale:.3g} to {hi * scale:.3g} {unit}"
 
 
 def _rest_ends_run(params: PlantParameters, y: np.ndarray, level: float, band: float) -> bool:
@@ -910,6 +898,17 @@ def _distinct_cycles(p, hunting: Sequence[_Run], fc: float, trace: bool) -> list
     return cycles
 
 
+def _run_cycle(run: _Run, crossover: float) -> Cycle:
+    """The cycle a hunting move repeated, as its run left it (no Newton): enough to start the
+    fold's continuation from, which converges on the cycle at every step anyway."""
+    m = run.outcome
+    return Cycle(crossover=float(crossover), amplitude=float(m.amplitude or 0.0),
+                 period=float(m.period or 0.0), stable=True, multiplier=None,
+                 multiplier_check=None, method="simulation", residual=math.nan,
+                 crossings=int(run.crossings), on_limiter=None, deflection_range=None,
+                 section_state=_ro(run.section_state))
+
+
 def _boundary(spec, iso, p, fc, cycle, effects, family, say) -> dict:
     """The hunting-free crossover: the fold of the cycle (found first if needed)."""
     scan = spec.simulation.crossover_scan
@@ -929,10 +928,8 @@ def _boundary(spec, iso, p, fc, cycle, effects, family, say) -> dict:
             tests += 1
             h = [r for r in runs if r.outcome.hunts]
             if h:
-                found = converge_cycle(pf, h[0].level, h[0].section_state, h[0].crossings, f,
-                                       period=h[0].outcome.period, trace=False)
-                if found is not None:
-                    break
+                found = _run_cycle(h[0], f)
+                break
         if found is None:
             return {"hunting_free_from": scan.start, "bracket": [scan.start, scan.start],
                     "kind": "bound", "resolution": 0.0, "tests": tests, "branch": [],
@@ -958,14 +955,7 @@ def _boundary(spec, iso, p, fc, cycle, effects, family, say) -> dict:
             return {"hunting_free_from": hi, "bracket": [lo, hi], "kind": "fold",
                     "resolution": hi - lo, "tests": tests, "branch": sorted(branch),
                     "note": "the fold of the cycle, confirmed by the move family above it"}
-        nxt = converge_cycle(ph, h[0].level, h[0].section_state, h[0].crossings, hi,
-                             period=h[0].outcome.period, trace=False)
-        if nxt is None:
-            return {"hunting_free_from": hi, "bracket": [lo, hi], "kind": "fold",
-                    "resolution": hi - lo, "tests": tests, "branch": sorted(branch),
-                    "note": "the fold of the cycle; a move just above it still hunted but its "
-                            "cycle did not converge"}
-        cycle = nxt
+        cycle = _run_cycle(h[0], hi)
     return {"hunting_free_from": hi, "bracket": [lo, hi], "kind": "fold",
             "resolution": hi - lo, "tests": tests, "branch": sorted(branch),
             "note": "several cycles; the last fold found"}

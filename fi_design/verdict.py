@@ -15,9 +15,9 @@ confirmation; this module turns them into what a review board signs:
   without integrator has no hunting boundary; a crossover scan that settles
   everywhere gives a bound; the search cap of step 2 is a bound, not a
   result);
-- :func:`recommend` -- what would make the stage pass (the isolator the
-  guideline suggests and what the simulation says it would do, a higher
-  crossover), kept apart from the verdict;
+- :func:`recommendation` -- what to build so that the stage passes, from
+  the design search of :mod:`fi_design.recommend`, kept apart from the
+  verdict;
 - :func:`judge` -- the :class:`~fi_design.results.design.Verdict`.
 
 The verdict judges the spec's own plant: the isolated stage when the spec has
@@ -42,8 +42,8 @@ from .results import Check, Status
 from .results.design import (Confirmation, CrossoverResult, FlexureResult, Margins, PidResult,
                              Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict)
 
-__all__ = ["run_robustness", "robustness_check", "robustness_as_check", "margins", "recommend",
-           "judge"]
+__all__ = ["run_robustness", "robustness_check", "robustness_as_check", "margins",
+           "recommendation", "judge"]
 
 #: Plant judged for a spec with / without isolator.
 _OWN = {True: "isolated", False: "non_isolated"}
@@ -294,93 +294,20 @@ def margins(spec: _spec.Spec, crossover: CrossoverResult, stiffness: StiffnessRe
 # --------------------------------------------------------------------------- recommendation
 
 
-def recommend(spec: _spec.Spec, crossover: CrossoverResult, simulation: Confirmation | None,
-              robustness: RobustnessCheck | None) -> Recommendation | None:
-    """What would make the stage pass, kept apart from the verdict.
-
-    For a stage without isolator whose simulation does not settle (or that
-    fails the robustness check): the isolator step 3 suggests, with what the
-    simulation says it would do. For any stage that hunts at its crossover but
-    settles higher up, and whose loop reaches that crossover: the crossover to
-    raise it to.
+def recommendation(search: Any) -> Recommendation:
+    """The design's recommendation from the design search (:func:`fi_design.recommend.recommend`).
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
-    crossover : CrossoverResult
-        Step 2 (the achievable crossover).
-    simulation : Confirmation or None
-        The nonlinear confirmation.
-    robustness : RobustnessCheck or None
-        The robustness check.
+    search : fi_design.results.recommend.RecommendResult
+        The search.
 
     Returns
     -------
-    Recommendation or None
-        None when nothing needs recommending (or nothing was simulated).
+    Recommendation
     """
-    if simulation is None:
-        return None
-    own = _OWN[spec.has_isolator]
-    mine = simulation.stage[own]
-    scatter_fails = robustness is not None and robustness.status == "FAIL"
-    if mine.acceptable and not scatter_fails:
-        return None
-    parts: list[str] = []
-    iso_info = None
-    if not spec.has_isolator:
-        sug = simulation.stage["isolated"]
-        land = simulation.landing
-        k = land.stiffness if land is not None else None
-        iso_info = {"stroke": land.stroke if land is not None else None, "stiffness": k,
-                    "outcome": sug.outcome, "moves_hunting": len(sug.hunting_moves),
-                    "hunting_free_from": simulation.min_hunting_free_crossover["isolated"],
-                    "end_stop_clearance": None if land is None
-                    else land.stroke - abs(land.deflection)}
-        text = (f"add a friction isolator: the guideline suggests a "
-                f"{land.stroke * 1e3:.3g} mm stroke and k = {k:.4g} N/m; simulated at "
-                f"{crossover.desired:g} Hz the stage would then "
-                + (f"hunt after {len(sug.hunting_moves)} of {len(sug.moves)} moves"
-                   if sug.hunts else _BEHAVIOUR.get(sug.outcome, sug.outcome)))
-        m = iso_info["hunting_free_from"]
-        text += ", hunting-free from " + (f"{m:g} Hz" if m is not None else "no scanned crossover")
-        if robustness is not None and robustness.comparison is not None:
-            c = robustness.comparison
-            iso_info["hunting_probability"] = c["hunting_probability"]
-            iso_info["interval"] = c["interval"]
-            text += (f", hunting in {_pct(c['hunting_probability'])} of the scatter samples "
-                     f"({_pct(c['interval'][0])} to {_pct(c['interval'][1])})")
-            if c["hunting_probability"] is not None and \
-                    c["hunting_probability"] > robustness.limit:
-                text += (f", above the {_pct(robustness.limit)} limit: as it stands it would "
-                         "not pass the robustness check either")
-        parts.append(text + ". Specify it (the isolator section) and run the design again "
-                     "to sign it off")
-    m_own = simulation.min_hunting_free_crossover[own]
-    raise_to = None
-    if (not mine.acceptable and m_own is not None and m_own > crossover.desired
-            and mine.static_error_bound is None):
-        raise_to = m_own
-        reach = crossover.achievable
-        if reach is not None and crossover.limit_kind != "scan_limit" and reach < m_own:
-            parts.append(f"a crossover of {m_own:g} Hz would settle, but the loop reaches only "
-                         f"{reach:.3g} Hz (step 2)")
-        else:
-            bound = (" (step 2 sets no limit below its search cap; check it with the "
-                     "hardware's sampling and delay)" if crossover.limit_kind == "scan_limit"
-                     else f" (step 2: achievable {reach:.3g} Hz)" if reach is not None else "")
-            parts.append(("or " if parts else "") + f"raise the crossover above "
-                         f"{m_own:.4g} Hz, from which no move of the family hunts{bound}")
-    if not parts and scatter_fails:
-        parts.append("look for more margin to hunting under scatter: `fi-design robustness` "
-                     "studies the scatter, and the hunting map of the report (`--map`) shows "
-                     "where crossover and stroke give room")
-    if not parts:
-        return None
-    text = "; ".join(parts)
-    return Recommendation(text=text[0].upper() + text[1:] + ".", isolator=iso_info,
-                          crossover=raise_to)
+    return Recommendation(text=search.advice, isolator=search.isolator,
+                          crossover=search.crossover, feasible=search.feasible, search=search)
 
 
 # --------------------------------------------------------------------------- verdict
@@ -397,9 +324,7 @@ _BEHAVIOUR = {
 
 def _behaviour_reason(st: Any, label: str) -> Reason:
     """The verdict's reason on the plant's stage-level answer (every move of its family)."""
-    from .confirm import stage_text
-
-    text = stage_text(st, label) + "."
+    text = st.describe(label) + "."
     if st.outcome == "settles":
         return Reason("PASS", "simulation", text + " No move ends in a hunting cycle.")
     if st.outcome == "static_error":

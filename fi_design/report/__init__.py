@@ -41,7 +41,7 @@ solver wall times are left out.
 
 from __future__ import annotations
 
-from . import design, study  # noqa: F401  (register the context builders)
+from . import design, recommend, study  # noqa: F401  (register the context builders)
 from .blocks import FigureBlock, Section, Table, figure_block
 from .checks import check_label, check_row
 from .context import build_context, document_context

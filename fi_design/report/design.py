@@ -145,8 +145,6 @@ def _stage_rows(sim: Any) -> list[dict]:
     else:
         names = {"isolated": "with isolator (as specified)",
                  "non_isolated": "without isolator (comparison)"}
-    from ..confirm import stage_text
-
     rows = []
     for key, name in names.items():
         st = sim.stage[key]
@@ -167,7 +165,7 @@ def _stage_rows(sim: Any) -> list[dict]:
             "free_from": st.hunting_free_from,
             "bracket": (f"fold bisected to {qty(b['resolution'], 'Hz')}"
                         if b.get("kind") == "fold" else b.get("note", "")),
-            "text": stage_text(st, name[0].upper() + name[1:]),
+            "text": st.describe(name[0].upper() + name[1:]),
         })
     return rows
 

@@ -16,6 +16,7 @@ TITLES = {
     "study": "Hunting maps of the paper's parameter study",
     "robustness": "Robustness of the hunting verdict",
     "reconcile": "Model and measurement reconciliation",
+    "recommend": "Friction isolator recommendation (design search)",
 }
 
 

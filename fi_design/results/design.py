@@ -740,26 +740,38 @@ class Margins(Result):
 
 @dataclass(frozen=True)
 class Recommendation(Result):
-    """What would make the stage pass, apart from the verdict on it.
+    """What to build so that the stage passes, apart from the verdict on it.
 
     Attributes
     ----------
     text : str
         The recommendation in words.
     isolator : dict or None
-        For a stage without isolator, the suggested one and what the
-        simulation says it would do: ``stroke`` [m], ``stiffness`` [N/m],
-        ``outcome`` at the design crossover, ``hunting_cycles``,
-        ``hunting_free_from`` [Hz], ``end_stop_clearance`` [m] and, when the
-        robustness check ran, ``hunting_probability`` [-] and ``interval``.
+        The recommended (or nearest) isolator: ``stroke`` [m], ``stiffness``
+        [N/m], ``damping`` [N s/m] or None (the default ratio).
     crossover : float or None
-        The lowest hunting-free crossover of the stage as specified [Hz], when
-        raising the crossover to it would help and the loop can reach it.
+        The recommended controller crossover [Hz].
+    feasible : bool
+        Whether the search found a design the sign-off passes.
+    search : fi_design.results.recommend.RecommendResult or None
+        The design search behind it (:func:`fi_design.recommend.recommend`);
+        its JSON is this recommendation's.
     """
 
     text: str
     isolator: dict | None = None
     crossover: float | None = None
+    feasible: bool = False
+    search: Any = field(default=None, repr=False)
+
+    def to_dict(self) -> dict:
+        """``text`` and the search's JSON (``feasible``, ``isolator``, ``crossover``,
+        ``binding``, ...)."""
+        out = {"text": self.text, "isolator": to_jsonable(self.isolator),
+               "crossover": self.crossover, "feasible": self.feasible}
+        if self.search is not None:
+            out.update(self.search.to_dict())
+        return out
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,20 @@ import numpy as np
 
 from . import Result, dataclass_dict, to_jsonable
 
-__all__ = ["MOVE_OUTCOMES", "MoveOutcome", "CycleTrace", "Cycle", "StageHunting"]
+__all__ = ["MOVE_OUTCOMES", "MoveOutcome", "CycleTrace", "Cycle", "StageHunting", "length_text",
+           "length_range"]
+
+def length_text(x: float) -> str:
+    """A length [m] in words: in um below a millimetre, in mm from there (3 digits)."""
+    x = float(x)
+    return f"{x * 1e6:.3g} um" if abs(x) < 1e-3 else f"{x * 1e3:.3g} mm"
+
+
+def length_range(lo: float, hi: float) -> str:
+    """Two lengths [m] in one unit, the larger's: ``"0.396 to 50 mm"``."""
+    unit, scale = ("um", 1e6) if max(abs(lo), abs(hi)) < 1e-3 else ("mm", 1e3)
+    return f"{lo * scale:.3g} to {hi * scale:.3g} {unit}"
+
 
 #: How a move can end: at rest at the target, in a sustained cycle, at rest
 #: off the target (a loop without integrator: its static error; with an
@@ -260,6 +273,53 @@ class StageHunting(Result):
         amps = [c.amplitude for c in (self.cycle, *self.other_cycles) if c is not None]
         amps += [m.amplitude for m in self.moves if m.hunts and m.amplitude is not None]
         return float(max(amps)) if amps else 0.0
+
+    def describe(self, label: str) -> str:
+        """The plant's stage-level answer in one sentence, beginning with ``label``.
+
+        Parameters
+        ----------
+        label : str
+            What the sentence is about, e.g. ``"The isolated stage as specified"``.
+
+        Returns
+        -------
+        str
+        """
+        fc = self.crossover
+        n = len(self.moves)
+        if self.hunts:
+            h = self.hunting_moves
+            dist = sorted(abs(m.distance) for m in h)
+            c = self.cycle
+            if c is not None:
+                cyc = f"a cycle of {length_text(c.amplitude)} peak to peak, period {c.period:.3g} s"
+                if c.on_limiter:
+                    cyc += ", the joint on its limiter"
+            else:
+                m = h[0]
+                cyc = (f"a cycle of {length_text(m.amplitude)} peak to peak" if m.amplitude else "a cycle")
+            moves = (f"the {length_text(dist[0])} move" if len(dist) == 1 else
+                     f"{len(h)} of {n} moves, from {length_range(dist[0], dist[-1])},")
+            sm = self.spec_move
+            own = ("" if sm is None or sm.hunts else
+                   f"; after the spec's own motion it {'settles' if sm.outcome == 'settles' else sm.outcome}")
+            return f"{label} hunts at {fc:g} Hz: {moves} end in {cyc}{own}"
+        if self.outcome == "stuck":
+            m = next(m for m in self.moves if m.outcome in ("stuck", "rests"))
+            return (f"{label} sticks at {fc:g} Hz: after the {length_text(abs(m.distance))} move it "
+                    f"rests {length_text(abs(m.final_error))} from its target ({m.reason})")
+        if self.outcome == "undetermined":
+            m = next(m for m in self.moves if m.outcome == "undetermined")
+            return (f"{label} cannot be judged at {fc:g} Hz after the {length_text(abs(m.distance))} move: "
+                    f"{m.reason}")
+        if self.outcome == "static_error":
+            worst = max(abs(m.final_error) for m in self.moves)
+            return (f"{label} comes to rest at {fc:g} Hz after all {n} moves, at most "
+                    f"{length_text(worst)} from the target, within the (Fs + |offset|) / kp = "
+                    f"{length_text(self.static_error_bound)} that static friction can hold against a "
+                    "loop without integrator")
+        return f"{label} comes to rest at its target at {fc:g} Hz after all {n} moves"
 
     def to_dict(self) -> dict:
         """The contract's form: ``hunts``, ``moves_tried``, ``moves_hunting``,

@@ -1,0 +1,66 @@
+"""The sign-off: the design, and when it fails, a design that passes.
+
+:func:`design` is the library's and the design command's entry point: the
+four guideline steps, the simulated confirmation and the verdict
+(:func:`fi_design.guideline.design`), and, when the verdict fails, the design
+search of :func:`fi_design.recommend.recommend` as the result's
+``recommendation``: what to build, found by the same computation that signs
+a design off.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from .guideline import design as _design
+from .results.design import DesignResult
+from .spec import Spec
+
+__all__ = ["design"]
+
+
+def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
+           executor: Any = None, progress: Callable[[str], None] | None = None,
+           recommend: bool = True) -> DesignResult:
+    """Run the guideline on a spec, confirm it by simulation, and recommend when it fails.
+
+    Parameters
+    ----------
+    spec : Spec, path or mapping
+        A validated spec, or a YAML path or mapping.
+    confirm : bool, optional
+        Simulate (see :func:`fi_design.guideline.design`). Default True; a
+        design that was not simulated is never recommended on.
+    executor : concurrent.futures-style executor, optional
+        Runs the simulations (the confirmation, the robustness samples and
+        the design search's evaluations); None runs them here. The library
+        creates no pool.
+    progress : callable, optional
+        ``progress(text)`` as the work proceeds.
+    recommend : bool, optional
+        When the simulated verdict is FAIL, search the design space for a
+        design that passes (:func:`fi_design.recommend.recommend`: seconds to
+        a minute) and return it as ``recommendation``. Default True.
+
+    Returns
+    -------
+    DesignResult
+
+    Raises
+    ------
+    fi_design.errors.SpecError
+        When ``spec`` is a path or mapping that does not validate.
+    """
+    result = _design(spec, confirm=confirm, executor=executor, progress=progress)
+    if not (recommend and result.simulation is not None and result.verdict.status == "FAIL"):
+        return result
+    from .recommend import recommend as search
+    from .verdict import recommendation
+
+    if progress is not None:
+        progress("searching for a design that passes ...")
+    found = search(result.spec, executor=executor, progress=progress)
+    return replace(result, recommendation=recommendation(found))

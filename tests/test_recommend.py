@@ -1,0 +1,115 @@
+"""The design search: a recommendation the tool itself signs off, checked by what it did not make.
+
+The recommended design of the paper setup is checked by moves simulated with the
+independent solve_ivp simulator of ``tests/independent.py`` (none hunts), by the product's
+kernel over a dense move scan at the four corners of the friction scatter, and by the design
+command on it (it passes). A space with no feasible point says so, with the nearest design.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from fi_design.recommend import recommend
+from fi_design.stage import stage_hunts
+
+from conftest import variant
+
+
+@pytest.fixture(scope="module")
+def paper_recommendation(paper_spec):
+    return recommend(paper_spec)
+
+
+def test_paper_recommendation_passes_where_the_spec_fails(paper_recommendation, paper_spec):
+    r = paper_recommendation
+    assert r.feasible and r.design.status == "feasible"
+    d = r.design
+    # the spec's own isolator hunts up to 11.28 Hz; the recommendation has margin
+    assert d.hunting_free_from < d.crossover and r.margins["crossover_factor"] > 1.2
+    assert d.stiffness <= paper_spec.friction.static / d.stroke          # k <= k_max
+    assert r.margins["end_stop_clearance"] > 0
+    assert d.unsettled_probability is not None and d.unsettled_probability <= 0.05
+    assert r.stage_hunting is not None and not r.stage_hunting.hunts
+    # the crossover is the highest the loop margins allow: step 2's achievable one
+    assert d.crossover == pytest.approx(11.82, abs=0.01)
+    assert any("gain margin of case 4" in b for b in r.binding)
+    # the spec's own design is a point of the map that hunts at some crossover below
+    statuses = {c.status for c in r.candidates}
+    assert {"feasible", "hunts", "k_max"} <= statuses
+    data = json.loads(json.dumps(r.to_dict(), allow_nan=False))
+    assert data["feasible"] is True and set(data["isolator"]) == {"stroke", "stiffness",
+                                                                  "damping"}
+    assert {"crossover", "binding", "stage_hunting", "robustness", "margins"} <= set(data)
+
+
+def test_recommended_design_settles_under_the_scatter_corners_for_a_dense_scan(
+        paper_recommendation, paper_spec):
+    """The product's kernel, 60 moves of 0.01 to 100 mm, at Fs and Fc scattered by +-20 %."""
+    d = paper_recommendation.design
+    dense = np.geomspace(1e-5, 0.1, 60)
+    for fs, fc in ((0.8, 0.8), (0.8, 1.2), (1.2, 0.8), (1.2, 1.2)):
+        spec = variant(paper_spec, **{
+            "isolator.stroke": d.stroke, "isolator.stiffness": d.stiffness,
+            "isolator.damping": d.damping, "controller.crossover": d.crossover,
+            "friction.static": 4.0 * fs, "friction.coulomb": 1.0 * fc})
+        moves, _ = stage_hunts(spec, True, family=dense)
+        assert not any(m.hunts for m in moves), (fs, fc)
+        assert all(m.outcome == "settles" for m in moves), (fs, fc)
+
+
+def _independent(design, distance, t_end=25.0):
+    from independent import generate
+
+    return generate(1.6, 0.4, friction=dict(Fs=4.0, Fc=1.0, vs=3e-3, sigma0=1e6, sigma1=1414.0,
+                                            sigma2=20.0),
+                    isolator=dict(k=design.stiffness, s=design.stroke, c=design.damping),
+                    controller=dict(rule=dict(fc=design.crossover)),
+                    moves=[dict(distance=distance, velocity=0.05, acceleration=1.0)],
+                    t_end=t_end, rate=500.0)
+
+
+def test_recommended_design_settles_in_the_independent_simulator(paper_recommendation):
+    """solve_ivp on its own equations: the moves that hunt on the spec's isolator settle."""
+    d = paper_recommendation.design
+    for distance in (0.4e-3, 20e-3):
+        rec = _independent(d, distance)
+        e = rec.truth.x1 - rec.reference
+        tail = rec.time > 15.0
+        assert np.max(np.abs(e[tail])) < 1e-5, distance   # in the 10 um band, for good
+
+
+@pytest.mark.slow
+def test_recommended_design_dense_scan_in_the_independent_simulator(paper_recommendation):
+    d = paper_recommendation.design
+    for distance in np.geomspace(3e-5, 5e-2, 12):
+        rec = _independent(d, float(distance))
+        e = rec.truth.x1 - rec.reference
+        assert np.max(np.abs(e[rec.time > 15.0])) < 1e-5, distance
+
+
+def test_an_empty_space_says_so_with_the_nearest_design(paper_spec):
+    """Strokes of 0.05 to 0.1 mm: every move family hunts at every stiffness."""
+    spec = variant(paper_spec, **{"requirements.recommend": {"stroke": ["0.05 mm", "0.1 mm"]},
+                                  "requirements.robustness": {"samples": 20}})
+    r = recommend(spec, grid=(2, 3))
+    assert not r.feasible and r.design.status != "feasible"
+    assert r.violates and "What would open the space" in r.advice
+    assert "a longer stroke" in r.advice and "friction gap" in r.advice
+    assert all(c.status != "feasible" for c in r.candidates)
+    assert r.to_dict()["feasible"] is False
+
+
+def test_no_isolator_gets_one_and_keeps_a_crossover_the_model_does_not_limit(repo_root):
+    from fi_design.specfile import load_spec
+
+    spec = variant(load_spec(repo_root / "examples" / "no_isolator.yaml"),
+                   **{"requirements.robustness": {"samples": 20}})
+    r = recommend(spec, grid=(3, 3))
+    assert r.spec_design["suggested"]
+    # no parasitic mode, no sampling: the linear model sets no limit, so the crossover stays
+    assert r.design.crossover == pytest.approx(8.0)
+    assert r.feasible and not r.stage_hunting.hunts
