@@ -14,7 +14,6 @@ from typing import Any
 
 import numpy as np
 
-from . import spec as _spec
 from .errors import ArgumentError
 
 # --------------------------------------------------------------------------- design report
@@ -452,7 +451,7 @@ def deflection_figure(confirmation: Any, spec: Any) -> Any:
 
 
 @styled
-def scan_figure(confirmation: Any, spec: Any) -> Any:
+def scan_figure(confirmation: Any) -> Any:
     """Hunting cycles against the crossover for both plants (the crossover scans).
 
     Hunting points filled, settled points open, ``stuck`` squares and
@@ -461,10 +460,9 @@ def scan_figure(confirmation: Any, spec: Any) -> Any:
 
     Parameters
     ----------
-    confirmation : fi_design.confirm.Confirmation
-        The simulated confirmation (its ``scans``).
-    spec : fi_design.spec.Spec
-        The design spec (desired crossover).
+    confirmation : fi_design.results.design.Confirmation
+        The simulated confirmation: its ``scans``, and the design crossover
+        its plants were simulated at.
 
     Returns
     -------
@@ -494,7 +492,7 @@ def scan_figure(confirmation: Any, spec: Any) -> Any:
             ax.text(scan.minimum, 0.97 if key == "isolated" else 0.87,
                     f" hunting-free from {scan.minimum:g} Hz", color=col, fontsize=7,
                     transform=ax.get_xaxis_transform(), va="top", ha="left")
-    fc = _spec.design_crossover(spec)
+    fc = confirmation.non_isolated.crossover
     ax.axvline(fc, color="0.3", lw=0.9, ls="--")
     ax.text(fc, 0.77, f" design {fc:g} Hz", color="0.3", fontsize=7,
             transform=ax.get_xaxis_transform(), va="top", ha="left")

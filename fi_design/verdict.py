@@ -37,7 +37,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from . import spec as _spec
+from .model import Model
 from .results import Check, Status
 from .results.design import (Confirmation, CrossoverResult, FlexureResult, Margins, PidResult,
                              Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict)
@@ -61,7 +61,7 @@ def _um(x: float) -> str:
 # --------------------------------------------------------------------------- robustness
 
 
-def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
+def run_robustness(model: Model, suggestion: tuple[float, float] | None = None,
                    progress: Callable[[int, int], None] | None = None) -> Any:
     """Simulate the samples of ``requirements.robustness`` (the study, not yet judged).
 
@@ -74,8 +74,9 @@ def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = No
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model
+        The resolved model; the study varies its spec (``model.spec``) by
+        dotted paths.
     suggestion : (stroke, stiffness), optional
         Isolator to add when the spec has none [m, N/m].
     progress : callable, optional
@@ -89,7 +90,8 @@ def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = No
     from .confirm import with_isolator
     from .studies import PositionFriction, Scatter, robustness
 
-    cfg = spec.requirements.robustness
+    spec = model.spec
+    cfg = model.requirements.robustness
     scatter = [Scatter(path, spread) for path, spread in (("friction.static", cfg.static),
                                                          ("friction.coulomb", cfg.coulomb))
                if spread > 0]
@@ -98,14 +100,14 @@ def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = No
     if cfg.samples == 0 or (not scatter and ripple is None):
         return None
     target = spec
-    if not spec.has_isolator and suggestion is not None:
+    if not model.has_isolator and suggestion is not None:
         target = with_isolator(spec, *suggestion)
     return robustness(target, scatter, cfg.samples, seed=cfg.seed,
                       distribution=cfg.distribution, position_friction=ripple,
                       confidence=cfg.confidence, executor=None, progress=progress, cache=None)
 
 
-def robustness_check(spec: _spec.Spec, study: Any) -> RobustnessCheck:
+def robustness_check(model: Model, study: Any) -> RobustnessCheck:
     """Judge a robustness study against ``requirements.robustness.hunting_probability``.
 
     FAIL when the estimated probability exceeds the limit; WARN when it does
@@ -114,8 +116,9 @@ def robustness_check(spec: _spec.Spec, study: Any) -> RobustnessCheck:
 
     Parameters
     ----------
-    spec : Spec
-        The design spec (its requirements and whether it has an isolator).
+    model : Model
+        The resolved model (its requirements, its loop and whether it has an
+        isolator).
     study : fi_design.studies.RobustnessResult
         From :func:`run_robustness`.
 
@@ -123,12 +126,12 @@ def robustness_check(spec: _spec.Spec, study: Any) -> RobustnessCheck:
     -------
     RobustnessCheck
     """
-    cfg = spec.requirements.robustness
-    own = _OWN[spec.has_isolator]
+    cfg = model.requirements.robustness
+    own = _OWN[model.has_isolator]
     mine = study.isolated if own == "isolated" else study.not_isolated
     other = study.not_isolated if own == "isolated" else study.isolated
     p, limit = mine.probability, cfg.hunting_probability
-    unsettled = mine.counts["undetermined"] + (mine.counts["stuck"] if _spec_integrates(spec)
+    unsettled = mine.counts["undetermined"] + (mine.counts["stuck"] if model.law.integrator
                                                else 0)
     if p is None:
         status = "WARN"
@@ -152,12 +155,6 @@ def robustness_check(spec: _spec.Spec, study: Any) -> RobustnessCheck:
         counts=dict(mine.counts), comparison=comparison, study=study)
 
 
-def _spec_integrates(spec: _spec.Spec) -> bool:
-    from .pid import control_law
-
-    return control_law(spec).integrator
-
-
 def _scatter_words(r: RobustnessCheck) -> str:
     names = {"friction.static": "Fs", "friction.coulomb": "Fc"}
     spread = sorted(set(r.scatter.values()))
@@ -176,15 +173,15 @@ def _scatter_words(r: RobustnessCheck) -> str:
 # --------------------------------------------------------------------------- margins
 
 
-def margins(spec: _spec.Spec, crossover: CrossoverResult, stiffness: StiffnessResult,
+def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult,
             flexure: FlexureResult | None, pid: PidResult,
             simulation: Confirmation | None) -> Margins:
     """Distances to the limits, each only where it means something.
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model
+        The resolved model.
     crossover : CrossoverResult
         Step 2.
     stiffness : StiffnessResult
@@ -202,7 +199,7 @@ def margins(spec: _spec.Spec, crossover: CrossoverResult, stiffness: StiffnessRe
     """
     notes: list[str] = []
     out: dict[str, Any] = {}
-    own = _OWN[spec.has_isolator]
+    own = _OWN[model.has_isolator]
     fc = crossover.desired
 
     if crossover.achievable is None:
@@ -244,10 +241,10 @@ def margins(spec: _spec.Spec, crossover: CrossoverResult, stiffness: StiffnessRe
             out["static_error"] = abs(v.metrics.final_error)
             out["static_error_bound"] = v.static_error_bound
         land = simulation.landing
-        if spec.has_isolator and land is not None:
+        if model.has_isolator and land is not None:
             out["resting_deflection"] = land.deflection
             out["end_stop_clearance"] = land.stroke - abs(land.deflection)
-    if spec.has_isolator:
+    if model.has_isolator:
         out["stiffness_factor"] = stiffness.maximum / stiffness.chosen
         if flexure is not None and flexure.feasible:
             lo, hi = flexure.stiffness_range
@@ -264,7 +261,7 @@ def margins(spec: _spec.Spec, crossover: CrossoverResult, stiffness: StiffnessRe
 # --------------------------------------------------------------------------- recommendation
 
 
-def recommend(spec: _spec.Spec, crossover: CrossoverResult, simulation: Confirmation | None,
+def recommend(model: Model, crossover: CrossoverResult, simulation: Confirmation | None,
               robustness: RobustnessCheck | None) -> Recommendation | None:
     """What would make the stage pass, kept apart from the verdict.
 
@@ -276,8 +273,8 @@ def recommend(spec: _spec.Spec, crossover: CrossoverResult, simulation: Confirma
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model
+        The resolved model.
     crossover : CrossoverResult
         Step 2 (the achievable crossover).
     simulation : Confirmation or None
@@ -292,14 +289,14 @@ def recommend(spec: _spec.Spec, crossover: CrossoverResult, simulation: Confirma
     """
     if simulation is None:
         return None
-    own = _OWN[spec.has_isolator]
+    own = _OWN[model.has_isolator]
     mine = getattr(simulation, own)
     scatter_fails = robustness is not None and robustness.status == "FAIL"
     if mine.acceptable and not scatter_fails:
         return None
     parts: list[str] = []
     iso_info = None
-    if not spec.has_isolator:
+    if not model.has_isolator:
         sug = simulation.isolated
         land = simulation.landing
         k = land.stiffness if land is not None else None
@@ -397,15 +394,15 @@ def _behaviour_reason(v: Any, fc: float, label: str) -> Reason:
                   f"{m.reason}.")
 
 
-def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[str, str]],
+def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, str]],
           simulation: Confirmation | None, robustness: RobustnessCheck | None,
           margin: Margins) -> Verdict:
     """The verdict on the hardware as specified.
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model
+        The resolved model.
     checks : sequence of Check
         Every check of the four steps and the confirmation.
     warnings : sequence of (path, message)
@@ -421,9 +418,9 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
     -------
     Verdict
     """
-    own = _OWN[spec.has_isolator]
-    fc = _spec.design_crossover(spec)
-    label = ("The isolated stage as specified" if spec.has_isolator
+    own = _OWN[model.has_isolator]
+    fc = model.crossover
+    label = ("The isolated stage as specified" if model.has_isolator
              else "The stage as specified (without isolator)")
     reasons: list[Reason] = []
     behaviour = None
@@ -442,7 +439,7 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
                 f"({100 * r.confidence:.3g} % interval {_pct(r.interval[0])} to "
                 f"{_pct(r.interval[1])})")
         left = r.counts["invalid"] + r.counts["failed"]
-        kinds = ("stuck", "undetermined") if _spec_integrates(spec) else ("undetermined",)
+        kinds = ("stuck", "undetermined") if model.law.integrator else ("undetermined",)
         others = {k: r.counts[k] for k in kinds if r.counts[k]}
         notes = []
         if others:
@@ -476,7 +473,7 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
     if clearance is not None and margin.resting_deflection and clearance > 0:
         d = abs(margin.resting_deflection)
         rise = (d + clearance) / d - 1.0
-        spread = spec.requirements.robustness.coulomb
+        spread = model.requirements.robustness.coulomb
         if rise <= spread:
             reasons.append(Reason(
                 "WARN", "end_stop_clearance",

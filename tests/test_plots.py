@@ -45,7 +45,7 @@ def _figures(design, studies, reconciliation):
     yield "sensitivity", plots.sensitivity_figure(design)
     yield "error", plots.error_figure(sim, design.spec)
     yield "deflection", plots.deflection_figure(sim, design.spec)
-    yield "scan", plots.scan_figure(sim, design.spec)
+    yield "scan", plots.scan_figure(sim)
     yield "sweep map", plots.sweep_figure(studies["map"])
     yield "sweep line", plots.sweep_figure(studies["line"])
     yield "design map", plots.design_map_figure(studies["map"])

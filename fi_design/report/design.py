@@ -25,15 +25,14 @@ __all__ = ["design_context", "REFERENCES"]
 
 
 def _cases_table(result: Any) -> list[dict]:
-    """Rows of the margins table; a case without a crossing in the loop's band shows no
-    phase or delay margin (INFO): they are not margins to pass."""
+    """Rows of the margins table, with each case's status as the analysis judged it; a case
+    without a crossing in the loop's band (INFO) shows no phase or delay margin: they are
+    not margins to pass."""
     numbers = {c.name: c.number for c in result.loop.cases}
     rows = []
     for c in result.crossover.cases:
-        status = "PASS" if c.passed else "FAIL"
-        out_of_band = c.passed and not c.in_band
-        if out_of_band:
-            status = "INFO"
+        status = c.status.value
+        out_of_band = c.status == "INFO"
         rows.append({
             "number": numbers.get(c.name, ""), "description": c.description,
             "crossover": c.crossover, "crossovers": len(c.crossovers),
@@ -171,7 +170,7 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "Joint deflection of the isolated stage against the stroke; beyond the dashed lines "
             "the limiter carries the cart.", fig_no()),
         "scan": figure_entry(
-            (lambda: plots.scan_figure(sim, spec)) if figures else None, "scan",
+            (lambda: plots.scan_figure(sim)) if figures else None, "scan",
             f"Hunting cycles down the crossover scan (grid {num(scan.grid[0])} to "
             f"{num(scan.grid[1])} Hz in steps of {num(scan.grid[2])} Hz), both plants. The scan "
             "runs from the top down and stops at the first crossover that does not settle; "
