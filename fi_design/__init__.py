@@ -11,6 +11,8 @@ reports.
 The public API (imported lazily, so ``import fi_design`` stays fast):
 
 - :func:`load_spec` -- read and validate a YAML spec or a mapping;
+- :func:`resolve` -- the spec resolved once into a :class:`Model` (every
+  default filled in; ``model.at(...)`` varies it);
 - :func:`design` -- the four guideline steps and the simulated confirmation;
 - :func:`simulate` -- one nonlinear simulation;
 - :func:`sweep`, :func:`robustness` -- parameter studies;
@@ -34,6 +36,8 @@ except PackageNotFoundError:  # running from a source tree without install
 _API = {
     "load_spec": "fi_design.specfile",
     "Spec": "fi_design.spec",
+    "resolve": "fi_design.model",
+    "Model": "fi_design.model",
     "design": "fi_design.guideline",
     "DesignResult": "fi_design.results.design",
     "simulate": "fi_design.simulation",

@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
+from .errors import ArgumentError
 from .flexure import size_flexure
 from .model import Model, as_model
 from .results import Check, Status, frozen_array
@@ -536,8 +537,10 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
     ----------
     spec : Spec, Model, path or mapping
         A validated spec, its resolved model, or a YAML path or mapping for
-        :func:`fi_design.specfile.load_spec`. The parameter studies the
-        sign-off runs (robustness, the report's map) vary the model's spec.
+        :func:`fi_design.specfile.load_spec`. The robustness study of the
+        sign-off varies the spec, so a model varied with
+        :meth:`~fi_design.model.Model.at` is designed with ``confirm=False``
+        (or ``requirements.robustness.samples: 0``).
     confirm : bool, optional
         Simulate the stage with and without the isolator, scan the crossover
         for the lowest hunting-free one, check the landing deflection and
@@ -570,6 +573,9 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
     ------
     fi_design.errors.SpecError
         When ``spec`` is a path or mapping that does not validate.
+    fi_design.errors.ArgumentError
+        A model varied with :meth:`~fi_design.model.Model.at` with the
+        robustness study to run.
     """
     from . import __version__
     from . import verdict as _verdict
@@ -583,6 +589,12 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
     spec = model.spec
     suggestion = suggested_isolator(model) if not model.has_isolator else None
     robust = confirm and model.requirements.robustness.samples > 0
+    if robust and model.changed:
+        raise ArgumentError(
+            f"this model differs from its spec at {', '.join(model.changed)} (Model.at), but "
+            "the robustness study of the sign-off varies the spec: design it with "
+            "confirm=False, or write the values into the spec "
+            "(fi_design.specfile.with_values) and design that")
     pending = []
     if confirm and executor is not None:
         pending.append(executor.submit(run_confirmation, model, suggestion))

@@ -26,8 +26,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Any
-
 import numpy as np
 
 from . import effects as _effects
@@ -221,18 +219,22 @@ class Model:
     effects : tuple
         Effect entries of the model (the spec's ``effects`` items), applied
         in order by :meth:`plant`.
+    changed : tuple of str
+        The spec paths whose values :meth:`at` changed, in order (empty: the
+        spec as resolved). A study that varies the spec does not see them.
     """
 
-    spec: Any
+    spec: _spec.Spec
     m1: float
     m2: float
     friction: FrictionLaw
     offset: float
     joint: Joint | None
     limiter: Limiter | None
-    modes: tuple
+    modes: tuple[_spec.ParasiticMode, ...]
     law: ControlLaw
     effects: tuple = ()
+    changed: tuple[str, ...] = ()
 
     # ---- views
 
@@ -262,7 +264,7 @@ class Model:
         return self.law.delay
 
     @property
-    def requirements(self):
+    def requirements(self) -> _spec.Requirements:
         """The spec's ``requirements`` (margins, hunting metric, robustness)."""
         return self.spec.requirements
 
@@ -313,6 +315,10 @@ class Model:
         model = self
         if stiffness is not None or stroke is not None or damping is not None:
             model = self._with_joint(stiffness, stroke, damping)
+        paths = [path for path, value in (
+            ("controller.crossover", crossover), ("isolator.stiffness", stiffness),
+            ("isolator.stroke", stroke), ("isolator.damping", damping),
+            ("friction.model", friction_model), ("effects", effects)) if value is not None]
         law, friction = model.law, model.friction
         if crossover is not None:
             law = at_crossover(law, _positive(crossover, "controller.crossover", "Hz"))
@@ -322,7 +328,8 @@ class Model:
                                 f"{friction_model!r}", path="friction.model")
             friction = replace(friction, model=friction_model)
         entries = model.effects if effects is None else _checked_effects(effects, model.joint)
-        return replace(model, law=law, friction=friction, effects=entries)
+        changed = self.changed + tuple(p for p in paths if p not in self.changed)
+        return replace(model, law=law, friction=friction, effects=entries, changed=changed)
 
     def _with_joint(self, stiffness, stroke, damping) -> "Model":
         """The model with the joint's values changed (an isolator added when it has none)."""

@@ -1,6 +1,6 @@
 """The spec resolved once (fi_design.model): its values, its variants, its one home per value.
 
-The resolved values are checked against the formulas of DESIGN.md written out here, the
+The resolved values are checked against the documented formulas written out here, the
 friction curve against the compiled kernel's Stribeck function, the variants of
 ``Model.at`` against the spec resolved with the same values, and the design workflow
 against rebuilding any value from the spec more than once.
@@ -30,7 +30,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "fi_design"
 
 
 def test_resolve_fills_the_defaults_design_md_gives(paper_spec):
-    """Bristle, joint and limiter damping and the proposed stiffness, from DESIGN.md."""
+    """Bristle, joint and limiter damping and the proposed stiffness, as the spec documents them."""
     bare = variant(paper_spec, **{"friction.bristle_damping": None, "isolator.stiffness": None,
                                   "isolator.damping": None, "isolator.limiter": None})
     m = resolve(bare)
@@ -50,7 +50,7 @@ def test_resolve_fills_the_defaults_design_md_gives(paper_spec):
 
 
 def test_the_kernel_parameters_are_the_resolved_values(paper_spec):
-    """Model.plant: joint, limiter, friction and the rule's gains of DESIGN.md section 2."""
+    """Model.plant: joint, limiter, friction and the tuning rule's gains."""
     m = resolve(paper_spec)
     p = m.plant(True)
     assert (p.m1, p.m2, p.k, p.c, p.s) == (1.6, 0.4, 6667.0, 4.62, 0.3e-3)
@@ -184,7 +184,7 @@ def test_steady_state_friction_is_the_kernels_stribeck_curve(paper_spec):
         g = kernel().stribeck(vi, 0.0, sgn, p)[0]
         s2 = 20.0 if vi > 0 else 30.0
         assert fi == pytest.approx(sgn * g + s2 * vi, rel=1e-13)
-    # DESIGN.md: g(v) = Fc + (Fs - Fc) exp(-(v/vs)^2), Fs scaled by Fc_neg / Fc going back
+    # g(v) = Fc + (Fs - Fc) exp(-(v/vs)^2), Fs scaled by Fc_neg / Fc going back
     fs_neg = 4.0 * 1.5 / 1.0
     assert m.friction.steady_state(-0.002) == pytest.approx(
         -(1.5 + (fs_neg - 1.5) * math.exp(-(0.002 / 3e-3) ** 2)) - 30.0 * 0.002, rel=1e-14)
@@ -354,7 +354,7 @@ def test_report_and_console_show_the_status_the_analysis_gave(paper_spec):
 
 
 def _old_curve(p, form, stribeck, v):
-    """The identified friction curve as written out from its definition (DESIGN.md section 8)."""
+    """The identified friction curve written out from its definition (the report's curve before)."""
     symmetric = form == "symmetric"
     fc_pos = p["coulomb"] + (p["offset"] if symmetric else 0.0)
     fc_neg = (p["coulomb"] - p["offset"]) if symmetric else p["coulomb_negative"]
@@ -409,3 +409,18 @@ def test_the_identification_report_draws_the_results_curve(identified, monkeypat
     fitted = [ln for ln in fig.axes[0].get_lines() if len(ln.get_xdata()) > 100
               and ln.get_linestyle() == "-"]
     assert fitted and all(np.all(np.asarray(ln.get_ydata()) == 123.0) for ln in fitted)
+
+
+def test_a_varied_model_says_what_it_changed_and_design_takes_it(paper_spec):
+    from fi_design.errors import ArgumentError
+    from fi_design.guideline import design
+
+    m = resolve(paper_spec)
+    assert m.changed == ()
+    varied = m.at(crossover=10.0).at(stiffness=5000.0, crossover=9.0)
+    assert varied.changed == ("controller.crossover", "isolator.stiffness")
+    result = design(varied, confirm=False)  # the linear steps on the varied model
+    assert result.crossover.desired == 9.0 and result.stiffness.chosen == 5000.0
+    assert result.model is varied and result.spec is paper_spec
+    with pytest.raises(ArgumentError, match="controller.crossover, isolator.stiffness"):
+        design(varied)  # the robustness study would vary the spec, not the model

@@ -413,7 +413,7 @@ def design_context(result: DesignResult, *, date: Any = None, command: str | Non
                             sha256=result.spec_sha256, version=result.fi_design_version,
                             source=result.fi_design_source),
         "verdict": verdict(result),
-        "inputs": spec_inputs(spec),
+        "inputs": spec_inputs(spec, result.model),
         "steps": guideline_steps(result, figures),
         "linear": _linear(result, figures, fig_no),
         "nonlinear": _nonlinear(result, figures, fig_no),
