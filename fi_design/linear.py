@@ -304,7 +304,7 @@ def controller_polynomials(controller: ControlLaw | PidGains) -> tuple[np.ndarra
     Parameters
     ----------
     controller : ControlLaw or PidGains
-        The loop's controller (:func:`fi_design.pid.control_law`), or the
+        The loop's controller (``model.law``), or the
         rule's gains.
 
     Returns
