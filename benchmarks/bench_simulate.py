@@ -49,11 +49,12 @@ def kernel_only(spec, isolated: bool):
     """Time only the compiled integrator (the same call simulate() makes)."""
     from fi_design.compiled import run
     from fi_design.trajectory import from_moves
-    from fi_design.simulation import plant_parameters, tolerances
+    from fi_design.model import resolve
+    from fi_design.simulation import tolerances
 
     key = (id(spec), isolated)
     if key not in _PREPARED:
-        par = plant_parameters(spec, isolated)
+        par = resolve(spec).plant(isolated)
         ref = from_moves(spec.motion.moves, spec.motion.duration)
         _PREPARED[key] = (par.to_array(), np.zeros(par.n_states), ref, tolerances(par, 1e-6),
                           np.arange(20001) / 1000.0)
@@ -71,9 +72,10 @@ def plain_solve_ivp(spec, isolated: bool, t_end: float, method: str):
 
     from fi_design import equations as plant
     from fi_design.trajectory import from_moves
-    from fi_design.simulation import plant_parameters, tolerances
+    from fi_design.model import resolve
+    from fi_design.simulation import tolerances
 
-    par = plant_parameters(spec, isolated)
+    par = resolve(spec).plant(isolated)
     p = par.to_array()
     ref = from_moves(spec.motion.moves, t_end)
     n = par.n_states
@@ -106,9 +108,10 @@ def python_control_run(spec, isolated: bool, t_end: float):
 
     from fi_design import equations as plant
     from fi_design.trajectory import from_moves
-    from fi_design.simulation import plant_parameters, tolerances
+    from fi_design.model import resolve
+    from fi_design.simulation import tolerances
 
-    par = plant_parameters(spec, isolated)
+    par = resolve(spec).plant(isolated)
     p = par.to_array()
     ref = from_moves(spec.motion.moves, t_end)
     n = par.n_states

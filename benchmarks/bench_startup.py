@@ -80,13 +80,13 @@ def whole_commands(rounds: int, work: Path) -> list[tuple[str, float, float, flo
     yard = [py, "-c", "import control"]
     cases = {
         "first-ever `fi-design SPEC --json out.json`, every cache empty":
-            (fi + [str(SPEC), "--json", "first.json", "--force"], None),
+            (fi + [str(SPEC), "--json", "first.json", "--force", "--no-recommend"], None),
         "`fi-design SPEC --json out.json`, warm": (fi + [str(SPEC), "--json", "w.json",
-                                                         "--force"], warm),
+                                                         "--force", "--no-recommend"], warm),
         "`fi-design SPEC --report out.html`, warm": (fi + [str(SPEC), "--report", "w.html",
-                                                           "--force"], warm),
+                                                           "--force", "--no-recommend"], warm),
         "`fi-design SPEC --report out.pdf`, warm": (fi + [str(SPEC), "--report", "w.pdf",
-                                                          "--force"], warm),
+                                                          "--force", "--no-recommend"], warm),
     }
     for cmd, env in cases.values():  # warm every cache once
         if env is not None:

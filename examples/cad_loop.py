@@ -45,10 +45,9 @@ def main() -> None:
         print(f"{stroke_mm:>12.2f} {stiffness['maximum']:>12.0f} {stiffness['chosen']:>10.0f} "
               f"{crossover['achievable']:>19.3g}")
 
-    # A validated spec can also be copied with a changed section (values in SI);
-    # model_copy does not re-validate, so give SI floats only.
-    faster = base_spec.model_copy(update={
-        "controller": base_spec.controller.model_copy(update={"crossover": 15.0})})
+    # The spec resolved once into a model (every default filled in); model.at gives
+    # the same stage with a value changed, checked like the spec (SpecError otherwise).
+    faster = fi_design.resolve(base_spec).at(crossover=15.0)
     result = fi_design.design(faster, confirm=False).to_dict()
     print(f"crossover 15 Hz: achievable {result['crossover']['achievable']:.3g} Hz, "
           f"limited by {result['crossover']['limited_by'] or 'nothing'}")

@@ -14,6 +14,8 @@ The public API (imported lazily, so ``import fi_design`` stays fast):
 - :func:`design` -- the four guideline steps, the simulated confirmation and
   the sign-off verdict, with a recommendation that passes when it fails;
 - :func:`recommend` -- search the isolator and crossover for a design that passes;
+- :func:`resolve` -- the spec resolved once into a :class:`Model` (every
+  default filled in; ``model.at(...)`` varies it);
 - :func:`simulate` -- one nonlinear simulation;
 - :func:`sweep`, :func:`robustness` -- parameter studies;
 - :func:`load_measurement`, :func:`reconcile` -- compare with measured data;
@@ -38,6 +40,8 @@ _API = {
     "Spec": "fi_design.spec",
     "design": "fi_design.signoff",
     "recommend": "fi_design.recommend",
+    "resolve": "fi_design.model",
+    "Model": "fi_design.model",
     "DesignResult": "fi_design.results.design",
     "simulate": "fi_design.simulation",
     "SimulationResult": "fi_design.results.simulation",

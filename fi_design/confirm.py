@@ -36,14 +36,12 @@ error its outcome is ``static_error``, not ``stuck``
 
 from __future__ import annotations
 
-import numpy as np
-
 from . import spec as _spec
 from .errors import ArgumentError
-from .results import Check, Status, frozen_array
+from .model import Model, as_model
+from .results import Check, Status
 from .results.design import Confirmation, Landing, PlantVerdict
 from .results.simulation import SimulationResult
-from .results.stage import StageHunting
 from .simulation import simulate
 from .stage import stage_hunting
 
@@ -54,23 +52,39 @@ def _hunts(v: PlantVerdict) -> bool:
     return v.metrics.verdict == "hunting"
 
 
-def landing(spec: _spec.Spec, result: SimulationResult) -> Landing:
-    """Landing deflection and flexure force of an isolated simulation."""
-    k = _spec.drive_stiffness(spec)
-    s = spec.isolator.stroke
+def landing(model: Model | _spec.Spec, result: SimulationResult) -> Landing:
+    """Landing deflection and flexure force of an isolated simulation of ``model``.
+
+    Parameters
+    ----------
+    model : Model or Spec
+        The resolved model (a spec is resolved) the result simulated.
+    result : SimulationResult
+        The isolated simulation.
+
+    Returns
+    -------
+    Landing
+    """
+    model = as_model(model)
+    k, s = model.joint.stiffness, model.joint.stroke
     d = float(result.deflection[-1])
     return Landing(deflection=d, stroke=s, stiffness=k, force=k * min(abs(d), s),
-                   static_friction=spec.friction.static, on_limiter=abs(d) >= s,
+                   static_friction=model.friction.Fs, on_limiter=abs(d) >= s,
                    rule_force=k * s)
 
 
 def with_isolator(spec: _spec.Spec, stroke: float, stiffness: float) -> _spec.Spec:
-    """The spec with an isolator of the given stroke [m] and stiffness [N/m] added."""
-    iso = _spec.Isolator(stiffness=stiffness, stroke=stroke)
-    return spec.model_copy(update={"isolator": iso})
+    """The spec with an isolator of the given stroke [m] and stiffness [N/m] added, validated.
+
+    The spec-level twin of ``resolve(spec).at(stroke=..., stiffness=...)``,
+    for the studies, which vary a spec: the same isolator (default damping
+    and limiter), checked like every spec.
+    """
+    return spec.with_sections(isolator={"stiffness": stiffness, "stroke": stroke})
 
 
-def static_error_bound(spec: _spec.Spec) -> float | None:
+def static_error_bound(model: Model | _spec.Spec) -> float | None:
     """The static error a loop without integrator may leave against friction [m].
 
     ``(max(Fc, Fc_negative) + |offset|) / kp``: the cart comes to rest once the
@@ -79,33 +93,30 @@ def static_error_bound(spec: _spec.Spec) -> float | None:
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model or Spec
+        The resolved model (a spec is resolved).
 
     Returns
     -------
     float or None
     """
-    from .pid import control_law
-
-    f = spec.friction
-    fc = max(f.coulomb, f.coulomb_negative if f.coulomb_negative is not None else f.coulomb)
-    return control_law(spec).static_error(fc + abs(f.offset))
+    model = as_model(model)
+    f = model.friction
+    return model.law.static_error(max(f.coulomb(1), f.coulomb(-1)) + abs(model.offset))
 
 
-def _other_model(spec: _spec.Spec) -> _spec.Spec:
-    other = "switch" if spec.friction.model == "lugre" else "lugre"
-    return spec.model_copy(update={"friction": spec.friction.model_copy(update={"model": other})})
+def _other_model(model: Model) -> Model:
+    return model.at(friction_model="switch" if model.friction.model == "lugre" else "lugre")
 
 
-def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
+def confirm(spec: _spec.Spec | Model, suggestion: tuple[float, float] | None = None,
             progress=None) -> Confirmation:
     """Simulate both plants, scan the crossover, check the landing and cross-check.
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    spec : Spec or Model
+        The design spec, or its resolved model.
     suggestion : (stroke, stiffness), optional
         Isolator to simulate when the spec has none [m, N/m]; required then.
     progress : callable, optional
@@ -116,39 +127,43 @@ def confirm(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
     -------
     Confirmation
     """
-    suggested = spec.isolator is None
+    model = as_model(spec)
+    suggested = not model.has_isolator
     if suggested:
         if suggestion is None:
             raise ArgumentError("a spec without isolator needs a suggested (stroke, stiffness)")
-        spec_iso = with_isolator(spec, *suggestion)
+        stroke, stiffness = suggestion
+        model_iso = model.at(stroke=stroke, stiffness=stiffness)
     else:
-        spec_iso = spec
+        model_iso = model
+
     def say(text: str) -> None:
         if progress is not None:
             progress(text)
 
     say("simulating the stage with and without the isolator ...")
-    bound = static_error_bound(spec)
-    res_iso = simulate(spec_iso, isolated=True)
-    res_non = simulate(spec, isolated=False)
+    bound = static_error_bound(model)
+    res_iso = simulate(model_iso, isolated=True)
+    res_non = simulate(model, isolated=False)
     iso = PlantVerdict.of("isolated", res_iso, bound)
     non = PlantVerdict.of("non_isolated", res_non, bound)
-    stage = {"isolated": stage_hunting(spec_iso, True, progress=progress),
-             "non_isolated": stage_hunting(spec, False, progress=progress)}
-    cfg = spec.simulation.crossover_scan
+    stage = {"isolated": stage_hunting(model_iso, True, progress=progress),
+             "non_isolated": stage_hunting(model, False, progress=progress)}
+    cfg = model.spec.simulation.crossover_scan
     widths = [st.boundary["resolution"] for st in stage.values() if st.boundary]
     mins = {"isolated": stage["isolated"].hunting_free_from,
             "non_isolated": stage["non_isolated"].hunting_free_from,
             "resolution": max(widths) if widths else None,
             "search": [cfg.start, max(cfg.stop, res_iso.crossover)]}
-    land = landing(spec_iso, res_iso)
+    land = landing(model_iso, res_iso)
     say("cross-checking with the other friction model ...")
-    other_iso = PlantVerdict.of("isolated", simulate(_other_model(spec_iso), isolated=True),
+    other_iso = PlantVerdict.of("isolated", simulate(_other_model(model_iso), isolated=True),
                                 bound)
-    other_non = PlantVerdict.of("non_isolated", simulate(_other_model(spec), isolated=False),
+    other_non = PlantVerdict.of("non_isolated", simulate(_other_model(model), isolated=False),
                                 bound)
     agree = _hunts(other_iso) == _hunts(iso) and _hunts(other_non) == _hunts(non)
-    checks = _checks(spec, iso, non, stage, mins, land, agree, other_iso, other_non, suggested)
+    checks = _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
+                     suggested)
     return Confirmation(isolated=iso, non_isolated=non, stage=stage,
                         min_hunting_free_crossover=mins, landing=land,
                         cross_check={"isolated": other_iso, "non_isolated": other_non},
@@ -165,11 +180,10 @@ def _plant_text(v: PlantVerdict, label: str, fc: float) -> str:
     return f"{label} at {fc:g} Hz: {m.verdict} ({m.reason})"
 
 
-
-def _checks(spec, iso, non, stage, mins, land, agree, other_iso, other_non,
+def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
             suggested) -> list[Check]:
     """The confirmation's checks: the spec's own plant judged, the other one information."""
-    fc = _spec.design_crossover(spec)
+    fc = model.crossover
     step = "simulation (paper section 2.3)"
     integrates = iso.static_error_bound is None
     if suggested:

@@ -578,7 +578,8 @@ CASE_COLUMNS = {
 #: What the short headers of the limit-case table mean (the table's caption).
 CASE_CAPTION = ("fc: gain crossover; PM, GM, MM, DM: phase, gain, modulus and delay margin "
                 "(inf: no crossing); an unstable case fails with 'stability'")
-_CASE_SKIP = {"name", "description", "passed", "failed", "crossovers", "stable", "in_band"}
+_CASE_SKIP = {"name", "description", "passed", "failed", "crossovers", "stable", "in_band",
+              "status"}
 
 
 def _cases_table(cases: list, numbers: dict) -> Any:
@@ -602,9 +603,7 @@ def _cases_table(cases: list, numbers: dict) -> Any:
         label = case.get("description") or case.get("name") or ""
         cells = [Text("inf" if case.get(k) is None and "margin" in k else _fmt(case.get(k)))
                  for k in keys]
-        passed = case.get("passed") if case.get("in_band", True) or not case.get("passed") \
-            else None  # no crossing in the loop's band: its margins are not a pass
-        status = _status_text("INFO" if passed is None else "PASS" if passed else "FAIL")
+        status = _status_text(case["status"])  # as the analysis judged it
         if case.get("failed"):
             status.append(" " + ", ".join(map(str, case["failed"])))
         t.add_row(number, Text(str(label)), *cells, status)

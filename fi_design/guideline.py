@@ -39,14 +39,15 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
+from .errors import ArgumentError
 from .flexure import size_flexure
-from .pid import ControlLaw, control_law
+from .model import Model, as_model
 from .results import Check, Status, frozen_array
+from .results.controller import ControlLaw
 from .results.design import (CaseResponse, Confirmation, CrossoverResult, DesignResult,
                              FlexureResult, FrictionGapResult, IsolatorAdvice, LoopResponses,
                              ModeSeparation, PidResult, StiffnessResult)
-from .spec import (Spec, design_crossover, drive_stiffness, proposed_stiffness, stiffness_limit,
-                   warnings_for)
+from .spec import Spec, proposed_stiffness, stiffness_limit, warnings_for
 
 if TYPE_CHECKING:  # pragma: no cover
     from .execution import Executor
@@ -76,13 +77,13 @@ def _g(x: float | None, digits: int = 4) -> str:
 # --------------------------------------------------------------------------- step 1
 
 
-def step1_friction_gap(spec: Spec) -> FrictionGapResult:
+def step1_friction_gap(model: Model | Spec) -> FrictionGapResult:
     """Guideline step 1: compare Fs - Fc with ``requirements.friction_gap``.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
 
     Returns
     -------
@@ -94,18 +95,19 @@ def step1_friction_gap(spec: Spec) -> FrictionGapResult:
         (what it is there for; the simulation confirms it) or with a loop
         without integrator (no hunting by the paper's mechanism).
     """
-    f = spec.friction
-    gap = f.static - f.coulomb
-    thr = spec.requirements.friction_gap
+    model = as_model(model)
+    f = model.friction
+    gap = f.Fs - f.Fc
+    thr = model.requirements.friction_gap
     risk = gap >= thr
     status = Status.PASS
     if risk:
         msg = (f"Fs - Fc = {gap:.3g} N is at or above the {thr:.3g} N threshold: stick-slip "
                "can make an integrating controller hunt")
-        if not control_law(spec).integrator:
+        if not model.law.integrator:
             status = Status.INFO
             msg += "; this loop has no integrator"
-        elif spec.isolator is not None:
+        elif model.has_isolator:
             status = Status.INFO
             msg += "; the isolator is there to prevent it (the simulation checks it)"
         else:
@@ -115,23 +117,23 @@ def step1_friction_gap(spec: Spec) -> FrictionGapResult:
                "hunting, is unlikely")
     check = Check("friction_gap", not risk if status != Status.INFO else None, gap, thr, "N",
                   msg, step="step 1 friction gap", status=status)
-    return FrictionGapResult(static=f.static, coulomb=f.coulomb, gap=gap, threshold=thr,
+    return FrictionGapResult(static=f.Fs, coulomb=f.Fc, gap=gap, threshold=thr,
                              hunting_risk=risk, checks=(check,))
 
 
 # --------------------------------------------------------------------------- step 2
 
 
-def step2_crossover(spec: Spec) -> CrossoverResult:
+def step2_crossover(model: Model | Spec) -> CrossoverResult:
     """Guideline step 2: desired versus achievable crossover.
 
-    The limit cases use the spec's joint stiffness (the proposed one when the
+    The limit cases use the model's joint stiffness (the proposed one when the
     spec gives none, as step 3 would choose).
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
 
     Returns
     -------
@@ -139,15 +141,18 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
         Achievable crossover and its limit, per-case margins at the desired
         crossover, the parasitic separation, and the checks: one reachability
         check, phase and gain margin (and modulus margin if required) per case,
-        one separation check per parasitic mode.
+        one separation check per parasitic mode. The margin checks take the
+        judgement of each case's requirements as the linear analysis made it
+        (:attr:`fi_design.results.linear.CaseMargins.criteria`).
     """
     from . import linear
 
-    req = spec.requirements
-    fc = design_crossover(spec)
-    cases = linear.limit_cases(spec)
-    at = linear.analyse(spec, fc, cases=cases)
-    ach = linear.achievable_crossover(spec)
+    model = as_model(model)
+    req = model.requirements
+    fc = model.crossover
+    cases = linear.limit_cases(model)
+    at = linear.analyse(model, cases=cases)
+    ach = linear.achievable_crossover(model)
     step = "step 2 crossover"
     checks: list[Check] = []
     reach = ach.frequency is not None and fc <= ach.frequency * (1 + 1e-9)
@@ -168,7 +173,6 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
     for c in at.cases:
         where = f"case {linear.CASE_NUMBERS[c.name]} ({c.description})"
         at_f = f" at {c.crossover:.3g} Hz" if c.crossover is not None else ""
-        ok = c.stable and c.phase_margin_deg >= req.phase_margin
         if not c.stable:
             msg = f"{where}: the closed loop is unstable"
         elif not c.in_band:
@@ -179,8 +183,8 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
                                    "0 dB") + ": no phase margin in the loop's band")
         else:
             msg = f"{where}: phase margin {c.phase_margin_deg:.3g} deg{at_f}"
-        checks.append(Check(f"phase_margin.{c.name}", ok if c.in_band or not ok else None,
-                            c.phase_margin_deg, req.phase_margin, "deg", msg, step=step))
+        checks.append(_criterion_check(c, "phase margin", f"phase_margin.{c.name}",
+                                       c.phase_margin_deg, req.phase_margin, "deg", msg, step))
         gm = c.gain_margin_db
         if math.isinf(gm):
             msg = f"{where}: the phase never crosses -180 deg, unlimited gain margin"
@@ -189,18 +193,17 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
                    f"if the gain falls {abs(gm):.3g} dB)")
         else:
             msg = f"{where}: gain margin {gm:.3g} dB"
-        checks.append(Check(f"gain_margin.{c.name}", c.stable and abs(gm) >= req.gain_margin,
-                            abs(gm), req.gain_margin, "dB", msg, step=step))
+        checks.append(_criterion_check(c, "gain margin", f"gain_margin.{c.name}", abs(gm),
+                                       req.gain_margin, "dB", msg, step))
         if req.modulus_margin is not None:
-            checks.append(Check(f"modulus_margin.{c.name}",
-                                c.stable and c.modulus_margin >= req.modulus_margin,
-                                c.modulus_margin, req.modulus_margin, "-",
-                                f"{where}: modulus margin min|1 + L| = {c.modulus_margin:.3g}",
-                                step=step))
+            checks.append(_criterion_check(
+                c, "modulus margin", f"modulus_margin.{c.name}", c.modulus_margin,
+                req.modulus_margin, "-",
+                f"{where}: modulus margin min|1 + L| = {c.modulus_margin:.3g}", step))
 
     modes = []
     sep = req.parasitic_separation
-    for m in (spec.isolator.parasitic_modes if spec.isolator is not None else ()):
+    for m in model.modes:
         need = sep * fc
         ok = m.frequency >= need
         modes.append(ModeSeparation(m.name, m.frequency, need, m.collocated, ok))
@@ -217,19 +220,28 @@ def step2_crossover(spec: Spec) -> CrossoverResult:
         checks=tuple(checks))
 
 
+def _criterion_check(case, criterion: str, name: str, value, limit, unit: str, message: str,
+                     step: str) -> Check:
+    """A check of one requirement of a limit case, judged as the linear analysis judged it."""
+    status = case.criteria[criterion]
+    passed = None if status == Status.INFO else status == Status.PASS
+    return Check(name, passed, value, limit, unit, message, step=step, status=status)
+
+
 # --------------------------------------------------------------------------- loop responses
 
 
-def loop_responses(spec: Spec, crossover: CrossoverResult, points: int = 500) -> LoopResponses:
+def loop_responses(model: Model | Spec, crossover: CrossoverResult,
+                   points: int = 500) -> LoopResponses:
     """The loop of every limit case over a frequency grid that holds every crossover and mode.
 
-    The loop is the one whose margins step 2 reports: the spec's controller at
-    the desired crossover, the joint stiffness of the cases.
+    The loop is the one whose margins step 2 reports: the model's controller
+    at the desired crossover, its joint stiffness.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
     crossover : CrossoverResult
         Step 2 (desired crossover, the gain crossovers of each case, the
         joint stiffness the cases use).
@@ -242,18 +254,18 @@ def loop_responses(spec: Spec, crossover: CrossoverResult, points: int = 500) ->
     """
     from . import linear
 
+    model = as_model(model)
     fc = crossover.desired
     lows = [fc / 30.0] + [c / 3.0 for case in crossover.cases for c in case.crossovers
                           if c and c > 0]
-    modes = spec.isolator.parasitic_modes if spec.isolator is not None else ()
-    highs = [30.0 * fc] + [2.0 * m.frequency for m in modes]
+    highs = [30.0 * fc] + [2.0 * m.frequency for m in model.modes]
     lo = 10.0 ** math.floor(math.log10(min(lows)))
     hi = 10.0 ** math.ceil(math.log10(max(highs)))
     f = np.geomspace(lo, hi, points)
     s = 2j * math.pi * f
     cases = []
-    for lc in linear.limit_cases(spec, crossover.stiffness):
-        num, den = linear.loop_polynomials(spec, lc)
+    for lc in linear.limit_cases(model):
+        num, den = linear.loop_polynomials(model, lc)
         cases.append(CaseResponse(name=lc.name, number=lc.number, description=lc.description,
                                   loop=frozen_array(np.polyval(num, s) / np.polyval(den, s),
                                                     dtype=complex)))
@@ -263,7 +275,7 @@ def loop_responses(spec: Spec, crossover: CrossoverResult, points: int = 500) ->
 # --------------------------------------------------------------------------- step 3
 
 
-def step3_stiffness(spec: Spec) -> StiffnessResult:
+def step3_stiffness(model: Model | Spec) -> StiffnessResult:
     """Guideline step 3: maximum drive stiffness from static friction and stroke.
 
     ``k_max = Fs / (stiffness_safety * stroke)``: at full stroke the flexure must
@@ -273,19 +285,22 @@ def step3_stiffness(spec: Spec) -> StiffnessResult:
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec. Without an isolator the suggested stroke
-        (:data:`SUGGESTED_STROKE`) is used and the result is a suggestion.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved). Without an isolator the
+        suggested stroke (:data:`SUGGESTED_STROKE`) is used and the result is
+        a suggestion.
 
     Returns
     -------
     StiffnessResult
         k_max, the chosen stiffness and why, with a check chosen <= k_max.
     """
-    Fs = spec.friction.static
-    safety = spec.requirements.stiffness_safety
+    model = as_model(model)
+    spec = model.spec
+    Fs = model.friction.Fs
+    safety = model.requirements.stiffness_safety
     step = "step 3 drive stiffness"
-    if spec.isolator is None:
+    if model.joint is None:
         s = SUGGESTED_STROKE
         kmax = stiffness_limit(spec, s)
         k = proposed_stiffness(spec, s)
@@ -296,10 +311,10 @@ def step3_stiffness(spec: Spec) -> StiffnessResult:
                                "paper's 0.3 mm stroke (no isolator in the spec)", stroke=s,
                                static=Fs, safety=safety, force_at_stroke=k * s, suggested=True,
                                checks=(check,))
-    s = spec.isolator.stroke
+    s = model.joint.stroke
     kmax = stiffness_limit(spec, s)
-    k = drive_stiffness(spec)
-    if spec.isolator.stiffness is not None:
+    k = model.joint.stiffness
+    if model.joint.stiffness_given:
         source = "given in the spec (isolator.stiffness)"
     else:
         source = ("proposed: k_max / 2, so the flexure force at full stroke is Fs / 2, leaving "
@@ -316,13 +331,14 @@ def step3_stiffness(spec: Spec) -> StiffnessResult:
                            checks=(check,))
 
 
-def step3_flexure(spec: Spec, stiffness: StiffnessResult | None = None) -> FlexureResult | None:
+def step3_flexure(model: Model | Spec,
+                  stiffness: StiffnessResult | None = None) -> FlexureResult | None:
     """Guideline step 3, second half: size the leaf-spring guide of ``isolator.flexure``.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
     stiffness : StiffnessResult, optional
         Step 3's stiffness result (computed when omitted).
 
@@ -332,14 +348,16 @@ def step3_flexure(spec: Spec, stiffness: StiffnessResult | None = None) -> Flexu
         None when the spec has no ``isolator.flexure`` section. The required
         parasitic frequency is ``parasitic_separation`` x the desired crossover.
     """
-    if spec.isolator is None or spec.isolator.flexure is None:
+    model = as_model(model)
+    spec = model.spec
+    if model.joint is None or spec.isolator is None or spec.isolator.flexure is None:
         return None
-    st = stiffness if stiffness is not None else step3_stiffness(spec)
+    st = stiffness if stiffness is not None else step3_stiffness(model)
     return size_flexure(spec.isolator.flexure, target_stiffness=st.chosen,
                         maximum_stiffness=st.maximum, stroke=st.stroke,
-                        stage_mass=spec.stage.mass,
-                        required_frequency=spec.requirements.parasitic_separation
-                        * design_crossover(spec))
+                        stage_mass=model.m1,
+                        required_frequency=model.requirements.parasitic_separation
+                        * model.crossover)
 
 
 def _flexure_checks(fx: FlexureResult | None) -> tuple[Check, ...]:
@@ -386,7 +404,7 @@ def _controller_words(c: ControlLaw) -> str:
     return ", ".join(parts)
 
 
-def step4_pid(spec: Spec) -> PidResult:
+def step4_pid(model: Model | Spec) -> PidResult:
     """Guideline step 4: PID gains from the moving mass and the desired crossover.
 
     With the hardware's own gains (``controller.gains``) the loop uses them;
@@ -395,8 +413,8 @@ def step4_pid(spec: Spec) -> PidResult:
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
 
     Returns
     -------
@@ -406,8 +424,9 @@ def step4_pid(spec: Spec) -> PidResult:
         maximum moving mass best); a loop without integrator an INFO with its
         static error Fc / kp (no hunting by the paper's mechanism).
     """
-    ctl = spec.controller
-    law = control_law(spec)
+    model = as_model(model)
+    ctl = model.spec.controller
+    law = model.law
     g = law.rule
     step = "step 4 PID"
     if law.source == "rule":
@@ -422,16 +441,16 @@ def step4_pid(spec: Spec) -> PidResult:
                f"kp = {r['kp']:.4g} N/m, ki = {r['ki']:.4g} N/(m s), kd = {r['kd']:.4g} N s/m "
                f"with a D roll-off of {r['roll_off'] / (2 * math.pi):.4g} Hz")
         checks = [Check("pid", None, law.kp, g.kp, "N/m", msg, step=step)]
-    static = law.static_error(spec.friction.coulomb)
+    static = law.static_error(model.friction.Fc)
     if static is not None:
         checks.append(Check(
             "pid.integrator", None, static, None, "m",
             f"the loop has no integrator: no hunting by the paper's mechanism (integral action "
             f"building up through stiction), a static error instead of up to Fc / kp = "
             f"{static * 1e6:.3g} um against the Coulomb friction", step=step))
-    if ctl.tuning_mass == "stage" and spec.isolator is not None:
+    if ctl.tuning_mass == "stage" and model.has_isolator:
         checks.append(Check(
-            "pid.tuning_mass", None, g.tuning_mass, spec.total_mass, "kg",
+            "pid.tuning_mass", None, g.tuning_mass, model.total_mass, "kg",
             "tuned on the stage mass alone: with the limiter engaged the loop sees m1 + m2 and "
             "crosses over lower (the paper tunes on the maximum moving mass)", step=step,
             status=Status.WARN))
@@ -443,23 +462,23 @@ def step4_pid(spec: Spec) -> PidResult:
 # --------------------------------------------------------------------------- no isolator
 
 
-def suggested_isolator(spec: Spec) -> tuple[float, float]:
+def suggested_isolator(model: Model | Spec) -> tuple[float, float]:
     """Stroke [m] and drive stiffness [N/m] to start from when the spec has no isolator.
 
     The paper's 0.3 mm stroke (:data:`SUGGESTED_STROKE`) and k = Fs / (2 x
     safety x stroke), half the maximum of step 3.
     """
-    return SUGGESTED_STROKE, proposed_stiffness(spec, SUGGESTED_STROKE)
+    return SUGGESTED_STROKE, proposed_stiffness(as_model(model).spec, SUGGESTED_STROKE)
 
 
-def isolator_advice(spec: Spec, gap: FrictionGapResult, crossover: CrossoverResult,
+def isolator_advice(model: Model | Spec, gap: FrictionGapResult, crossover: CrossoverResult,
                     ) -> IsolatorAdvice:
     """For a stage without isolator: does one look needed, and where to start.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec (no isolator section).
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved) of a stage without isolator.
     gap : FrictionGapResult
         Step 1.
     crossover : CrossoverResult
@@ -472,8 +491,9 @@ def isolator_advice(spec: Spec, gap: FrictionGapResult, crossover: CrossoverResu
         crossover is limited; not needed below the gap threshold; undecided
         when the linear model sets no crossover limit within the scan.
     """
-    s, k = suggested_isolator(spec)
-    kmax = stiffness_limit(spec, s)
+    model = as_model(model)
+    s, k = suggested_isolator(model)
+    kmax = stiffness_limit(model.spec, s)
     start = (f"start from a {s * 1e3:.3g} mm stroke (the paper's) and k = {_g(k)} N/m "
              f"(Fs / (2 x stroke); k_max = {_g(kmax)} N/m)")
     if not gap.hunting_risk:
@@ -505,16 +525,22 @@ def _sha256(spec: Spec) -> str:
     return hashlib.sha256(spec.model_dump_json().encode()).hexdigest()
 
 
-def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
+def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool = True,
            executor: Executor | None = None,
            progress: Callable[[str], None] | None = None) -> DesignResult:
     """Run the four guideline steps on a spec and confirm them by simulation.
 
+    The spec is resolved once (:func:`fi_design.model.resolve`) and every
+    step, the confirmation and the verdict read the resolved model.
+
     Parameters
     ----------
-    spec : Spec, path or mapping
-        A validated spec, or a YAML path or mapping for
-        :func:`fi_design.specfile.load_spec`.
+    spec : Spec, Model, path or mapping
+        A validated spec, its resolved model, or a YAML path or mapping for
+        :func:`fi_design.specfile.load_spec`. The robustness study of the
+        sign-off varies the spec, so a model varied with
+        :meth:`~fi_design.model.Model.at` is designed with ``confirm=False``
+        (or ``requirements.robustness.samples: 0``).
     confirm : bool, optional
         Simulate the stage with and without the isolator, scan the crossover
         for the lowest hunting-free one, check the landing deflection and
@@ -548,38 +574,50 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     ------
     fi_design.errors.SpecError
         When ``spec`` is a path or mapping that does not validate.
+    fi_design.errors.ArgumentError
+        A model varied with :meth:`~fi_design.model.Model.at` with the
+        robustness study to run.
     """
     from . import __version__
     from . import verdict as _verdict
     from .confirm import confirm as run_confirmation
 
-    if not isinstance(spec, Spec):
+    if not isinstance(spec, (Spec, Model)):
         from .specfile import load_spec
 
         spec = load_spec(spec)
-    suggestion = suggested_isolator(spec) if spec.isolator is None else None
-    robust = confirm and spec.requirements.robustness.samples > 0
+    model = as_model(spec)
+    spec = model.spec
+    suggestion = suggested_isolator(model) if not model.has_isolator else None
+    robust = confirm and model.requirements.robustness.samples > 0
+    if robust and model.changed:
+        raise ArgumentError(
+            f"this model differs from its spec at {', '.join(model.changed)} (Model.at), but "
+            "the robustness study of the sign-off varies the spec: design it with "
+            "confirm=False, or write the values into the spec "
+            "(fi_design.specfile.with_values) and design that")
     pending = []
     if confirm and executor is not None:
-        pending.append(executor.submit(run_confirmation, spec, suggestion))
+        pending.append(executor.submit(run_confirmation, model, suggestion))
     try:
-        gap = step1_friction_gap(spec)
-        xo = step2_crossover(spec)
-        st = step3_stiffness(spec)
-        fx = step3_flexure(spec, st)
-        pid = step4_pid(spec)
+        gap = step1_friction_gap(model)
+        xo = step2_crossover(model)
+        st = step3_stiffness(model)
+        fx = step3_flexure(model, st)
+        pid = step4_pid(model)
     except BaseException:
         for fut in pending:
             fut.cancel()
         raise
-    advice = isolator_advice(spec, gap, xo) if spec.isolator is None else None
+    advice = isolator_advice(model, gap, xo) if not model.has_isolator else None
     checks = gap.checks + xo.checks + st.checks + _flexure_checks(fx) + pid.checks
     result = DesignResult(
         spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,
-        loop=loop_responses(spec, xo), isolator_advice=advice, checks=checks,
+        loop=loop_responses(model, xo), isolator_advice=advice, checks=checks,
         warnings=tuple(warnings_for(spec)),
-        conclusion=_conclusion(spec, gap, xo, st, fx, pid, advice, checks),
-        fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None)
+        conclusion=_conclusion(model, gap, xo, st, fx, pid, advice, checks),
+        fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None,
+        model=model)
     sim = study = None
     if confirm:
         if progress is not None:
@@ -589,32 +627,30 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
             if progress is not None:
                 progress("simulating the friction scatter of requirements.robustness ...")
             study = _verdict.run_robustness(
-                spec, suggestion, None if progress is None else
+                model, suggestion, None if progress is None else
                 (lambda done, total: progress(f"friction scatter: {done}/{total} samples")),
                 executor=executor)
         sim = pending[0].result() if pending else \
-            run_confirmation(spec, suggestion, progress=progress)
-        own = "isolated" if spec.has_isolator else "non_isolated"
-        text = _conclusion(spec, gap, xo, st, fx, pid, advice, checks,
+            run_confirmation(model, suggestion, progress=progress)
+        own = "isolated" if model.has_isolator else "non_isolated"
+        text = _conclusion(model, gap, xo, st, fx, pid, advice, checks,
                            hunts=sim.stage[own].hunts)
         result = replace(result, simulation=sim, checks=result.checks + sim.checks,
-                         conclusion=text + _simulation_sentence(spec, sim))
-    rob = None if study is None else _verdict.robustness_check(spec, study)
+                         conclusion=text + _simulation_sentence(model, sim))
+    rob = None if study is None else _verdict.robustness_check(model, study)
     if rob is not None:  # a check like the others: the tally counts it
         result = replace(result, checks=result.checks + (_verdict.robustness_as_check(rob),))
-    margins = _verdict.margins(spec, xo, st, fx, pid, sim)
+    margins = _verdict.margins(model, xo, st, fx, pid, sim)
     result = replace(
         result, robustness=rob, margins=margins,
-        verdict=_verdict.judge(spec, result.checks, result.warnings, sim, rob, margins))
-
+        verdict=_verdict.judge(model, result.checks, result.warnings, sim, rob, margins))
     log.info("design of %r: %s, %d checks, %d failed", spec.name, result.verdict.status,
              len(result.checks), len(result.failed_checks))
     return result
 
 
-def _simulation_sentence(spec: Spec, sim: Confirmation) -> str:
+def _simulation_sentence(model: Model, sim: Confirmation) -> str:
     """The conclusion's sentences on the simulated stage (the spec's own plant first)."""
-
     mins = sim.min_hunting_free_crossover
 
     def f(x):
@@ -639,7 +675,7 @@ def _simulation_sentence(spec: Spec, sim: Confirmation) -> str:
     return text
 
 
-def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: StiffnessResult,
+def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: StiffnessResult,
                 fx: FlexureResult | None, pid: PidResult, advice: IsolatorAdvice | None,
                 checks: tuple[Check, ...], hunts: bool = False) -> str:
     from .linear import CASE_NUMBERS
@@ -662,7 +698,7 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
     else:
         parts.append(f"Static friction exceeds Coulomb friction by only {gap.gap:.3g} N, below "
                      f"the {gap.threshold:.3g} N threshold, so hunting is unlikely"
-                     + (" and the isolator may not be needed." if spec.isolator is not None
+                     + (" and the isolator may not be needed." if model.has_isolator
                         else "."))
     n = len(xo.cases)
     bad = [c for c in xo.cases if not c.passed]
@@ -689,7 +725,7 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
                           f"{', '.join(c.failed)})" for c in bad)
         parts.append(f"At {at} of {xo.desired:.3g} Hz the margins fail in "
                      f"{which}; {ach}.")
-    if spec.isolator is not None:
+    if model.has_isolator:
         ok = st.chosen <= st.maximum * (1 + 1e-12)
         parts.append(f"The drive stiffness of {_g(st.chosen)} N/m is "
                      + ("within" if ok else "above")

@@ -8,7 +8,9 @@ and appendix of the other reports. Sections: the identified parameters, the
 force-velocity map with the fitted friction curve (both directions), the force
 residual over time, the fit statistics, what is and is not identifiable, and
 the processing. The figures are drawn here with matplotlib's ``Figure`` API
-(never pyplot).
+(never pyplot); the fitted curve is the result's own
+(:meth:`fi_design.identification.IdentificationResult.friction_curve`, the
+model's steady-state friction law).
 """
 
 from __future__ import annotations
@@ -39,44 +41,6 @@ def _figure(height: float) -> Any:
     return report_figure(height, top=0.3)
 
 
-def friction_curve(result: Any, velocity: np.ndarray) -> np.ndarray:
-    """The identified steady-state friction plus offset at ``velocity`` [N].
-
-    Coulomb plus viscous friction per direction and the offset, in the
-    identification's form; where static friction and the Stribeck velocity
-    are both identified, the Stribeck term (Fs - Fc) exp(-(v/vs)^2) on top
-    (the negative direction's scaled by its Coulomb ratio). Zero velocity
-    gets the mean of the two sides.
-
-    Parameters
-    ----------
-    result : fi_design.identification.IdentificationResult
-        The identification.
-    velocity : ndarray
-        Velocities [m/s].
-
-    Returns
-    -------
-    ndarray
-        Force [N], the shape of ``velocity``.
-    """
-    v = np.asarray(velocity, dtype=float)
-    p = {k: (x.value if x.value is not None else 0.0) for k, x in result.parameters.items()}
-    symmetric = result.form == "symmetric"
-    fc_pos = p["coulomb"] + (p["offset"] if symmetric else 0.0)
-    fc_neg = (p["coulomb"] - p["offset"]) if symmetric else p["coulomb_negative"]
-    pos = fc_pos + p["viscous"] * v
-    neg = -fc_neg + p["viscous_negative"] * v
-    par = result.parameters
-    if par["static"].identifiable and par["stribeck_velocity"].identifiable:
-        gap = p["static"] - p["coulomb"]  # the form's positive direction, offset aside
-        e = np.exp(-(v / p["stribeck_velocity"]) ** 2)
-        ratio = 1.0 if symmetric else p["coulomb_negative"] / p["coulomb"]
-        pos = pos + gap * e
-        neg = neg - gap * ratio * e
-    return np.where(v > 0, pos, np.where(v < 0, neg, 0.5 * (pos + neg)))
-
-
 @styled
 def force_velocity_figure(result: Any) -> Any:
     """The force-velocity map: measured friction (force minus inertia) and the fitted curve.
@@ -105,7 +69,7 @@ def force_velocity_figure(result: Any) -> Any:
     for side in (-1.0, 1.0):
         vv = side * np.unique(np.concatenate([np.linspace(1e-9, top, 200),
                                               np.geomspace(1e-4 * top, top, 200)]))
-        ax.plot(vv, friction_curve(result, vv / 1e3), color=COLOURS["fit"], lw=1.4,
+        ax.plot(vv, result.friction_curve(vv / 1e3), color=COLOURS["fit"], lw=1.4,
                 label="identified friction + offset" if side > 0 else None)
     ax.axhline(0.0, color="0.5", lw=0.6)
     ax.axvline(0.0, color="0.5", lw=0.6)

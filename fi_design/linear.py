@@ -63,10 +63,11 @@ import control
 import numpy as np
 
 from .errors import SpecError
-from .pid import ControlLaw, PidGains, control_law
-from .results import dataclass_dict, frozen_array
-from .spec import (Spec, antiresonance, bristle_damping, design_crossover, drive_stiffness,
-                   joint_damping)
+from .model import Model, as_model
+from .results import Status, frozen_array
+from .results.controller import ControlLaw, PidGains
+from .results.linear import CRITERIA, AchievableCrossover, CaseMargins, LoopAnalysis
+from .spec import Spec, antiresonance
 
 __all__ = [
     "ISOLATED_CASES", "RIGID_CASES", "CASE_DESCRIPTIONS", "CASE_NUMBERS", "SCAN_LIMIT",
@@ -198,16 +199,15 @@ def mode_factor(mode) -> tuple[np.ndarray, np.ndarray]:
     return num, den
 
 
-def limit_cases(spec: Spec, stiffness: float | None = None) -> tuple[LimitCase, ...]:
-    """The linear limit cases of a spec.
+def limit_cases(model: Model | Spec) -> tuple[LimitCase, ...]:
+    """The linear limit cases of a model.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
-    stiffness : float, optional
-        Joint drive stiffness k [N/m]; default :func:`fi_design.spec.drive_stiffness`
-        (the given value, else the proposed one). Ignored without isolator.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved): masses, friction, the joint's
+        stiffness and damping (:meth:`~fi_design.model.Model.at` varies them),
+        the parasitic modes.
 
     Returns
     -------
@@ -215,24 +215,22 @@ def limit_cases(spec: Spec, stiffness: float | None = None) -> tuple[LimitCase, 
         Four cases for an isolated stage (:data:`ISOLATED_CASES`), two without
         isolator (:data:`RIGID_CASES`).
     """
-    f = spec.friction
-    m1, m2, M = spec.stage.mass, spec.cart.mass, spec.total_mass
-    s0, s1 = f.bristle_stiffness, bristle_damping(spec)
-    s2 = f.viscous if f.viscous_negative is None else min(f.viscous, f.viscous_negative)
-    if spec.isolator is None:
+    model = as_model(model)
+    f = model.friction
+    m1, m2, M = model.m1, model.m2, model.total_mass
+    s0, s1 = f.sigma0, f.sigma1
+    s2 = min(f.viscous(1), f.viscous(-1))
+    if model.joint is None:
         raw = {"sliding": _rigid(M, s2, 0.0), "stuck": _rigid(M, s1 + s2, s0)}
-        modes = ()
     else:
-        k = drive_stiffness(spec) if stiffness is None else float(stiffness)
-        c = joint_damping(spec, k)
+        k, c = model.joint.stiffness, model.joint.damping
         raw = {
             "sliding_free": _two_mass(m1, m2, k, c, 0.0, s2),
             "stuck_free": _two_mass(m1, m2, k, c, s0, s1 + s2),
             "sliding_limited": _rigid(M, s2, 0.0),
             "stuck_limited": _rigid(M, s1 + s2, s0),
         }
-        modes = spec.isolator.parasitic_modes
-    factors = [mode_factor(m) for m in modes]
+    factors = [mode_factor(m) for m in model.modes]
     out = []
     for i, (name, (sys, num, den)) in enumerate(raw.items(), start=1):
         num, den = np.asarray(num, float), np.asarray(den, float)
@@ -244,57 +242,59 @@ def limit_cases(spec: Spec, stiffness: float | None = None) -> tuple[LimitCase, 
     return tuple(out)
 
 
-def _case(spec: Spec, case, stiffness: float | None) -> LimitCase:
+def _case(model: Model, case) -> LimitCase:
     if isinstance(case, LimitCase):
         return case
-    for c in limit_cases(spec, stiffness):
+    cases = limit_cases(model)
+    for c in cases:
         if c.name == case or c.number == case:
             return c
-    names = ", ".join(c.name for c in limit_cases(spec, stiffness))
+    names = ", ".join(c.name for c in cases)
     raise SpecError(f"unknown limit case {case!r}; this spec has: {names}")
 
 
 # --------------------------------------------------------------------------- controller, delay
 
 
-def delay_time(spec: Spec) -> float:
+def delay_time(model: Model | Spec) -> float:
     """Loop delay of the linear analysis.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
 
     Returns
     -------
     float
-        ``controller.delay`` plus half a sample period (zero-order hold) when
-        ``controller.sample_rate`` is set [s].
+        The controller's computational delay plus half a sample period
+        (zero-order hold) when it samples [s].
     """
-    ctl = spec.controller
-    t = ctl.delay
-    if ctl.sample_rate is not None:
-        t += 0.5 / ctl.sample_rate
+    law = as_model(model).law
+    t = law.delay
+    if law.sample_period > 0.0:
+        t += 0.5 * law.sample_period
     return t
 
 
-def delay_polynomials(spec: Spec) -> tuple[np.ndarray, np.ndarray]:
+def delay_polynomials(model: Model | Spec) -> tuple[np.ndarray, np.ndarray]:
     """Pade approximation of :func:`delay_time` (order ``controller.pade_order``).
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
 
     Returns
     -------
     num, den : numpy.ndarray
         Descending powers of s [rad/s]; ``([1.], [1.])`` without delay.
     """
-    t = delay_time(spec)
+    model = as_model(model)
+    t = delay_time(model)
     if t <= 0.0:
         return np.array([1.0]), np.array([1.0])
-    num, den = control.pade(t, spec.controller.pade_order)
+    num, den = control.pade(t, model.spec.controller.pade_order)
     return np.asarray(num, float), np.asarray(den, float)
 
 
@@ -304,7 +304,7 @@ def controller_polynomials(controller: ControlLaw | PidGains) -> tuple[np.ndarra
     Parameters
     ----------
     controller : ControlLaw or PidGains
-        The loop's controller (:func:`fi_design.pid.control_law`), or the
+        The loop's controller (``model.law``), or the
         rule's gains.
 
     Returns
@@ -364,111 +364,93 @@ def controller_tf(controller: ControlLaw | PidGains):
     return control.tf(*controller_polynomials(controller))
 
 
-def delay_tf(spec: Spec):
+def delay_tf(model: Model | Spec):
     """The Pade delay model as a transfer function.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
 
     Returns
     -------
     control.TransferFunction
         The all-pass approximation of :func:`delay_time`; 1 without delay.
     """
-    return control.tf(*delay_polynomials(spec))
+    return control.tf(*delay_polynomials(model))
 
 
-def _controller(spec: Spec, crossover: float | None,
-                gains: ControlLaw | PidGains | None) -> ControlLaw | PidGains:
-    return control_law(spec, crossover) if gains is None else gains
-
-
-def loop_polynomials(spec: Spec, case, crossover: float | None = None,
-                     stiffness: float | None = None,
-                     gains: ControlLaw | PidGains | None = None) -> tuple[np.ndarray, np.ndarray]:
+def loop_polynomials(model: Model | Spec, case,
+                     controller: ControlLaw | PidGains | None = None) \
+        -> tuple[np.ndarray, np.ndarray]:
     """Numerator and denominator of the loop L = C D P of one case.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved); ``model.at(crossover=...,
+        stiffness=...)`` gives the loop at another crossover or stiffness.
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
-    crossover : float, optional
-        Shift the controller to this crossover [Hz]; default the spec's.
-    stiffness : float, optional
-        Joint drive stiffness [N/m]; default the spec's.
-    gains : ControlLaw or PidGains, optional
-        Use this controller (``crossover`` is then ignored).
+    controller : ControlLaw or PidGains, optional
+        Use this controller instead of the model's ``law``.
 
     Returns
     -------
     num, den : numpy.ndarray
         Descending powers of s [rad/s]; L is dimensionless.
     """
-    lc = _case(spec, case, stiffness)
-    cn, cd = controller_polynomials(_controller(spec, crossover, gains))
-    dn, dd = delay_polynomials(spec)
+    model = as_model(model)
+    lc = _case(model, case)
+    cn, cd = controller_polynomials(model.law if controller is None else controller)
+    dn, dd = delay_polynomials(model)
     return (np.polymul(np.polymul(cn, dn), lc.num), np.polymul(np.polymul(cd, dd), lc.den))
 
 
-def loop_transfer_function(spec: Spec, case, crossover: float | None = None,
-                           stiffness: float | None = None,
-                           gains: ControlLaw | PidGains | None = None):
+def loop_transfer_function(model: Model | Spec, case,
+                           controller: ControlLaw | PidGains | None = None):
     """Loop transfer function L(s) = C(s) D(s) P(s) of one limit case.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
-    crossover : float, optional
-        Shift the controller to this crossover [Hz]; default the spec's.
-    stiffness : float, optional
-        Joint drive stiffness [N/m]; default the spec's.
-    gains : ControlLaw or PidGains, optional
-        Use this controller (``crossover`` is then ignored).
+    controller : ControlLaw or PidGains, optional
+        Use this controller instead of the model's ``law``.
 
     Returns
     -------
     control.TransferFunction
         Dimensionless L(s), s in rad/s.
     """
-    return control.tf(*loop_polynomials(spec, case, crossover, stiffness, gains))
+    return control.tf(*loop_polynomials(model, case, controller))
 
 
-def sensitivity(spec: Spec, case, crossover: float | None = None,
-                stiffness: float | None = None, gains: ControlLaw | PidGains | None = None):
+def sensitivity(model: Model | Spec, case, controller: ControlLaw | PidGains | None = None):
     """Sensitivity S = 1 / (1 + L) of one limit case.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
-    crossover : float, optional
-        Shift the controller to this crossover [Hz]; default the spec's.
-    stiffness : float, optional
-        Joint drive stiffness [N/m]; default the spec's.
-    gains : ControlLaw or PidGains, optional
-        Use this controller (``crossover`` is then ignored).
+    controller : ControlLaw or PidGains, optional
+        Use this controller instead of the model's ``law``.
 
     Returns
     -------
     control.TransferFunction
         S(s), dimensionless; ``1 / max|S|`` is the modulus margin.
     """
-    num, den = loop_polynomials(spec, case, crossover, stiffness, gains)
+    num, den = loop_polynomials(model, case, controller)
     return control.tf(den, np.polyadd(den, num))
 
 
-def complementary_sensitivity(spec: Spec, case, crossover: float | None = None,
-                              stiffness: float | None = None,
-                              gains: ControlLaw | PidGains | None = None):
+def complementary_sensitivity(model: Model | Spec, case,
+                              controller: ControlLaw | PidGains | None = None):
     """The closed loop from the reference to x1 of one limit case.
 
     T = C_r D P / (1 + L), where C_r is the part of the controller acting on
@@ -477,102 +459,34 @@ def complementary_sensitivity(spec: Spec, case, crossover: float | None = None,
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved).
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
-    crossover : float, optional
-        Shift the controller to this crossover [Hz]; default the spec's.
-    stiffness : float, optional
-        Joint drive stiffness [N/m]; default the spec's.
-    gains : ControlLaw or PidGains, optional
-        Use this controller (``crossover`` is then ignored).
+    controller : ControlLaw or PidGains, optional
+        Use this controller instead of the model's ``law``.
 
     Returns
     -------
     control.TransferFunction
         T(s), dimensionless.
     """
-    ctl = _controller(spec, crossover, gains)
-    num, den = loop_polynomials(spec, case, crossover, stiffness, ctl)
+    model = as_model(model)
+    ctl = model.law if controller is None else controller
+    num, den = loop_polynomials(model, case, ctl)
     closed = np.polyadd(den, num)
     if isinstance(ctl, PidGains) or ctl.derivative_on == "error":
         return control.tf(num, closed)
     # reference path: C_r D P (1 + L)^-1 = rn dn pn (cd / rd) / closed, where rd divides cd
-    lc = _case(spec, case, stiffness)
+    lc = _case(model, case)
     cn, cd = controller_polynomials(ctl)
     rn, rd = reference_polynomials(ctl)
-    dn, _ = delay_polynomials(spec)
+    dn, _ = delay_polynomials(model)
     q, _ = np.polydiv(cd, rd)
     return control.tf(np.polymul(np.polymul(rn, dn), np.polymul(lc.num, q)), closed)
 
 
 # --------------------------------------------------------------------------- margins
-
-
-@dataclass(frozen=True)
-class CaseMargins:
-    """Loop margins of one limit case at one tuned crossover.
-
-    Attributes
-    ----------
-    name : str
-        Case name (see :data:`ISOLATED_CASES`).
-    description : str
-        The case in words.
-    crossover : float or None
-        Gain crossover [Hz] with the worst phase margin (the loop may cross
-        0 dB several times; ``crossovers`` lists all). None without crossing.
-    phase_margin_deg : float
-        Worst phase margin over the crossings [deg]: the phase distance of
-        L(j w) from -180 deg, ``|wrap(angle L + 180)|``. Negative when the
-        closed loop is unstable. ``inf`` without a crossing.
-    gain_margin_db : float
-        Gain margin [dB] at the phase crossover nearest to 0 dB, signed:
-        positive, the gain may rise by this much; negative, the loop goes
-        unstable when the gain falls by this much (a conditionally stable
-        loop: the integrator on an undamped mass starts the phase below
-        -180 deg). ``inf`` without a phase crossover (``None`` in JSON).
-    modulus_margin : float
-        Smallest distance of L(j w) from -1, min |1 + L| = 1 / max |S| [-].
-    delay_margin : float
-        Smallest extra loop delay that makes the loop unstable [s]: over the
-        crossings, the phase lag left to -180 deg [rad] divided by the
-        crossing frequency [rad/s]. 0 when the closed loop is unstable.
-    stable : bool
-        All closed-loop poles (roots of den + num of L) in the open left half-plane.
-    crossovers : tuple of float
-        All gain crossovers [Hz], ascending.
-    passed : bool
-        Stable, and phase, gain and (if required) modulus margins meet the
-        spec's requirements.
-    failed : tuple of str
-        The requirements not met: ``stability``, ``phase margin``,
-        ``gain margin``, ``modulus margin``.
-    in_band : bool
-        Whether a gain crossover lies within the loop's band, at or above
-        :data:`BAND_FACTOR` below the controller's crossover. A case that
-        crosses 0 dB only far below (the integrator against the stiff
-        bristles of a stuck cart crosses at millihertz) or never has no phase
-        or delay margin worth reporting; its gain margin still counts.
-    """
-
-    name: str
-    description: str
-    crossover: float | None
-    phase_margin_deg: float
-    gain_margin_db: float
-    modulus_margin: float
-    delay_margin: float
-    stable: bool
-    crossovers: tuple[float, ...] = ()
-    passed: bool = True
-    failed: tuple[str, ...] = ()
-    in_band: bool = True
-
-    def to_dict(self) -> dict:
-        """Plain JSON data; infinite margins become null."""
-        return dataclass_dict(self)
 
 
 def _scaled(p: np.ndarray, w0: float) -> np.ndarray:
@@ -635,8 +549,14 @@ def loop_margins(num: Sequence[float], den: Sequence[float], scale: float = 1.0,
                        delay_margin=delay, stable=stable, crossovers=crossings)
 
 
-def _judge(m: CaseMargins, spec: Spec) -> CaseMargins:
-    req = spec.requirements
+def _judge(m: CaseMargins, requirements, band_low: float) -> CaseMargins:
+    """The case judged against the requirements, with its crossings' band from ``band_low`` [Hz].
+
+    The one place where a limit case is judged (:attr:`CaseMargins.status`,
+    :attr:`CaseMargins.criteria`); the guideline's checks, the report and
+    the console read the judgement.
+    """
+    req = requirements
     failed = []
     if not m.stable:
         failed.append("stability")
@@ -646,85 +566,62 @@ def _judge(m: CaseMargins, spec: Spec) -> CaseMargins:
         failed.append("gain margin")
     if req.modulus_margin is not None and m.modulus_margin < req.modulus_margin:
         failed.append("modulus margin")
-    return replace(m, passed=not failed, failed=tuple(failed))
+    in_band = any(f >= band_low for f in m.crossovers)
+    criteria = {}
+    for name in CRITERIA:
+        if name == "modulus margin" and req.modulus_margin is None:
+            continue
+        if name in failed or not m.stable:  # a margin of an unstable loop is no margin
+            criteria[name] = Status.FAIL
+        elif name == "phase margin" and not in_band:  # no crossing in the loop's band
+            criteria[name] = Status.INFO
+        else:
+            criteria[name] = Status.PASS
+    status = (Status.FAIL if failed else Status.INFO if not in_band else Status.PASS)
+    return replace(m, passed=not failed, failed=tuple(failed), in_band=in_band, status=status,
+                   criteria=criteria)
 
 
-@dataclass(frozen=True)
-class LoopAnalysis:
-    """Margins of every limit case at one tuned crossover.
-
-    Attributes
-    ----------
-    crossover : float
-        Crossover of the controller [Hz].
-    stiffness : float or None
-        Joint drive stiffness used [N/m]; None without isolator.
-    delay : float
-        Loop delay modelled [s] (Pade approximation).
-    controller : fi_design.pid.ControlLaw
-        The loop's controller.
-    cases : tuple of CaseMargins
-        One per limit case, in the paper's order.
-    passed : bool
-        All cases meet the margin requirements.
-    """
-
-    crossover: float
-    stiffness: float | None
-    delay: float
-    controller: ControlLaw
-    cases: tuple[CaseMargins, ...]
-    passed: bool
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return dataclass_dict(self)
-
-
-def analyse(spec: Spec, crossover: float | None = None, stiffness: float | None = None,
-            cases: Sequence[LimitCase] | None = None) -> LoopAnalysis:
-    """Margins of all limit cases with the loop's controller at ``crossover``.
+def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None) -> LoopAnalysis:
+    """Margins of all limit cases with the model's controller.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec (plant, controller, delay, requirements).
-    crossover : float, optional
-        Shift the controller to this crossover [Hz] (the rule retunes,
-        explicit gains scale); default the spec's.
-    stiffness : float, optional
-        Joint drive stiffness [N/m]; default the spec's.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved): plant, controller, delay,
+        requirements. ``model.at(crossover=..., stiffness=...)`` analyses
+        another crossover or stiffness.
     cases : sequence of LimitCase, optional
-        Precomputed :func:`limit_cases` (saves rebuilding them in a loop).
+        Precomputed :func:`limit_cases` of the model (saves rebuilding them
+        in a loop).
 
     Returns
     -------
     LoopAnalysis
-        Per-case margins judged against ``spec.requirements``.
+        Per-case margins judged against ``requirements``.
     """
-    lcs = limit_cases(spec, stiffness) if cases is None else tuple(cases)
-    law = control_law(spec, crossover)
-    out = _margins(spec, law, lcs, first_fail=False)
-    k = None
-    if spec.isolator is not None:
-        k = drive_stiffness(spec) if stiffness is None else float(stiffness)
-    return LoopAnalysis(crossover=law.crossover, stiffness=k, delay=delay_time(spec),
+    model = as_model(model)
+    lcs = limit_cases(model) if cases is None else tuple(cases)
+    law = model.law
+    out = _margins(model, lcs, first_fail=False)
+    k = model.joint.stiffness if model.joint is not None else None
+    return LoopAnalysis(crossover=law.crossover, stiffness=k, delay=delay_time(model),
                         controller=law, cases=tuple(out), passed=all(c.passed for c in out))
 
 
-def _margins(spec: Spec, law: ControlLaw, lcs: Sequence[LimitCase],
-             first_fail: bool) -> list[CaseMargins]:
+def _margins(model: Model, lcs: Sequence[LimitCase], first_fail: bool) -> list[CaseMargins]:
     """Judged margins of each case (stopping at the first failing one when ``first_fail``)."""
+    law = model.law
     cn, cd = controller_polynomials(law)
-    dn, dd = delay_polynomials(spec)
+    dn, dd = delay_polynomials(model)
     ln, ld = np.polymul(cn, dn), np.polymul(cd, dd)
     wc = 2.0 * math.pi * law.crossover
     out = []
     low = law.crossover / BAND_FACTOR
     for lc in lcs:
         m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den), scale=wc,
-                                name=lc.name, description=lc.description), spec)
-        m = replace(m, in_band=any(f >= low for f in m.crossovers))
+                                name=lc.name, description=lc.description),
+                   model.requirements, low)
         out.append(m)
         if first_fail and not m.passed:
             break
@@ -734,63 +631,16 @@ def _margins(spec: Spec, law: ControlLaw, lcs: Sequence[LimitCase],
 # --------------------------------------------------------------------------- achievable crossover
 
 
-@dataclass(frozen=True)
-class AchievableCrossover:
-    """The highest crossover at which every limit case meets the requirements.
-
-    Attributes
-    ----------
-    frequency : float or None
-        Achievable crossover [Hz] (to the bisection tolerance); None when no
-        scanned crossover is feasible.
-    limited_by : str
-        What limits it, in words: the case and margin, the parasitic mode,
-        or ``nothing up to the scan limit ...``.
-    kind : str
-        ``margin`` (a loop margin or stability of a case), ``mode`` (parasitic
-        separation), ``scan_limit`` (nothing found up to the top of the scan)
-        or ``infeasible`` (no scanned crossover works).
-    case : str or None
-        Name of the limiting case (``kind == "margin"``).
-    criterion : str or None
-        The failing requirement: ``stability``, ``phase margin``,
-        ``gain margin``, ``modulus margin`` or ``parasitic separation``.
-    scan_start, scan_stop : float
-        Range of the scan [Hz].
-    feasible_ranges : tuple of tuple of float
-        Feasible stretches of the scan grid, ``(low, high)`` [Hz], at grid
-        resolution (the top one refined). Several stretches mean that a lower
-        crossover can fail where a higher one passes.
-    evaluations : int
-        Crossovers evaluated.
-    """
-
-    frequency: float | None
-    limited_by: str
-    kind: str
-    case: str | None
-    criterion: str | None
-    scan_start: float
-    scan_stop: float
-    feasible_ranges: tuple[tuple[float, float], ...]
-    evaluations: int
-
-    def to_dict(self) -> dict:
-        """Plain JSON data."""
-        return dataclass_dict(self)
-
-
 def _units(criterion: str) -> str:
     return {"phase margin": "deg", "gain margin": "dB", "modulus margin": ""}.get(criterion, "")
 
 
-def achievable_crossover(spec: Spec, stiffness: float | None = None,
-                         start: float | None = None, stop: float | None = None,
-                         rtol: float = 1e-3) -> AchievableCrossover:
+def achievable_crossover(model: Model | Spec, start: float | None = None,
+                         stop: float | None = None, rtol: float = 1e-3) -> AchievableCrossover:
     """The highest crossover at which all limit cases meet the requirements.
 
     At each crossover the PID is retuned by the spec's rule (explicit gains
-    scale in frequency, :meth:`fi_design.pid.ControlLaw.at_crossover`); a
+    scale in frequency, :meth:`fi_design.model.Model.at`); a
     crossover is feasible when every case is stable and meets ``requirements.phase_margin``,
     ``requirements.gain_margin`` and ``requirements.modulus_margin`` (if set),
     and every parasitic mode lies at or above ``requirements.parasitic_separation``
@@ -799,10 +649,9 @@ def achievable_crossover(spec: Spec, stiffness: float | None = None,
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        The design spec.
-    stiffness : float, optional
-        Joint drive stiffness [N/m]; default the spec's.
+    model : fi_design.model.Model or fi_design.spec.Spec
+        The resolved model (a spec is resolved); its joint stiffness and the
+        desired crossover.
     start : float, optional
         Lowest crossover scanned [Hz]; default the smaller of :data:`SCAN_START`
         and a tenth of the desired crossover.
@@ -818,15 +667,16 @@ def achievable_crossover(spec: Spec, stiffness: float | None = None,
     AchievableCrossover
         The frequency and what limits it.
     """
-    lcs = limit_cases(spec, stiffness)
-    req = spec.requirements
+    model = as_model(model)
+    lcs = limit_cases(model)
+    req = model.requirements
     sep = req.parasitic_separation
-    modes = spec.isolator.parasitic_modes if spec.isolator is not None else ()
-    ctl = spec.controller
-    f_lo = min(SCAN_START, design_crossover(spec) / 10.0) if start is None else float(start)
+    modes = model.modes
+    f_lo = min(SCAN_START, model.crossover / 10.0) if start is None else float(start)
     scan_limit = SCAN_LIMIT if stop is None else float(stop)
-    if ctl.sample_rate is not None:
-        scan_limit = min(scan_limit, 0.5 * ctl.sample_rate)
+    rate = model.spec.controller.sample_rate  # the setting as given (its Nyquist frequency)
+    if rate is not None:
+        scan_limit = min(scan_limit, 0.5 * rate)
     mode_limit, low_mode = math.inf, None
     for m in modes:
         if m.frequency / sep < mode_limit:
@@ -841,8 +691,8 @@ def achievable_crossover(spec: Spec, stiffness: float | None = None,
     def failures(fc: float, first_only: bool) -> list[CaseMargins]:
         nonlocal count
         count += 1
-        res = analyse(spec, fc, stiffness, cases=lcs).cases if not first_only else \
-            _analyse_until_fail(spec, fc, lcs)
+        at = model.at(crossover=fc)
+        res = _margins(at, lcs, first_fail=first_only)
         return [c for c in res if not c.passed]
 
     ok = np.array([not failures(float(f), True) for f in grid])
@@ -865,7 +715,7 @@ def achievable_crossover(spec: Spec, stiffness: float | None = None,
         return AchievableCrossover(
             frequency=None,
             limited_by=(f"no crossover from {f_lo:.3g} Hz to {f_hi:.4g} Hz meets the "
-                        f"requirements; at {f_lo:.3g} Hz it is {_describe(bad, spec)}"),
+                        f"requirements; at {f_lo:.3g} Hz it is {_describe(bad, req)}"),
             kind="infeasible", case=bad.name, criterion=bad.failed[0], scan_start=f_lo,
             scan_stop=f_hi, feasible_ranges=(), evaluations=count)
 
@@ -881,24 +731,19 @@ def achievable_crossover(spec: Spec, stiffness: float | None = None,
     ranges = ranges[:-1] + ((ranges[-1][0], a),)
     log.debug("achievable crossover %.4g Hz after %d evaluations", a, count)
     return AchievableCrossover(
-        frequency=a, limited_by=_describe(bad, spec, above=a), kind="margin",
+        frequency=a, limited_by=_describe(bad, req, above=a), kind="margin",
         case=bad.name, criterion=bad.failed[0], scan_start=f_lo, scan_stop=f_hi,
         feasible_ranges=ranges, evaluations=count)
 
 
-def _analyse_until_fail(spec: Spec, fc: float, lcs: Sequence[LimitCase]) -> list[CaseMargins]:
-    """Like :func:`analyse` but stops at the first failing case (for the scan)."""
-    return _margins(spec, control_law(spec, fc), lcs, first_fail=True)
-
-
-def _describe(m: CaseMargins, spec: Spec, above: float | None = None) -> str:
+def _describe(m: CaseMargins, requirements, above: float | None = None) -> str:
     """What fails in a case, in words.
 
     With ``above``: ``the gain margin of case 4 (cart stuck, limiter engaged)
     falls below 6 dB above 11.8 Hz``; without: ``the gain margin of case 4
     (...) is 5.2 dB, below the 6 dB required``.
     """
-    req = spec.requirements
+    req = requirements
     where = f"case {CASE_NUMBERS[m.name]} ({m.description})"
     crit = m.failed[0]
     if crit == "stability":

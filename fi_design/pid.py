@@ -29,64 +29,12 @@ The same controller in parallel form, as the simulation uses it::
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 from .errors import SpecError
+from .results.controller import ControlLaw, PidGains
 
-__all__ = ["PidGains", "tune_pid", "pid_gains", "ControlLaw", "control_law"]
-
-
-@dataclass(frozen=True)
-class PidGains:
-    """PID gains of the rule, in both series and parallel form.
-
-    Attributes
-    ----------
-    crossover : float
-        Crossover frequency fc the gains are tuned for [Hz].
-    wc : float
-        Crossover angular frequency 2 pi fc [rad/s].
-    tuning_mass : float
-        Mass the gains are tuned on [kg] (m1 + m2 or m1).
-    ks : float
-        Series-form gain [N/m]: ``m wc^2 / derivative_ratio``.
-    wi : float
-        Integrator corner [rad/s]: ``wc / integrator_ratio``.
-    wd : float
-        Lead (differentiator) corner [rad/s]: ``wc / derivative_ratio``.
-    wt : float
-        Roll-off (tamed differentiator) corner [rad/s]: ``derivative_ratio wc``.
-    kp : float
-        Parallel proportional gain [N/m]: ``ks (1 + wi/wd)``.
-    ki : float
-        Parallel integral gain [N/(m s)]: ``ks wi``.
-    kd : float
-        Parallel derivative gain [N s/m]: ``ks / wd``.
-    """
-
-    crossover: float
-    wc: float
-    tuning_mass: float
-    ks: float
-    wi: float
-    wd: float
-    wt: float
-    kp: float
-    ki: float
-    kd: float
-
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI floats)."""
-        from .results import dataclass_dict
-
-        return dataclass_dict(self)
-
-    def series(self, s: complex) -> complex:
-        """C(s) in series form, for a complex Laplace variable ``s`` [rad/s].
-
-        Returns the controller's complex gain [N/m]; numpy arrays work too.
-        """
-        return self.ks * (1 + self.wi / s) * (1 + s / self.wd) / (1 + s / self.wt)
+__all__ = ["tune_pid", "pid_gains", "control_law", "at_crossover"]
 
 
 def pid_gains(mass: float, crossover: float, derivative_ratio: float = 3.0,
@@ -162,185 +110,19 @@ def tune_pid(spec, crossover: float | None = None, mass: float | None = None) ->
 # --------------------------------------------------------------------------- the loop's controller
 
 
-@dataclass(frozen=True)
-class ControlLaw:
-    """The controller of the loop: one description for the linear analysis, the kernel and the report.
-
-    A parallel PID with a first-order low-pass on the D term, acting on the
-    error e = r - x (x the measured position)::
-
-        u = kp e + ki integral(e) + kd s / (1 + s / roll_off) d + feedforward
-
-    where ``d`` is e (``derivative_on == "error"``) or -x (``"measurement"``:
-    velocity feedback). The paper's rule is one such controller: its
-    C(s) = (kp + ki/s + kd s) / (1 + s/wt) of :class:`PidGains` is exactly
-    ``kp' + ki/s + kd' s / (1 + s/wt)`` with ``kp' = kp - ki/wt`` and
-    ``kd' = kd - kp'/wt`` (expand both over s (1 + s/wt)). Sampled with a
-    zero-order hold when ``sample_period`` > 0 (integrator by the trapezoidal
-    rule, the D term by the Tustin rule, or the backward difference for an
-    ideal D); the command reaches the stage ``delay`` later, saturated at
-    ``force_limit``.
-
-    Attributes
-    ----------
-    source : str
-        ``"rule"`` (tuned from the crossover) or ``"gains"`` (the hardware's).
-    crossover : float
-        The loop's crossover [Hz]: the rule's fc, or where the gains cross a
-        free tuning mass over (|C(j w)| = m w^2).
-    kp : float
-        Proportional gain [N/m].
-    ki : float
-        Integral gain [N/(m s)]; 0 for a PD loop.
-    kd : float
-        Derivative gain [N s/m].
-    roll_off : float
-        Corner of the D term's low-pass [rad/s]; ``inf`` for an ideal D.
-    derivative_on : str
-        ``"error"`` or ``"measurement"``.
-    sample_period : float
-        Controller period [s]; 0 for continuous time.
-    delay : float
-        Computational delay [s].
-    force_limit : float
-        Actuator saturation [N]; ``inf`` for none.
-    ff_mass, ff_viscous, ff_coulomb : float
-        Feedforward mass [kg], viscous [N s/m] and Coulomb [N] terms.
-    tuning_mass : float
-        Mass the rule tunes on, and the crossover refers to [kg].
-    derivative_ratio, integrator_ratio : float
-        The rule's ratios (``controller`` section) [-].
-    rule : PidGains
-        The rule's gains at ``crossover`` (the recommendation beside explicit gains).
-    """
-
-    source: str
-    crossover: float
-    kp: float
-    ki: float
-    kd: float
-    roll_off: float
-    derivative_on: str
-    sample_period: float
-    delay: float
-    force_limit: float
-    ff_mass: float
-    ff_viscous: float
-    ff_coulomb: float
-    tuning_mass: float
-    derivative_ratio: float
-    integrator_ratio: float
-    rule: PidGains = field(repr=False)
-
-    @property
-    def integrator(self) -> bool:
-        """Whether the loop integrates (ki > 0); a PD loop cannot hunt by the paper's mechanism."""
-        return self.ki > 0.0
-
-    @property
-    def is_rule(self) -> bool:
-        """The rule's own controller, unaltered (D on the error, roll-off at its wt)."""
-        return (self.source == "rule" and self.derivative_on == "error"
-                and self.roll_off == self.rule.wt)
-
-    def at_crossover(self, crossover: float) -> "ControlLaw":
-        """The same loop shifted to another crossover [Hz].
-
-        The rule retunes (:func:`pid_gains`); explicit gains scale in
-        frequency by ``lam = crossover / self.crossover`` (kp lam^2, ki lam^3,
-        kd lam, roll-off lam), which keeps the loop's shape and is exactly
-        what retuning the rule does.
-        """
-        lam = crossover / self.crossover
-        rule = pid_gains(self.tuning_mass, crossover, self.derivative_ratio,
-                         self.integrator_ratio)
-        if self.source == "rule":
-            kp, ki, kd = _filtered_d(rule)
-            wf = rule.wt if self.roll_off == self.rule.wt else self.roll_off * lam
-            return replace(self, crossover=float(crossover), kp=kp, ki=ki, kd=kd, roll_off=wf,
-                           rule=rule)
-        return replace(self, crossover=float(crossover), kp=self.kp * lam ** 2,
-                       ki=self.ki * lam ** 3, kd=self.kd * lam, roll_off=self.roll_off * lam,
-                       rule=rule)
-
-    def kernel_form(self) -> dict[str, float]:
-        """Gains of the kernel's continuous law v = kp e + I + kd e' - kdm x', u' = wt (v - u).
-
-        Returns ``kp`` [N/m], ``ki`` [N/(m s)], ``kd`` and ``kdm`` [N s/m],
-        ``wt`` [rad/s] of :mod:`fi_design.plant`: the D term's low-pass moved
-        onto the whole output (kp + ki/wf on e, kp/wf + kd on e' or kd on -x'),
-        which is the same transfer function; the rule's own gains exactly.
-        """
-        if self.is_rule:
-            g = self.rule
-            return dict(kp=g.kp, ki=g.ki, kd=g.kd, kdm=0.0, wt=g.wt)
-        wf = self.roll_off
-        on_error = self.derivative_on == "error"
-        if math.isinf(wf):
-            return dict(kp=self.kp, ki=self.ki, kd=self.kd if on_error else 0.0,
-                        kdm=0.0 if on_error else self.kd, wt=math.inf)
-        return dict(kp=self.kp + self.ki / wf, ki=self.ki,
-                    kd=self.kp / wf + (self.kd if on_error else 0.0),
-                    kdm=0.0 if on_error else self.kd, wt=wf)
-
-    def discrete_form(self) -> dict[str, float]:
-        """Coefficients of the kernel's discrete controller (``dp, dc, da, db, dmeas``).
-
-        Per sample: ``u_k = dp e_k + I_k + D_k`` with the trapezoidal
-        integrator ``I_k = I_{k-1} + dc (e_k + e_{k-1})`` (dc = ki T / 2) and
-        ``D_k = da D_{k-1} + db (d_k - d_{k-1})``: the Tustin rule for a
-        filtered D (da = (2 - wf T)/(2 + wf T), db = 2 kd wf/(2 + wf T)), the
-        backward difference for an ideal one (da = 0, db = kd / T).
-        """
-        T = self.sample_period
-        wf = self.roll_off
-        if math.isinf(wf):
-            da, db = 0.0, self.kd / T
-        else:
-            da, db = (2.0 - wf * T) / (2.0 + wf * T), 2.0 * self.kd * wf / (2.0 + wf * T)
-        return dict(dp=self.kp, dc=0.5 * self.ki * T, da=da, db=db,
-                    dmeas=1.0 if self.derivative_on == "measurement" else 0.0)
-
-    def static_error(self, force: float) -> float | None:
-        """Static position error of a loop without integrator against a force [m].
-
-        ``force / kp``: what a PD loop leaves against, e.g., Coulomb friction;
-        None when the loop integrates (no static error).
-        """
-        return None if self.integrator else force / self.kp
-
-    def rule_in_this_form(self) -> dict[str, float]:
-        """The rule's gains at this crossover in this controller's form, to set beside it.
-
-        ``kp``, ``ki``, ``kd`` [N/m, N/(m s), N s/m] of ``kp + ki/s + kd s/(1 + s/wt)``
-        with the rule's roll-off ``roll_off`` = wt [rad/s]: gains a drive
-        with a filtered D term can take as they are.
-        """
-        kp, ki, kd = _filtered_d(self.rule)
-        return dict(kp=kp, ki=ki, kd=kd, roll_off=self.rule.wt)
-
-    def to_dict(self) -> dict:
-        """Plain JSON data (SI; rad/s for ``roll_off``, infinities as null; without ``rule``)."""
-        from .results import dataclass_dict
-
-        return dataclass_dict(self)
-
-
-def _filtered_d(g: PidGains) -> tuple[float, float, float]:
-    """The rule's gains in the filtered-D form: (kp', ki, kd') with the roll-off wt."""
-    kp = g.kp - g.ki / g.wt
-    return kp, g.ki, g.kd - kp / g.wt
-
-
 def control_law(spec, crossover: float | None = None) -> ControlLaw:
-    """The loop's controller for a spec (the hardware's gains, or the rule's).
+    """The loop's controller of a spec (the hardware's gains, or the rule's).
+
+    :func:`fi_design.model.resolve` builds it once per spec; the analyses
+    read it from the model (``model.law``) and shift it with
+    :meth:`fi_design.model.Model.at`.
 
     Parameters
     ----------
     spec : fi_design.spec.Spec
         The design spec (``controller`` section and masses).
     crossover : float, optional
-        Shift the loop to this crossover [Hz] (:meth:`ControlLaw.at_crossover`);
+        Shift the loop to this crossover [Hz] (:func:`at_crossover`);
         default the spec's (with explicit gains: their own crossover).
 
     Returns
@@ -359,17 +141,50 @@ def control_law(spec, crossover: float | None = None) -> ControlLaw:
         delay=ctl.delay, force_limit=math.inf if ctl.force_limit is None else ctl.force_limit,
         ff_mass=ff.mass if ff else 0.0, ff_viscous=ff.viscous if ff else 0.0,
         ff_coulomb=ff.coulomb if ff else 0.0, tuning_mass=m,
-        derivative_ratio=ctl.derivative_ratio, integrator_ratio=ctl.integrator_ratio)
+        derivative_ratio=ctl.derivative_ratio, integrator_ratio=ctl.integrator_ratio,
+        roll_off_given=ctl.roll_off is not None)
     if ctl.gains is None:
-        fc = own if crossover is None else float(crossover)
-        rule = pid_gains(m, fc, ctl.derivative_ratio, ctl.integrator_ratio)
-        kp, ki, kd = _filtered_d(rule)
+        rule = pid_gains(m, own, ctl.derivative_ratio, ctl.integrator_ratio)
+        f = rule.filtered_d()
         wf = rule.wt if ctl.roll_off is None else 2.0 * math.pi * ctl.roll_off
-        return ControlLaw(source="rule", crossover=fc, kp=kp, ki=ki, kd=kd, roll_off=wf,
-                          rule=rule, **common)
-    g = ctl.gains
-    wf = math.inf if ctl.roll_off is None else 2.0 * math.pi * ctl.roll_off
-    law = ControlLaw(source="gains", crossover=own, kp=g.kp, ki=g.ki, kd=g.kd, roll_off=wf,
-                     rule=pid_gains(m, own, ctl.derivative_ratio, ctl.integrator_ratio),
-                     **common)
-    return law if crossover is None else law.at_crossover(crossover)
+        law = ControlLaw(source="rule", crossover=own, kp=f["kp"], ki=f["ki"], kd=f["kd"],
+                         roll_off=wf, rule=rule, **common)
+    else:
+        g = ctl.gains
+        wf = math.inf if ctl.roll_off is None else 2.0 * math.pi * ctl.roll_off
+        law = ControlLaw(source="gains", crossover=own, kp=g.kp, ki=g.ki, kd=g.kd, roll_off=wf,
+                         rule=pid_gains(m, own, ctl.derivative_ratio, ctl.integrator_ratio),
+                         **common)
+    return law if crossover is None else at_crossover(law, crossover)
+
+
+def at_crossover(law: ControlLaw, crossover: float) -> ControlLaw:
+    """The same loop shifted to another crossover [Hz].
+
+    The rule retunes (:func:`pid_gains`; a roll-off the spec gives stays
+    where it is, the default moves with the rule's wt); explicit gains
+    scale in frequency by ``lam = crossover / law.crossover`` (kp lam^2,
+    ki lam^3, kd lam, roll-off lam), which keeps the loop's shape and is
+    exactly what retuning the rule does.
+
+    Parameters
+    ----------
+    law : ControlLaw
+        The loop's controller.
+    crossover : float
+        The new crossover [Hz], > 0.
+
+    Returns
+    -------
+    ControlLaw
+        A new law; ``law`` is unchanged.
+    """
+    rule = pid_gains(law.tuning_mass, crossover, law.derivative_ratio, law.integrator_ratio)
+    if law.source == "rule":
+        f = rule.filtered_d()
+        wf = law.roll_off if law.roll_off_given else rule.wt
+        return replace(law, crossover=float(crossover), kp=f["kp"], ki=f["ki"], kd=f["kd"],
+                       roll_off=wf, rule=rule)
+    lam = crossover / law.crossover
+    return replace(law, crossover=float(crossover), kp=law.kp * lam ** 2,
+                   ki=law.ki * lam ** 3, kd=law.kd * lam, roll_off=law.roll_off * lam, rule=rule)

@@ -14,7 +14,6 @@ from typing import Any
 
 import numpy as np
 
-from . import spec as _spec
 from .errors import ArgumentError
 
 # --------------------------------------------------------------------------- design report
@@ -594,7 +593,7 @@ def cycle_figure(confirmation: Any, spec: Any) -> Any:
 
 
 @styled
-def boundary_figure(confirmation: Any, spec: Any) -> Any:
+def boundary_figure(confirmation: Any) -> Any:
     """The stage-level boundary on the crossover axis.
 
     For each plant, the peak-to-peak amplitude of its hunting cycle as the
@@ -605,9 +604,8 @@ def boundary_figure(confirmation: Any, spec: Any) -> Any:
     Parameters
     ----------
     confirmation : fi_design.results.design.Confirmation
-        The simulated confirmation (``stage`` and ``min_hunting_free_crossover``).
-    spec : fi_design.spec.Spec
-        The design spec (design crossover).
+        The simulated confirmation (``stage``: the crossover its plants were
+        judged at, their branches and folds).
 
     Returns
     -------
@@ -629,7 +627,7 @@ def boundary_figure(confirmation: Any, spec: Any) -> Any:
             ax.axvline(m, color=col, lw=0.9, ls=":")
             ax.text(m, 0.62 - 0.1 * n, f"no move hunts from {m:.4g} Hz ", color=col,
                     fontsize=7, transform=ax.get_xaxis_transform(), va="top", ha="right")
-    fc = _spec.design_crossover(spec)
+    fc = confirmation.stage["isolated"].crossover
     ax.axvline(fc, color="0.3", lw=0.9, ls="--")
     ax.text(fc, 0.04, f" design {fc:g} Hz", color="0.3", fontsize=7,
             transform=ax.get_xaxis_transform(), va="bottom", ha="left")

@@ -161,7 +161,6 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
     """
     from . import linear
     from .guideline import step2_crossover
-    from .pid import control_law
     from .studies.points import evaluate
 
     if min(grid) < 1:
@@ -300,7 +299,7 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
 
     ranked = sorted((c for c in quiet if c["status"] is None),
                     key=lambda c: (-(c.get("factor") or 0.0), c["stiffness"]))
-    chosen, signed = None, None
+    chosen = None
     for c in ranked:
         say(f"signing off the design {c['stroke'] * 1e3:.3g} mm, {c['stiffness']:.4g} N/m, "
             f"{c['crossover']:.4g} Hz (friction scatter included) ...")
@@ -317,7 +316,7 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
             c["violations"] += [x.text for x in fails]
             continue
         c["status"] = "feasible"
-        chosen, signed = c, r
+        chosen = c
         break
     for c in cells:
         if c["status"] is None:
@@ -357,11 +356,15 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
 def _meets_margins(spec: _spec.Spec, fc: float) -> bool:
     """Whether every limit case meets its margins (and the modes their separation) at fc."""
     from . import linear
+    from .model import resolve
 
-    res = linear.analyse(spec, fc)
+    model = resolve(spec)
+    if abs(fc - model.crossover) > 1e-9 * fc:
+        model = model.at(crossover=fc)
+    res = linear.analyse(model)
     sep = spec.requirements.parasitic_separation
-    modes = spec.isolator.parasitic_modes if spec.isolator is not None else ()
-    return all(c.passed for c in res.cases) and all(m.frequency >= sep * fc for m in modes)
+    return all(c.passed for c in res.cases) and all(m.frequency >= sep * fc
+                                                     for m in model.modes)
 
 
 def _flexure(base: _spec.Spec, stroke: float, k: float, kmax: float, fc: float) -> Any:

@@ -1,7 +1,8 @@
 """One nonlinear simulation of the stage, with or without the isolator.
 
-:func:`simulate` builds the kernel parameters from a spec (PID tuned by the
-guideline rule, effects applied), integrates with the fast RODAS4 kernel
+:func:`simulate` takes the kernel parameters from the resolved model
+(:meth:`fi_design.model.Model.plant`: the loop's controller, effects
+applied), integrates with the fast RODAS4 kernel
 (``method="fast"``) or with scipy's solve_ivp on the same equations
 (``method="reference"``), and returns a :class:`SimulationResult` with the
 traces at the output rate and the hunting metrics.
@@ -20,11 +21,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import effects as _effects
 from . import spec as _spec
 from .errors import SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
-from .pid import ControlLaw, control_law
+from .model import Model, as_model
 from .plant import PlantParameters, state_index
 from .replay import (DRIVES, command_state, initial_state, record_state, reference_state,
                      replay_fit)
@@ -38,73 +38,7 @@ METHODS = ("fast", "reference")
 WINDOW = 0.1
 
 
-# --------------------------------------------------------------------------- parameters
-
-
-def plant_parameters(spec: _spec.Spec, isolated: bool, crossover: float | None = None,
-                     effects=None, law: ControlLaw | None = None) -> PlantParameters:
-    """Kernel parameters of a spec.
-
-    Parameters
-    ----------
-    spec : Spec
-        The design spec.
-    isolated : bool
-        Two-mass plant with joint and limiters (True) or one rigid mass.
-    crossover : float, optional
-        Shift the controller to this crossover [Hz] (the rule retunes,
-        explicit gains scale); default the spec's.
-    effects : sequence, optional
-        Effect entries (spec ``effects`` items) to apply; default the spec's.
-    law : ControlLaw, optional
-        The controller; default :func:`fi_design.pid.control_law` of the spec
-        (and ``crossover``).
-
-    Returns
-    -------
-    PlantParameters
-        The controller from the nominal masses; effects then change the true
-        plant (a mass error does not retune the controller).
-    """
-    if isolated and spec.isolator is None:
-        raise SimulationError("the spec has no isolator: cannot simulate the isolated plant")
-    if law is None:
-        law = control_law(spec, crossover)
-    fr = spec.friction
-    iso = spec.isolator
-    if isolated:
-        k = _spec.drive_stiffness(spec)
-        joint = dict(k=k, c=_spec.joint_damping(spec, k), s=iso.stroke,
-                     k_stop=iso.limiter.stiffness, c_stop=_spec.limiter_damping(spec))
-    else:
-        joint = dict(k=0.0, c=0.0, s=0.0, k_stop=0.0, c_stop=0.0)
-    params = PlantParameters(
-        m1=spec.stage.mass, m2=spec.cart.mass, **joint,
-        Fs=fr.static, Fc=fr.coulomb, vs=fr.stribeck_velocity, sigma0=fr.bristle_stiffness,
-        sigma1=_spec.bristle_damping(spec), sigma2=fr.viscous, **law.kernel_form(),
-        Fc_neg=math.nan if fr.coulomb_negative is None else fr.coulomb_negative,
-        sigma2_neg=math.nan if fr.viscous_negative is None else fr.viscous_negative,
-        offset=fr.offset, ff_mass=law.ff_mass, ff_viscous=law.ff_viscous,
-        ff_coulomb=law.ff_coulomb, delay=law.delay, force_limit=law.force_limit,
-        isolated=1.0 if isolated else 0.0, switch_model=1.0 if fr.model == "switch" else 0.0)
-    if law.sample_period > 0.0:
-        params = replace(params, sample_period=law.sample_period, **law.discrete_form())
-    return apply_effects(params, spec.effects if effects is None else effects)
-
-
-def apply_effects(params: PlantParameters, entries) -> PlantParameters:
-    """Set the kernel parameters of effect entries (neutral values change nothing)."""
-    changes: dict[str, float] = {}
-    for entry in entries:
-        eff = _effects.get(entry.type)
-        for par in eff.parameters:
-            value = getattr(entry, par.name)
-            if value is None:
-                continue
-            if par.combine == "add":
-                value = getattr(params, par.kernel_field) + value
-            changes[par.kernel_field] = float(value)
-    return replace(params, **changes) if changes else params
+# --------------------------------------------------------------------------- tolerances
 
 
 def tolerances(params: PlantParameters, rtol: float) -> np.ndarray:
@@ -124,7 +58,7 @@ def tolerances(params: PlantParameters, rtol: float) -> np.ndarray:
 # --------------------------------------------------------------------------- simulate
 
 
-def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast", *,
+def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str = "fast", *,
              crossover: float | None = None, reference: Trajectory | None = None,
              initial_position: float = 0.0, duration: float | None = None,
              effects=None, rtol: float | None = None, record=None, drive: str = "closed",
@@ -133,16 +67,18 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    spec : Spec or Model
+        The design spec (resolved here, :func:`fi_design.model.resolve`), or
+        a resolved model (:meth:`fi_design.model.Model.at` varies it).
     isolated : bool, optional
         Simulate the isolated plant (True) or the stage without isolator
-        (False); None follows the spec.
+        (False); None follows the model.
     method : {"fast", "reference"}
         RODAS4 kernel, or scipy solve_ivp (Radau, tight tolerance) on the same
         equations for checks and benchmarks.
     crossover : float, optional
-        Shift the controller to this crossover [Hz]; default the spec's.
+        Shift the controller to this crossover [Hz] (``model.at(crossover=...)``);
+        default the model's.
     reference : Trajectory, optional
         A given reference signal instead of the spec's moves.
     initial_position : float
@@ -151,7 +87,7 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         Simulated time [s]; default ``spec.motion.duration`` (or the end of a
         given reference or record).
     effects : sequence, optional
-        Effect entries replacing the spec's ``effects`` list.
+        Effect entries replacing the model's (``model.at(effects=...)``).
     rtol : float, optional
         Relative tolerance of the chosen method; default
         ``spec.simulation.tolerance`` for the fast path and 1e-4 times it for
@@ -191,18 +127,20 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
         raise SimulationError(f"method must be one of {METHODS}, got {method!r}")
     if drive not in DRIVES:
         raise SimulationError(f"drive must be one of {DRIVES}, got {drive!r}")
-    iso = spec.has_isolator if isolated is None else bool(isolated)
-    law = control_law(spec, crossover)
-    params = plant_parameters(spec, iso, effects=effects, law=law)
+    model = as_model(spec)
+    if crossover is not None or effects is not None:
+        model = model.at(crossover=crossover, effects=effects)
+    iso = model.has_isolator if isolated is None else bool(isolated)
+    params = model.plant(iso)
     if record is not None:
-        return _replay(spec, iso, method, law, params, record, drive, window, rtol, effects,
-                       initial_command)
+        return _replay(model, iso, method, params, record, drive, window, rtol, initial_command)
     if drive != "closed":
         raise SimulationError("drive='force' replays a record: give record=")
     params = replace(params, x1_initial=float(initial_position))
+    motion = model.spec.motion
     if reference is None:
-        t_end = spec.motion.duration if duration is None else duration
-        ref = from_moves(spec.motion.moves, t_end)
+        t_end = motion.duration if duration is None else duration
+        ref = from_moves(motion.moves, t_end)
         if initial_position:
             c = np.array(ref.coeffs)
             c[:, 0] += initial_position
@@ -210,22 +148,23 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
     else:
         ref = reference
         t_end = float(ref.breaks[-1]) if duration is None else duration
-    rate = spec.simulation.output_rate
+    rate = model.spec.simulation.output_rate
     n_out = int(math.floor(t_end * rate + 1e-9)) + 1
     t_out = np.arange(n_out) / rate
     y0 = np.zeros(params.n_states)
     idx = state_index(iso)
     y0[idx["x1"]] = initial_position
     y0[idx["x2"]] = initial_position
-    out, wall = _integrate(spec, method, params, y0, ref, t_end, t_out, rtol)
-    return _result(spec, iso, method, law, params, out, t_out, wall,
-                   effects, move_end=spec.motion.end_time if reference is None else 0.0)
+    out, wall = _integrate(model, method, params, y0, ref, t_end, t_out, rtol)
+    return _result(model, iso, method, params, out, t_out, wall,
+                   move_end=motion.end_time if reference is None else 0.0)
 
 
-def _integrate(spec, method, params, y0, ref, t_end, t_out, rtol, input_time=None,
+def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=None,
                input_force=None):
     """One integration with the chosen method; returns the Integration and its wall time [s]."""
-    tol = rtol if rtol is not None else spec.simulation.tolerance * (
+    settings = model.spec.simulation
+    tol = rtol if rtol is not None else settings.tolerance * (
         1.0 if method == "fast" else 1e-4)
     x_bound = 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(y0[0]))
     start = _time.perf_counter()
@@ -235,7 +174,7 @@ def _integrate(spec, method, params, y0, ref, t_end, t_out, rtol, input_time=Non
         kernel()  # loads the built kernel (or compiles it) before the clock starts
         start = _time.perf_counter()
         out = run(params.to_array(), y0, ref.breaks, ref.coeffs, ref.land, t_end, t_out, tol,
-                  tolerances(params, tol), 0.05, spec.simulation.max_steps, x_bound,
+                  tolerances(params, tol), 0.05, settings.max_steps, x_bound,
                   input_time, input_force)
     else:
         from .refsolve import solve_reference
@@ -245,7 +184,7 @@ def _integrate(spec, method, params, y0, ref, t_end, t_out, rtol, input_time=Non
     return out, _time.perf_counter() - start
 
 
-def _result(spec, iso, method, law, params, out, t_out, wall, effects, *, move_end,
+def _result(model, iso, method, params, out, t_out, wall, *, move_end,
             time_offset=0.0, drive="closed", record=None, window=None) -> SimulationResult:
     """The result of an integration; ``record`` (a Measurement) for a replay."""
     success = out.code == 0
@@ -253,11 +192,10 @@ def _result(spec, iso, method, law, params, out, t_out, wall, effects, *, move_e
     Y, R = out.states, out.reference
     idx = state_index(iso)
     t = t_out + time_offset
-    metrics = _metrics(spec, t, Y[:, idx["x1"]] - R, success, message, move_end)
+    metrics = _metrics(model, t, Y[:, idx["x1"]] - R, success, message, move_end)
     return SimulationResult(
-        spec=spec, isolated=iso, method=method, friction_model=spec.friction.model,
-        crossover=law.crossover,
-        effects=tuple(e.type for e in (spec.effects if effects is None else effects)),
+        spec=model.spec, isolated=iso, method=method, friction_model=model.friction.model,
+        crossover=model.crossover, effects=tuple(e.type for e in model.effects),
         time=frozen_array(t), reference=frozen_array(R), position=frozen_array(Y[:, idx["x1"]]),
         cart_position=frozen_array(Y[:, idx["x2"]]), velocity=frozen_array(Y[:, idx["v1"]]),
         cart_velocity=frozen_array(Y[:, idx["v2"]]), force=frozen_array(out.command),
@@ -270,8 +208,7 @@ def _result(spec, iso, method, law, params, out, t_out, wall, effects, *, move_e
         replay=None if record is None else replay_fit(record, Y[:, idx["x1"]], out.command))
 
 
-def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects,
-            initial_command=None):
+def _replay(model, iso, method, params, record, drive, window, rtol, initial_command=None):
     """Replay a measured record, closed loop or open loop in re-anchored windows."""
     t0 = float(record.time[0])
     t_out = np.asarray(record.time, dtype=float) - t0
@@ -279,10 +216,10 @@ def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects
     if drive == "closed":
         dist = record.disturbance
         command = command_state(record, 0) if initial_command is None else float(initial_command)
-        y0, p0 = _anchor(law, params, record, 0, ref, command)
-        out, wall = _integrate(spec, method, p0, y0, ref, float(t_out[-1]), t_out, rtol,
+        y0, p0 = _anchor(model.law, params, record, 0, ref, command)
+        out, wall = _integrate(model, method, p0, y0, ref, float(t_out[-1]), t_out, rtol,
                                None if dist is None else t_out, dist)
-        return _result(spec, iso, method, law, p0, out, t_out, wall, effects, move_end=0.0,
+        return _result(model, iso, method, p0, out, t_out, wall, move_end=0.0,
                        time_offset=t0, record=record)
     if record.force is None:
         raise SimulationError("an open-loop replay (drive='force') needs the record's force_N "
@@ -297,17 +234,17 @@ def _replay(spec, iso, method, law, params, record, drive, window, rtol, effects
     pieces, wall = [], 0.0
     for a, b in zip(starts[:-1], starts[1:]):
         stop = min(b + 1, len(t_out))  # integrate to the next window's start
-        y0, p0 = _anchor(law, open_loop, record, a, ref, None)
+        y0, p0 = _anchor(model.law, open_loop, record, a, ref, None)
         tw = t_out[a:stop] - t_out[a]
         seg = Trajectory(ref.breaks - t_out[a], ref.coeffs, land=False)
-        out, dt = _integrate(spec, method, p0, y0, seg, float(tw[-1]), tw, rtol, tw,
+        out, dt = _integrate(model, method, p0, y0, seg, float(tw[-1]), tw, rtol, tw,
                              record.force[a:stop])
         wall += dt
         pieces.append((int(a), int(b - a), out))
         if out.code != 0:
             break
     merged, labels = _merge(pieces, t_out)
-    return _result(spec, iso, method, law, open_loop, merged, t_out, wall, effects, move_end=0.0,
+    return _result(model, iso, method, open_loop, merged, t_out, wall, move_end=0.0,
                    time_offset=t0, drive="force", record=record, window=labels)
 
 
@@ -350,8 +287,8 @@ def _merge(pieces, t_out):
         t_reached=float(t_out[a]) + last.t_reached), labels
 
 
-def _metrics(spec, t, err, success, message, move_end) -> HuntingMetrics:
-    h = spec.requirements.hunting
+def _metrics(model, t, err, success, message, move_end) -> HuntingMetrics:
+    h = model.requirements.hunting
     return hunting_metrics(t, err, window_start=h.window_start, window_length=h.window_length,
                            min_distance=h.min_distance, min_height=h.min_height,
                            settle_band=h.settle_band, motion_end=move_end, success=success,

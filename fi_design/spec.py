@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import datetime
 import math
+import sys
 from typing import Annotated, Any, Literal, Union
 
 from pydantic import (BaseModel, BeforeValidator, ConfigDict, Discriminator, Field, PrivateAttr,
@@ -705,6 +706,59 @@ class Spec(StrictModel):
         """m1 + m2 [kg]."""
         return self.stage.mass + self.cart.mass
 
+    def with_sections(self, **sections: Any) -> "Spec":
+        """A new spec with whole sections replaced, validated again.
+
+        Unlike pydantic's ``model_copy(update=...)``, which skips
+        validation, the new spec passes every check of the spec (sections
+        given as mappings are validated as in the YAML file, and the checks
+        across sections run); the sections not named are shared. For single
+        values at dotted paths, with units, use
+        :func:`fi_design.specfile.with_values`.
+
+        Parameters
+        ----------
+        **sections
+            Top-level section name (``isolator``, ``friction``, ``effects``,
+            ...) to its new value: a validated section, a mapping in SI, or
+            None to drop an optional section.
+
+        Returns
+        -------
+        Spec
+            A new spec without file origin.
+
+        Raises
+        ------
+        SpecError
+            An unknown section, or a value the spec refuses; the message
+            names the path.
+
+        Examples
+        --------
+        >>> from fi_design.specfile import load_spec
+        >>> spec = load_spec("examples/paper_setup.yaml")
+        >>> spec.with_sections(isolator=None).has_isolator
+        False
+        """
+        from pydantic import ValidationError
+
+        from .errors import SpecError
+
+        fields = type(self).model_fields
+        for name in sections:
+            if name not in fields:
+                raise SpecError(f"unknown section '{name}'; the spec has: {', '.join(fields)}",
+                                path=name)
+        data = {name: getattr(self, name) for name in self.model_fields_set}
+        data.update(sections)
+        try:
+            return type(self).model_validate(data)
+        except ValidationError as exc:
+            err = exc.errors(include_url=False)[0]
+            path = ".".join(str(p) for p in err["loc"]) or None
+            raise SpecError(err["msg"].removeprefix("Value error, "), path=path) from None
+
 
 # --------------------------------------------------------------------------- derived defaults
 
@@ -723,28 +777,30 @@ def gains_crossover(spec: Spec) -> float:
     The frequency where |C(j w)| = m w^2, i.e. where the loop of the gains
     around a free tuning mass m crosses 0 dB (the rule's definition of the
     crossover, DESIGN.md section 2), with C(s) = kp + ki / s + kd s / (1 + s / wf)
-    and wf the D term's roll-off (none when not given). Found by bisection
-    on a log scale (|C| / (m w^2) falls with w for every such C).
+    and wf the D term's roll-off (none when not given). |C| / (m w^2) falls
+    with w for every such C, so ``log |C| - log(m w^2)`` has one root in
+    ``log w``, found by scipy's ``brentq`` between 1e-6 and 1e9 rad/s (an end
+    of that range when the root lies beyond it).
     """
+    from scipy.optimize import brentq
+
     ctl = spec.controller
     g = ctl.gains
     m = tuning_mass(spec)
     wf = 2.0 * math.pi * ctl.roll_off if ctl.roll_off is not None else math.inf
 
-    def excess(w: float) -> float:
+    def excess(x: float) -> float:
+        w = math.exp(x)
         d = 1j * w * g.kd if math.isinf(wf) else 1j * w * g.kd / (1.0 + 1j * w / wf)
-        return abs(g.kp + g.ki / (1j * w) + d) / (m * w * w) - 1.0
+        return math.log(abs(g.kp + g.ki / (1j * w) + d)) - math.log(m * w * w)
 
-    lo, hi = 1e-6, 1e9
-    for _ in range(200):
-        mid = math.sqrt(lo * hi)
-        if excess(mid) > 0.0:
-            lo = mid
-        else:
-            hi = mid
-        if hi / lo < 1.0 + 1e-12:
-            break
-    return math.sqrt(lo * hi) / (2.0 * math.pi)
+    lo, hi = math.log(1e-6), math.log(1e9)
+    if excess(hi) >= 0.0:
+        return math.exp(hi) / (2.0 * math.pi)
+    if excess(lo) <= 0.0:
+        return math.exp(lo) / (2.0 * math.pi)
+    return math.exp(brentq(excess, lo, hi, xtol=1e-15, rtol=4.0 * sys.float_info.epsilon)) \
+        / (2.0 * math.pi)
 
 
 def design_crossover(spec: Spec) -> float:
@@ -771,7 +827,20 @@ def limiter_damping(spec: Spec) -> float:
     lim = spec.isolator.limiter if spec.isolator else Limiter()
     if lim.damping is not None:
         return lim.damping
-    return 2.0 * 0.2 * math.sqrt(lim.stiffness * spec.stage.mass)
+    return default_limiter_damping(lim.stiffness, spec.stage.mass)
+
+
+def default_limiter_damping(stiffness: float, stage_mass: float) -> float:
+    """The default limiter damping 2 * 0.2 * sqrt(k_stop m1) [N s/m] (damping ratio 0.2).
+
+    Parameters
+    ----------
+    stiffness : float
+        Contact stiffness k_stop [N/m].
+    stage_mass : float
+        Stage mass m1 [kg].
+    """
+    return 2.0 * 0.2 * math.sqrt(stiffness * stage_mass)
 
 
 def stiffness_limit(spec: Spec, stroke: float | None = None) -> float:
@@ -799,6 +868,10 @@ def drive_stiffness(spec: Spec) -> float:
     return iso.stiffness if iso.stiffness is not None else proposed_stiffness(spec)
 
 
+#: Damping ratio of the joint mode when the spec gives no joint damping [-].
+JOINT_DAMPING_RATIO = 0.05
+
+
 def joint_damping(spec: Spec, stiffness: float | None = None) -> float:
     """Joint damping c [N s/m]: given, else 2 * 0.05 * sqrt(k m1 m2 / (m1 + m2))."""
     iso = spec.isolator
@@ -807,8 +880,24 @@ def joint_damping(spec: Spec, stiffness: float | None = None) -> float:
     if iso.damping is not None:
         return iso.damping
     k = stiffness if stiffness is not None else drive_stiffness(spec)
-    m1, m2 = spec.stage.mass, spec.cart.mass
-    return 2.0 * 0.05 * math.sqrt(k * m1 * m2 / (m1 + m2))
+    return default_joint_damping(k, spec.stage.mass, spec.cart.mass)
+
+
+def default_joint_damping(stiffness: float, stage_mass: float, cart_mass: float) -> float:
+    """The default joint damping [N s/m]: :data:`JOINT_DAMPING_RATIO` of the joint mode.
+
+    ``2 zeta sqrt(k m1 m2 / (m1 + m2))``: the joint's mode, stage against
+    cart on the drive stiffness, damped at the ratio zeta.
+
+    Parameters
+    ----------
+    stiffness : float
+        Drive stiffness k [N/m].
+    stage_mass, cart_mass : float
+        m1 and m2 [kg].
+    """
+    m1, m2 = stage_mass, cart_mass
+    return 2.0 * JOINT_DAMPING_RATIO * math.sqrt(stiffness * m1 * m2 / (m1 + m2))
 
 
 def antiresonance(mode: ParasiticMode) -> float:

@@ -42,7 +42,7 @@ import functools
 import logging
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -52,7 +52,8 @@ from .errors import ArgumentError
 from .plant import (N_WATCH, W_ARM, W_BAND, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_REPEAT,
                     W_REST_ANYWHERE, W_START, PlantParameters, state_index)
 from .results.stage import Cycle, CycleTrace, MoveOutcome, StageHunting, length_text
-from .simulation import plant_parameters, tolerances
+from .model import Model, as_model
+from .simulation import tolerances
 from .trajectory import Trajectory, from_moves, profile_duration
 
 log = logging.getLogger(__name__)
@@ -114,16 +115,17 @@ class Watch:
     max_steps: int
 
 
-def watch_settings(spec: _spec.Spec, params: PlantParameters) -> Watch:
-    """The :class:`Watch` of a spec's plant.
+def watch_settings(model: Model, params: PlantParameters) -> Watch:
+    """The :class:`Watch` of a model's plant.
 
     Parameters
     ----------
-    spec : Spec
-        The design spec (hunting settings, tolerance, step budget).
+    model : Model
+        The resolved model (its spec's hunting settings, tolerance, step budget).
     params : PlantParameters
         The plant (its controller's gains).
     """
+    spec = model.spec
     h = spec.requirements.hunting
     integrates = _integrates(params)
     if integrates:
@@ -169,14 +171,14 @@ def _largest_move(spec: _spec.Spec) -> _spec.Move:
     return max(spec.motion.moves, key=lambda mv: abs(mv.distance))
 
 
-def family_distances(spec: _spec.Spec, isolated: bool,
+def family_distances(model: Model | _spec.Spec, isolated: bool,
                      params: PlantParameters | None = None) -> tuple[float, ...]:
     """Signed distances of the move family of one plant [m].
 
     Parameters
     ----------
-    spec : Spec
-        The design spec (``motion.family``).
+    model : Model or Spec
+        The resolved model (its spec's ``motion.family``; a spec is resolved).
     isolated : bool
         Which plant: the default smallest distance is a tenth of the stroke
         with the isolator, 0.1 mm without.
@@ -188,13 +190,15 @@ def family_distances(spec: _spec.Spec, isolated: bool,
     tuple of float
         Positive distances first, increasing, then the negative ones.
     """
+    model = as_model(model)
+    spec = model.spec
     fam = spec.motion.family
     if fam.distances is not None:
         return tuple(float(d) for d in fam.distances)
     if fam.smallest is not None:
         lo = fam.smallest
-    elif isolated and spec.isolator is not None:
-        lo = 0.1 * spec.isolator.stroke
+    elif isolated and model.joint is not None:
+        lo = 0.1 * model.joint.stroke
     else:
         lo = 1e-4
     hi = fam.largest if fam.largest is not None else 5.0 * abs(_largest_move(spec).distance)
@@ -709,22 +713,20 @@ def cycle_exists(params: PlantParameters, level: float, guess: np.ndarray, w: Wa
     return None
 
 
-def cycle_fold(spec: _spec.Spec, isolated: bool, cycle: Cycle, *, top: float | None = None,
-               effects=None, progress: Callable[[str], None] | None = None) -> dict:
+def cycle_fold(model: Model, isolated: bool, cycle: Cycle, *, top: float | None = None,
+               progress: Callable[[str], None] | None = None) -> dict:
     """The crossover above which a cycle no longer exists (its fold), by bisection.
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model
+        The resolved model.
     isolated : bool
         Which plant.
     cycle : Cycle
         The cycle at ``cycle.crossover``.
     top : float, optional
         Highest crossover searched [Hz]; default ``simulation.crossover_scan.stop``.
-    effects : sequence, optional
-        Effect entries replacing the spec's.
     progress : callable, optional
         ``progress(text)``.
 
@@ -734,7 +736,7 @@ def cycle_fold(spec: _spec.Spec, isolated: bool, cycle: Cycle, *, top: float | N
         ``{"fold": Hz or None, "bracket": [lo, hi], "kind": "fold" | "bound",
         "tests": int, "state": section state at lo, "crossings": int}``.
     """
-    top = spec.simulation.crossover_scan.stop if top is None else top
+    top = model.spec.simulation.crossover_scan.stop if top is None else top
     lo, state, q = cycle.crossover, np.array(cycle.section_state), cycle.crossings
     period = cycle.period
     branch = [[float(lo), float(cycle.amplitude), float(cycle.period)]]
@@ -743,8 +745,9 @@ def cycle_fold(spec: _spec.Spec, isolated: bool, cycle: Cycle, *, top: float | N
     def exists(fc: float) -> bool:
         nonlocal tests, lo, state, q, period
         tests += 1
-        p = plant_parameters(spec, isolated, crossover=fc, effects=effects)
-        found = cycle_exists(p, float(state[0]), state, watch_settings(spec, p), period)
+        at = model.at(crossover=fc)
+        p = at.plant(isolated)
+        found = cycle_exists(p, float(state[0]), state, watch_settings(at, p), period)
         if found is None:
             return False
         lo = fc
@@ -776,28 +779,49 @@ def cycle_fold(spec: _spec.Spec, isolated: bool, cycle: Cycle, *, top: float | N
 # --------------------------------------------------------------------------- the stage
 
 
-def _moves(spec, isolated, params, horizon, family):
+def _moves(model, isolated, params, horizon, family):
     """(distance, label, reference, move end) of the spec's motion and the family."""
+    spec = model.spec
     ref, end = _spec_reference(spec, horizon)
     net = ref.final
     out = [(net, "spec", ref, end)]
-    dists = family_distances(spec, isolated, params) if family is None else tuple(family)
+    dists = family_distances(model, isolated, params) if family is None else tuple(family)
     for d in dists:
         r, e = _family_reference(spec, d, horizon)
         out.append((float(d), "family", r, e))
     return out
 
 
-def stage_hunts(spec: _spec.Spec, isolated: bool, *, crossover: float | None = None,
-                effects=None, family: Sequence[float] | None = None, first_only: bool = False,
-                params: PlantParameters | None = None) -> tuple[tuple[MoveOutcome, ...],
-                                                                list[_Run]]:
-    """Run the spec's motion and every move of the family; the outcomes and the runs."""
-    p = params if params is not None else plant_parameters(spec, isolated, crossover=crossover,
-                                                            effects=effects)
-    w = watch_settings(spec, p)
+def stage_hunts(model: Model | _spec.Spec, isolated: bool, *, crossover: float | None = None,
+                family: Sequence[float] | None = None, first_only: bool = False) \
+        -> tuple[tuple[MoveOutcome, ...], list[_Run]]:
+    """Run the spec's motion and every move of the family; the outcomes and the runs.
+
+    Parameters
+    ----------
+    model : Model or Spec
+        The resolved model (a spec is resolved).
+    isolated : bool
+        Which plant.
+    crossover : float, optional
+        Judge at this crossover [Hz] (``model.at(crossover=...)``).
+    family : sequence of float, optional
+        Signed move distances [m] replacing ``motion.family``.
+    first_only : bool
+        Stop at the first move that hunts.
+
+    Returns
+    -------
+    (tuple of MoveOutcome, list)
+        The outcomes, and the runs behind them (for the cycles).
+    """
+    model = as_model(model)
+    if crossover is not None:
+        model = model.at(crossover=crossover)
+    p = model.plant(isolated)
+    w = watch_settings(model, p)
     runs: list[_Run] = []
-    for dist, label, ref, end in _moves(spec, isolated, p, w.horizon, family):
+    for dist, label, ref, end in _moves(model, isolated, p, w.horizon, family):
         r = move_outcome(p, ref, end, w, distance=dist, label=label)
         runs.append(r)
         if first_only and r.outcome.hunts:
@@ -805,8 +829,8 @@ def stage_hunts(spec: _spec.Spec, isolated: bool, *, crossover: float | None = N
     return tuple(r.outcome for r in runs), runs
 
 
-def stage_hunting(spec: _spec.Spec, isolated: bool | None = None, *,
-                  crossover: float | None = None, effects=None,
+def stage_hunting(model: Model | _spec.Spec, isolated: bool | None = None, *,
+                  crossover: float | None = None,
                   family: Sequence[float] | None = None, first_only: bool = False,
                   converge: bool = True, boundary: bool = True, trace: bool = True,
                   progress: Callable[[str], None] | None = None) -> StageHunting:
@@ -814,14 +838,12 @@ def stage_hunting(spec: _spec.Spec, isolated: bool | None = None, *,
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model or Spec
+        The resolved model (a spec is resolved).
     isolated : bool, optional
         Which plant; None follows the spec.
     crossover : float, optional
-        Controller crossover [Hz]; default the spec's.
-    effects : sequence, optional
-        Effect entries replacing the spec's ``effects``.
+        Controller crossover [Hz]; default the model's.
     family : sequence of float, optional
         Signed move distances [m] replacing ``motion.family``.
     first_only : bool
@@ -840,18 +862,18 @@ def stage_hunting(spec: _spec.Spec, isolated: bool | None = None, *,
     -------
     StageHunting
     """
-    iso = spec.has_isolator if isolated is None else bool(isolated)
-    if iso and spec.isolator is None:
+    model = as_model(model)
+    if crossover is not None:
+        model = model.at(crossover=crossover)
+    iso = model.has_isolator if isolated is None else bool(isolated)
+    if iso and not model.has_isolator:
         raise ArgumentError("the spec has no isolator: cannot judge the isolated plant")
-    from .pid import control_law
-
-    fc = control_law(spec, crossover).crossover
-    p = plant_parameters(spec, iso, crossover=crossover, effects=effects)
+    fc = model.crossover
+    p = model.plant(iso)
     plant = "isolated" if iso else "non_isolated"
     say = progress or (lambda text: None)
     say(f"simulating the move family ({plant.replace('_', '-')} plant) ...")
-    outcomes, runs = stage_hunts(spec, iso, effects=effects, family=family,
-                                 first_only=first_only, params=p)
+    outcomes, runs = stage_hunts(model, iso, family=family, first_only=first_only)
     hunting = [r for r in runs if r.outcome.hunts]
     cycle = None
     others: list[Cycle] = []
@@ -862,18 +884,15 @@ def stage_hunting(spec: _spec.Spec, isolated: bool | None = None, *,
             cycle, others = cycles[0], cycles[1:]
     free_from, bound = None, None
     if boundary and _integrates(p):
-        bound = _boundary(spec, iso, p, fc, cycle, effects, family, say)
+        bound = _boundary(model, iso, fc, cycle, family, say)
         free_from = bound.pop("hunting_free_from")
-    law = control_law(spec, crossover)
-    fr = spec.friction
-    neg = 1.0 if fr.coulomb_negative is None or fr.coulomb == 0 else \
-        fr.coulomb_negative / fr.coulomb
-    held = fr.static * max(1.0, neg)  # what static friction can hold against the loop
+    fr = model.friction
+    held = max(fr.static(1.0), fr.static(-1.0))  # what static friction can hold against the loop
     return StageHunting(plant=plant, crossover=float(fc), moves=outcomes, cycle=cycle,
                         other_cycles=tuple(others), hunting_free_from=free_from,
                         boundary=bound, first_only=first_only,
-                        static_error_bound=law.static_error(held + abs(fr.offset)),
-                        settle_band=spec.requirements.hunting.settle_band)
+                        static_error_bound=model.law.static_error(held + abs(model.offset)),
+                        settle_band=model.spec.requirements.hunting.settle_band)
 
 
 def _distinct_cycles(p, hunting: Sequence[_Run], fc: float, trace: bool) -> list[Cycle]:
@@ -909,9 +928,9 @@ def _run_cycle(run: _Run, crossover: float) -> Cycle:
                  section_state=_ro(run.section_state))
 
 
-def _boundary(spec, iso, p, fc, cycle, effects, family, say) -> dict:
+def _boundary(model, iso, fc, cycle, family, say) -> dict:
     """The hunting-free crossover: the fold of the cycle (found first if needed)."""
-    scan = spec.simulation.crossover_scan
+    scan = model.spec.simulation.crossover_scan
     top = max(scan.stop, fc)
     tests = 0
     branch: list = []
@@ -922,9 +941,7 @@ def _boundary(spec, iso, p, fc, cycle, effects, family, say) -> dict:
         while f > scan.start * (1 + 1e-9):
             f = max(scan.start, f / FOLD_STEP)
             say(f"looking for a hunting cycle below the design crossover: {f:.3g} Hz")
-            pf = plant_parameters(spec, iso, crossover=f, effects=effects)
-            _, runs = stage_hunts(spec, iso, effects=effects, family=family, first_only=True,
-                                  params=pf)
+            _, runs = stage_hunts(model, iso, crossover=f, family=family, first_only=True)
             tests += 1
             h = [r for r in runs if r.outcome.hunts]
             if h:
@@ -936,7 +953,7 @@ def _boundary(spec, iso, p, fc, cycle, effects, family, say) -> dict:
                     "note": f"no move of the family hunts from {scan.start:g} Hz up"}
         cycle = found
     for _ in range(4):
-        fold = cycle_fold(spec, iso, cycle, top=top, effects=effects, progress=say)
+        fold = cycle_fold(model, iso, cycle, top=top, progress=say)
         tests += fold["tests"]
         lo, hi = fold["bracket"]
         branch += fold["branch"]
@@ -946,9 +963,7 @@ def _boundary(spec, iso, p, fc, cycle, effects, family, say) -> dict:
                     "note": f"the cycle persists up to {hi:.4g} Hz, the top of the search"}
         # another cycle above the fold?
         say(f"checking every move just above the fold at {hi:.4g} Hz ...")
-        ph = plant_parameters(spec, iso, crossover=hi, effects=effects)
-        _, runs = stage_hunts(spec, iso, effects=effects, family=family, first_only=True,
-                              params=ph)
+        _, runs = stage_hunts(model, iso, crossover=hi, family=family, first_only=True)
         tests += 1
         h = [r for r in runs if r.outcome.hunts]
         if not h:

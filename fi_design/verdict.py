@@ -37,7 +37,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from . import spec as _spec
+from .model import Model
 from .results import Check, Status
 from .results.design import (Confirmation, CrossoverResult, FlexureResult, Margins, PidResult,
                              Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict)
@@ -62,7 +62,7 @@ def _um(x: float) -> str:
 # --------------------------------------------------------------------------- robustness
 
 
-def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = None,
+def run_robustness(model: Model, suggestion: tuple[float, float] | None = None,
                    progress: Callable[[int, int], None] | None = None,
                    executor: Any = None) -> Any:
     """Simulate the samples of ``requirements.robustness`` (the study, not yet judged).
@@ -76,8 +76,9 @@ def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = No
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model
+        The resolved model; the study varies its spec (``model.spec``) by
+        dotted paths.
     suggestion : (stroke, stiffness), optional
         Isolator to add when the spec has none [m, N/m].
     progress : callable, optional
@@ -93,7 +94,8 @@ def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = No
     from .confirm import with_isolator
     from .studies import PositionFriction, Scatter, robustness
 
-    cfg = spec.requirements.robustness
+    spec = model.spec
+    cfg = model.requirements.robustness
     scatter = [Scatter(path, spread) for path, spread in (("friction.static", cfg.static),
                                                          ("friction.coulomb", cfg.coulomb))
                if spread > 0]
@@ -102,7 +104,7 @@ def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = No
     if cfg.samples == 0 or (not scatter and ripple is None):
         return None
     target = spec
-    if not spec.has_isolator and suggestion is not None:
+    if not model.has_isolator and suggestion is not None:
         target = with_isolator(spec, *suggestion)
     return robustness(target, scatter, cfg.samples, seed=cfg.seed,
                       distribution=cfg.distribution, position_friction=ripple,
@@ -110,7 +112,7 @@ def run_robustness(spec: _spec.Spec, suggestion: tuple[float, float] | None = No
                       cache=None)
 
 
-def robustness_check(spec: _spec.Spec, study: Any) -> RobustnessCheck:
+def robustness_check(model: Model, study: Any) -> RobustnessCheck:
     """Judge a robustness study against ``requirements.robustness.hunting_probability``.
 
     FAIL when the estimated probability exceeds the limit; WARN when it does
@@ -119,8 +121,9 @@ def robustness_check(spec: _spec.Spec, study: Any) -> RobustnessCheck:
 
     Parameters
     ----------
-    spec : Spec
-        The design spec (its requirements and whether it has an isolator).
+    model : Model
+        The resolved model (its requirements, its loop and whether it has an
+        isolator).
     study : fi_design.studies.RobustnessResult
         From :func:`run_robustness`.
 
@@ -128,8 +131,8 @@ def robustness_check(spec: _spec.Spec, study: Any) -> RobustnessCheck:
     -------
     RobustnessCheck
     """
-    cfg = spec.requirements.robustness
-    own = _OWN[spec.has_isolator]
+    cfg = model.requirements.robustness
+    own = _OWN[model.has_isolator]
     mine = study.isolated if own == "isolated" else study.not_isolated
     other = study.not_isolated if own == "isolated" else study.isolated
     # a sample fails when its stage does not settle, whatever the reason
@@ -180,12 +183,6 @@ def robustness_as_check(r: RobustnessCheck) -> Check:
                  status=Status(r.status))
 
 
-def _spec_integrates(spec: _spec.Spec) -> bool:
-    from .pid import control_law
-
-    return control_law(spec).integrator
-
-
 def _scatter_words(r: RobustnessCheck) -> str:
     names = {"friction.static": "Fs", "friction.coulomb": "Fc"}
     spread = sorted(set(r.scatter.values()))
@@ -204,15 +201,15 @@ def _scatter_words(r: RobustnessCheck) -> str:
 # --------------------------------------------------------------------------- margins
 
 
-def margins(spec: _spec.Spec, crossover: CrossoverResult, stiffness: StiffnessResult,
+def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult,
             flexure: FlexureResult | None, pid: PidResult,
             simulation: Confirmation | None) -> Margins:
     """Distances to the limits, each only where it means something.
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model
+        The resolved model.
     crossover : CrossoverResult
         Step 2.
     stiffness : StiffnessResult
@@ -230,7 +227,7 @@ def margins(spec: _spec.Spec, crossover: CrossoverResult, stiffness: StiffnessRe
     """
     notes: list[str] = []
     out: dict[str, Any] = {}
-    own = _OWN[spec.has_isolator]
+    own = _OWN[model.has_isolator]
     fc = crossover.desired
 
     if crossover.achievable is None:
@@ -274,10 +271,10 @@ def margins(spec: _spec.Spec, crossover: CrossoverResult, stiffness: StiffnessRe
             out["static_error"] = max(rest) if rest else 0.0
             out["static_error_bound"] = st.static_error_bound
         land = simulation.landing
-        if spec.has_isolator and land is not None:
+        if model.has_isolator and land is not None:
             out["resting_deflection"] = land.deflection
             out["end_stop_clearance"] = land.stroke - abs(land.deflection)
-    if spec.has_isolator:
+    if model.has_isolator:
         out["stiffness_factor"] = stiffness.maximum / stiffness.chosen
         if flexure is not None and flexure.feasible:
             lo, hi = flexure.stiffness_range
@@ -333,15 +330,15 @@ def _behaviour_reason(st: Any, label: str) -> Reason:
     return Reason("FAIL", "simulation", text[0].upper() + text[1:])
 
 
-def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[str, str]],
+def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, str]],
           simulation: Confirmation | None, robustness: RobustnessCheck | None,
           margin: Margins) -> Verdict:
     """The verdict on the hardware as specified.
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model
+        The resolved model.
     checks : sequence of Check
         Every check of the four steps and the confirmation.
     warnings : sequence of (path, message)
@@ -357,9 +354,9 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
     -------
     Verdict
     """
-    own = _OWN[spec.has_isolator]
-    fc = _spec.design_crossover(spec)
-    label = ("The isolated stage as specified" if spec.has_isolator
+    own = _OWN[model.has_isolator]
+    fc = model.crossover
+    label = ("The isolated stage as specified" if model.has_isolator
              else "The stage as specified (without isolator)")
     reasons: list[Reason] = []
     behaviour = None
@@ -373,7 +370,7 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
             reasons.append(Reason("FAIL", c.name, f"{c.step}: {c.message}."))
     if robustness is not None:
         r = robustness
-        kinds = ("hunting", "stuck", "undetermined") if _spec_integrates(spec) else \
+        kinds = ("hunting", "stuck", "undetermined") if model.law.integrator else \
             ("hunting", "undetermined")
         why = ", ".join(f"{r.counts[k]} {'hunt' if k == 'hunting' else k}"
                         for k in kinds if r.counts[k])
@@ -407,7 +404,7 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
     if clearance is not None and margin.resting_deflection and clearance > 0:
         d = abs(margin.resting_deflection)
         rise = (d + clearance) / d - 1.0
-        spread = spec.requirements.robustness.coulomb
+        spread = model.requirements.robustness.coulomb
         if rise <= spread:
             reasons.append(Reason(
                 "WARN", "end_stop_clearance",

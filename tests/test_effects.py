@@ -17,7 +17,8 @@ import yaml
 
 from fi_design import effects as fx
 from fi_design.plant import PlantParameters
-from fi_design.simulation import plant_parameters, simulate
+from fi_design.model import resolve
+from fi_design.simulation import simulate
 from fi_design.spec import EFFECT_MODELS
 from fi_design.specfile import load_spec, origin
 from fi_design.units import KNOWN_UNITS
@@ -84,7 +85,7 @@ PLANT_CASES = [(n, iso) for n in fx.EFFECT_NAMES for iso in (True, False)
 @pytest.mark.parametrize("name, isolated", PLANT_CASES)
 def test_neutral_effect_leaves_the_simulation_bit_identical(paper_spec, name, isolated):
     base = simulate(paper_spec, isolated=isolated)
-    params = plant_parameters(paper_spec, isolated)
+    params = resolve(paper_spec).plant(isolated)
     neutral = entry(name, neutral_values(fx.get(name), params))
     r = simulate(paper_spec, isolated=isolated, effects=(neutral,))
     assert np.array_equal(r.position, base.position)
@@ -133,7 +134,7 @@ def test_delay_effect_adds_to_the_controller_delay(paper_spec):
     raw = copy.deepcopy(origin(paper_spec).raw)
     raw["controller"]["delay"] = "1 ms"
     spec = load_spec(raw)
-    p = plant_parameters(spec, True, effects=(entry("time_delay", {"delay": 2e-3}),))
+    p = resolve(spec).at(effects=(entry("time_delay", {"delay": 2e-3}),)).plant(True)
     assert p.delay == pytest.approx(3e-3)
 
 

@@ -16,13 +16,13 @@ from fi_design import kernel
 from fi_design.equations import jacobian
 from fi_design.plant import MODE_SIGN
 from fi_design.trajectory import from_moves
-from fi_design.simulation import plant_parameters
+from fi_design.model import resolve
 
 
 @pytest.mark.parametrize("isolated", [True, False])
 def test_structured_solve_equals_dense_solve(paper_spec, isolated):
     """Eliminating the leaf states gives the same solution as a dense solve."""
-    p = plant_parameters(paper_spec, isolated).to_array()
+    p = resolve(paper_spec).plant(isolated).to_array()
     n = 7 if isolated else 5
     rng = np.random.default_rng(1)
     modes = np.zeros(4, dtype=np.int64)

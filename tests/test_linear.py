@@ -10,6 +10,7 @@ import pytest
 from scipy.optimize import brentq
 
 from fi_design import linear
+from fi_design.model import resolve
 
 from conftest import variant
 
@@ -218,14 +219,15 @@ def test_modulus_gain_and_delay_margin_consistent(paper_spec):
 
 def test_unstable_loop_is_reported(paper_spec):
     spec = variant(paper_spec, **{"controller.delay": "10 ms"})
-    result = linear.analyse(spec, crossover=30.0)
+    at30 = resolve(spec).at(crossover=30.0)
+    result = linear.analyse(at30)
     bad = [x for x in result.cases if not x.stable]
     assert bad and not result.passed
     for case in bad:
         assert case.phase_margin_deg < 0 and case.delay_margin == 0.0
         assert "stability" in case.failed
         poles = control.feedback(
-            linear.loop_transfer_function(spec, case.name, 30.0), 1).poles()
+            linear.loop_transfer_function(at30, case.name), 1).poles()
         assert np.max(poles.real) > 0
 
 
@@ -244,8 +246,9 @@ def test_paper_achievable_crossover_and_its_boundary(paper_spec):
     assert ach.kind == "margin" and ach.case == "stuck_limited" and ach.criterion == "gain margin"
     assert "gain margin of case 4 (cart stuck, limiter engaged)" in ach.limited_by
     assert 8.0 < ach.frequency < 150.0 / 3
-    assert linear.analyse(paper_spec, ach.frequency * 0.998).passed
-    assert not linear.analyse(paper_spec, ach.frequency * 1.003).passed
+    model = resolve(paper_spec)
+    assert linear.analyse(model.at(crossover=ach.frequency * 0.998)).passed
+    assert not linear.analyse(model.at(crossover=ach.frequency * 1.003)).passed
 
 
 def test_nothing_limits_an_ideal_loop(paper_spec):

@@ -19,7 +19,8 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from fi_design import equations
-from fi_design.simulation import plant_parameters, simulate
+from fi_design.model import resolve
+from fi_design.simulation import simulate
 
 FRICTION = dict(static=st.floats(0.5, 20.0), ratio=st.floats(0.05, 1.0),
                 vs=st.floats(1e-4, 2e-2), sigma0=st.floats(1e4, 1e8),
@@ -28,10 +29,10 @@ FRICTION = dict(static=st.floats(0.5, 20.0), ratio=st.floats(0.05, 1.0),
 
 def _parameters(spec, static, ratio, vs, sigma0, sigma1, sigma2) -> np.ndarray:
     """The kernel parameters of the paper stage (rigid) with the friction drawn."""
-    friction = spec.friction.model_copy(update={
-        "static": static, "coulomb": ratio * static, "stribeck_velocity": vs,
-        "bristle_stiffness": sigma0, "bristle_damping": sigma1, "viscous": sigma2})
-    return plant_parameters(spec.model_copy(update={"friction": friction}), False).to_array()
+    friction = {**spec.friction.model_dump(), "static": static, "coulomb": ratio * static,
+                "stribeck_velocity": vs, "bristle_stiffness": sigma0, "bristle_damping": sigma1,
+                "viscous": sigma2}
+    return resolve(spec.with_sections(friction=friction)).plant(False).to_array()
 
 
 @settings(max_examples=200, deadline=None)

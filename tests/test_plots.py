@@ -47,7 +47,7 @@ def _figures(design, studies, reconciliation):
     yield "deflection", plots.deflection_figure(sim, design.spec)
     yield "moves", plots.moves_figure(sim)
     yield "cycle", plots.cycle_figure(sim, design.spec)
-    yield "boundary", plots.boundary_figure(sim, design.spec)
+    yield "boundary", plots.boundary_figure(sim)
     yield "sweep map", plots.sweep_figure(studies["map"])
     yield "sweep line", plots.sweep_figure(studies["line"])
     yield "design map", plots.design_map_figure(studies["map"])

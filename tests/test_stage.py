@@ -64,12 +64,12 @@ def test_family_spans_a_tenth_of_the_stroke_to_five_times_the_move(paper_spec):
 def test_asymmetric_friction_tries_both_directions(paper_spec):
     from conftest import variant
 
-    from fi_design.simulation import plant_parameters
+    from fi_design.model import resolve
 
     spec = variant(paper_spec, **{"friction.coulomb_negative": "1.5 N"})
-    d = family_distances(spec, True, plant_parameters(spec, True))
+    d = family_distances(spec, True, resolve(spec).plant(True))
     assert len(d) == 48 and sum(x < 0 for x in d) == 24
-    sym = family_distances(paper_spec, True, plant_parameters(paper_spec, True))
+    sym = family_distances(paper_spec, True, resolve(paper_spec).plant(True))
     assert all(x > 0 for x in sym)
 
 
@@ -161,9 +161,9 @@ def test_canudas_de_wit_1995_pid_example_hunts_with_its_published_cycle():
 def test_rest_within_the_band_is_final_only_below_static_friction(paper_spec):
     """Without isolator the bristles carry sigma0 (z + r - x1) once the loop pulls x1 to r."""
     from fi_design.plant import state_index
-    from fi_design.simulation import plant_parameters
+    from fi_design.model import resolve
 
-    p = plant_parameters(paper_spec, False)
+    p = resolve(paper_spec).plant(False)
     idx = state_index(False)
     y = np.zeros(p.n_states)
     z_limit = p.Fs / p.sigma0  # 4 um of bristle deflection holds 4 N
@@ -175,9 +175,9 @@ def test_rest_within_the_band_is_final_only_below_static_friction(paper_spec):
 
 def test_isolated_rest_is_final_while_the_flexure_force_stays_below_fs(paper_spec):
     from fi_design.plant import state_index
-    from fi_design.simulation import plant_parameters
+    from fi_design.model import resolve
 
-    p = plant_parameters(paper_spec, True)
+    p = resolve(paper_spec).plant(True)
     idx = state_index(True)
     y = np.zeros(p.n_states)
     y[idx["x2"]] = -0.28e-3  # cart stuck 0.28 mm behind: k d = 1.87 N < 4 N
@@ -188,9 +188,9 @@ def test_isolated_rest_is_final_while_the_flexure_force_stays_below_fs(paper_spe
 
 def test_orbit_is_found_from_a_rough_guess_and_falls_to_nothing_from_rest(paper_spec,
                                                                         paper_isolated):
-    from fi_design.simulation import plant_parameters
+    from fi_design.model import resolve
 
-    p = plant_parameters(paper_spec, True)
+    p = resolve(paper_spec).plant(True)
     c = paper_isolated.cycle
     rough = np.array(c.section_state) * (1 + 0.05)
     again = converge_cycle(p, 0.0, rough, 1, 8.0, period=c.period, trace=False)
@@ -225,10 +225,11 @@ def test_the_watch_lands_on_the_section_and_leaves_the_trajectory_alone(paper_sp
     """Section crossings are stepped to (x1 = r to round-off) and agree with the trace."""
     from fi_design.compiled import run
     from fi_design.plant import N_WATCH, W_ARM, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_START
-    from fi_design.simulation import plant_parameters, tolerances
+    from fi_design.model import resolve
+    from fi_design.simulation import tolerances
     from fi_design.stage import _family_reference
 
-    p = plant_parameters(paper_spec, False)
+    p = resolve(paper_spec).plant(False)
     ref, end = _family_reference(paper_spec, 0.01, 12.0)
     t_out = np.arange(0.0, end + 12.0, 1e-4)
     args = (p.to_array(), np.zeros(p.n_states), ref.breaks, ref.coeffs, True, end + 12.0, t_out,

@@ -112,9 +112,9 @@ def processing(measured: Measurement, spec=None, *, cutoff: float | None = None,
             raise DataError(f"cut-off {cutoff:g} Hz: must lie in (0, {top:g}] Hz for a record "
                             f"sampled at {fs:g} Hz", column="time_s", source=measured.source)
     elif spec is not None:
-        from ..spec import design_crossover
+        from ..model import as_model
 
-        fc = design_crossover(spec)
+        fc = as_model(spec).crossover
         cutoff = CROSSOVER_FACTOR * fc
         rule = f"{CROSSOVER_FACTOR:g} x the loop's crossover ({fc:.4g} Hz)"
     else:
@@ -204,7 +204,7 @@ def joint_model(measured: Measurement, spec) -> Joint:
             "the spec has an isolator but the record no deflection_m column: the cart's motion "
             "is not measured, so stage and cart are taken as one rigid mass (the joint's "
             "deflection neglected); stage and cart mass are not separable",))
-    from ..spec import joint_damping
+    from ..model import as_model
 
     iso = spec.isolator
     if iso.stiffness is None:
@@ -214,7 +214,7 @@ def joint_model(measured: Measurement, spec) -> Joint:
             "separated; their sum u = m1 a1 + m2 a2 + F_f(v2) + offset is used with the cart's "
             "motion x2 = x1 - d for the friction and the masses in the spec's ratio: the total "
             "mass is identified, its split between stage and cart is not",))
-    c = joint_damping(spec)
+    c = as_model(spec).joint.damping
     c_note = ("given" if iso.damping is not None else
               "the spec's default (damping ratio 0.05), not a measured value")
     return Joint("two_mass", iso.stiffness, c, ratio, (

@@ -11,6 +11,7 @@ samples (:class:`Samples`); ``to_dict()`` is the JSON of ``--json``.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, Mapping
@@ -18,6 +19,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 import numpy as np
 
 from ..measured import Measurement
+from ..model import FrictionLaw
 from ..results import dataclass_dict
 
 if TYPE_CHECKING:
@@ -401,6 +403,48 @@ class IdentificationResult:
     def value(self, name: str) -> float | None:
         """The value of parameter ``name`` [SI], or None."""
         return self.parameters[name].value
+
+    @property
+    def friction(self) -> FrictionLaw:
+        """The identified friction as the model's friction law (its form's Coulomb values).
+
+        Coulomb and viscous friction per direction as identified (the
+        symmetric form: one Coulomb value both ways, the offset apart, see
+        :meth:`friction_curve`); static friction and the Stribeck velocity
+        only where both are identified, else no Stribeck term (Fs = Fc).
+        A value not identified counts as 0.
+        """
+        p = {k: (x.value if x.value is not None else 0.0) for k, x in self.parameters.items()}
+        stribeck = (self.parameters["static"].identifiable
+                    and self.parameters["stribeck_velocity"].identifiable)
+        symmetric = self.form == "symmetric"
+        return FrictionLaw(
+            model="lugre", Fs=p["static"] if stribeck else p["coulomb"], Fc=p["coulomb"],
+            vs=p["stribeck_velocity"] if stribeck else math.nan,
+            sigma0=p["bristle_stiffness"], sigma1=0.0, sigma2=p["viscous"],
+            Fc_neg=None if symmetric else p["coulomb_negative"],
+            sigma2_neg=p["viscous_negative"])
+
+    def friction_curve(self, velocity) -> np.ndarray:
+        """The identified steady-state friction plus offset at ``velocity`` [N].
+
+        :meth:`fi_design.model.FrictionLaw.steady_state` of :attr:`friction`,
+        plus the offset in the symmetric form (where it carries the
+        difference between the two directions' Coulomb friction); at zero
+        velocity the mean of the two sides.
+
+        Parameters
+        ----------
+        velocity : array_like
+            Velocities of the bearing side [m/s].
+
+        Returns
+        -------
+        numpy.ndarray
+            Force [N], the shape of ``velocity``.
+        """
+        offset = self.parameters["offset"].value if self.form == "symmetric" else None
+        return self.friction.steady_state(velocity) + (offset or 0.0)
 
     def to_dict(self) -> dict:
         """Plain JSON data: ``parameters``, ``fit`` (DESIGN.md section 8) and the context."""

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import DataError
 from ..measured import Measurement
-from ..pid import control_law
+from ..model import as_model
 from ..replay import command_state
 from ..simulation import simulate
 from ..trajectory import from_samples
@@ -70,8 +70,9 @@ class Comparison:
 
     Parameters
     ----------
-    spec : Spec
-        The spec of the stage.
+    spec : Spec or Model
+        The spec of the stage, or its resolved model (``model``; the spec is
+        resolved once here).
     measured : Measurement
         The record.
     isolated : bool
@@ -89,7 +90,8 @@ class Comparison:
 
     def __init__(self, spec, measured: Measurement, isolated: bool, noise: NoiseLevels,
                  lattice: Lattice, settle_window: float | None, drive: str) -> None:
-        self.spec = spec
+        self.model = as_model(spec)
+        self.spec = self.model.spec
         self.meas = measured
         self.iso = isolated
         self.noise = noise
@@ -102,7 +104,7 @@ class Comparison:
             raise DataError("the trace has no duration", column="time_s", source=measured.source)
         self.has_force = measured.force is not None and drive == "closed"
         self.has_defl = measured.deflection is not None and isolated
-        self.rtol = model_tolerance(spec, noise)
+        self.rtol = model_tolerance(self.spec, noise)
         self.initial_command = command_state(measured, 0) if self.has_force else None
         self.n_sims = 0
         self.fail_level = FAIL_FACTOR
@@ -132,7 +134,7 @@ class Comparison:
         """
         self.n_sims += 1
         u0 = None if self.initial_command is None else self.initial_command + command_correction
-        res = simulate(self.spec, self.iso, effects=list(entries),
+        res = simulate(self.model, self.iso, effects=list(entries),
                        rtol=self.rtol if rtol is None else rtol,
                        record=self.meas, drive=self.drive, initial_command=u0)
         x = np.asarray(res.position, dtype=float)
@@ -171,7 +173,7 @@ class Comparison:
             return self.run(entries)
         self.n_sims += 1
         span = float(self.meas.time[-1] - self.meas.time[0])
-        res = simulate(self.spec, self.iso, effects=list(entries), rtol=self.rtol,
+        res = simulate(self.model, self.iso, effects=list(entries), rtol=self.rtol,
                        record=self.meas, drive=self.drive, window=2.0 * span + 1.0)
         x = np.asarray(res.position, dtype=float)
         u = np.asarray(res.force, dtype=float)
@@ -211,7 +213,7 @@ class Comparison:
                 merged.append([run.start, run.stop])
         self.moves = [range(i0, i1) for i0, i1 in merged if i1 - i0 >= 2]
         if settle_window is None:
-            law = control_law(self.spec)
+            law = self.model.law
             tau = law.kp / law.ki if law.ki > 0 else 1.0 / (2.0 * math.pi * law.crossover)
             settle_window = 5.0 * tau
         self.settle_window = float(settle_window)

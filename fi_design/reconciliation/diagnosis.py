@@ -25,7 +25,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..pid import control_law
 from .comparison import Comparison, ModelRun
 from ..results.reconciliation import Cause, Diagnosis
 from .significance import EXPLAINED_MIN
@@ -57,7 +56,7 @@ def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
     meas = cmp.meas.force if use_force else cmp.meas.position
     model = nominal.force if use_force else nominal.position
     r = np.where(np.isfinite(model), meas - model, 0.0)
-    crossover = control_law(cmp.spec).crossover
+    crossover = cmp.model.crossover
     spec = _spectrum(r, cmp.t)
     causes = sorted(_causes(cmp, r, crossover, use_force), key=lambda c: -c.share)
     mismatch = misfit >= STRUCTURE_MISFIT and best_explained < EXPLAINED_MIN

@@ -347,7 +347,7 @@ def noise_only_refit(cmp: Comparison, space: Space, baseline: Baseline, max_poin
         deflection = run.deflection + nz.deflection * rng.standard_normal(n)
     synthetic = measurement_from_arrays(meas.time, meas.reference, position, force, deflection,
                                         disturbance_N=meas.disturbance, source="noise-only refit")
-    null_cmp = Comparison(cmp.spec, synthetic, cmp.iso, nz, Lattice(step=None), cmp.settle_window,
+    null_cmp = Comparison(cmp.model, synthetic, cmp.iso, nz, Lattice(step=None), cmp.settle_window,
                           cmp.drive)
     # the record was made from the baseline's run: it started from the baseline's command
     if cmp.initial_command is not None:

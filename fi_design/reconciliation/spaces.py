@@ -278,9 +278,7 @@ def _space(name: str, cmp: Comparison, lattice: Lattice, params) -> Space | None
 
 
 def _crossover(cmp: Comparison) -> float:
-    from ..pid import control_law
-
-    return control_law(cmp.spec).crossover
+    return cmp.model.crossover
 
 
 def _reference(p: _effects.Parameter, params) -> float | None:

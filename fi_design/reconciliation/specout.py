@@ -45,14 +45,15 @@ def spec_with_entries(spec, entries):
     Returns
     -------
     Spec
-        The entries are validated; the rest of the spec is shared.
+        A new spec, validated again (:meth:`fi_design.spec.Spec.with_sections`);
+        the other sections are shared.
     """
     new = [make_entry(e["type"], {k: v for k, v in e.items() if k != "type"}) for e in entries]
     names = {e.type for e in new}
     kept = [e for e in spec.effects if e.type not in names]
     if "joint_damping" in names and spec.isolator is None:
         raise SimulationError("effect joint_damping needs an isolator")
-    return spec.model_copy(update={"effects": tuple(kept + new)})
+    return spec.with_sections(effects=tuple(kept + new))
 
 
 def fixed_spec_text(result) -> str:

@@ -21,7 +21,6 @@ from .. import effects as _effects
 from ..errors import DataError, SimulationError
 from ..measured import Measurement
 from ..replay import DRIVES
-from ..simulation import plant_parameters
 from .comparison import MAX_POINTS, Comparison, ModelRun
 from .diagnosis import diagnose
 from .fitting import (Baseline, FitOutcome, JointObjective, fit, fit_baseline, joint_fit,
@@ -115,7 +114,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     nominal = _nominal(cmp, list(spec.effects), max_points)
     if not nominal.run.ok:
         return _failed_nominal(cmp, nominal, started, threshold)
-    evidence = scan(cmp, nominal.run, lattice, plant_parameters(spec, iso, effects=nominal.entries))
+    evidence = scan(cmp, nominal.run, lattice, cmp.model.at(effects=nominal.entries).plant(iso))
     search = _search(cmp, evidence, args.names, nominal, max_effects, threshold, max_points, say)
     say("corrected model", 0.97)
     final = _final(cmp, search, nominal)
@@ -225,7 +224,7 @@ def _search(cmp, evidence: Evidence, names, nominal: Baseline, max_effects: int,
     n_sims = 0
     for index in range(max_effects):
         remaining = [nm for nm in names if nm not in {c.candidate.name for c in chosen}]
-        params = plant_parameters(cmp.spec, cmp.iso, effects=baseline.entries)
+        params = cmp.model.at(effects=baseline.entries).plant(cmp.iso)
         # later passes start from the signatures of the gap the earlier effects leave
         hints = evidence if index == 0 else scan(cmp, baseline.run, cmp.lattice, params)
         spaces = candidate_spaces(cmp, hints, remaining, cmp.lattice, params)

@@ -25,15 +25,14 @@ __all__ = ["design_context", "REFERENCES"]
 
 
 def _cases_table(result: Any) -> list[dict]:
-    """Rows of the margins table; a case without a crossing in the loop's band shows no
-    phase or delay margin (INFO): they are not margins to pass."""
+    """Rows of the margins table, with each case's status as the analysis judged it; a case
+    without a crossing in the loop's band (INFO) shows no phase or delay margin: they are
+    not margins to pass."""
     numbers = {c.name: c.number for c in result.loop.cases}
     rows = []
     for c in result.crossover.cases:
-        status = "PASS" if c.passed else "FAIL"
-        out_of_band = c.passed and not c.in_band
-        if out_of_band:
-            status = "INFO"
+        status = c.status.value
+        out_of_band = c.status == "INFO"
         rows.append({
             "number": numbers.get(c.name, ""), "description": c.description,
             "crossover": c.crossover, "crossovers": len(c.crossovers),
@@ -227,7 +226,7 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "Joint deflection of the isolated stage after the spec's own motion, against the "
             "stroke; beyond the dashed lines the limiter carries the cart.", fig_no()),
         "boundary": figure_entry(
-            (lambda: plots.boundary_figure(sim, spec)) if figures else None, "boundary",
+            (lambda: plots.boundary_figure(sim)) if figures else None, "boundary",
             "The stage-level boundary: the peak to peak of each plant's hunting cycle as the "
             "crossover rises, up to the cycle's fold (dotted), from which no move of the "
             "family hunts; dashed, the design crossover.", fig_no()),
@@ -468,7 +467,7 @@ def design_context(result: DesignResult, *, date: Any = None, command: str | Non
                             sha256=result.spec_sha256, version=result.fi_design_version,
                             source=result.fi_design_source),
         "verdict": verdict(result),
-        "inputs": spec_inputs(spec),
+        "inputs": spec_inputs(spec, result.model),
         "steps": guideline_steps(result, figures),
         "linear": _linear(result, figures, fig_no),
         "nonlinear": _nonlinear(result, figures, fig_no),

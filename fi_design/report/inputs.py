@@ -10,16 +10,15 @@ from .meta import spec_file
 __all__ = ["spec_inputs"]
 
 
-#: Derived defaults: path -> (rule in words, function of the spec).
-def _derived_rules() -> dict[str, tuple[str, Callable[[Any], float]]]:
-    from .. import spec as s
-
-    return {
-        "friction.bristle_damping": ("sqrt(sigma0 (m1 + m2))", s.bristle_damping),
-        "isolator.stiffness": ("k_max / 2 (step 3)", s.drive_stiffness),
-        "isolator.damping": ("2 \u00b7 0.05 \u00b7 sqrt(k m1 m2 / (m1 + m2))", s.joint_damping),
-        "isolator.limiter.damping": ("2 \u00b7 0.2 \u00b7 sqrt(k_stop m1)", s.limiter_damping),
-    }
+#: Derived defaults: path -> (rule in words, its value in the resolved model).
+_DERIVED: dict[str, tuple[str, Callable[[Any], float]]] = {
+    "friction.bristle_damping": ("sqrt(sigma0 (m1 + m2))", lambda m: m.friction.sigma1),
+    "isolator.stiffness": ("k_max / 2 (step 3)", lambda m: m.joint.stiffness),
+    "isolator.damping": ("2 \u00b7 0.05 \u00b7 sqrt(k m1 m2 / (m1 + m2))",
+                         lambda m: m.joint.damping),
+    "isolator.limiter.damping": ("2 \u00b7 0.2 \u00b7 sqrt(k_stop m1)",
+                                 lambda m: m.limiter.damping),
+}
 
 
 _MISSING = object()
@@ -52,13 +51,15 @@ def _first_sentence(text: str) -> str:
     return text.rstrip(".")
 
 
-def spec_inputs(spec: Any) -> list[dict]:
+def spec_inputs(spec: Any, model: Any) -> list[dict]:
     """Every value of a spec, grouped by section, with unit and whether it was given.
 
     Parameters
     ----------
     spec : fi_design.spec.Spec
         The spec (its origin tells given values from defaults).
+    model : fi_design.model.Model
+        The spec resolved: the values of the derived defaults.
 
     Returns
     -------
@@ -74,7 +75,7 @@ def spec_inputs(spec: Any) -> list[dict]:
 
     src = spec_file(spec)
     raw = src["raw"] if src["raw"] is not None else {}
-    rules = _derived_rules()
+    rules = _DERIVED
     groups: list[dict] = []
 
     def leaf(path: str, value: Any, written: Any, info: Any, parent: Any) -> dict:
@@ -91,9 +92,9 @@ def spec_inputs(spec: Any) -> list[dict]:
             rule = rules.get(generic)
             if rule is not None:
                 try:
-                    row["value"] = float(rule[1](spec))
+                    row["value"] = float(rule[1](model))
                     row["source"] = f"derived default: {rule[0]}"
-                except (ValueError, AttributeError):
+                except AttributeError:  # no joint or limiter: a stage without isolator
                     row["source"] = "not given"
             elif generic.startswith("report.document_ids."):
                 kind = generic.rsplit(".", 1)[1]

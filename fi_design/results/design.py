@@ -14,13 +14,13 @@ import numpy as np
 
 from ..provenance import Source, current_source
 from . import Check, Result, Status, to_jsonable
+from .controller import ControlLaw, PidGains
+from .linear import CaseMargins
 from .simulation import HuntingMetrics, SimulationResult
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ..model import Model
     from ..spec import Spec
-
-# Values from the analyses below (fi_design.linear's CaseMargins, fi_design.pid's PidGains and
-# ControlLaw) are typed Any here: the results layer imports no analysis, not even for a type.
 
 __all__ = ["FrictionGapResult", "ModeSeparation", "CrossoverResult", "StiffnessResult",
            "FlexureResult", "PidResult", "CaseResponse", "LoopResponses", "IsolatorAdvice",
@@ -96,7 +96,7 @@ class CrossoverResult(Result):
         What limits the achievable crossover, in words.
     limit_kind : str
         ``margin``, ``mode``, ``scan_limit`` or ``infeasible``
-        (see :class:`fi_design.linear.AchievableCrossover`).
+        (see :class:`fi_design.results.linear.AchievableCrossover`).
     limiting_case : str or None
         Case name when a margin limits.
     feasible_ranges : tuple of tuple of float
@@ -106,8 +106,9 @@ class CrossoverResult(Result):
         sample period).
     stiffness : float or None
         Joint stiffness the cases use [N/m]; None without isolator.
-    cases : tuple of fi_design.linear.CaseMargins
-        Margins of each limit case with the PID tuned at the desired crossover.
+    cases : tuple of fi_design.results.linear.CaseMargins
+        Margins of each limit case with the PID tuned at the desired
+        crossover, each judged (its ``status`` and ``criteria``).
     parasitic_modes : tuple of ModeSeparation
         Each parasitic mode against ``parasitic_separation`` x desired crossover.
     checks : tuple of Check
@@ -122,7 +123,7 @@ class CrossoverResult(Result):
     feasible_ranges: tuple[tuple[float, float], ...]
     delay: float
     stiffness: float | None
-    cases: tuple[Any, ...]
+    cases: tuple[CaseMargins, ...]
     parasitic_modes: tuple[ModeSeparation, ...]
     checks: tuple[Check, ...] = field(default=(), repr=False)
 
@@ -247,7 +248,7 @@ class PidResult(Result):
 
     Attributes
     ----------
-    gains : fi_design.pid.PidGains
+    gains : fi_design.results.controller.PidGains
         The rule's gains at the loop's crossover (JSON: flattened into the
         ``pid`` object); with explicit hardware gains, the recommendation.
     tuning_rule : str
@@ -256,7 +257,7 @@ class PidResult(Result):
         wd = wc / ratio, wt = ratio x wc [-].
     integrator_ratio : float
         wi = wc / ratio [-].
-    controller : fi_design.pid.ControlLaw
+    controller : fi_design.results.controller.ControlLaw
         The loop's controller: the rule's, or the hardware's own gains
         (``source``), as the analysis and the simulation use it.
     static_error : float or None
@@ -266,11 +267,11 @@ class PidResult(Result):
         The step's checks.
     """
 
-    gains: Any
+    gains: PidGains
     tuning_rule: str
     derivative_ratio: float
     integrator_ratio: float
-    controller: Any
+    controller: ControlLaw
     static_error: float | None
     checks: tuple[Check, ...] = field(default=(), repr=False)
 
@@ -825,6 +826,9 @@ class DesignResult(Result):
     recommendation : Recommendation or None
         What would make the stage pass (a suggested isolator, a higher
         crossover); None when there is nothing to add.
+    model : fi_design.model.Model or None
+        The resolved model every step read (not in JSON); ``spec`` is the
+        spec it was resolved from.
     """
 
     spec: Spec = field(repr=False)
@@ -846,6 +850,7 @@ class DesignResult(Result):
     margins: Margins | None = None
     recommendation: Recommendation | None = None
     fi_design_source: Source = field(default_factory=current_source)
+    model: "Model | None" = field(default=None, repr=False)
 
     @property
     def passed(self) -> bool:

@@ -558,13 +558,13 @@ class ReconcileResult(Result):
         return {g.name: g.after for g in self.gaps}
 
     def corrected_spec(self):
-        """The spec with the chosen effects in its ``effects`` list (a new Spec).
+        """The spec with the chosen effects in its ``effects`` list (a new Spec, validated).
 
         An entry of a type the spec already lists replaces it.
         """
         names = {e.type for e in self.effect_entries}
         kept = [e for e in self.spec.effects if e.type not in names]
-        return self.spec.model_copy(update={"effects": tuple(kept + list(self.effect_entries))})
+        return self.spec.with_sections(effects=tuple(kept + list(self.effect_entries)))
 
     def to_dict(self) -> dict:
         """Plain JSON data: the contract keys first, then the details (SI)."""

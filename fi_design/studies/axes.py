@@ -131,11 +131,12 @@ def is_number(word: str) -> bool:
     return True
 
 
+#: Spec paths whose default depends on other values: their value in the resolved model.
 _DERIVED = {
-    "isolator.stiffness": lambda s: _spec.drive_stiffness(s),
-    "isolator.damping": lambda s: _spec.joint_damping(s),
-    "friction.bristle_damping": lambda s: _spec.bristle_damping(s),
-    "isolator.limiter.damping": lambda s: _spec.limiter_damping(s),
+    "isolator.stiffness": lambda m: m.joint.stiffness,
+    "isolator.damping": lambda m: m.joint.damping,
+    "friction.bristle_damping": lambda m: m.friction.sigma1,
+    "isolator.limiter.damping": lambda m: m.limiter.damping,
 }
 
 
@@ -160,10 +161,12 @@ def design_value(spec: _spec.Spec, path: str) -> float | None:
     except SpecError:
         return None
     if value is None and path in _DERIVED:
-        try:
-            value = _DERIVED[path](spec)
-        except ValueError:
+        from ..model import resolve
+
+        model = resolve(spec)
+        if model.joint is None and path.startswith("isolator."):
             return None
+        value = _DERIVED[path](model)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return None
     return float(value)

@@ -147,13 +147,14 @@ def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
     DesignMap
     """
     from ..confirm import with_isolator
+    from ..model import resolve
 
     spec = result.spec
     suggested = spec.isolator is None
     if suggested:
         adv = result.isolator_advice
         spec = with_isolator(spec, adv.stroke, adv.stiffness)
-    fc = _spec.design_crossover(spec)
+    fc = (result.model if result.model is not None else resolve(spec)).crossover
     s = spec.isolator.stroke
     nx, ny = resolution
     x = make_axis("controller.crossover", np.linspace(0.125 * fc, 2.5 * fc, nx), spec=spec)

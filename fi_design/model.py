@@ -1,0 +1,511 @@
+"""The spec resolved once: the model every analysis reads.
+
+A :class:`~fi_design.spec.Spec` mirrors the YAML file; several of its values
+are left to defaults that depend on other values (the bristle, joint and
+limiter damping, the drive stiffness step 3 proposes) or are derived from it
+(the loop's controller, the crossover of the hardware's gains). :func:`resolve`
+works all of them out once and returns a :class:`Model`: a frozen value with
+every number the linear analysis, the simulation, the confirmation, the
+verdict and the studies need, in SI. Like pvlib's ``ModelChain``, the choices
+are made once and every step runs on the resolved model.
+
+A study or a search varies the model with :meth:`Model.at`, which returns a
+new, checked model (another crossover, stiffness, stroke, joint damping,
+friction model or effects list), never by rebuilding it from the spec.
+:meth:`Model.plant` gives the kernel's parameters of one plant.
+
+The public entry points (:func:`fi_design.design`, :func:`fi_design.simulate`,
+the studies) take a spec and resolve it at the top; they take a model as well
+(:func:`as_model`).
+
+Units: masses kg, stiffnesses N/m, dampings N s/m, forces N, velocities m/s,
+lengths m, the crossover Hz.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+import numpy as np
+
+from . import effects as _effects
+from . import spec as _spec
+from .errors import ArgumentError, SimulationError, SpecError
+from .pid import at_crossover, control_law
+from .plant import PlantParameters
+from .results.controller import ControlLaw
+
+__all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "apply_effects"]
+
+#: Friction models of the spec (``friction.model``).
+FRICTION_MODELS = ("lugre", "switch")
+
+
+# --------------------------------------------------------------------------- parts
+
+
+@dataclass(frozen=True)
+class FrictionLaw:
+    """The bearing's friction, resolved: LuGre parameters per sliding direction.
+
+    The negative direction's Coulomb friction and viscous coefficient are
+    None where the spec gives none: they then follow the positive
+    direction's (the kernel's convention, so that an effect that changes
+    ``Fc`` or ``sigma2`` changes both directions). :meth:`coulomb`,
+    :meth:`static` and :meth:`viscous` give the value of either direction.
+
+    Attributes
+    ----------
+    model : str
+        ``"lugre"`` or ``"switch"`` (Karnopp-type cross-check).
+    Fs : float
+        Static friction sliding in the positive direction [N].
+    Fc : float
+        Coulomb friction in the positive direction [N].
+    vs : float
+        Stribeck velocity [m/s]; it does not enter where ``Fs == Fc`` (no
+        Stribeck term).
+    sigma0 : float
+        Bristle stiffness [N/m].
+    sigma1 : float
+        Bristle damping [N s/m] (the spec's default filled in).
+    sigma2 : float
+        Viscous friction coefficient in the positive direction [N s/m].
+    Fc_neg : float or None
+        Coulomb friction sliding in the negative direction [N]; None: ``Fc``.
+        Static friction that way scales with it: ``Fs Fc_neg / Fc``.
+    sigma2_neg : float or None
+        Viscous coefficient in the negative direction [N s/m]; None: ``sigma2``.
+    """
+
+    model: str
+    Fs: float
+    Fc: float
+    vs: float
+    sigma0: float
+    sigma1: float
+    sigma2: float
+    Fc_neg: float | None = None
+    sigma2_neg: float | None = None
+
+    def coulomb(self, direction: float) -> float:
+        """Coulomb friction [N] sliding in ``direction`` (> 0 positive, < 0 negative)."""
+        return self.Fc if direction > 0 or self.Fc_neg is None else self.Fc_neg
+
+    def static(self, direction: float) -> float:
+        """Static friction [N] in ``direction``: ``Fs``, scaled by the Coulomb ratio for < 0."""
+        return self.Fs if direction > 0 or self.Fc_neg is None else self.Fs * self.Fc_neg / self.Fc
+
+    def viscous(self, direction: float) -> float:
+        """Viscous coefficient [N s/m] in ``direction``."""
+        return self.sigma2 if direction > 0 or self.sigma2_neg is None else self.sigma2_neg
+
+    @property
+    def symmetric(self) -> bool:
+        """Whether both directions have the same friction."""
+        return self.coulomb(-1) == self.Fc and self.viscous(-1) == self.sigma2
+
+    def steady_state(self, velocity) -> np.ndarray:
+        """The steady-state friction force at a constant sliding velocity [N].
+
+        ``sign(v) g(v) + sigma2 v`` with ``g(v) = Fc + (Fs - Fc) exp(-(v/vs)^2)``,
+        each term with the values of the sliding direction (the Stribeck
+        curve of LuGre and of the switch model alike). At ``v = 0`` the force
+        is not determined by the velocity (the bristles carry anything up to
+        the breakaway force): the mean of the two one-sided limits,
+        ``(Fs - Fs_neg) / 2``, 0 for symmetric friction.
+
+        Parameters
+        ----------
+        velocity : float or array_like
+            Sliding velocity of the cart v [m/s].
+
+        Returns
+        -------
+        numpy.ndarray
+            Friction force [N] acting against the motion, the shape of
+            ``velocity``.
+        """
+        v = np.asarray(velocity, dtype=float)
+        sides = []
+        for d in (1.0, -1.0):
+            side = d * self.coulomb(d) + self.viscous(d) * v
+            if self.Fs != self.Fc:  # a Stribeck term (vs does not enter without one)
+                gap = self.static(d) - self.coulomb(d)
+                side = side + d * gap * np.exp(-(v / self.vs) ** 2)
+            sides.append(side)
+        pos, neg = sides
+        return np.where(v > 0, pos, np.where(v < 0, neg, 0.5 * (pos + neg)))
+
+
+@dataclass(frozen=True)
+class Joint:
+    """The isolator's joint: drive stiffness, damping and stroke.
+
+    Attributes
+    ----------
+    stiffness : float
+        Drive stiffness k [N/m]: the spec's, else the one step 3 proposes.
+    damping : float
+        Joint damping c [N s/m]: the spec's, else damping ratio
+        :data:`fi_design.spec.JOINT_DAMPING_RATIO` of the joint mode.
+    stroke : float
+        One-sided stroke s before the limiter engages [m].
+    stiffness_given : bool
+        Whether the spec gives the stiffness; if not it is the proposed
+        k_max / 2 and follows the stroke (:meth:`Model.at`).
+    damping_given : bool
+        Whether the spec gives the damping; if not it keeps the joint mode's
+        damping ratio when the stiffness changes.
+    """
+
+    stiffness: float
+    damping: float
+    stroke: float
+    stiffness_given: bool = True
+    damping_given: bool = True
+
+
+@dataclass(frozen=True)
+class Limiter:
+    """The stroke limiter (end stop) of the joint.
+
+    Attributes
+    ----------
+    stiffness : float
+        Contact stiffness k_stop [N/m].
+    damping : float
+        Contact damping c_stop [N s/m] (the spec's default filled in).
+    """
+
+    stiffness: float
+    damping: float
+
+
+# --------------------------------------------------------------------------- the model
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """A spec resolved into the numbers every analysis reads (SI).
+
+    Build it with :func:`resolve`; vary it with :meth:`at`. The physical
+    values live here, and only here: read them from the model, not from
+    ``spec``, which may differ after :meth:`at`.
+
+    Attributes
+    ----------
+    spec : fi_design.spec.Spec
+        The spec it was resolved from: its name, motion, requirements and
+        simulation settings hold for the model; its physical values may
+        differ after :meth:`at`.
+    m1 : float
+        Stage mass [kg] (actuator side, carries the sensor).
+    m2 : float
+        Cart mass [kg] (bearing side, friction acts on it).
+    friction : FrictionLaw
+        The bearing's friction.
+    offset : float
+        Constant load force on the stage [N] (m1 a1 = u - offset - ...).
+    joint : Joint or None
+        The isolator's joint; None for a stage without isolator.
+    limiter : Limiter or None
+        The isolator's end stop; None without isolator.
+    modes : tuple of fi_design.spec.ParasiticMode
+        Parasitic flexure modes (empty without isolator).
+    law : fi_design.results.controller.ControlLaw
+        The loop's controller: the rule's PID at the crossover or the
+        hardware's gains, with sampling, delay, saturation and feedforward.
+    effects : tuple
+        Effect entries of the model (the spec's ``effects`` items), applied
+        in order by :meth:`plant`.
+    changed : tuple of str
+        The spec paths whose values :meth:`at` changed, in order (empty: the
+        spec as resolved). A study that varies the spec does not see them.
+    """
+
+    spec: _spec.Spec
+    m1: float
+    m2: float
+    friction: FrictionLaw
+    offset: float
+    joint: Joint | None
+    limiter: Limiter | None
+    modes: tuple[_spec.ParasiticMode, ...]
+    law: ControlLaw
+    effects: tuple = ()
+    changed: tuple[str, ...] = ()
+
+    # ---- views
+
+    @property
+    def total_mass(self) -> float:
+        """m1 + m2 [kg]."""
+        return self.m1 + self.m2
+
+    @property
+    def has_isolator(self) -> bool:
+        """Whether the model has the isolator's joint."""
+        return self.joint is not None
+
+    @property
+    def crossover(self) -> float:
+        """The loop's (design) crossover [Hz]: the rule's fc, or the gains' own."""
+        return self.law.crossover
+
+    @property
+    def sample_period(self) -> float:
+        """Controller period [s]; 0 for continuous time."""
+        return self.law.sample_period
+
+    @property
+    def delay(self) -> float:
+        """Computational delay of the controller [s]."""
+        return self.law.delay
+
+    @property
+    def requirements(self) -> _spec.Requirements:
+        """The spec's ``requirements`` (margins, hunting metric, robustness)."""
+        return self.spec.requirements
+
+    # ---- variants
+
+    def at(self, *, crossover: float | None = None, stiffness: float | None = None,
+           stroke: float | None = None, damping: float | None = None,
+           friction_model: str | None = None, effects=None) -> "Model":
+        """The same model with some values changed, checked like the spec checks them.
+
+        Parameters
+        ----------
+        crossover : float, optional
+            Shift the loop to this crossover [Hz]: the rule retunes, explicit
+            gains scale in frequency (:func:`fi_design.pid.at_crossover`).
+        stiffness : float, optional
+            Drive stiffness k [N/m]. A damping the spec does not give keeps
+            the joint mode's damping ratio.
+        stroke : float, optional
+            One-sided stroke [m]. A stiffness the spec does not give is the
+            proposed one of the new stroke (k_max / 2). On a model without
+            isolator, ``stroke`` (and ``stiffness``, else the proposed one)
+            adds an isolator with the spec's default damping and limiter.
+        damping : float, optional
+            Joint damping c [N s/m].
+        friction_model : {"lugre", "switch"}, optional
+            The friction model.
+        effects : sequence of effect entries, optional
+            Effect entries (spec ``effects`` items) replacing the model's,
+            applied in order: an entry of a type listed before sets its
+            values again (or, for an additive parameter, adds to them), as
+            the reconciliation stacks a candidate on the spec's effects.
+
+        Returns
+        -------
+        Model
+            A new model; this one is unchanged.
+
+        Raises
+        ------
+        SpecError
+            A value the spec would refuse (not positive, not finite, an
+            unknown friction model, an entry that is not an effect entry,
+            ``joint_damping`` without isolator), or an isolator value for a
+            model without isolator and without ``stroke``; the message names
+            the spec path.
+        """
+        model = self
+        if stiffness is not None or stroke is not None or damping is not None:
+            model = self._with_joint(stiffness, stroke, damping)
+        paths = [path for path, value in (
+            ("controller.crossover", crossover), ("isolator.stiffness", stiffness),
+            ("isolator.stroke", stroke), ("isolator.damping", damping),
+            ("friction.model", friction_model), ("effects", effects)) if value is not None]
+        law, friction = model.law, model.friction
+        if crossover is not None:
+            law = at_crossover(law, _positive(crossover, "controller.crossover", "Hz"))
+        if friction_model is not None:
+            if friction_model not in FRICTION_MODELS:
+                raise SpecError(f"must be one of {', '.join(FRICTION_MODELS)}, got "
+                                f"{friction_model!r}", path="friction.model")
+            friction = replace(friction, model=friction_model)
+        entries = model.effects if effects is None else _checked_effects(effects, model.joint)
+        changed = self.changed + tuple(p for p in paths if p not in self.changed)
+        return replace(model, law=law, friction=friction, effects=entries, changed=changed)
+
+    def _with_joint(self, stiffness, stroke, damping) -> "Model":
+        """The model with the joint's values changed (an isolator added when it has none)."""
+        j = self.joint
+        if j is None and stroke is None:
+            raise SpecError("the model has no isolator: give its stroke to add one",
+                            path="isolator.stroke")
+        s = j.stroke if stroke is None else _positive(stroke, "isolator.stroke", "m")
+        given_k = stiffness is not None or (j is not None and j.stiffness_given)
+        if stiffness is not None:
+            k = _positive(stiffness, "isolator.stiffness", "N/m")
+        elif given_k:
+            k = j.stiffness
+        else:
+            k = _spec.proposed_stiffness(self.spec, s)
+        given_c = damping is not None or (j is not None and j.damping_given)
+        if damping is not None:
+            c = _finite(damping, "isolator.damping", "N s/m")
+            if c < 0.0:
+                raise SpecError(f"must be at least 0 N s/m, got {damping!r}",
+                                path="isolator.damping")
+        elif given_c:
+            c = j.damping
+        else:
+            c = _spec.default_joint_damping(k, self.m1, self.m2)
+        joint = Joint(stiffness=k, damping=c, stroke=s, stiffness_given=given_k,
+                      damping_given=given_c)
+        if j is not None:
+            return replace(self, joint=joint)
+        lim = _spec.Limiter()  # the spec's defaults: no modes, the default end stop
+        return replace(self, joint=joint, modes=(),
+                       limiter=Limiter(lim.stiffness,
+                                       _spec.default_limiter_damping(lim.stiffness, self.m1)))
+
+    # ---- the kernel's parameters
+
+    def plant(self, isolated: bool) -> PlantParameters:
+        """The kernel's parameters of one plant, the model's effects applied.
+
+        Parameters
+        ----------
+        isolated : bool
+            The two-mass plant with joint and limiter (True) or one rigid
+            mass m1 + m2 (False).
+
+        Returns
+        -------
+        fi_design.plant.PlantParameters
+            The controller from the nominal masses; the effects then change
+            the true plant (a mass error does not retune the controller).
+
+        Raises
+        ------
+        SimulationError
+            ``isolated`` for a model without isolator.
+        """
+        if isolated and self.joint is None:
+            raise SimulationError("the spec has no isolator: cannot simulate the isolated plant")
+        law, f = self.law, self.friction
+        if isolated:
+            j, lim = self.joint, self.limiter
+            joint = dict(k=j.stiffness, c=j.damping, s=j.stroke, k_stop=lim.stiffness,
+                         c_stop=lim.damping)
+        else:
+            joint = dict(k=0.0, c=0.0, s=0.0, k_stop=0.0, c_stop=0.0)
+        params = PlantParameters(
+            m1=self.m1, m2=self.m2, **joint, Fs=f.Fs, Fc=f.Fc, vs=f.vs, sigma0=f.sigma0,
+            sigma1=f.sigma1, sigma2=f.sigma2, **law.kernel_form(),
+            Fc_neg=math.nan if f.Fc_neg is None else f.Fc_neg,
+            sigma2_neg=math.nan if f.sigma2_neg is None else f.sigma2_neg,
+            offset=self.offset, ff_mass=law.ff_mass, ff_viscous=law.ff_viscous,
+            ff_coulomb=law.ff_coulomb, delay=law.delay, force_limit=law.force_limit,
+            isolated=1.0 if isolated else 0.0, switch_model=1.0 if f.model == "switch" else 0.0)
+        if law.sample_period > 0.0:
+            params = replace(params, sample_period=law.sample_period, **law.discrete_form())
+        return apply_effects(params, self.effects)
+
+
+# --------------------------------------------------------------------------- resolving
+
+
+def resolve(spec: _spec.Spec) -> Model:
+    """Resolve a spec into its :class:`Model`, every default and derived value worked out once.
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        A validated spec.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    ArgumentError
+        ``spec`` is not a :class:`~fi_design.spec.Spec`.
+
+    Examples
+    --------
+    >>> from fi_design.specfile import load_spec
+    >>> model = resolve(load_spec("examples/paper_setup.yaml"))
+    >>> model.crossover, model.joint.stiffness, round(model.joint.damping, 2)
+    (8.0, 6667.0, 4.62)
+    >>> round(model.at(crossover=10.0).law.kp, 1)
+    3333.7
+    """
+    if not isinstance(spec, _spec.Spec):
+        raise ArgumentError(f"expected a Spec (or a Model), got {type(spec).__name__}")
+    f = spec.friction
+    friction = FrictionLaw(model=f.model, Fs=f.static, Fc=f.coulomb, vs=f.stribeck_velocity,
+                           sigma0=f.bristle_stiffness, sigma1=_spec.bristle_damping(spec),
+                           sigma2=f.viscous, Fc_neg=f.coulomb_negative,
+                           sigma2_neg=f.viscous_negative)
+    iso = spec.isolator
+    joint = limiter = None
+    modes: tuple = ()
+    if iso is not None:
+        k = _spec.drive_stiffness(spec)
+        joint = Joint(stiffness=k, damping=_spec.joint_damping(spec, k), stroke=iso.stroke,
+                      stiffness_given=iso.stiffness is not None,
+                      damping_given=iso.damping is not None)
+        limiter = Limiter(stiffness=iso.limiter.stiffness, damping=_spec.limiter_damping(spec))
+        modes = tuple(iso.parasitic_modes)
+    return Model(spec=spec, m1=spec.stage.mass, m2=spec.cart.mass, friction=friction,
+                 offset=f.offset, joint=joint, limiter=limiter, modes=modes,
+                 law=control_law(spec), effects=tuple(spec.effects))
+
+
+def as_model(spec_or_model) -> Model:
+    """A model as given, or the spec resolved (:func:`resolve`)."""
+    return spec_or_model if isinstance(spec_or_model, Model) else resolve(spec_or_model)
+
+
+def apply_effects(params: PlantParameters, entries) -> PlantParameters:
+    """Set the kernel parameters of effect entries (neutral values change nothing)."""
+    changes: dict[str, float] = {}
+    for entry in entries:
+        eff = _effects.get(entry.type)
+        for par in eff.parameters:
+            value = getattr(entry, par.name)
+            if value is None:
+                continue
+            if par.combine == "add":
+                value = getattr(params, par.kernel_field) + value
+            changes[par.kernel_field] = float(value)
+    return replace(params, **changes) if changes else params
+
+
+# --------------------------------------------------------------------------- checks
+
+
+def _finite(value, path: str, unit: str) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise SpecError(f"expected a number [{unit}], got {value!r}", path=path) from None
+    if not math.isfinite(x):
+        raise SpecError(f"must be a finite number [{unit}], got {value!r}", path=path)
+    return x
+
+
+def _positive(value, path: str, unit: str) -> float:
+    x = _finite(value, path, unit)
+    if not x > 0.0:
+        raise SpecError(f"must be greater than 0 {unit}, got {value!r}", path=path)
+    return x
+
+
+def _checked_effects(entries, joint: Joint | None) -> tuple:
+    out = tuple(entries)
+    known = tuple(_spec.EFFECT_MODELS.values())
+    for i, e in enumerate(out):
+        if not isinstance(e, known):
+            raise SpecError(f"expected a validated effect entry, got {type(e).__name__}",
+                            path=f"effects[{i}]")
+    if any(e.type == "joint_damping" for e in out) and joint is None:
+        raise SpecError("effect joint_damping needs an isolator", path="effects")
+    return out

@@ -1,0 +1,227 @@
+"""The loop's controller as values: the rule's PID gains and the control law.
+
+Produced by :func:`fi_design.pid.pid_gains` (the tuning rule, guideline step 4)
+and by :func:`fi_design.model.resolve` (the loop's controller of a spec,
+through :func:`fi_design.pid.control_law`). The linear analysis, the kernel's
+parameters, the replay and the report all read these values; the arithmetic
+here only restates a law in another form (parallel, filtered, kernel,
+discrete), it never retunes one (that is :func:`fi_design.pid.at_crossover`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from . import dataclass_dict
+
+__all__ = ["PidGains", "ControlLaw"]
+
+
+@dataclass(frozen=True)
+class PidGains:
+    """PID gains of the rule, in both series and parallel form.
+
+    Attributes
+    ----------
+    crossover : float
+        Crossover frequency fc the gains are tuned for [Hz].
+    wc : float
+        Crossover angular frequency 2 pi fc [rad/s].
+    tuning_mass : float
+        Mass the gains are tuned on [kg] (m1 + m2 or m1).
+    ks : float
+        Series-form gain [N/m]: ``m wc^2 / derivative_ratio``.
+    wi : float
+        Integrator corner [rad/s]: ``wc / integrator_ratio``.
+    wd : float
+        Lead (differentiator) corner [rad/s]: ``wc / derivative_ratio``.
+    wt : float
+        Roll-off (tamed differentiator) corner [rad/s]: ``derivative_ratio wc``.
+    kp : float
+        Parallel proportional gain [N/m]: ``ks (1 + wi/wd)``.
+    ki : float
+        Parallel integral gain [N/(m s)]: ``ks wi``.
+    kd : float
+        Parallel derivative gain [N s/m]: ``ks / wd``.
+    """
+
+    crossover: float
+    wc: float
+    tuning_mass: float
+    ks: float
+    wi: float
+    wd: float
+    wt: float
+    kp: float
+    ki: float
+    kd: float
+
+    def to_dict(self) -> dict:
+        """Plain JSON data (SI floats)."""
+        return dataclass_dict(self)
+
+    def series(self, s: complex) -> complex:
+        """C(s) in series form, for a complex Laplace variable ``s`` [rad/s].
+
+        Returns the controller's complex gain [N/m]; numpy arrays work too.
+        """
+        return self.ks * (1 + self.wi / s) * (1 + s / self.wd) / (1 + s / self.wt)
+
+    def filtered_d(self) -> dict[str, float]:
+        """The same C(s) as ``kp + ki/s + kd s / (1 + s/wt)`` (a filtered D term).
+
+        ``(kp + ki/s + kd s) / (1 + s/wt)`` expands to this form with
+        ``kp' = kp - ki/wt`` and ``kd' = kd - kp'/wt`` (expand both over
+        s (1 + s/wt)). Returns ``kp`` [N/m], ``ki`` [N/(m s)], ``kd`` [N s/m]
+        and the roll-off ``roll_off`` = wt [rad/s].
+        """
+        kp = self.kp - self.ki / self.wt
+        return dict(kp=kp, ki=self.ki, kd=self.kd - kp / self.wt, roll_off=self.wt)
+
+
+@dataclass(frozen=True)
+class ControlLaw:
+    """The controller of the loop: one description for the linear analysis, the kernel and the report.
+
+    A parallel PID with a first-order low-pass on the D term, acting on the
+    error e = r - x (x the measured position)::
+
+        u = kp e + ki integral(e) + kd s / (1 + s / roll_off) d + feedforward
+
+    where ``d`` is e (``derivative_on == "error"``) or -x (``"measurement"``:
+    velocity feedback). The paper's rule is one such controller: its
+    C(s) = (kp + ki/s + kd s) / (1 + s/wt) of :class:`PidGains` is exactly
+    ``kp' + ki/s + kd' s / (1 + s/wt)`` (:meth:`PidGains.filtered_d`). Sampled
+    with a zero-order hold when ``sample_period`` > 0 (integrator by the
+    trapezoidal rule, the D term by the Tustin rule, or the backward
+    difference for an ideal D); the command reaches the stage ``delay``
+    later, saturated at ``force_limit``.
+
+    Attributes
+    ----------
+    source : str
+        ``"rule"`` (tuned from the crossover) or ``"gains"`` (the hardware's).
+    crossover : float
+        The loop's crossover [Hz]: the rule's fc, or where the gains cross a
+        free tuning mass over (|C(j w)| = m w^2).
+    kp : float
+        Proportional gain [N/m].
+    ki : float
+        Integral gain [N/(m s)]; 0 for a PD loop.
+    kd : float
+        Derivative gain [N s/m].
+    roll_off : float
+        Corner of the D term's low-pass [rad/s]; ``inf`` for an ideal D.
+    derivative_on : str
+        ``"error"`` or ``"measurement"``.
+    sample_period : float
+        Controller period [s]; 0 for continuous time.
+    delay : float
+        Computational delay [s].
+    force_limit : float
+        Actuator saturation [N]; ``inf`` for none.
+    ff_mass, ff_viscous, ff_coulomb : float
+        Feedforward mass [kg], viscous [N s/m] and Coulomb [N] terms.
+    tuning_mass : float
+        Mass the rule tunes on, and the crossover refers to [kg].
+    derivative_ratio, integrator_ratio : float
+        The rule's ratios (``controller`` section) [-].
+    rule : PidGains
+        The rule's gains at ``crossover`` (the recommendation beside explicit
+        gains; not in the JSON).
+    roll_off_given : bool
+        Whether the spec gives the roll-off (``controller.roll_off``): the
+        rule's law keeps a given roll-off where it is when the crossover
+        shifts, and moves the default (its wt) with the crossover (not in the
+        JSON).
+    """
+
+    source: str
+    crossover: float
+    kp: float
+    ki: float
+    kd: float
+    roll_off: float
+    derivative_on: str
+    sample_period: float
+    delay: float
+    force_limit: float
+    ff_mass: float
+    ff_viscous: float
+    ff_coulomb: float
+    tuning_mass: float
+    derivative_ratio: float
+    integrator_ratio: float
+    rule: PidGains = field(repr=False)
+    roll_off_given: bool = field(default=False, repr=False)
+
+    @property
+    def integrator(self) -> bool:
+        """Whether the loop integrates (ki > 0); a PD loop cannot hunt by the paper's mechanism."""
+        return self.ki > 0.0
+
+    @property
+    def is_rule(self) -> bool:
+        """The rule's own controller, unaltered (D on the error, roll-off at its wt)."""
+        return (self.source == "rule" and self.derivative_on == "error"
+                and self.roll_off == self.rule.wt)
+
+    def kernel_form(self) -> dict[str, float]:
+        """Gains of the kernel's continuous law v = kp e + I + kd e' - kdm x', u' = wt (v - u).
+
+        Returns ``kp`` [N/m], ``ki`` [N/(m s)], ``kd`` and ``kdm`` [N s/m],
+        ``wt`` [rad/s] of :mod:`fi_design.plant`: the D term's low-pass moved
+        onto the whole output (kp + ki/wf on e, kp/wf + kd on e' or kd on -x'),
+        which is the same transfer function; the rule's own gains exactly.
+        """
+        if self.is_rule:
+            g = self.rule
+            return dict(kp=g.kp, ki=g.ki, kd=g.kd, kdm=0.0, wt=g.wt)
+        wf = self.roll_off
+        on_error = self.derivative_on == "error"
+        if math.isinf(wf):
+            return dict(kp=self.kp, ki=self.ki, kd=self.kd if on_error else 0.0,
+                        kdm=0.0 if on_error else self.kd, wt=math.inf)
+        return dict(kp=self.kp + self.ki / wf, ki=self.ki,
+                    kd=self.kp / wf + (self.kd if on_error else 0.0),
+                    kdm=0.0 if on_error else self.kd, wt=wf)
+
+    def discrete_form(self) -> dict[str, float]:
+        """Coefficients of the kernel's discrete controller (``dp, dc, da, db, dmeas``).
+
+        Per sample: ``u_k = dp e_k + I_k + D_k`` with the trapezoidal
+        integrator ``I_k = I_{k-1} + dc (e_k + e_{k-1})`` (dc = ki T / 2) and
+        ``D_k = da D_{k-1} + db (d_k - d_{k-1})``: the Tustin rule for a
+        filtered D (da = (2 - wf T)/(2 + wf T), db = 2 kd wf/(2 + wf T)), the
+        backward difference for an ideal one (da = 0, db = kd / T).
+        """
+        T = self.sample_period
+        wf = self.roll_off
+        if math.isinf(wf):
+            da, db = 0.0, self.kd / T
+        else:
+            da, db = (2.0 - wf * T) / (2.0 + wf * T), 2.0 * self.kd * wf / (2.0 + wf * T)
+        return dict(dp=self.kp, dc=0.5 * self.ki * T, da=da, db=db,
+                    dmeas=1.0 if self.derivative_on == "measurement" else 0.0)
+
+    def static_error(self, force: float) -> float | None:
+        """Static position error of a loop without integrator against a force [m].
+
+        ``force / kp``: what a PD loop leaves against, e.g., Coulomb friction;
+        None when the loop integrates (no static error).
+        """
+        return None if self.integrator else force / self.kp
+
+    def rule_in_this_form(self) -> dict[str, float]:
+        """The rule's gains at this crossover in this controller's form, to set beside it.
+
+        ``kp``, ``ki``, ``kd`` [N/m, N/(m s), N s/m] of ``kp + ki/s + kd s/(1 + s/wt)``
+        with the rule's roll-off ``roll_off`` = wt [rad/s]: gains a drive
+        with a filtered D term can take as they are.
+        """
+        return self.rule.filtered_d()
+
+    def to_dict(self) -> dict:
+        """Plain JSON data (SI; rad/s for ``roll_off``, infinities as null; without ``rule``)."""
+        return dataclass_dict(self)
