@@ -13,6 +13,9 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Optional
 
+from .display import axis_unit, number, quantity, scale, unit_text
+from .effects import values_text as _effects_text
+
 if TYPE_CHECKING:  # pragma: no cover
     from rich.console import Console
 
@@ -39,67 +42,6 @@ def make_console(stderr: bool = False) -> "Console":
     return console
 
 
-def _fmt(value: Any, digits: int = 4) -> str:
-    """A number for a table cell: ``digits`` significant digits, '-' for none.
-
-    Plain notation from 1e-4 to 1e6 (``13333``, ``0.001348``), else a power of
-    ten (``3.2e-08``); integers in full.
-    """
-    if value is None:
-        return "-"
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float) or hasattr(value, "dtype"):
-        x = float(value)
-        if not math.isfinite(x):
-            return "-" if math.isnan(x) else "inf" if x > 0 else "-inf"
-        ax = abs(x)
-        if x == 0 or not 1e-4 <= ax < 1e6:
-            return "0" if x == 0 else f"{x:.{digits}g}"
-        decimals = max(0, digits - 1 - math.floor(math.log10(ax)))
-        text = f"{x:.{decimals}f}"
-        if "." in text:
-            text = text.rstrip("0").rstrip(".")
-        return "0" if text in ("-0", "") else text
-    return str(value)
-
-
-def _qty(value: Any, unit: str, digits: int = 4) -> str:
-    """A value with its unit for a table cell, scaled for reading: ``1.37 mm``, ``25.2 µm``.
-
-    Lengths below 0.1 mm are shown in µm, longer ones in mm, speeds in mm/s,
-    stresses with a prefix (the report's rule, :func:`fi_design.report.filters.display_scale`).
-
-    Parameters
-    ----------
-    value : float or None
-        SI value.
-    unit : str
-        Its SI unit.
-    digits : int, optional
-        Significant digits.
-
-    Returns
-    -------
-    str
-        ``-`` for None.
-    """
-    from .report.filters import display_scale
-
-    if value is None or isinstance(value, bool) or not isinstance(value, (int, float)):
-        return _fmt(value)
-    if not math.isfinite(value):
-        return "inf" if value > 0 else "-inf" if value < 0 else "-"
-    if value == 0:
-        return "0"
-    if unit == "m" and 0 < abs(value) < 5e-10:
-        return "< 0.001 \u00b5m"  # below what a position sensor resolves
-    shown, factor = display_scale(unit, value)
-    return f"{_fmt(value * factor, digits)} {shown}".rstrip()
-
-
 def _table(title: str | None = None, **options: Any):
     """A compact rich table: simple head rule, one space between columns, title on the left."""
     from rich import box
@@ -107,18 +49,6 @@ def _table(title: str | None = None, **options: Any):
 
     return Table(title=title, title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False,
                  collapse_padding=True, **options)
-
-
-def _row_scale(unit: str, values: Any) -> tuple[str, float]:
-    """One display unit for a table row of SI values (µm for micrometre-sized lengths)."""
-    from .report.filters import display_scale, unit_text
-
-    finite = [abs(v) for v in values if isinstance(v, (int, float)) and not isinstance(v, bool)
-              and math.isfinite(v) and v != 0]
-    if unit in ("-", "1", ""):
-        return "-", 1.0
-    shown, factor = display_scale(unit, max(finite) if finite else None)
-    return shown or unit_text(unit), factor
 
 
 def _status_text(status: Any):
@@ -184,10 +114,10 @@ def checks_table(checks, title: str = "Checks", cases: Any = None):
         if row["message"]:
             cell.append("\n")
             cell.append(Text(row["message"], style="dim"))
-        limit = _fmt(row["limit"])
+        limit = number(row["limit"])
         if row["sense"] and row["limit"] is not None:
             limit = f"{row['sense']} {limit}"
-        table.add_row(cell, _status_text(c.status), _fmt(row["value"]), limit,
+        table.add_row(cell, _status_text(c.status), number(row["value"]), limit,
                       Text(row["unit"] or ""))
     return table
 
@@ -244,8 +174,8 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     if gap:
         risk = gap.get("hunting_risk")
         console.print(Text(
-            f"Friction gap Fs - Fc = {_fmt(gap.get('gap'))} N (threshold "
-            f"{_fmt(gap.get('threshold'))} N): "
+            f"Friction gap Fs - Fc = {number(gap.get('gap'))} N (threshold "
+            f"{number(gap.get('threshold'))} N): "
             + ("hunting is a risk" if risk else "hunting unlikely" if risk is not None else "")))
 
     loop = getattr(result, "loop", None)
@@ -265,8 +195,8 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
                 t.add_column(Text(col), justify="right", no_wrap=True)
             for label, g in (("hardware", hw), ("rule", rule)):
                 wf = g.get("roll_off")
-                t.add_row(label, _fmt(g.get("kp")), _fmt(g.get("ki")), _fmt(g.get("kd")),
-                          "none" if wf is None else _fmt(wf / (2 * math.pi)))
+                t.add_row(label, number(g.get("kp")), number(g.get("ki")), number(g.get("kd")),
+                          "none" if wf is None else number(wf / (2 * math.pi)))
             console.print(t)
         else:
             t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
@@ -274,17 +204,17 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
             for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]",
                         "tuning mass [kg]"):
                 t.add_column(Text(col), justify="right", no_wrap=True)
-            t.add_row(_fmt(pid.get("kp")), _fmt(pid.get("ki")), _fmt(pid.get("kd")),
-                      _fmt(pid.get("wt")), _fmt(pid.get("tuning_mass")))
+            t.add_row(number(pid.get("kp")), number(pid.get("ki")), number(pid.get("kd")),
+                      number(pid.get("wt")), number(pid.get("tuning_mass")))
             console.print(t)
 
     xo = data.get("crossover") or {}
     if xo:
-        line = (f"Crossover: desired {_fmt(xo.get('desired'))} Hz, achievable "
-                f"{_fmt(xo.get('achievable'))} Hz")
+        line = (f"Crossover: desired {number(xo.get('desired'))} Hz, achievable "
+                f"{number(xo.get('achievable'))} Hz")
         if xo.get("limit_kind") == "scan_limit":   # the search cap: a bound, not a result
-            line = (f"Crossover: desired {_fmt(xo.get('desired'))} Hz; the linear model limits "
-                    f"it nowhere below {_fmt(xo.get('achievable'))} Hz (the search cap)")
+            line = (f"Crossover: desired {number(xo.get('desired'))} Hz; the linear model limits "
+                    f"it nowhere below {number(xo.get('achievable'))} Hz (the search cap)")
         elif xo.get("limited_by"):
             line += f", limited by {xo['limited_by']}"
         console.print(Text(line))
@@ -296,15 +226,15 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     if stiff.get("maximum") is not None:
         if stiff.get("suggested"):
             text = (f"Drive stiffness (suggestion for an isolator with a "
-                    f"{_fmt(1e3 * stiff['stroke'], 3)} mm stroke): k_max = "
-                    f"{_fmt(stiff['maximum'])} N/m, start from k = {_fmt(stiff.get('chosen'))} N/m")
+                    f"{number(1e3 * stiff['stroke'], 3)} mm stroke): k_max = "
+                    f"{number(stiff['maximum'])} N/m, start from k = {number(stiff.get('chosen'))} N/m")
         else:
-            text = (f"Drive stiffness: k_max = {_fmt(stiff['maximum'])} N/m, chosen k = "
-                    f"{_fmt(stiff.get('chosen'))} N/m")
+            text = (f"Drive stiffness: k_max = {number(stiff['maximum'])} N/m, chosen k = "
+                    f"{number(stiff.get('chosen'))} N/m")
             if stiff.get("source"):
                 text += f" ({stiff['source']})"
             if stiff.get("force_at_stroke") is not None:
-                text += f", flexure force at full stroke {_fmt(stiff['force_at_stroke'], 3)} N"
+                text += f", flexure force at full stroke {number(stiff['force_at_stroke'], 3)} N"
         console.print(Text(text))
 
     sim = data.get("simulation")
@@ -371,7 +301,7 @@ def print_verdict(console: "Console", result) -> None:
                          f"{mar.crossover_factor:.3g}x the hunting-free "
                          f"{mar.hunting_free_crossover:g} Hz")
         if mar.end_stop_clearance is not None:
-            items.append(f"end stop {_qty(mar.end_stop_clearance, 'm', 3)} away at rest")
+            items.append(f"end stop {quantity(mar.end_stop_clearance, 'm', 3)} away at rest")
         if mar.stiffness_factor is not None:
             items.append(f"k_max / k = {mar.stiffness_factor:.3g}")
         if mar.stiffness_range is not None:
@@ -379,8 +309,8 @@ def print_verdict(console: "Console", result) -> None:
             items.append(f"k {lo:.4g}-{hi:.4g} N/m for t = {1e3 * mar.thickness:.3g} \u00b1 "
                          f"{1e3 * mar.thickness_tolerance:.2g} mm")
         if mar.static_error is not None:
-            items.append(f"static error {_qty(mar.static_error, 'm', 3)} of "
-                         f"{_qty(mar.static_error_bound, 'm', 3)} (Fc + |offset|) / kp")
+            items.append(f"static error {quantity(mar.static_error, 'm', 3)} of "
+                         f"{quantity(mar.static_error_bound, 'm', 3)} (Fc + |offset|) / kp")
         if items:
             body.add_row(Text("Margins", style="bold"), Text("; ".join(items)))
     if result.recommendation is not None:
@@ -421,7 +351,7 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None) -> A
     for _, name in plants:
         t.add_column(Text(name), justify="right")
     counted = "in the window" if window is None else \
-        f"in [{_fmt(float(window[0]))} s, {_fmt(float(window[1]))} s)"
+        f"in [{number(float(window[0]))} s, {number(float(window[1]))} s)"
 
     def verdict_text(verdict: str) -> Any:
         style = {"settled": "bold green", "hunting": "bold red"}.get(verdict, "bold yellow")
@@ -435,19 +365,19 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None) -> A
         return f"{m:g} Hz" + (f" (±{step:g})" if step else "")
 
     def period(v: dict) -> str:
-        return "-" if v.get("period") is None else f"{_fmt(v['period'], 3)} s"
+        return "-" if v.get("period") is None else f"{number(v['period'], 3)} s"
 
     def settling(v: dict) -> str:
         st = v.get("settling_time")
-        return "never" if st is None else f"{_fmt(st, 3)} s"
+        return "never" if st is None else f"{number(st, 3)} s"
 
     rows = [
         ("Verdict", lambda k, v: verdict_text(v.get("verdict", ""))),
         (f"Hunting cycles {counted}", lambda k, v: str(v.get("hunting_cycles"))),
-        ("Amplitude, peak to peak", lambda k, v: _qty(v.get("amplitude"), "m", 3)),
+        ("Amplitude, peak to peak", lambda k, v: quantity(v.get("amplitude"), "m", 3)),
         ("Period", lambda k, v: period(v)),
         ("Settling time after the motion", lambda k, v: settling(v)),
-        ("Final error x1 - r", lambda k, v: _qty(v.get("final_error"), "m", 3)),
+        ("Final error x1 - r", lambda k, v: quantity(v.get("final_error"), "m", 3)),
         ("Hunting-free from (scan step)", lambda k, v: free_from(k)),
     ]
     if other:
@@ -500,16 +430,16 @@ def _cases_table(cases: list, numbers: dict) -> Any:
         t.add_column(Text(CASE_COLUMNS.get(k, _header(k))), justify="right", no_wrap=True)
     t.add_column("Status", min_width=6)
     for i, case in enumerate(cases, 1):
-        number = str(numbers.get(case.get("name"), i))
+        case_no = str(numbers.get(case.get("name"), i))
         label = case.get("description") or case.get("name") or ""
-        cells = [Text("inf" if case.get(k) is None and "margin" in k else _fmt(case.get(k)))
+        cells = [Text("inf" if case.get(k) is None and "margin" in k else number(case.get(k)))
                  for k in keys]
         passed = case.get("passed") if case.get("in_band", True) or not case.get("passed") \
             else None  # no crossing in the loop's band: its margins are not a pass
         status = _status_text("INFO" if passed is None else "PASS" if passed else "FAIL")
         if case.get("failed"):
             status.append(" " + ", ".join(map(str, case["failed"])))
-        t.add_row(number, Text(str(label)), *cells, status)
+        t.add_row(case_no, Text(str(label)), *cells, status)
     return t
 
 
@@ -554,12 +484,12 @@ def print_simulation(console: "Console", result) -> None:
     fit = result.replay
     if fit is not None:
         rows += [
-            ("position, model - measured, rms [\u00b5m]", _fmt(1e6 * fit.position_rms, 4)),
-            ("position, model - measured, max [\u00b5m]", _fmt(1e6 * fit.position_max, 4)),
-            ("tracking error r - x1 rms, model [\u00b5m]", _fmt(1e6 * fit.tracking_rms_model, 4)),
+            ("position, model - measured, rms [\u00b5m]", number(1e6 * fit.position_rms, 4)),
+            ("position, model - measured, max [\u00b5m]", number(1e6 * fit.position_max, 4)),
+            ("tracking error r - x1 rms, model [\u00b5m]", number(1e6 * fit.tracking_rms_model, 4)),
             ("tracking error r - x1 rms, measured [\u00b5m]",
-             _fmt(1e6 * fit.tracking_rms_measured, 4)),
-            ("commanded force, model - measured, rms [N]", _fmt(fit.force_rms, 4)),
+             number(1e6 * fit.tracking_rms_measured, 4)),
+            ("commanded force, model - measured, rms [N]", number(fit.force_rms, 4)),
         ]
         if result.window is not None:
             rows.append(("re-anchored windows [-]", str(int(result.window.max()) + 1)))
@@ -567,16 +497,16 @@ def print_simulation(console: "Console", result) -> None:
         rows += [
             ("verdict", m.verdict),
             ("hunting cycles in the window [-]", str(m.hunting_cycles)),
-            ("amplitude (peak to peak)", _qty(m.amplitude, "m")),
-            ("period [s]", _fmt(m.period, 4)),
-            ("settling time [s]", _fmt(m.settling_time, 4)),
-            ("final error", _qty(m.final_error, "m")),
+            ("amplitude (peak to peak)", quantity(m.amplitude, "m")),
+            ("period [s]", number(m.period, 4)),
+            ("settling time [s]", number(m.settling_time, 4)),
+            ("final error", quantity(m.final_error, "m")),
         ]
     rows += [
         ("integration", "ok" if result.success else result.message),
         ("steps / rejected / events [-]", f"{result.n_steps} / {result.n_rejected} / "
                                           f"{result.n_events}"),
-        ("wall time [ms]", _fmt(1e3 * result.wall_time, 3)),
+        ("wall time [ms]", number(1e3 * result.wall_time, 3)),
     ]
     for k, v in rows:
         t.add_row(Text(k), Text(str(v)))
@@ -619,15 +549,13 @@ class ProgressBar:
 
 
 def _axis_values_text(axis) -> str:
-    from .plots import display_unit
-
     from .plots import quantity_name
 
-    unit, f = display_unit(axis.unit)
+    unit, f = axis_unit(axis.unit)
     v = axis.values
     scale = "log" if axis.log else "linear"
-    return (f"{quantity_name(axis.path)} ({axis.path}): {len(v)} values {_fmt(v[0] * f)} to "
-            f"{_fmt(v[-1] * f)} {unit} ({scale})")
+    return (f"{quantity_name(axis.path)} ({axis.path}): {len(v)} values {number(v[0] * f)} to "
+            f"{number(v[-1] * f)} {unit} ({scale})")
 
 
 _CELL = {"settled": ("·", "green"), "stuck": ("s", "yellow"), "undetermined": ("?", "yellow"),
@@ -655,21 +583,19 @@ def sweep_grid_table(result, max_columns: int = 25):
     from rich.table import Table
     from rich.text import Text
 
-    from .plots import display_unit
-
     x, y = result.x, result.y
     if len(x.values) > max_columns:
         return None
-    xu, xf = display_unit(x.unit)
+    xu, xf = axis_unit(x.unit)
     if y is not None:
-        yu, yf = display_unit(y.unit)
+        yu, yf = axis_unit(y.unit)
     t = Table(box=box.SIMPLE_HEAD, pad_edge=False)
     t.add_column(Text("" if y is None else f"[{yu}]"), justify="right", no_wrap=True)
     for v in x.values:
-        t.add_column(Text(_fmt(v * xf, 3)), justify="right", no_wrap=True)
+        t.add_column(Text(number(v * xf, 3)), justify="right", no_wrap=True)
     rows = result.verdict.reshape(-1, len(x.values))
     cycles = result.hunting_cycles.reshape(-1, len(x.values))
-    labels = [""] if y is None else [_fmt(v * yf, 3) for v in y.values]
+    labels = [""] if y is None else [number(v * yf, 3) for v in y.values]
     for label, vrow, crow in zip(labels, rows, cycles):
         cells = []
         for v, c in zip(vrow, crow):
@@ -738,8 +664,6 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
     """
     from rich.text import Text
 
-    from .plots import display_unit
-
     from .plots import quantity_name
 
     _heading(console, f"Sweep of {result.spec.name}", spec_path)
@@ -749,12 +673,12 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
         console.print(Text(_axis_values_text(result.y)))
     _print_grid(console, result)
     _print_counts(console, result.counts())
-    xu, xf = display_unit(result.x.unit)
+    xu, xf = axis_unit(result.x.unit)
     above = result.boundary("above")
     if result.y is None:
         if not math.isnan(above[0]):
             console.print(Text(f"no hunting from {quantity_name(result.x.path).lower()} = "
-                               f"{_fmt(above[0] * xf)} {xu} upwards"))
+                               f"{number(above[0] * xf)} {xu} upwards"))
     failed = [p for p in result.points if p.status == "failed"]
     for p in failed[:3]:
         console.print(Text(f"failed at {dict(zip(result.paths, p.values))}: {p.message}",
@@ -809,14 +733,12 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
     """
     from rich.text import Text
 
-    from .plots import display_unit
-
     _heading(console, f"Robustness of {result.spec.name}", spec_path)
     for sc in result.scatter:
-        unit, f = display_unit("") if sc.relative else display_unit(
+        unit, f = axis_unit("") if sc.relative else axis_unit(
             _path_unit(sc.path, result.spec))
         spread = f"{sc.spread:.3g} of nominal ({100 * sc.spread:.3g} %)" if sc.relative else \
-            f"{_fmt(sc.spread * f)} {unit}"
+            f"{number(sc.spread * f)} {unit}"
         console.print(Text(f"scatter {sc.path}: {result.distribution}, spread {spread}"))
     if result.position_friction is not None:
         pf = result.position_friction
@@ -908,7 +830,7 @@ def print_reconcile(console: "Console", result) -> None:
         for col in ("Effect", "Misfit before", "Misfit after"):
             s.add_column(col, justify="left" if col == "Effect" else "right", no_wrap=True)
         for st in result.steps:
-            s.add_row(Text(st.name), _fmt(st.misfit_before), _fmt(st.misfit_after))
+            s.add_row(Text(st.name), number(st.misfit_before), number(st.misfit_after))
         console.print(s)
     t = _table("Candidates (best first)")
     longest = max((len(c.name) for c in result.candidates), default=6)
@@ -918,9 +840,8 @@ def print_reconcile(console: "Console", result) -> None:
                      min_width=longest if col == "Effect" else None,
                      ratio=1 if col == "Fitted parameters" else None)
     for c in result.candidates:
-        params = ", ".join(_fitted(c.name, k, v, c.uncertainty.get(k))
-                           for k, v in c.parameters.items() if v is not None)
-        t.add_row(Text(c.name), _fmt(c.score), f"{100 * c.explained:.1f} %", Text(params))
+        params = _effects_text(c.name, c.parameters, c.uncertainty)
+        t.add_row(Text(c.name), number(c.score), f"{100 * c.explained:.1f} %", Text(params))
     console.print(t)
     for c in result.candidates:
         if c.name not in result.effects and c.reasons:
@@ -930,35 +851,21 @@ def print_reconcile(console: "Console", result) -> None:
         g.add_column(col, justify="left" if col in ("Metric", "Unit") else "right",
                      no_wrap=True)
     for m in result.gaps:
-        unit, factor = _row_scale(m.unit, (m.before, m.after, m.noise))
-        g.add_row(Text(m.name), Text(unit), *[_fmt(None if v is None else v * factor)
-                                              for v in (m.before, m.after, m.noise)])
+        unit, factor = scale(m.unit, (m.before, m.after, m.noise))
+        g.add_row(Text(m.name), Text(unit or "-"), *[number(None if v is None else v * factor)
+                                                     for v in (m.before, m.after, m.noise)])
     console.print(g)
     nz = result.noise
-    parts = [f"position {_fmt(nz.position, 3)} m ({nz.source.get('position')})"]
+    parts = [f"position {quantity(nz.position, 'm', 3)} ({nz.source.get('position')})"]
     if nz.force is not None:
-        parts.append(f"force {_fmt(nz.force, 3)} N ({nz.source.get('force')})")
+        parts.append(f"force {quantity(nz.force, 'N', 3)} ({nz.source.get('force')})")
     if nz.deflection is not None:
-        parts.append(f"deflection {_fmt(nz.deflection, 3)} m ({nz.source.get('deflection')})")
+        parts.append(f"deflection {quantity(nz.deflection, 'm', 3)} "
+                     f"({nz.source.get('deflection')})")
     console.print(Text("Noise: " + ", ".join(parts)))
     console.print(Text("Position lattice: " + result.lattice.detail))
     for name, why in result.skipped.items():
         console.print(Text(f"skipped {name}: {why}", style="dim"))
-
-
-def _fitted(effect: str, name: str, value: float, error: Any) -> str:
-    """``wavelength = 5 ± 1.2e-05 mm``: a fitted effect parameter in its display unit."""
-    from .effects import CATALOGUE
-    from .report.filters import display_scale
-
-    units = {p.name: p.unit for p in CATALOGUE[effect].parameters} if effect in CATALOGUE \
-        else {}
-    unit = units.get(name, "")
-    shown, factor = ("", 1.0) if unit in ("", "1") else display_scale(unit, value)
-    text = f"{name} = {_fmt(value * factor)}"
-    if error:
-        text += f" ± {_fmt(error * factor, 2)}"
-    return f"{text} {shown}".rstrip()
 
 
 def print_identification(console: "Console", result) -> None:
@@ -984,20 +891,18 @@ def print_identification(console: "Console", result) -> None:
     for col, just in (("Parameter", "left"), ("Value", "right"), ("Std. error", "right"),
                       ("Unit", "left"), ("Identifiable", "left")):
         t.add_column(col, justify=just, no_wrap=True)
-    from .report.filters import unit_text
-
     for name, p in result.parameters.items():
-        t.add_row(Text(name), _fmt(p.value, 6), _fmt(p.std_error, 3), Text(unit_text(p.unit)),
+        t.add_row(Text(name), number(p.value, 6), number(p.std_error, 3), Text(unit_text(p.unit)),
                   Text("yes" if p.identifiable else "no",
                        style="green" if p.identifiable else "yellow"))
     console.print(t)
     f = result.fit
-    console.print(Text(f"Fit: RMS force residual {_fmt(f.force_rms_residual, 3)} N, relative "
-                       f"error {_fmt(f.relative_error, 3)}, condition number "
-                       f"{_fmt(f.condition_number, 3)}, {f.samples_used} samples used "
-                       f"({_fmt(f.effective_samples, 3)} effective)"))
+    console.print(Text(f"Fit: RMS force residual {number(f.force_rms_residual, 3)} N, relative "
+                       f"error {number(f.relative_error, 3)}, condition number "
+                       f"{number(f.condition_number, 3)}, {f.samples_used} samples used "
+                       f"({number(f.effective_samples, 3)} effective)"))
     ms = result.masses
-    console.print(Text(f"Masses: stage {_fmt(ms.stage, 5)} kg, cart {_fmt(ms.cart, 5)} kg "
+    console.print(Text(f"Masses: stage {number(ms.stage, 5)} kg, cart {number(ms.cart, 5)} kg "
                        f"({ms.source})"))
     for name in ("static", "stribeck_velocity", "bristle_stiffness"):
         p = result.parameters[name]  # how it was estimated, or why not

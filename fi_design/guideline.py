@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
+from .display import number
 from .flexure import size_flexure
 from .pid import ControlLaw, control_law
 from .results import Check, Status, frozen_array
@@ -65,12 +66,8 @@ SUGGESTED_STROKE = 0.3e-3
 
 
 def _g(x: float | None, digits: int = 4) -> str:
-    """``digits`` significant digits; plain (no exponent) from 1e4 to 1e6."""
-    if x is None:
-        return "-"
-    if 1e4 <= abs(x) < 1e6:
-        return f"{x:.0f}"
-    return f"{x:.{digits}g}"
+    """A number as every table prints it (:func:`fi_design.display.number`)."""
+    return number(x, digits)
 
 
 # --------------------------------------------------------------------------- step 1
@@ -411,15 +408,15 @@ def step4_pid(spec: Spec) -> PidResult:
     g = law.rule
     step = "step 4 PID"
     if law.source == "rule":
-        msg = (f"tuned at {g.crossover:.4g} Hz on {g.tuning_mass:.4g} kg: kp = {g.kp:.4g} N/m, "
-               f"ki = {g.ki:.4g} N/(m s), kd = {g.kd:.4g} N s/m, wt = {g.wt:.4g} rad/s")
+        msg = (f"tuned at {g.crossover:.4g} Hz on {g.tuning_mass:.4g} kg: kp = {_g(g.kp)} N/m, "
+               f"ki = {_g(g.ki)} N/(m s), kd = {_g(g.kd)} N s/m, wt = {_g(g.wt)} rad/s")
         checks = [Check("pid", None, g.kp, None, "N/m", msg, step=step)]
     else:
         r = law.rule_in_this_form()
-        msg = (f"the hardware's gains kp = {law.kp:.4g} N/m, ki = {law.ki:.4g} N/(m s), "
-               f"kd = {law.kd:.4g} N s/m ({_controller_words(law)}) cross over at "
+        msg = (f"the hardware's gains kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s), "
+               f"kd = {_g(law.kd)} N s/m ({_controller_words(law)}) cross over at "
                f"{law.crossover:.4g} Hz on {law.tuning_mass:.4g} kg; the rule there would give "
-               f"kp = {r['kp']:.4g} N/m, ki = {r['ki']:.4g} N/(m s), kd = {r['kd']:.4g} N s/m "
+               f"kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), kd = {_g(r['kd'])} N s/m "
                f"with a D roll-off of {r['roll_off'] / (2 * math.pi):.4g} Hz")
         checks = [Check("pid", None, law.kp, g.kp, "N/m", msg, step=step)]
     static = law.static_error(spec.friction.coulomb)
@@ -702,13 +699,13 @@ def _conclusion(spec: Spec, gap: FrictionGapResult, xo: CrossoverResult, st: Sti
     g = pid.gains
     law = pid.controller
     if law.source == "rule":
-        parts.append(f"The PID tuned on {g.tuning_mass:.3g} kg has kp = {g.kp:.4g} N/m, "
-                     f"ki = {g.ki:.4g} N/(m s) and kd = {g.kd:.4g} N s/m.")
+        parts.append(f"The PID tuned on {g.tuning_mass:.3g} kg has kp = {_g(g.kp)} N/m, "
+                     f"ki = {_g(g.ki)} N/(m s) and kd = {_g(g.kd)} N s/m.")
     else:
-        parts.append(f"The hardware's controller (kp = {law.kp:.4g} N/m, ki = {law.ki:.4g} "
-                     f"N/(m s), kd = {law.kd:.4g} N s/m; {_controller_words(law)}) crosses over "
+        parts.append(f"The hardware's controller (kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
+                     f"N/(m s), kd = {_g(law.kd)} N s/m; {_controller_words(law)}) crosses over "
                      f"at {law.crossover:.3g} Hz on {law.tuning_mass:.3g} kg; the rule would tune "
-                     f"kp = {g.kp:.4g} N/m, ki = {g.ki:.4g} N/(m s), kd = {g.kd:.4g} N s/m there.")
+                     f"kp = {_g(g.kp)} N/m, ki = {_g(g.ki)} N/(m s), kd = {_g(g.kd)} N s/m there.")
     if pid.static_error is not None:
         parts.append(f"The loop has no integrator, so it cannot hunt by the paper's mechanism; "
                      f"it leaves a static error of up to Fc / kp = "

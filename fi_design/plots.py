@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from . import spec as _spec
+from .display import axis_unit
 from .errors import ArgumentError
 
 # --------------------------------------------------------------------------- design report
@@ -555,37 +556,14 @@ def figure_svg(fig: Any, prefix: str, text_as_paths: bool = False) -> str:
 # --------------------------------------------------------------------------- parameter studies
 # (fi_design.studies: hunting maps, the paper's Figure 4, robustness)
 
-#: SI unit -> (unit shown on axes, factor applied to SI values).
-DISPLAY_UNITS: dict[str, tuple[str, float]] = {
-    "m": ("mm", 1e3),
-    "N/m": ("N/mm", 1e-3),
-    "m/s": ("mm/s", 1e3),
-    "m/s**2": ("m/s²", 1.0),
-    "N*s/m": ("N s/m", 1.0),
-    "kg/m**3": ("kg/m³", 1.0),
-    "1": ("-", 1.0),
-}
-
 #: Marks drawn on map cells whose verdict is not a plain count.
 VERDICT_MARKS = {"stuck": "s", "undetermined": "?", "failed": "×"}
 
 
 def display_unit(unit: str) -> tuple[str, float]:
-    """Unit shown on an axis for an SI unit, and the factor from SI.
-
-    Parameters
-    ----------
-    unit : str
-        SI unit as stored in the spec (``"m"``, ``"N/m"``, ``"Hz"``, ...).
-
-    Returns
-    -------
-    label : str
-        Unit text for axis labels (``"mm"`` for metres).
-    factor : float
-        Multiply SI values by this to get the shown unit.
-    """
-    return DISPLAY_UNITS.get(unit, (unit, 1.0))
+    """Unit shown on an axis for an SI unit, and the factor from SI
+    (:func:`fi_design.display.axis_unit`)."""
+    return axis_unit(unit)
 
 
 #: Names of the values sweeps and studies usually vary, by dotted spec path.

@@ -38,6 +38,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from . import spec as _spec
+from .display import percent, quantities, quantity
 from .results import Check, Status
 from .results.design import (Confirmation, CrossoverResult, FlexureResult, Margins, PidResult,
                              Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict)
@@ -49,13 +50,11 @@ _OWN = {True: "isolated", False: "non_isolated"}
 
 
 def _pct(x: float | None) -> str:
-    if x is None:
-        return "n/a"
-    return f"{100 * x:.2g} %" if x < 0.1 else f"{100 * x:.3g} %"
+    return percent(x, 3)
 
 
 def _um(x: float) -> str:
-    return f"{x * 1e6:.3g} um"
+    return quantity(x, "m", 3)
 
 
 # --------------------------------------------------------------------------- robustness
@@ -480,10 +479,10 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
         if rise <= spread:
             reasons.append(Reason(
                 "WARN", "end_stop_clearance",
-                f"The cart rests {_um(clearance)} from its end stop (joint deflection "
-                f"{_um(d)} of the {_um(d + clearance)} stroke): a friction force "
-                f"{100 * rise:.2g} % higher would put it on the limiter, within the "
-                f"+-{100 * spread:.3g} % scatter of Fc."))
+                "The cart rests {} from its end stop (joint deflection {} of the {} stroke): "
+                "a friction force ".format(*quantities((clearance, d, d + clearance), "m", 3))
+                + f"{percent(rise, 2)} higher would put it on the limiter, within the "
+                f"\u00b1{percent(spread)} scatter of Fc."))
     for c in checks:
         if c.status == Status.WARN:
             reasons.append(Reason("WARN", c.name, f"{c.step}: {c.message}."))

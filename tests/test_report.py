@@ -51,10 +51,10 @@ def _artifacts() -> Path:
 
 @pytest.mark.parametrize("value,expected", [
     (None, "\u2013"), (True, "yes"), (False, "no"), ("text", "text"), (0, "0"), (0.0, "0"),
-    (2.0, "2"), (0.3, "0.3"), (47.306, "47.31"), (47.30, "47.3"), (13333.33, f"13{NNBSP}333"),
-    (6667.0, "6667"), (-0.6247, "-0.6247"), (1e6, "1 \u00d7 10\u2076"),
-    (3.2e-8, "3.2 \u00d7 10\u207b\u2078"), (2.5e-4, "0.00025"), (float("inf"), "\u221e"),
-    (float("-inf"), "-\u221e"), (float("nan"), "n/a"), (12345, f"12{NNBSP}345"),
+    (2.0, "2"), (0.3, "0.3"), (47.306, "47.31"), (47.30, "47.3"), (13333.33, "13333"),
+    (6667.0, "6667"), (-0.6247, "-0.6247"), (1e6, f"1{NBSP}\u00d7{NBSP}10\u2076"),
+    (3.2e-8, f"3.2{NBSP}\u00d7{NBSP}10\u207b\u2078"), (2.5e-4, "0.00025"), (float("inf"), "\u221e"),
+    (float("-inf"), "-\u221e"), (float("nan"), "n/a"), (12345, "12345"),
     (150.8, "150.8"), (0.001348, "0.001348"),
 ])
 def test_num(value, expected):
@@ -63,7 +63,7 @@ def test_num(value, expected):
 
 def test_num_digits():
     assert report.num(math.pi, 3) == "3.14"
-    assert report.num(123456.7, 3) == f"123{NNBSP}457"
+    assert report.num(123456.7, 3) == "123457"
 
 
 @pytest.mark.parametrize("value,unit,expected", [
@@ -112,7 +112,7 @@ def test_check_labels_name_the_limit_case(paper_confirmed_design):
 
 
 def test_tex_quantities():
-    assert report.tex_num(13333.3) == "13\\,333"
+    assert report.tex_num(13333.3) == "13333"
     assert report.tex_num(2e11) == "2 \\times 10^{11}"
     assert report.tex_qty(3e-4, "m") == "0.3\\ \\mathrm{mm}"
     assert report.tex_qty(100.5, "N s/m") == "100.5\\ \\mathrm{N\\cdot s/m}"

@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ..display import NBSP, quantity, scale
 from ..results import Status
 from .filters import display_scale, num, qty
 
@@ -245,9 +246,13 @@ def key_figures(result: Any) -> list[dict]:
         css = "fail" if m.end_stop_clearance <= 0 else "info"
         if any(r.source == "end_stop_clearance" for r in v.reasons):
             css = "warn"
-        rows.append(_figure("End-stop clearance at rest", m.end_stop_clearance, "m", "> 0",
-                            f"joint deflection {qty(m.resting_deflection, 'm')} of the "
-                            f"\u00b1{qty(spec.isolator.stroke, 'm')} stroke", css, 3))
+        # the clearance, the deflection and the stroke are read together: one unit
+        one = scale("m", (m.end_stop_clearance, m.resting_deflection, spec.isolator.stroke))
+        defl, stroke = (quantity(x, "m", 3, sep=NBSP, shown=one) for x in
+                        (m.resting_deflection, spec.isolator.stroke))
+        rows.append(_figure("End-stop clearance at rest", num(m.end_stop_clearance * one[1], 3),
+                            one[0], "> 0", f"joint deflection {defl} of the \u00b1{stroke} "
+                                           "stroke", css))
     if m.stiffness_factor is not None:
         rows.append(_figure("k_max / k", num(m.stiffness_factor, 3), "1", "\u2265 1",
                             f"k = {qty(result.stiffness.chosen, 'N/m')}, k_max = "

@@ -18,6 +18,7 @@ from .. import effects as _effects
 from ..results.reconciliation import ReconcileResult
 from .blocks import FigureBlock, Section, Table, figure_block
 from .context import build_context, document_context
+from ..display import NBSP
 from .filters import num, qty
 
 __all__ = ["gap_sections", "gap_context", "render_gap_report", "TITLE"]
@@ -26,27 +27,8 @@ __all__ = ["gap_sections", "gap_context", "render_gap_report", "TITLE"]
 TITLE = "Model-measurement reconciliation"
 
 
-def _param_unit(effect: str, name: str) -> str:
-    try:
-        return _effects.get(effect).parameter(name).unit
-    except KeyError:
-        return ""
-
-
 def _params_text(effect: str, values: dict, unc: dict | None = None) -> str:
-    parts = []
-    for k, v in values.items():
-        if v is None:
-            continue
-        unit = _param_unit(effect, k)
-        text = f"{k} = {qty(v, unit if unit not in ('1', 'rad') else '')}"
-        if unit == "rad":
-            text += " rad"
-        s = (unc or {}).get(k)
-        if s:
-            text += f" ± {qty(s, unit if unit not in ('1', 'rad') else '', 2)}"
-        parts.append(text)
-    return ", ".join(parts)
+    return _effects.values_text(effect, values, unc, sep=NBSP)
 
 
 def _short(reasons: tuple) -> str:
