@@ -70,7 +70,8 @@ def test_written_spec_reads_back_with_the_effect(run, files):
     _, out = run
     _, spec_path, _ = files
     text = out["spec"].read_text()
-    assert text.startswith("# the test stage")  # the input's text and comments are kept
+    assert text.startswith("# effects added by fi-design reconcile")
+    assert "\n# the test stage\n" in text  # the input's text and comments are kept
     fixed = load_spec(out["spec"])
     assert [e.type for e in fixed.effects] == ["cable_force"]
     assert load_spec(spec_path).effects == ()  # the input is untouched

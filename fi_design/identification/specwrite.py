@@ -1,8 +1,9 @@
-"""The spec with the identified values: ``--write-spec`` (DESIGN.md section 8).
+"""The spec with the identified values: ``--write-spec`` (docs/interfaces.md).
 
 :func:`spec_values` lists the values by dotted path, :func:`identified_spec`
 validates them as a spec, :func:`identified_spec_text` writes the input
-spec's own YAML text with the values replaced in place and commented.
+spec's own YAML text with the values replaced in place and commented
+(:func:`fi_design.specedit.edited_spec_text`: comments and layout kept).
 """
 
 from __future__ import annotations
@@ -98,15 +99,13 @@ _SPEC_UNITS = {"stage.mass": "kg", "cart.mass": "kg", "friction.coulomb": "N",
 def identified_spec_text(result: IdentificationResult) -> str:
     """YAML text of the input spec with the identified values filled in (``--write-spec``).
 
-    The spec file's own text is kept, comments included: each value of
-    :func:`spec_values` replaces the one written in the file (block or
-    one-line flow mapping), with a comment giving the estimate, its
-    standard error and the value it replaced; a missing key is added to its
-    section. A header comment names the record and the form. Where the text
-    cannot be edited in place (a spec given as a mapping, a section written
-    in a multi-line flow style), the spec is written anew from its data with
-    the same header, and says that comments were not kept. The text is
-    checked with :func:`fi_design.specfile.load_spec` before it is returned.
+    The spec file's own text is kept, comments and layout included
+    (:func:`fi_design.specedit.edited_spec_text`): each value of
+    :func:`spec_values` replaces the one written in the file, with a comment
+    giving the estimate, its standard error and the value it replaced; a
+    missing key is added to its section. A header comment names the record
+    and the form. The text is checked with :func:`fi_design.specfile.load_spec`
+    before it is returned.
 
     Parameters
     ----------
@@ -124,35 +123,24 @@ def identified_spec_text(result: IdentificationResult) -> str:
         No spec, or an identified value the spec cannot hold.
     """
     from ..errors import SpecError
-    from ..specfile import load_spec, origin, parse_yaml
+    from ..specedit import edited_spec_text, spec_quantity
+    from ..specfile import origin
 
     spec = result.spec
     if spec is None:
         raise SpecError("identification without a spec: nothing to fill in (give --spec)")
     identified_spec(spec, result.parameters, result.masses, result.form)  # refuses bad values
     values = spec_values(result)
-    comments = {path: _value_comment(result, path) for path in values}
     org = origin(spec)
-    header = _header(result)
-    text = None
-    if org is not None and org.path is not None:
-        try:
-            text = _edited(org.path.read_text(encoding="utf-8"), org, values, comments)
-        except (OSError, UnicodeDecodeError):
-            text = None
-    if text is not None:
-        text = header + "\n" + text
-        try:
-            data, _ = parse_yaml(text.encode("utf-8"), "<identified spec>")
-            load_spec(data)
-        except SpecError:
-            text = None
-    if text is None:
-        text = _rewritten(org.raw if org is not None else spec.model_dump(exclude_none=True),
-                          values, header)
-        data, _ = parse_yaml(text.encode("utf-8"), "<identified spec>")
-        load_spec(data)
-    return text
+    raw = org.raw if org is not None else {}
+    comments = {}
+    for path in values:
+        section, key = path.split(".")
+        old = (raw.get(section) or {}).get(key) if isinstance(raw.get(section), dict) else None
+        comments[path] = _value_comment(result, path) + ("" if old is None else f" (was {old})")
+    return edited_spec_text(spec, {p: spec_quantity(p, v, digits=6) for p, v in values.items()},
+                            comments=comments, header=_header(result),
+                            source="<identified spec>")
 
 
 def _quantity(path: str, value: float) -> str:
@@ -196,54 +184,3 @@ def _header(result: IdentificationResult) -> str:
         lines.append("# friction.bristle_damping is not identified: its default, sqrt(sigma0 "
                      "(m1 + m2)), follows the identified bristle stiffness.")
     return "\n".join(lines)
-
-
-def _edited(text: str, org, values: dict, comments: dict) -> str | None:
-    """The spec text with values replaced or added in place; None where that is not safe."""
-    import re
-
-    lines = text.split("\n")
-    inserts: dict[int, list[str]] = {}
-    for path, value in values.items():
-        section, key = path.split(".")
-        new = _quantity(path, value)
-        line_no = org.lines.get((section, key))
-        if line_no is not None:
-            i = line_no - 1
-            block = re.match(rf"^(\s*){re.escape(key)}\s*:\s*([^#]*?)\s*(#.*)?$", lines[i])
-            if block:
-                old = block.group(2)
-                extra = f"; {block.group(3)[1:].strip()}" if block.group(3) else ""
-                lines[i] = f"{block.group(1)}{key}: {new}  # {comments[path]} (was {old}){extra}"
-                continue
-            flow = re.compile(rf"(\b{re.escape(key)}\s*:\s*)([^,}}#]+?)(\s*[,}}])")
-            if lines[i].count("{") == 1 and lines[i].count("}") == 1 and \
-                    len(flow.findall(lines[i])) == 1:
-                body, _, old_comment = lines[i].partition("#")
-                body = flow.sub(lambda m: m.group(1) + new + m.group(3), body).rstrip()
-                note = f"{key}: {comments[path]}" + (f"; {old_comment.strip()}" if old_comment
-                                                     else "")
-                lines[i] = f"{body}  # {note}"
-                continue
-            return None
-        keys = [ln for loc, ln in org.lines.items() if len(loc) >= 2 and loc[0] == section]
-        head = org.lines.get((section,))
-        if head is None or not keys or min(keys) == head:
-            return None  # section missing or written in flow style: no safe place
-        first = lines[min(keys) - 1]
-        indent = first[:len(first) - len(first.lstrip())]
-        inserts.setdefault(max(keys) - 1, []).append(f"{indent}{key}: {new}  # {comments[path]}")
-    for i in sorted(inserts, reverse=True):
-        lines[i + 1:i + 1] = inserts[i]
-    return "\n".join(lines)
-
-
-def _rewritten(raw: dict, values: dict, header: str) -> str:
-    import yaml
-
-    data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in raw.items()}
-    for path, value in values.items():
-        section, key = path.split(".")
-        data.setdefault(section, {})[key] = _quantity(path, value)
-    return (header + "\n# (written anew from the spec's data: its comments are not kept)\n"
-            + yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
