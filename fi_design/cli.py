@@ -14,7 +14,8 @@ library raises; :class:`~fi_design.cliparts.DefaultCommandGroup` translates:
 - exit 1: internal error -- a bug; ``--debug`` or ``FI_DESIGN_DEBUG=1`` shows
   the traceback;
 - exit 3: the design verdict is at or below the level of ``--fail-on``
-  (``fail``: FAIL; ``warn``: FAIL or PASS_WITH_WARNINGS), for scripts and CI;
+  (``fail``: the design does not pass, FAIL or NOT_CONFIRMED; ``warn``: also
+  PASS_WITH_WARNINGS), for scripts and CI;
   the outputs are written first;
 - exit 130: a parameter study interrupted with Ctrl-C.
 
@@ -68,10 +69,14 @@ def design_command(
         "--map", help="Add a crossover x stroke hunting map around the design point to the "
                       "report (about 50 more simulations; also `report: {map: true}` in the "
                       "spec).")] = False,
+    write_spec: Optional[Path] = output_option("--write-spec", "OUT.yaml",
+        "Write the spec with step 4's gains as controller.gains and controller.roll_off (the "
+        "form the spec and a drive take; comments kept; never the input)."),
     fail_on: Annotated[Optional[str], typer.Option(
         "--fail-on", metavar="fail|warn",
         help="Exit with code 3 (after writing the outputs) when the verdict is at or below "
-             "this level: 'fail' on FAIL, 'warn' on FAIL or PASS_WITH_WARNINGS; for scripts "
+             "this level: 'fail' when it does not pass (FAIL, or NOT_CONFIRMED without "
+             "simulation), 'warn' on PASS_WITH_WARNINGS too; for scripts "
              "and CI.")] = None,
     force: Force = False,
 ) -> None:
@@ -86,7 +91,7 @@ def design_command(
     (HTML or PDF) on request. With --fail-on, exits 3 when the verdict is at
     or below that level.
     """
-    levels = {"fail": "FAIL", "warn": "PASS_WITH_WARNINGS"}
+    levels = {"fail": "NOT_CONFIRMED", "warn": "PASS_WITH_WARNINGS"}
     if fail_on is not None and fail_on not in levels:
         raise typer.BadParameter(f"expected 'fail' or 'warn', got {fail_on!r}",
                                  param_hint="--fail-on")
@@ -97,7 +102,8 @@ def design_command(
         raise typer.BadParameter("the map simulates; it cannot go with --no-simulation",
                                  param_hint="--map")
     outs = check_outputs((spec,), force, json=(json_out, (".json",)),
-                    report=(report_out, (".html", ".pdf")))
+                         report=(report_out, (".html", ".pdf")),
+                         spec=(write_spec, (".yaml", ".yml")))
     spec_obj = load(spec)
 
     from .console import Status, make_console, print_design
@@ -109,6 +115,10 @@ def design_command(
             confirmation_pool(not no_simulation) as pool:
         result = design(spec_obj, confirm=not no_simulation, executor=pool, progress=status)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
+    if outs["spec"] is not None:
+        from .handoff import gains_spec_text
+
+        payloads["spec"] = gains_spec_text(result)
     print_design(console, result, spec_path=spec)
     write_outputs(console, outs, payloads)
     design_map = None

@@ -184,29 +184,7 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
 
     pid = data.get("pid") or {}
     if pid:
-        if pid.get("source") == "gains":
-            # the hardware's loop beside the rule's gains in the same form
-            hw, rule = pid["controller"], pid["rule_in_hardware_form"]
-            t = Table(title="PID gains (step 4): the hardware's, and the rule's at the same "
-                            "crossover", title_justify="left", box=box.SIMPLE_HEAD,
-                      pad_edge=False)
-            t.add_column("")
-            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "D roll-off [Hz]"):
-                t.add_column(Text(col), justify="right", no_wrap=True)
-            for label, g in (("hardware", hw), ("rule", rule)):
-                wf = g.get("roll_off")
-                t.add_row(label, number(g.get("kp")), number(g.get("ki")), number(g.get("kd")),
-                          "none" if wf is None else number(wf / (2 * math.pi)))
-            console.print(t)
-        else:
-            t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
-                      pad_edge=False)
-            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]",
-                        "tuning mass [kg]"):
-                t.add_column(Text(col), justify="right", no_wrap=True)
-            t.add_row(number(pid.get("kp")), number(pid.get("ki")), number(pid.get("kd")),
-                      number(pid.get("wt")), number(pid.get("tuning_mass")))
-            console.print(t)
+        console.print(_gains_table(pid))
 
     xo = data.get("crossover") or {}
     if xo:
@@ -253,9 +231,44 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
         console.print(Text("warning: ", style="bold yellow").append(Text(_warning_text(w))))
 
 
+def _gains_table(pid: dict) -> Any:
+    """Step 4's gains in the form the spec's ``controller.gains`` takes (``pid.hand_off``).
+
+    With the hardware's own gains, the rule's at the same crossover in the same
+    form beside them. The roll-off is ``controller.roll_off``: a low-pass on the
+    D term only; the sampling and delay are the ones the analysis used.
+    """
+    from rich.text import Text
+
+    hand = pid["hand_off"]
+    rows = [("hardware" if pid.get("source") == "gains" else "rule", hand)]
+    if pid.get("source") == "gains":
+        rows.append(("rule", {**hand, **pid["rule_in_hardware_form"],
+                              "roll_off": pid["rule_in_hardware_form"]["roll_off"]
+                              / (2 * math.pi)}))
+    t = _table("PID gains (step 4) as controller.gains takes them: kp + ki/s + kd s / (1 + "
+               "s/(2 pi roll_off)), the roll-off on the D term only")
+    t.add_column("")
+    for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "roll_off [Hz]"):
+        t.add_column(Text(col), justify="right", no_wrap=True)
+    for label, g in rows:
+        t.add_row(label, number(g["kp"]), number(g["ki"]), number(g["kd"]),
+                  "none" if g["roll_off"] is None else number(g["roll_off"]))
+    sampled = ("continuous" if hand["sample_rate"] is None
+               else f"sampled at {quantity(hand['sample_rate'], 'Hz')}")
+    delay = "no delay" if not hand["delay"] else f"delay {quantity(hand['delay'], 's')}"
+    t.caption = Text(f"D on the {hand['derivative_on']}, {sampled}, {delay}, tuned on "
+                     f"{quantity(pid['tuning_mass'], 'kg')} (controller.derivative_on, "
+                     "sample_rate and delay); --write-spec writes them into a spec",
+                     style="dim")
+    t.caption_justify = "left"
+    return t
+
+
 #: Border and title style of the verdict box per status; a stage that does not settle gets a
 #: heavy frame, so the box differs in shape too (monochrome terminals, logs).
 _VERDICT_LOOK = {"PASS": ("green", "ROUNDED"), "PASS_WITH_WARNINGS": ("yellow", "ROUNDED"),
+                 "NOT_CONFIRMED": ("yellow", "DOUBLE"),
                  "FAIL": ("red", "HEAVY")}
 
 
@@ -265,7 +278,8 @@ def print_verdict(console: "Console", result) -> None:
     The box names what the stage as specified does (settles, hunts, ...), lists
     the reasons (FAIL, WARN, PASS), then the robustness under friction scatter,
     the margins with units and the recommendation. A green rounded frame for
-    PASS, yellow for PASS_WITH_WARNINGS, a heavy red one for FAIL.
+    PASS, yellow for PASS_WITH_WARNINGS, a double yellow one for NOT_CONFIRMED (not
+    simulated: it does not pass), a heavy red one for FAIL.
 
     Parameters
     ----------

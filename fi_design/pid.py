@@ -3,7 +3,7 @@
 Light on purpose (``math`` only, no python-control), so the simulation can
 import it without paying for ``import control``.
 
-The rule (DESIGN.md section 2, paper section 2.2), with ``wc = 2 pi fc`` and
+The rule (paper section 2.2; docs/model.md), with ``wc = 2 pi fc`` and
 ``r = derivative_ratio``, ``ri = integrator_ratio``::
 
     C(s) = ks (1 + wi/s) (1 + s/wd) / (1 + s/wt)      (series form)
@@ -12,8 +12,8 @@ The rule (DESIGN.md section 2, paper section 2.2), with ``wc = 2 pi fc`` and
 The lead-lag part ``(1 + s/wd) / (1 + s/wt)`` has its phase maximum at the
 geometric mean ``sqrt(wd wt) = wc`` and a gain ``r`` there, so ``ks = m wc^2 / r``
 puts ``|C(j wc)| = m wc^2`` without the integrator: a free mass ``1/(m s^2)``
-then crosses over at ``wc``. With the default ratio 3 this is DESIGN.md's
-``kp = m wc^2 / 3``.
+then crosses over at ``wc``. With the default ratio 3 this is
+``kp = m wc^2 / 3`` of docs/model.md.
 
 The integrator adds ``|1 + wi/(j wc)| = sqrt(1 + (wi/wc)^2) = sqrt(1 + 1/ri^2)``
 (0.5 % for ``ri = 10``), so the exact crossover of a free mass lies a fraction
@@ -308,6 +308,29 @@ class ControlLaw:
         None when the loop integrates (no static error).
         """
         return None if self.integrator else force / self.kp
+
+    def hand_off(self) -> dict[str, float | str | None]:
+        """This loop in the form the spec's ``controller`` section takes (step 4's hand-off).
+
+        ``controller.gains`` with ``controller.roll_off`` means
+        ``kp + ki/s + kd s / (1 + s / (2 pi roll_off))``: the low-pass on the D
+        term only. The rule's ``(kp + ki/s + kd s) / (1 + s/wt)``, with the
+        roll-off on the whole PID, is the same controller with other numbers
+        (see the class docstring); these are the numbers a drive, or the spec,
+        takes.
+
+        Returns
+        -------
+        dict
+            ``kp`` [N/m], ``ki`` [N/(m s)], ``kd`` [N s/m], ``roll_off`` [Hz]
+            (None for an ideal D), ``derivative_on``, ``sample_rate`` [Hz]
+            (None: continuous) and ``delay`` [s], as the analysis used them.
+        """
+        return {"kp": self.kp, "ki": self.ki, "kd": self.kd,
+                "roll_off": None if math.isinf(self.roll_off) else self.roll_off / (2 * math.pi),
+                "derivative_on": self.derivative_on,
+                "sample_rate": None if self.sample_period == 0 else 1.0 / self.sample_period,
+                "delay": self.delay}
 
     def rule_in_this_form(self) -> dict[str, float]:
         """The rule's gains at this crossover in this controller's form, to set beside it.

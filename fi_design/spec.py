@@ -221,9 +221,11 @@ class Controller(StrictModel):
 
     crossover: OptQ("Hz") = Field(None, gt=0, description="Desired crossover frequency fc [Hz]; "
                                                            "the rule tunes the PID for it. "
-                                                           "Optional with `gains` (the achieved "
-                                                           "crossover is computed and must then "
-                                                           "agree within 10 %).")
+                                                           "Optional with gains: then the "
+                                                           "crossover the gains were tuned for, "
+                                                           "within 10 % of where they cross the "
+                                                           "tuning mass over (without it, that "
+                                                           "crossover is computed).")
     gains: Gains | None = Field(None, description="The hardware's own gains; omit to tune by the "
                                                   "rule.")
     derivative_on: Literal["error", "measurement"] = Field(
@@ -682,13 +684,17 @@ def gains_crossover(spec: Spec) -> float:
 
 
 def design_crossover(spec: Spec) -> float:
-    """The loop's crossover [Hz]: ``controller.crossover`` for the rule, else the gains' own.
+    """The loop's crossover [Hz]: ``controller.crossover``, else the gains' own.
 
-    With explicit gains a given crossover only has to agree with theirs
-    (:data:`CROSSOVER_AGREEMENT`); the loop crosses over where the gains do.
+    With explicit gains a given crossover names the crossover they were tuned
+    for (it must agree with where they cross the tuning mass over within
+    :data:`CROSSOVER_AGREEMENT`): the rule's gains written as
+    ``controller.gains`` beside the rule's ``crossover`` give the same design,
+    crossover scan included. Without it, the gains' own crossover
+    (:func:`gains_crossover`).
     """
     ctl = spec.controller
-    return ctl.crossover if ctl.gains is None else gains_crossover(spec)
+    return ctl.crossover if ctl.crossover is not None else gains_crossover(spec)
 
 
 

@@ -150,8 +150,11 @@ def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
     yaml.dump(document, buf)
     out = buf.getvalue()
     if lines:
-        head = "\n".join(ln if ln.startswith("#") else f"# {ln}".rstrip()
-                         for block in lines for ln in block.splitlines())
+        import textwrap
+
+        head = "\n".join(ln if ln.startswith("#") else "\n".join(
+            textwrap.wrap(ln, 96, initial_indent="# ", subsequent_indent="# "))
+            for block in lines for ln in block.splitlines())
         out = head + "\n" + out
     data, _ = parse_yaml(out.encode("utf-8"), source)
     try:
@@ -253,7 +256,7 @@ def _set_comment(parent: Any, key: Any, text: str) -> None:
     tail, column = "", None
     if old is not None:
         tail = old.value.partition("\n")[2]
-        column = old.column
+        column = old.column if old.value.lstrip().startswith("#") else None
     if column is None:  # align with the section's other comments
         columns = [t.column for t in (_token(parent, k) for k in parent)
                    if t is not None and t.value.lstrip().startswith("#")]

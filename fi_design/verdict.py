@@ -499,6 +499,7 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
     order = {"FAIL": 0, "WARN": 1, "PASS": 2}
     reasons.sort(key=lambda r: order[r.severity])
     status = ("FAIL" if any(r.severity == "FAIL" for r in reasons) else
+              "NOT_CONFIRMED" if simulation is None else
               "PASS_WITH_WARNINGS" if any(r.severity == "WARN" for r in reasons) else "PASS")
     nwarn = sum(r.severity == "WARN" for r in reasons)
     what = (f"{label} {_BEHAVIOUR.get(behaviour, behaviour)} at {fc:.4g} Hz"
@@ -512,6 +513,8 @@ def judge(spec: _spec.Spec, checks: Sequence[Check], warnings: Sequence[tuple[st
     listed = ", ".join(on[:-1]) + " and on " + on[-1] if len(on) > 1 else "".join(on)
     tail = {"FAIL": f"It fails on {listed}" + (f"; {warned}" if nwarn else ""),
             "PASS_WITH_WARNINGS": f"Nothing fails; {warned}",
+            "NOT_CONFIRMED": "Nothing of the linear steps fails, but without the simulation "
+                             "it does not pass" + (f"; {warned}" if nwarn > 1 else ""),
             "PASS": "Nothing fails, nothing to review"}[status]
     return Verdict(status=status, reasons=tuple(reasons), plant=own, behaviour=behaviour,
                    headline=f"{what}. {tail}.")

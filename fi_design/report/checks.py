@@ -22,7 +22,8 @@ __all__ = ["STEP_SOURCES", "SENSE", "STATUS_TEXT", "BEHAVIOUR", "check_label", "
            "key_figures", "verdict"]
 
 #: The verdict's status as printed.
-STATUS_TEXT = {"PASS": "PASS", "PASS_WITH_WARNINGS": "PASS with warnings", "FAIL": "FAIL"}
+STATUS_TEXT = {"PASS": "PASS", "PASS_WITH_WARNINGS": "PASS with warnings",
+               "NOT_CONFIRMED": "NOT CONFIRMED (not simulated)", "FAIL": "FAIL"}
 
 #: The judged plant's behaviour: (css class, stamp) by outcome; None: not simulated.
 BEHAVIOUR = {
@@ -285,7 +286,7 @@ def verdict(result: Any) -> dict:
     Returns
     -------
     dict
-        ``status`` (``PASS``, ``PASS_WITH_WARNINGS``, ``FAIL``), ``overall``
+        ``status`` (``PASS``, ``PASS_WITH_WARNINGS``, ``NOT_CONFIRMED``, ``FAIL``), ``overall``
         (as printed), ``css`` (pass, warn, fail), ``behaviour`` (the stamp),
         ``behaviour_css``, ``headline``, ``reasons`` (``severity``, ``css``,
         ``text``), ``figures`` (:func:`key_figures`), ``notes`` (margins not
@@ -302,7 +303,8 @@ def verdict(result: Any) -> dict:
         if not groups or groups[-1]["step"] != check.step:
             groups.append({"step": check.step, "title": _step_title(check.step), "rows": []})
         groups[-1]["rows"].append(row)
-    css = {"PASS": "pass", "PASS_WITH_WARNINGS": "warn", "FAIL": "fail"}[v.status]
+    css = {"PASS": "pass", "PASS_WITH_WARNINGS": "warn", "NOT_CONFIRMED": "warn",
+           "FAIL": "fail"}[v.status]
     behaviour_css, stamp = BEHAVIOUR[v.behaviour]
     return {
         "status": v.status, "overall": STATUS_TEXT[v.status], "css": css,
