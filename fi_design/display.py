@@ -254,9 +254,9 @@ def quantity(value: Any, unit: str = "", digits: int = 4, *, sep: str = " ",
         return number(value, digits)
     if unit == "m" and shown is None and 0 < abs(value) < _SUB_NANO:
         return _attach("< 0.001", "\u00b5m", sep)  # below what a position sensor resolves
+    if not math.isfinite(value):  # no unit on n/a or an infinity
+        return number(value)
     unit_shown, factor = shown or display_scale(unit, value)
-    if not math.isfinite(value):
-        return _attach(number(value), unit_shown, sep)
     return _attach(number(value if factor == 1.0 else value * factor, digits), unit_shown, sep)
 
 

@@ -65,16 +65,23 @@ def friction_curve(result: Any, velocity: np.ndarray) -> np.ndarray:
     symmetric = result.form == "symmetric"
     fc_pos = p["coulomb"] + (p["offset"] if symmetric else 0.0)
     fc_neg = (p["coulomb"] - p["offset"]) if symmetric else p["coulomb_negative"]
+    one_way = getattr(result, "direction", "both")
+    if one_way == "negative":  # the level of the one direction the record holds, offset in it
+        fc_neg = p["coulomb_negative"]
     pos = fc_pos + p["viscous"] * v
     neg = -fc_neg + p["viscous_negative"] * v
     par = result.parameters
     if par["static"].identifiable and par["stribeck_velocity"].identifiable:
-        gap = p["static"] - p["coulomb"]  # the form's positive direction, offset aside
+        level = fc_neg if one_way == "negative" else p["coulomb"]
+        gap = p["static"] - level  # the form's positive direction, offset aside
         e = np.exp(-(v / p["stribeck_velocity"]) ** 2)
-        ratio = 1.0 if symmetric else p["coulomb_negative"] / p["coulomb"]
+        ratio = 1.0 if symmetric or one_way != "both" else p["coulomb_negative"] / p["coulomb"]
         pos = pos + gap * e
         neg = neg - gap * ratio * e
-    return np.where(v > 0, pos, np.where(v < 0, neg, 0.5 * (pos + neg)))
+    curve = np.where(v > 0, pos, np.where(v < 0, neg, 0.5 * (pos + neg)))
+    if one_way != "both":  # nothing is known of the other direction: no curve there
+        curve = np.where(v < 0 if one_way == "positive" else v > 0, np.nan, curve)
+    return curve
 
 
 @styled

@@ -40,6 +40,12 @@ WINDOW = 0.1
 
 # --------------------------------------------------------------------------- parameters
 
+#: Coulomb friction the kernel takes for a spec without any (``friction.coulomb: 0``, static
+#: friction alone, Armstrong-Helouvry's case), as a fraction of Fs [-]: LuGre's bristle rate
+#: dz/dt = v - sigma0 |v| z / g(v) needs g(v) = Fc + (Fs - Fc) exp(-(v/vs)^2) > 0 at every
+#: speed, so g is kept at or above 0.1 % of Fs (with Fs = 4 N a sliding friction of 4 mN).
+COULOMB_FLOOR = 1e-3
+
 
 def plant_parameters(spec: _spec.Spec, isolated: bool, crossover: float | None = None,
                      effects=None, law: ControlLaw | None = None) -> PlantParameters:
@@ -80,7 +86,8 @@ def plant_parameters(spec: _spec.Spec, isolated: bool, crossover: float | None =
         joint = dict(k=0.0, c=0.0, s=0.0, k_stop=0.0, c_stop=0.0)
     params = PlantParameters(
         m1=spec.stage.mass, m2=spec.cart.mass, **joint,
-        Fs=fr.static, Fc=fr.coulomb, vs=fr.stribeck_velocity, sigma0=fr.bristle_stiffness,
+        Fs=fr.static, Fc=max(fr.coulomb, COULOMB_FLOOR * fr.static), vs=fr.stribeck_velocity,
+        sigma0=fr.bristle_stiffness,
         sigma1=_spec.bristle_damping(spec), sigma2=fr.viscous, **law.kernel_form(),
         Fc_neg=math.nan if fr.coulomb_negative is None else fr.coulomb_negative,
         sigma2_neg=math.nan if fr.viscous_negative is None else fr.viscous_negative,

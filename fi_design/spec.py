@@ -76,7 +76,10 @@ class Friction(StrictModel):
         "lugre", description="Friction model: 'lugre' (default) or 'switch' (Karnopp-type "
                              "stick-slip cross-check).")
     static: Q("N") = Field(gt=0, description="Static friction force Fs [N].")
-    coulomb: Q("N") = Field(gt=0, description="Coulomb (sliding) friction force Fc [N].")
+    coulomb: Q("N") = Field(ge=0, description="Coulomb (sliding) friction force Fc [N]; 0 for "
+                                              "static friction without Coulomb friction "
+                                              "(simulated with 0.1 % of Fs, LuGre needs it "
+                                              "above 0).")
     stribeck_velocity: Q("m/s") = Field(gt=0, description="Stribeck velocity vs [m/s].")
     viscous: Q("N*s/m") = Field(0.0, ge=0, description="Viscous friction coefficient sigma2 "
                                                         "[N s/m]. Default 0.")
@@ -102,6 +105,10 @@ class Friction(StrictModel):
         if self.static < self.coulomb:
             raise ValueError(f"static friction Fs = {self.static:g} N must be at least the "
                              f"Coulomb friction Fc = {self.coulomb:g} N")
+        if self.coulomb == 0 and self.coulomb_negative is not None:
+            raise ValueError("coulomb_negative needs a Coulomb friction above 0: static "
+                             "friction in the negative direction scales with coulomb_negative / "
+                             "coulomb")
         return self
 
 

@@ -383,6 +383,11 @@ class IdentificationResult:
     dynamic : Dynamic
         The events and fits behind ``static``, ``stribeck_velocity`` and
         ``bristle_stiffness``.
+    direction : str
+        The directions the record slides in: ``"both"``, or ``"positive"`` or
+        ``"negative"`` only (then the other direction's friction and the
+        offset are not identifiable, and that direction's Coulomb friction
+        includes the offset).
     """
 
     parameters: Mapping[str, Parameter]
@@ -397,6 +402,7 @@ class IdentificationResult:
     measurement: Measurement = field(repr=False)
     spec: Any = field(default=None, repr=False)
     dynamic: Dynamic = field(default_factory=Dynamic, repr=False)
+    direction: str = "both"
 
     def value(self, name: str) -> float | None:
         """The value of parameter ``name`` [SI], or None."""
@@ -411,6 +417,7 @@ class IdentificationResult:
             "parameters": {k: p.to_dict() for k, p in self.parameters.items()},
             "fit": self.fit.to_dict(),
             "form": self.form,
+            "direction": self.direction,
             "model": self.model,
             "masses": self.masses.to_dict(),
             "processing": self.processing.to_dict(),

@@ -31,15 +31,25 @@ def spec_values(result: IdentificationResult) -> dict[str, float]:
     the record; the Stribeck velocity and bristle stiffness not identified
     keep the spec's own values.
 
+    A record that slides in one direction only identifies that direction's
+    friction with the force offset included: the spec's offset is kept and
+    that direction's Coulomb friction is the identified level less it
+    (``coulomb = level - offset`` forwards, ``coulomb_negative = level +
+    offset`` backwards); the other direction keeps the spec's own friction,
+    written out (so that it no longer follows ``coulomb``).
+
     Parameters
     ----------
     result : IdentificationResult
         The identification (with a spec).
     """
-    return _values(result.spec, result.parameters, result.masses, result.form)
+    return _values(result.spec, result.parameters, result.masses, result.form,
+                   result.direction)
 
 
-def _values(spec, params, masses, form) -> dict[str, float]:
+def _values(spec, params, masses, form, direction: str = "both") -> dict[str, float]:
+    if direction != "both":
+        return _one_direction_values(spec, params, masses, direction)
     v = {"stage.mass": masses.stage, "cart.mass": masses.cart,
          "friction.coulomb": params["coulomb"].value,
          "friction.viscous": params["viscous"].value,
@@ -61,7 +71,34 @@ def _values(spec, params, masses, form) -> dict[str, float]:
     return v
 
 
-def identified_spec(spec, params, masses, form):
+def _one_direction_values(spec, params, masses, direction: str) -> dict[str, float]:
+    """The values of a record that slides one way (see :func:`spec_values`)."""
+    from ..errors import SpecError
+
+    if spec is None:
+        raise SpecError("identification without a spec: nothing to fill in (give --spec)")
+    f = spec.friction
+    v = {"stage.mass": masses.stage, "cart.mass": masses.cart}
+    if direction == "positive":
+        v["friction.coulomb"] = params["coulomb"].value - f.offset
+        v["friction.viscous"] = params["viscous"].value
+        v["friction.coulomb_negative"] = f.coulomb if f.coulomb_negative is None \
+            else f.coulomb_negative
+        v["friction.viscous_negative"] = f.viscous if f.viscous_negative is None \
+            else f.viscous_negative
+    else:
+        v["friction.coulomb_negative"] = params["coulomb_negative"].value + f.offset
+        v["friction.viscous_negative"] = params["viscous_negative"].value
+    for name in DYNAMIC:
+        p = params.get(name)
+        if p is not None and p.identifiable and p.value is not None:
+            v[f"friction.{name}"] = p.value
+    if "friction.static" not in v and "friction.coulomb" in v:  # keep the spec's friction gap
+        v["friction.static"] = v["friction.coulomb"] + f.static - f.coulomb
+    return v
+
+
+def identified_spec(spec, params, masses, form, direction: str = "both"):
     """The spec with identified values (a :class:`~fi_design.spec.Spec`, no file origin).
 
     Raises
@@ -73,7 +110,7 @@ def identified_spec(spec, params, masses, form):
     from ..errors import SpecError
     from ..specfile import with_values
 
-    values = _values(spec, params, masses, form)
+    values = _values(spec, params, masses, form, direction)
     bad = [k for k in ("stage.mass", "cart.mass", "friction.coulomb",
                        "friction.coulomb_negative", "friction.viscous",
                        "friction.viscous_negative") if k in values and values[k] < 0.0
@@ -81,7 +118,7 @@ def identified_spec(spec, params, masses, form):
     if bad:
         raise SpecError(f"the identified value {values[bad[0]]:.4g} {_SPEC_UNITS[bad[0]]} is "
                         f"not positive, which a spec cannot hold: {IMPLAUSIBLE}", path=bad[0])
-    if values.get("friction.static", math.inf) < values["friction.coulomb"]:
+    if values.get("friction.static", math.inf) < values.get("friction.coulomb", 0.0):
         raise SpecError(f"the identified static friction {values['friction.static']:.4g} N lies "
                         f"below the Coulomb friction {values['friction.coulomb']:.4g} N, which a "
                         f"spec cannot hold: {IMPLAUSIBLE}", path="friction.static")
@@ -129,7 +166,8 @@ def identified_spec_text(result: IdentificationResult) -> str:
     spec = result.spec
     if spec is None:
         raise SpecError("identification without a spec: nothing to fill in (give --spec)")
-    identified_spec(spec, result.parameters, result.masses, result.form)  # refuses bad values
+    identified_spec(spec, result.parameters, result.masses, result.form,
+                    result.direction)  # refuses bad values
     values = spec_values(result)
     org = origin(spec)
     raw = org.raw if org is not None else {}
@@ -156,6 +194,18 @@ def _value_comment(result: IdentificationResult, path: str) -> str:
         if se is not None:
             return f"identified {_quantity(path, getattr(m, section))} +- {se:.2g} {unit}"
         return f"the identified total mass, {m.source}"
+    if result.direction != "both":
+        side = result.direction
+        own = {"positive": ("coulomb", "viscous"),
+               "negative": ("coulomb_negative", "viscous_negative")}[side]
+        if key not in own and key in ("coulomb", "coulomb_negative", "viscous",
+                                      "viscous_negative"):
+            return f"the spec's own value: the record slides in the {side} direction only"
+        if key in ("coulomb", "coulomb_negative"):
+            p = result.parameters[key]
+            return (f"identified {_quantity(path, p.value)} +- {p.std_error:.2g} {unit} sliding "
+                    f"{side}, the offset included, {'less' if key == 'coulomb' else 'plus'} "
+                    "the spec's offset (one direction cannot separate them)")
     if key == "coulomb_negative" and result.form == "symmetric":
         return "symmetric form: equal to coulomb"
     if key == "offset" and result.form == "per_direction":
