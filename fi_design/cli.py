@@ -297,7 +297,8 @@ def sweep_command(
         spec_obj, ax, ay, isolated=isolated, executor=ex, progress=bar, cache=cache))
     console = make_console()
     write_study(console, outs, result, sweep_figure)
-    print_sweep(console, result, spec_path=spec, executor=pool.describe())
+    print_sweep(console, result, spec_path=spec, executor=pool.describe(),
+                files=tuple(p for p in (outs["figure"], outs["csv"]) if p is not None))
 
 
 @app.command("study")
@@ -368,7 +369,7 @@ def study_command(
         write_atomic(targets[name], data)
     console.print(f"wrote {', '.join(payloads)} to {out}", markup=False)
     write_report(console, report_path, result)
-    print_study(console, result, spec_path=spec, executor=pool.describe())
+    print_study(console, result, spec_path=spec, executor=pool.describe(), out=out)
 
 
 @app.command("robustness")

@@ -13,7 +13,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Optional
 
-from .display import axis_unit, number, quantity, scale, unit_text
+from .display import axis_unit, number, percent, quantity, scale, unit_text
 from .effects import values_text as _effects_text
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -303,11 +303,10 @@ def print_verdict(console: "Console", result) -> None:
         body.add_row(_status_text(r.severity), Text(r.text))
     rob, mar = result.robustness, result.margins
     if rob is not None:
-        p = "-" if rob.hunting_probability is None else f"{100 * rob.hunting_probability:.3g} %"
         body.add_row(Text("Scatter", style="bold"), Text(
-            f"hunting in {p} of {rob.valid} samples ({100 * rob.interval[0]:.2g}-"
-            f"{100 * rob.interval[1]:.3g} % at {100 * rob.confidence:.3g} %), limit "
-            f"{100 * rob.limit:.3g} %"))
+            f"hunting in {percent(rob.hunting_probability)} of {rob.valid} samples "
+            f"({percent(rob.interval[0])} to {percent(rob.interval[1])} at "
+            f"{percent(rob.confidence)}), limit {percent(rob.limit)}"))
     if mar is not None:
         items = []
         if mar.crossover_factor is not None:
@@ -576,19 +575,24 @@ _CELL = {"settled": ("·", "green"), "stuck": ("s", "yellow"), "undetermined": (
          "invalid": ("-", "dim"), "failed": ("×", "bold red")}
 
 
-def sweep_grid_table(result, max_columns: int = 25):
-    """The map as a rich table: hunting cycles per point, marks for the other verdicts.
+#: Widest map printed on the console [columns]; a wider one is named by its file.
+MAX_MAP_COLUMNS = 60
+
+
+def sweep_grid_table(result, columns: slice | None = None):
+    """The map (or a block of its columns) as a rich table: cycles per point, marks otherwise.
 
     Parameters
     ----------
     result : fi_design.studies.SweepResult
         A two-dimensional sweep (a line is shown as one row).
-    max_columns : int, optional
-        Wider maps are not tabulated (None is returned).
+    columns : slice, optional
+        The x values to tabulate (default all): :func:`sweep_grid_tables`
+        splits a wide map into blocks that fit the console.
 
     Returns
     -------
-    rich.table.Table or None
+    rich.table.Table
         Rows are y values, columns x values, both in display units; a cell
         holds the cycle count of a hunting point, ``·`` settled, ``s`` stuck,
         ``?`` undetermined, ``-`` invalid, ``×`` failed.
@@ -598,21 +602,21 @@ def sweep_grid_table(result, max_columns: int = 25):
     from rich.text import Text
 
     x, y = result.x, result.y
-    if len(x.values) > max_columns:
-        return None
+    cols = range(len(x.values))[columns or slice(None)]
     xu, xf = axis_unit(x.unit)
     if y is not None:
         yu, yf = axis_unit(y.unit)
     t = Table(box=box.SIMPLE_HEAD, pad_edge=False)
     t.add_column(Text("" if y is None else f"[{yu}]"), justify="right", no_wrap=True)
-    for v in x.values:
-        t.add_column(Text(number(v * xf, 3)), justify="right", no_wrap=True)
+    for j in cols:
+        t.add_column(Text(number(x.values[j] * xf, 3)), justify="right", no_wrap=True)
     rows = result.verdict.reshape(-1, len(x.values))
     cycles = result.hunting_cycles.reshape(-1, len(x.values))
     labels = [""] if y is None else [number(v * yf, 3) for v in y.values]
     for label, vrow, crow in zip(labels, rows, cycles):
         cells = []
-        for v, c in zip(vrow, crow):
+        for j in cols:
+            v, c = vrow[j], crow[j]
             if v == "hunting":
                 cells.append(Text(str(int(c)), style="bold red"))
             else:
@@ -620,6 +624,37 @@ def sweep_grid_table(result, max_columns: int = 25):
                 cells.append(Text(mark, style=style))
         t.add_row(label, *cells)
     return t
+
+
+def sweep_grid_tables(result, width: int) -> list:
+    """The map in blocks of columns that each fit ``width`` characters, whole values in headers.
+
+    Returns
+    -------
+    list of rich.table.Table
+        One table when the map fits, else one per block of x values (each
+        with the row labels); empty when the map has more than
+        :data:`MAX_MAP_COLUMNS` columns.
+    """
+    from rich.console import Console
+
+    n = len(result.x.values)
+    if n > MAX_MAP_COLUMNS:
+        return []
+    probe = Console(width=10_000, color_system=None, legacy_windows=False)
+
+    def fits(a: int, b: int) -> bool:
+        table = sweep_grid_table(result, slice(a, b))
+        return probe.measure(table).maximum <= width
+
+    tables, a = [], 0
+    while a < n:
+        b = n
+        while b > a + 1 and not fits(a, b):
+            b -= 1
+        tables.append(sweep_grid_table(result, slice(a, b)))
+        a = b
+    return tables
 
 
 def grid_caption(result) -> str:
@@ -642,13 +677,28 @@ def grid_caption(result) -> str:
     return text + "; · settled, s stuck, ? undetermined, - invalid, × failed"
 
 
-def _print_grid(console: "Console", result) -> None:
+def _print_grid(console: "Console", result, files: tuple = ()) -> None:
+    """The map at the console's width: in blocks of columns where it is wider.
+
+    A map wider than :data:`MAX_MAP_COLUMNS` is not tabulated: the line says
+    so and names the files that hold it (``files``), or the options that
+    write them.
+    """
     from rich.text import Text
 
-    table = sweep_grid_table(result)
-    if table is not None:
-        console.print(Text(grid_caption(result), style="dim"))
-        console.print(table)
+    tables = sweep_grid_tables(result, console.width)
+    if not tables:
+        where = (", ".join(str(f) for f in files) if files else
+                 "--figure OUT.svg or --csv OUT.csv (not written in this run)")
+        console.print(Text(f"the map has {len(result.x.values)} columns, too many to print "
+                           f"here: see {where}"))
+        return
+    console.print(Text(grid_caption(result), style="dim"))
+    if len(tables) > 1:
+        console.print(Text(f"(in {len(tables)} blocks of columns to fit {console.width} "
+                           "characters)", style="dim"))
+    for t in tables:
+        console.print(t)
 
 
 def _print_counts(console: "Console", counts: dict) -> None:
@@ -662,7 +712,7 @@ def _print_run(console: "Console", run, executor: str) -> None:
 
 
 def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
-                executor: str = "") -> None:
+                executor: str = "", files: tuple = ()) -> None:
     """Print the summary of a :class:`~fi_design.studies.SweepResult`.
 
     Parameters
@@ -675,6 +725,8 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
         The spec file, named in the heading.
     executor : str, optional
         How the points ran, for the last line.
+    files : tuple of pathlib.Path, optional
+        The files written with the map (named when the map is too wide to print).
     """
     from rich.text import Text
 
@@ -685,7 +737,7 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
     console.print(Text(f"{_axis_values_text(result.x)}; {plant}"))
     if result.y is not None:
         console.print(Text(_axis_values_text(result.y)))
-    _print_grid(console, result)
+    _print_grid(console, result, files)
     _print_counts(console, result.counts())
     xu, xf = axis_unit(result.x.unit)
     above = result.boundary("above")
@@ -704,7 +756,7 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
 
 
 def print_study(console: "Console", result, spec_path: Optional[Path] = None,
-                executor: str = "") -> None:
+                executor: str = "", out: Optional[Path] = None) -> None:
     """Print the summary of a :class:`~fi_design.studies.StudyResult`: one grid per map.
 
     Parameters
@@ -717,6 +769,8 @@ def print_study(console: "Console", result, spec_path: Optional[Path] = None,
         The spec file, named in the heading.
     executor : str, optional
         How the points ran, for the last line.
+    out : pathlib.Path, optional
+        The study's directory, whose files are named when a map is too wide to print.
     """
     from rich.text import Text
 
@@ -725,7 +779,8 @@ def print_study(console: "Console", result, spec_path: Optional[Path] = None,
         d = m.definition
         console.print(Text(f"\n{d.key}) {d.title}", style="bold"))
         console.print(Text(f"paper: {d.paper}", style="dim"))
-        _print_grid(console, m.result)
+        files = () if out is None else (out / f"map_{d.key}.csv", out / "figure4.svg")
+        _print_grid(console, m.result, files)
         _print_counts(console, m.result.counts())
     _print_run(console, result.run, executor)
 

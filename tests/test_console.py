@@ -119,3 +119,22 @@ def test_reconcile_and_identify_summaries_read_at_80_columns():
     assert "Identifiable" in ident and "N·s/m" in ident
 
 
+
+
+def test_a_wide_map_prints_whole_axis_values_in_blocks(paper_spec_path):
+    """At 80 columns the sweep's axis labels read '6.…', '10…' (and '2.…' at 120)."""
+    for width in (80, 120):
+        sweep = _run(["sweep", str(paper_spec_path), "--x", "controller.crossover=2 Hz:20 Hz:20",
+                      "--y", "isolator.stroke=0.1 mm:0.3 mm:2", "-j", "1"], width)
+        _readable(sweep, width)
+        headers = [ln for ln in sweep.splitlines() if ln.strip().startswith("[mm]")]
+        values = [float(v) for ln in headers for v in ln.split()[1:]]
+        assert values == pytest.approx([2 + 18 * i / 19 for i in range(20)], rel=6e-3), headers
+
+
+def test_a_map_too_wide_to_print_names_its_file(paper_spec_path, tmp_path):
+    csv = tmp_path / "line.csv"
+    out = _run(["sweep", str(paper_spec_path), "--x", "controller.crossover=2 Hz:20 Hz:70",
+                "--csv", str(csv), "-j", "1"], 80)
+    flat = " ".join(out.split())
+    assert f"the map has 70 columns, too many to print here: see {csv}" in flat
