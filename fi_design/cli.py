@@ -160,7 +160,7 @@ def simulate_command(
 ) -> None:
     """Simulate the stage once, or replay a measured record, and print the result.
 
-    The CSV has the columns of measured data (DESIGN.md section 4): time_s,
+    The CSV has the columns of measured data (docs/interfaces.md): time_s,
     reference_m, position_m, force_N (the commanded force) and, with the
     isolator, deflection_m; overlay it on your measurements. An open-loop
     replay (--drive force) adds a column ``window`` numbering the re-anchored
@@ -228,7 +228,7 @@ def init_command(
 
     out = check_output(path, force=force, extensions=(".yaml", ".yml"))
     text = files("fi_design").joinpath("example_spec.yaml").read_text(encoding="utf-8")
-    write_atomic(out, text)
+    write_atomic(out, text.replace("{path}", str(path)))
     typer.echo(f"wrote {out}; edit it, then run: fi-design {out}")
 
 

@@ -76,7 +76,7 @@ class Effect:
     Attributes
     ----------
     name : str
-        Stable name from DESIGN.md section 5.
+        Stable name (the interface: docs/effects.md).
     description : str
         How the effect enters the equations, one line.
     parameters : tuple of Parameter

@@ -1,6 +1,6 @@
 """The design spec: validated, immutable, in SI.
 
-A spec mirrors the YAML file key for key (DESIGN.md section 3), so one dotted
+A spec mirrors the YAML file key for key (docs/interfaces.md), so one dotted
 path (``friction.static``, ``isolator.stroke``) names a quantity in the file, in
 error messages, in ``fi-design sweep --x PATH=...`` and in JSON. Every physical
 field accepts an SI number or a string with units; after validation it holds an
@@ -22,6 +22,7 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Discriminator, Fie
                       Tag, WithJsonSchema, create_model, model_validator)
 
 from . import effects as _effects
+from .display import number
 from .trajectory import profile_duration
 from .units import to_si
 
@@ -219,11 +220,11 @@ class Feedforward(StrictModel):
 
 
 class Controller(StrictModel):
-    """The position controller: the paper's PID rule (DESIGN.md section 2) or the hardware's gains.
+    """The position controller: the paper's PID rule (paper section 2.2) or the hardware's gains.
 
-    Without ``gains`` the PID is tuned from ``crossover`` by the rule; with
-    ``gains`` the loop, the four limit cases, the simulation and the report
-    use the given gains, and the rule's gains are shown beside them.
+    Without gains the PID is tuned from the crossover by the rule; with gains
+    the loop, the four limit cases, the simulation and the report use the
+    given gains, and the rule's gains are shown beside them (docs/model.md).
     """
 
     crossover: OptQ("Hz") = Field(None, gt=0, description="Desired crossover frequency fc [Hz]; "
@@ -241,7 +242,7 @@ class Controller(StrictModel):
     roll_off: OptQ("Hz") = Field(None, gt=0, description="First-order low-pass of the D term "
                                                          "[Hz]. Default: with the rule its wt "
                                                          "(derivative_ratio x crossover); with "
-                                                         "`gains` none (an ideal D, sampled when "
+                                                         "gains none (an ideal D, sampled when "
                                                          "sample_rate is set).")
     force_limit: OptQ("N") = Field(None, gt=0, description="Actuator saturation of the hardware "
                                                            "[N]; null: none.")
@@ -344,10 +345,10 @@ class Ripple(StrictModel):
 class Robustness(StrictModel):
     """Friction scatter under which the design must stay hunting-free (part of the verdict).
 
-    The design command draws ``samples`` variants of the spec with static and
+    The design command draws 'samples' variants of the spec with static and
     Coulomb friction scattered (and, optionally, a ripple along the rail with
     a random phase per sample), simulates the stage as specified in each, and
-    compares the probability of hunting with ``hunting_probability``.
+    compares the probability of hunting with 'hunting_probability'.
     """
 
     static: Q("1") = Field(0.2, ge=0, lt=1, description="Scatter of static friction Fs, a "
@@ -594,7 +595,7 @@ EffectEntry = Annotated[
 
 
 class Spec(StrictModel):
-    """A friction-isolator design spec (DESIGN.md section 3), values in SI."""
+    """A friction-isolator design spec, values in SI (the keys: docs/interfaces.md)."""
 
     name: str = Field("Unnamed stage", description="Project or stage name.")
     stage: Body = Field(description="The actuated stage (m1, carries the sensor).")
@@ -605,8 +606,10 @@ class Spec(StrictModel):
     motion: Motion
     requirements: Requirements = Field(default_factory=Requirements)
     measurement: Measurement | None = None
-    effects: tuple[EffectEntry, ...] = Field((), description="Effects added to the model "
-                                                             "(DESIGN.md section 5).")
+    effects: tuple[EffectEntry, ...] = Field((), description="Effects added to the model, "
+                                                             "from the effects catalogue "
+                                                             "(fi-design schema --markdown "
+                                                             "lists them).")
     report: ReportInfo = Field(default_factory=ReportInfo)
     simulation: Simulation = Field(default_factory=Simulation)
 
@@ -665,7 +668,7 @@ def gains_crossover(spec: Spec) -> float:
 
     The frequency where |C(j w)| = m w^2, i.e. where the loop of the gains
     around a free tuning mass m crosses 0 dB (the rule's definition of the
-    crossover, DESIGN.md section 2), with C(s) = kp + ki / s + kd s / (1 + s / wf)
+    crossover, docs/model.md), with C(s) = kp + ki / s + kd s / (1 + s / wf)
     and wf the D term's roll-off (none when not given). Found by bisection
     on a log scale (|C| / (m w^2) falls with w for every such C).
     """
@@ -772,13 +775,14 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     A warning fires on the user's own values, and on a default only where the
     default is a poor fit for this spec (and then says so): a bristle damping
     the user gave that breaks the LuGre dissipativity condition sigma1 < sigma2
-    Fc / (Fs - Fc) (the default sqrt(sigma0 (m1 + m2)), damping ratio 0.5 of
-    the presliding mode, breaks it too, deliberately: a bristle damping low
-    enough to meet it rings in presliding; a value written out equal to the
-    default to four digits counts as the default), a stroke within five
-    presliding ranges, a hunting window that starts before the last move
-    ends, and a loop without the hardware's sampling and delay (a continuous
-    controller without delay: the margins and the hunting depend on both).
+    Fc / (Fs - Fc) (the warning recommends a value within the bound and says
+    what it costs: the presliding mode then rings; the default sqrt(sigma0
+    (m1 + m2)), damping ratio 0.5 of the presliding mode, breaks the bound
+    deliberately and is not warned about when left out), a stroke within
+    five presliding ranges, a hunting window that starts before the last
+    move ends, and a loop without the hardware's sampling and delay (a
+    continuous controller without delay: the margins and the hunting depend
+    on both).
     """
     out: list[tuple[str, str]] = []
     f = spec.friction
@@ -787,12 +791,18 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
         s1 = f.bristle_damping
         default = math.sqrt(f.bristle_stiffness * spec.total_mass)
         bound = f.viscous * f.coulomb / gap
-        if s1 >= bound and abs(s1 / default - 1.0) > 5e-4:
+        if s1 >= bound:
+            within = 0.9 * bound
+            ratio = within / (2.0 * default)  # sigma1 / (2 sqrt(sigma0 m)) of the presliding mode
+            advice = (f"a value below the bound, e.g. {number(within, 3)} N s/m, keeps it "
+                      f"dissipative but damps the presliding mode at a ratio of only "
+                      f"{number(ratio, 2)}, where the default sqrt(sigma0 (m1 + m2)) = "
+                      f"{number(default)} N s/m damps it at 0.5" if bound > 0 else
+                      "only sigma1 = 0 meets it without viscous or Coulomb friction")
             out.append(("friction.bristle_damping",
-                        f"sigma1 = {s1:.4g} N s/m (given) exceeds sigma2 Fc / (Fs - Fc) = "
-                        f"{bound:.4g} N s/m: the LuGre model is not guaranteed dissipative "
-                        f"(Barabanov and Ortega); the default sqrt(sigma0 (m1 + m2)) = "
-                        f"{default:.4g} N s/m damps the presliding mode at a ratio of 0.5"))
+                        f"sigma1 = {number(s1)} N s/m (given) is not below sigma2 Fc / (Fs - Fc) "
+                        f"= {number(bound)} N s/m: the LuGre model is not guaranteed dissipative "
+                        f"(Barabanov and Ortega); {advice}; leave the key out for the default"))
     if spec.isolator is not None:
         presl = f.static / f.bristle_stiffness
         if spec.isolator.stroke < 5 * presl:

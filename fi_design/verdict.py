@@ -342,9 +342,9 @@ def recommend(spec: _spec.Spec, crossover: CrossoverResult, simulation: Confirma
                          f"{m_own:g} Hz, from which the stage as specified settles in the "
                          f"scan{bound}")
     if not parts and scatter_fails:
-        parts.append("look for more margin to hunting under scatter: `fi-design robustness` "
-                     "studies the scatter, and the hunting map of the report (`--map`) shows "
-                     "where crossover and stroke give room")
+        parts.append("look for more margin to hunting under scatter: the command fi-design "
+                     "robustness studies the scatter, and the hunting map of the report (the "
+                     "option --map) shows where crossover and stroke give room")
     if not parts:
         return None
     text = "; ".join(parts)

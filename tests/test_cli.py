@@ -18,7 +18,7 @@ from conftest import BIN, ROOT
 
 runner = CliRunner()
 
-#: The JSON contract of `fi-design SPEC --json` (DESIGN.md section 6 and the guideline).
+#: The JSON contract of `fi-design SPEC --json` (docs/interfaces.md and the guideline).
 CONTRACT = {
     "friction_gap": ("gap", "threshold", "hunting_risk"),
     "pid": ("kp", "ki", "kd", "wt", "tuning_mass"),
@@ -269,3 +269,27 @@ def _fake_design(monkeypatch, calls):
         return _FakeResult()
 
     monkeypatch.setattr(fi_design.guideline, "design", fake)
+
+
+def test_init_derives_what_it_can_and_names_its_file(tmp_path):
+    """init wrote the 2 kg example's bristle damping, stiffness and joint damping as given
+    values, which stayed when the user changed the masses; and its header named bearing.yaml
+    whatever the file was called."""
+    import re
+
+    from fi_design import load_spec
+    from fi_design import spec as sp
+
+    path = tmp_path / "stage42.yaml"
+    r = runner.invoke(app, ["init", str(path)])
+    assert r.exit_code == 0, r.output
+    text = path.read_text()
+    assert f"fi-design {path}" in text and "bearing.yaml" not in text
+    spec = load_spec(path)
+    assert spec.friction.bristle_damping is None and spec.isolator.stiffness is None
+    assert spec.isolator.damping is None
+    heavier = tmp_path / "heavier.yaml"
+    heavier.write_text(re.sub(r"mass: 1\.6 kg", "mass: 16 kg", text, count=1))
+    big = load_spec(heavier)
+    assert sp.bristle_damping(big) == pytest.approx((1e6 * 16.4) ** 0.5)
+    assert sp.joint_damping(big) > sp.joint_damping(spec)

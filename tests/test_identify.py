@@ -9,7 +9,7 @@ Three kinds of evidence:
 - the real EMPS record (a ball-screw axis of about 100 kg under its documented PD loop):
   cross-validation between its halves, the documented order of the mass, and a closed-loop
   replay with the identified friction against the measured position;
-- bad input, the JSON of DESIGN.md section 8, the written spec and the report.
+- bad input, the JSON of docs/interfaces.md, the written spec and the report.
 """
 
 from __future__ import annotations

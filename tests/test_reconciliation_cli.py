@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 import yaml
@@ -85,6 +86,8 @@ def test_report_is_escaped_html(run):
         assert anchor in html
     assert "<script>alert(1)</script>" not in html
     assert "&lt;script&gt;" in html
+    visible = re.sub(r"<[^>]+>", " ", re.sub(r"<(svg|style)\b.*?</\1>", " ", html, flags=re.S))
+    assert "`" not in visible and "DESIGN.md" not in visible
 
 
 def test_outputs_never_overwrite_inputs(files):

@@ -693,3 +693,17 @@ def test_templates_ship_in_the_wheel_and_load_from_an_installed_copy(tmp_path):
     from fi_design.provenance import code_digest
 
     assert commit == "None" and digest == code_digest()
+
+
+def _visible_text(html: str) -> str:
+    """The text a reader sees: no figures, styles or tags."""
+    html = re.sub(r"<(svg|style|script)\b.*?</\1>", " ", html, flags=re.S)
+    return re.sub(r"<[^>]+>", " ", html)
+
+
+def test_no_markup_of_another_format_in_the_html(design_html):
+    """Literal backticks (Markdown) stood in the recommendation; RST roles and the developers'
+    design document have no place in a report either."""
+    text = _visible_text(design_html)
+    for mark in ("`", ":func:", ":class:", "DESIGN.md"):
+        assert mark not in text, (mark, text[max(0, text.find(mark) - 80):text.find(mark) + 80])

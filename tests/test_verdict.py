@@ -168,8 +168,9 @@ def test_robustness_failure_and_its_figures(cases):
 def test_warnings_only_pass_with_warnings(cases):
     r = cases["settling_isolated"]
     warns = [x for x in r.verdict.reasons if x.severity == "WARN"]
-    assert r.passed and [x.source for x in warns] == ["input"]
-    assert "controller.sample_rate" in warns[0].text     # no sampling and delay: say so
+    assert r.passed and [x.source for x in warns] == ["input", "input"]
+    assert "friction.bristle_damping" in warns[0].text   # the given sigma1 breaks its bound
+    assert "controller.sample_rate" in warns[1].text     # no sampling and delay: say so
     assert r.verdict.at_or_below("PASS_WITH_WARNINGS") and not r.verdict.at_or_below("FAIL")
 
 

@@ -1,4 +1,4 @@
-"""Result types of an identification (DESIGN.md section 8): values, not behaviour.
+"""Result types of an identification (JSON: docs/interfaces.md): values, not behaviour.
 
 :class:`IdentificationResult` holds one :class:`Parameter` per name of
 :data:`NAMES` (value, standard error, unit, identifiable, note), the
@@ -23,7 +23,7 @@ from ..results import dataclass_dict
 if TYPE_CHECKING:
     from .events import Excitation
 
-#: Parameters of an identification, in the order of DESIGN.md section 8.
+#: Parameters of an identification, in the order of its JSON (docs/interfaces.md).
 NAMES = ("mass", "coulomb", "coulomb_negative", "viscous", "viscous_negative", "offset",
          "static", "stribeck_velocity", "bristle_stiffness")
 #: SI unit of every parameter.
@@ -62,7 +62,7 @@ class Parameter:
     note: str
 
     def to_dict(self) -> dict:
-        """Plain JSON data (DESIGN.md section 8)."""
+        """Plain JSON data (docs/interfaces.md)."""
         return dataclass_dict(self)
 
 
@@ -348,7 +348,7 @@ class Dynamic:
 
 @dataclass(frozen=True, eq=False)
 class IdentificationResult:
-    """Friction and mass identified from a measured record (DESIGN.md section 8).
+    """Friction and mass identified from a measured record (docs/interfaces.md).
 
     Attributes
     ----------
@@ -409,7 +409,7 @@ class IdentificationResult:
         return self.parameters[name].value
 
     def to_dict(self) -> dict:
-        """Plain JSON data: ``parameters``, ``fit`` (DESIGN.md section 8) and the context."""
+        """Plain JSON data: ``parameters``, ``fit`` (docs/interfaces.md) and the context."""
         from .. import __version__
         from ..provenance import current_source
 

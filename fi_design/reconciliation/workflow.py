@@ -60,7 +60,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     isolated : bool, optional
         Model the isolated plant; default: whether the spec has an isolator.
     candidates : sequence of str, optional
-        Effect names to try; default the whole catalogue (DESIGN.md section 5).
+        Effect names to try; default the whole catalogue (docs/effects.md).
     max_effects : int
         Effects to name at most (default 1); each later one is searched on
         the gap the earlier ones leave.
