@@ -56,7 +56,7 @@ STUDIES = ("paper",)
 @app.command("design")
 def design_command(
     spec: Annotated[Path, typer.Argument(
-        metavar="SPEC.yaml", help="The design spec (YAML); `fi-design init` writes an example.",
+        metavar="SPEC.yaml", help="The design spec (YAML); fi-design init writes an example.",
         show_default=False)],
     json_out: JsonOut = None,
     no_simulation: Annotated[bool, typer.Option(
@@ -67,7 +67,7 @@ def design_command(
         "extension."),
     with_map: Annotated[bool, typer.Option(
         "--map", help="Add a crossover x stroke hunting map around the design point to the "
-                      "report (about 50 more simulations; also `report: {map: true}` in the "
+                      "report (about 50 more simulations; also report: {map: true} in the "
                       "spec).")] = False,
     write_spec: Optional[Path] = output_option("--write-spec", "OUT.yaml",
         "Write the spec with step 4's gains as controller.gains and controller.roll_off (the "
@@ -163,7 +163,7 @@ def simulate_command(
     The CSV has the columns of measured data (docs/interfaces.md): time_s,
     reference_m, position_m, force_N (the commanded force) and, with the
     isolator, deflection_m; overlay it on your measurements. An open-loop
-    replay (--drive force) adds a column ``window`` numbering the re-anchored
+    replay (--drive force) adds a column 'window' numbering the re-anchored
     windows.
     """
     check_drive(drive, record)
@@ -328,7 +328,7 @@ def study_command(
 ) -> None:
     """Run a named parameter study around the spec's design point.
 
-    `fi-design study paper SPEC.yaml` evaluates the paper's four maps (Figure
+    fi-design study paper SPEC.yaml evaluates the paper's four maps (Figure
     4) with the spec as the design point and writes the figure, one CSV per
     map and the JSON of the whole study into --out.
     """
@@ -520,8 +520,9 @@ def identify_command(
         "Write the report: force-velocity map, force residual, fit statistics (HTML, or PDF "
         "for a .pdf name)."),
     form: Annotated[str, typer.Option(
-        "--form", help="symmetric: one Coulomb friction and an offset; per-direction: Coulomb "
-                       "friction per direction, no offset.")] = "symmetric",
+        "--form", metavar="symmetric|per-direction",
+        help="symmetric: one Coulomb friction and an offset; per-direction: Coulomb "
+             "friction per direction, no offset.")] = "symmetric",
     force: Force = False,
 ) -> None:
     """Identify mass, friction and force offset from a measured record (guideline step 1).

@@ -293,3 +293,17 @@ def test_init_derives_what_it_can_and_names_its_file(tmp_path):
     big = load_spec(heavier)
     assert sp.bristle_damping(big) == pytest.approx((1e6 * 16.4) ** 0.5)
     assert sp.joint_damping(big) > sp.joint_damping(spec)
+
+
+@pytest.mark.parametrize("name", [None, "design", "simulate", "schema", "init", "sweep",
+                                  "study", "robustness", "reconcile", "identify"])
+def test_help_shows_no_type_labels_or_markup(name):
+    """--help showed '<bool>' beside every flag, '<path>' beside SPEC.yaml and RST or Markdown
+    markup (``window``, `fi-design init`)."""
+    import re
+
+    r = runner.invoke(app, ([name] if name else []) + ["--help"], env={"COLUMNS": "200"})
+    assert r.exit_code == 0, r.output
+    assert not re.search(r"<(bool|path|str|int|float|text|integer)\b[^>]*>", r.output), r.output
+    for mark in ("`", ":func:", ":class:", ":mod:"):
+        assert mark not in r.output, (mark, r.output)
