@@ -15,8 +15,8 @@ from typing import Any
 from ..display import (DISPLAY_SCALES, NBSP, UNIT_TEXT, display_scale, number, quantity,
                        unit_text)
 
-__all__ = ["num", "qty", "unit_text", "display_scale", "tex_num", "tex_qty", "FILTERS",
-           "UNIT_TEXT", "DISPLAY_SCALES"]
+__all__ = ["num", "qty", "unit_text", "display_scale", "tex_num", "tex_qty", "wrapped_lines",
+           "FILTERS", "UNIT_TEXT", "DISPLAY_SCALES", "WRAP_WIDTH", "WRAP_MARK"]
 
 _PLAIN_DIGITS = str.maketrans("\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078"
                               "\u2079", "-0123456789")
@@ -97,5 +97,33 @@ def tex_qty(value: float, unit: str, digits: int = 4) -> str:
     return f"{text}\\ \\mathrm{{{unit_tex}}}"
 
 
+#: Characters of a spec line the appendix prints in one row (A4 at the appendix's 7.8 pt
+#: monospace: about 100 fit); a longer line continues in rows marked by ``WRAP_MARK``.
+WRAP_WIDTH = 96
+#: What the appendix prints before a row that continues the line above (CSS-generated: a mark
+#: of the page, not a character of the text, whose SHA-256 stays the file's).
+WRAP_MARK = "\u21aa "
+
+
+def wrapped_lines(text: str, width: int = WRAP_WIDTH) -> list[list[str]]:
+    """The text's lines cut into rows of at most ``width`` characters (the line end kept).
+
+    Joined, the rows give the text back exactly: ``"".join(sum(rows, []))``.
+    A continuation row holds ``len(WRAP_MARK)`` characters fewer, room for the mark.
+    """
+    out = []
+    for line in text.splitlines(keepends=True):
+        body = line.rstrip("\r\n")
+        end = line[len(body):]
+        rows, rest, room = [], body, width
+        while len(rest) > room:
+            rows.append(rest[:room])
+            rest = rest[room:]
+            room = width - len(WRAP_MARK)
+        rows.append(rest + end)
+        out.append(rows)
+    return out
+
+
 #: The jinja filters of every report template.
-FILTERS = {"num": num, "qty": qty, "unit": unit_text}
+FILTERS = {"num": num, "qty": qty, "unit": unit_text, "rows": wrapped_lines}
