@@ -264,6 +264,22 @@ def quantities(values: Sequence[Any], unit: str, digits: int = 4, *,
                sep: str = " ") -> list[str]:
     """Values read together (one sentence, one row) in one unit, picked by the largest.
 
+    Parameters
+    ----------
+    values : sequence of float or None
+        SI values.
+    unit : str
+        Their SI unit.
+    digits : int, optional
+        Significant digits.
+    sep : str, optional
+        Between number and unit.
+
+    Returns
+    -------
+    list of str
+        One text per value, all in the unit :func:`scale` picks.
+
     Examples
     --------
     >>> quantities([22e-6, 278e-6, 300e-6], "m", 3)
@@ -307,7 +323,19 @@ def with_error(value: Any, error: Any, unit: str = "", digits: int = 4, error_di
 
 
 def percent(fraction: Any, digits: int = 3) -> str:
-    """A fraction as a percentage: ``percent(0.0612)`` -> ``6.12 %``; None -> ``n/a``."""
+    """A fraction as a percentage: ``percent(0.0612)`` -> ``6.12 %``; None -> ``n/a``.
+
+    Parameters
+    ----------
+    fraction : float or None
+        The fraction [-].
+    digits : int, optional
+        Significant digits of the percentage.
+
+    Returns
+    -------
+    str
+    """
     if fraction is None or not _is_number(fraction):
         return "n/a"
     return f"{number(100.0 * fraction, digits)} %"
