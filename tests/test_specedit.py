@@ -118,3 +118,22 @@ def test_spec_quantity_keeps_every_digit():
     assert text == "33073.41234567891 N/(m*s)"
     spec_unit = spec_quantity("isolator.stroke", 1e-05)
     assert spec_unit == "1e-05 m"
+
+
+def test_a_recommended_isolator_and_crossover_written_into_a_spec_without_one():
+    """What `recommend --write-spec` needs: a section added, values replaced, comments kept."""
+    spec = load_spec(EXAMPLES / "no_isolator.yaml")
+    values = {"isolator.stroke": spec_quantity("isolator.stroke", 3e-4),
+              "isolator.stiffness": spec_quantity("isolator.stiffness", 6666.67),
+              "isolator.damping": spec_quantity("isolator.damping", 4.62),
+              "controller.crossover": spec_quantity("controller.crossover", 9.5)}
+    text = edited_spec_text(spec, values, comments={"isolator.stroke": "recommended"},
+                            header="recommended by a test")
+    written = load_spec(yaml.safe_load(text))
+    assert written.isolator.stroke == 3e-4 and written.isolator.stiffness == 6666.67
+    assert written.isolator.damping == 4.62 and written.controller.crossover == 9.5
+    original = (EXAMPLES / "no_isolator.yaml").read_text()
+    for line in original.splitlines():
+        if "crossover:" not in line:
+            assert line in text, line  # every other line of the input, comments included
+    assert "\n\nisolator:\n  stroke: 0.0003 m" in text  # a new section after a blank line
