@@ -4,7 +4,9 @@ A CAD or automation script varies a design parameter, re-validates the spec and
 reads the numbers it needs from the result. Here the stroke of the isolator
 goes from 0.1 mm to 0.5 mm; for each stroke the drive stiffness is left open so
 that step 3 chooses it, and the script prints the maximum drive stiffness
-k_max = Fs / stroke and the crossover the controller can reach.
+k_max = Fs / stroke and the crossover the controller can reach. The linear
+steps alone (``confirm=False``) do not simulate the stage, so the verdict's
+status is NOT_CONFIRMED: a design that was not simulated never passes.
 
 Run from anywhere:  python examples/cad_loop.py
 """
@@ -32,7 +34,8 @@ def main() -> None:
     with open(HERE / "paper_setup.yaml", encoding="utf-8") as fh:
         mapping = yaml.safe_load(fh)
 
-    print(f"{'stroke [mm]':>12} {'k_max [N/m]':>12} {'k [N/m]':>10} {'achievable fc [Hz]':>19}")
+    print(f"{'stroke [mm]':>12} {'k_max [N/m]':>12} {'k [N/m]':>10} {'achievable fc [Hz]':>19}"
+          f"  status")
     for stroke_mm in (0.1, 0.2, 0.3, 0.5):
         variant = copy.deepcopy(mapping)
         variant["isolator"]["stroke"] = f"{stroke_mm} mm"
@@ -43,7 +46,7 @@ def main() -> None:
         stiffness = result["stiffness"]
         crossover = result["crossover"]
         print(f"{stroke_mm:>12.2f} {stiffness['maximum']:>12.0f} {stiffness['chosen']:>10.0f} "
-              f"{crossover['achievable']:>19.3g}")
+              f"{crossover['achievable']:>19.3g}  {result['verdict']['status']}")
 
     # The spec resolved once into a model (every default filled in); model.at gives
     # the same stage with a value changed, checked like the spec (SpecError otherwise).

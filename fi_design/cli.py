@@ -14,7 +14,8 @@ library raises; :class:`~fi_design.cliparts.DefaultCommandGroup` translates:
 - exit 1: internal error -- a bug; ``--debug`` or ``FI_DESIGN_DEBUG=1`` shows
   the traceback;
 - exit 3: the design verdict is at or below the level of ``--fail-on``
-  (``fail``: FAIL; ``warn``: FAIL or PASS_WITH_WARNINGS), for scripts and CI;
+  (``fail``: the design does not pass, FAIL or NOT_CONFIRMED; ``warn``: also
+  PASS_WITH_WARNINGS), for scripts and CI;
   the outputs are written first;
 - exit 130: a parameter study interrupted with Ctrl-C.
 
@@ -56,7 +57,7 @@ STUDIES = ("paper",)
 @app.command("design")
 def design_command(
     spec: Annotated[Path, typer.Argument(
-        metavar="SPEC.yaml", help="The design spec (YAML); `fi-design init` writes an example.",
+        metavar="SPEC.yaml", help="The design spec (YAML); fi-design init writes an example.",
         show_default=False)],
     json_out: JsonOut = None,
     no_simulation: Annotated[bool, typer.Option(
@@ -67,17 +68,21 @@ def design_command(
         "extension."),
     with_map: Annotated[bool, typer.Option(
         "--map", help="Add a crossover x stroke hunting map around the design point to the "
-                      "report (about 50 more simulations; also `report: {map: true}` in the "
+                      "report (about 50 more simulations; also report: {map: true} in the "
                       "spec).")] = False,
+    write_spec: Optional[Path] = output_option("--write-spec", "OUT.yaml",
+        "Write the spec with step 4's gains as controller.gains and controller.roll_off (the "
+        "form the spec and a drive take; comments kept; never the input)."),
     fail_on: Annotated[Optional[str], typer.Option(
         "--fail-on", metavar="fail|warn",
         help="Exit with code 3 (after writing the outputs) when the verdict is at or below "
-             "this level: 'fail' on FAIL, 'warn' on FAIL or PASS_WITH_WARNINGS; for scripts "
+             "this level: 'fail' when it does not pass (FAIL, or NOT_CONFIRMED without "
+             "simulation), 'warn' on PASS_WITH_WARNINGS too; for scripts "
              "and CI.")] = None,
     no_recommend: Annotated[bool, typer.Option(
         "--no-recommend", help="On a FAIL verdict, skip the search for a design that passes "
-                               "(it takes seconds to a minute; `fi-design recommend` runs it "
-                               "alone).")] = False,
+                               "(it takes seconds to a minute; the command fi-design recommend "
+                               "runs it alone).")] = False,
     force: Force = False,
 ) -> None:
     """Run the four-step guideline on a spec and confirm it by simulation (the default command).
@@ -91,7 +96,7 @@ def design_command(
     writes JSON and the sign-off report (HTML or PDF) on request. With
     --fail-on, exits 3 when the verdict is at or below that level.
     """
-    levels = {"fail": "FAIL", "warn": "PASS_WITH_WARNINGS"}
+    levels = {"fail": "NOT_CONFIRMED", "warn": "PASS_WITH_WARNINGS"}
     if fail_on is not None and fail_on not in levels:
         raise typer.BadParameter(f"expected 'fail' or 'warn', got {fail_on!r}",
                                  param_hint="--fail-on")
@@ -102,7 +107,8 @@ def design_command(
         raise typer.BadParameter("the map simulates; it cannot go with --no-simulation",
                                  param_hint="--map")
     outs = check_outputs((spec,), force, json=(json_out, (".json",)),
-                    report=(report_out, (".html", ".pdf")))
+                         report=(report_out, (".html", ".pdf")),
+                         spec=(write_spec, (".yaml", ".yml")))
     spec_obj = load(spec)
 
     from .console import Status, make_console, print_design
@@ -115,6 +121,10 @@ def design_command(
         result = design(spec_obj, confirm=not no_simulation, executor=pool, progress=status,
                         recommend=not no_recommend)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
+    if outs["spec"] is not None:
+        from .handoff import gains_spec_text
+
+        payloads["spec"] = gains_spec_text(result)
     print_design(console, result, spec_path=spec)
     write_outputs(console, outs, payloads)
     design_map = None
@@ -156,10 +166,10 @@ def simulate_command(
 ) -> None:
     """Simulate the stage once, or replay a measured record, and print the result.
 
-    The CSV has the columns of measured data (DESIGN.md section 4): time_s,
+    The CSV has the columns of measured data (docs/interfaces.md): time_s,
     reference_m, position_m, force_N (the commanded force) and, with the
     isolator, deflection_m; overlay it on your measurements. An open-loop
-    replay (--drive force) adds a column ``window`` numbering the re-anchored
+    replay (--drive force) adds a column 'window' numbering the re-anchored
     windows.
     """
     check_drive(drive, record)
@@ -224,7 +234,7 @@ def init_command(
 
     out = check_output(path, force=force, extensions=(".yaml", ".yml"))
     text = files("fi_design").joinpath("example_spec.yaml").read_text(encoding="utf-8")
-    write_atomic(out, text)
+    write_atomic(out, text.replace("{path}", str(path)))
     typer.echo(f"wrote {out}; edit it, then run: fi-design {out}")
 
 
@@ -296,7 +306,8 @@ def sweep_command(
         measure=measure))
     console = make_console()
     write_study(console, outs, result, sweep_figure)
-    print_sweep(console, result, spec_path=spec, executor=pool.describe())
+    print_sweep(console, result, spec_path=spec, executor=pool.describe(),
+                files=tuple(p for p in (outs["figure"], outs["csv"]) if p is not None))
 
 
 @app.command("study")
@@ -327,7 +338,7 @@ def study_command(
 ) -> None:
     """Run a named parameter study around the spec's design point.
 
-    `fi-design study paper SPEC.yaml` evaluates the paper's four maps (Figure
+    fi-design study paper SPEC.yaml evaluates the paper's four maps (Figure
     4) with the spec as the design point and writes the figure, one CSV per
     map and the JSON of the whole study into --out.
     """
@@ -370,7 +381,7 @@ def study_command(
         write_atomic(targets[name], data)
     console.print(f"wrote {', '.join(payloads)} to {out}", markup=False)
     write_report(console, report_path, result)
-    print_study(console, result, spec_path=spec, executor=pool.describe())
+    print_study(console, result, spec_path=spec, executor=pool.describe(), out=out)
 
 
 @app.command("robustness")
@@ -564,8 +575,9 @@ def identify_command(
         "Write the report: force-velocity map, force residual, fit statistics (HTML, or PDF "
         "for a .pdf name)."),
     form: Annotated[str, typer.Option(
-        "--form", help="symmetric: one Coulomb friction and an offset; per-direction: Coulomb "
-                       "friction per direction, no offset.")] = "symmetric",
+        "--form", metavar="symmetric|per-direction",
+        help="symmetric: one Coulomb friction and an offset; per-direction: Coulomb "
+             "friction per direction, no offset.")] = "symmetric",
     force: Force = False,
 ) -> None:
     """Identify mass, friction and force offset from a measured record (guideline step 1).

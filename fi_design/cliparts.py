@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Optional
 
 import typer
-from typer.core import TyperGroup
+from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
 from .errors import FiDesignError
 
@@ -48,6 +48,37 @@ def _debug_requested(ctx: typer.Context | None = None) -> bool:
     return bool(ctx is not None and ctx.params.get("debug"))
 
 
+class _HelpOption(TyperOption):
+    """An option whose help shows its metavar only: no ``<bool>`` beside a flag."""
+
+    def display_type_rich(self, ctx: Any) -> str | None:
+        return None if self.is_flag else super().display_type_rich(ctx)
+
+
+class _HelpArgument(TyperArgument):
+    """An argument named by its metavar (``SPEC.yaml``), without ``<path>`` beside it."""
+
+    def display_type_rich(self, ctx: Any) -> str | None:
+        return None if self.metavar else super().display_type_rich(ctx)
+
+
+def plain_help(params: list) -> list:
+    """The parameters of a command, made to show their help without type labels (in place)."""
+    for param in params:
+        if type(param) is TyperOption:
+            param.__class__ = _HelpOption
+        elif type(param) is TyperArgument:
+            param.__class__ = _HelpArgument
+    return params
+
+
+class HelpCommand(TyperCommand):
+    """A command whose ``--help`` names each option by its metavar, flags plainly."""
+
+    def get_params(self, ctx: Any) -> list:
+        return plain_help(super().get_params(ctx))
+
+
 class DefaultCommandGroup(TyperGroup):
     """A command group that runs :data:`DEFAULT_COMMAND` when no command is named.
 
@@ -64,6 +95,15 @@ class DefaultCommandGroup(TyperGroup):
     """
 
     default_command = DEFAULT_COMMAND
+
+    def get_params(self, ctx: Any) -> list:
+        return plain_help(super().get_params(ctx))
+
+    def get_command(self, ctx: Any, cmd_name: str) -> Any:
+        command = super().get_command(ctx, cmd_name)
+        if type(command) is TyperCommand:  # every command's help without type labels
+            command.__class__ = HelpCommand
+        return command
 
     def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
         args = list(args)

@@ -37,6 +37,7 @@ error its outcome is ``static_error``, not ``stuck``
 from __future__ import annotations
 
 from . import spec as _spec
+from .display import quantities, quantity
 from .errors import ArgumentError
 from .model import Model, as_model
 from .results import Check, Status
@@ -174,9 +175,9 @@ def confirm(spec: _spec.Spec | Model, suggestion: tuple[float, float] | None = N
 def _plant_text(v: PlantVerdict, label: str, fc: float) -> str:
     m = v.metrics
     if v.outcome == "static_error":
-        return (f"{label} at {fc:g} Hz: at rest {abs(m.final_error) * 1e6:.3g} um from its "
-                f"target, within the static error (Fc + |offset|) / kp = "
-                f"{v.static_error_bound * 1e6:.3g} um of a loop without integrator (not stuck)")
+        rest, bound = quantities((abs(m.final_error), v.static_error_bound), "m", 3)
+        return (f"{label} at {fc:g} Hz: at rest {rest} from its target, within the static "
+                f"error (Fc + |offset|) / kp = {bound} of a loop without integrator (not stuck)")
     return f"{label} at {fc:g} Hz: {m.verdict} ({m.reason})"
 
 
@@ -249,7 +250,7 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
         where = "the suggested isolator's cart" if suggested else "the cart"
         out.append(Check(
             "landing_force", None if suggested else ok, land.force, land.static_friction, "N",
-            f"{where} lands at {land.deflection * 1e6:.3g} um joint deflection "
+            f"{where} lands at {quantity(land.deflection, 'm', 3)} joint deflection "
             f"({'on the limiter' if land.on_limiter else 'inside the stroke'}): flexure force "
             f"k min(|d|, s) = {land.force:.3g} N against Fs = {land.static_friction:.3g} N "
             f"(the rule's bound k s = {land.rule_force:.3g} N)", "step 3 refinement: landing"))

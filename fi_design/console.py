@@ -13,6 +13,9 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Optional
 
+from .display import axis_unit, number, percent, quantity, scale, unit_text
+from .effects import values_text as _effects_text
+
 if TYPE_CHECKING:  # pragma: no cover
     from rich.console import Console
 
@@ -39,67 +42,6 @@ def make_console(stderr: bool = False) -> "Console":
     return console
 
 
-def _fmt(value: Any, digits: int = 4) -> str:
-    """A number for a table cell: ``digits`` significant digits, '-' for none.
-
-    Plain notation from 1e-4 to 1e6 (``13333``, ``0.001348``), else a power of
-    ten (``3.2e-08``); integers in full.
-    """
-    if value is None:
-        return "-"
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float) or hasattr(value, "dtype"):
-        x = float(value)
-        if not math.isfinite(x):
-            return "-" if math.isnan(x) else "inf" if x > 0 else "-inf"
-        ax = abs(x)
-        if x == 0 or not 1e-4 <= ax < 1e6:
-            return "0" if x == 0 else f"{x:.{digits}g}"
-        decimals = max(0, digits - 1 - math.floor(math.log10(ax)))
-        text = f"{x:.{decimals}f}"
-        if "." in text:
-            text = text.rstrip("0").rstrip(".")
-        return "0" if text in ("-0", "") else text
-    return str(value)
-
-
-def _qty(value: Any, unit: str, digits: int = 4) -> str:
-    """A value with its unit for a table cell, scaled for reading: ``1.37 mm``, ``25.2 µm``.
-
-    Lengths below 0.1 mm are shown in µm, longer ones in mm, speeds in mm/s,
-    stresses with a prefix (the report's rule, :func:`fi_design.report.filters.display_scale`).
-
-    Parameters
-    ----------
-    value : float or None
-        SI value.
-    unit : str
-        Its SI unit.
-    digits : int, optional
-        Significant digits.
-
-    Returns
-    -------
-    str
-        ``-`` for None.
-    """
-    from .report.filters import display_scale
-
-    if value is None or isinstance(value, bool) or not isinstance(value, (int, float)):
-        return _fmt(value)
-    if not math.isfinite(value):
-        return "inf" if value > 0 else "-inf" if value < 0 else "-"
-    if value == 0:
-        return "0"
-    if unit == "m" and 0 < abs(value) < 5e-10:
-        return "< 0.001 \u00b5m"  # below what a position sensor resolves
-    shown, factor = display_scale(unit, value)
-    return f"{_fmt(value * factor, digits)} {shown}".rstrip()
-
-
 def _table(title: str | None = None, **options: Any):
     """A compact rich table: simple head rule, one space between columns, title on the left."""
     from rich import box
@@ -107,18 +49,6 @@ def _table(title: str | None = None, **options: Any):
 
     return Table(title=title, title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False,
                  collapse_padding=True, **options)
-
-
-def _row_scale(unit: str, values: Any) -> tuple[str, float]:
-    """One display unit for a table row of SI values (µm for micrometre-sized lengths)."""
-    from .report.filters import display_scale, unit_text
-
-    finite = [abs(v) for v in values if isinstance(v, (int, float)) and not isinstance(v, bool)
-              and math.isfinite(v) and v != 0]
-    if unit in ("-", "1", ""):
-        return "-", 1.0
-    shown, factor = display_scale(unit, max(finite) if finite else None)
-    return shown or unit_text(unit), factor
 
 
 def _status_text(status: Any):
@@ -184,10 +114,10 @@ def checks_table(checks, title: str = "Checks", cases: Any = None):
         if row["message"]:
             cell.append("\n")
             cell.append(Text(row["message"], style="dim"))
-        limit = _fmt(row["limit"])
+        limit = number(row["limit"])
         if row["sense"] and row["limit"] is not None:
             limit = f"{row['sense']} {limit}"
-        table.add_row(cell, _status_text(c.status), _fmt(row["value"]), limit,
+        table.add_row(cell, _status_text(c.status), number(row["value"]), limit,
                       Text(row["unit"] or ""))
     return table
 
@@ -244,8 +174,8 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     if gap:
         risk = gap.get("hunting_risk")
         console.print(Text(
-            f"Friction gap Fs - Fc = {_fmt(gap.get('gap'))} N (threshold "
-            f"{_fmt(gap.get('threshold'))} N): "
+            f"Friction gap Fs - Fc = {number(gap.get('gap'))} N (threshold "
+            f"{number(gap.get('threshold'))} N): "
             + ("hunting is a risk" if risk else "hunting unlikely" if risk is not None else "")))
 
     loop = getattr(result, "loop", None)
@@ -254,37 +184,15 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
 
     pid = data.get("pid") or {}
     if pid:
-        if pid.get("source") == "gains":
-            # the hardware's loop beside the rule's gains in the same form
-            hw, rule = pid["controller"], pid["rule_in_hardware_form"]
-            t = Table(title="PID gains (step 4): the hardware's, and the rule's at the same "
-                            "crossover", title_justify="left", box=box.SIMPLE_HEAD,
-                      pad_edge=False)
-            t.add_column("")
-            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "D roll-off [Hz]"):
-                t.add_column(Text(col), justify="right", no_wrap=True)
-            for label, g in (("hardware", hw), ("rule", rule)):
-                wf = g.get("roll_off")
-                t.add_row(label, _fmt(g.get("kp")), _fmt(g.get("ki")), _fmt(g.get("kd")),
-                          "none" if wf is None else _fmt(wf / (2 * math.pi)))
-            console.print(t)
-        else:
-            t = Table(title="PID gains (step 4)", title_justify="left", box=box.SIMPLE_HEAD,
-                      pad_edge=False)
-            for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "wt [rad/s]",
-                        "tuning mass [kg]"):
-                t.add_column(Text(col), justify="right", no_wrap=True)
-            t.add_row(_fmt(pid.get("kp")), _fmt(pid.get("ki")), _fmt(pid.get("kd")),
-                      _fmt(pid.get("wt")), _fmt(pid.get("tuning_mass")))
-            console.print(t)
+        console.print(_gains_table(pid))
 
     xo = data.get("crossover") or {}
     if xo:
-        line = (f"Crossover: desired {_fmt(xo.get('desired'))} Hz, achievable "
-                f"{_fmt(xo.get('achievable'))} Hz")
+        line = (f"Crossover: desired {number(xo.get('desired'))} Hz, achievable "
+                f"{number(xo.get('achievable'))} Hz")
         if xo.get("limit_kind") == "scan_limit":   # the search cap: a bound, not a result
-            line = (f"Crossover: desired {_fmt(xo.get('desired'))} Hz; the linear model limits "
-                    f"it nowhere below {_fmt(xo.get('achievable'))} Hz (the search cap)")
+            line = (f"Crossover: desired {number(xo.get('desired'))} Hz; the linear model limits "
+                    f"it nowhere below {number(xo.get('achievable'))} Hz (the search cap)")
         elif xo.get("limited_by"):
             line += f", limited by {xo['limited_by']}"
         console.print(Text(line))
@@ -296,15 +204,15 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     if stiff.get("maximum") is not None:
         if stiff.get("suggested"):
             text = (f"Drive stiffness (suggestion for an isolator with a "
-                    f"{_fmt(1e3 * stiff['stroke'], 3)} mm stroke): k_max = "
-                    f"{_fmt(stiff['maximum'])} N/m, start from k = {_fmt(stiff.get('chosen'))} N/m")
+                    f"{number(1e3 * stiff['stroke'], 3)} mm stroke): k_max = "
+                    f"{number(stiff['maximum'])} N/m, start from k = {number(stiff.get('chosen'))} N/m")
         else:
-            text = (f"Drive stiffness: k_max = {_fmt(stiff['maximum'])} N/m, chosen k = "
-                    f"{_fmt(stiff.get('chosen'))} N/m")
+            text = (f"Drive stiffness: k_max = {number(stiff['maximum'])} N/m, chosen k = "
+                    f"{number(stiff.get('chosen'))} N/m")
             if stiff.get("source"):
                 text += f" ({stiff['source']})"
             if stiff.get("force_at_stroke") is not None:
-                text += f", flexure force at full stroke {_fmt(stiff['force_at_stroke'], 3)} N"
+                text += f", flexure force at full stroke {number(stiff['force_at_stroke'], 3)} N"
         console.print(Text(text))
 
     sim = data.get("simulation")
@@ -327,9 +235,44 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
         console.print(Text("warning: ", style="bold yellow").append(Text(_warning_text(w))))
 
 
+def _gains_table(pid: dict) -> Any:
+    """Step 4's gains in the form the spec's ``controller.gains`` takes (``pid.hand_off``).
+
+    With the hardware's own gains, the rule's at the same crossover in the same
+    form beside them. The roll-off is ``controller.roll_off``: a low-pass on the
+    D term only; the sampling and delay are the ones the analysis used.
+    """
+    from rich.text import Text
+
+    hand = pid["hand_off"]
+    rows = [("hardware" if pid.get("source") == "gains" else "rule", hand)]
+    if pid.get("source") == "gains":
+        rows.append(("rule", {**hand, **pid["rule_in_hardware_form"],
+                              "roll_off": pid["rule_in_hardware_form"]["roll_off"]
+                              / (2 * math.pi)}))
+    t = _table("PID gains (step 4) as controller.gains takes them: kp + ki/s + kd s / (1 + "
+               "s/(2 pi roll_off)), the roll-off on the D term only")
+    t.add_column("")
+    for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "roll_off [Hz]"):
+        t.add_column(Text(col), justify="right", no_wrap=True)
+    for label, g in rows:
+        t.add_row(label, number(g["kp"]), number(g["ki"]), number(g["kd"]),
+                  "none" if g["roll_off"] is None else number(g["roll_off"]))
+    sampled = ("continuous" if hand["sample_rate"] is None
+               else f"sampled at {quantity(hand['sample_rate'], 'Hz')}")
+    delay = "no delay" if not hand["delay"] else f"delay {quantity(hand['delay'], 's')}"
+    t.caption = Text(f"D on the {hand['derivative_on']}, {sampled}, {delay}, tuned on "
+                     f"{quantity(pid['tuning_mass'], 'kg')} (controller.derivative_on, "
+                     "sample_rate and delay); --write-spec writes them into a spec",
+                     style="dim")
+    t.caption_justify = "left"
+    return t
+
+
 #: Border and title style of the verdict box per status; a stage that does not settle gets a
 #: heavy frame, so the box differs in shape too (monochrome terminals, logs).
 _VERDICT_LOOK = {"PASS": ("green", "ROUNDED"), "PASS_WITH_WARNINGS": ("yellow", "ROUNDED"),
+                 "NOT_CONFIRMED": ("yellow", "DOUBLE"),
                  "FAIL": ("red", "HEAVY")}
 
 
@@ -339,7 +282,8 @@ def print_verdict(console: "Console", result) -> None:
     The box names what the stage as specified does (settles, hunts, ...), lists
     the reasons (FAIL, WARN, PASS), then the robustness under friction scatter,
     the margins with units and the recommendation. A green rounded frame for
-    PASS, yellow for PASS_WITH_WARNINGS, a heavy red one for FAIL.
+    PASS, yellow for PASS_WITH_WARNINGS, a double yellow one for NOT_CONFIRMED (not
+    simulated: it does not pass), a heavy red one for FAIL.
 
     Parameters
     ----------
@@ -363,19 +307,18 @@ def print_verdict(console: "Console", result) -> None:
         body.add_row(_status_text(r.severity), Text(r.text))
     rob, mar = result.robustness, result.margins
     if rob is not None:
-        p = "-" if rob.hunting_probability is None else f"{100 * rob.hunting_probability:.3g} %"
         body.add_row(Text("Scatter", style="bold"), Text(
-            f"does not settle in {p} of {rob.valid} samples ({100 * rob.interval[0]:.2g}-"
-            f"{100 * rob.interval[1]:.3g} % at {100 * rob.confidence:.3g} %), limit "
-            f"{100 * rob.limit:.3g} %"))
+            f"does not settle in {percent(rob.hunting_probability)} of {rob.valid} samples "
+            f"({percent(rob.interval[0])} to {percent(rob.interval[1])} at "
+            f"{percent(rob.confidence)}), limit {percent(rob.limit)}"))
     if mar is not None:
         items = []
         if mar.crossover_factor is not None:
             items.append(f"crossover {'>= ' if mar.crossover_factor_bound else ''}"
                          f"{mar.crossover_factor:.3g}x the hunting-free "
-                         f"{_fmt(mar.hunting_free_crossover, 4)} Hz")
+                         f"{number(mar.hunting_free_crossover, 4)} Hz")
         if mar.end_stop_clearance is not None:
-            items.append(f"end stop {_qty(mar.end_stop_clearance, 'm', 3)} away at rest")
+            items.append(f"end stop {quantity(mar.end_stop_clearance, 'm', 3)} away at rest")
         if mar.stiffness_factor is not None:
             items.append(f"k_max / k = {mar.stiffness_factor:.3g}")
         if mar.stiffness_range is not None:
@@ -383,8 +326,8 @@ def print_verdict(console: "Console", result) -> None:
             items.append(f"k {lo:.4g}-{hi:.4g} N/m for t = {1e3 * mar.thickness:.3g} \u00b1 "
                          f"{1e3 * mar.thickness_tolerance:.2g} mm")
         if mar.static_error is not None:
-            items.append(f"static error {_qty(mar.static_error, 'm', 3)} of "
-                         f"{_qty(mar.static_error_bound, 'm', 3)} (Fc + |offset|) / kp")
+            items.append(f"static error {quantity(mar.static_error, 'm', 3)} of "
+                         f"{quantity(mar.static_error_bound, 'm', 3)} (Fc + |offset|) / kp")
         if items:
             body.add_row(Text("Margins", style="bold"), Text("; ".join(items)))
     if result.recommendation is not None:
@@ -435,8 +378,8 @@ def moves_strips(stages: dict, suggested: bool = False) -> list:
             if not side:
                 continue
             lo, hi = abs(side[0]["distance"]), abs(side[-1]["distance"])
-            unit, f = _row_scale("m", [lo, hi])
-            line = Text(f"Moves {_fmt(lo * f, 3)} to {_fmt(hi * f, 3)} {unit}, "
+            unit, f = scale("m", [lo, hi])
+            line = Text(f"Moves {number(lo * f, 3)} to {number(hi * f, 3)} {unit}, "
                         f"{names[key]}{word}: ")
             for m in side:
                 glyph, style = MOVE_GLYPHS.get(m["outcome"], ("x", "bold yellow"))
@@ -479,7 +422,7 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None,
     for _, name in plants:
         t.add_column(Text(name), justify="right")
     counted = "in the window" if window is None else \
-        f"in [{_fmt(float(window[0]))} s, {_fmt(float(window[1]))} s)"
+        f"in [{number(float(window[0]))} s, {number(float(window[1]))} s)"
 
     def verdict_text(verdict: str) -> Any:
         style = {"settled": "bold green", "settles": "bold green", "static_error": "bold green",
@@ -496,7 +439,7 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None,
         b = stage(key).get("boundary") or {}
         if m is None:
             return "above the search" if b.get("kind") == "bound" else "-"
-        return f"{_fmt(m, 4)} Hz" + ("" if b.get("kind") == "fold" else " (bound)")
+        return f"{number(m, 4)} Hz" + ("" if b.get("kind") == "fold" else " (bound)")
 
     def hunting_moves(key: str) -> str:
         st = stage(key)
@@ -508,9 +451,9 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None,
         d = sorted(abs(x) for x in stage(key).get("entered_by") or [])
         if not d:
             return "-"
-        unit, f = _row_scale("m", d)
-        return _qty(d[0], "m", 3) if len(d) == 1 else \
-            f"{_fmt(d[0] * f, 3)} to {_fmt(d[-1] * f, 3)} {unit}"
+        unit, f = scale("m", d)
+        return quantity(d[0], "m", 3) if len(d) == 1 else \
+            f"{number(d[0] * f, 3)} to {number(d[-1] * f, 3)} {unit}"
 
     def cycle(key: str, name: str, unit: str | None = None) -> Any:
         c = stage(key).get("cycle")
@@ -518,19 +461,19 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None,
             return "-"
         value = c[name]
         if unit == "m":
-            return _qty(value, "m", 3)
+            return quantity(value, "m", 3)
         if unit == "s":
-            return f"{_fmt(value, 3)} s"
+            return f"{number(value, 3)} s"
         if isinstance(value, bool):
             return "yes" if value else "no"
-        return _fmt(value, 3)
+        return number(value, 3)
 
     def period(v: dict) -> str:
-        return "-" if v.get("period") is None else f"{_fmt(v['period'], 3)} s"
+        return "-" if v.get("period") is None else f"{number(v['period'], 3)} s"
 
     def settling(v: dict) -> str:
         st = v.get("settling_time")
-        return "never" if st is None else f"{_fmt(st, 3)} s"
+        return "never" if st is None else f"{number(st, 3)} s"
 
     rows = [
         ("Stage, after every move", lambda k, v: verdict_text(stage(k).get("outcome", ""))),
@@ -543,10 +486,10 @@ def _simulation_table(sim: dict, window: tuple[float, float] | None = None,
         ("No move hunts from", lambda k, v: free_from(k)),
         ("Spec's motion: verdict", lambda k, v: verdict_text(v.get("verdict", ""))),
         (f"Hunting cycles {counted}", lambda k, v: str(v.get("hunting_cycles"))),
-        ("Amplitude, peak to peak", lambda k, v: _qty(v.get("amplitude"), "m", 3)),
+        ("Amplitude, peak to peak", lambda k, v: quantity(v.get("amplitude"), "m", 3)),
         ("Period", lambda k, v: period(v)),
         ("Settling time after the motion", lambda k, v: settling(v)),
-        ("Final error x1 - r", lambda k, v: _qty(v.get("final_error"), "m", 3)),
+        ("Final error x1 - r", lambda k, v: quantity(v.get("final_error"), "m", 3)),
     ]
     if other:
         rows.append((f"Cross-check, {_MODEL_NAMES.get(other_model, other_model)} model",
@@ -599,14 +542,14 @@ def _cases_table(cases: list, numbers: dict) -> Any:
         t.add_column(Text(CASE_COLUMNS.get(k, _header(k))), justify="right", no_wrap=True)
     t.add_column("Status", min_width=6)
     for i, case in enumerate(cases, 1):
-        number = str(numbers.get(case.get("name"), i))
+        case_no = str(numbers.get(case.get("name"), i))
         label = case.get("description") or case.get("name") or ""
-        cells = [Text("inf" if case.get(k) is None and "margin" in k else _fmt(case.get(k)))
+        cells = [Text("inf" if case.get(k) is None and "margin" in k else number(case.get(k)))
                  for k in keys]
         status = _status_text(case["status"])  # as the analysis judged it
         if case.get("failed"):
             status.append(" " + ", ".join(map(str, case["failed"])))
-        t.add_row(number, Text(str(label)), *cells, status)
+        t.add_row(case_no, Text(str(label)), *cells, status)
     return t
 
 
@@ -651,12 +594,12 @@ def print_simulation(console: "Console", result) -> None:
     fit = result.replay
     if fit is not None:
         rows += [
-            ("position, model - measured, rms [\u00b5m]", _fmt(1e6 * fit.position_rms, 4)),
-            ("position, model - measured, max [\u00b5m]", _fmt(1e6 * fit.position_max, 4)),
-            ("tracking error r - x1 rms, model [\u00b5m]", _fmt(1e6 * fit.tracking_rms_model, 4)),
+            ("position, model - measured, rms [\u00b5m]", number(1e6 * fit.position_rms, 4)),
+            ("position, model - measured, max [\u00b5m]", number(1e6 * fit.position_max, 4)),
+            ("tracking error r - x1 rms, model [\u00b5m]", number(1e6 * fit.tracking_rms_model, 4)),
             ("tracking error r - x1 rms, measured [\u00b5m]",
-             _fmt(1e6 * fit.tracking_rms_measured, 4)),
-            ("commanded force, model - measured, rms [N]", _fmt(fit.force_rms, 4)),
+             number(1e6 * fit.tracking_rms_measured, 4)),
+            ("commanded force, model - measured, rms [N]", number(fit.force_rms, 4)),
         ]
         if result.window is not None:
             rows.append(("re-anchored windows [-]", str(int(result.window.max()) + 1)))
@@ -664,16 +607,16 @@ def print_simulation(console: "Console", result) -> None:
         rows += [
             ("verdict", m.verdict),
             ("hunting cycles in the window [-]", str(m.hunting_cycles)),
-            ("amplitude (peak to peak)", _qty(m.amplitude, "m")),
-            ("period [s]", _fmt(m.period, 4)),
-            ("settling time [s]", _fmt(m.settling_time, 4)),
-            ("final error", _qty(m.final_error, "m")),
+            ("amplitude (peak to peak)", quantity(m.amplitude, "m")),
+            ("period [s]", number(m.period, 4)),
+            ("settling time [s]", number(m.settling_time, 4)),
+            ("final error", quantity(m.final_error, "m")),
         ]
     rows += [
         ("integration", "ok" if result.success else result.message),
         ("steps / rejected / events [-]", f"{result.n_steps} / {result.n_rejected} / "
                                           f"{result.n_events}"),
-        ("wall time [ms]", _fmt(1e3 * result.wall_time, 3)),
+        ("wall time [ms]", number(1e3 * result.wall_time, 3)),
     ]
     for k, v in rows:
         t.add_row(Text(k), Text(str(v)))
@@ -716,34 +659,37 @@ class ProgressBar:
 
 
 def _axis_values_text(axis) -> str:
-    from .plots import display_unit
-
     from .plots import quantity_name
 
-    unit, f = display_unit(axis.unit)
+    unit, f = axis_unit(axis.unit)
     v = axis.values
     scale = "log" if axis.log else "linear"
-    return (f"{quantity_name(axis.path)} ({axis.path}): {len(v)} values {_fmt(v[0] * f)} to "
-            f"{_fmt(v[-1] * f)} {unit} ({scale})")
+    return (f"{quantity_name(axis.path)} ({axis.path}): {len(v)} values {number(v[0] * f)} to "
+            f"{number(v[-1] * f)} {unit} ({scale})")
 
 
 _CELL = {"settled": ("·", "green"), "stuck": ("s", "yellow"), "undetermined": ("?", "yellow"),
          "invalid": ("-", "dim"), "failed": ("×", "bold red")}
 
 
-def sweep_grid_table(result, max_columns: int = 25):
-    """The map as a rich table: hunting cycles per point, marks for the other verdicts.
+#: Widest map printed on the console [columns]; a wider one is named by its file.
+MAX_MAP_COLUMNS = 60
+
+
+def sweep_grid_table(result, columns: slice | None = None):
+    """The map (or a block of its columns) as a rich table: cycles per point, marks otherwise.
 
     Parameters
     ----------
     result : fi_design.studies.SweepResult
         A two-dimensional sweep (a line is shown as one row).
-    max_columns : int, optional
-        Wider maps are not tabulated (None is returned).
+    columns : slice, optional
+        The x values to tabulate (default all): :func:`sweep_grid_tables`
+        splits a wide map into blocks that fit the console.
 
     Returns
     -------
-    rich.table.Table or None
+    rich.table.Table
         Rows are y values, columns x values, both in display units; a cell
         holds the cycle count of a hunting point, ``·`` settled, ``s`` stuck,
         ``?`` undetermined, ``-`` invalid, ``×`` failed.
@@ -752,26 +698,24 @@ def sweep_grid_table(result, max_columns: int = 25):
     from rich.table import Table
     from rich.text import Text
 
-    from .plots import display_unit
-
     x, y = result.x, result.y
-    if len(x.values) > max_columns:
-        return None
-    xu, xf = display_unit(x.unit)
+    cols = range(len(x.values))[columns or slice(None)]
+    xu, xf = axis_unit(x.unit)
     if y is not None:
-        yu, yf = display_unit(y.unit)
+        yu, yf = axis_unit(y.unit)
     t = Table(box=box.SIMPLE_HEAD, pad_edge=False)
     t.add_column(Text("" if y is None else f"[{yu}]"), justify="right", no_wrap=True)
-    for v in x.values:
-        t.add_column(Text(_fmt(v * xf, 3)), justify="right", no_wrap=True)
+    for j in cols:
+        t.add_column(Text(number(x.values[j] * xf, 3)), justify="right", no_wrap=True)
     rows = result.verdict.reshape(-1, len(x.values))
     stage = getattr(result, "measure", "move") == "stage"
     values = (result.amplitude * 1e3 if stage else result.hunting_cycles).reshape(
         -1, len(x.values))
-    labels = [""] if y is None else [_fmt(v * yf, 3) for v in y.values]
+    labels = [""] if y is None else [number(v * yf, 3) for v in y.values]
     for label, vrow, crow in zip(labels, rows, values):
         cells = []
-        for v, c in zip(vrow, crow):
+        for j in cols:
+            v, c = vrow[j], crow[j]
             if v == "hunting":
                 cells.append(Text(f"{c:.2g}" if stage else str(int(c)), style="bold red"))
             else:
@@ -779,6 +723,37 @@ def sweep_grid_table(result, max_columns: int = 25):
                 cells.append(Text(mark, style=style))
         t.add_row(label, *cells)
     return t
+
+
+def sweep_grid_tables(result, width: int) -> list:
+    """The map in blocks of columns that each fit ``width`` characters, whole values in headers.
+
+    Returns
+    -------
+    list of rich.table.Table
+        One table when the map fits, else one per block of x values (each
+        with the row labels); empty when the map has more than
+        :data:`MAX_MAP_COLUMNS` columns.
+    """
+    from rich.console import Console
+
+    n = len(result.x.values)
+    if n > MAX_MAP_COLUMNS:
+        return []
+    probe = Console(width=10_000, color_system=None, legacy_windows=False)
+
+    def fits(a: int, b: int) -> bool:
+        table = sweep_grid_table(result, slice(a, b))
+        return probe.measure(table).maximum <= width
+
+    tables, a = [], 0
+    while a < n:
+        b = n
+        while b > a + 1 and not fits(a, b):
+            b -= 1
+        tables.append(sweep_grid_table(result, slice(a, b)))
+        a = b
+    return tables
 
 
 def grid_caption(result) -> str:
@@ -804,13 +779,28 @@ def grid_caption(result) -> str:
     return text + "; · settled, s stuck, ? undetermined, - invalid, × failed"
 
 
-def _print_grid(console: "Console", result) -> None:
+def _print_grid(console: "Console", result, files: tuple = ()) -> None:
+    """The map at the console's width: in blocks of columns where it is wider.
+
+    A map wider than :data:`MAX_MAP_COLUMNS` is not tabulated: the line says
+    so and names the files that hold it (``files``), or the options that
+    write them.
+    """
     from rich.text import Text
 
-    table = sweep_grid_table(result)
-    if table is not None:
-        console.print(Text(grid_caption(result), style="dim"))
-        console.print(table)
+    tables = sweep_grid_tables(result, console.width)
+    if not tables:
+        where = (", ".join(str(f) for f in files) if files else
+                 "--figure OUT.svg or --csv OUT.csv (not written in this run)")
+        console.print(Text(f"the map has {len(result.x.values)} columns, too many to print "
+                           f"here: see {where}"))
+        return
+    console.print(Text(grid_caption(result), style="dim"))
+    if len(tables) > 1:
+        console.print(Text(f"(in {len(tables)} blocks of columns to fit {console.width} "
+                           "characters)", style="dim"))
+    for t in tables:
+        console.print(t)
 
 
 def _print_counts(console: "Console", counts: dict) -> None:
@@ -824,7 +814,7 @@ def _print_run(console: "Console", run, executor: str) -> None:
 
 
 def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
-                executor: str = "") -> None:
+                executor: str = "", files: tuple = ()) -> None:
     """Print the summary of a :class:`~fi_design.studies.SweepResult`.
 
     Parameters
@@ -837,10 +827,10 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
         The spec file, named in the heading.
     executor : str, optional
         How the points ran, for the last line.
+    files : tuple of pathlib.Path, optional
+        The files written with the map (named when the map is too wide to print).
     """
     from rich.text import Text
-
-    from .plots import display_unit
 
     from .plots import quantity_name
 
@@ -849,14 +839,14 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
     console.print(Text(f"{_axis_values_text(result.x)}; {plant}"))
     if result.y is not None:
         console.print(Text(_axis_values_text(result.y)))
-    _print_grid(console, result)
+    _print_grid(console, result, files)
     _print_counts(console, result.counts())
-    xu, xf = display_unit(result.x.unit)
+    xu, xf = axis_unit(result.x.unit)
     above = result.boundary("above")
     if result.y is None:
         if not math.isnan(above[0]):
             console.print(Text(f"no hunting from {quantity_name(result.x.path).lower()} = "
-                               f"{_fmt(above[0] * xf)} {xu} upwards"))
+                               f"{number(above[0] * xf)} {xu} upwards"))
     failed = [p for p in result.points if p.status == "failed"]
     for p in failed[:3]:
         console.print(Text(f"failed at {dict(zip(result.paths, p.values))}: {p.message}",
@@ -868,7 +858,7 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
 
 
 def print_study(console: "Console", result, spec_path: Optional[Path] = None,
-                executor: str = "") -> None:
+                executor: str = "", out: Optional[Path] = None) -> None:
     """Print the summary of a :class:`~fi_design.studies.StudyResult`: one grid per map.
 
     Parameters
@@ -881,6 +871,8 @@ def print_study(console: "Console", result, spec_path: Optional[Path] = None,
         The spec file, named in the heading.
     executor : str, optional
         How the points ran, for the last line.
+    out : pathlib.Path, optional
+        The study's directory, whose files are named when a map is too wide to print.
     """
     from rich.text import Text
 
@@ -889,7 +881,8 @@ def print_study(console: "Console", result, spec_path: Optional[Path] = None,
         d = m.definition
         console.print(Text(f"\n{d.key}) {d.title}", style="bold"))
         console.print(Text(f"paper: {d.paper}", style="dim"))
-        _print_grid(console, m.result)
+        files = () if out is None else (out / f"map_{d.key}.csv", out / "figure4.svg")
+        _print_grid(console, m.result, files)
         _print_counts(console, m.result.counts())
     _print_run(console, result.run, executor)
 
@@ -911,14 +904,12 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
     """
     from rich.text import Text
 
-    from .plots import display_unit
-
     _heading(console, f"Robustness of {result.spec.name}", spec_path)
     for sc in result.scatter:
-        unit, f = display_unit("") if sc.relative else display_unit(
+        unit, f = axis_unit("") if sc.relative else axis_unit(
             _path_unit(sc.path, result.spec))
         spread = f"{sc.spread:.3g} of nominal ({100 * sc.spread:.3g} %)" if sc.relative else \
-            f"{_fmt(sc.spread * f)} {unit}"
+            f"{number(sc.spread * f)} {unit}"
         console.print(Text(f"scatter {sc.path}: {result.distribution}, spread {spread}"))
     if result.position_friction is not None:
         pf = result.position_friction
@@ -1010,7 +1001,7 @@ def print_reconcile(console: "Console", result) -> None:
         for col in ("Effect", "Misfit before", "Misfit after"):
             s.add_column(col, justify="left" if col == "Effect" else "right", no_wrap=True)
         for st in result.steps:
-            s.add_row(Text(st.name), _fmt(st.misfit_before), _fmt(st.misfit_after))
+            s.add_row(Text(st.name), number(st.misfit_before), number(st.misfit_after))
         console.print(s)
     t = _table("Candidates (best first)")
     longest = max((len(c.name) for c in result.candidates), default=6)
@@ -1020,9 +1011,8 @@ def print_reconcile(console: "Console", result) -> None:
                      min_width=longest if col == "Effect" else None,
                      ratio=1 if col == "Fitted parameters" else None)
     for c in result.candidates:
-        params = ", ".join(_fitted(c.name, k, v, c.uncertainty.get(k))
-                           for k, v in c.parameters.items() if v is not None)
-        t.add_row(Text(c.name), _fmt(c.score), f"{100 * c.explained:.1f} %", Text(params))
+        params = _effects_text(c.name, c.parameters, c.uncertainty)
+        t.add_row(Text(c.name), number(c.score), f"{100 * c.explained:.1f} %", Text(params))
     console.print(t)
     for c in result.candidates:
         if c.name not in result.effects and c.reasons:
@@ -1032,35 +1022,21 @@ def print_reconcile(console: "Console", result) -> None:
         g.add_column(col, justify="left" if col in ("Metric", "Unit") else "right",
                      no_wrap=True)
     for m in result.gaps:
-        unit, factor = _row_scale(m.unit, (m.before, m.after, m.noise))
-        g.add_row(Text(m.name), Text(unit), *[_fmt(None if v is None else v * factor)
-                                              for v in (m.before, m.after, m.noise)])
+        unit, factor = scale(m.unit, (m.before, m.after, m.noise))
+        g.add_row(Text(m.name), Text(unit or "-"), *[number(None if v is None else v * factor)
+                                                     for v in (m.before, m.after, m.noise)])
     console.print(g)
     nz = result.noise
-    parts = [f"position {_fmt(nz.position, 3)} m ({nz.source.get('position')})"]
+    parts = [f"position {quantity(nz.position, 'm', 3)} ({nz.source.get('position')})"]
     if nz.force is not None:
-        parts.append(f"force {_fmt(nz.force, 3)} N ({nz.source.get('force')})")
+        parts.append(f"force {quantity(nz.force, 'N', 3)} ({nz.source.get('force')})")
     if nz.deflection is not None:
-        parts.append(f"deflection {_fmt(nz.deflection, 3)} m ({nz.source.get('deflection')})")
+        parts.append(f"deflection {quantity(nz.deflection, 'm', 3)} "
+                     f"({nz.source.get('deflection')})")
     console.print(Text("Noise: " + ", ".join(parts)))
     console.print(Text("Position lattice: " + result.lattice.detail))
     for name, why in result.skipped.items():
         console.print(Text(f"skipped {name}: {why}", style="dim"))
-
-
-def _fitted(effect: str, name: str, value: float, error: Any) -> str:
-    """``wavelength = 5 ± 1.2e-05 mm``: a fitted effect parameter in its display unit."""
-    from .effects import CATALOGUE
-    from .report.filters import display_scale
-
-    units = {p.name: p.unit for p in CATALOGUE[effect].parameters} if effect in CATALOGUE \
-        else {}
-    unit = units.get(name, "")
-    shown, factor = ("", 1.0) if unit in ("", "1") else display_scale(unit, value)
-    text = f"{name} = {_fmt(value * factor)}"
-    if error:
-        text += f" ± {_fmt(error * factor, 2)}"
-    return f"{text} {shown}".rstrip()
 
 
 def print_identification(console: "Console", result) -> None:
@@ -1086,20 +1062,18 @@ def print_identification(console: "Console", result) -> None:
     for col, just in (("Parameter", "left"), ("Value", "right"), ("Std. error", "right"),
                       ("Unit", "left"), ("Identifiable", "left")):
         t.add_column(col, justify=just, no_wrap=True)
-    from .report.filters import unit_text
-
     for name, p in result.parameters.items():
-        t.add_row(Text(name), _fmt(p.value, 6), _fmt(p.std_error, 3), Text(unit_text(p.unit)),
+        t.add_row(Text(name), number(p.value, 6), number(p.std_error, 3), Text(unit_text(p.unit)),
                   Text("yes" if p.identifiable else "no",
                        style="green" if p.identifiable else "yellow"))
     console.print(t)
     f = result.fit
-    console.print(Text(f"Fit: RMS force residual {_fmt(f.force_rms_residual, 3)} N, relative "
-                       f"error {_fmt(f.relative_error, 3)}, condition number "
-                       f"{_fmt(f.condition_number, 3)}, {f.samples_used} samples used "
-                       f"({_fmt(f.effective_samples, 3)} effective)"))
+    console.print(Text(f"Fit: RMS force residual {number(f.force_rms_residual, 3)} N, relative "
+                       f"error {number(f.relative_error, 3)}, condition number "
+                       f"{number(f.condition_number, 3)}, {f.samples_used} samples used "
+                       f"({number(f.effective_samples, 3)} effective)"))
     ms = result.masses
-    console.print(Text(f"Masses: stage {_fmt(ms.stage, 5)} kg, cart {_fmt(ms.cart, 5)} kg "
+    console.print(Text(f"Masses: stage {number(ms.stage, 5)} kg, cart {number(ms.cart, 5)} kg "
                        f"({ms.source})"))
     for name in ("static", "stribeck_velocity", "bristle_stiffness"):
         p = result.parameters[name]  # how it was estimated, or why not
@@ -1140,19 +1114,19 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
     t.add_column(Text("as specified" + (" (suggested)" if sd.get("suggested") else "")),
                  justify="right")
     t.add_column(Text("recommended" if result.feasible else "nearest"), justify="right")
-    t.add_row("Stroke", _qty(sd["stroke"], "m", 3), _qty(d.stroke, "m", 3))
-    t.add_row("Drive stiffness", f"{_fmt(sd['stiffness'])} N/m", f"{_fmt(d.stiffness)} N/m")
+    t.add_row("Stroke", quantity(sd["stroke"], "m", 3), quantity(d.stroke, "m", 3))
+    t.add_row("Drive stiffness", f"{number(sd['stiffness'])} N/m", f"{number(d.stiffness)} N/m")
     t.add_row("Joint damping", "", "default ratio" if d.damping is None
-              else f"{_fmt(d.damping, 3)} N s/m")
-    t.add_row("Crossover", f"{_fmt(sd['crossover'])} Hz", f"{_fmt(d.crossover)} Hz")
+              else f"{number(d.damping, 3)} N s/m")
+    t.add_row("Crossover", f"{number(sd['crossover'])} Hz", f"{number(d.crossover)} Hz")
     t.add_row("No move hunts from", "", "-" if d.hunting_free_from is None
-              else f"{_fmt(d.hunting_free_from)} Hz")
+              else f"{number(d.hunting_free_from)} Hz")
     t.add_row("Crossover factor", "", "-" if m.get("crossover_factor") is None
-              else _fmt(m["crossover_factor"], 3))
-    t.add_row("k_max / k", "", _fmt(m.get("stiffness_factor"), 3))
-    t.add_row("End-stop clearance at rest", "", _qty(m.get("end_stop_clearance"), "m", 3))
+              else number(m["crossover_factor"], 3))
+    t.add_row("k_max / k", "", number(m.get("stiffness_factor"), 3))
+    t.add_row("End-stop clearance at rest", "", quantity(m.get("end_stop_clearance"), "m", 3))
     t.add_row("Not settling under scatter", "", "-" if d.unsettled_probability is None
-              else f"{_fmt(100 * d.unsettled_probability, 3)} %")
+              else f"{number(100 * d.unsettled_probability, 3)} %")
     console.print(t)
     if result.binding:
         console.print(Text("Binds it: ", style="bold").append("; ".join(result.binding)))
@@ -1161,9 +1135,9 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
     # the design space at a glance: rows of stiffness (top: stiff), columns of stroke
     grid = Table(box=box.SIMPLE_HEAD, pad_edge=False)
     grid.add_column(Text("k [N/m]"), justify="right", no_wrap=True)
-    unit, f = _row_scale("m", result.strokes)
+    unit, f = scale("m", result.strokes)
     for s in result.strokes:
-        grid.add_column(Text(_fmt(s * f, 3)), justify="center", no_wrap=True)
+        grid.add_column(Text(number(s * f, 3)), justify="center", no_wrap=True)
     nk = len(result.stiffnesses)
     for j in reversed(range(nk)):
         cells = []
@@ -1173,8 +1147,8 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
             if c is not None and c.stroke == d.stroke and c.stiffness == d.stiffness:
                 style += " reverse"
             cells.append(Text(glyph, style=style))
-        grid.add_row(_fmt(result.stiffnesses[j], 3), *cells)
-    console.print(Text(f"Design space at {_fmt(d.crossover)} Hz: columns stroke [{unit}], "
+        grid.add_row(number(result.stiffnesses[j], 3), *cells)
+    console.print(Text(f"Design space at {number(d.crossover)} Hz: columns stroke [{unit}], "
                        "rows drive stiffness", style="dim"))
     console.print(grid)
     console.print(Text("\u2713 passes, \u00b7 not signed off (ranked below), \u25cf some move "

@@ -1,4 +1,4 @@
-"""The catalogue of physical effects the model can carry (DESIGN.md section 5).
+"""The catalogue of physical effects the model can carry (docs/effects.md).
 
 Effects are data. Each :class:`Effect` has a stable name, a one-line physical
 description and its :class:`Parameter` entries (unit, fitting bounds, neutral
@@ -18,6 +18,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Mapping
+
+from .display import with_error
 
 
 @dataclass(frozen=True)
@@ -73,7 +76,7 @@ class Effect:
     Attributes
     ----------
     name : str
-        Stable name from DESIGN.md section 5.
+        Stable name (the interface: docs/effects.md).
     description : str
         How the effect enters the equations, one line.
     parameters : tuple of Parameter
@@ -151,7 +154,7 @@ CATALOGUE: dict[str, Effect] = {e.name: e for e in (
         Parameter("stiffness", "N/m", "cable stiffness k_c", "cable_stiffness", (-500.0, 500.0)),
         Parameter("preload", "N", "constant cable force F0", "cable_preload", (-10.0, 10.0),
                   required=False),)),
-    Effect("time_delay", "the actuator force u is applied `delay` later", (
+    Effect("time_delay", "the actuator force u is applied a delay later", (
         Parameter("delay", "s", "extra loop delay", "delay", (0.0, 0.02), combine="add"),)),
     Effect("quantization", "the controller sees round(x1 / q) q", (
         Parameter("resolution", "m", "position quantization step q", "quantization",
@@ -195,3 +198,28 @@ def get(name: str) -> Effect:
         return CATALOGUE[name]
     except KeyError:
         raise KeyError(f"unknown effect {name!r}; known: {', '.join(EFFECT_NAMES)}") from None
+
+
+def values_text(name: str, values: Mapping[str, float | None],
+                errors: Mapping[str, float | None] | None = None, *, sep: str = " ") -> str:
+    """The values of an effect for a reader, each with its standard error in one unit.
+
+    Parameters
+    ----------
+    name : str
+        Effect name (catalogue entry); a name it does not know gives plain numbers.
+    values : mapping of str to float or None
+        Parameter name to SI value (None: left out).
+    errors : mapping of str to float or None, optional
+        Parameter name to its standard error (SI).
+    sep : str, optional
+        Between number and unit (a no-break space in reports).
+
+    Returns
+    -------
+    str
+        ``amplitude = 0.25 ± 1.1 × 10⁻⁵, wavelength = 5 ± 3.5 × 10⁻⁵ mm, phase = 0.8 rad``.
+    """
+    units = {p.name: p.unit for p in CATALOGUE[name].parameters} if name in CATALOGUE else {}
+    return ", ".join(f"{k} = {with_error(v, (errors or {}).get(k), units.get(k, ''), sep=sep)}"
+                     for k, v in values.items() if v is not None)

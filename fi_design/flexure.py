@@ -44,6 +44,7 @@ import math
 
 import numpy as np
 
+from .display import quantity
 from .results.design import FlexureResult
 
 __all__ = [
@@ -254,7 +255,8 @@ def stiffness_range(stiffness: float, thickness: float, tolerance: float) -> tup
 
 
 def _mm(x: float) -> str:
-    return f"{x * 1e3:.3g} mm"
+    """A flexure dimension: always in mm, so that the lengths of one sentence share a unit."""
+    return quantity(x, "m", 3, shown=("mm", 1e3))
 
 
 def size_flexure(flexure, *, target_stiffness: float, maximum_stiffness: float, stroke: float,

@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping
 import numpy as np
 
 from .errors import ArgumentError
+from .display import number, quantity
 from .flexure import size_flexure
 from .model import Model, as_model
 from .results import Check, Status, frozen_array
@@ -66,12 +67,8 @@ SUGGESTED_STROKE = 0.3e-3
 
 
 def _g(x: float | None, digits: int = 4) -> str:
-    """``digits`` significant digits; plain (no exponent) from 1e4 to 1e6."""
-    if x is None:
-        return "-"
-    if 1e4 <= abs(x) < 1e6:
-        return f"{x:.0f}"
-    return f"{x:.{digits}g}"
+    """A number as every table prints it (:func:`fi_design.display.number`)."""
+    return number(x, digits)
 
 
 # --------------------------------------------------------------------------- step 1
@@ -396,11 +393,10 @@ def _controller_words(c: ControlLaw) -> str:
     """The structure of a controller in words (D input, roll-off, sampling)."""
     parts = [f"D on the {c.derivative_on}",
              "ideal D" if math.isinf(c.roll_off) else
-             f"D roll-off {c.roll_off / (2 * math.pi):.4g} Hz"]
+             f"D roll-off {_g(c.roll_off / (2 * math.pi))} Hz"]
     parts.append("continuous" if c.sample_period == 0 else
-                 f"sampled at {1.0 / c.sample_period:.4g} Hz")
-    if c.delay > 0:
-        parts.append(f"delay {c.delay * 1e3:.3g} ms")
+                 f"sampled at {quantity(1.0 / c.sample_period, 'Hz')}")
+    parts.append("no delay" if c.delay == 0 else f"delay {quantity(c.delay, 's')}")
     return ", ".join(parts)
 
 
@@ -430,24 +426,26 @@ def step4_pid(model: Model | Spec) -> PidResult:
     g = law.rule
     step = "step 4 PID"
     if law.source == "rule":
-        msg = (f"tuned at {g.crossover:.4g} Hz on {g.tuning_mass:.4g} kg: kp = {g.kp:.4g} N/m, "
-               f"ki = {g.ki:.4g} N/(m s), kd = {g.kd:.4g} N s/m, wt = {g.wt:.4g} rad/s")
-        checks = [Check("pid", None, g.kp, None, "N/m", msg, step=step)]
+        msg = (f"tuned at {_g(g.crossover)} Hz on {_g(g.tuning_mass)} kg; as controller.gains "
+               f"takes them (controller.roll_off filters the D term only): kp = {_g(law.kp)} "
+               f"N/m, ki = {_g(law.ki)} N/(m s), kd = {_g(law.kd)} N s/m "
+               f"({_controller_words(law)})")
+        checks = [Check("pid", None, law.kp, None, "N/m", msg, step=step)]
     else:
         r = law.rule_in_this_form()
-        msg = (f"the hardware's gains kp = {law.kp:.4g} N/m, ki = {law.ki:.4g} N/(m s), "
-               f"kd = {law.kd:.4g} N s/m ({_controller_words(law)}) cross over at "
+        msg = (f"the hardware's gains kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s), "
+               f"kd = {_g(law.kd)} N s/m ({_controller_words(law)}) cross over at "
                f"{law.crossover:.4g} Hz on {law.tuning_mass:.4g} kg; the rule there would give "
-               f"kp = {r['kp']:.4g} N/m, ki = {r['ki']:.4g} N/(m s), kd = {r['kd']:.4g} N s/m "
+               f"kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), kd = {_g(r['kd'])} N s/m "
                f"with a D roll-off of {r['roll_off'] / (2 * math.pi):.4g} Hz")
-        checks = [Check("pid", None, law.kp, g.kp, "N/m", msg, step=step)]
+        checks = [Check("pid", None, law.kp, r["kp"], "N/m", msg, step=step)]
     static = law.static_error(model.friction.Fc)
     if static is not None:
         checks.append(Check(
             "pid.integrator", None, static, None, "m",
             f"the loop has no integrator: no hunting by the paper's mechanism (integral action "
             f"building up through stiction), a static error instead of up to Fc / kp = "
-            f"{static * 1e6:.3g} um against the Coulomb friction", step=step))
+            f"{quantity(static, 'm', 3)} against the Coulomb friction", step=step))
     if ctl.tuning_mass == "stage" and model.has_isolator:
         checks.append(Check(
             "pid.tuning_mass", None, g.tuning_mass, model.total_mass, "kg",
@@ -747,17 +745,18 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
     g = pid.gains
     law = pid.controller
     if law.source == "rule":
-        parts.append(f"The PID tuned on {g.tuning_mass:.3g} kg has kp = {g.kp:.4g} N/m, "
-                     f"ki = {g.ki:.4g} N/(m s) and kd = {g.kd:.4g} N s/m.")
+        parts.append(f"The PID tuned on {_g(g.tuning_mass)} kg, in the form controller.gains "
+                     f"takes, has kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s) and kd = "
+                     f"{_g(law.kd)} N s/m ({_controller_words(law)}).")
     else:
-        parts.append(f"The hardware's controller (kp = {law.kp:.4g} N/m, ki = {law.ki:.4g} "
-                     f"N/(m s), kd = {law.kd:.4g} N s/m; {_controller_words(law)}) crosses over "
+        parts.append(f"The hardware's controller (kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
+                     f"N/(m s), kd = {_g(law.kd)} N s/m; {_controller_words(law)}) crosses over "
                      f"at {law.crossover:.3g} Hz on {law.tuning_mass:.3g} kg; the rule would tune "
-                     f"kp = {g.kp:.4g} N/m, ki = {g.ki:.4g} N/(m s), kd = {g.kd:.4g} N s/m there.")
+                     f"kp = {_g(g.kp)} N/m, ki = {_g(g.ki)} N/(m s), kd = {_g(g.kd)} N s/m there.")
     if pid.static_error is not None:
         parts.append(f"The loop has no integrator, so it cannot hunt by the paper's mechanism; "
                      f"it leaves a static error of up to Fc / kp = "
-                     f"{pid.static_error * 1e6:.3g} um instead.")
+                     f"{quantity(pid.static_error, 'm', 3)} instead.")
     failed = [c.name for c in checks if c.status == Status.FAIL]
     if failed:
         parts.append(f"{len(failed)} check(s) fail ({', '.join(failed)}): revise the design "

@@ -1,7 +1,7 @@
 """The four linear limit cases and their loop margins (guideline step 2).
 
 Near standstill the friction isolator's plant switches between four linear
-limit cases (DESIGN.md section 2, paper Figure 2), from actuator force u [N]
+limit cases (docs/model.md, paper Figure 2), from actuator force u [N]
 to stage position x1 [m]:
 
 ====================  =====================================================================

@@ -1,4 +1,4 @@
-"""Measured traces from the real stage (DESIGN.md section 4).
+"""Measured traces from the real stage (the CSV layout: docs/interfaces.md).
 
 A measurement is a CSV file with a header row; columns are found by their
 header, in any order:
@@ -232,7 +232,7 @@ def _checked(arrays: dict, source: str | None) -> Measurement:
 
 
 def load_measurement(path: str | os.PathLike) -> Measurement:
-    """Read and check a measured trace (CSV, DESIGN.md section 4).
+    """Read and check a measured trace (CSV, docs/interfaces.md).
 
     Parameters
     ----------

@@ -39,6 +39,11 @@ __all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "a
 
 #: Friction models of the spec (``friction.model``).
 FRICTION_MODELS = ("lugre", "switch")
+#: Coulomb friction the kernel takes for a spec without any (``friction.coulomb: 0``, static
+#: friction alone, Armstrong-Helouvry's case), as a fraction of Fs [-]: LuGre's bristle rate
+#: dz/dt = v - sigma0 |v| z / g(v) needs g(v) = Fc + (Fs - Fc) exp(-(v/vs)^2) > 0 at every
+#: speed, so g is kept at or above 0.1 % of Fs (with Fs = 4 N a sliding friction of 4 mN).
+COULOMB_FLOOR = 1e-3
 
 
 # --------------------------------------------------------------------------- parts
@@ -396,7 +401,8 @@ class Model:
         else:
             joint = dict(k=0.0, c=0.0, s=0.0, k_stop=0.0, c_stop=0.0)
         params = PlantParameters(
-            m1=self.m1, m2=self.m2, **joint, Fs=f.Fs, Fc=f.Fc, vs=f.vs, sigma0=f.sigma0,
+            m1=self.m1, m2=self.m2, **joint, Fs=f.Fs, Fc=max(f.Fc, COULOMB_FLOOR * f.Fs),
+            vs=f.vs, sigma0=f.sigma0,
             sigma1=f.sigma1, sigma2=f.sigma2, **law.kernel_form(),
             Fc_neg=math.nan if f.Fc_neg is None else f.Fc_neg,
             sigma2_neg=math.nan if f.sigma2_neg is None else f.sigma2_neg,

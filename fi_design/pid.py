@@ -3,7 +3,7 @@
 Light on purpose (``math`` only, no python-control), so the simulation can
 import it without paying for ``import control``.
 
-The rule (DESIGN.md section 2, paper section 2.2), with ``wc = 2 pi fc`` and
+The rule (paper section 2.2; docs/model.md), with ``wc = 2 pi fc`` and
 ``r = derivative_ratio``, ``ri = integrator_ratio``::
 
     C(s) = ks (1 + wi/s) (1 + s/wd) / (1 + s/wt)      (series form)
@@ -12,8 +12,8 @@ The rule (DESIGN.md section 2, paper section 2.2), with ``wc = 2 pi fc`` and
 The lead-lag part ``(1 + s/wd) / (1 + s/wt)`` has its phase maximum at the
 geometric mean ``sqrt(wd wt) = wc`` and a gain ``r`` there, so ``ks = m wc^2 / r``
 puts ``|C(j wc)| = m wc^2`` without the integrator: a free mass ``1/(m s^2)``
-then crosses over at ``wc``. With the default ratio 3 this is DESIGN.md's
-``kp = m wc^2 / 3``.
+then crosses over at ``wc``. With the default ratio 3 this is
+``kp = m wc^2 / 3`` of docs/model.md.
 
 The integrator adds ``|1 + wi/(j wc)| = sqrt(1 + (wi/wc)^2) = sqrt(1 + 1/ri^2)``
 (0.5 % for ``ri = 10``), so the exact crossover of a free mass lies a fraction

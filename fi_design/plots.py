@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from .display import axis_unit
 from .errors import ArgumentError
 
 # --------------------------------------------------------------------------- design report
@@ -127,6 +128,46 @@ def _phase_deg(L: np.ndarray, f: np.ndarray, near: float) -> np.ndarray:
     return ph - 360.0 * math.ceil((ph[i] - 90.0) / 360.0)
 
 
+#: The loop's band reaches this factor below the design crossover (the limit cases' in-band
+#: test, ``linear.BAND_FACTOR``); the Bode and sensitivity plots start 3 times lower still.
+BAND_FACTOR = 10.0
+
+
+def design_band(result: Any) -> tuple[float, float]:
+    """The frequency span of the Bode and sensitivity plots [Hz]: the design band.
+
+    From a decade below the lowest in-band gain crossover (at least 30 times
+    below the design crossover) to the top of the loop's grid (30 times the
+    crossover, twice the highest parasitic mode), on whole decades. A
+    crossover far below the band (the integrator against a stuck cart's
+    bristles, millihertz) is not drawn: the caption names it
+    (:func:`out_of_band_crossovers`).
+
+    Parameters
+    ----------
+    result : fi_design.results.design.DesignResult
+        The design.
+
+    Returns
+    -------
+    (float, float)
+        Lowest and highest frequency [Hz].
+    """
+    fc = result.crossover.desired
+    low = fc / BAND_FACTOR
+    inside = [x for c in result.crossover.cases for x in c.crossovers if x and x >= low]
+    lo = min([fc / 30.0] + [x / 3.0 for x in inside])
+    f = np.asarray(result.loop.frequency)
+    lo = max(10.0 ** math.floor(math.log10(lo)), float(f[0]))
+    return lo, float(f[-1])
+
+
+def out_of_band_crossovers(result: Any) -> list[tuple[Any, float]]:
+    """(case, crossover [Hz]) of the gain crossovers below :func:`design_band`."""
+    lo, _ = design_band(result)
+    return [(c, x) for c in result.crossover.cases for x in c.crossovers if x and x < lo]
+
+
 @styled
 def bode_figure(result: Any) -> Any:
     """Open-loop Bode plot of the four limit cases (paper Figure 2) in one figure.
@@ -181,7 +222,11 @@ def bode_figure(result: Any) -> Any:
     mag.set_ylabel("|L| [dB]")
     pha.set_ylabel("phase of L [deg]")
     pha.set_xlabel("frequency [Hz]")
-    mag.set_xlim(f[0], f[-1])
+    lo, hi = design_band(result)
+    mag.set_xlim(lo, hi)
+    inside = (f >= lo) & (f <= hi)
+    band_mag = np.concatenate([20 * np.log10(np.abs(L[inside])) for _, L in responses])
+    mag.set_ylim(max(np.nanmin(band_mag), -120.0) - 5, min(np.nanmax(band_mag), 160.0) + 5)
     mag.annotate(f"fc = {fc:g} Hz", (fc, 0.02), xycoords=mag.get_xaxis_transform(),
                  xytext=(3, 0), textcoords="offset points", ha="left", va="bottom",
                  fontsize=7.5, color="0.3")
@@ -264,7 +309,7 @@ def sensitivity_figure(result: Any) -> Any:
     ax.axvline(result.crossover.desired, color="0.3", lw=0.9, ls="--")
     ax.set_ylim(-60, 15)
     _log_x(ax, numticks=6)
-    ax.set_xlim(f[0], f[-1])
+    ax.set_xlim(*design_band(result))
     ax.legend(loc="lower right")
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("|S| [dB]")
@@ -765,37 +810,14 @@ def figure_svg(fig: Any, prefix: str, text_as_paths: bool = False) -> str:
 # --------------------------------------------------------------------------- parameter studies
 # (fi_design.studies: hunting maps, the paper's Figure 4, robustness)
 
-#: SI unit -> (unit shown on axes, factor applied to SI values).
-DISPLAY_UNITS: dict[str, tuple[str, float]] = {
-    "m": ("mm", 1e3),
-    "N/m": ("N/mm", 1e-3),
-    "m/s": ("mm/s", 1e3),
-    "m/s**2": ("m/s²", 1.0),
-    "N*s/m": ("N s/m", 1.0),
-    "kg/m**3": ("kg/m³", 1.0),
-    "1": ("-", 1.0),
-}
-
 #: Marks drawn on map cells whose verdict is not a plain count.
 VERDICT_MARKS = {"stuck": "s", "undetermined": "?", "failed": "×"}
 
 
 def display_unit(unit: str) -> tuple[str, float]:
-    """Unit shown on an axis for an SI unit, and the factor from SI.
-
-    Parameters
-    ----------
-    unit : str
-        SI unit as stored in the spec (``"m"``, ``"N/m"``, ``"Hz"``, ...).
-
-    Returns
-    -------
-    label : str
-        Unit text for axis labels (``"mm"`` for metres).
-    factor : float
-        Multiply SI values by this to get the shown unit.
-    """
-    return DISPLAY_UNITS.get(unit, (unit, 1.0))
+    """Unit shown on an axis for an SI unit, and the factor from SI
+    (:func:`fi_design.display.axis_unit`)."""
+    return axis_unit(unit)
 
 
 #: Names of the values sweeps and studies usually vary, by dotted spec path.
@@ -1227,7 +1249,10 @@ def figure_bytes(fig: Any, fmt: str = "svg") -> bytes:
 # (fi_design.reconciliation: measured trace against the nominal and the corrected model)
 
 #: Colours of the reconciliation overlays.
-GAP_COLOURS = {"measured": "0.25", "nominal": "C3", "corrected": "C0"}
+GAP_COLOURS = {"measured": "0.45", "nominal": "C3", "corrected": "C0"}
+#: Line widths [pt] and drawing order of the overlays: the measurement wide underneath.
+GAP_WIDTHS = {"measured": 3.2, "nominal": 1.0, "corrected": 0.9}
+GAP_ORDER = {"measured": 1, "nominal": 2, "corrected": 3}
 
 
 def _gap_label(result: Any) -> str:
@@ -1239,9 +1264,11 @@ def _gap_label(result: Any) -> str:
 def gap_overlay_figure(result: Any) -> Any:
     """Measured trace with the nominal and the corrected model on top.
 
-    Panels: position error x1 - r [um]; commanded force [N] when measured;
-    joint deflection [um] when measured. Segments compared by features
-    (stick-slip holds) are shaded.
+    Panels: position error x1 - r [µm]; commanded force [N] when measured;
+    joint deflection [µm] when measured. The measurement is drawn wide and
+    light underneath, the models thin on top, so that it shows where the
+    corrected model follows it. Segments compared by features (stick-slip
+    holds) are shaded.
 
     Parameters
     ----------
@@ -1274,8 +1301,11 @@ def gap_overlay_figure(result: Any) -> Any:
             if minus_ref:
                 y = y - r
             tt, yy = decimate(t, y * scale)
-            ax.plot(tt, yy, color=GAP_COLOURS[name], lw=0.9 if name == "measured" else 1.1,
-                    ls="-" if name != "nominal" else "--",
+            # the measured trace wide and light underneath, the models thin on top: where the
+            # corrected model follows the measurement, the measurement still shows around it
+            ax.plot(tt, yy, color=GAP_COLOURS[name], lw=GAP_WIDTHS[name],
+                    ls="-" if name != "nominal" else "--", zorder=GAP_ORDER[name],
+                    alpha=0.55 if name == "measured" else 1.0, solid_capstyle="butt",
                     label={"measured": "measured", "nominal": "nominal model",
                            "corrected": _gap_label(result)}[name])
         ax.set_ylabel(label)

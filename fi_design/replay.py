@@ -1,4 +1,4 @@
-"""Replay of a measured record: the model's state taken from the data (DESIGN.md section 8).
+"""Replay of a measured record: the model's state taken from the data (docs/interfaces.md).
 
 A record may start in motion (the EMPS axis moves at 13 mm/s at its first
 sample), so a replay never starts from rest: the stage position and velocity

@@ -15,7 +15,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from .guideline import design as _design
+from . import guideline
 from .results.design import DesignResult
 from .spec import Spec
 
@@ -54,7 +54,7 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     fi_design.errors.SpecError
         When ``spec`` is a path or mapping that does not validate.
     """
-    result = _design(spec, confirm=confirm, executor=executor, progress=progress)
+    result = guideline.design(spec, confirm=confirm, executor=executor, progress=progress)
     if not (recommend and result.simulation is not None and result.verdict.status == "FAIL"):
         return result
     from .recommend import recommend as search

@@ -93,7 +93,7 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
         ``spec.simulation.tolerance`` for the fast path and 1e-4 times it for
         the reference.
     record : fi_design.measured.Measurement, optional
-        Replay this measured record (DESIGN.md section 8) instead of the
+        Replay this measured record (docs/interfaces.md) instead of the
         spec's motion: the model starts from the state in the data (position
         and velocity from the first samples, the controller consistent with
         the first force sample) and its outputs are at the record's times.

@@ -1,6 +1,6 @@
 """The design spec: validated, immutable, in SI.
 
-A spec mirrors the YAML file key for key (DESIGN.md section 3), so one dotted
+A spec mirrors the YAML file key for key (docs/interfaces.md), so one dotted
 path (``friction.static``, ``isolator.stroke``) names a quantity in the file, in
 error messages, in ``fi-design sweep --x PATH=...`` and in JSON. Every physical
 field accepts an SI number or a string with units; after validation it holds an
@@ -23,6 +23,7 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Discriminator, Fie
                       Tag, WithJsonSchema, create_model, model_validator)
 
 from . import effects as _effects
+from .display import number
 from .trajectory import profile_duration
 from .units import to_si
 
@@ -77,7 +78,10 @@ class Friction(StrictModel):
         "lugre", description="Friction model: 'lugre' (default) or 'switch' (Karnopp-type "
                              "stick-slip cross-check).")
     static: Q("N") = Field(gt=0, description="Static friction force Fs [N].")
-    coulomb: Q("N") = Field(gt=0, description="Coulomb (sliding) friction force Fc [N].")
+    coulomb: Q("N") = Field(ge=0, description="Coulomb (sliding) friction force Fc [N]; 0 for "
+                                              "static friction without Coulomb friction "
+                                              "(simulated with 0.1 % of Fs, LuGre needs it "
+                                              "above 0).")
     stribeck_velocity: Q("m/s") = Field(gt=0, description="Stribeck velocity vs [m/s].")
     viscous: Q("N*s/m") = Field(0.0, ge=0, description="Viscous friction coefficient sigma2 "
                                                         "[N s/m]. Default 0.")
@@ -103,6 +107,10 @@ class Friction(StrictModel):
         if self.static < self.coulomb:
             raise ValueError(f"static friction Fs = {self.static:g} N must be at least the "
                              f"Coulomb friction Fc = {self.coulomb:g} N")
+        if self.coulomb == 0 and self.coulomb_negative is not None:
+            raise ValueError("coulomb_negative needs a Coulomb friction above 0: static "
+                             "friction in the negative direction scales with coulomb_negative / "
+                             "coulomb")
         return self
 
 
@@ -213,18 +221,20 @@ class Feedforward(StrictModel):
 
 
 class Controller(StrictModel):
-    """The position controller: the paper's PID rule (DESIGN.md section 2) or the hardware's gains.
+    """The position controller: the paper's PID rule (paper section 2.2) or the hardware's gains.
 
-    Without ``gains`` the PID is tuned from ``crossover`` by the rule; with
-    ``gains`` the loop, the four limit cases, the simulation and the report
-    use the given gains, and the rule's gains are shown beside them.
+    Without gains the PID is tuned from the crossover by the rule; with gains
+    the loop, the four limit cases, the simulation and the report use the
+    given gains, and the rule's gains are shown beside them (docs/model.md).
     """
 
     crossover: OptQ("Hz") = Field(None, gt=0, description="Desired crossover frequency fc [Hz]; "
                                                            "the rule tunes the PID for it. "
-                                                           "Optional with `gains` (the achieved "
-                                                           "crossover is computed and must then "
-                                                           "agree within 10 %).")
+                                                           "Optional with gains: then the "
+                                                           "crossover the gains were tuned for, "
+                                                           "within 10 % of where they cross the "
+                                                           "tuning mass over (without it, that "
+                                                           "crossover is computed).")
     gains: Gains | None = Field(None, description="The hardware's own gains; omit to tune by the "
                                                   "rule.")
     derivative_on: Literal["error", "measurement"] = Field(
@@ -233,7 +243,7 @@ class Controller(StrictModel):
     roll_off: OptQ("Hz") = Field(None, gt=0, description="First-order low-pass of the D term "
                                                          "[Hz]. Default: with the rule its wt "
                                                          "(derivative_ratio x crossover); with "
-                                                         "`gains` none (an ideal D, sampled when "
+                                                         "gains none (an ideal D, sampled when "
                                                          "sample_rate is set).")
     force_limit: OptQ("N") = Field(None, gt=0, description="Actuator saturation of the hardware "
                                                            "[N]; null: none.")
@@ -375,10 +385,10 @@ class Ripple(StrictModel):
 class Robustness(StrictModel):
     """Friction scatter under which the design must stay hunting-free (part of the verdict).
 
-    The design command draws ``samples`` variants of the spec with static and
+    The design command draws 'samples' variants of the spec with static and
     Coulomb friction scattered (and, optionally, a ripple along the rail with
     a random phase per sample), simulates the stage as specified in each, and
-    compares the probability of hunting with ``hunting_probability``.
+    compares the probability of hunting with 'hunting_probability'.
     """
 
     static: Q("1") = Field(0.2, ge=0, lt=1, description="Scatter of static friction Fs, a "
@@ -652,7 +662,7 @@ EffectEntry = Annotated[
 
 
 class Spec(StrictModel):
-    """A friction-isolator design spec (DESIGN.md section 3), values in SI."""
+    """A friction-isolator design spec, values in SI (the keys: docs/interfaces.md)."""
 
     name: str = Field("Unnamed stage", description="Project or stage name.")
     stage: Body = Field(description="The actuated stage (m1, carries the sensor).")
@@ -663,8 +673,10 @@ class Spec(StrictModel):
     motion: Motion
     requirements: Requirements = Field(default_factory=Requirements)
     measurement: Measurement | None = None
-    effects: tuple[EffectEntry, ...] = Field((), description="Effects added to the model "
-                                                             "(DESIGN.md section 5).")
+    effects: tuple[EffectEntry, ...] = Field((), description="Effects added to the model, "
+                                                             "from the effects catalogue "
+                                                             "(fi-design schema --markdown "
+                                                             "lists them).")
     report: ReportInfo = Field(default_factory=ReportInfo)
     simulation: Simulation = Field(default_factory=Simulation)
 
@@ -776,7 +788,7 @@ def gains_crossover(spec: Spec) -> float:
 
     The frequency where |C(j w)| = m w^2, i.e. where the loop of the gains
     around a free tuning mass m crosses 0 dB (the rule's definition of the
-    crossover, DESIGN.md section 2), with C(s) = kp + ki / s + kd s / (1 + s / wf)
+    crossover, docs/model.md), with C(s) = kp + ki / s + kd s / (1 + s / wf)
     and wf the D term's roll-off (none when not given). |C| / (m w^2) falls
     with w for every such C, so ``log |C| - log(m w^2)`` has one root in
     ``log w``, found by scipy's ``brentq`` between 1e-6 and 1e9 rad/s (an end
@@ -804,13 +816,17 @@ def gains_crossover(spec: Spec) -> float:
 
 
 def design_crossover(spec: Spec) -> float:
-    """The loop's crossover [Hz]: ``controller.crossover`` for the rule, else the gains' own.
+    """The loop's crossover [Hz]: ``controller.crossover``, else the gains' own.
 
-    With explicit gains a given crossover only has to agree with theirs
-    (:data:`CROSSOVER_AGREEMENT`); the loop crosses over where the gains do.
+    With explicit gains a given crossover names the crossover they were tuned
+    for (it must agree with where they cross the tuning mass over within
+    :data:`CROSSOVER_AGREEMENT`): the rule's gains written as
+    ``controller.gains`` beside the rule's ``crossover`` give the same design,
+    crossover scan included. Without it, the gains' own crossover
+    (:func:`gains_crossover`).
     """
     ctl = spec.controller
-    return ctl.crossover if ctl.gains is None else gains_crossover(spec)
+    return ctl.crossover if ctl.crossover is not None else gains_crossover(spec)
 
 
 
@@ -914,13 +930,14 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     A warning fires on the user's own values, and on a default only where the
     default is a poor fit for this spec (and then says so): a bristle damping
     the user gave that breaks the LuGre dissipativity condition sigma1 < sigma2
-    Fc / (Fs - Fc) (the default sqrt(sigma0 (m1 + m2)), damping ratio 0.5 of
-    the presliding mode, breaks it too, deliberately: a bristle damping low
-    enough to meet it rings in presliding; a value written out equal to the
-    default to four digits counts as the default), a stroke within five
-    presliding ranges, a hunting window that starts before the last move
-    ends, and a loop without the hardware's sampling and delay (a continuous
-    controller without delay: the margins and the hunting depend on both).
+    Fc / (Fs - Fc) (the warning recommends a value within the bound and says
+    what it costs: the presliding mode then rings; the default sqrt(sigma0
+    (m1 + m2)), damping ratio 0.5 of the presliding mode, breaks the bound
+    deliberately and is not warned about when left out), a stroke within
+    five presliding ranges, a hunting window that starts before the last
+    move ends, and a loop without the hardware's sampling and delay (a
+    continuous controller without delay: the margins and the hunting depend
+    on both).
     """
     out: list[tuple[str, str]] = []
     f = spec.friction
@@ -929,12 +946,18 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
         s1 = f.bristle_damping
         default = math.sqrt(f.bristle_stiffness * spec.total_mass)
         bound = f.viscous * f.coulomb / gap
-        if s1 >= bound and abs(s1 / default - 1.0) > 5e-4:
+        if s1 >= bound:
+            within = 0.9 * bound
+            ratio = within / (2.0 * default)  # sigma1 / (2 sqrt(sigma0 m)) of the presliding mode
+            advice = (f"a value below the bound, e.g. {number(within, 3)} N s/m, keeps it "
+                      f"dissipative but damps the presliding mode at a ratio of only "
+                      f"{number(ratio, 2)}, where the default sqrt(sigma0 (m1 + m2)) = "
+                      f"{number(default)} N s/m damps it at 0.5" if bound > 0 else
+                      "only sigma1 = 0 meets it without viscous or Coulomb friction")
             out.append(("friction.bristle_damping",
-                        f"sigma1 = {s1:.4g} N s/m (given) exceeds sigma2 Fc / (Fs - Fc) = "
-                        f"{bound:.4g} N s/m: the LuGre model is not guaranteed dissipative "
-                        f"(Barabanov and Ortega); the default sqrt(sigma0 (m1 + m2)) = "
-                        f"{default:.4g} N s/m damps the presliding mode at a ratio of 0.5"))
+                        f"sigma1 = {number(s1)} N s/m (given) is not below sigma2 Fc / (Fs - Fc) "
+                        f"= {number(bound)} N s/m: the LuGre model is not guaranteed dissipative "
+                        f"(Barabanov and Ortega); {advice}; leave the key out for the default"))
     if spec.isolator is not None:
         presl = f.static / f.bristle_stiffness
         if spec.isolator.stroke < 5 * presl:

@@ -1,10 +1,12 @@
 """Reading a spec: safe YAML with line numbers, validation, clear errors.
 
 :func:`load_spec` is the one entry point. It accepts a path or an already
-parsed mapping. YAML is read with PyYAML's safe loader; tags that would build
-Python objects, duplicate keys and alias bombs are refused. Validation errors
-become a :class:`~fi_design.errors.SpecError` naming the dotted field path and
-the YAML line, with a suggestion for misspelt keys.
+parsed mapping. YAML is read with ruamel.yaml in round-trip mode
+(:func:`yaml_loader`), which builds plain data only and keeps each key's line
+and the comments (a spec written back, :mod:`fi_design.specedit`, keeps them);
+tags beyond YAML's core schema, duplicate keys and alias bombs are refused.
+Validation errors become a :class:`~fi_design.errors.SpecError` naming the
+dotted field path and the YAML line, with a suggestion for misspelt keys.
 """
 
 from __future__ import annotations
@@ -40,8 +42,9 @@ class SpecOrigin:
     raw : dict
         The mapping as written (before units and defaults), used to tell given
         values from defaults.
-    lines : dict
-        YAML line (1-based) of every key, by location tuple.
+    document : ruamel.yaml.comments.CommentedMap or None
+        The file as ruamel.yaml's round-trip loader read it: the YAML line of
+        every key (:meth:`line`); None for a mapping.
     text : str or None
         The file's text exactly as read (comments, layout and line endings
         kept; ``text.encode("utf-8")`` are the bytes ``sha256`` was computed
@@ -51,8 +54,44 @@ class SpecOrigin:
     path: Path | None
     sha256: str
     raw: dict
-    lines: dict = field(default_factory=dict, repr=False)
+    document: Any = field(default=None, repr=False, compare=False)
     text: str | None = field(default=None, repr=False)
+
+    def line(self, loc: tuple) -> int | None:
+        """The 1-based YAML line of the key or list entry at ``loc``, or of its nearest parent.
+
+        Parameters
+        ----------
+        loc : tuple
+            Location: keys and list indices (``("friction", "static")``,
+            ``("motion", "moves", 0, "distance")``).
+
+        Returns
+        -------
+        int or None
+            None for a spec read from a mapping, or a location the file does
+            not have at all.
+        """
+        return document_line(self.document, loc)
+
+
+def document_line(document: Any, loc: tuple) -> int | None:
+    """The 1-based line of ``loc`` in a round-trip document (or of its nearest parent)."""
+    best = None
+    node = document
+    for part in loc:
+        lc = getattr(node, "lc", None)
+        try:
+            if isinstance(part, int) and isinstance(node, list) and 0 <= part < len(node):
+                best = lc.item(part)[0] + 1
+            elif isinstance(node, dict) and part in node:
+                best = lc.key(part)[0] + 1
+            else:
+                return best
+        except (AttributeError, KeyError, TypeError):  # an entry ruamel has no position for
+            return best
+        node = node[part]
+    return best
 
 
 def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
@@ -80,12 +119,12 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
     if isinstance(source, Mapping):
         raw = _plain(source)
         digest = hashlib.sha256(json.dumps(raw, sort_keys=True, default=str).encode()).hexdigest()
-        return _validate(raw, SpecOrigin(None, digest, raw, {}))
+        return _validate(raw, SpecOrigin(None, digest, raw))
     path = Path(source)
     data = read_bytes(path)
-    raw, lines = parse_yaml(data, str(path))
+    raw, document = parse_yaml(data, str(path))
     # parse_yaml decoded the bytes as UTF-8 already: the text encodes back to the same bytes
-    return _validate(raw, SpecOrigin(path, hashlib.sha256(data).hexdigest(), raw, lines,
+    return _validate(raw, SpecOrigin(path, hashlib.sha256(data).hexdigest(), raw, document,
                                      data.decode("utf-8")))
 
 
@@ -109,18 +148,46 @@ def read_bytes(path: Path) -> bytes:
         raise SpecFileError(f"{path}: cannot read ({exc.strerror})") from None
 
 
-def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, dict]:
-    """Parse YAML bytes safely into a mapping and a line map.
+#: Tags a spec may carry (YAML's core schema); any other tag is refused.
+_PLAIN_TAGS = frozenset(f"tag:yaml.org,2002:{t}" for t in
+                        ("str", "int", "float", "bool", "null", "map", "seq", "timestamp"))
+
+
+def yaml_loader():
+    """The YAML reader and writer of spec files: ruamel.yaml in round-trip mode.
+
+    Round-trip mode builds plain data only (no tag constructs a Python object)
+    and keeps what a writer needs: comments, key order, flow or block style and
+    each key's line.
+    """
+    from ruamel.yaml import YAML
+
+    yaml = YAML(typ="rt")
+    yaml.width = 4096  # never re-wrap a user's long lines
+    yaml.preserve_quotes = True
+    return yaml
+
+
+def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, Any]:
+    """Parse YAML bytes safely into a mapping and its round-trip document.
 
     Returns
     -------
     raw : dict
-        The top-level mapping.
-    lines : dict
-        1-based line of each key, keyed by location tuple (``("friction",
-        "static")``, ``("motion", "moves", 0)``).
+        The top-level mapping as plain Python data.
+    document : ruamel.yaml.comments.CommentedMap
+        The same data as ruamel.yaml read it, with comments and the line of
+        every key (:func:`document_line`).
+
+    Raises
+    ------
+    SpecError
+        Not UTF-8, empty, not valid YAML, a control character, a tag other
+        than YAML's core schema, a key given twice, an alias bomb, or a top
+        level that is not a mapping; the message names the line.
     """
-    import yaml
+    from ruamel.yaml.error import MarkedYAMLError, YAMLError
+    from ruamel.yaml.reader import ReaderError
 
     try:
         text = data.decode("utf-8")
@@ -129,43 +196,34 @@ def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, dict]:
     if not text.strip() or all(ln.strip().startswith("#") or not ln.strip()
                                for ln in text.splitlines()):
         raise SpecError("the spec file is empty", source=source)
+    yaml = yaml_loader()
     try:
-        loader = yaml.SafeLoader(text)
-    except yaml.reader.ReaderError as exc:  # a NUL or other control character
-        line = text.count("\n", 0, exc.position) + 1
-        raise SpecError(f"control character U+{exc.character:04X} is not allowed in a YAML "
-                        "spec: the file is not plain text", line=line, source=source) from None
-    try:
-        node = loader.get_single_node()
+        node = yaml.compose(text)
         if node is None:
             raise SpecError("the spec file is empty", source=source)
         _count_nodes(node, source)
-        lines: dict = {}
-        _walk(node, (), lines, source)
-        raw = loader.construct_document(node)
-    except yaml.constructor.ConstructorError as exc:
-        line = exc.problem_mark.line + 1 if exc.problem_mark else None
-        what = exc.problem or "unsupported YAML"
-        if "constructor for the tag" in what:
-            what = (what.replace("could not determine a constructor for the tag",
-                                 "YAML tag") + " is not allowed: a spec holds plain data only")
-        raise SpecError(what, line=line, source=source) from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
+        _check_nodes(node, (), source)
+        document = yaml.constructor.construct_document(node)
+    except ReaderError as exc:  # a NUL or other control character
+        line = text.count("\n", 0, exc.position) + 1
+        raise SpecError(f"control character U+{exc.character:04X} is not allowed in a YAML "
+                        "spec: the file is not plain text", line=line, source=source) from None
+    except MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark else None
-        problem = getattr(exc, "problem", None) or str(exc)
+        problem = exc.problem or exc.context or str(exc)
         raise SpecError(f"not valid YAML: {problem}", line=line, source=source) from None
-    finally:
-        loader.dispose()
-    if not isinstance(raw, dict):
-        kind = "a list" if isinstance(raw, list) else f"a {type(raw).__name__}"
+    except YAMLError as exc:
+        raise SpecError(f"not valid YAML: {exc}", source=source) from None
+    if not isinstance(document, dict):
+        kind = "a list" if isinstance(document, list) else f"a {type(document).__name__}"
         raise SpecError(f"the top level must be a mapping of sections (name, stage, cart, ...), "
                         f"got {kind}", line=1, source=source)
-    return raw, lines
+    return _plain(document), document
 
 
 def _count_nodes(node, source: str) -> None:
-    import yaml
+    from ruamel.yaml.nodes import MappingNode, SequenceNode
 
     memo: dict[int, int] = {}
 
@@ -174,9 +232,9 @@ def _count_nodes(node, source: str) -> None:
         if key in memo:
             return memo[key]
         memo[key] = 1  # cycles count once
-        if isinstance(n, yaml.SequenceNode):
+        if isinstance(n, SequenceNode):
             total = 1 + sum(size(c) for c in n.value)
-        elif isinstance(n, yaml.MappingNode):
+        elif isinstance(n, MappingNode):
             total = 1 + sum(size(k) + size(v) for k, v in n.value)
         else:
             total = 1
@@ -189,32 +247,50 @@ def _count_nodes(node, source: str) -> None:
     size(node)
 
 
-def _walk(node, loc: tuple, lines: dict, source: str) -> None:
-    import yaml
+def _check_nodes(node, loc: tuple, source: str, seen: set | None = None) -> None:
+    """Refuse tags beyond YAML's core schema and keys given twice, naming the line."""
+    from ruamel.yaml.nodes import MappingNode, SequenceNode
 
-    if isinstance(node, yaml.MappingNode):
-        seen: dict = {}
+    seen = set() if seen is None else seen
+    if id(node) in seen:  # an alias: checked where it was defined
+        return
+    seen.add(id(node))
+    tag = str(node.tag) if node.tag is not None else None
+    if tag is not None and tag not in _PLAIN_TAGS:
+        shown = "!!" + tag[len("tag:yaml.org,2002:"):] if tag.startswith("tag:yaml.org,2002:") \
+            else tag
+        raise SpecError(f"YAML tag '{shown}' is not allowed: a spec holds plain data only",
+                        line=node.start_mark.line + 1, source=source)
+    if isinstance(node, MappingNode):
+        keys: dict = {}
         for knode, vnode in node.value:
             key = knode.value
             line = knode.start_mark.line + 1
-            if key in seen:
-                path = _dotted(loc + (key,))
-                raise SpecError(f"key '{key}' appears twice (also on line {seen[key]})", path=path,
-                                line=line, source=source)
-            seen[key] = line
-            lines[loc + (key,)] = line
-            _walk(vnode, loc + (key,), lines, source)
-    elif isinstance(node, yaml.SequenceNode):
+            if isinstance(key, str) and key in keys:
+                raise SpecError(f"key '{key}' appears twice (also on line {keys[key]})",
+                                path=_dotted(loc + (key,)), line=line, source=source)
+            keys[key] = line
+            _check_nodes(knode, loc, source, seen)
+            _check_nodes(vnode, loc + (key,), source, seen)
+    elif isinstance(node, SequenceNode):
         for i, item in enumerate(node.value):
-            lines[loc + (i,)] = item.start_mark.line + 1
-            _walk(item, loc + (i,), lines, source)
+            _check_nodes(item, loc + (i,), source, seen)
 
 
 def _plain(obj: Any) -> Any:
+    """Plain Python data: dict, list, str, int, float, bool, None (ruamel's scalar types too)."""
     if isinstance(obj, Mapping):
         return {str(k): _plain(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
         return [_plain(v) for v in obj]
+    if isinstance(obj, bool) or obj is None:
+        return obj
+    if isinstance(obj, str):
+        return str(obj)
+    if isinstance(obj, int):
+        return int(obj)
+    if isinstance(obj, float):
+        return float(obj)
     return obj
 
 
@@ -228,17 +304,20 @@ def _validate(raw: dict, org: SpecOrigin) -> Spec:
     try:
         spec = Spec.model_validate(raw)
     except ValidationError as exc:
-        errors = exc.errors(include_url=False)
+        # an unknown key first: a misspelt required key also makes it "missing", and the
+        # typo is the cause the user has to see
+        errors = sorted(exc.errors(include_url=False),
+                        key=lambda e: e["type"] != "extra_forbidden")
         msgs = [_describe(e, raw) for e in errors]
         first_loc = _clean_loc(errors[0]["loc"], raw)
         if not first_loc and msgs[0][0]:
             first_loc = tuple(msgs[0][0].split("."))
-        line = _line_for(first_loc, org.lines)
+        line = org.line(first_loc)
         text = msgs[0][1]
         if len(msgs) > 1:
             extra = []
             for (p, m), e in list(zip(msgs, errors))[1:8]:
-                ln = _line_for(_clean_loc(e["loc"], raw), org.lines)
+                ln = org.line(_clean_loc(e["loc"], raw))
                 extra.append(f"  - {p or '(top level)'}{f' (line {ln})' if ln else ''}: {m}")
             text += f"\n{len(msgs) - 1} more problem(s):\n" + "\n".join(extra)
         raise SpecError(text, path=msgs[0][0] or None, line=line, source=source) from None
@@ -273,13 +352,6 @@ def _dotted(loc: tuple) -> str:
         else:
             out += ("." if out else "") + str(part)
     return out
-
-
-def _line_for(loc: tuple, lines: dict) -> int | None:
-    for n in range(len(loc), 0, -1):
-        if loc[:n] in lines:
-            return lines[loc[:n]]
-    return None
 
 
 def _model_at(loc: tuple):

@@ -38,6 +38,8 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from .model import Model
+from . import spec as _spec
+from .display import percent, quantities, quantity
 from .results import Check, Status
 from .results.design import (Confirmation, CrossoverResult, FlexureResult, Margins, PidResult,
                              Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict)
@@ -50,13 +52,11 @@ _OWN = {True: "isolated", False: "non_isolated"}
 
 
 def _pct(x: float | None) -> str:
-    if x is None:
-        return "n/a"
-    return f"{100 * x:.2g} %" if x < 0.1 else f"{100 * x:.3g} %"
+    return percent(x, 3)
 
 
 def _um(x: float) -> str:
-    return f"{x * 1e6:.3g} um"
+    return quantity(x, "m", 3)
 
 
 # --------------------------------------------------------------------------- robustness
@@ -408,10 +408,10 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
         if rise <= spread:
             reasons.append(Reason(
                 "WARN", "end_stop_clearance",
-                f"The cart rests {_um(clearance)} from its end stop (joint deflection "
-                f"{_um(d)} of the {_um(d + clearance)} stroke): a friction force "
-                f"{100 * rise:.2g} % higher would put it on the limiter, within the "
-                f"+-{100 * spread:.3g} % scatter of Fc."))
+                "The cart rests {} from its end stop (joint deflection {} of the {} stroke): "
+                "a friction force ".format(*quantities((clearance, d, d + clearance), "m", 3))
+                + f"{percent(rise, 2)} higher would put it on the limiter, within the "
+                f"\u00b1{percent(spread)} scatter of Fc."))
     for c in checks:
         if c.status == Status.WARN and c.name != "robustness":
             reasons.append(Reason("WARN", c.name, f"{c.step}: {c.message}."))
@@ -428,6 +428,7 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
     order = {"FAIL": 0, "WARN": 1, "PASS": 2}
     reasons.sort(key=lambda r: order[r.severity])
     status = ("FAIL" if any(r.severity == "FAIL" for r in reasons) else
+              "NOT_CONFIRMED" if simulation is None else
               "PASS_WITH_WARNINGS" if any(r.severity == "WARN" for r in reasons) else "PASS")
     nwarn = sum(r.severity == "WARN" for r in reasons)
     what = (f"{label} {_BEHAVIOUR.get(behaviour, behaviour)} at {fc:.4g} Hz"
@@ -446,6 +447,8 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
     listed = ", ".join(on[:-1]) + " and on " + on[-1] if len(on) > 1 else "".join(on)
     tail = {"FAIL": f"It fails on {listed}" + (f"; {warned}" if nwarn else ""),
             "PASS_WITH_WARNINGS": f"Nothing fails; {warned}",
+            "NOT_CONFIRMED": "Nothing of the linear steps fails, but without the simulation "
+                             "it does not pass" + (f"; {warned}" if nwarn > 1 else ""),
             "PASS": "Nothing fails, nothing to review"}[status]
     return Verdict(status=status, reasons=tuple(reasons), plant=own, behaviour=behaviour,
                    headline=f"{what}. {tail}.")

@@ -2,7 +2,7 @@
 
 The project's estimators (reconciliation, friction identification) and its kernel must be
 tested on data that the product's own kernel did not make. This module is a second, separate
-transcription of the physics of ``DESIGN.md`` (sections 2, 5 and 8), written from the equations
+transcription of the physics of ``docs/model.md`` and ``docs/effects.md``, written from the equations
 only and integrated with :func:`scipy.integrate.solve_ivp` (implicit Radau, tight tolerance).
 It imports nothing from fi_design's model code; :mod:`fi_design.measured` is used only to
 package a record as a :class:`~fi_design.measured.Measurement` (:meth:`Record.measurement`).
@@ -128,7 +128,7 @@ ZENO_COUNT = 8
 ZENO_HOLD = 1e-6
 ZENO_BAND = 0.01
 
-#: Default limiter stiffness [N/m] (DESIGN.md section 2).
+#: Default limiter stiffness [N/m] (docs/model.md).
 K_STOP = 1e6
 
 _FRICTION_KEYS = {"Fs", "Fc", "vs", "sigma0", "sigma1", "sigma2", "Fc_neg", "sigma2_neg",
@@ -209,7 +209,7 @@ class Truth:
 
 @dataclass(frozen=True, eq=False)
 class Record:
-    """A simulated record in the measured-data layout (DESIGN.md sections 4 and 8).
+    """A simulated record in the measured-data layout (docs/interfaces.md).
 
     Attributes
     ----------
@@ -458,7 +458,7 @@ class _Simulation:
                 self.c = float(eff["joint_damping"]["damping"])
             self.k_stop = float(isolator.get("k_stop", K_STOP))
             c_stop = isolator.get("c_stop")
-            # the default of DESIGN.md, from the nominal stage mass (a parameter default)
+            # the default of docs/model.md, from the nominal stage mass (a parameter default)
             self.c_stop = (2 * 0.2 * math.sqrt(self.k_stop * m1) if c_stop is None
                            else float(c_stop))
         else:
@@ -1197,7 +1197,7 @@ def generate(m1, m2=0.0, *, friction=None, isolator=None, controller=None, moves
     rate : float
         Output sample rate [Hz].
     effects : dict or None
-        Effects of DESIGN.md sections 5 and 8, ``{name: {parameter: value}}`` with the
+        Effects of docs/effects.md, ``{name: {parameter: value}}`` with the
         catalogue's names and SI parameters; each changes the true stage.
     noise : dict or None
         Standard deviations of Gaussian recording noise: ``position`` [m], ``deflection``

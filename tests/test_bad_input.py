@@ -192,3 +192,17 @@ def test_usage_errors_exit_2(tmp_path, paper_spec_path):
     assert not out.exists()
     r = runner.invoke(app, ["design"])
     assert r.exit_code == 2
+
+
+def test_unknown_key_is_reported_before_the_missing_field_it_causes(tmp_path):
+    """A misspelt required key is both unknown and missing: the typo comes first."""
+    text = edit("static: 4 N", "statc: 4 N")
+    spec = tmp_path / "typo.yaml"
+    spec.write_text(text)
+    result, out = _run(str(spec), tmp_path)
+    _assert_refused(result, out, tmp_path, ["friction.statc", "friction.static"])
+    first = result.stderr.splitlines()[0]
+    n = line_of(text, "statc:")
+    assert f"{spec}:{n}: friction.statc: unknown key 'statc'; did you mean 'static'?" in first, \
+        result.stderr
+    assert "required field is missing" in result.stderr.split("\n", 1)[1]

@@ -18,7 +18,7 @@ from conftest import BIN, ROOT
 
 runner = CliRunner()
 
-#: The JSON contract of `fi-design SPEC --json` (DESIGN.md section 6 and the guideline).
+#: The JSON contract of `fi-design SPEC --json` (docs/interfaces.md and the guideline).
 CONTRACT = {
     "friction_gap": ("gap", "threshold", "hunting_risk"),
     "pid": ("kp", "ki", "kd", "wt", "tuning_mass"),
@@ -262,10 +262,48 @@ class _FakeResult:
 def _fake_design(monkeypatch, calls):
     """Replace the (slow) design and simulations by stubs: these tests are about plumbing."""
     import fi_design.cli
-    import fi_design.guideline
+    import fi_design.signoff
 
     def fake(spec, **kwargs):
         calls.append(spec)
         return _FakeResult()
 
-    monkeypatch.setattr(fi_design.guideline, "design", fake)
+    monkeypatch.setattr(fi_design.signoff, "design", fake)
+
+
+def test_init_derives_what_it_can_and_names_its_file(tmp_path):
+    """init wrote the 2 kg example's bristle damping, stiffness and joint damping as given
+    values, which stayed when the user changed the masses; and its header named bearing.yaml
+    whatever the file was called."""
+    import re
+
+    from fi_design import load_spec
+    from fi_design import spec as sp
+
+    path = tmp_path / "stage42.yaml"
+    r = runner.invoke(app, ["init", str(path)])
+    assert r.exit_code == 0, r.output
+    text = path.read_text()
+    assert f"fi-design {path}" in text and "bearing.yaml" not in text
+    spec = load_spec(path)
+    assert spec.friction.bristle_damping is None and spec.isolator.stiffness is None
+    assert spec.isolator.damping is None
+    heavier = tmp_path / "heavier.yaml"
+    heavier.write_text(re.sub(r"mass: 1\.6 kg", "mass: 16 kg", text, count=1))
+    big = load_spec(heavier)
+    assert sp.bristle_damping(big) == pytest.approx((1e6 * 16.4) ** 0.5)
+    assert sp.joint_damping(big) > sp.joint_damping(spec)
+
+
+@pytest.mark.parametrize("name", [None, "design", "simulate", "schema", "init", "sweep",
+                                  "study", "robustness", "reconcile", "identify"])
+def test_help_shows_no_type_labels_or_markup(name):
+    """--help showed '<bool>' beside every flag, '<path>' beside SPEC.yaml and RST or Markdown
+    markup (``window``, `fi-design init`)."""
+    import re
+
+    r = runner.invoke(app, ([name] if name else []) + ["--help"], env={"COLUMNS": "200"})
+    assert r.exit_code == 0, r.output
+    assert not re.search(r"<(bool|path|str|int|float|text|integer)\b[^>]*>", r.output), r.output
+    for mark in ("`", ":func:", ":class:", ":mod:"):
+        assert mark not in r.output, (mark, r.output)

@@ -110,26 +110,32 @@ def test_reconcile_and_identify_summaries_read_at_80_columns():
     _readable(rec, 80)
     assert "position_dependent_friction" in rec
     assert re.search(r"position_rms_move\s+µm\s", rec), "lengths of the gap table in µm"
-    assert re.search(r"wavelength = 5 ± [\d.e+-]+\s+mm", " ".join(rec.split()))
+    assert re.search(r"wavelength = 5 ± [\d.]+(\s×\s10[⁻⁰¹²³⁴⁵⁶⁷⁸⁹]+)?\s+mm", rec)
+    # no bare SI in the headline, the noise levels in reading units
+    assert "SI" not in rec and "wavelength = 0.005" not in rec
+    assert re.search(r"Noise: position [\d.]+\s+µm", rec), rec
     ident = _run(["identify", str(EXAMPLES / "measured_trace.csv"), "--spec",
                   str(EXAMPLES / "measured_stage.yaml")], 80)
     _readable(ident, 80)
     assert "Identifiable" in ident and "N·s/m" in ident
 
 
-@pytest.mark.parametrize("value,unit,text", [
-    (1.366e-3, "m", "1.366 mm"), (2.52e-8, "m", "0.0252 µm"), (1.4e-12, "m", "< 0.001 µm"),
-    (-6.25e-4, "m", "-0.625 mm"), (0.0, "m", "0"), (None, "m", "-"), (3.155e7, "Pa", "31.55 MPa"),
-    (3e-3, "m/s", "3 mm/s"), (2.5, "s", "2.5 s"),
-])
-def test_quantities_in_cells(value, unit, text):
-    assert con._qty(value, unit) == text
 
 
-@pytest.mark.parametrize("value,text", [
-    (13333.33, "13333"), (0.3, "0.3"), (2.0, "2"), (3.2e-8, "3.2e-08"), (1.37e6, "1.37e+06"),
-    (0.00134799, "0.001348"), (float("inf"), "inf"), (float("nan"), "-"), (5, "5"),
-    (None, "-"), (True, "yes"),
-])
-def test_numbers_in_cells(value, text):
-    assert con._fmt(value) == text
+def test_a_wide_map_prints_whole_axis_values_in_blocks(paper_spec_path):
+    """At 80 columns the sweep's axis labels read '6.…', '10…' (and '2.…' at 120)."""
+    for width in (80, 120):
+        sweep = _run(["sweep", str(paper_spec_path), "--x", "controller.crossover=2 Hz:20 Hz:20",
+                      "--y", "isolator.stroke=0.1 mm:0.3 mm:2", "-j", "1"], width)
+        _readable(sweep, width)
+        headers = [ln for ln in sweep.splitlines() if ln.strip().startswith("[mm]")]
+        values = [float(v) for ln in headers for v in ln.split()[1:]]
+        assert values == pytest.approx([2 + 18 * i / 19 for i in range(20)], rel=6e-3), headers
+
+
+def test_a_map_too_wide_to_print_names_its_file(paper_spec_path, tmp_path):
+    csv = tmp_path / "line.csv"
+    out = _run(["sweep", str(paper_spec_path), "--x", "controller.crossover=2 Hz:20 Hz:70",
+                "--csv", str(csv), "-j", "1"], 80)
+    flat = " ".join(out.split())
+    assert f"the map has 70 columns, too many to print here: see {csv}" in flat

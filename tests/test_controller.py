@@ -1,4 +1,4 @@
-"""The hardware's controller (DESIGN.md section 8) against analytic answers.
+"""The hardware's controller (docs/model.md) against analytic answers.
 
 Each new controller term is checked against a hand-derived result, never
 against the product itself: the closed-loop poles and zeros of a PD loop

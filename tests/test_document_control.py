@@ -352,3 +352,32 @@ def test_generic_reports_take_their_kind_s_id(paper_spec):
                       ("calibration", "FI-0001-CALIBRATION")):
         ctx = report.document_context("t", paper_spec, [], date=DATE, kind=kind)
         assert ctx["meta"]["document_id"] == doc
+
+
+def test_appendix_marks_the_rows_of_a_wrapped_spec_line(tmp_path):
+    """The PDF wrapped long spec lines without a mark, so the printed text read differently
+    from the text the SHA-256 is checked against."""
+    import shutil
+    import subprocess
+
+    long_comment = "# " + " ".join(f"word{i}" for i in range(40))  # about 280 characters
+    text = (EXAMPLES / "paper_setup.yaml").read_text(encoding="utf-8") + long_comment + "\n"
+    path = tmp_path / "stage.yaml"
+    path.write_bytes(text.encode("utf-8"))
+    result = design(load_spec(path), confirm=False)
+    ctx = report.build_context(result, date=DATE, figures=False)
+    assert "continues in rows marked" in ctx["appendix"]["spec_note"]
+    html = report.render_html(ctx)
+    tree = _html_tree(html)
+    (pre,) = _by_class(tree, "pre", "spec")
+    assert "".join(pre.itertext()) == text  # the text itself is the file's, byte for byte
+    rows = _by_class(tree, "span", "wrapped")
+    assert len(rows) == 2 and all(len(r.text) <= 94 for r in rows)
+    assert hashlib.sha256("".join(pre.itertext()).encode()).hexdigest() == result.spec_sha256
+    if shutil.which("pdftotext") is None:
+        return  # the mark in the PDF itself needs poppler-utils to read back
+    pdf = report.render_report(result, tmp_path / "r.pdf", date=DATE)
+    out = subprocess.run(["pdftotext", "-layout", str(pdf), "-"], capture_output=True,
+                         text=True, timeout=60).stdout
+    marked = [ln for ln in out.splitlines() if ln.strip().startswith("\u21aa")]
+    assert len(marked) == 2 and "word39" in marked[-1], marked

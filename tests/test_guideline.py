@@ -78,7 +78,8 @@ def test_json_contract_for_the_paper_setup(paper_design, paper_spec):
 
 def test_paper_verdict(paper_design):
     r = paper_design
-    assert r.passed and not r.failed_checks
+    # nothing of the four steps fails, but the linear steps alone do not pass a design
+    assert not r.failed_checks and not r.passed and r.verdict.status == "NOT_CONFIRMED"
     names = [c.name for c in r.checks]
     assert names[0] == "friction_gap" and "crossover_achievable" in names
     assert {f"phase_margin.{n}" for n in ("sliding_free", "stuck_free", "sliding_limited",

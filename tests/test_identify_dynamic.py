@@ -33,7 +33,7 @@ from fi_design.specfile import parse_yaml
 
 import independent
 
-#: The paper's stage without its isolator (2 kg, LuGre as in DESIGN.md): its rule loop hunts.
+#: The paper's stage without its isolator (2 kg, LuGre as in docs/model.md): its rule loop hunts.
 PAPER = dict(Fs=4.0, Fc=1.0, vs=3e-3, sigma0=1e6, sigma1=1414.0, sigma2=20.0)
 #: A 2 kg stage with a softer bristle and a load offset, for the sweep and presliding records.
 SMALL = dict(Fs=1.5, Fc=1.0, vs=2e-3, sigma0=1e5, sigma1=450.0, sigma2=20.0, offset=0.1)

@@ -1,7 +1,7 @@
 """The independent simulator (tests/independent.py) against analytic answers only.
 
 Nothing here compares with fi_design's kernel: every expected value is derived by hand from the
-equations of DESIGN.md (steady states, closed forms, exact responses of linear systems by the
+equations of docs/model.md (steady states, closed forms, exact responses of linear systems by the
 matrix exponential, discrete recursions written out anew).
 """
 
@@ -20,7 +20,7 @@ from independent import Truth, generate
 
 HERE = Path(__file__).resolve().parent
 
-#: The paper's bearing (DESIGN.md example values).
+#: The paper's bearing (the example values of docs/model.md).
 LUGRE = dict(Fs=4.0, Fc=1.0, vs=3e-3, sigma0=1e6, sigma1=1414.0, sigma2=20.0)
 ISOLATOR = dict(k=6667.0, c=4.62, s=0.3e-3)
 

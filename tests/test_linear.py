@@ -41,7 +41,7 @@ def two_mass(s, cart_k, cart_c, c=c):
 
 
 def hand_cases(c=c):
-    """The four plants u -> x1 of DESIGN.md section 2 with joint damping c."""
+    """The four plants u -> x1 of docs/model.md with joint damping c."""
     return {
         "sliding_free": lambda s: two_mass(s, 0.0, s2, c),              # cart: sigma2 only
         "stuck_free": lambda s: two_mass(s, s0, s1 + s2, c),            # cart on the bristles

@@ -1,4 +1,4 @@
-"""Measured-data files (DESIGN.md section 4): good layouts load, bad ones name column and row."""
+"""Measured-data files (docs/interfaces.md): good layouts load, bad ones name column and row."""
 
 from __future__ import annotations
 

@@ -220,3 +220,54 @@ def test_error_figure_shows_the_settling_at_the_band_scale(paper_confirmed_desig
     texts = " ".join(t.get_text() for t in iso.texts)
     assert "in the band from" in texts
     assert "never stays in the band" in " ".join(t.get_text() for t in non.texts)
+
+
+def test_bode_plot_spans_the_design_band(paper_confirmed_design):
+    """It spanned 1e-4 to 1e3 Hz (case 4's millihertz crossover), the design band a third of
+    the width; the band now fills the plot and the caption names what is left out."""
+    import math
+
+    from fi_design.report.design import _bode_caption
+
+    d = paper_confirmed_design
+    fc = d.crossover.desired
+    for fig in (plots.bode_figure(d), plots.sensitivity_figure(d)):
+        lo, hi = fig.axes[0].get_xlim()
+        assert lo >= fc / 100
+        band = math.log10(10 * fc / (fc / 10)) / math.log10(hi / lo)
+        assert band >= 0.5, (lo, hi)
+    caption = _bode_caption(d)
+    assert "case 4 also crosses 0 dB at 0.00135" in caption and "not drawn" in caption
+
+
+def test_the_measured_trace_shows_under_the_corrected_one(reconciliation):
+    """The corrected model, drawn on top with the measurement's width, hid it where the two
+    agree: the measurement is now wide underneath, the models thin on top."""
+    fig = plots.gap_overlay_figure(reconciliation)
+    lines = {ln.get_label(): ln for ln in fig.axes[0].lines}
+    measured = lines["measured"]
+    for label, line in lines.items():
+        if label != "measured" and not label.startswith("_"):
+            assert line.get_linewidth() * 2 < measured.get_linewidth(), label
+            assert line.get_zorder() > measured.get_zorder(), label
+
+
+def test_captions_say_only_what_is_drawn(reconciliation, paper_confirmed_design):
+    """The overlay's caption spoke of shading that was not drawn."""
+    from types import SimpleNamespace
+
+    from fi_design.report.design import _error_caption
+    from fi_design.report.gap import _overlay_caption
+
+    text = _overlay_caption(reconciliation)
+    shaded = any(not s.coherent for s in reconciliation.segments)
+    assert ("Shaded" in text) == shaded
+    assert "failed" not in text and "cable_force" in text
+    flat = SimpleNamespace(peak_times=(), settling_time=None)
+    still = SimpleNamespace(suggested_isolator=False, isolated=SimpleNamespace(metrics=flat),
+                            non_isolated=SimpleNamespace(metrics=flat))
+    caption = _error_caption(still, paper_confirmed_design.spec)
+    assert "circles" not in caption and "no peak counted" in caption
+    assert "dotted" not in caption
+    full = _error_caption(paper_confirmed_design.simulation, paper_confirmed_design.spec)
+    assert "circles, the peaks the metric counts" in full and "dotted" in full

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 import yaml
@@ -70,7 +71,8 @@ def test_written_spec_reads_back_with_the_effect(run, files):
     _, out = run
     _, spec_path, _ = files
     text = out["spec"].read_text()
-    assert text.startswith("# the test stage")  # the input's text and comments are kept
+    assert text.startswith("# effects added by fi-design reconcile")
+    assert "\n# the test stage\n" in text  # the input's text and comments are kept
     fixed = load_spec(out["spec"])
     assert [e.type for e in fixed.effects] == ["cable_force"]
     assert load_spec(spec_path).effects == ()  # the input is untouched
@@ -84,6 +86,8 @@ def test_report_is_escaped_html(run):
         assert anchor in html
     assert "<script>alert(1)</script>" not in html
     assert "&lt;script&gt;" in html
+    visible = re.sub(r"<[^>]+>", " ", re.sub(r"<(svg|style)\b.*?</\1>", " ", html, flags=re.S))
+    assert "`" not in visible and "DESIGN.md" not in visible
 
 
 def test_outputs_never_overwrite_inputs(files):
@@ -106,3 +110,19 @@ def test_bad_measurement_exits_2_naming_the_column(files, tmp_path):
     assert "position_mm" in r.output and "Traceback" not in r.output
     r = runner.invoke(app, ["reconcile", str(spec_path), str(tmp_path / "missing.csv")])
     assert r.exit_code == 2 and "no such file" in r.output
+
+
+def test_gap_table_unit_column_matches_its_values(run):
+    """The gap table's unit column said m for values printed in µm (each with its own unit)."""
+    _, out = run
+    html = out["report"].read_text()
+    section = html.split('id="gap"', 1)[1].split("</table>", 1)[0]
+    rows = re.findall(r"<tr>(.*?)</tr>", section, flags=re.S)[1:]
+    assert rows
+    for row in rows:
+        cells = [re.sub(r"<[^>]+>", "", c).strip() for c in re.findall(r"<td[^>]*>(.*?)</td>",
+                                                                        row, flags=re.S)]
+        name, unit, values = cells[0], cells[1], cells[2:8]
+        assert unit != "m", (name, unit)  # lengths are read in µm or mm
+        for v in values:  # a number alone: the unit column names its unit
+            assert re.fullmatch(r"-|–|n/a|-?[\d.]+(\s×\s10[⁻⁰¹²³⁴⁵⁶⁷⁸⁹]+)?", v), (name, v)

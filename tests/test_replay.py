@@ -1,4 +1,4 @@
-"""Replay of measured records (DESIGN.md section 8) on a real axis and on traces that start moving.
+"""Replay of measured records (docs/interfaces.md) on a real axis and on traces that start moving.
 
 The EMPS record is a real ball-screw axis under its own PD loop (D on the
 measured velocity, 1 kHz), recorded in motion; nobody here generated it. Its

@@ -376,3 +376,31 @@ def test_spec_effects_list_is_what_simulate_uses(paper_spec, tmp_path):
         {"type": "cable_force", "stiffness": 50.0, "preload": 0.5}))
     assert np.array_equal(a.position, b.position)
     assert a.effects == ("cable_force",)
+
+
+def test_static_friction_without_coulomb_friction(paper_spec):
+    """friction.coulomb: 0 (Armstrong-Helouvry's static friction without Coulomb friction) was
+    refused; it simulates, and at speed the friction is the viscous part alone."""
+    move = {"distance": "50 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2"}
+    spec = variant(paper_spec, **{"friction.coulomb": "0 N", "isolator": None,
+                                  "motion.moves": [move]})
+    assert spec.friction.coulomb == 0.0
+    fr, v = spec.friction, 0.05
+    cruise = {}
+    for fc in (0.0, 1.0):
+        res = simulate(variant(spec, **{"friction.coulomb": fc}), isolated=False)
+        assert res.success, res.message
+        t = np.asarray(res.time)
+        steady = (t > 0.6) & (t < 0.9)  # cruising at 50 mm/s, the servo error settled
+        assert np.allclose(np.gradient(np.asarray(res.position), t)[steady], v, rtol=1e-2)
+        cruise[fc] = float(np.mean(np.asarray(res.force)[steady]))
+    # viscous sigma2 v plus the 0.1 % of Fs that keeps LuGre's g(v) above 0; Fc = 1 N adds 1 N
+    assert cruise[0.0] == pytest.approx(fr.viscous * v + 1e-3 * fr.static, rel=2e-3)
+    assert cruise[1.0] == pytest.approx(fr.viscous * v + 1.0, rel=2e-3)
+
+
+def test_coulomb_negative_needs_a_coulomb_friction(paper_spec):
+    from fi_design.errors import SpecError
+
+    with pytest.raises(SpecError, match="coulomb_negative needs a Coulomb friction above 0"):
+        variant(paper_spec, **{"friction.coulomb": "0 N", "friction.coulomb_negative": "1 N"})

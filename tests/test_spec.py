@@ -88,16 +88,17 @@ def test_file_and_mapping_give_the_same_spec(paper_spec, paper_spec_path):
 
 
 def test_warnings_fire_on_the_users_own_values(paper_spec):
-    # sigma1 = 1414 N s/m in the file is the default sqrt(sigma0 (m1 + m2)) written out: no
-    # warning; the loop is continuous without delay: a warning on what the spec leaves out
-    assert [p for p, _ in sp.warnings_for(paper_spec)] == ["controller.sample_rate"]
-    hardware = variant(paper_spec, **{"controller.sample_rate": "2 kHz"})
-    assert sp.warnings_for(hardware) == []
-    assert sp.warnings_for(variant(paper_spec, **{"controller.delay": "1 ms"})) == []
-    assert sp.warnings_for(variant(paper_spec, effects=[{"type": "time_delay",
-                                                         "delay": "1 ms"}])) == []
-    omitted = variant(hardware, **{"friction.bristle_damping": None})
-    assert sp.warnings_for(omitted) == []     # the default, chosen on purpose (docstring)
+    # sigma1 = 1414 N s/m is written in the file: the user's value, and it breaks the bound;
+    # the loop is continuous without delay: a warning on what the spec leaves out
+    assert [p for p, _ in sp.warnings_for(paper_spec)] == ["friction.bristle_damping",
+                                                           "controller.sample_rate"]
+    hardware = variant(paper_spec, **{"controller.sample_rate": "2 kHz",
+                                      "friction.bristle_damping": None})
+    assert sp.warnings_for(hardware) == []    # the default, chosen on purpose (docstring)
+    assert sp.warnings_for(variant(hardware, **{"controller.sample_rate": None,
+                                                "controller.delay": "1 ms"})) == []
+    assert sp.warnings_for(variant(hardware, **{"controller.sample_rate": None}, effects=[
+        {"type": "time_delay", "delay": "1 ms"}])) == []
     own = variant(hardware, **{"friction.bristle_damping": "500 N*s/m"})
     [(path, message)] = sp.warnings_for(own)
     assert path == "friction.bristle_damping"
@@ -111,6 +112,19 @@ def test_warnings_fire_on_the_users_own_values(paper_spec):
     assert "the default window start" in found["requirements.hunting.window_start"]
     given = variant(calm, **{"requirements.hunting": {"window_start": "10 s"}})
     assert "default" not in dict(sp.warnings_for(given))["requirements.hunting.window_start"]
+
+
+def test_the_bristle_damping_warning_recommends_a_value_within_its_bound(paper_spec):
+    """It recommended the default, which breaks the same bound, and did not fire on the paper
+    example (1414 N s/m written out, far above sigma2 Fc / (Fs - Fc) = 6.67 N s/m)."""
+    import re
+
+    f = paper_spec.friction
+    bound = f.viscous * f.coulomb / (f.static - f.coulomb)
+    message = dict(sp.warnings_for(paper_spec))["friction.bristle_damping"]
+    suggested = float(re.search(r"e\.g\. ([\d.]+) N s/m", message).group(1))
+    assert 0 < suggested < bound, message
+    assert "presliding mode at a ratio of only" in message
 
 
 def test_motion_spans_and_end_time(paper_spec):

@@ -1,4 +1,4 @@
-"""Friction identification from a measured record: guideline step 1 from data (DESIGN.md section 8).
+"""Friction identification from a measured record: guideline step 1 from data (docs/interfaces.md).
 
 :func:`identify` estimates the moving mass, Coulomb and viscous friction and a
 force offset from a measured record (position and actuator force), with
@@ -56,7 +56,7 @@ EMPS axis):
    no longer positive (the initial positive sequence); the covariance is
    scaled by ``n / n_eff``. (Not a bootstrap.)
 
-The model (DESIGN.md sections 2 and 8): the actuator force u (``force_N``,
+The model (docs/model.md): the actuator force u (``force_N``,
 the force that acts, an injected ``disturbance_N`` included) moves the total
 mass against friction and a constant offset::
 

@@ -21,8 +21,9 @@ from ..measured import Measurement, measurement_from_arrays
 from .dynamic import dynamic_parameters
 from .events import excitation
 from .preprocess import JITTER, check_record, joint_model, prepare, processing
-from .regression import (IMPLAUSIBLE, Solution, check_directions, equations, fit_statistics,
-                         force_rss, form_note, rigid_parameters, split_masses, solve, threshold_note)
+from .regression import (IMPLAUSIBLE, Solution, check_directions, direction_words, equations,
+                         fit_statistics, force_rss, form_note, rigid_parameters, split_masses,
+                         solve, symmetric_view, threshold_note)
 from .results import FORMS, NAMES, ForcePrediction, IdentificationResult
 
 ProgressCallback = Callable[[str, float], None]
@@ -65,14 +66,17 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     Returns
     -------
     IdentificationResult
-        ``to_dict()`` is the JSON of DESIGN.md section 8.
+        ``to_dict()`` is the JSON of docs/interfaces.md. A record that slides
+        in one direction only identifies the mass and that direction's
+        friction (the offset included); the rest is not identifiable, with
+        the reason (``direction``).
 
     Raises
     ------
     DataError
         No ``force_N`` column, too few samples, a constant position, sampling
-        the filter cannot take, motion in one direction only, too few sliding
-        samples; the message names the column and what is needed.
+        the filter cannot take, too few sliding samples; the message names
+        the column and what is needed.
     ValueError
         An unknown ``form``.
 
@@ -102,16 +106,24 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     for hold in (True, False):  # the force as a held command, or as a sampled force
         p = replace(proc, force_hold=hold)
         prep = prepare(measured, p, joint)
-        check_directions(prep, p, measured.source)
-        sol = solve(equations(prep, form, joint), prep.used)
-        fits.append((force_rss(prep, sol, joint), p, prep, sol))
-    _, proc, prep, sol = min(fits, key=lambda f: f[0])
+        direction = check_directions(prep, p, measured.source)
+        sol = solve(equations(prep, form, joint, direction), prep.used)
+        fits.append((force_rss(prep, sol, joint), p, prep, sol, direction))
+    _, proc, prep, sol, direction = min(fits, key=lambda f: f[0])
     samples, fit = fit_statistics(prep, sol, joint)
     say("excitation", 0.5)
     exc = excitation(measured, proc, spec=spec)
-    params = rigid_parameters(sol, form, joint)
+    params = rigid_parameters(sol, form, joint, direction)
     masses = split_masses(sol, joint, spec, params["mass"])
-    notes = list(joint.notes) + [form_note(form), threshold_note(proc)]
+    if direction:
+        side, other = direction_words(direction)
+        shape = (f"the record slides in the {side} direction only: the mass and that "
+                 f"direction's Coulomb and viscous friction (the force offset included) are "
+                 f"identified; the {other} direction's friction and the offset are not "
+                 "identifiable from it")
+    else:
+        shape = form_note(form)
+    notes = list(joint.notes) + [shape, threshold_note(proc)]
     for name, p in list(params.items()):
         if p.value is not None and p.value <= 0.0 and name != "offset":
             params[name] = replace(p, note=p.note + "; " + IMPLAUSIBLE)
@@ -120,10 +132,13 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
         notes.append("force_N is used as the force that acts (the injected disturbance_N "
                      "included); the controller's own output force_N - disturbance_N is not")
     say("dynamic parameters", 0.7)
-    dynamic, details = dynamic_parameters(measured, proc, joint, sol, form, exc, spec)
+    dynamic, details = dynamic_parameters(measured, proc, joint, symmetric_view(sol, direction),
+                                          form if not direction else "symmetric", exc, spec)
+    sliding = next((params[k].value for k in ("coulomb", "coulomb_negative")
+                    if params[k].value is not None), None)  # a one-way record has one of them
     for name, p in dynamic.items():
-        if name == "static" and p.value is not None and params["coulomb"].value is not None \
-                and p.value < params["coulomb"].value:
+        if name == "static" and p.value is not None and sliding is not None \
+                and p.value < sliding:
             p = replace(p, note=p.note + f"; below the Coulomb friction: {IMPLAUSIBLE}")
             notes.append(f"static = {p.value:.4g} N lies below the Coulomb friction: "
                          f"{IMPLAUSIBLE}")
@@ -133,7 +148,7 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
         parameters=MappingProxyType({k: params[k] for k in NAMES}), fit=fit, form=form,
         model=joint.model, masses=masses, processing=proc, excitation=exc,
         notes=tuple(notes), samples=samples, measurement=measured, spec=spec,
-        dynamic=details)
+        dynamic=details, direction={0: "both", 1: "positive", -1: "negative"}[direction])
 
 
 def predict_force(result: IdentificationResult, measured: Measurement) -> ForcePrediction:

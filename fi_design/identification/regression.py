@@ -20,6 +20,9 @@ from .results import UNITS, Fit, Masses, Parameter, Processing, Samples
 
 #: Fewest used (decimated, sliding) samples per direction of motion.
 MIN_DIRECTION_SAMPLES = 10
+#: Largest condition number of the column-scaled regressor: beyond it two columns are the same
+#: within the record's precision (one speed only: Coulomb and viscous friction alike).
+MAX_CONDITION = 1e8
 
 #: Why a mass or friction that comes out negative cannot be right.
 IMPLAUSIBLE = ("physically impossible, so the model (mass, Coulomb and viscous friction "
@@ -36,10 +39,22 @@ def friction_columns(p: Prepared, form: str) -> dict[str, np.ndarray]:
             "viscous_negative": c["vneg"]}
 
 
-def equations(p: Prepared, form: str, joint: Joint) -> list[tuple[np.ndarray, dict]]:
-    """The equations as (left-hand side, {parameter: column}), all on every sample."""
-    fric = friction_columns(p, form)
-    off = {"offset": p.cols["one"]} if form == "symmetric" else {}
+def equations(p: Prepared, form: str, joint: Joint,
+              direction: int = 0) -> list[tuple[np.ndarray, dict]]:
+    """The equations as (left-hand side, {parameter: column}), all on every sample.
+
+    ``direction`` +1 or -1: the record slides that way only, so only that
+    direction's Coulomb and viscous friction are columns; the offset is not
+    one (a constant and sign(v) are the same column there).
+    """
+    if direction:
+        c = p.cols
+        fric = ({"coulomb": c["pos"], "viscous": c["vpos"]} if direction > 0 else
+                {"coulomb_negative": -c["neg"], "viscous_negative": c["vneg"]})
+        off = {}
+    else:
+        fric = friction_columns(p, form)
+        off = {"offset": p.cols["one"]} if form == "symmetric" else {}
     if joint.model == "two_mass":
         stage = (p.force - p.joint, {"stage_mass": p.a1, **off})
         cart = (p.joint, {"cart_mass": p.a2, **fric})
@@ -99,8 +114,15 @@ def solve(equations: list, used: np.ndarray) -> Solution:
     n_eff = sum(len(r) / effective_fraction(w * r) for w, r in zip(weights, res))
     inflation = n / n_eff
     sv = svdvals(Aw / np.linalg.norm(Aw, axis=0))
-    return Solution(names=names, theta=theta, cov=cov * inflation, cond=float(sv[0] / sv[-1]),
-                     n_used=int(used.sum()), n_eff=n / inflation)
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
+    if cond > MAX_CONDITION:
+        raise DataError(f"the record does not excite every parameter (the regressor's condition "
+                        f"number is {cond:.3g}, above {MAX_CONDITION:.0e}, for "
+                        f"{', '.join(names)}): it needs acceleration and sliding at varied "
+                        "speeds (at one speed Coulomb and viscous friction are alike)",
+                        column="position_m")
+    return Solution(names=names, theta=theta, cov=cov * inflation, cond=cond,
+                    n_used=int(used.sum()), n_eff=n / inflation)
 
 
 def effective_fraction(r: np.ndarray) -> float:
@@ -126,17 +148,58 @@ def force_rss(prep: Prepared, sol: Solution, joint: Joint) -> float:
     return fit.force_rms_residual ** 2
 
 
-def check_directions(prep: Prepared, proc: Processing, source: str | None) -> None:
+def check_directions(prep: Prepared, proc: Processing, source: str | None) -> int:
+    """The directions the record slides in: 0 both, +1 or -1 one only.
+
+    A direction counts with :data:`MIN_DIRECTION_SAMPLES` used samples; in one
+    direction only, that direction's friction is identified and the rest is
+    not identifiable (:func:`rigid_parameters`).
+
+    Raises
+    ------
+    DataError
+        Too little sliding in either direction.
+    """
     used = prep.used
     pos = int(np.sum(used & (prep.v > 0)))
     neg = int(np.sum(used & (prep.v < 0)))
-    if min(pos, neg) < MIN_DIRECTION_SAMPLES:
+    if max(pos, neg) < MIN_DIRECTION_SAMPLES:
         raise DataError(
             f"too little sliding: {pos} usable samples moving in the positive direction and "
             f"{neg} in the negative one faster than {proc.velocity_threshold:.3g} m/s (at least "
-            f"{MIN_DIRECTION_SAMPLES} each after decimation by {proc.decimation}); identification "
-            "needs sliding in both directions (otherwise Coulomb friction and the offset are "
-            "indistinguishable)", column="position_m", source=source)
+            f"{MIN_DIRECTION_SAMPLES} in one direction after decimation by {proc.decimation}); "
+            "identification needs sliding at varied speeds", column="position_m", source=source)
+    if min(pos, neg) >= MIN_DIRECTION_SAMPLES:
+        return 0
+    return 1 if pos >= MIN_DIRECTION_SAMPLES else -1
+
+
+def direction_words(direction: int) -> tuple[str, str]:
+    """(the direction the record slides in, the other one) in words."""
+    return ("positive", "negative") if direction > 0 else ("negative", "positive")
+
+
+def symmetric_view(sol: Solution, direction: int) -> Solution:
+    """A one-direction solution in the symmetric layout the dynamic estimates read.
+
+    That direction's Coulomb friction becomes ``coulomb`` (the offset included)
+    and its viscous friction stands in for both directions' (the record holds
+    no other); a solution of both directions is returned as it is.
+    """
+    if not direction:
+        return sol
+    names = list(sol.names)
+    level, visc, other = (("coulomb", "viscous", "viscous_negative") if direction > 0 else
+                          ("coulomb_negative", "viscous_negative", "viscous"))
+    names[names.index(level)] = "coulomb"
+    i = names.index(visc)
+    theta = np.append(sol.theta, sol.theta[i])
+    cov = np.pad(sol.cov, ((0, 1), (0, 1)))
+    cov[-1, :-1] = cov[i, :-1]
+    cov[:-1, -1] = cov[:-1, i]
+    cov[-1, -1] = cov[i, i]
+    return Solution(names=names + [other], theta=theta, cov=cov, cond=sol.cond,
+                    n_used=sol.n_used, n_eff=sol.n_eff)
 
 
 def fit_statistics(prep: Prepared, sol: Solution, joint: Joint) -> tuple[Samples, Fit]:
@@ -164,7 +227,8 @@ def fit_statistics(prep: Prepared, sol: Solution, joint: Joint) -> tuple[Samples
     return samples, fit
 
 
-def rigid_parameters(sol: Solution, form: str, joint: Joint) -> dict[str, Parameter]:
+def rigid_parameters(sol: Solution, form: str, joint: Joint,
+                     direction: int = 0) -> dict[str, Parameter]:
     idx = {n: i for i, n in enumerate(sol.names)}
     se = np.sqrt(np.clip(np.diag(sol.cov), 0.0, None))
 
@@ -183,6 +247,8 @@ def rigid_parameters(sol: Solution, form: str, joint: Joint) -> dict[str, Parame
         out["mass"] = est("mass", "total moving mass" + (
             "" if joint.model == "rigid" else " (stage and cart accelerations in the spec's "
                                               "mass ratio)"))
+    if direction:
+        return {**out, **_one_direction(est, direction)}
     if form == "symmetric":
         out["coulomb"] = est("coulomb", "Coulomb friction, both directions (symmetric form)")
         out["coulomb_negative"] = Parameter(
@@ -206,6 +272,30 @@ def rigid_parameters(sol: Solution, form: str, joint: Joint) -> dict[str, Parame
     out["viscous_negative"] = est("viscous_negative", "viscous friction sliding in the negative "
                                                       "direction")
     return out
+
+
+def _one_direction(est, direction: int) -> dict[str, Parameter]:
+    """The friction of a record that slides one way: that direction's, the rest not identifiable."""
+    side, other = direction_words(direction)
+    level, visc = ("coulomb", "viscous") if direction > 0 else ("coulomb_negative",
+                                                                 "viscous_negative")
+    other_level, other_visc = ("coulomb_negative", "viscous_negative") if direction > 0 else \
+        ("coulomb", "viscous")
+    missing = (f"not identifiable: the record slides in the {side} direction only and holds "
+               f"nothing of the {other} one; a record that slides both ways identifies it")
+    return {
+        level: est(level, f"Coulomb friction sliding in the {side} direction, the force offset "
+                          "included (in one direction of motion a constant force and sign(v) "
+                          "are the same column)"),
+        other_level: Parameter(None, None, "N", False, missing),
+        visc: est(visc, f"viscous friction sliding in the {side} direction"),
+        other_visc: Parameter(None, None, "N*s/m", False, missing),
+        "offset": Parameter(
+            None, None, "N", False,
+            f"not identifiable: the record slides in the {side} direction only, where a "
+            f"constant force and Coulomb friction are the same column; it is included in {level}; "
+            "a record that slides both ways separates them"),
+    }
 
 
 def split_masses(sol: Solution, joint: Joint, spec, total: Parameter) -> Masses:

@@ -1,4 +1,4 @@
-"""Result types of an identification (DESIGN.md section 8): values, not behaviour.
+"""Result types of an identification (JSON: docs/interfaces.md): values, not behaviour.
 
 :class:`IdentificationResult` holds one :class:`Parameter` per name of
 :data:`NAMES` (value, standard error, unit, identifiable, note), the
@@ -25,7 +25,7 @@ from ..results import dataclass_dict
 if TYPE_CHECKING:
     from .events import Excitation
 
-#: Parameters of an identification, in the order of DESIGN.md section 8.
+#: Parameters of an identification, in the order of its JSON (docs/interfaces.md).
 NAMES = ("mass", "coulomb", "coulomb_negative", "viscous", "viscous_negative", "offset",
          "static", "stribeck_velocity", "bristle_stiffness")
 #: SI unit of every parameter.
@@ -64,7 +64,7 @@ class Parameter:
     note: str
 
     def to_dict(self) -> dict:
-        """Plain JSON data (DESIGN.md section 8)."""
+        """Plain JSON data (docs/interfaces.md)."""
         return dataclass_dict(self)
 
 
@@ -350,7 +350,7 @@ class Dynamic:
 
 @dataclass(frozen=True, eq=False)
 class IdentificationResult:
-    """Friction and mass identified from a measured record (DESIGN.md section 8).
+    """Friction and mass identified from a measured record (docs/interfaces.md).
 
     Attributes
     ----------
@@ -385,6 +385,11 @@ class IdentificationResult:
     dynamic : Dynamic
         The events and fits behind ``static``, ``stribeck_velocity`` and
         ``bristle_stiffness``.
+    direction : str
+        The directions the record slides in: ``"both"``, or ``"positive"`` or
+        ``"negative"`` only (then the other direction's friction and the
+        offset are not identifiable, and that direction's Coulomb friction
+        includes the offset).
     """
 
     parameters: Mapping[str, Parameter]
@@ -399,6 +404,7 @@ class IdentificationResult:
     measurement: Measurement = field(repr=False)
     spec: Any = field(default=None, repr=False)
     dynamic: Dynamic = field(default_factory=Dynamic, repr=False)
+    direction: str = "both"
 
     def value(self, name: str) -> float | None:
         """The value of parameter ``name`` [SI], or None."""
@@ -443,11 +449,26 @@ class IdentificationResult:
         numpy.ndarray
             Force [N], the shape of ``velocity``.
         """
-        offset = self.parameters["offset"].value if self.form == "symmetric" else None
-        return self.friction.steady_state(velocity) + (offset or 0.0)
+        v = np.asarray(velocity, dtype=float)
+        if self.direction == "both":
+            offset = self.parameters["offset"].value if self.form == "symmetric" else None
+            return self.friction.steady_state(v) + (offset or 0.0)
+        # a record that slides one way: that direction's level (offset in it), nothing of the
+        # other direction (NaN there)
+        p = {k: (x.value if x.value is not None else 0.0) for k, x in self.parameters.items()}
+        negative = self.direction == "negative"
+        level = p["coulomb_negative"] if negative else p["coulomb"] + p["offset"]
+        slope = p["viscous_negative"] if negative else p["viscous"]
+        curve = (-level if negative else level) + slope * v
+        par = self.parameters
+        if par["static"].identifiable and par["stribeck_velocity"].identifiable:
+            gap = p["static"] - (level if negative else p["coulomb"])
+            e = np.exp(-(v / p["stribeck_velocity"]) ** 2)
+            curve = curve + (-gap if negative else gap) * e
+        return np.where(v > 0 if negative else v < 0, np.nan, curve)
 
     def to_dict(self) -> dict:
-        """Plain JSON data: ``parameters``, ``fit`` (DESIGN.md section 8) and the context."""
+        """Plain JSON data: ``parameters``, ``fit`` (docs/interfaces.md) and the context."""
         from .. import __version__
         from ..provenance import current_source
 
@@ -455,6 +476,7 @@ class IdentificationResult:
             "parameters": {k: p.to_dict() for k, p in self.parameters.items()},
             "fit": self.fit.to_dict(),
             "form": self.form,
+            "direction": self.direction,
             "model": self.model,
             "masses": self.masses.to_dict(),
             "processing": self.processing.to_dict(),

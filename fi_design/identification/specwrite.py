@@ -1,8 +1,9 @@
-"""The spec with the identified values: ``--write-spec`` (DESIGN.md section 8).
+"""The spec with the identified values: ``--write-spec`` (docs/interfaces.md).
 
 :func:`spec_values` lists the values by dotted path, :func:`identified_spec`
 validates them as a spec, :func:`identified_spec_text` writes the input
-spec's own YAML text with the values replaced in place and commented.
+spec's own YAML text with the values replaced in place and commented
+(:func:`fi_design.specedit.edited_spec_text`: comments and layout kept).
 """
 
 from __future__ import annotations
@@ -30,15 +31,25 @@ def spec_values(result: IdentificationResult) -> dict[str, float]:
     the record; the Stribeck velocity and bristle stiffness not identified
     keep the spec's own values.
 
+    A record that slides in one direction only identifies that direction's
+    friction with the force offset included: the spec's offset is kept and
+    that direction's Coulomb friction is the identified level less it
+    (``coulomb = level - offset`` forwards, ``coulomb_negative = level +
+    offset`` backwards); the other direction keeps the spec's own friction,
+    written out (so that it no longer follows ``coulomb``).
+
     Parameters
     ----------
     result : IdentificationResult
         The identification (with a spec).
     """
-    return _values(result.spec, result.parameters, result.masses, result.form)
+    return _values(result.spec, result.parameters, result.masses, result.form,
+                   result.direction)
 
 
-def _values(spec, params, masses, form) -> dict[str, float]:
+def _values(spec, params, masses, form, direction: str = "both") -> dict[str, float]:
+    if direction != "both":
+        return _one_direction_values(spec, params, masses, direction)
     v = {"stage.mass": masses.stage, "cart.mass": masses.cart,
          "friction.coulomb": params["coulomb"].value,
          "friction.viscous": params["viscous"].value,
@@ -60,7 +71,34 @@ def _values(spec, params, masses, form) -> dict[str, float]:
     return v
 
 
-def identified_spec(spec, params, masses, form):
+def _one_direction_values(spec, params, masses, direction: str) -> dict[str, float]:
+    """The values of a record that slides one way (see :func:`spec_values`)."""
+    from ..errors import SpecError
+
+    if spec is None:
+        raise SpecError("identification without a spec: nothing to fill in (give --spec)")
+    f = spec.friction
+    v = {"stage.mass": masses.stage, "cart.mass": masses.cart}
+    if direction == "positive":
+        v["friction.coulomb"] = params["coulomb"].value - f.offset
+        v["friction.viscous"] = params["viscous"].value
+        v["friction.coulomb_negative"] = f.coulomb if f.coulomb_negative is None \
+            else f.coulomb_negative
+        v["friction.viscous_negative"] = f.viscous if f.viscous_negative is None \
+            else f.viscous_negative
+    else:
+        v["friction.coulomb_negative"] = params["coulomb_negative"].value + f.offset
+        v["friction.viscous_negative"] = params["viscous_negative"].value
+    for name in DYNAMIC:
+        p = params.get(name)
+        if p is not None and p.identifiable and p.value is not None:
+            v[f"friction.{name}"] = p.value
+    if "friction.static" not in v and "friction.coulomb" in v:  # keep the spec's friction gap
+        v["friction.static"] = v["friction.coulomb"] + f.static - f.coulomb
+    return v
+
+
+def identified_spec(spec, params, masses, form, direction: str = "both"):
     """The spec with identified values (a :class:`~fi_design.spec.Spec`, no file origin).
 
     Raises
@@ -72,7 +110,7 @@ def identified_spec(spec, params, masses, form):
     from ..errors import SpecError
     from ..specfile import with_values
 
-    values = _values(spec, params, masses, form)
+    values = _values(spec, params, masses, form, direction)
     bad = [k for k in ("stage.mass", "cart.mass", "friction.coulomb",
                        "friction.coulomb_negative", "friction.viscous",
                        "friction.viscous_negative") if k in values and values[k] < 0.0
@@ -80,7 +118,7 @@ def identified_spec(spec, params, masses, form):
     if bad:
         raise SpecError(f"the identified value {values[bad[0]]:.4g} {_SPEC_UNITS[bad[0]]} is "
                         f"not positive, which a spec cannot hold: {IMPLAUSIBLE}", path=bad[0])
-    if values.get("friction.static", math.inf) < values["friction.coulomb"]:
+    if values.get("friction.static", math.inf) < values.get("friction.coulomb", 0.0):
         raise SpecError(f"the identified static friction {values['friction.static']:.4g} N lies "
                         f"below the Coulomb friction {values['friction.coulomb']:.4g} N, which a "
                         f"spec cannot hold: {IMPLAUSIBLE}", path="friction.static")
@@ -98,15 +136,13 @@ _SPEC_UNITS = {"stage.mass": "kg", "cart.mass": "kg", "friction.coulomb": "N",
 def identified_spec_text(result: IdentificationResult) -> str:
     """YAML text of the input spec with the identified values filled in (``--write-spec``).
 
-    The spec file's own text is kept, comments included: each value of
-    :func:`spec_values` replaces the one written in the file (block or
-    one-line flow mapping), with a comment giving the estimate, its
-    standard error and the value it replaced; a missing key is added to its
-    section. A header comment names the record and the form. Where the text
-    cannot be edited in place (a spec given as a mapping, a section written
-    in a multi-line flow style), the spec is written anew from its data with
-    the same header, and says that comments were not kept. The text is
-    checked with :func:`fi_design.specfile.load_spec` before it is returned.
+    The spec file's own text is kept, comments and layout included
+    (:func:`fi_design.specedit.edited_spec_text`): each value of
+    :func:`spec_values` replaces the one written in the file, with a comment
+    giving the estimate, its standard error and the value it replaced; a
+    missing key is added to its section. A header comment names the record
+    and the form. The text is checked with :func:`fi_design.specfile.load_spec`
+    before it is returned.
 
     Parameters
     ----------
@@ -124,35 +160,25 @@ def identified_spec_text(result: IdentificationResult) -> str:
         No spec, or an identified value the spec cannot hold.
     """
     from ..errors import SpecError
-    from ..specfile import load_spec, origin, parse_yaml
+    from ..specedit import edited_spec_text, spec_quantity
+    from ..specfile import origin
 
     spec = result.spec
     if spec is None:
         raise SpecError("identification without a spec: nothing to fill in (give --spec)")
-    identified_spec(spec, result.parameters, result.masses, result.form)  # refuses bad values
+    identified_spec(spec, result.parameters, result.masses, result.form,
+                    result.direction)  # refuses bad values
     values = spec_values(result)
-    comments = {path: _value_comment(result, path) for path in values}
     org = origin(spec)
-    header = _header(result)
-    text = None
-    if org is not None and org.path is not None:
-        try:
-            text = _edited(org.path.read_text(encoding="utf-8"), org, values, comments)
-        except (OSError, UnicodeDecodeError):
-            text = None
-    if text is not None:
-        text = header + "\n" + text
-        try:
-            data, _ = parse_yaml(text.encode("utf-8"), "<identified spec>")
-            load_spec(data)
-        except SpecError:
-            text = None
-    if text is None:
-        text = _rewritten(org.raw if org is not None else spec.model_dump(exclude_none=True),
-                          values, header)
-        data, _ = parse_yaml(text.encode("utf-8"), "<identified spec>")
-        load_spec(data)
-    return text
+    raw = org.raw if org is not None else {}
+    comments = {}
+    for path in values:
+        section, key = path.split(".")
+        old = (raw.get(section) or {}).get(key) if isinstance(raw.get(section), dict) else None
+        comments[path] = _value_comment(result, path) + ("" if old is None else f" (was {old})")
+    return edited_spec_text(spec, {p: spec_quantity(p, v, digits=6) for p, v in values.items()},
+                            comments=comments, header=_header(result),
+                            source="<identified spec>")
 
 
 def _quantity(path: str, value: float) -> str:
@@ -168,6 +194,18 @@ def _value_comment(result: IdentificationResult, path: str) -> str:
         if se is not None:
             return f"identified {_quantity(path, getattr(m, section))} +- {se:.2g} {unit}"
         return f"the identified total mass, {m.source}"
+    if result.direction != "both":
+        side = result.direction
+        own = {"positive": ("coulomb", "viscous"),
+               "negative": ("coulomb_negative", "viscous_negative")}[side]
+        if key not in own and key in ("coulomb", "coulomb_negative", "viscous",
+                                      "viscous_negative"):
+            return f"the spec's own value: the record slides in the {side} direction only"
+        if key in ("coulomb", "coulomb_negative"):
+            p = result.parameters[key]
+            return (f"identified {_quantity(path, p.value)} +- {p.std_error:.2g} {unit} sliding "
+                    f"{side}, the offset included, {'less' if key == 'coulomb' else 'plus'} "
+                    "the spec's offset (one direction cannot separate them)")
     if key == "coulomb_negative" and result.form == "symmetric":
         return "symmetric form: equal to coulomb"
     if key == "offset" and result.form == "per_direction":
@@ -196,54 +234,3 @@ def _header(result: IdentificationResult) -> str:
         lines.append("# friction.bristle_damping is not identified: its default, sqrt(sigma0 "
                      "(m1 + m2)), follows the identified bristle stiffness.")
     return "\n".join(lines)
-
-
-def _edited(text: str, org, values: dict, comments: dict) -> str | None:
-    """The spec text with values replaced or added in place; None where that is not safe."""
-    import re
-
-    lines = text.split("\n")
-    inserts: dict[int, list[str]] = {}
-    for path, value in values.items():
-        section, key = path.split(".")
-        new = _quantity(path, value)
-        line_no = org.lines.get((section, key))
-        if line_no is not None:
-            i = line_no - 1
-            block = re.match(rf"^(\s*){re.escape(key)}\s*:\s*([^#]*?)\s*(#.*)?$", lines[i])
-            if block:
-                old = block.group(2)
-                extra = f"; {block.group(3)[1:].strip()}" if block.group(3) else ""
-                lines[i] = f"{block.group(1)}{key}: {new}  # {comments[path]} (was {old}){extra}"
-                continue
-            flow = re.compile(rf"(\b{re.escape(key)}\s*:\s*)([^,}}#]+?)(\s*[,}}])")
-            if lines[i].count("{") == 1 and lines[i].count("}") == 1 and \
-                    len(flow.findall(lines[i])) == 1:
-                body, _, old_comment = lines[i].partition("#")
-                body = flow.sub(lambda m: m.group(1) + new + m.group(3), body).rstrip()
-                note = f"{key}: {comments[path]}" + (f"; {old_comment.strip()}" if old_comment
-                                                     else "")
-                lines[i] = f"{body}  # {note}"
-                continue
-            return None
-        keys = [ln for loc, ln in org.lines.items() if len(loc) >= 2 and loc[0] == section]
-        head = org.lines.get((section,))
-        if head is None or not keys or min(keys) == head:
-            return None  # section missing or written in flow style: no safe place
-        first = lines[min(keys) - 1]
-        indent = first[:len(first) - len(first.lstrip())]
-        inserts.setdefault(max(keys) - 1, []).append(f"{indent}{key}: {new}  # {comments[path]}")
-    for i in sorted(inserts, reverse=True):
-        lines[i + 1:i + 1] = inserts[i]
-    return "\n".join(lines)
-
-
-def _rewritten(raw: dict, values: dict, header: str) -> str:
-    import yaml
-
-    data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in raw.items()}
-    for path, value in values.items():
-        section, key = path.split(".")
-        data.setdefault(section, {})[key] = _quantity(path, value)
-    return (header + "\n# (written anew from the spec's data: its comments are not kept)\n"
-            + yaml.safe_dump(data, sort_keys=False, allow_unicode=True))

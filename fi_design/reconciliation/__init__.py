@@ -2,7 +2,7 @@
 
 :func:`reconcile` compares the nominal model of a spec with a measured record
 (:mod:`fi_design.measured`), names the physical effect of the catalogue
-(DESIGN.md sections 5 and 8, :mod:`fi_design.effects`) that explains the
+(docs/effects.md, :mod:`fi_design.effects`) that explains the
 disagreement, fits its parameters with honest uncertainties, and shows the gap
 before and after; or answers ``none``, and says when the model's structure,
 not a missing effect, is the problem.

@@ -17,10 +17,12 @@ def make_entry(name: str, values: dict):
 
 
 def entry_input(name: str, values: dict) -> dict:
-    """The spec-file form of an effect entry: SI numbers, angles as ``"<value> rad"``.
+    """The spec-file form of an effect entry: each value a string with its unit.
 
-    Angles need their unit in a spec (a bare number is ambiguous), so phases are
-    written with ``rad``; every other value is a plain SI float.
+    ``{"type": "quantization", "resolution": "1e-05 m"}``: every YAML reader
+    reads the value back as written (a bare ``1e-05`` is a string to YAML 1.1
+    readers), angles carry the unit a spec requires of them, and every digit
+    is kept (``repr``); a plain fraction stays a number.
     """
     eff = _effects.get(name)
     out: dict = {"type": name}
@@ -28,7 +30,7 @@ def entry_input(name: str, values: dict) -> dict:
         if v is None:
             continue
         unit = eff.parameter(k).unit
-        out[k] = f"{float(v)!r} rad" if unit == "rad" else float(v)
+        out[k] = float(v) if unit in ("1", "") else f"{float(v)!r} {unit}"
     return out
 
 
@@ -59,11 +61,10 @@ def spec_with_entries(spec, entries):
 def fixed_spec_text(result) -> str:
     """YAML text of the spec with the chosen effects added to its ``effects`` list.
 
-    When the spec was read from a file without an ``effects`` key, the file's
-    text is kept (comments included) and an ``effects:`` block is appended;
-    otherwise the spec as written is re-emitted with the new entries. The
-    text is validated with :func:`fi_design.specfile.load_spec` before it is
-    returned.
+    The input spec's own text is edited (:func:`fi_design.specedit.edited_spec_text`:
+    comments and layout kept): an entry of the same type is replaced, the
+    others are kept; a header comment names the record and the conclusion.
+    With the answer ``none`` the spec is written unchanged under that header.
 
     Parameters
     ----------
@@ -73,54 +74,37 @@ def fixed_spec_text(result) -> str:
     Returns
     -------
     str
-        YAML that ``load_spec`` reads back.
+        YAML that ``load_spec`` reads back (checked).
     """
-    import yaml
-
-    from ..specfile import load_spec, origin, parse_yaml
+    from ..specedit import edited_spec_text
+    from ..specfile import origin
 
     spec = result.spec
-    org = origin(spec)
     entries = [entry_input(e["type"], {k: v for k, v in e.items() if k != "type"})
                for e in result.entries]
     names = {e["type"] for e in entries}
-    comment = ("# effects added by fi-design reconcile"
-               + (f" from {result.measurement.source}" if result.measurement.source else "")
+    header = ("effects added by fi-design reconcile" if entries else
+              "fi-design reconcile added no effect (the answer is none)")
+    header += ((f" from {result.measurement.source}" if result.measurement.source else "")
                + ": " + result.conclusion.replace("\n", " "))
-    raw_text = None
-    if org is not None and org.path is not None:
-        try:
-            raw_text = org.path.read_text(encoding="utf-8")
-        except OSError:
-            raw_text = None
-    if raw_text is not None and "effects" not in org.raw:
-        lines = [raw_text.rstrip("\n"), "", _wrap_comment(comment), "effects:"]
-        for e in entries:
-            lines.append("  - " + _flow(e))
-        text = "\n".join(lines) + "\n"
-    else:
-        raw = dict(org.raw) if org is not None else spec.model_dump(exclude_none=True)
-        old = [e for e in (raw.get("effects") or []) if not (isinstance(e, dict)
-                                                             and e.get("type") in names)]
-        raw["effects"] = old + entries
-        text = _wrap_comment(comment) + "\n" + yaml.safe_dump(raw, sort_keys=False,
-                                                              allow_unicode=True)
-    data, _ = parse_yaml(text.encode("utf-8"), "<fixed spec>")
-    load_spec(data)
-    return text
+    values = {}
+    if entries:
+        org = origin(spec)
+        written = (org.raw.get("effects") or []) if org is not None else \
+            [_input_form(e) for e in spec.effects]
+        kept = [e for e in written if not (isinstance(e, dict) and e.get("type") in names)]
+        values["effects"] = kept + entries
+    return edited_spec_text(spec, values, header=_wrap_comment(header),
+                            source="<reconciled spec>")
+
+
+def _input_form(entry) -> dict:
+    """A validated effect entry of the spec in the spec-file form."""
+    values = entry.model_dump(exclude={"type"}, exclude_none=True)
+    return entry_input(entry.type, values)
 
 
 def _wrap_comment(text: str, width: int = 96) -> str:
     import textwrap
 
-    return "\n".join("# " + line if not line.startswith("#") else line
-                     for line in textwrap.wrap(text.lstrip("# "), width - 2))
-
-
-def _flow(entry: dict) -> str:
-    parts = [f"type: {entry['type']}"]
-    for k, v in entry.items():
-        if k == "type":
-            continue
-        parts.append(f"{k}: {v!r}" if isinstance(v, float) else f"{k}: '{v}'")
-    return "{" + ", ".join(parts) + "}"
+    return "\n".join("# " + line for line in textwrap.wrap(text, width - 2))

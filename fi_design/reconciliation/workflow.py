@@ -18,6 +18,7 @@ from typing import Callable
 import numpy as np
 
 from .. import effects as _effects
+from ..display import number
 from ..errors import DataError, SimulationError
 from ..measured import Measurement
 from ..replay import DRIVES
@@ -58,7 +59,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     isolated : bool, optional
         Model the isolated plant; default: whether the spec has an isolator.
     candidates : sequence of str, optional
-        Effect names to try; default the whole catalogue (DESIGN.md section 5).
+        Effect names to try; default the whole catalogue (docs/effects.md).
     max_effects : int
         Effects to name at most (default 1); each later one is searched on
         the gap the earlier ones leave.
@@ -441,16 +442,6 @@ def _failed_nominal(cmp: Comparison, nominal: Baseline, started: float,
 # --------------------------------------------------------------------------- wording
 
 
-def _fmt_params(values: dict, sigmas: dict) -> str:
-    parts = []
-    for k, v in values.items():
-        if v is None:
-            continue
-        s = sigmas.get(k)
-        parts.append(f"{k} = {v:.4g}" + (f" +- {s:.2g}" if s else ""))
-    return ", ".join(parts)
-
-
 def _conclusion(steps, candidates, chi2_nom, chi2_cor, n, ambiguous, diagnosis) -> str:
     before, after = math.sqrt(chi2_nom / n), math.sqrt(chi2_cor / n)
     if diagnosis.mismatch:
@@ -461,20 +452,20 @@ def _conclusion(steps, candidates, chi2_nom, chi2_cor, n, ambiguous, diagnosis) 
     if not steps:
         if before <= 1.0 + 3.0 * math.sqrt(2.0 / n):
             return (f"The nominal model agrees with the measurement within noise (misfit "
-                    f"{before:.3g} noise units): no effect is missing.")
+                    f"{number(before, 3)} noise units): no effect is missing.")
         best = next((c for c in candidates if c.success), None)
         tail = ""
         if best is not None:
             why = best.reasons[0] if best.reasons else "not significant"
             tail = f" The best candidate, {best.name}, is not a finding: {why}."
-        return (f"The model misses the measurement by {before:.3g} noise units, but no catalogue "
+        return (f"The model misses the measurement by {number(before, 3)} noise units, but no catalogue "
                 f"effect explains the gap beyond what noise and the fit's freedom give: the "
                 f"answer is none.{tail}")
-    lines = [f"{s.name} ({_fmt_params(s.parameters, s.uncertainty)}, SI; misfit "
-             f"{s.misfit_before:.3g} -> {s.misfit_after:.3g})" for s in steps]
+    lines = [f"{s.name} ({_effects.values_text(s.name, s.parameters, s.uncertainty)}; misfit "
+             f"{number(s.misfit_before, 3)} -> {number(s.misfit_after, 3)})" for s in steps]
     text = (f"The measurement shows {', then '.join(lines)}. With "
-            f"{'them' if len(steps) > 1 else 'it'} the misfit drops from {before:.3g} to "
-            f"{after:.3g} noise units.")
+            f"{'them' if len(steps) > 1 else 'it'} the misfit drops from {number(before, 3)} to "
+            f"{number(after, 3)} noise units.")
     if ambiguous:
         text += (" Also consistent with the data, not decisively worse: "
                  + ", ".join(ambiguous) + ".")

@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ..display import NBSP, quantity, scale
 from ..results import Status
 from .filters import display_scale, num, qty
 
@@ -21,7 +22,8 @@ __all__ = ["STEP_SOURCES", "SENSE", "STATUS_TEXT", "BEHAVIOUR", "check_label", "
            "key_figures", "verdict"]
 
 #: The verdict's status as printed.
-STATUS_TEXT = {"PASS": "PASS", "PASS_WITH_WARNINGS": "PASS with warnings", "FAIL": "FAIL"}
+STATUS_TEXT = {"PASS": "PASS", "PASS_WITH_WARNINGS": "PASS with warnings",
+               "NOT_CONFIRMED": "NOT CONFIRMED (not simulated)", "FAIL": "FAIL"}
 
 #: The judged plant's behaviour: (css class, stamp) by outcome; None: not simulated.
 BEHAVIOUR = {
@@ -252,9 +254,13 @@ def key_figures(result: Any) -> list[dict]:
         css = "fail" if m.end_stop_clearance <= 0 else "info"
         if any(r.source == "end_stop_clearance" for r in v.reasons):
             css = "warn"
-        rows.append(_figure("End-stop clearance at rest", m.end_stop_clearance, "m", "> 0",
-                            f"joint deflection {qty(m.resting_deflection, 'm')} of the "
-                            f"\u00b1{qty(spec.isolator.stroke, 'm')} stroke", css, 3))
+        # the clearance, the deflection and the stroke are read together: one unit
+        one = scale("m", (m.end_stop_clearance, m.resting_deflection, spec.isolator.stroke))
+        defl, stroke = (quantity(x, "m", 3, sep=NBSP, shown=one) for x in
+                        (m.resting_deflection, spec.isolator.stroke))
+        rows.append(_figure("End-stop clearance at rest", num(m.end_stop_clearance * one[1], 3),
+                            one[0], "> 0", f"joint deflection {defl} of the \u00b1{stroke} "
+                                           "stroke", css))
     if m.stiffness_factor is not None:
         rows.append(_figure("k_max / k", num(m.stiffness_factor, 3), "1", "\u2265 1",
                             f"k = {qty(result.stiffness.chosen, 'N/m')}, k_max = "
@@ -287,7 +293,7 @@ def verdict(result: Any) -> dict:
     Returns
     -------
     dict
-        ``status`` (``PASS``, ``PASS_WITH_WARNINGS``, ``FAIL``), ``overall``
+        ``status`` (``PASS``, ``PASS_WITH_WARNINGS``, ``NOT_CONFIRMED``, ``FAIL``), ``overall``
         (as printed), ``css`` (pass, warn, fail), ``behaviour`` (the stamp),
         ``behaviour_css``, ``headline``, ``reasons`` (``severity``, ``css``,
         ``text``), ``figures`` (:func:`key_figures`), ``notes`` (margins not
@@ -304,7 +310,8 @@ def verdict(result: Any) -> dict:
         if not groups or groups[-1]["step"] != check.step:
             groups.append({"step": check.step, "title": _step_title(check.step), "rows": []})
         groups[-1]["rows"].append(row)
-    css = {"PASS": "pass", "PASS_WITH_WARNINGS": "warn", "FAIL": "fail"}[v.status]
+    css = {"PASS": "pass", "PASS_WITH_WARNINGS": "warn", "NOT_CONFIRMED": "warn",
+           "FAIL": "fail"}[v.status]
     behaviour_css, stamp = BEHAVIOUR[v.behaviour]
     if v.status == "FAIL" and behaviour_css in ("settles", "static-error"):
         behaviour_css, stamp = NOMINAL

@@ -75,16 +75,16 @@ def _linear(result: Any, figures: bool, fig_no: _Numbering) -> dict:
             "number of crossings."),
         "bode": figure_entry(
             (lambda: plots.bode_figure(result)) if figures else None, "bode",
-            f"Open-loop Bode plot of the {n} limit cases. Dots: gain crossovers; dashed: the "
-            "desired crossover.", fig_no()),
+            _bode_caption(result), fig_no()),
         "nyquist": figure_entry(
             (lambda: plots.nyquist_figure(result)) if figures else None, "nyquist",
             f"Nyquist plot near the critical point -1 (+). Dotted: |1 + L| = {num(m)}. Colours "
             "and line styles as in the Bode plot.", fig_no(), "half"),
         "sensitivity": figure_entry(
             (lambda: plots.sensitivity_figure(result)) if figures else None, "sensitivity",
-            "Sensitivity |S| = |1/(1 + L)|; dots mark each peak (1 / modulus margin).",
-            fig_no(), "half"),
+            "Sensitivity |S| = |1/(1 + L)| over the band of the Bode plot; dots mark each "
+            "case's peak (1 / modulus margin), dotted: the modulus margin's limit, dashed: the "
+            "desired crossover.", fig_no(), "half"),
         "cases": _cases_table(result),
         "requirements": {"phase_margin": req.phase_margin, "gain_margin": req.gain_margin,
                          "modulus_margin": req.modulus_margin},
@@ -96,6 +96,44 @@ def _linear(result: Any, figures: bool, fig_no: _Numbering) -> dict:
                  "stuck cart), or never, has no phase or delay margin in the loop's band: "
                  "shown as \u2013 (INFO), its gain margin still counts."),
     }
+
+
+def _bode_caption(result: Any) -> str:
+    """What the Bode plot draws: its band, the marks, and the crossovers it leaves out."""
+    from .. import plots
+
+    lo, hi = plots.design_band(result)
+    text = (f"Open-loop Bode plot of the {len(result.crossover.cases)} limit cases from "
+            f"{qty(lo, 'Hz')} to {qty(hi, 'Hz')}, the loop's band around the desired "
+            f"crossover of {qty(result.crossover.desired, 'Hz')} (dashed). Dots: the gain "
+            "crossovers.")
+    numbers = {c.name: c.number for c in result.loop.cases}
+    far = plots.out_of_band_crossovers(result)
+    if far:
+        text += " Below the band, not drawn: " + "; ".join(
+            f"case {numbers.get(c.name, '?')} also crosses 0 dB at {qty(x, 'Hz', 3)}"
+            for c, x in far) + " (the integrator against a stiff support, outside the loop's band)."
+    return text
+
+
+def _error_caption(sim: Any, spec: Any) -> str:
+    """What the position-error figure draws, mark by mark: only what is there."""
+    h = spec.requirements.hunting
+    plants = [sim.isolated, sim.non_isolated]
+    which = ("with the suggested isolator and without it" if sim.suggested_isolator
+             else "with and without the isolator")
+    marks = ["grey, the counting window", "dashed, the minimum peak height"]
+    if any(len(p.metrics.peak_times) for p in plants):
+        marks.append("circles, the peaks the metric counts")
+    else:
+        marks.append("no peak counted in either plant")
+    right = [f"green, the settle band of \u00b1{qty(h.settle_band, 'm')}"]
+    if any(p.metrics.settling_time is not None for p in plants):
+        right.append("dotted, where the error enters it for good (the settling time)")
+    return (f"Position error after the spec's own motion {which}. Left, in mm, as the "
+            "paper's Figure 5: "
+            + "; ".join(marks) + ". Right, in \u00b5m after the motion: " + "; ".join(right)
+            + ".")
 
 
 #: Friction models as the literature names them.
@@ -216,11 +254,7 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             fig_no()),
         "error": figure_entry(
             (lambda: plots.error_figure(sim, spec)) if figures else None, "error",
-            "Position error after the spec's own motion, with and without the isolator. Left, "
-            "in mm, as the paper's Figure 5: grey, the counting window; dashed, the minimum "
-            "peak height; circles, the peaks the metric counts. Right, in \u00b5m after the "
-            f"motion: green, the settle band of \u00b1{num(h.settle_band * 1e6)} \u00b5m; "
-            "dotted, where the error enters it for good (the settling time).", fig_no()),
+            _error_caption(sim, spec), fig_no()),
         "deflection": figure_entry(
             (lambda: plots.deflection_figure(sim, spec)) if figures else None, "deflection",
             "Joint deflection of the isolated stage after the spec's own motion, against the "

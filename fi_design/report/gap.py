@@ -18,6 +18,7 @@ from .. import effects as _effects
 from ..results.reconciliation import ReconcileResult
 from .blocks import FigureBlock, Section, Table, figure_block
 from .context import build_context, document_context
+from ..display import NBSP, scale
 from .filters import num, qty
 
 __all__ = ["gap_sections", "gap_context", "render_gap_report", "TITLE"]
@@ -26,27 +27,24 @@ __all__ = ["gap_sections", "gap_context", "render_gap_report", "TITLE"]
 TITLE = "Model-measurement reconciliation"
 
 
-def _param_unit(effect: str, name: str) -> str:
-    try:
-        return _effects.get(effect).parameter(name).unit
-    except KeyError:
-        return ""
-
-
 def _params_text(effect: str, values: dict, unc: dict | None = None) -> str:
-    parts = []
-    for k, v in values.items():
-        if v is None:
-            continue
-        unit = _param_unit(effect, k)
-        text = f"{k} = {qty(v, unit if unit not in ('1', 'rad') else '')}"
-        if unit == "rad":
-            text += " rad"
-        s = (unc or {}).get(k)
-        if s:
-            text += f" ± {qty(s, unit if unit not in ('1', 'rad') else '', 2)}"
-        parts.append(text)
-    return ", ".join(parts)
+    return _effects.values_text(effect, values, unc, sep=NBSP)
+
+
+def _overlay_caption(result: Any) -> str:
+    """What the overlay draws: the traces there are, the shading where segments have it."""
+    text = "Measured trace (wide grey line, underneath), nominal model (red, dashed)"
+    if result.effects:
+        text += (f" and the model corrected by {', '.join(result.effects)} (blue, thin, on top: "
+                 "where it follows the measurement the grey shows around it)")
+    text += "."
+    if any(not seg.coherent for seg in result.segments):
+        text += " Shaded: holds with stick-slip, compared by phase-free features."
+    failed = [n for n, run in (("nominal", result.nominal), ("corrected", result.corrected))
+              if (n == "nominal" or result.effects) and not run.success]
+    if failed:
+        text += f" The {' and '.join(failed)} run failed and is drawn as far as it got."
+    return text
 
 
 def _short(reasons: tuple) -> str:
@@ -78,13 +76,6 @@ def gap_sections(result: Any, figures: bool = True) -> list:
             return FigureBlock(None, caption, name)
         return figure_block(make(result), caption, name)
 
-    def cell(v, unit):
-        if v is None:
-            return "-"
-        if unit == "-":
-            return num(v)
-        return qty(v, unit)
-
     sections = []
     diag = result.diagnosis
     if diag.mismatch:
@@ -106,7 +97,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
     meas = result.measurement
     finding = [result.conclusion]
     if result.effect != "none":
-        finding.append(f"Fitted parameters (SI, one standard deviation): "
+        finding.append(f"Fitted parameters (one standard deviation): "
                        f"{_params_text(result.effect, result.parameters, result.uncertainty)}.")
     finding.append(
         f"Measured trace: {meas.source or 'in memory'}, {meas.n} samples over "
@@ -144,10 +135,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
         tables=(Table(("Channel", "Noise (std)", "Source"), tuple(nrows),
                       caption="Noise levels every gap is judged against",
                       numeric=(False, True, False)),),
-        figures=(fig(plots.gap_overlay_figure,
-                     "Measured trace (grey), nominal model (red, dashed) and corrected "
-                     "model (blue). Shaded: holds with stick-slip, compared by "
-                     "phase-free features. A failed run ends where it failed.", "gap-overlay"),
+        figures=(fig(plots.gap_overlay_figure, _overlay_caption(result), "gap-overlay"),
                  fig(plots.gap_residual_figure,
                      "Measured minus modelled position; the grey band is two noise "
                      "standard deviations.", "gap-residual")),
@@ -164,15 +152,16 @@ def gap_sections(result: Any, figures: bool = True) -> list:
             "effects", "Effects found, in order",
             paragraphs=("Each effect was searched on the gap the ones before it leave, and "
                         "refitted with them; each row is the gap it closed.",),
-            tables=(Table(("#", "Effect", "Parameters (SI)", "Misfit", "Position RMS",
+            tables=(Table(("#", "Effect", "Parameters", "Misfit", "Position RMS",
                            "Force RMS"), tuple(srows),
                           numeric=(True, False, False, True, True, True)),)))
     grows = []
     for g in result.gaps:
         flag = "" if g.significant_after is None else ("yes" if g.significant_after else "no")
-        grows.append((g.name, g.unit, cell(g.measured, g.unit), cell(g.nominal, g.unit),
-                      cell(g.corrected, g.unit), cell(g.before, g.unit), cell(g.after, g.unit),
-                      cell(g.noise, g.unit), flag))
+        values = (g.measured, g.nominal, g.corrected, g.before, g.after, g.noise)
+        shown, factor = scale(g.unit, values)  # one unit per row, named in the unit column
+        grows.append((g.name, shown or "\u2013",
+                      *("-" if v is None else num(v * factor) for v in values), flag))
     sections.append(Section(
         "gap", "Gap before and after",
         paragraphs=("Sample-wise measures compare the traces point by point in the move, settle "
@@ -202,7 +191,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
                     f"refit on a noise-only record improves three times less. Distances are in "
                     f"those standard errors; runs that failed or ran away (an unstable loop) "
                     f"scored ten times the nominal misfit and could never win.",),
-        tables=(Table(("#", "Effect", "Status", "Score", "Explained", "Fitted parameters (SI)",
+        tables=(Table(("#", "Effect", "Status", "Score", "Explained", "Fitted parameters",
                        "Distance from the model's value", "Simulations (failed)",
                        "Why not named"), tuple(crows),
                       numeric=(True, False, False, True, True, False, False, True, False)),),

@@ -7,6 +7,8 @@ import hashlib
 import os
 from typing import Any
 
+from .filters import WRAP_MARK, WRAP_WIDTH, wrapped_lines
+
 __all__ = ["TITLES", "report_date", "title_block", "spec_file", "spec_listing", "versions"]
 
 #: Title of each kind of report.
@@ -115,10 +117,21 @@ def spec_listing(spec: Any) -> dict:
     Returns
     -------
     dict
-        ``spec_yaml`` (the text), ``spec_note`` (what it is),
-        ``spec_sha256`` (the hash printed beside it) and ``spec_verbatim``
-        (True when the text is the file's and the hash is the text's).
+        ``spec_yaml`` (the text; the appendix prints it in the rows of
+        :func:`~fi_design.report.filters.wrapped_lines`, marking every row that
+        continues a line), ``spec_note`` (what it is), ``spec_sha256`` (the hash printed
+        beside it) and ``spec_verbatim`` (True when the text is the file's and
+        the hash is the text's).
     """
+    out = _listing(spec)
+    if any(len(rows) > 1 for rows in wrapped_lines(out["spec_yaml"])):
+        out["spec_note"] += (f"; a line longer than {WRAP_WIDTH} characters continues in rows "
+                             f"marked {WRAP_MARK.strip()}, a mark of the page that is not part "
+                             "of the text (join each such row to the line above)")
+    return out
+
+
+def _listing(spec: Any) -> dict:
     src = spec_file(spec)
     if src["text"] is not None:
         note = ("the spec file exactly as read, comments kept; the SHA-256 of this text "

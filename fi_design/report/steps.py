@@ -217,21 +217,41 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
                   f"k_i = k_s \\omega_i = {tex_qty(g.ki, 'N/(m s)')},\\quad "
                   f"k_d = k_s / \\omega_d = {tex_qty(g.kd, 'N s/m')}"),
     ]
+    law = result.pid.controller
+    hand = law.hand_off()
+    if law.source == "rule":  # the same controller in the form controller.gains takes
+        eqs += [
+            eq("C(s) = \\frac{k_p + k_i/s + k_d s}{1 + s/\\omega_t} = k_p' + \\frac{k_i}{s} + "
+               "\\frac{k_d' s}{1 + s/\\omega_t}"),
+            eq(f"k_p' = k_p - k_i/\\omega_t = {tex_qty(hand['kp'], 'N/m')},\\quad "
+               f"k_d' = k_d - k_p'/\\omega_t = {tex_qty(hand['kd'], 'N s/m')},\\quad "
+               f"f_t = \\omega_t / 2\\pi = {tex_qty(hand['roll_off'], 'Hz')}"),
+        ]
+    sampled = ("continuous" if hand["sample_rate"] is None
+               else f"sampled at {qty(hand['sample_rate'], 'Hz')}")
+    delay = "no delay" if not hand["delay"] else f"delay {qty(hand['delay'], 's')}"
     steps.append({
         "number": 4, "title": "PID gains", "source": "paper \u00a72.2 and \u00a74 step 4",
         "equations": eqs,
         "results": [
             {"quantity": "tuning mass m", "value": g.tuning_mass, "unit": "kg"},
-            {"quantity": "proportional gain kp", "value": g.kp, "unit": "N/m"},
-            {"quantity": "integral gain ki", "value": g.ki, "unit": "N/(m s)"},
-            {"quantity": "derivative gain kd", "value": g.kd, "unit": "N s/m"},
-            {"quantity": "roll-off \u03c9t", "value": g.wt, "unit": "rad/s"},
+            {"quantity": "controller.gains.kp", "value": hand["kp"], "unit": "N/m"},
+            {"quantity": "controller.gains.ki", "value": hand["ki"], "unit": "N/(m s)"},
+            {"quantity": "controller.gains.kd", "value": hand["kd"], "unit": "N s/m"},
+            {"quantity": "controller.roll_off (D term only)",
+             "value": "none (an ideal D)" if hand["roll_off"] is None else hand["roll_off"],
+             "unit": "Hz"},
         ],
         "explanation": (
             "The gains follow from the moving mass and the crossover: the lead-lag part has its "
             "phase maximum at \u03c9c, and k_s puts |C(j\u03c9c)| = m \u03c9c\u00b2, so a free "
             "mass m crosses over at \u03c9c. The paper tunes on the maximum moving mass m1 + m2 "
-            "(the limiter engaged), which it found best. The simulation uses the parallel form "
-            "(kp + ki/s + kd s) / (1 + s/\u03c9t)."),
+            "(the limiter engaged), which it found best. The results are the loop as analysed, "
+            "in the form a drive and the spec's controller.gains take: kp + ki/s + kd s / "
+            "(1 + s/(2\u03c0 roll_off)), the roll-off filtering the D term only (the rule's "
+            "kp, ki, kd above have the roll-off on the whole PID and are other numbers for the "
+            f"same controller); D on the {hand['derivative_on']}, {sampled}, {delay} "
+            "(controller.sample_rate and controller.delay: the hardware's, where given). "
+            "fi-design SPEC.yaml --write-spec OUT.yaml writes them into a copy of the spec."),
     })
     return steps

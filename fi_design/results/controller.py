@@ -213,6 +213,29 @@ class ControlLaw:
         """
         return None if self.integrator else force / self.kp
 
+    def hand_off(self) -> dict[str, float | str | None]:
+        """This loop in the form the spec's ``controller`` section takes (step 4's hand-off).
+
+        ``controller.gains`` with ``controller.roll_off`` means
+        ``kp + ki/s + kd s / (1 + s / (2 pi roll_off))``: the low-pass on the D
+        term only. The rule's ``(kp + ki/s + kd s) / (1 + s/wt)``, with the
+        roll-off on the whole PID, is the same controller with other numbers
+        (see the class docstring); these are the numbers a drive, or the spec,
+        takes.
+
+        Returns
+        -------
+        dict
+            ``kp`` [N/m], ``ki`` [N/(m s)], ``kd`` [N s/m], ``roll_off`` [Hz]
+            (None for an ideal D), ``derivative_on``, ``sample_rate`` [Hz]
+            (None: continuous) and ``delay`` [s], as the analysis used them.
+        """
+        return {"kp": self.kp, "ki": self.ki, "kd": self.kd,
+                "roll_off": None if math.isinf(self.roll_off) else self.roll_off / (2 * math.pi),
+                "derivative_on": self.derivative_on,
+                "sample_rate": None if self.sample_period == 0 else 1.0 / self.sample_period,
+                "delay": self.delay}
+
     def rule_in_this_form(self) -> dict[str, float]:
         """The rule's gains at this crossover in this controller's form, to set beside it.
 

@@ -242,6 +242,19 @@ class FlexureResult(Result):
     stiffness_range: tuple[float, float] | None = None
 
 
+#: What the top-level gains of ``pid`` in the JSON are (the rule's, roll-off on the whole PID).
+RULE_FORM = ("the rule's gains: C(s) = ks (1 + wi/s) (1 + s/wd) / (1 + s/wt) = (kp + ki/s + kd s) "
+             "/ (1 + s/wt), the roll-off wt [rad/s] on the whole PID; not the form of "
+             "controller.gains (see hand_off)")
+#: What ``pid.controller`` is.
+CONTROLLER_FORM = ("the loop as analysed and simulated: kp + ki/s + kd s / (1 + s/roll_off), the "
+                   "roll-off [rad/s] on the D term only (inf: an ideal D)")
+#: What ``pid.hand_off`` is.
+HAND_OFF_FORM = ("the loop in the form the spec takes: controller.gains {kp, ki, kd} with "
+                 "controller.roll_off [Hz] on the D term only, controller.derivative_on, "
+                 "controller.sample_rate [Hz] and controller.delay [s]")
+
+
 @dataclass(frozen=True)
 class PidResult(Result):
     """Step 4: the PID gains, and the loop's controller.
@@ -276,12 +289,17 @@ class PidResult(Result):
     checks: tuple[Check, ...] = field(default=(), repr=False)
 
     def to_dict(self) -> dict:
-        """Flat JSON: the rule's gains plus the rule, its ratios and the loop's controller."""
-        out = {**self.gains.to_dict(), "tuning_rule": self.tuning_rule,
+        """JSON: the rule's gains (flat, labelled by ``form``), the rule and its ratios, the
+        loop's controller and ``hand_off``, the loop in the form the spec's
+        ``controller.gains`` takes (with ``roll_off`` in Hz on the D term, the sampling and
+        the delay the analysis used)."""
+        out = {"form": RULE_FORM, **self.gains.to_dict(), "tuning_rule": self.tuning_rule,
                "derivative_ratio": self.derivative_ratio,
                "integrator_ratio": to_jsonable(self.integrator_ratio),
                "source": self.controller.source, "integrator": self.controller.integrator,
-               "static_error": self.static_error, "controller": self.controller.to_dict()}
+               "static_error": self.static_error,
+               "controller": {"form": CONTROLLER_FORM, **self.controller.to_dict()},
+               "hand_off": {"form": HAND_OFF_FORM, **self.controller.hand_off()}}
         if self.controller.source == "gains":
             out["rule_in_hardware_form"] = to_jsonable(self.controller.rule_in_this_form())
         return out
@@ -525,7 +543,7 @@ class Confirmation(Result):
 
 
 #: Statuses of a design verdict, from best to worst.
-VERDICT_STATUSES = ("PASS", "PASS_WITH_WARNINGS", "FAIL")
+VERDICT_STATUSES = ("PASS", "PASS_WITH_WARNINGS", "NOT_CONFIRMED", "FAIL")
 
 
 @dataclass(frozen=True)
@@ -557,12 +575,15 @@ class Verdict(Result):
     Attributes
     ----------
     status : str
-        ``"PASS"``, ``"PASS_WITH_WARNINGS"`` or ``"FAIL"``
+        ``"PASS"``, ``"PASS_WITH_WARNINGS"``, ``"NOT_CONFIRMED"`` or ``"FAIL"``
         (:data:`VERDICT_STATUSES`). FAIL when a check fails, when the
         spec's own plant hunts, sticks away from its target or cannot be
         determined at the design crossover, or when it hunts under friction
         scatter more often than ``requirements.robustness.hunting_probability``;
-        PASS_WITH_WARNINGS when nothing fails but something needs review.
+        NOT_CONFIRMED when nothing fails but the stage was not simulated
+        (``design(confirm=False)``, ``--no-simulation``): the linear steps alone
+        cannot tell whether it hunts, so it does not pass; PASS_WITH_WARNINGS
+        when nothing fails but something needs review.
     reasons : tuple of Reason
         Why: failures first, then warnings, then what holds.
     plant : str
@@ -586,15 +607,17 @@ class Verdict(Result):
 
     @property
     def passed(self) -> bool:
-        """Whether the status is PASS or PASS_WITH_WARNINGS."""
-        return self.status != "FAIL"
+        """Whether the status is PASS or PASS_WITH_WARNINGS (a design not simulated never is)."""
+        return self.status in ("PASS", "PASS_WITH_WARNINGS")
 
     def at_or_below(self, level: str) -> bool:
         """Whether the status is ``level`` or worse.
 
         Parameters
         ----------
-        level : {"PASS", "PASS_WITH_WARNINGS", "FAIL"}
+        level : {"PASS", "PASS_WITH_WARNINGS", "NOT_CONFIRMED", "FAIL"}
+            In the order of :data:`VERDICT_STATUSES`: NOT_CONFIRMED is below
+            PASS_WITH_WARNINGS (it does not pass) and above FAIL.
 
         Returns
         -------
@@ -854,10 +877,14 @@ class DesignResult(Result):
 
     @property
     def passed(self) -> bool:
-        """The verdict is PASS or PASS_WITH_WARNINGS (before it is set: no check failed)."""
+        """The verdict is PASS or PASS_WITH_WARNINGS: simulated and nothing fails.
+
+        Before the verdict is set, and without the simulation, False: a
+        design that was not simulated cannot pass.
+        """
         if self.verdict is not None:
             return self.verdict.passed
-        return not any(c.status == Status.FAIL for c in self.checks)
+        return False
 
     @property
     def failed_checks(self) -> tuple[Check, ...]:

@@ -196,7 +196,7 @@ class Candidate(Result):
     Attributes
     ----------
     name : str
-        Effect name (DESIGN.md section 5).
+        Effect name (docs/effects.md).
     parameters : dict of str to float
         Fitted parameters, SI (keys as in the spec's effect entry).
     uncertainty : dict of str to float or None

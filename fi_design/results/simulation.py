@@ -183,7 +183,7 @@ class SimulationResult(Result):
         return self.position - self.cart_position if self.isolated else None
 
     def traces(self) -> dict[str, np.ndarray]:
-        """Columns in the measured-data layout (DESIGN.md section 4).
+        """Columns in the measured-data layout (docs/interfaces.md).
 
         ``time_s``, ``reference_m``, ``position_m``, ``force_N`` and, for the
         isolated plant, ``deflection_m``.

@@ -1,0 +1,291 @@
+"""Writing a spec back: the input's own YAML with values replaced, comments and layout kept.
+
+Every ``--write-spec`` of the command line goes through :func:`edited_spec_text`:
+the spec file is read again with ruamel.yaml's round-trip loader
+(:func:`fi_design.specfile.yaml_loader`), the values are set at their dotted
+paths (``controller.gains``, ``friction.coulomb``, ``effects``), each with an
+optional end-of-line comment, and the document is written out with the input's
+comments, key order, flow or block style and indentation. The text is then
+read back and validated like any spec (:func:`fi_design.specfile.load_spec`),
+so a spec the tool writes always loads in the tool.
+
+:func:`spec_quantity` writes a value as a string with the unit of its field
+(``"6842.91 N/m"``), so that the written file reads the same whatever YAML
+reader opens it (a bare ``1e-05`` is a string to YAML 1.1 readers).
+"""
+
+from __future__ import annotations
+
+import io
+import re
+from typing import Any, Mapping, Sequence
+
+from .errors import ArgumentError, SpecError
+from .spec import Spec
+from .specfile import load_spec, origin, parse_yaml, path_unit, yaml_loader
+
+__all__ = ["edited_spec_text", "spec_quantity", "REMOVE"]
+
+
+class _Remove:
+    def __repr__(self) -> str:
+        return "REMOVE"
+
+
+#: A value of :func:`edited_spec_text` that removes the key.
+REMOVE = _Remove()
+
+_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$")
+
+
+def spec_quantity(path: str, value: float, digits: int | None = None) -> Any:
+    """A value as the spec file takes it: a string with its field's unit.
+
+    Parameters
+    ----------
+    path : str
+        Dotted spec path (``"controller.gains.kp"``, ``"isolator.stroke"``).
+    value : float
+        SI value (Hz for frequencies).
+    digits : int, optional
+        Significant digits; default all of them (``repr``: the file gives the
+        same float back).
+
+    Returns
+    -------
+    str or float
+        ``"6842.912 N/m"``; a plain number for a value without a unit.
+
+    Examples
+    --------
+    >>> spec_quantity("isolator.stroke", 0.0003)
+    '0.0003 m'
+    >>> spec_quantity("controller.gains.ki", 33073.41, digits=6)
+    '33073.4 N/(m*s)'
+    """
+    unit = path_unit(path)
+    number = repr(float(value)) if digits is None else f"{float(value):.{digits}g}"
+    if unit in ("", "1"):
+        return float(number)
+    return f"{number} {unit}"
+
+
+def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
+                     comments: Mapping[str, str] | None = None,
+                     header: str | Sequence[str] | None = None,
+                     source: str = "<written spec>") -> str:
+    """The spec's YAML with values replaced at dotted paths; comments and layout kept.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec to start from. Read from a file, its own text is edited
+        (comments, key order, flow or block style, indentation kept); given as
+        a mapping, the mapping is written in block style.
+    values : mapping of str to value, optional
+        Dotted path (``"friction.coulomb"``, ``"controller.gains"``,
+        ``"motion.moves[0].distance"``, ``"effects"``) to the value written
+        there: a string (with units), a number, a bool, None, a mapping (a new
+        section, block style) or a list (of mappings: flow-style entries, as
+        effect entries are written); :data:`REMOVE` removes the key. A
+        missing section on the way is added.
+    comments : mapping of str to str, optional
+        Dotted path to an end-of-line comment for that key; a comment the key
+        already had is kept after it.
+    header : str or sequence of str, optional
+        Comment lines put at the top of the file (``#`` added where missing).
+    source : str, optional
+        Name of the text in an error message.
+
+    Returns
+    -------
+    str
+        YAML text that :func:`fi_design.specfile.load_spec` reads (checked).
+
+    Raises
+    ------
+    SpecError
+        A value the spec refuses (the message names the path), or a path into
+        a value rather than a section.
+
+    Examples
+    --------
+    >>> from fi_design.specfile import load_spec
+    >>> spec = load_spec("examples/paper_setup.yaml")
+    >>> text = edited_spec_text(spec, {"isolator.stroke": "0.5 mm"},
+    ...                         comments={"isolator.stroke": "a longer stroke"})
+    >>> [ln for ln in text.splitlines() if "stroke: 0.5 mm" in ln][0].split("#")[1].strip()
+    'a longer stroke; one-sided, before the limiter engages'
+    """
+    yaml = yaml_loader()
+    org = origin(spec)
+    lines = [] if not header else [header] if isinstance(header, str) else list(header)
+    if org is not None and org.text is not None:
+        text = org.text
+        yaml.indent(**_indents(text))
+        document = yaml.load(text)
+    else:
+        lines.append("(written anew from the spec's data: it was not read from a file, so "
+                     "there are no comments to keep)")
+        from .specfile import _plain
+
+        raw = org.raw if org is not None else spec.model_dump(mode="json", exclude_none=True)
+        document = _commented(_plain(raw))
+        yaml.indent(mapping=2, sequence=4, offset=2)
+    for path, value in (values or {}).items():
+        parent, key = _parent(document, path)
+        if value is REMOVE:
+            if key in parent:
+                del parent[key]
+        elif isinstance(parent, dict) and key not in parent:
+            _append(parent, key, _commented(value), top=parent is document)
+        else:
+            parent[key] = _commented(value)
+    for path, note in (comments or {}).items():
+        parent, key = _parent(document, path)
+        if key in parent:
+            old = _eol_comment(parent, key)
+            _set_comment(parent, key, note + (f"; {old}" if old else ""))
+    buf = io.StringIO()
+    yaml.dump(document, buf)
+    out = buf.getvalue()
+    if lines:
+        import textwrap
+
+        head = "\n".join(ln if ln.startswith("#") else "\n".join(
+            textwrap.wrap(ln, 96, initial_indent="# ", subsequent_indent="# "))
+            for block in lines for ln in block.splitlines())
+        out = head + "\n" + out
+    data, _ = parse_yaml(out.encode("utf-8"), source)
+    try:
+        load_spec(data)
+    except SpecError as exc:
+        raise SpecError(f"the spec to write does not load: {exc.message}", path=exc.path) from None
+    return out
+
+
+def _indents(text: str) -> dict[str, int]:
+    """ruamel.yaml's indentation settings that reproduce a file's own layout.
+
+    The mapping indent is that of the first key nested under a top-level key;
+    the sequence's dash offset and indent come from the first block list entry.
+    """
+    mapping, offset = 2, 2
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    for prev, ln in zip(lines, lines[1:]):
+        if not prev.startswith((" ", "-")) and prev.rstrip().split("#")[0].rstrip().endswith(":"):
+            n = len(ln) - len(ln.lstrip(" "))
+            if n and not ln.lstrip().startswith("-"):
+                mapping = n
+                break
+    for prev, ln in zip(lines, lines[1:]):
+        if ln.lstrip().startswith("- ") and prev.rstrip().split("#")[0].rstrip().endswith(":"):
+            offset = (len(ln) - len(ln.lstrip(" "))) - (len(prev) - len(prev.lstrip(" ")))
+            break
+    offset = max(offset, 0)
+    return {"mapping": mapping, "sequence": offset + 2, "offset": offset}
+
+
+def _parent(document: Any, path: str) -> tuple[Any, Any]:
+    """The container and key of a dotted path, adding missing sections on the way."""
+    from ruamel.yaml.comments import CommentedMap
+
+    steps: list = []
+    for part in path.split("."):
+        m = _PART.match(part.strip())
+        if not m:
+            raise ArgumentError(f"not a spec path: {path!r}")
+        steps.append(m.group(1))
+        steps += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
+    node = document
+    for i, step in enumerate(steps[:-1]):
+        done = ".".join(str(s) for s in steps[:i + 1])
+        if isinstance(step, int):
+            if not isinstance(node, list) or step >= len(node):
+                raise SpecError(f"the spec has no entry {step} here", path=done)
+            node = node[step]
+            continue
+        if not isinstance(node, dict):
+            raise SpecError("holds a value, not a section", path=done)
+        if node.get(step) is None:
+            if step in node:
+                node[step] = CommentedMap()
+            else:
+                _append(node, step, CommentedMap(), top=node is document)
+        node = node[step]
+    if not isinstance(node, (dict, list)):
+        raise SpecError("holds a value, not a section", path=path)
+    return node, steps[-1]
+
+
+def _commented(value: Any, flow: bool = False) -> Any:
+    """Plain data as ruamel's round-trip types: mappings in lists written in flow style."""
+    from ruamel.yaml.comments import CommentedMap, CommentedSeq
+
+    if isinstance(value, Mapping):
+        out = CommentedMap((k, _commented(v, flow=flow)) for k, v in value.items())
+        if flow:
+            out.fa.set_flow_style()
+        return out
+    if isinstance(value, (list, tuple)):
+        return CommentedSeq(_commented(v, flow=True) for v in value)
+    return value
+
+
+def _eol_comment(parent: Any, key: Any) -> str:
+    """The end-of-line comment a key has in the file, without the ``#``."""
+    token = _token(parent, key)
+    if token is None or not getattr(token, "value", None):
+        return ""
+    first = token.value.split("\n")[0].strip()
+    return first[1:].strip() if first.startswith("#") else ""
+
+
+def _token(parent: Any, key: Any) -> Any:
+    ca = getattr(parent, "ca", None)
+    item = ca.items.get(key) if ca is not None else None
+    return item[2] if item and len(item) > 2 else None
+
+
+def _set_comment(parent: Any, key: Any, text: str) -> None:
+    """Set a key's end-of-line comment, keeping its column and the blank lines after it."""
+    from ruamel.yaml.error import CommentMark
+    from ruamel.yaml.tokens import CommentToken
+
+    old = _token(parent, key)
+    tail, column = "", None
+    if old is not None:
+        tail = old.value.partition("\n")[2]
+        column = old.column if old.value.lstrip().startswith("#") else None
+    if column is None:  # align with the section's other comments
+        columns = [t.column for t in (_token(parent, k) for k in parent)
+                   if t is not None and t.value.lstrip().startswith("#")]
+        column = max(columns, default=0)
+    token = CommentToken(f"# {' '.join(text.split())}\n{tail}", CommentMark(column), None)
+    item = parent.ca.items.setdefault(key, [None, None, None, None])
+    item[2] = token
+
+
+def _append(parent: Any, key: Any, value: Any, *, top: bool) -> None:
+    """Add a new key at the end of a mapping, after the blank lines that closed it.
+
+    ruamel.yaml keeps a section's closing blank line in the comment of its
+    last key; the new key takes it over, so the section stays separated from
+    the next. A new top-level section gets a blank line before it.
+    """
+    from ruamel.yaml.error import CommentMark
+    from ruamel.yaml.tokens import CommentToken
+
+    keys = list(parent)
+    parent[key] = value
+    if not keys:
+        return
+    if top:
+        parent.yaml_set_comment_before_after_key(key, before="\n")
+        return
+    last = _token(parent, keys[-1])
+    if last is None or "\n\n" not in last.value:
+        return
+    head, _, tail = last.value.partition("\n")
+    last.value = head + "\n"
+    parent.ca.items[key] = [None, None, CommentToken("\n" + tail, CommentMark(0), None), None]

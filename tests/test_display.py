@@ -1,0 +1,91 @@
+"""fi_design.display: one home for numbers and units, so that every place reads alike."""
+
+from __future__ import annotations
+
+import doctest
+import re
+
+import pytest
+
+from fi_design import display
+from fi_design.display import NBSP, number, quantities, quantity, scale, with_error
+
+#: A length with its unit as the package prints it (µm or mm; lengths are never printed in m).
+LENGTH = re.compile(r"(-?[\d.]+)[ \u00a0](µm|mm)\b")
+
+
+def test_doctests():
+    failures, tried = doctest.testmod(display)
+    assert tried >= 8 and failures == 0
+
+
+@pytest.mark.parametrize("value,text", [
+    (13333.33, "13333"), (0.3, "0.3"), (2.0, "2"), (3.2e-8, f"3.2{NBSP}×{NBSP}10⁻⁸"),
+    (1.37e6, f"1.37{NBSP}×{NBSP}10⁶"), (0.00134799, "0.001348"), (float("inf"), "∞"),
+    (float("nan"), "n/a"), (5, "5"), (None, "–"), (True, "yes"), (999999.7, f"1{NBSP}×{NBSP}10⁶"),
+    (33073.4, "33073"), (-0.6247, "-0.6247"),
+])
+def test_numbers(value, text):
+    assert number(value) == text
+
+
+@pytest.mark.parametrize("value,unit,text", [
+    (1.366e-3, "m", "1.366 mm"), (2.52e-8, "m", "0.0252 µm"), (1.4e-12, "m", "< 0.001 µm"),
+    (-6.25e-4, "m", "-0.625 mm"), (0.0, "m", "0 mm"), (None, "m", "–"),
+    (3.155e7, "Pa", "31.55 MPa"), (3e-3, "m/s", "3 mm/s"), (2.5, "s", "2.5 s"),
+    (100.5, "N*s/m", "100.5 N·s/m"), (47.31, "deg", "47.31°"),
+])
+def test_quantities(value, unit, text):
+    assert quantity(value, unit) == text
+
+
+def test_values_read_together_share_one_unit():
+    assert scale("m", [22e-6, 278e-6, 300e-6]) == ("mm", 1e3)
+    assert quantities([22e-6, 278e-6, 300e-6], "m", 3) == ["0.022 mm", "0.278 mm", "0.3 mm"]
+    assert quantities([22e-6, 31e-6], "m") == ["22 µm", "31 µm"]
+    assert with_error(0.005, 3.1e-8, "m") == f"5 ± 3.1{NBSP}×{NBSP}10⁻⁵ mm"
+
+
+def test_an_effect_value_and_its_error_share_a_unit():
+    """The gap report printed 'wavelength = 5 mm ± 0.031 µm': one value in two units."""
+    from fi_design.report.gap import _params_text
+
+    text = _params_text("position_dependent_friction", {"amplitude": 0.25, "wavelength": 0.005},
+                        {"amplitude": 1.1e-5, "wavelength": 3.1e-8})
+    wave = text.split("wavelength = ")[1]
+    assert wave.count("mm") == 1 and "µm" not in wave, text
+    assert wave.startswith("5 ± 3.1"), text
+
+
+def test_prose_and_tables_print_a_number_alike(paper_spec, capsys):
+    """ki read 3.307e+04 in the conclusion and 33073 in the table; one form now."""
+    from fi_design.console import make_console, print_design
+    from fi_design.guideline import design
+    from fi_design.specfile import with_values
+
+    spec = with_values(paper_spec, {"controller.crossover": "10 Hz"})
+    result = design(spec, confirm=False)
+    ki = result.pid.gains.ki
+    assert ki > 1e4
+    assert f"ki = {number(ki)} N/(m s)" in result.conclusion, result.conclusion
+    assert "e+0" not in result.conclusion
+    print_design(make_console(), result)
+    out = capsys.readouterr().out
+    assert number(ki) in out and "e+0" not in out
+
+
+def test_end_stop_figure_unit_matches_its_note(paper_confirmed_design):
+    """The key figure said 22 µm beside a deflection of 0.278 mm."""
+    from fi_design.report.checks import key_figures
+
+    row = next(r for r in key_figures(paper_confirmed_design)
+               if r["label"].startswith("End-stop clearance"))
+    units = {u for _, u in LENGTH.findall(row["note"])}
+    assert units == {row["unit"]}, row
+
+
+def test_verdict_sentence_gives_its_lengths_in_one_unit(paper_confirmed_design):
+    reason = next(r.text for r in paper_confirmed_design.verdict.reasons
+                  if r.source == "end_stop_clearance")
+    units = {u for _, u in LENGTH.findall(reason)}
+    assert len(units) == 1 and " um" not in reason, reason

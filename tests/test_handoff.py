@@ -1,0 +1,112 @@
+"""Step 4 handed over: gains printed and written in the form controller.gains reads, and a design
+that was not simulated never passes."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+from typer.testing import CliRunner
+
+from fi_design.cli import app
+from fi_design.guideline import design
+from fi_design.specfile import load_spec
+
+from conftest import variant
+
+runner = CliRunner()
+
+MARGINS = ("crossover", "phase_margin_deg", "gain_margin_db", "modulus_margin", "delay_margin")
+
+
+def _cases(result):
+    return [{k: getattr(c, k) for k in MARGINS} for c in result.crossover.cases]
+
+
+def _printed_gains(output: str) -> dict:
+    """kp, ki, kd and roll_off [Hz] as the console's step-4 table prints them."""
+    line = next(ln for ln in output.splitlines() if re.match(r"^\s*rule\s+[\d.]", ln))
+    kp, ki, kd, roll = (float(x) for x in line.split()[1:5])
+    return {"kp": kp, "ki": ki, "kd": kd, "roll_off": roll}
+
+
+def test_printed_gains_copied_into_controller_gains_keep_the_loop(paper_spec, tmp_path):
+    """The report put the roll-off on the whole PID: copied into controller.gains, those numbers
+    moved a 10 Hz crossover to 11.13 Hz and took 1.2 dB of gain margin."""
+    from fi_design.specedit import edited_spec_text
+
+    spec = variant(paper_spec, **{"controller.crossover": "10 Hz"})
+    path = tmp_path / "rule10.yaml"
+    path.write_text(edited_spec_text(spec))
+    out = runner.invoke(app, [str(path), "--no-simulation"], env={"COLUMNS": "120"})
+    assert out.exit_code == 0, out.output
+    printed = _printed_gains(out.stdout)
+    copied = variant(spec, **{"controller.crossover": None,
+                              "controller.gains": {"kp": printed["kp"], "ki": printed["ki"],
+                                                   "kd": printed["kd"]},
+                              "controller.roll_off": f"{printed['roll_off']} Hz"})
+    ruled, hw = design(spec, confirm=False), design(copied, confirm=False)
+    for a, b in zip(_cases(ruled), _cases(hw)):  # four printed digits: the same loop
+        assert b["crossover"] == pytest.approx(a["crossover"], rel=2e-3)
+        assert b["gain_margin_db"] == pytest.approx(a["gain_margin_db"], abs=0.02)
+        assert b["phase_margin_deg"] == pytest.approx(a["phase_margin_deg"], abs=0.1)
+
+
+def test_json_labels_both_forms(paper_spec):
+    d = design(paper_spec, confirm=False).to_dict()["pid"]
+    assert "whole PID" in d["form"] and "not the form of controller.gains" in d["form"]
+    hand = d["hand_off"]
+    assert "controller.gains" in hand["form"] and "D term only" in hand["form"]
+    assert (hand["kp"], hand["ki"], hand["kd"]) == (d["controller"]["kp"], d["controller"]["ki"],
+                                                    d["controller"]["kd"])
+    assert hand["kp"] != d["kp"]  # the rule's whole-PID kp is another number
+    assert hand["roll_off"] == pytest.approx(24.0)  # Hz: wt = 3 wc at 8 Hz
+    assert hand["sample_rate"] is None and hand["delay"] == 0.0
+    assert hand["derivative_on"] == "error"
+
+
+def test_write_spec_round_trips_exactly(paper_confirmed_design, paper_spec_path, tmp_path):
+    """The design of the written spec gives the same crossover, margins and simulation."""
+    out = tmp_path / "handed.yaml"
+    r = runner.invoke(app, [str(paper_spec_path), "--no-simulation", "--write-spec", str(out)])
+    assert r.exit_code == 0, r.output
+    text = out.read_text()
+    assert "# fc: PID tuned on m1 + m2" in text  # the input's comments kept
+    handed = load_spec(out)
+    assert handed.controller.gains is not None
+    first, again = paper_confirmed_design, design(handed)
+    assert again.pid.controller.source == "gains"
+    assert again.crossover.desired == first.crossover.desired
+    assert again.crossover.achievable == pytest.approx(first.crossover.achievable, rel=1e-9)
+    for a, b in zip(_cases(first), _cases(again)):
+        for k in MARGINS:
+            assert b[k] == pytest.approx(a[k], rel=1e-9), k
+    for plant in ("isolated", "non_isolated"):
+        va, vb = getattr(first.simulation, plant), getattr(again.simulation, plant)
+        assert vb.outcome == va.outcome
+        assert vb.metrics.hunting_cycles == va.metrics.hunting_cycles
+        # the same loop to the last bit of the gains; a limit cycle magnifies the rounding
+        # of kp' + ki/wt = kp to parts per million, far below what the report prints
+        assert vb.metrics.final_error == pytest.approx(va.metrics.final_error, rel=1e-4,
+                                                       abs=1e-12)
+    assert again.simulation.min_hunting_free_crossover == \
+        first.simulation.min_hunting_free_crossover
+    assert again.margins.crossover_factor == pytest.approx(first.margins.crossover_factor)
+
+
+def test_design_without_simulation_never_passes(paper_spec):
+    result = design(paper_spec, confirm=False)
+    assert not result.failed_checks  # nothing of the linear steps fails ...
+    assert result.verdict.status == "NOT_CONFIRMED"  # ... yet it was not simulated
+    assert result.passed is False and result.to_dict()["passed"] is False
+    assert "does not pass" in result.verdict.headline
+
+
+def test_no_simulation_fails_the_ci_gate(paper_spec_path, tmp_path):
+    out = tmp_path / "r.json"
+    r = runner.invoke(app, [str(paper_spec_path), "--no-simulation", "--fail-on", "fail",
+                            "--json", str(out)])
+    assert r.exit_code == 3, r.output
+    assert json.loads(out.read_text())["verdict"]["status"] == "NOT_CONFIRMED"
+    assert "Verdict: NOT_CONFIRMED" in r.stdout
