@@ -317,7 +317,7 @@ def test_every_kind_of_report_has_its_own_document_id(paper_spec):
            for kind in REPORT_KINDS}
     assert ids == {"design": "FI-0001", "sweep": "FI-0001-SWEEP", "study": "FI-0001-STUDY",
                    "robustness": "FI-0001-ROBUSTNESS", "reconcile": "FI-0001-RECONCILE",
-                   "identify": "FI-0001-IDENTIFY"}
+                   "identify": "FI-0001-IDENTIFY", "recommend": "FI-0001-RECOMMEND"}
     assert title_block(paper_spec, "sweep", date=DATE, command=None)["running"].startswith(
         "FI-0001-SWEEP rev. A")
 
