@@ -25,6 +25,8 @@ from .spec import Spec
 MAX_BYTES = 1_000_000
 #: Largest number of YAML nodes after alias expansion (alias-bomb guard).
 MAX_NODES = 20_000
+#: Deepest nesting of mappings and lists accepted; a spec nests five levels.
+MAX_DEPTH = 32
 
 
 @dataclass(frozen=True)
@@ -136,7 +138,12 @@ def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, dict]:
         raise SpecError(f"control character U+{exc.character:04X} is not allowed in a YAML "
                         "spec: the file is not plain text", line=line, source=source) from None
     try:
-        node = loader.get_single_node()
+        try:
+            node = loader.get_single_node()
+        except RecursionError:  # PyYAML composes recursively: a few hundred levels exhaust it
+            raise SpecError(f"the YAML is nested more than {MAX_DEPTH} levels deep (mappings or "
+                            "lists inside each other); a spec nests a few levels",
+                            source=source) from None
         if node is None:
             raise SpecError("the spec file is empty", source=source)
         _count_nodes(node, source)
@@ -192,11 +199,21 @@ def _count_nodes(node, source: str) -> None:
 def _walk(node, loc: tuple, lines: dict, source: str) -> None:
     import yaml
 
+    if len(loc) > MAX_DEPTH:
+        raise SpecError(f"the YAML is nested more than {MAX_DEPTH} levels deep (mappings or "
+                        "lists inside each other); a spec nests a few levels",
+                        path=_dotted(loc[:3]) + ("..." if len(loc) > 3 else ""),
+                        line=node.start_mark.line + 1, source=source)
     if isinstance(node, yaml.MappingNode):
         seen: dict = {}
         for knode, vnode in node.value:
-            key = knode.value
             line = knode.start_mark.line + 1
+            if not isinstance(knode, yaml.ScalarNode):
+                kind = "a list" if isinstance(knode, yaml.SequenceNode) else "a mapping"
+                raise SpecError(f"a key must be a plain name, got {kind} (a YAML complex key "
+                                "'? ...')", path=_dotted(loc) or None, line=line,
+                                source=source)
+            key = knode.value
             if key in seen:
                 path = _dotted(loc + (key,))
                 raise SpecError(f"key '{key}' appears twice (also on line {seen[key]})", path=path,
@@ -247,14 +264,21 @@ def _validate(raw: dict, org: SpecOrigin) -> Spec:
 
 
 def _clean_loc(loc: tuple, raw: dict) -> tuple:
-    """Drop union tags that pydantic inserts (``effects.0.time_delay.delay``)."""
+    """Drop union tags that pydantic inserts (``effects.0.time_delay.delay``).
+
+    The tag is the entry's own ``type`` right after its index, even where a
+    parameter has the effect's name (``effects.0.stribeck_velocity.stribeck_velocity``).
+    """
     out: list = []
     node: Any = raw
+    tagged = False
     for part in loc:
-        if isinstance(node, dict) and isinstance(part, str) and part not in node \
-                and out and out[-1] != part and isinstance(out[-1], int) \
+        if isinstance(node, dict) and isinstance(part, str) and not tagged and len(out) >= 2 \
+                and isinstance(out[-1], int) and out[-2] == "effects" \
                 and node.get("type") == part:
+            tagged = True
             continue
+        tagged = False
         out.append(part)
         if isinstance(node, dict):
             node = node.get(part)
@@ -282,13 +306,28 @@ def _line_for(loc: tuple, lines: dict) -> int | None:
     return None
 
 
-def _model_at(loc: tuple):
-    """The pydantic model class that holds the field at ``loc`` (None if unknown)."""
+def _model_at(loc: tuple, raw: Any = None):
+    """The pydantic model class that holds the field at ``loc`` (None if unknown).
+
+    An entry of ``effects`` is the model of its ``type`` in ``raw`` (the
+    mapping as written), so its keys and units are that effect's.
+    """
     import typing
 
+    from .spec import EFFECT_MODELS
+
     model: Any = Spec
-    for part in loc[:-1]:
+    node: Any = raw
+    for n, part in enumerate(loc[:-1]):
+        node = node.get(part) if isinstance(node, dict) and not isinstance(part, int) else \
+            node[part] if isinstance(node, list) and isinstance(part, int) \
+            and part < len(node) else None
         if isinstance(part, int):
+            if n >= 1 and loc[n - 1] == "effects":
+                kind = node.get("type") if isinstance(node, dict) else None
+                model = EFFECT_MODELS.get(kind) if isinstance(kind, str) else None
+                if model is None:
+                    return None
             continue
         if not (isinstance(model, type) and hasattr(model, "model_fields")):
             return None
@@ -317,13 +356,13 @@ def _describe(err: dict, raw: dict) -> tuple[str, str]:
     kind = err["type"]
     msg = err["msg"]
     if kind == "missing":
-        model = _model_at(loc)
+        model = _model_at(loc, raw)
         desc = ""
         if model is not None and loc and loc[-1] in model.model_fields:
             desc = model.model_fields[loc[-1]].description or ""
         return path, "required field is missing" + (f" ({desc})" if desc else "")
     if kind == "extra_forbidden":
-        model = _model_at(loc)
+        model = _model_at(loc, raw)
         key = loc[-1] if loc else ""
         hint = ""
         if model is not None:
@@ -333,6 +372,8 @@ def _describe(err: dict, raw: dict) -> tuple[str, str]:
         return path, f"unknown key '{key}'{hint}"
     if kind == "unknown_effect":
         given = err.get("input", {}).get("type") if isinstance(err.get("input"), dict) else None
+        if not isinstance(err.get("input"), dict):
+            return path, _not_an_effect_entry(err.get("input"))
         close = difflib.get_close_matches(str(given), list(_effects.EFFECT_NAMES), n=1)
         hint = f" (did you mean '{close[0]}'?)" if close else ""
         return path + ".type", (f"unknown effect '{given}'{hint}; known: "
@@ -344,28 +385,50 @@ def _describe(err: dict, raw: dict) -> tuple[str, str]:
             return named.group(1), named.group(2)
         return path, text
     if kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
-        unit = _unit_at(loc)
+        unit = _unit_at(loc, raw)
         bound = list(err.get("ctx", {}).values())[0]
         words = {"greater_than": "greater than", "greater_than_equal": "at least",
                  "less_than": "less than", "less_than_equal": "at most"}[kind]
-        return path, f"must be {words} {bound:g}{' ' + unit if unit else ''}, got {err['input']!r}"
+        shown = f" {unit}" if unit not in ("", "1") else ""
+        return path, f"must be {words} {bound:g}{shown}, got {_shown(err['input'])}"
     if kind in ("finite_number",):
         return path, "must be a finite number"
+    if isinstance(err.get("input"), int) and len(str(abs(err["input"]))) > 300:
+        digits = len(str(abs(err["input"])))
+        return path, f"the number {_shown(err['input'])} ({digits} digits) is too large"
     if kind in ("float_type", "float_parsing"):
-        return path, f"expected a number or a string with units, got {err['input']!r}"
+        return path, f"expected a number or a string with units, got {_shown(err['input'])}"
     if kind in ("model_type", "model_attributes_type", "dict_type"):
-        model = _model_at(loc + ("x",))
+        model = _model_at(loc + ("x",), raw)
         keys = ", ".join(model.model_fields) if model is not None else ""
-        return path, f"expected a mapping{' with keys ' + keys if keys else ''}, got {err['input']!r}"
+        return path, (f"expected a mapping{' with keys ' + keys if keys else ''}, got "
+                      f"{_shown(err['input'])}")
     return path, msg
+
+
+def _shown(value: Any) -> str:
+    """A value read from the spec, for a message: its repr, cut to 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:28] + "..." + text[-8:]
+
+
+def _not_an_effect_entry(given: Any) -> str:
+    """The message for an ``effects`` entry that is not a mapping (``- time_delay``)."""
+    from . import effects as _effects
+
+    name = given if isinstance(given, str) and given in _effects.CATALOGUE else "time_delay"
+    required = [p.name for p in _effects.get(name).parameters if p.required]
+    example = "{type: " + name + "".join(f", {p}: ..." for p in required) + "}"
+    return (f"an effect is a mapping with its type and parameters, e.g. {example}; got "
+            f"{given!r}")
 
 
 #: A top-level validator's message that names its field: ``"controller.crossover: ..."``.
 _NAMED = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]=]*): (.+)$", re.S)
 
 
-def _unit_at(loc: tuple) -> str:
-    model = _model_at(loc)
+def _unit_at(loc: tuple, raw: Any = None) -> str:
+    model = _model_at(loc, raw)
     if model is None or not loc or loc[-1] not in model.model_fields:
         return ""
     desc = model.model_fields[loc[-1]].description or ""
