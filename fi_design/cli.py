@@ -38,8 +38,8 @@ from typing import Annotated, Optional
 import typer
 
 from .cliparts import (DEFAULT_COMMAND, EXIT_VERDICT, Drive, ExecutorKind, Force, Jobs,
-                       JsonOut, NoCache, NoIsolator, Scheduler, SpecArg, app, check_drive,
-                       check_outputs, check_spec_path, command_line, json_text, load,
+                       JsonOut, NoCache, NoIsolator, Scheduler, SpecArg, app, at_most,
+                       check_drive, check_outputs, check_spec_path, command_line, json_text, load,
                        output_option, run_study, study_pool, write_outputs, write_report,
                        write_study)
 
@@ -301,8 +301,10 @@ def study_command(
                                             "map_A.csv ... map_D.csv and study.json (created "
                                             "if missing).")] = Path("paper_study"),
     resolution: Annotated[int, typer.Option(
-        "--resolution", "-n", min=2, max=200, metavar="N",
-        help="Points per axis of every map.")] = 12,
+        "--resolution", "-n", min=2, metavar="N",
+        callback=at_most(150, "points per axis (four maps of 150 x 150 are 90 000 simulations)"),
+        help="Points per axis of every map (at most 150: four maps of 150 x 150 are 90 000 "
+             "simulations).")] = 12,
     report_out: Optional[Path] = output_option("--report", "OUT.html",
         "Also write the report of the four maps (HTML, or PDF for a .pdf name)."),
     maps: Annotated[str, typer.Option(
@@ -365,7 +367,11 @@ def study_command(
 def robustness_command(
     spec: SpecArg,
     samples: Annotated[int, typer.Option(
-        "--samples", "-n", min=1, metavar="N", help="Number of random samples.")] = 100,
+        "--samples", "-n", min=1, metavar="N",
+        callback=at_most(100_000, "samples of a study (each simulated with and without the "
+                                  "isolator)"),
+        help="Number of random samples (at most 100 000, each simulated with and without the "
+             "isolator).")] = 100,
     scatter: Annotated[Optional[list[str]], typer.Option(
         "--scatter", metavar="PATH=SPREAD",
         help="A scattered spec value and its spread: '10%' of the nominal value (standard "

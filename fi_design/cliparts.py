@@ -181,10 +181,27 @@ Drive = Annotated[str, typer.Option(
     help="How the model replays the record: 'closed' (its controller closes the loop on the "
          "measured reference) or 'force' (the plant alone, driven open loop by the measured "
          "force_N and re-anchored to the measurement in windows).")]
+#: Most worker processes a study starts (--jobs): more than the machine has cores only adds
+#: memory and start-up time.
+MAX_JOBS = 64
+
+
+def at_most(limit: int, why: str) -> Any:
+    """An option callback refusing a number above ``limit``, with the number read and why."""
+
+    def check(value: Any) -> Any:
+        if value is not None and value > limit:
+            raise typer.BadParameter(f"{value} is more than {limit}, the most {why}")
+        return value
+
+    return check
+
+
 Jobs = Annotated[int, typer.Option(
     "--jobs", "-j", min=0, metavar="N",
+    callback=at_most(MAX_JOBS, "worker processes a study starts"),
     help="Worker processes (local executor) or local dask workers; 0 = all cores, "
-         "1 = serial in this process.")]
+         "1 = serial in this process; at most 64.")]
 ExecutorKind = Annotated[str, typer.Option(
     "--executor", metavar="local|dask",
     help="local: a process pool on this machine (default); dask: a dask.distributed "

@@ -552,10 +552,9 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     from . import verdict as _verdict
     from .confirm import confirm as run_confirmation
 
-    if not isinstance(spec, Spec):
-        from .specfile import load_spec
+    from .specfile import as_spec
 
-        spec = load_spec(spec)
+    spec = as_spec(spec)
     suggestion = suggested_isolator(spec) if spec.isolator is None else None
     robust = confirm and spec.requirements.robustness.samples > 0
     pending = []

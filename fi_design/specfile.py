@@ -91,6 +91,40 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
                                      data.decode("utf-8")))
 
 
+def as_spec(spec: Any, name: str = "spec") -> Spec:
+    """The spec a library function was given: a :class:`Spec`, or a path or mapping to load.
+
+    Every public workflow takes what :func:`fi_design.design` takes, so a
+    script can pass the same mapping to each.
+
+    Parameters
+    ----------
+    spec : Spec, str, pathlib.Path or mapping
+        The spec, or what :func:`load_spec` reads.
+    name : str, optional
+        The argument's name, for the message.
+
+    Returns
+    -------
+    Spec
+
+    Raises
+    ------
+    ArgumentError
+        ``spec`` is none of these (None, a number, a list).
+    SpecFileError, SpecError
+        As :func:`load_spec`.
+    """
+    from .errors import ArgumentError
+
+    if isinstance(spec, Spec):
+        return spec
+    if isinstance(spec, (str, Path, Mapping)):
+        return load_spec(spec)
+    raise ArgumentError(f"{name} must be a Spec, a path to a YAML spec or a mapping, got "
+                        f"{type(spec).__name__}")
+
+
 def origin(spec: Spec) -> SpecOrigin | None:
     """Return the :class:`SpecOrigin` recorded by :func:`load_spec`, if any."""
     return spec._origin

@@ -272,3 +272,44 @@ def test_usage_errors_exit_2(tmp_path, paper_spec_path):
     assert not out.exists()
     r = runner.invoke(app, ["design"])
     assert r.exit_code == 2
+
+
+# --------------------------------------------------------------------------- sizes a user sets
+
+NO_SPEC = "absent-spec.yaml"  # options are refused before the spec is read
+
+SIZES = [
+    ("sweep-points", ["sweep", "PAPER", "--x", "controller.crossover=1 Hz:30 Hz:10000000000",
+                      "--json", "OUT"],
+     ["controller.crossover", "N = 10000000000 points", "at most 100000"]),
+    ("sweep-grid", ["sweep", "PAPER", "--x", "controller.crossover=1 Hz:30 Hz:1000",
+                    "--y", "isolator.stroke=0.1 mm:1 mm:1000", "--json", "OUT"],
+     ["1000 x 1000 = 1000000 points", "at most 100000"]),
+    ("replay-window", ["simulate", "MSPEC", "--record", "TRACE", "--drive", "force",
+                       "--window", "1e-12", "--json", "OUT"],
+     ["window = 1e-12 s", "fewer than 10 samples"]),
+    ("robustness-samples", ["robustness", NO_SPEC, "--scatter", "friction.static=10%",
+                            "--samples", "1000000000", "--json", "OUT"],
+     ["--samples", "1000000000", "100000"]),
+    ("study-resolution", ["study", "paper", NO_SPEC, "--resolution", "200"],
+     ["--resolution", "200", "150"]),
+    ("jobs", ["sweep", NO_SPEC, "--x", "stage.mass=1,2", "--jobs", "100000", "--json", "OUT"],
+     ["--jobs", "100000", "64"]),
+]
+
+
+@pytest.mark.parametrize("argv,expected", [c[1:] for c in SIZES], ids=[c[0] for c in SIZES])
+def test_sizes_are_bounded_up_front(tmp_path, monkeypatch, argv, expected):
+    """A size that cannot finish (memory, hours of work, a fork per job) is refused before any
+    work, naming the option or value, what was read and the bound."""
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "out.json"
+    names = {"PAPER": str(EXAMPLES / "paper_setup.yaml"),
+             "MSPEC": str(EXAMPLES / "measured_stage.yaml"),
+             "TRACE": str(EXAMPLES / "measured_trace.csv"), "OUT": str(out)}
+    result = runner.invoke(app, [names.get(a, a) for a in argv])
+    assert result.exit_code == 2, (result.exit_code, result.output)
+    assert "Traceback" not in result.output
+    for text in expected:
+        assert text in result.output, f"{text!r} not in {result.output!r}"
+    assert not out.exists()

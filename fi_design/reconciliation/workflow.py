@@ -18,7 +18,9 @@ from typing import Callable
 import numpy as np
 
 from .. import effects as _effects
-from ..errors import DataError, SimulationError
+from ..arguments import integer, number
+from ..errors import ArgumentError, DataError, SimulationError
+from ..specfile import as_spec
 from ..measured import Measurement
 from ..replay import DRIVES
 from ..simulation import plant_parameters
@@ -105,6 +107,11 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     """
     started = _time.perf_counter()
     say = progress or _silent
+    spec = as_spec(spec)
+    threshold = number(threshold, "threshold", "-", positive=True)
+    max_points = integer(max_points, "max_points", minimum=100)
+    settle_window = None if settle_window is None else \
+        number(settle_window, "settle_window", "s", positive=True)
     args = _check_arguments(spec, measured, isolated, candidates, max_effects, drive)
     iso = args.isolated
     say("reading the record", 0.0)
@@ -162,8 +169,12 @@ def _check_arguments(spec, measured, isolated, candidates, max_effects,
         if name not in _effects.CATALOGUE:
             raise SimulationError(f"unknown effect {name!r}; known: "
                                   + ", ".join(_effects.EFFECT_NAMES))
-    if max_effects < 1:
+    if not isinstance(measured, Measurement):
+        raise ArgumentError(f"measured must be a Measurement (fi_design.load_measurement), got "
+                            f"{type(measured).__name__}")
+    if isinstance(max_effects, int) and max_effects < 1:
         raise SimulationError("max_effects must be at least 1")
+    integer(max_effects, "max_effects", minimum=1, maximum=len(_effects.EFFECT_NAMES))
     if drive not in DRIVES:
         raise SimulationError(f"drive must be one of {DRIVES}, got {drive!r}")
     if drive == "force" and measured.force is None:
