@@ -105,8 +105,9 @@ def design_command(
     from .pools import confirmation_pool
 
     console, err = make_console(), make_console(stderr=True)
-    with Status(err, "running the design guideline ...") as status, \
-            confirmation_pool(not no_simulation) as pool:
+    # the pool's workers fork before the spinner's thread starts (fork and threads do not mix)
+    with confirmation_pool(not no_simulation) as pool, \
+            Status(err, "running the design guideline ...") as status:
         result = design(spec_obj, confirm=not no_simulation, executor=pool, progress=status)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
     print_design(console, result, spec_path=spec)
@@ -160,7 +161,8 @@ def simulate_command(
     if not window > 0:
         raise typer.BadParameter(f"must be a positive time in seconds, got {window!r}",
                                  param_hint="--window")
-    outs = check_outputs((spec,), force, csv=(csv_out, (".csv",)), json=(json_out, (".json",)))
+    inputs = (spec,) if record is None else (spec, record)
+    outs = check_outputs(inputs, force, csv=(csv_out, (".csv",)), json=(json_out, (".json",)))
     spec_obj = load(spec)
 
     from .console import Status, make_console, print_simulation

@@ -313,3 +313,39 @@ def test_sizes_are_bounded_up_front(tmp_path, monkeypatch, argv, expected):
     for text in expected:
         assert text in result.output, f"{text!r} not in {result.output!r}"
     assert not out.exists()
+
+
+# --------------------------------------------------------------------------- inputs never lost
+
+
+def test_the_record_is_an_input_not_an_output(tmp_path):
+    """`simulate --record rec.csv --csv rec.csv --force` replaced the measured record with the
+    replay: every input is protected, even with --force."""
+    record = tmp_path / "rec.csv"
+    record.write_bytes((EXAMPLES / "measured_trace.csv").read_bytes())
+    before = record.read_bytes()
+    result = runner.invoke(app, ["simulate", str(EXAMPLES / "measured_stage.yaml"), "--record",
+                                 str(record), "--csv", str(record), "--force"])
+    assert result.exit_code == 2, result.output
+    assert "refusing to overwrite the input file" in result.stderr
+    assert record.read_bytes() == before
+
+
+def test_a_file_that_appears_during_the_run_is_kept(tmp_path, paper_spec_path, monkeypatch):
+    """A file created after the start-up check (another program, another run) is not replaced
+    without --force; the run says so and exits 2."""
+    import fi_design.guideline as guideline
+
+    out = tmp_path / "out.json"
+    real = guideline.design
+
+    def design_while_someone_writes(*args, **kwargs):
+        out.write_text("written by someone else")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(guideline, "design", design_while_someone_writes)
+    result = runner.invoke(app, [str(paper_spec_path), "--no-simulation", "--json", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "appeared while this run worked" in result.stderr
+    assert out.read_text() == "written by someone else"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.json"]
