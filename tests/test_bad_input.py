@@ -349,3 +349,21 @@ def test_a_file_that_appears_during_the_run_is_kept(tmp_path, paper_spec_path, m
     assert "appeared while this run worked" in result.stderr
     assert out.read_text() == "written by someone else"
     assert [p.name for p in tmp_path.iterdir()] == ["out.json"]
+
+
+def test_a_record_without_excitation_is_refused_not_agreed_with(tmp_path):
+    """`reconcile` on a record in which nothing moves answered "agrees within noise (misfit 0):
+    no effect is missing" although nothing was tested; it is refused, saying what was read."""
+    import numpy as np
+
+    still = tmp_path / "still.csv"
+    t = np.arange(0.0, 8.0, 1e-3)
+    rows = "\n".join(f"{x:.3f},0,0,0.0,0" for x in t)
+    still.write_text("time_s,reference_m,position_m,force_N,deflection_m\n" + rows + "\n")
+    out = tmp_path / "gap.json"
+    result = runner.invoke(app, ["reconcile", str(EXAMPLES / "measured_stage.yaml"), str(still),
+                                 "--json", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "no excitation" in result.stderr and "position_m" in result.stderr
+    assert "the reference spans 0 m" in result.stderr
+    assert not out.exists()

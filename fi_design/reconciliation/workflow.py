@@ -24,6 +24,7 @@ from ..specfile import as_spec
 from ..measured import Measurement
 from ..replay import DRIVES
 from ..simulation import plant_parameters
+from ..spec import design_crossover
 from .comparison import MAX_POINTS, Comparison, ModelRun
 from .diagnosis import diagnose
 from .fitting import (Baseline, FitOutcome, JointObjective, fit, fit_baseline, joint_fit,
@@ -37,6 +38,7 @@ from .signatures import Evidence, scan
 from .significance import (NESTED, NULL_SEED, THRESHOLD, block_jackknife, judge,
                            noise_only_refit, numerical_error, passes_primary, prefer_simpler)
 from .spaces import Space, candidate_spaces
+from .records import check_excitation, for_the_model
 from .specout import make_entry
 
 ProgressCallback = Callable[[str, float], None]
@@ -92,7 +94,11 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     Raises
     ------
     DataError
-        The trace is too short for the comparison.
+        The trace is too short for the comparison, holds no excitation
+        (neither the stage nor its reference moves), or is too long even
+        thinned to the lowest rate the model allows (:mod:`.records`; a
+        record logged faster than the model needs is thinned, and the
+        conclusion says so).
     SimulationError
         The arguments are inconsistent (an isolated plant without isolator,
         an unknown effect or drive, ``drive="force"`` without a force column).
@@ -117,6 +123,8 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     say("reading the record", 0.0)
     lattice = find_lattice(measured.position, estimate_noise(measured.position))
     noise = noise_levels(spec, measured, iso, lattice, force_is_input=drive == "force")
+    check_excitation(measured, noise.position)
+    measured, thinning = for_the_model(measured, design_crossover(spec))
     cmp = Comparison(spec, measured, iso, noise, lattice, settle_window, drive)
     say("nominal model", 0.02)
     nominal = _nominal(cmp, list(spec.effects), max_points)
@@ -133,6 +141,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     ambiguous = _ambiguous(first, search.chosen, threshold)
     conclusion = _conclusion(final.steps, first, nominal.chi2, final.chi2, cmp.n_points,
                              ambiguous, diagnosis)
+    conclusion = f"{conclusion} {thinning}" if thinning else conclusion
     say("done", 1.0)
     steps = final.steps
     return ReconcileResult(
