@@ -179,9 +179,9 @@ def simulate_command(
     print_simulation(console, result)
     payloads = {}
     if outs["csv"] is not None:
-        from .measured import columns_csv
+        from .measured import write_columns_csv
 
-        payloads["csv"] = columns_csv(result.traces())
+        payloads["csv"] = lambda fh: write_columns_csv(fh, result.traces())
     if outs["json"] is not None:
         payloads["json"] = json_text(result)
     write_outputs(console, outs, payloads)

@@ -340,7 +340,8 @@ def json_text(result: Any) -> str:
 
 
 def write_outputs(console: "Console", outs: dict, payloads: dict) -> None:
-    """Write each payload (text or bytes) to its checked path, atomically, and say so.
+    """Write each payload (text, bytes, or a function that writes text into an open file, for
+    outputs of millions of rows) to its checked path, atomically, and say so.
 
     Parameters
     ----------
@@ -351,10 +352,14 @@ def write_outputs(console: "Console", outs: dict, payloads: dict) -> None:
     payloads : dict
         Content by the same names.
     """
-    from .output import write_atomic
+    from .output import atomic_path, write_atomic
 
     for name, data in payloads.items():
-        write_atomic(outs[name], data)
+        if callable(data):
+            with atomic_path(outs[name]) as tmp, open(tmp, "w", encoding="utf-8") as fh:
+                data(fh)
+        else:
+            write_atomic(outs[name], data)
         console.print(f"wrote {outs[name]}", markup=False)
 
 

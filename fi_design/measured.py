@@ -481,10 +481,36 @@ def columns_csv(columns: Mapping[str, np.ndarray], comment: str | None = None) -
         Lines written before the header, each prefixed with ``# ``.
     """
     out = io.StringIO()
+    write_columns_csv(out, columns, comment)
+    return out.getvalue()
+
+
+#: Rows written at a time by :func:`write_columns_csv`.
+CHUNK_ROWS = 65_536
+
+
+def write_columns_csv(fh: IO[str], columns: Mapping[str, np.ndarray],
+                      comment: str | None = None) -> None:
+    """Write :func:`columns_csv`'s text to an open file, a chunk of rows at a time.
+
+    Memory stays at one chunk of text (a record of millions of rows is not
+    held as one string).
+
+    Parameters
+    ----------
+    fh : text file
+        Where to write.
+    columns : mapping of str to ndarray
+        Header to values (SI), in order, of equal length.
+    comment : str, optional
+        Lines written before the header, each prefixed with ``# ``.
+    """
     if comment:
         for line in comment.splitlines():
-            out.write(f"# {line}\n")
-    out.write(",".join(columns) + "\n")
-    data = np.column_stack([np.asarray(v, dtype=float) for v in columns.values()])
-    np.savetxt(out, data, delimiter=",", fmt="%.10g")
-    return out.getvalue()
+            fh.write(f"# {line}\n")
+    fh.write(",".join(columns) + "\n")
+    values = [np.asarray(v, dtype=float) for v in columns.values()]
+    n = len(values[0]) if values else 0
+    for start in range(0, n, CHUNK_ROWS):
+        block = np.column_stack([v[start:start + CHUNK_ROWS] for v in values])
+        np.savetxt(fh, block, delimiter=",", fmt="%.10g")

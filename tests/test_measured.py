@@ -175,3 +175,17 @@ def test_thinned_keeps_every_nth_sample_as_recorded():
     assert t.n == 10 and t.columns == m.columns
     assert np.array_equal(t.position, m.position[::10]) and t.time[1] == pytest.approx(1e-3)
     assert thinned(m, 1) is m
+
+
+def test_columns_are_written_a_chunk_at_a_time(monkeypatch):
+    """A record of millions of rows is written in chunks, not held as one string: same text."""
+    import io
+
+    import fi_design.measured as measured
+
+    cols = {"time_s": np.arange(10) * 1e-3, "position_m": np.linspace(0, 1e-3, 10)}
+    whole = measured.columns_csv(cols, comment="c")
+    monkeypatch.setattr(measured, "CHUNK_ROWS", 3)
+    out = io.StringIO()
+    measured.write_columns_csv(out, cols, comment="c")
+    assert out.getvalue() == whole and whole.count("\n") == 12
