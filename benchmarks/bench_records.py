@@ -9,7 +9,9 @@ at 10 kHz (back-and-forth moves of 15 mm every 4 s, the model's own motion
 with sensor noise: 1e5 samples are 10 s, 2e6 samples 200 s), then runs each
 command on each record as a user does, in a fresh process
 (``python -m fi_design ...``), and reads the process's peak resident memory
-from ``wait4``. The yardstick, run the same way on the same file in the same
+from ``wait4``. The records are made in a process of their own, so that this
+one stays small: a child's peak counts the pages it shares with its parent
+between fork and exec. The yardstick, run the same way on the same file in the same
 run: a process that only reads the CSV's numbers with ``numpy.loadtxt``
 (the memory of the data itself and the time to parse it). Prints, or with
 ``--write`` puts into BENCHMARKS.md between the ``bench_records`` markers, a
@@ -97,7 +99,7 @@ def section(sizes: list[int], commands: list[str]) -> str:
         work = Path(tmp)
         for n in sizes:
             record = work / f"record_{n}.csv"
-            make_record(n, record)
+            subprocess.run([sys.executable, __file__, "--make", str(n), str(record)], check=True)
             mb = record.stat().st_size / 1e6
             y_wall, y_mem, _ = measure([sys.executable, "-c", YARDSTICK, str(record)], work)
             for name in commands:
@@ -133,7 +135,11 @@ def main() -> None:
     ap.add_argument("--sizes", default="1e5,1e6,2e6")
     ap.add_argument("--commands", default=",".join(COMMANDS))
     ap.add_argument("--write", action="store_true", help="update BENCHMARKS.md")
+    ap.add_argument("--make", nargs=2, metavar=("N", "PATH"), help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.make:
+        make_record(int(args.make[0]), Path(args.make[1]))
+        return
     sizes = [int(float(s)) for s in args.sizes.split(",")]
     commands = [c for c in args.commands.split(",") if c]
     text = section(sizes, commands)
