@@ -191,6 +191,12 @@ def simulate(spec: _spec.Spec, isolated: bool | None = None, method: str = "fast
     SimulationError
         An unknown method or drive, or a drive that needs what the record
         lacks (``force_N`` for ``drive="force"``).
+    ArgumentError
+        ``spec`` is not a spec, path or mapping; a number argument is not a
+        finite number (``crossover="5 Hz"``); a ``duration`` or a record of
+        more than :data:`fi_design.spec.MAX_OUTPUT_SAMPLES` output samples;
+        a ``window`` of fewer than :data:`MIN_WINDOW_SAMPLES` record samples
+        or more than :data:`MAX_WINDOWS` windows.
     """
     if method not in METHODS:
         raise SimulationError(f"method must be one of {METHODS}, got {method!r}")

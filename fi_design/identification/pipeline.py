@@ -18,8 +18,8 @@ import numpy as np
 
 from ..arguments import choice, integer, number
 from ..errors import ArgumentError, DataError
-from ..specfile import as_spec
 from ..measured import Measurement, measurement_from_arrays
+from ..specfile import as_spec
 from .dynamic import dynamic_parameters
 from .events import excitation
 from .preprocess import JITTER, check_record, joint_model, prepare, processing

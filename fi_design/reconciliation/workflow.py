@@ -99,6 +99,9 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
         thinned to the lowest rate the model allows (:mod:`.records`; a
         record logged faster than the model needs is thinned, and the
         conclusion says so).
+    ArgumentError
+        ``measured`` is not a Measurement, ``spec`` not a spec, path or
+        mapping, or a number argument is not a number in its range.
     SimulationError
         The arguments are inconsistent (an isolated plant without isolator,
         an unknown effect or drive, ``drive="force"`` without a force column).

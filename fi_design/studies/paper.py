@@ -124,6 +124,8 @@ def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
     SpecError
         Resolution below 2, an unknown map letter, or maps C/D for a spec
         without isolator.
+    ArgumentError
+        A resolution that is not a whole number or above :data:`MAX_RESOLUTION`.
     """
     from .. import __version__
 

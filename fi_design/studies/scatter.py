@@ -211,7 +211,8 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
     ------
     SpecError
         No scatter and no position-dependent friction, a path twice, fewer
-        than one sample, an unknown distribution, a confidence outside (0, 1).
+        than one sample or more than :data:`~.points.MAX_POINTS`, an unknown
+        distribution, a confidence outside (0, 1).
     ArgumentError
         A scatter that is not a :class:`Scatter`.
     """

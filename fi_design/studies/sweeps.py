@@ -78,8 +78,9 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
     Raises
     ------
     SpecError
-        Unknown path, a path to a non-numeric value, the same path twice, or
-        an isolated sweep of a spec without isolator.
+        Unknown path, a path to a non-numeric value, the same path twice, an
+        isolated sweep of a spec without isolator, or a grid of more than
+        :data:`~.points.MAX_POINTS` points.
     ArgumentError
         An axis that is neither an :class:`~.axes.Axis` nor a ``(path, values)``
         pair.
