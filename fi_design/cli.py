@@ -39,7 +39,7 @@ from typing import Annotated, Optional
 import typer
 
 from .cliparts import (DEFAULT_COMMAND, EXIT_VERDICT, Drive, ExecutorKind, Force, Jobs,
-                       JsonOut, Measure, NoCache, NoIsolator, Scheduler, SpecArg, app,
+                       JsonOut, Measure, NoCache, NoIsolator, Scheduler, SpecArg, app, at_most,
                        check_drive, check_measure, check_outputs, check_spec_path,
                        command_line, json_text, load,
                        output_option, run_study, study_pool, write_outputs, write_report,
@@ -116,8 +116,9 @@ def design_command(
     from .signoff import design
 
     console, err = make_console(), make_console(stderr=True)
-    with Status(err, "running the design guideline ...") as status, \
-            confirmation_pool(not no_simulation) as pool:
+    # the pool's workers fork before the spinner's thread starts (fork and threads do not mix)
+    with confirmation_pool(not no_simulation) as pool, \
+            Status(err, "running the design guideline ...") as status:
         result = design(spec_obj, confirm=not no_simulation, executor=pool, progress=status,
                         recommend=not no_recommend)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
@@ -176,7 +177,8 @@ def simulate_command(
     if not window > 0:
         raise typer.BadParameter(f"must be a positive time in seconds, got {window!r}",
                                  param_hint="--window")
-    outs = check_outputs((spec,), force, csv=(csv_out, (".csv",)), json=(json_out, (".json",)))
+    inputs = (spec,) if record is None else (spec, record)
+    outs = check_outputs(inputs, force, csv=(csv_out, (".csv",)), json=(json_out, (".json",)))
     spec_obj = load(spec)
 
     from .console import Status, make_console, print_simulation
@@ -193,9 +195,9 @@ def simulate_command(
     print_simulation(console, result)
     payloads = {}
     if outs["csv"] is not None:
-        from .measured import columns_csv
+        from .measured import write_columns_csv
 
-        payloads["csv"] = columns_csv(result.traces())
+        payloads["csv"] = lambda fh: write_columns_csv(fh, result.traces())
     if outs["json"] is not None:
         payloads["json"] = json_text(result)
     write_outputs(console, outs, payloads)
@@ -321,8 +323,10 @@ def study_command(
                                             "map_A.csv ... map_D.csv and study.json (created "
                                             "if missing).")] = Path("paper_study"),
     resolution: Annotated[int, typer.Option(
-        "--resolution", "-n", min=2, max=200, metavar="N",
-        help="Points per axis of every map.")] = 12,
+        "--resolution", "-n", min=2, metavar="N",
+        callback=at_most(150, "points per axis (four maps of 150 x 150 are 90 000 simulations)"),
+        help="Points per axis of every map (at most 150: four maps of 150 x 150 are 90 000 "
+             "simulations).")] = 12,
     report_out: Optional[Path] = output_option("--report", "OUT.html",
         "Also write the report of the four maps (HTML, or PDF for a .pdf name)."),
     maps: Annotated[str, typer.Option(
@@ -388,7 +392,11 @@ def study_command(
 def robustness_command(
     spec: SpecArg,
     samples: Annotated[int, typer.Option(
-        "--samples", "-n", min=1, metavar="N", help="Number of random samples.")] = 100,
+        "--samples", "-n", min=1, metavar="N",
+        callback=at_most(100_000, "samples of a study (each simulated with and without the "
+                                  "isolator)"),
+        help="Number of random samples (at most 100 000, each simulated with and without the "
+             "isolator).")] = 100,
     scatter: Annotated[Optional[list[str]], typer.Option(
         "--scatter", metavar="PATH=SPREAD",
         help="A scattered spec value and its spread: '10%' of the nominal value (standard "

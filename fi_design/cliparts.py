@@ -15,9 +15,11 @@ The commands themselves are in :mod:`fi_design.cli`.
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import os
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Optional
 
@@ -91,7 +93,11 @@ class DefaultCommandGroup(TyperGroup):
     The group also translates errors for every command: a
     :class:`~fi_design.errors.FiDesignError` exits 2 with its message, any
     other exception exits 1 with a short "internal error" note (the traceback
-    with ``--debug`` or ``FI_DESIGN_DEBUG=1``).
+    with ``--debug`` or ``FI_DESIGN_DEBUG=1``); SIGTERM and SIGHUP become
+    :class:`Terminated` in the main thread, so that temporary files are
+    removed and worker processes stopped as after Ctrl-C, and exit with 128
+    plus the signal's number. Every command runs in a :mod:`contextvars`
+    context of its own (the outputs it claims, :mod:`fi_design.output`).
     """
 
     default_command = DEFAULT_COMMAND
@@ -138,8 +144,15 @@ class DefaultCommandGroup(TyperGroup):
         return i
 
     def invoke(self, ctx: Any) -> Any:
+        import contextvars
+
         try:
-            return super().invoke(ctx)
+            with terminate_by_exception():
+                return contextvars.copy_context().run(super().invoke, ctx)
+        except Terminated as exc:
+            typer.echo(f"terminated by signal {exc.signum}; no output was written and no "
+                       "temporary file is left", err=True)
+            raise typer.Exit(128 + exc.signum) from None
         except (typer.Exit, typer.Abort, typer.TyperException, BrokenPipeError):
             raise  # usage errors, explicit exits, `fi-design ... | head`
         except Exception as exc:  # noqa: BLE001 -- the one place that turns errors into codes
@@ -157,6 +170,48 @@ class DefaultCommandGroup(TyperGroup):
                 "file.")
             typer.echo(f"internal error: {type(exc).__name__}: {exc}{note}", err=True)
             raise typer.Exit(EXIT_INTERNAL) from None
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP, raised in the main thread like Ctrl-C's KeyboardInterrupt.
+
+    Attributes
+    ----------
+    signum : int
+        The signal's number.
+    """
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def terminate_by_exception() -> Iterator[None]:
+    """Turn SIGTERM and SIGHUP into :class:`Terminated` for the duration (main thread only).
+
+    The default action of these signals ends the process at once: a
+    temporary file half written stays, worker processes are orphaned. As an
+    exception, they unwind like Ctrl-C does: every ``finally`` runs.
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def terminate(signum: int, frame: Any) -> None:
+        raise Terminated(signum)
+
+    kinds = [s for s in (getattr(signal, "SIGTERM", None), getattr(signal, "SIGHUP", None))
+             if s is not None]
+    previous = {s: signal.signal(s, terminate) for s in kinds}
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
 
 
 app = typer.Typer(
@@ -221,10 +276,27 @@ Drive = Annotated[str, typer.Option(
     help="How the model replays the record: 'closed' (its controller closes the loop on the "
          "measured reference) or 'force' (the plant alone, driven open loop by the measured "
          "force_N and re-anchored to the measurement in windows).")]
+#: Most worker processes a study starts (--jobs): more than the machine has cores only adds
+#: memory and start-up time.
+MAX_JOBS = 64
+
+
+def at_most(limit: int, why: str) -> Any:
+    """An option callback refusing a number above ``limit``, with the number read and why."""
+
+    def check(value: Any) -> Any:
+        if value is not None and value > limit:
+            raise typer.BadParameter(f"{value} is more than {limit}, the most {why}")
+        return value
+
+    return check
+
+
 Jobs = Annotated[int, typer.Option(
     "--jobs", "-j", min=0, metavar="N",
+    callback=at_most(MAX_JOBS, "worker processes a study starts"),
     help="Worker processes (local executor) or local dask workers; 0 = all cores, "
-         "1 = serial in this process.")]
+         "1 = serial in this process; at most 64.")]
 ExecutorKind = Annotated[str, typer.Option(
     "--executor", metavar="local|dask",
     help="local: a process pool on this machine (default); dask: a dask.distributed "
@@ -319,7 +391,8 @@ def json_text(result: Any) -> str:
 
 
 def write_outputs(console: "Console", outs: dict, payloads: dict) -> None:
-    """Write each payload (text or bytes) to its checked path, atomically, and say so.
+    """Write each payload (text, bytes, or a function that writes text into an open file, for
+    outputs of millions of rows) to its checked path, atomically, and say so.
 
     Parameters
     ----------
@@ -330,10 +403,14 @@ def write_outputs(console: "Console", outs: dict, payloads: dict) -> None:
     payloads : dict
         Content by the same names.
     """
-    from .output import write_atomic
+    from .output import atomic_path, write_atomic
 
     for name, data in payloads.items():
-        write_atomic(outs[name], data)
+        if callable(data):
+            with atomic_path(outs[name]) as tmp, open(tmp, "w", encoding="utf-8") as fh:
+                data(fh)
+        else:
+            write_atomic(outs[name], data)
         console.print(f"wrote {outs[name]}", markup=False)
 
 
@@ -392,12 +469,14 @@ def run_study(label: str, pool: Any, no_cache: bool, work: Any) -> Any:
     try:
         with pool as ex, ProgressBar(err, label) as bar:
             return work(ex, bar, None if no_cache else PointCache())
-    except KeyboardInterrupt:
-        err.print("interrupted; nothing was kept (--no-cache) and no output was written"
-                  if no_cache else "interrupted; the finished points are in the result cache: "
+    except KeyboardInterrupt as exc:
+        what = "terminated" if isinstance(exc, Terminated) else "interrupted"
+        err.print(f"{what}; nothing was kept (--no-cache) and no output was written"
+                  if no_cache else f"{what}; the finished points are in the result cache: "
                   "run the same command again to resume. No output was written",
                   markup=False, highlight=False)
-        raise typer.Exit(EXIT_INTERRUPTED) from None
+        raise typer.Exit(128 + exc.signum if isinstance(exc, Terminated) else
+                         EXIT_INTERRUPTED) from None
 
 
 def write_study(console: "Console", outs: dict, result: Any, figure: Any) -> None:

@@ -54,6 +54,10 @@ class Parameter:
     combine : str
         ``"set"``: the value replaces the kernel parameter; ``"add"``: it adds
         to the nominal one (an extra delay on top of the controller's).
+    limits : tuple of (str, float)
+        The physically possible values, as pydantic field constraints
+        (``(("gt", 0.0),)``: above zero; ``(("ge", 0.0), ("lt", 1.0))``); a
+        spec entry outside them is refused. Empty: any finite value.
     """
 
     name: str
@@ -67,6 +71,7 @@ class Parameter:
     periodic: bool = False
     required: bool = True
     combine: str = "set"
+    limits: tuple[tuple[str, float], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -128,26 +133,30 @@ class EffectSet:
 
 
 _TWO_PI = 2.0 * math.pi
+#: Limits of a parameter that must be above zero (a length, a mass, a resolution, a force limit).
+_POSITIVE = (("gt", 0.0),)
+#: Limits of a parameter that must not be negative (a friction, a damping, a delay).
+_NOT_NEGATIVE = (("ge", 0.0),)
 
 CATALOGUE: dict[str, Effect] = {e.name: e for e in (
     Effect("viscous_friction", "the bearing's viscous coefficient sigma2 differs from nominal", (
         Parameter("viscous", "N*s/m", "true viscous friction coefficient sigma2", "sigma2",
-                  (0.0, 500.0), neutral=None),)),
+                  (0.0, 500.0), neutral=None, limits=_NOT_NEGATIVE),)),
     Effect("stribeck_velocity", "the Stribeck velocity vs differs from nominal", (
         Parameter("stribeck_velocity", "m/s", "true Stribeck velocity vs", "vs",
-                  (1e-5, 0.1), neutral=None, log=True),)),
+                  (1e-5, 0.1), neutral=None, log=True, limits=_POSITIVE),)),
     Effect("position_dependent_friction",
            "Fs and Fc scaled by 1 + a sin(2 pi x2 / wavelength + phase) along the rail", (
-        Parameter("amplitude", "1", "relative amplitude a of the friction variation", "pdf_amplitude",
-                  (0.0, 0.9)),
+        Parameter("amplitude", "1", "relative amplitude a of the friction variation",
+                  "pdf_amplitude", (0.0, 0.9), limits=(("ge", 0.0), ("lt", 1.0))),
         Parameter("wavelength", "m", "spatial period of the variation", "pdf_wavelength",
-                  (2e-4, 0.05), neutral=1.0, log=True),
+                  (2e-4, 0.05), neutral=1.0, log=True, limits=_POSITIVE),
         Parameter("phase", "rad", "phase of the variation at x2 = 0", "pdf_phase",
                   (-math.pi, math.pi), periodic=True, required=False),)),
     Effect("force_ripple", "extra force A sin(2 pi x1 / pitch + phase) on the stage (motor cogging)", (
         Parameter("amplitude", "N", "ripple force amplitude A", "ripple_amplitude", (0.0, 10.0)),
         Parameter("pitch", "m", "spatial period of the ripple", "ripple_pitch",
-                  (2e-4, 0.05), neutral=1.0, log=True),
+                  (2e-4, 0.05), neutral=1.0, log=True, limits=_POSITIVE),
         Parameter("phase", "rad", "phase of the ripple at x1 = 0", "ripple_phase",
                   (-math.pi, math.pi), periodic=True, required=False),)),
     Effect("cable_force", "extra force -k_c (x1 - x1(0)) - F0 on the stage (cable slab)", (
@@ -155,20 +164,22 @@ CATALOGUE: dict[str, Effect] = {e.name: e for e in (
         Parameter("preload", "N", "constant cable force F0", "cable_preload", (-10.0, 10.0),
                   required=False),)),
     Effect("time_delay", "the actuator force u is applied a delay later", (
-        Parameter("delay", "s", "extra loop delay", "delay", (0.0, 0.02), combine="add"),)),
+        Parameter("delay", "s", "extra loop delay", "delay", (0.0, 0.02), combine="add",
+                  limits=_NOT_NEGATIVE),)),
     Effect("quantization", "the controller sees round(x1 / q) q", (
         Parameter("resolution", "m", "position quantization step q", "quantization",
-                  (1e-8, 1e-4), log=True),)),
+                  (1e-8, 1e-4), log=True, limits=_NOT_NEGATIVE),)),
     Effect("force_saturation", "the actuator force is clipped to +-limit", (
         Parameter("limit", "N", "actuator force limit", "force_limit", (0.1, 1000.0),
-                  neutral=math.inf, log=True),)),
+                  neutral=math.inf, log=True, limits=_POSITIVE),)),
     Effect("mass_error", "the true stage and cart masses differ from nominal", (
         Parameter("stage_mass", "kg", "true stage mass m1", "m1", (0.5, 2.0), neutral=None,
-                  relative=True, required=False),
+                  relative=True, required=False, limits=_POSITIVE),
         Parameter("cart_mass", "kg", "true cart mass m2", "m2", (0.5, 2.0), neutral=None,
-                  relative=True, required=False),)),
+                  relative=True, required=False, limits=_POSITIVE),)),
     Effect("joint_damping", "the joint damping c of the isolator differs from nominal", (
-        Parameter("damping", "N*s/m", "true joint damping c", "c", (0.0, 200.0), neutral=None),)),
+        Parameter("damping", "N*s/m", "true joint damping c", "c", (0.0, 200.0), neutral=None,
+                  limits=_NOT_NEGATIVE),)),
     Effect("force_offset", "a constant load force on the stage, m1 a1 = u - offset - ... "
                            "(drive offset, an inclined axis)", (
         Parameter("offset", "N", "constant load force on the stage", "offset", (-10.0, 10.0),
@@ -176,10 +187,11 @@ CATALOGUE: dict[str, Effect] = {e.name: e for e in (
     Effect("friction_asymmetry", "Coulomb and viscous friction differ when the cart slides in "
                                  "the negative direction (static friction scales with Coulomb)", (
         Parameter("coulomb_negative", "N", "Coulomb friction in the negative direction",
-                  "Fc_neg", (0.25, 4.0), neutral=None, relative=True, log=True),
+                  "Fc_neg", (0.25, 4.0), neutral=None, relative=True, log=True,
+                  limits=_NOT_NEGATIVE),
         Parameter("viscous_negative", "N*s/m", "viscous friction in the negative direction",
                   "sigma2_neg", (0.25, 4.0), neutral=None, relative=True, log=True,
-                  required=False),)),
+                  required=False, limits=_NOT_NEGATIVE),)),
 )}
 
 #: Stable effect names, in catalogue order.

@@ -580,10 +580,10 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
     from . import verdict as _verdict
     from .confirm import confirm as run_confirmation
 
-    if not isinstance(spec, (Spec, Model)):
-        from .specfile import load_spec
+    if not isinstance(spec, Model):
+        from .specfile import as_spec
 
-        spec = load_spec(spec)
+        spec = as_spec(spec)
     model = as_model(spec)
     spec = model.spec
     suggestion = suggested_isolator(model) if not model.has_isolator else None

@@ -13,18 +13,56 @@ things with it:
    name) to write it: the data goes to a temporary file in the same directory,
    is flushed to disk and moved into place with :func:`os.replace`. A failure
    leaves the old file untouched and no temporary file behind; a reader never
-   sees half a file.
+   sees half a file. SIGINT and SIGTERM are held while the temporary file is
+   made and removed, so an interruption (translated into an exception, as
+   the command line does) always removes it.
+
+The check also *claims* the path for the run (in the current
+:mod:`contextvars` context; the command line runs every command in a context
+of its own): it notes the file found there, or that there was none. The
+write then replaces only that file. A file that appeared during the run is
+not replaced without ``force``, and a file that another run wrote after the
+check is not replaced at all: of two runs writing one path, the first to
+finish writes it and the other raises :class:`~fi_design.errors.OutputError`
+saying so. Writers of one directory take turns (an exclusive ``flock`` on
+it) while they compare and move. A path nobody checked is replaced as before.
 """
 
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
+import signal
 import tempfile
+import threading
 from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from .errors import OutputError
+
+
+@dataclass(frozen=True)
+class Claim:
+    """An output path as a run checked it.
+
+    Attributes
+    ----------
+    force : bool
+        Whether the run may replace a file found at the check.
+    found : tuple or None
+        Identity of the file found then (device, inode, size, mtime in ns), None: no file.
+    """
+
+    force: bool
+    found: tuple | None
+
+
+#: The outputs the current run checked, by resolved path (see the module docstring).
+_CLAIMS: contextvars.ContextVar[dict | None] = contextvars.ContextVar("fi_design_output_claims",
+                                                                     default=None)
 
 
 def check_output(path: str | os.PathLike, *, force: bool = False,
@@ -82,7 +120,27 @@ def check_output(path: str | os.PathLike, *, force: bool = False,
             raise OutputError(f"{out}: file exists; use --force to overwrite it")
         if out.exists() and not out.is_file():
             raise OutputError(f"{out}: exists and is not a regular file")
+    _claim(out, force)
     return out
+
+
+def _claim(out: Path, force: bool) -> None:
+    """Note, for this run, the file found at ``out`` now (see the module docstring)."""
+    _set_claim(os.path.realpath(out), Claim(force=force, found=_identity(out)))
+
+
+def _set_claim(key: str, claim: Claim) -> None:
+    """Record a claim in a new mapping: a copied context never shares another run's claims."""
+    _CLAIMS.set({**(_CLAIMS.get() or {}), key: claim})
+
+
+def _identity(path: Path) -> tuple | None:
+    """Device, inode, size and modification time of a file; None when there is none."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
 
 
 def check_outputs(inputs: Iterable[str | os.PathLike], *, force: bool = False,
@@ -157,6 +215,8 @@ def check_output_dir(directory: str | os.PathLike, names: Iterable[str], *,
     for name in names:
         if out.is_dir():
             check_output(out / name, force=force, protect=protect)
+        else:
+            _claim(out / name, force)
         targets[name] = out / name
     return targets
 
@@ -200,24 +260,100 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """
     out = Path(path)
     parent = out.parent if str(out.parent) else Path(".")
+    held = _hold_signals()  # until the file is known to the cleanup below
+    tmp: Path | None = None
     try:
-        fd, tmp_name = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp", dir=parent)
-    except OSError as exc:
-        raise OutputError(f"{out}: cannot create a file in {parent} ({exc.strerror})") from None
-    os.close(fd)
-    tmp = Path(tmp_name)
-    try:
+        try:
+            fd, tmp_name = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp", dir=parent)
+        except OSError as exc:
+            raise OutputError(f"{out}: cannot create a file in {parent} ({exc.strerror})") \
+                from None
+        os.close(fd)
+        tmp = Path(tmp_name)
+        held = _release_signals(held)  # a signal held meanwhile raises here, inside the try
         yield tmp
         _fsync_file(tmp)
         os.chmod(tmp, _mode_for(out))
-        os.replace(tmp, out)
+        _move(tmp, out, parent)
     except OSError as exc:
-        _remove(tmp)
+        _remove_held(tmp, held)
+        if isinstance(exc, OutputError):
+            raise
         raise OutputError(f"{out}: cannot write ({exc.strerror or exc})") from None
     except BaseException:
-        _remove(tmp)
+        _remove_held(tmp, held)
         raise
     _fsync_dir(parent)
+
+
+def _remove_held(tmp: Path | None, held: Any) -> None:
+    """Remove the temporary file with SIGINT and SIGTERM held, then let them through."""
+    held = held if held is not None else _hold_signals()
+    try:
+        if tmp is not None:
+            _remove(tmp)
+    finally:
+        _release_signals(held)
+
+
+def _move(tmp: Path, out: Path, parent: Path) -> None:
+    """Move the finished temporary file into place, as the run's claim on ``out`` allows."""
+    claims = _CLAIMS.get() or {}
+    key = os.path.realpath(out)
+    claim = claims.get(key)
+    if claim is None:
+        os.replace(tmp, out)
+        return
+    with _directory_lock(parent):
+        now = _identity(out)
+        if now != claim.found:
+            if claim.found is None and not claim.force:
+                raise OutputError(f"{out}: the file appeared while this run worked; it was not "
+                                  "replaced (use --force to overwrite it)")
+            raise OutputError(f"{out}: was written by another run after this one checked it; "
+                              "that file is kept and this run's result was not written")
+        if claim.found is None:
+            os.link(tmp, out)  # fails if anyone created the file meanwhile: never clobbers
+            os.unlink(tmp)
+        else:
+            os.replace(tmp, out)
+        _set_claim(key, Claim(force=True, found=_identity(out)))  # the run's own file now
+
+
+@contextlib.contextmanager
+def _directory_lock(directory: Path) -> Iterator[None]:
+    """Hold an exclusive lock on a directory (writers of one directory take turns)."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    fd = os.open(directory, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
+
+
+#: Signals held while a temporary file is made or removed.
+_HELD = frozenset(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
+                  if hasattr(signal, name))
+
+
+def _hold_signals() -> Any:
+    """Hold SIGINT, SIGTERM and SIGHUP in the main thread; returns the mask to restore."""
+    if threading.current_thread() is not threading.main_thread() \
+            or not hasattr(signal, "pthread_sigmask"):
+        return None
+    return signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+
+
+def _release_signals(previous: Any) -> None:
+    """Restore the mask: a signal that came meanwhile is handled now. Returns None."""
+    if previous is not None:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+    return None
 
 
 def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:

@@ -9,15 +9,24 @@ CLI makes them here, as context managers that close them again:
   process does the linear analysis;
 - :class:`StudyPool`: the executor of a parameter study, a local process pool
   or a dask.distributed client.
+
+Both start their worker processes at once, when entered, before the caller
+starts a progress display's thread (fork and threads do not mix). The
+workers end with their parent: they leave SIGINT to it, die on SIGTERM, and
+Linux sends them SIGTERM when the parent dies, however it dies. When the
+work fails or is interrupted, a pool stops its own workers at once (never
+any other child process of the interpreter) instead of waiting for them.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
 import multiprocessing
 import os
+import signal
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from .errors import ArgumentError, FiDesignError
@@ -35,6 +44,53 @@ def _fork_context() -> Any:
     return None
 
 
+def _worker_start(parent: int, then: Callable[[], None] | None = None) -> None:
+    """Initializer of every worker: end with the parent, leave Ctrl-C to it, then ``then()``."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C and ends us
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the parent's handler: just end
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        try:  # PR_SET_PDEATHSIG: SIGTERM when the parent dies, even by SIGKILL
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM, 0, 0, 0)
+        except (OSError, AttributeError):  # pragma: no cover - no prctl
+            pass
+    if os.getppid() != parent:  # the parent died before the line above
+        os._exit(1)
+    if then is not None:
+        then()
+
+
+def _process_pool(workers: int, ctx: Any, then: Callable[[], None] | None = None) -> tuple:
+    """A started process pool and its own worker processes.
+
+    All workers are forked here, from the calling thread (before a progress
+    display's thread exists): with fork, a pool starts every worker at its
+    first task, and this submits a trivial one and waits for it.
+    """
+    from concurrent.futures import ProcessPoolExecutor
+
+    before = set(multiprocessing.active_children())
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                               initializer=functools.partial(_worker_start, os.getpid(), then))
+    try:
+        pool.submit(int).result()
+    except BaseException:
+        _stop(pool, [p for p in multiprocessing.active_children() if p not in before])
+        raise
+    return pool, [p for p in multiprocessing.active_children() if p not in before]
+
+
+def _stop(pool: Any, workers: list) -> None:
+    """Stop a pool at once: cancel what has not started, end its own workers (no others)."""
+    pool.shutdown(wait=False, cancel_futures=True)
+    for worker in workers:
+        if worker.is_alive():
+            worker.terminate()
+    for worker in workers:
+        worker.join(timeout=5)
+
+
 @contextlib.contextmanager
 def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
     """Worker processes for a design's confirmation and robustness, or None (run here).
@@ -43,9 +99,10 @@ def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
     confirmation's simulations and the robustness study then overlap each
     other and the linear analysis. The kernel and scipy.signal are loaded
     here first (:func:`fi_design.studies.warm_up`), so the forked workers
-    start with them.
-    When the work fails or is interrupted, the worker is stopped at once
-    rather than waited for.
+    start with them; the workers are started before this yields, so enter
+    it before a progress display (a spinner's thread).
+    When the work fails or is interrupted, the pool's own workers are
+    stopped at once rather than waited for.
 
     Parameters
     ----------
@@ -61,8 +118,6 @@ def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
     if ctx is None:
         yield None
         return
-    from concurrent.futures import ProcessPoolExecutor
-
     from .studies import warm_up
 
     # scipy.signal (the metric's peak finder; python-control needs it here anyway) is the
@@ -70,13 +125,11 @@ def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
     # inherit it instead of each importing it again on two cores (measured in BENCHMARKS.md)
     warm_up()
 
-    pool = ProcessPoolExecutor(max_workers=min(2, os.cpu_count() or 1), mp_context=ctx)
+    pool, workers = _process_pool(min(2, os.cpu_count() or 1), ctx)
     try:
         yield pool
     except BaseException:
-        pool.shutdown(wait=False, cancel_futures=True)
-        for child in multiprocessing.active_children():  # the pool's worker
-            child.terminate()
+        _stop(pool, workers)
         raise
     pool.shutdown(wait=True)
 
@@ -124,7 +177,7 @@ class StudyPool:
         try:
             return self._start()
         except BaseException:
-            self.__exit__(None, None, None)
+            self.__exit__(*sys.exc_info())
             raise
 
     def _start(self) -> Any:
@@ -135,14 +188,11 @@ class StudyPool:
             return self._dask()
         if self.jobs == 1:
             return None
-        from concurrent.futures import ProcessPoolExecutor
-
-        pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=_fork_context(),
-                                   initializer=warm_up)
-        self._closers.append(lambda: pool.shutdown(wait=True, cancel_futures=True))
-        # start the workers now, before the progress bar's thread exists (fork and threads
-        # do not mix); with fork all workers start at the first submit
-        pool.submit(int).result()
+        # the workers start now, before the progress bar's thread exists (fork and threads
+        # do not mix)
+        pool, workers = _process_pool(self.jobs, _fork_context(), warm_up)
+        self._closers.append(lambda failed: _stop(pool, workers) if failed else
+                             pool.shutdown(wait=True, cancel_futures=True))
         return pool
 
     def _dask(self) -> Any:
@@ -162,19 +212,20 @@ class StudyPool:
             else:
                 cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1, processes=True,
                                        dashboard_address=None, silence_logs=logging.ERROR)
-                self._closers.append(cluster.close)
+                self._closers.append(lambda failed: cluster.close())
                 client = Client(cluster)
         except (OSError, TimeoutError, ValueError) as exc:
             where = self.scheduler or "a local cluster"
             raise FiDesignError(f"cannot connect to the dask scheduler at {where}: {exc}") \
                 from None
-        self._closers.insert(0, client.close)
+        self._closers.insert(0, lambda failed: client.close())
         client.run(warm_up)  # every worker loads the kernel before its first chunk
         return client
 
     def __exit__(self, *exc: Any) -> None:
+        failed = exc[0] is not None
         for close in self._closers:
             try:
-                close()
+                close(failed)
             except Exception:  # noqa: BLE001 -- closing must not hide the real outcome
                 pass

@@ -22,7 +22,8 @@ from dataclasses import replace
 import numpy as np
 
 from . import spec as _spec
-from .errors import SimulationError
+from .arguments import number
+from .errors import ArgumentError, SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from .model import Model, as_model
 from .plant import PlantParameters, state_index
@@ -36,6 +37,10 @@ METHODS = ("fast", "reference")
 
 #: Default length of the re-anchored windows of an open-loop replay [s].
 WINDOW = 0.1
+#: Fewest record samples in a window of an open-loop replay.
+MIN_WINDOW_SAMPLES = 10
+#: Most windows of an open-loop replay (each one integration).
+MAX_WINDOWS = 100_000
 
 
 # --------------------------------------------------------------------------- tolerances
@@ -122,11 +127,19 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
     SimulationError
         An unknown method or drive, or a drive that needs what the record
         lacks (``force_N`` for ``drive="force"``).
+    ArgumentError
+        ``spec`` is not a spec, path or mapping; a number argument is not a
+        finite number (``crossover="5 Hz"``); a ``duration`` or a record of
+        more than :data:`fi_design.spec.MAX_OUTPUT_SAMPLES` output samples;
+        a ``window`` of fewer than :data:`MIN_WINDOW_SAMPLES` record samples
+        or more than :data:`MAX_WINDOWS` windows.
     """
     if method not in METHODS:
         raise SimulationError(f"method must be one of {METHODS}, got {method!r}")
     if drive not in DRIVES:
         raise SimulationError(f"drive must be one of {DRIVES}, got {drive!r}")
+    spec, crossover, duration, rtol = _checked_arguments(spec, crossover, duration, rtol, record)
+    initial_position = number(initial_position, "initial_position", "m")
     model = as_model(spec)
     if crossover is not None or effects is not None:
         model = model.at(crossover=crossover, effects=effects)
@@ -158,6 +171,36 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
     out, wall = _integrate(model, method, params, y0, ref, t_end, t_out, rtol)
     return _result(model, iso, method, params, out, t_out, wall,
                    move_end=motion.end_time if reference is None else 0.0)
+
+
+def _checked_arguments(spec, crossover, duration, rtol, record):
+    """The spec or model (a spec loaded when given as a path or mapping) and the numeric
+    arguments, checked."""
+    from .measured import Measurement
+    from .specfile import as_spec
+
+    if not isinstance(spec, Model):
+        spec = as_spec(spec)
+    settings = (spec.spec if isinstance(spec, Model) else spec).simulation
+    if crossover is not None:
+        crossover = number(crossover, "crossover", "Hz", positive=True)
+    if rtol is not None:
+        rtol = number(rtol, "rtol", "-", positive=True, maximum=0.1)
+    if record is not None and not isinstance(record, Measurement):
+        raise ArgumentError(f"record must be a Measurement (fi_design.load_measurement), got "
+                            f"{type(record).__name__}")
+    if record is not None and record.n > _spec.MAX_OUTPUT_SAMPLES:
+        raise ArgumentError(f"the record has {record.n} samples; a replay holds at most "
+                            f"{_spec.MAX_OUTPUT_SAMPLES} (about 150 bytes each): replay a part "
+                            "of it (fi_design.identification.segment)")
+    if duration is not None:
+        duration = number(duration, "duration", "s", positive=True)
+        samples = math.floor(duration * settings.output_rate + 1e-9) + 1
+        if samples > _spec.MAX_OUTPUT_SAMPLES:
+            raise ArgumentError(f"duration = {duration:g} s at simulation.output_rate = "
+                                f"{settings.output_rate:g} Hz makes {samples:.3g} output "
+                                f"samples; at most {_spec.MAX_OUTPUT_SAMPLES}")
+    return spec, crossover, duration, rtol
 
 
 def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=None,
@@ -224,8 +267,17 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
     if record.force is None:
         raise SimulationError("an open-loop replay (drive='force') needs the record's force_N "
                               "column")
-    if not window > 0.0:
-        raise SimulationError(f"window must be a positive time [s], got {window!r}")
+    window = number(window, "window", "s", positive=True)
+    least = MIN_WINDOW_SAMPLES * record.sample_period
+    if window < least:
+        raise ArgumentError(f"window = {window:g} s spans fewer than {MIN_WINDOW_SAMPLES} samples "
+                            f"of the record ({record.sample_period:g} s apart); give at least "
+                            f"{least:.3g} s")
+    count = math.ceil(float(t_out[-1]) / window)
+    if count > MAX_WINDOWS:
+        raise ArgumentError(f"window = {window:g} s cuts the {t_out[-1]:g} s record into {count} "
+                            f"windows; at most {MAX_WINDOWS}: give at least "
+                            f"{float(t_out[-1]) / MAX_WINDOWS:.3g} s")
     # the plant alone, driven by the measured force: no controller, no feedforward
     open_loop = replace(params, kp=0.0, ki=0.0, kd=0.0, kdm=0.0, wt=math.inf, ff_mass=0.0,
                         ff_viscous=0.0, ff_coulomb=0.0, sample_period=0.0, delay=0.0)

@@ -19,8 +19,8 @@ import math
 import sys
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import (BaseModel, BeforeValidator, ConfigDict, Discriminator, Field, PrivateAttr,
-                      Tag, WithJsonSchema, create_model, model_validator)
+from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, Discriminator,
+                      Field, PrivateAttr, Tag, WithJsonSchema, create_model, model_validator)
 
 from . import effects as _effects
 from .display import number
@@ -53,6 +53,21 @@ def OptQ(unit: str):
     shown = {"deg": "degree", "dB": "decibel", "1": "dimensionless"}.get(unit, unit)
     json = {"anyOf": [{"type": "number"}, {"type": "string"}, {"type": "null"}], "x-unit": shown}
     return Annotated[Union[float, None], BeforeValidator(_parser(unit)), WithJsonSchema(json)]
+
+
+def _plain_text(value: str) -> str:
+    """Refuse control characters in text (a ``"\\u0000"`` escape, terminal escapes): tabs and
+    line breaks are the only ones text may hold."""
+    for char in value:
+        code = ord(char)
+        if (code < 32 and char not in "\t\n\r") or 127 <= code < 160:
+            raise ValueError(f"control character U+{code:04X} is not allowed in text (read "
+                             f"{value!r}); write plain text")
+    return value
+
+
+#: A text field of the spec: plain text, control characters refused.
+Text = Annotated[str, AfterValidator(_plain_text)]
 
 
 class StrictModel(BaseModel):
@@ -126,7 +141,7 @@ class Limiter(StrictModel):
 class ParasiticMode(StrictModel):
     """A parasitic resonance of the flexure, added to the linear limit cases."""
 
-    name: str = Field("mode", description="Label used in reports.")
+    name: Text = Field("mode", description="Label used in reports.")
     frequency: Q("Hz") = Field(gt=0, description="Resonance frequency [Hz].")
     damping_ratio: float = Field(0.01, ge=0, lt=1, description="Modal damping ratio [-]. "
                                                                "Default 0.01.")
@@ -325,7 +340,9 @@ class Motion(StrictModel):
     """Reference motion: moves run one after another, then hold."""
 
     moves: tuple[Move, ...] = Field(min_length=1, description="The moves.")
-    duration: Q("s") = Field(20.0, gt=0, description="Simulated time [s]. Default 20 s.")
+    duration: Q("s") = Field(20.0, gt=0, description="Simulated time [s]; duration x "
+                                                      "simulation.output_rate at most 4e6 "
+                                                      "samples. Default 20 s.")
     family: Family = Field(default_factory=Family, description="The moves the stage must settle "
                                                                "after (stage-level hunting).")
 
@@ -468,19 +485,39 @@ class Measurement(StrictModel):
     force_noise: OptQ("N") = Field(None, ge=0, description="Force noise std [N].")
 
 
+#: Most output samples of one simulation (duration x output rate): about 150 bytes each in
+#: memory, so 0.6 GB; a 400 s record at 10 kHz.
+MAX_OUTPUT_SAMPLES = 4_000_000
+#: Most crossovers in the scan for the lowest hunting-free crossover (one simulation each).
+MAX_SCAN_POINTS = 1000
+#: Largest step budget of one simulation (about a microsecond per step: minutes).
+MAX_STEPS = 100_000_000
+
+
 class CrossoverScan(StrictModel):
     """Grid of the scan for the lowest hunting-free crossover."""
 
     start: Q("Hz") = Field(1.0, gt=0, description="Lowest crossover scanned [Hz]. Default 1 Hz.")
     stop: Q("Hz") = Field(30.0, gt=0, description="Highest crossover scanned [Hz]. "
                                                   "Default 30 Hz.")
-    step: Q("Hz") = Field(0.5, gt=0, description="Scan resolution [Hz]. Default 0.5 Hz.")
+    step: Q("Hz") = Field(0.5, gt=0, description="Scan resolution [Hz]; the scan holds at most "
+                                                 "1000 crossovers. Default 0.5 Hz.")
 
     @model_validator(mode="after")
     def _ordered(self) -> "CrossoverScan":
         if self.stop <= self.start:
             raise ValueError("stop must be above start")
+        points = scan_points(self.start, self.stop, self.step)
+        if points > MAX_SCAN_POINTS:
+            raise ValueError(f"{self.start:g} Hz to {self.stop:g} Hz in steps of {self.step:g} Hz "
+                             f"is {points} points (one simulation each); at most "
+                             f"{MAX_SCAN_POINTS}: give a coarser step or a narrower range")
         return self
+
+
+def scan_points(start: float, stop: float, step: float) -> int:
+    """Number of crossovers of a scan from ``start`` to ``stop`` in ``step`` [Hz], ends included."""
+    return int(math.ceil((stop + 0.5 * step - start) / step))
 
 
 class Simulation(StrictModel):
@@ -490,8 +527,10 @@ class Simulation(StrictModel):
                                                                   "adaptive integrator. "
                                                                   "Default 1e-6.")
     output_rate: Q("Hz") = Field(1000.0, gt=0, description="Sample rate of the output traces "
-                                                           "[Hz]. Default 1 kHz.")
-    max_steps: int = Field(2_000_000, ge=1000, description="Step budget per simulation.")
+                                                           "[Hz]; motion.duration x output_rate "
+                                                           "at most 4e6 samples. Default 1 kHz.")
+    max_steps: int = Field(2_000_000, ge=1000, le=MAX_STEPS,
+                           description="Step budget per simulation. At most 1e8.")
     crossover_scan: CrossoverScan = Field(default_factory=CrossoverScan)
 
 
@@ -503,11 +542,11 @@ REPORT_KINDS = {"design": "", "sweep": "SWEEP", "study": "STUDY", "robustness": 
 class Revision(StrictModel):
     """One entry of the revision history, oldest first."""
 
-    revision: str = Field(min_length=1, description="Revision label, as report.revision.")
+    revision: Text = Field(min_length=1, description="Revision label, as report.revision.")
     date: datetime.date | None = Field(None, description="Date of the revision (YYYY-MM-DD). "
                                                          "Default none.")
-    description: str = Field("", description="What changed. Default empty.")
-    author: str | None = Field(None, description="Who made the change. Default none.")
+    description: Text = Field("", description="What changed. Default empty.")
+    author: Text | None = Field(None, description="Who made the change. Default none.")
 
 
 class DocumentIds(StrictModel):
@@ -515,18 +554,18 @@ class DocumentIds(StrictModel):
     a suffix, FI-0001-SWEEP, FI-0001-STUDY, FI-0001-ROBUSTNESS, FI-0001-RECONCILE,
     FI-0001-IDENTIFY, FI-0001-RECOMMEND)."""
 
-    sweep: str | None = Field(None, min_length=1, description="Document id of a sweep report "
+    sweep: Text | None = Field(None, min_length=1, description="Document id of a sweep report "
                                                               "(fi-design sweep). Default "
                                                               "DOCUMENT_ID-SWEEP.")
-    study: str | None = Field(None, min_length=1, description="Document id of the paper study's "
+    study: Text | None = Field(None, min_length=1, description="Document id of the paper study's "
                                                               "report. Default DOCUMENT_ID-STUDY.")
-    robustness: str | None = Field(None, min_length=1, description="Document id of a "
+    robustness: Text | None = Field(None, min_length=1, description="Document id of a "
                                                                    "robustness report. Default "
                                                                    "DOCUMENT_ID-ROBUSTNESS.")
-    reconcile: str | None = Field(None, min_length=1, description="Document id of a "
+    reconcile: Text | None = Field(None, min_length=1, description="Document id of a "
                                                                   "reconciliation (gap) report. "
                                                                   "Default DOCUMENT_ID-RECONCILE.")
-    identify: str | None = Field(None, min_length=1, description="Document id of an "
+    identify: Text | None = Field(None, min_length=1, description="Document id of an "
                                                                  "identification report. Default "
                                                                  "DOCUMENT_ID-IDENTIFY.")
     recommend: str | None = Field(None, min_length=1, description="Document id of a "
@@ -540,16 +579,16 @@ class ReportInfo(StrictModel):
     report: the design report has document_id, every other kind document_id with the kind as
     a suffix (FI-0001-SWEEP) unless document_ids names it; the ids must differ."""
 
-    document_id: str = Field("FI-0001", min_length=1,
+    document_id: Text = Field("FI-0001", min_length=1,
                              description="Document id of the design report; the other "
                                          "reports derive theirs from it (see document_ids).")
-    revision: str = Field("A", min_length=1,
+    revision: Text = Field("A", min_length=1,
                           description="Revision. Default the last entry of report.revisions, "
                                       "else A; with revisions it must be the last entry's.")
-    status: str = Field("draft", description="Status (draft unless given).")
-    author: str | None = Field(None, description="Prepared by.")
-    checked_by: str | None = Field(None, description="Checked by (name in the signature block).")
-    approved_by: str | None = Field(None, description="Approved by (name in the signature "
+    status: Text = Field("draft", description="Status (draft unless given).")
+    author: Text | None = Field(None, description="Prepared by.")
+    checked_by: Text | None = Field(None, description="Checked by (name in the signature block).")
+    approved_by: Text | None = Field(None, description="Approved by (name in the signature "
                                                       "block).")
     revisions: tuple[Revision, ...] = Field((), description="Revision history, oldest first: "
                                                             "revision, date, description, "
@@ -629,11 +668,13 @@ def _effect_model(effect: _effects.Effect):
     fields: dict[str, Any] = {"type": (Literal[effect.name], Field(description=effect.description))}
     for p in effect.parameters:
         kind = p.unit
+        limits = dict(p.limits)
         if p.required:
-            fields[p.name] = (Q(kind), Field(description=f"{p.description} [{p.unit}]."))
+            fields[p.name] = (Q(kind), Field(description=f"{p.description} [{p.unit}].",
+                                             **limits))
         else:
             fields[p.name] = (OptQ(kind), Field(None, description=f"{p.description} [{p.unit}]. "
-                                                                  "Optional."))
+                                                                  "Optional.", **limits))
     model = create_model("Effect_" + effect.name, __base__=StrictModel, **fields)
     model.__doc__ = effect.description
     return model
@@ -664,7 +705,7 @@ EffectEntry = Annotated[
 class Spec(StrictModel):
     """A friction-isolator design spec, values in SI (the keys: docs/interfaces.md)."""
 
-    name: str = Field("Unnamed stage", description="Project or stage name.")
+    name: Text = Field("Unnamed stage", description="Project or stage name.")
     stage: Body = Field(description="The actuated stage (m1, carries the sensor).")
     cart: Body = Field(description="The bearing cart (m2, friction acts on it).")
     friction: Friction
@@ -690,6 +731,15 @@ class Spec(StrictModel):
         if end > self.motion.duration * (1 + 1e-9):
             raise ValueError(f"the hunting window ends at {end:g} s, after motion.duration = "
                              f"{self.motion.duration:g} s")
+        rate = self.simulation.output_rate
+        samples = math.floor(self.motion.duration * rate + 1e-9) + 1
+        if samples > MAX_OUTPUT_SAMPLES:
+            where = "simulation.output_rate" if "output_rate" in self.simulation.model_fields_set \
+                else "motion.duration"
+            raise ValueError(f"{where}: {rate:g} Hz over motion.duration = "
+                             f"{self.motion.duration:g} s makes {samples:.3g} output samples; at "
+                             f"most {MAX_OUTPUT_SAMPLES} fit in memory (about 150 bytes each): "
+                             "lower simulation.output_rate or motion.duration")
         names = [e.type for e in self.effects]
         dupes = sorted({n for n in names if names.count(n) > 1})
         if dupes:

@@ -27,6 +27,8 @@ from .spec import Spec
 MAX_BYTES = 1_000_000
 #: Largest number of YAML nodes after alias expansion (alias-bomb guard).
 MAX_NODES = 20_000
+#: Deepest nesting of mappings and lists accepted; a spec nests five levels.
+MAX_DEPTH = 32
 
 
 @dataclass(frozen=True)
@@ -128,6 +130,40 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
                                      data.decode("utf-8")))
 
 
+def as_spec(spec: Any, name: str = "spec") -> Spec:
+    """The spec a library function was given: a :class:`Spec`, or a path or mapping to load.
+
+    Every public workflow takes what :func:`fi_design.design` takes, so a
+    script can pass the same mapping to each.
+
+    Parameters
+    ----------
+    spec : Spec, str, pathlib.Path or mapping
+        The spec, or what :func:`load_spec` reads.
+    name : str, optional
+        The argument's name, for the message.
+
+    Returns
+    -------
+    Spec
+
+    Raises
+    ------
+    ArgumentError
+        ``spec`` is none of these (None, a number, a list).
+    SpecFileError, SpecError
+        As :func:`load_spec`.
+    """
+    from .errors import ArgumentError
+
+    if isinstance(spec, Spec):
+        return spec
+    if isinstance(spec, (str, Path, Mapping)):
+        return load_spec(spec)
+    raise ArgumentError(f"{name} must be a Spec, a path to a YAML spec or a mapping, got "
+                        f"{type(spec).__name__}")
+
+
 def origin(spec: Spec) -> SpecOrigin | None:
     """Return the :class:`SpecOrigin` recorded by :func:`load_spec`, if any."""
     return spec._origin
@@ -198,11 +234,16 @@ def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, Any]:
         raise SpecError("the spec file is empty", source=source)
     yaml = yaml_loader()
     try:
-        node = yaml.compose(text)
+        try:
+            node = yaml.compose(text)
+        except RecursionError:  # the composer recurses: a few hundred levels exhaust it
+            raise SpecError(f"the YAML is nested more than {MAX_DEPTH} levels deep (mappings or "
+                            "lists inside each other); a spec nests a few levels",
+                            source=source) from None
         if node is None:
             raise SpecError("the spec file is empty", source=source)
+        _check_nodes(node, (), source)  # depth first: the node count recurses
         _count_nodes(node, source)
-        _check_nodes(node, (), source)
         document = yaml.constructor.construct_document(node)
     except ReaderError as exc:  # a NUL or other control character
         line = text.count("\n", 0, exc.position) + 1
@@ -249,12 +290,17 @@ def _count_nodes(node, source: str) -> None:
 
 def _check_nodes(node, loc: tuple, source: str, seen: set | None = None) -> None:
     """Refuse tags beyond YAML's core schema and keys given twice, naming the line."""
-    from ruamel.yaml.nodes import MappingNode, SequenceNode
+    from ruamel.yaml.nodes import MappingNode, ScalarNode, SequenceNode
 
     seen = set() if seen is None else seen
     if id(node) in seen:  # an alias: checked where it was defined
         return
     seen.add(id(node))
+    if len(loc) > MAX_DEPTH:
+        raise SpecError(f"the YAML is nested more than {MAX_DEPTH} levels deep (mappings or "
+                        "lists inside each other); a spec nests a few levels",
+                        path=_dotted(loc[:3]) + ("..." if len(loc) > 3 else ""),
+                        line=node.start_mark.line + 1, source=source)
     tag = str(node.tag) if node.tag is not None else None
     if tag is not None and tag not in _PLAIN_TAGS:
         shown = "!!" + tag[len("tag:yaml.org,2002:"):] if tag.startswith("tag:yaml.org,2002:") \
@@ -264,8 +310,13 @@ def _check_nodes(node, loc: tuple, source: str, seen: set | None = None) -> None
     if isinstance(node, MappingNode):
         keys: dict = {}
         for knode, vnode in node.value:
-            key = knode.value
             line = knode.start_mark.line + 1
+            if not isinstance(knode, ScalarNode):
+                kind = "a list" if isinstance(knode, SequenceNode) else "a mapping"
+                raise SpecError(f"a key must be a plain name, got {kind} (a YAML complex key "
+                                "'? ...')", path=_dotted(loc) or None, line=line,
+                                source=source)
+            key = knode.value
             if isinstance(key, str) and key in keys:
                 raise SpecError(f"key '{key}' appears twice (also on line {keys[key]})",
                                 path=_dotted(loc + (key,)), line=line, source=source)
@@ -326,14 +377,21 @@ def _validate(raw: dict, org: SpecOrigin) -> Spec:
 
 
 def _clean_loc(loc: tuple, raw: dict) -> tuple:
-    """Drop union tags that pydantic inserts (``effects.0.time_delay.delay``)."""
+    """Drop union tags that pydantic inserts (``effects.0.time_delay.delay``).
+
+    The tag is the entry's own ``type`` right after its index, even where a
+    parameter has the effect's name (``effects.0.stribeck_velocity.stribeck_velocity``).
+    """
     out: list = []
     node: Any = raw
+    tagged = False
     for part in loc:
-        if isinstance(node, dict) and isinstance(part, str) and part not in node \
-                and out and out[-1] != part and isinstance(out[-1], int) \
+        if isinstance(node, dict) and isinstance(part, str) and not tagged and len(out) >= 2 \
+                and isinstance(out[-1], int) and out[-2] == "effects" \
                 and node.get("type") == part:
+            tagged = True
             continue
+        tagged = False
         out.append(part)
         if isinstance(node, dict):
             node = node.get(part)
@@ -354,13 +412,28 @@ def _dotted(loc: tuple) -> str:
     return out
 
 
-def _model_at(loc: tuple):
-    """The pydantic model class that holds the field at ``loc`` (None if unknown)."""
+def _model_at(loc: tuple, raw: Any = None):
+    """The pydantic model class that holds the field at ``loc`` (None if unknown).
+
+    An entry of ``effects`` is the model of its ``type`` in ``raw`` (the
+    mapping as written), so its keys and units are that effect's.
+    """
     import typing
 
+    from .spec import EFFECT_MODELS
+
     model: Any = Spec
-    for part in loc[:-1]:
+    node: Any = raw
+    for n, part in enumerate(loc[:-1]):
+        node = node.get(part) if isinstance(node, dict) and not isinstance(part, int) else \
+            node[part] if isinstance(node, list) and isinstance(part, int) \
+            and part < len(node) else None
         if isinstance(part, int):
+            if n >= 1 and loc[n - 1] == "effects":
+                kind = node.get("type") if isinstance(node, dict) else None
+                model = EFFECT_MODELS.get(kind) if isinstance(kind, str) else None
+                if model is None:
+                    return None
             continue
         if not (isinstance(model, type) and hasattr(model, "model_fields")):
             return None
@@ -389,13 +462,13 @@ def _describe(err: dict, raw: dict) -> tuple[str, str]:
     kind = err["type"]
     msg = err["msg"]
     if kind == "missing":
-        model = _model_at(loc)
+        model = _model_at(loc, raw)
         desc = ""
         if model is not None and loc and loc[-1] in model.model_fields:
             desc = model.model_fields[loc[-1]].description or ""
         return path, "required field is missing" + (f" ({desc})" if desc else "")
     if kind == "extra_forbidden":
-        model = _model_at(loc)
+        model = _model_at(loc, raw)
         key = loc[-1] if loc else ""
         hint = ""
         if model is not None:
@@ -405,6 +478,8 @@ def _describe(err: dict, raw: dict) -> tuple[str, str]:
         return path, f"unknown key '{key}'{hint}"
     if kind == "unknown_effect":
         given = err.get("input", {}).get("type") if isinstance(err.get("input"), dict) else None
+        if not isinstance(err.get("input"), dict):
+            return path, _not_an_effect_entry(err.get("input"))
         close = difflib.get_close_matches(str(given), list(_effects.EFFECT_NAMES), n=1)
         hint = f" (did you mean '{close[0]}'?)" if close else ""
         return path + ".type", (f"unknown effect '{given}'{hint}; known: "
@@ -416,28 +491,50 @@ def _describe(err: dict, raw: dict) -> tuple[str, str]:
             return named.group(1), named.group(2)
         return path, text
     if kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
-        unit = _unit_at(loc)
+        unit = _unit_at(loc, raw)
         bound = list(err.get("ctx", {}).values())[0]
         words = {"greater_than": "greater than", "greater_than_equal": "at least",
                  "less_than": "less than", "less_than_equal": "at most"}[kind]
-        return path, f"must be {words} {bound:g}{' ' + unit if unit else ''}, got {err['input']!r}"
+        shown = f" {unit}" if unit not in ("", "1") else ""
+        return path, f"must be {words} {bound:g}{shown}, got {_shown(err['input'])}"
     if kind in ("finite_number",):
         return path, "must be a finite number"
+    if isinstance(err.get("input"), int) and len(str(abs(err["input"]))) > 300:
+        digits = len(str(abs(err["input"])))
+        return path, f"the number {_shown(err['input'])} ({digits} digits) is too large"
     if kind in ("float_type", "float_parsing"):
-        return path, f"expected a number or a string with units, got {err['input']!r}"
+        return path, f"expected a number or a string with units, got {_shown(err['input'])}"
     if kind in ("model_type", "model_attributes_type", "dict_type"):
-        model = _model_at(loc + ("x",))
+        model = _model_at(loc + ("x",), raw)
         keys = ", ".join(model.model_fields) if model is not None else ""
-        return path, f"expected a mapping{' with keys ' + keys if keys else ''}, got {err['input']!r}"
+        return path, (f"expected a mapping{' with keys ' + keys if keys else ''}, got "
+                      f"{_shown(err['input'])}")
     return path, msg
+
+
+def _shown(value: Any) -> str:
+    """A value read from the spec, for a message: its repr, cut to 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:28] + "..." + text[-8:]
+
+
+def _not_an_effect_entry(given: Any) -> str:
+    """The message for an ``effects`` entry that is not a mapping (``- time_delay``)."""
+    from . import effects as _effects
+
+    name = given if isinstance(given, str) and given in _effects.CATALOGUE else "time_delay"
+    required = [p.name for p in _effects.get(name).parameters if p.required]
+    example = "{type: " + name + "".join(f", {p}: ..." for p in required) + "}"
+    return (f"an effect is a mapping with its type and parameters, e.g. {example}; got "
+            f"{given!r}")
 
 
 #: A top-level validator's message that names its field: ``"controller.crossover: ..."``.
 _NAMED = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]=]*): (.+)$", re.S)
 
 
-def _unit_at(loc: tuple) -> str:
-    model = _model_at(loc)
+def _unit_at(loc: tuple, raw: Any = None) -> str:
+    model = _model_at(loc, raw)
     if model is None or not loc or loc[-1] not in model.model_fields:
         return ""
     desc = model.model_fields[loc[-1]].description or ""

@@ -47,6 +47,10 @@ KNOWN_UNITS = {
 }
 
 _DB = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*dB\s*$")
+#: A comma between digits: a decimal comma ("1,25 kg") or a thousands separator ("6,667 N/m").
+_COMMA = re.compile(r"\d\s*,\s*\d")
+#: Two numbers side by side ("3 5 N"), which pint multiplies; "2 1/s" (a reciprocal unit) is fine.
+_TWO_NUMBERS = re.compile(r"(?:\d|\d\.)\s+[-+]?\.?\d(?![\d.eE+-]*\s*/)")
 
 
 @lru_cache(maxsize=1)
@@ -101,6 +105,9 @@ def to_si(value, unit: str, path: str | None = None) -> float:
     if unit not in KNOWN_UNITS:  # programming error, not user input
         raise ArgumentError(f"unknown target unit {unit!r}")
     if _is_number(value):
+        if isinstance(value, int) and abs(value) > 2 ** 1023:
+            raise UnitError(f"the number {str(value)[:12]}... ({len(str(abs(value)))} digits) is too "
+                            "large for a physical value", path=path)
         if unit == "deg":
             raise UnitError(f"a bare number is ambiguous for an angle; write e.g. '{value} deg'",
                             path=path)
@@ -114,12 +121,30 @@ def to_si(value, unit: str, path: str | None = None) -> float:
     text = value.strip()
     if not text:
         raise UnitError("empty value", path=path)
+    _refuse_misread(text, path)
     if unit == "dB":
         m = _DB.match(text)
         if not m:
             raise UnitError(f"cannot read {value!r} as a gain in dB (write e.g. '6 dB')", path=path)
         return _finite(float(m.group(1)), path, value)
     return _finite(_convert(text, unit, path), path, value)
+
+
+def _refuse_misread(text: str, path: str | None) -> None:
+    """Refuse text that pint would read as another number than the one written.
+
+    pint drops a comma between digits (``"1,25 kg"`` is 125 kg, ``"0,3 mm"``
+    is 0 mm) and multiplies two numbers written side by side (``"3 5 N"`` is
+    15 N); either is a value the user did not mean.
+    """
+    if _COMMA.search(text):
+        fixed = _COMMA.sub(lambda m: m.group(0).replace(",", ".").replace(" ", ""), text)
+        raise UnitError(f"cannot read {text!r}: a comma inside a number is not read; write "
+                        f"{fixed!r} if it is a decimal comma, or leave out a thousands "
+                        "separator", path=path)
+    if _TWO_NUMBERS.search(text):
+        raise UnitError(f"cannot read {text!r}: two numbers separated by a space (read as "
+                        "their product); write one number and its unit", path=path)
 
 
 def _convert(text: str, unit: str, path: str | None) -> float:

@@ -108,6 +108,86 @@ CASES = [
      ["stage", "expected a mapping"], "stage: [1.6"),
     ("zero-distance", edit("distance: 10 mm", "distance: 0 mm"),
      ["motion.moves[0]", "distance must not be zero"], None),
+    # values read wrong: a decimal comma or a space inside a number, named with what was read
+    ("decimal-comma-mass", edit("stage: {mass: 1.6 kg}", 'stage: {mass: "1,25 kg"}'),
+     ["stage.mass", "'1,25 kg'", "comma", "'1.25 kg'"], "stage: {mass"),
+    ("decimal-comma-frequency", edit("crossover: 8 Hz", 'crossover: "2,5 Hz"'),
+     ["controller.crossover", "'2,5 Hz'", "comma"], "crossover:"),
+    ("decimal-comma-to-zero", edit("stroke: 0.3 mm", 'stroke: "0,3 mm"'),
+     ["isolator.stroke", "'0,3 mm'", "comma"], "stroke:"),
+    ("thousands-comma", edit("stiffness: 6667 N/m", 'stiffness: "6,667 N/m"'),
+     ["isolator.stiffness", "'6,667 N/m'", "comma"], "6,667"),
+    ("space-in-number", edit("static: 4 N", 'static: "3 5 N"'),
+     ["friction.static", "'3 5 N'", "two numbers"], "static:"),
+    # effects with impossible parameters
+    ("effect-negative-delay", BASE + "effects:\n  - {type: time_delay, delay: -1 ms}\n",
+     ["effects[0].delay", "at least 0 s", "-0.001"], "type: time_delay"),
+    ("effect-negative-resolution",
+     BASE + "effects:\n  - {type: quantization, resolution: -1 um}\n",
+     ["effects[0].resolution", "at least 0 m"], "type: quantization"),
+    ("effect-negative-force-limit",
+     BASE + "effects:\n  - {type: force_saturation, limit: -10 N}\n",
+     ["effects[0].limit", "greater than 0 N"], "type: force_saturation"),
+    ("effect-negative-mass", BASE + "effects:\n  - {type: mass_error, stage_mass: -1 kg}\n",
+     ["effects[0].stage_mass", "greater than 0 kg"], "type: mass_error"),
+    ("effect-zero-cart-mass", BASE + "effects:\n  - {type: mass_error, cart_mass: 0}\n",
+     ["effects[0].cart_mass", "greater than 0 kg"], "type: mass_error"),
+    ("effect-negative-viscous",
+     BASE + "effects:\n  - {type: viscous_friction, viscous: -5 N*s/m}\n",
+     ["effects[0].viscous", "at least 0 N*s/m"], "type: viscous_friction"),
+    ("effect-negative-coulomb",
+     BASE + "effects:\n  - {type: friction_asymmetry, coulomb_negative: -1 N}\n",
+     ["effects[0].coulomb_negative", "at least 0 N"], "type: friction_asymmetry"),
+    ("effect-negative-viscous-negative",
+     BASE + "effects:\n  - {type: friction_asymmetry, coulomb_negative: 1 N, "
+            "viscous_negative: -1}\n",
+     ["effects[0].viscous_negative", "at least 0 N*s/m"], "type: friction_asymmetry"),
+    ("effect-negative-joint-damping",
+     BASE + "effects:\n  - {type: joint_damping, damping: -1 N*s/m}\n",
+     ["effects[0].damping", "at least 0 N*s/m"], "type: joint_damping"),
+    ("effect-zero-wavelength",
+     BASE + "effects:\n  - {type: position_dependent_friction, amplitude: 0.1, "
+            "wavelength: 0 m}\n",
+     ["effects[0].wavelength", "greater than 0 m"], "type: position_dependent_friction"),
+    ("effect-zero-pitch", BASE + "effects:\n  - {type: force_ripple, amplitude: 1 N, pitch: 0}\n",
+     ["effects[0].pitch", "greater than 0 m"], "type: force_ripple"),
+    ("effect-zero-stribeck",
+     BASE + "effects:\n  - {type: stribeck_velocity, stribeck_velocity: 0}\n",
+     ["effects[0].stribeck_velocity", "greater than 0 m/s"], "type: stribeck_velocity"),
+    ("effect-ripple-amplitude-2",
+     BASE + "effects:\n  - {type: position_dependent_friction, amplitude: 2, "
+            "wavelength: 1 mm}\n",
+     ["effects[0].amplitude", "less than 1", "2"], "type: position_dependent_friction"),
+    ("effect-bare-string", BASE + "effects:\n  - time_delay\n",
+     ["effects[0]", "'time_delay'", "{type: time_delay, delay: ...}"], "- time_delay"),
+    ("effect-unknown-key", BASE + "effects:\n  - {type: time_delay, delya: 1 ms}\n",
+     ["effects[0].delya", "unknown key 'delya'", "did you mean 'delay'"], "type: time_delay"),
+    ("effect-unknown-key-far", BASE + "effects:\n  - {type: force_ripple, amplitude: 1 N, "
+                                      "pitch: 1 mm, zzz: 1}\n",
+     ["effects[0].zzz", "allowed: type, amplitude, pitch, phase"], "type: force_ripple"),
+    # sizes without a bound: refused up front, naming the limit
+    ("output-rate-terahertz", BASE + "simulation: {output_rate: 1 THz}\n",
+     ["simulation.output_rate", "1e+12 Hz", "output samples", "at most"], "output_rate"),
+    ("duration-without-bound", edit("duration: 20 s", "duration: 1e9 s"),
+     ["motion.duration", "output samples", "at most"], "duration:"),
+    ("crossover-scan-micro-step", BASE + "simulation: {crossover_scan: {step: 1e-6 Hz}}\n",
+     ["simulation.crossover_scan", "29000001 points", "at most 1000"], "crossover_scan"),
+    ("step-budget-without-bound", BASE + "simulation: {max_steps: 100000000000}\n",
+     ["simulation.max_steps", "at most"], "max_steps"),
+    # parse-level crashes
+    ("nested-mappings", "a: " + "{b: " * 1000 + "1" + "}" * 1000 + "\n",
+     ["nested", "levels"], None),
+    ("complex-key", BASE + "? [a, b]\n: 1\n", ["key", "plain", "list"], "? [a, b]"),
+    ("huge-integer", edit("stage: {mass: 1.6 kg}", "stage: {mass: " + "9" * 401 + "}"),
+     ["stage.mass", "too large"], "stage: {mass"),
+    ("huge-integer-ratio", edit("derivative_ratio: 3", "derivative_ratio: " + "9" * 401),
+     ["controller.derivative_ratio", "401 digits", "too large"], "derivative_ratio:"),
+    # text that reaches the report
+    ("nul-escape-in-text", edit("author: A. Engineer ", 'approved_by: "X\\u0000Y"\n  author: '
+                                                        'A. Engineer '),
+     ["report.approved_by", "U+0000"], "approved_by:"),
+    ("escape-in-name", edit("name: Paper setup with friction isolator", 'name: "Paper\\x1b[31m"'),
+     ["name", "U+001B"], "name:"),
 ]
 
 
@@ -206,3 +286,98 @@ def test_unknown_key_is_reported_before_the_missing_field_it_causes(tmp_path):
     assert f"{spec}:{n}: friction.statc: unknown key 'statc'; did you mean 'static'?" in first, \
         result.stderr
     assert "required field is missing" in result.stderr.split("\n", 1)[1]
+
+
+# --------------------------------------------------------------------------- sizes a user sets
+
+NO_SPEC = "absent-spec.yaml"  # options are refused before the spec is read
+
+SIZES = [
+    ("sweep-points", ["sweep", "PAPER", "--x", "controller.crossover=1 Hz:30 Hz:10000000000",
+                      "--json", "OUT"],
+     ["controller.crossover", "N = 10000000000 points", "at most 100000"]),
+    ("sweep-grid", ["sweep", "PAPER", "--x", "controller.crossover=1 Hz:30 Hz:1000",
+                    "--y", "isolator.stroke=0.1 mm:1 mm:1000", "--json", "OUT"],
+     ["1000 x 1000 = 1000000 points", "at most 100000"]),
+    ("replay-window", ["simulate", "MSPEC", "--record", "TRACE", "--drive", "force",
+                       "--window", "1e-12", "--json", "OUT"],
+     ["window = 1e-12 s", "fewer than 10 samples"]),
+    ("robustness-samples", ["robustness", NO_SPEC, "--scatter", "friction.static=10%",
+                            "--samples", "1000000000", "--json", "OUT"],
+     ["--samples", "1000000000", "100000"]),
+    ("study-resolution", ["study", "paper", NO_SPEC, "--resolution", "200"],
+     ["--resolution", "200", "150"]),
+    ("jobs", ["sweep", NO_SPEC, "--x", "stage.mass=1,2", "--jobs", "100000", "--json", "OUT"],
+     ["--jobs", "100000", "64"]),
+]
+
+
+@pytest.mark.parametrize("argv,expected", [c[1:] for c in SIZES], ids=[c[0] for c in SIZES])
+def test_sizes_are_bounded_up_front(tmp_path, monkeypatch, argv, expected):
+    """A size that cannot finish (memory, hours of work, a fork per job) is refused before any
+    work, naming the option or value, what was read and the bound."""
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "out.json"
+    names = {"PAPER": str(EXAMPLES / "paper_setup.yaml"),
+             "MSPEC": str(EXAMPLES / "measured_stage.yaml"),
+             "TRACE": str(EXAMPLES / "measured_trace.csv"), "OUT": str(out)}
+    result = runner.invoke(app, [names.get(a, a) for a in argv])
+    assert result.exit_code == 2, (result.exit_code, result.output)
+    assert "Traceback" not in result.output
+    for text in expected:
+        assert text in result.output, f"{text!r} not in {result.output!r}"
+    assert not out.exists()
+
+
+# --------------------------------------------------------------------------- inputs never lost
+
+
+def test_the_record_is_an_input_not_an_output(tmp_path):
+    """`simulate --record rec.csv --csv rec.csv --force` replaced the measured record with the
+    replay: every input is protected, even with --force."""
+    record = tmp_path / "rec.csv"
+    record.write_bytes((EXAMPLES / "measured_trace.csv").read_bytes())
+    before = record.read_bytes()
+    result = runner.invoke(app, ["simulate", str(EXAMPLES / "measured_stage.yaml"), "--record",
+                                 str(record), "--csv", str(record), "--force"])
+    assert result.exit_code == 2, result.output
+    assert "refusing to overwrite the input file" in result.stderr
+    assert record.read_bytes() == before
+
+
+def test_a_file_that_appears_during_the_run_is_kept(tmp_path, paper_spec_path, monkeypatch):
+    """A file created after the start-up check (another program, another run) is not replaced
+    without --force; the run says so and exits 2."""
+    import fi_design.guideline as guideline
+
+    out = tmp_path / "out.json"
+    real = guideline.design
+
+    def design_while_someone_writes(*args, **kwargs):
+        out.write_text("written by someone else")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(guideline, "design", design_while_someone_writes)
+    result = runner.invoke(app, [str(paper_spec_path), "--no-simulation", "--json", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "appeared while this run worked" in result.stderr
+    assert out.read_text() == "written by someone else"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.json"]
+
+
+def test_a_record_without_excitation_is_refused_not_agreed_with(tmp_path):
+    """`reconcile` on a record in which nothing moves answered "agrees within noise (misfit 0):
+    no effect is missing" although nothing was tested; it is refused, saying what was read."""
+    import numpy as np
+
+    still = tmp_path / "still.csv"
+    t = np.arange(0.0, 8.0, 1e-3)
+    rows = "\n".join(f"{x:.3f},0,0,0.0,0" for x in t)
+    still.write_text("time_s,reference_m,position_m,force_N,deflection_m\n" + rows + "\n")
+    out = tmp_path / "gap.json"
+    result = runner.invoke(app, ["reconcile", str(EXAMPLES / "measured_stage.yaml"), str(still),
+                                 "--json", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "no excitation" in result.stderr and "position_m" in result.stderr
+    assert "the reference spans 0 m" in result.stderr
+    assert not out.exists()

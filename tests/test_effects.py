@@ -77,6 +77,21 @@ def test_effect_is_well_formed(name):
         assert p.combine in ("set", "add")
 
 
+_WITHIN = {"gt": lambda x, v: x > v, "ge": lambda x, v: x >= v, "lt": lambda x, v: x < v,
+           "le": lambda x, v: x <= v}
+
+
+@pytest.mark.parametrize("name", fx.EFFECT_NAMES)
+def test_fit_bounds_and_neutral_value_are_physically_possible(name):
+    """A fit never searches, and the neutral value never sets, what a spec entry refuses."""
+    for p in fx.get(name).parameters:
+        values = [] if p.relative else list(p.bounds)
+        if p.neutral is not None and math.isfinite(p.neutral):
+            values.append(p.neutral)
+        for op, limit in p.limits:
+            assert all(_WITHIN[op](x, limit) for x in values), (p.name, op, limit, values)
+
+
 #: Every effect on both plants, except joint damping, which needs a joint.
 PLANT_CASES = [(n, iso) for n in fx.EFFECT_NAMES for iso in (True, False)
                if not (n == "joint_damping" and not iso)]

@@ -43,3 +43,87 @@ def test_misuse_raises_library_errors():
         figure_bytes(object(), "jpg")
     assert issubclass(ArgumentError, ValueError) and issubclass(ReportError, TypeError)
     assert issubclass(OutputError, OSError)
+
+
+# --------------------------------------------------------------------------- library misuse
+
+
+class _NoWork:
+    """An executor that fails the test if a study starts any work: a size must be refused first."""
+
+    def submit(self, fn, *args, **kwargs):
+        raise AssertionError("the study started work it should have refused up front")
+
+
+def _calls():
+    """(id, call(spec, measured), library error class, words of the message)."""
+    import fi_design
+    from fi_design.studies import make_axis, paper_study, robustness, sweep
+    from fi_design.studies.scatter import Scatter
+
+    scatter = [Scatter(path="friction.static", spread=0.1, relative=True)]
+    return [
+        ("sweep-text-values", lambda s, m: sweep(s, ("stage.mass", ["1 kg", "2 kg"])),
+         SpecError, ["stage.mass", "'1 kg'", "numbers"]),
+        ("sweep-too-many-points", lambda s, m: sweep(
+            s, make_axis("controller.crossover", [5.0, 6.0]),
+            make_axis("stage.mass", [1.0] * 60_000), executor=_NoWork()),
+         SpecError, ["120000 points", "at most 100000"]),
+        ("axis-too-many-values", lambda s, m: make_axis("stage.mass", [1.0] * 100_001),
+         SpecError, ["100001 values", "at most 100000"]),
+        ("simulate-crossover-text", lambda s, m: fi_design.simulate(s, crossover="5 Hz"),
+         ArgumentError, ["crossover", "'5 Hz'"]),
+        ("simulate-duration-without-bound", lambda s, m: fi_design.simulate(s, duration=1e9),
+         ArgumentError, ["duration", "output samples", "at most 4000000"]),
+        ("simulate-spec-none", lambda s, m: fi_design.simulate(None),
+         ArgumentError, ["spec must be a Spec", "NoneType"]),
+        ("replay-window-picoseconds", lambda s, m: fi_design.simulate(
+            s, record=m, drive="force", window=1e-12),
+         ArgumentError, ["window = 1e-12 s", "fewer than 10 samples"]),
+        ("identify-unknown-form", lambda s, m: fi_design.identify(m, form="bogus"),
+         ArgumentError, ["form", "'bogus'", "'symmetric'"]),
+        ("identify-not-a-record", lambda s, m: fi_design.identify("trace.csv"),
+         ArgumentError, ["measured must be a Measurement", "str"]),
+        ("robustness-too-many-samples", lambda s, m: robustness(
+            s, scatter, samples=1_000_000, executor=_NoWork()),
+         SpecError, ["samples = 1000000", "at most 100000"]),
+        ("paper-study-too-fine", lambda s, m: paper_study(s, 1000, executor=_NoWork()),
+         ArgumentError, ["resolution", "at most 150"]),
+        ("reconcile-max-effects-text", lambda s, m: fi_design.reconcile(s, m, max_effects="2"),
+         ArgumentError, ["max_effects", "whole number"]),
+    ]
+
+
+@pytest.mark.parametrize("case", range(len(_calls())), ids=[c[0] for c in _calls()])
+def test_library_calls_raise_library_errors(case):
+    """Misuse raises a FiDesignError subclass (also the builtin), never numpy's ValueError,
+    an AttributeError, an OverflowError or a MemoryError, and before any work starts."""
+    import fi_design
+
+    from conftest import EXAMPLES
+
+    spec = fi_design.load_spec(EXAMPLES / "measured_stage.yaml")
+    measured = fi_design.load_measurement(EXAMPLES / "measured_trace.csv")
+    _, call, cls, words = _calls()[case]
+    with pytest.raises(cls) as err:
+        call(spec, measured)
+    assert isinstance(err.value, FiDesignError) and isinstance(err.value, ValueError)
+    for word in words:
+        assert word in str(err.value), str(err.value)
+
+
+def test_identify_takes_the_spec_mapping_design_takes():
+    """identify(record, mapping) reads the mapping as design(mapping) does (it was an
+    AttributeError: 'dict' object has no attribute 'controller')."""
+    import yaml
+
+    import fi_design
+
+    from conftest import EXAMPLES
+
+    raw = yaml.safe_load((EXAMPLES / "measured_stage.yaml").read_text())
+    measured = fi_design.load_measurement(EXAMPLES / "measured_trace.csv")
+    from_mapping = fi_design.identify(measured, raw)
+    from_spec = fi_design.identify(measured, fi_design.load_spec(raw))
+    assert from_mapping.value("mass") == from_spec.value("mass")
+    assert from_mapping.spec == from_spec.spec

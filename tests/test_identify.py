@@ -504,3 +504,24 @@ def test_one_direction_through_the_command_line_and_its_spec(one_way, tmp_path):
             d["parameters"]["viscous_negative"]["value"], rel=1e-5)
     assert spec.friction.offset == old.offset
     assert abs(level - (f["Fc"] + s * f["offset"])) < 1.0
+
+
+def test_epoch_time_stamps_give_the_same_identification():
+    """A record stamped in epoch seconds (t0 = 1.7e9 s) is the same record: its time steps
+    carry float rounding of 2.4e-7 s, which biased the sample rate (the median step) and the
+    mass by 40 standard errors."""
+    from fi_design.identification import identify
+    from fi_design.measured import measurement_from_arrays
+
+    t = np.arange(0.0, 4.0, 1e-4)
+    x = 0.01 * np.sin(2 * np.pi * 0.5 * t)
+    v = np.gradient(x, t)
+    a = np.gradient(v, t)
+    u = 2.0 * a + 3.0 * np.sign(v) + 40.0 * v + 0.5 + \
+        1e-3 * np.random.default_rng(0).standard_normal(len(t))
+    at_zero = identify(measurement_from_arrays(t, x, x, force_N=u))
+    at_epoch = identify(measurement_from_arrays(t + 1.7e9, x, x, force_N=u))
+    se = at_zero.parameters["mass"].std_error
+    assert abs(at_epoch.value("mass") - at_zero.value("mass")) < 3 * se
+    assert abs(at_epoch.value("coulomb") - at_zero.value("coulomb")) < \
+        3 * at_zero.parameters["coulomb"].std_error

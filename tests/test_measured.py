@@ -154,3 +154,38 @@ def test_emps_record_loads_as_documented(emps_record):
     r0 = (m.reference[1] - m.reference[0]) / (m.time[1] - m.time[0])
     v0 = (m.position[5] - m.position[0]) / (m.time[5] - m.time[0])
     assert r0 == pytest.approx(13.4e-3, rel=0.05) and v0 > 5e-3   # it starts in motion
+
+
+def test_a_text_column_beside_the_numbers_is_ignored(tmp_path):
+    """Numbers are read at numpy's speed; a file numpy refuses (a column of words) is read
+    cell by cell instead, with the same result."""
+    lines = ["time_s,reference_m,position_m,note"]
+    lines += [f"{i * 1e-3},{1e-5 * i},{1e-5 * i},run {i} ok" for i in range(25)]
+    m = load_measurement(_write(tmp_path, "\n".join(lines) + "\n"))
+    assert m.n == 25 and m.columns == ("time_s", "reference_m", "position_m")
+    assert m.position[7] == pytest.approx(7e-5)
+
+
+def test_thinned_keeps_every_nth_sample_as_recorded():
+    from fi_design.measured import thinned
+
+    m = measurement_from_arrays(np.arange(100) * 1e-4, np.zeros(100), np.arange(100) * 1e-6,
+                                force_N=np.ones(100))
+    t = thinned(m, 10)
+    assert t.n == 10 and t.columns == m.columns
+    assert np.array_equal(t.position, m.position[::10]) and t.time[1] == pytest.approx(1e-3)
+    assert thinned(m, 1) is m
+
+
+def test_columns_are_written_a_chunk_at_a_time(monkeypatch):
+    """A record of millions of rows is written in chunks, not held as one string: same text."""
+    import io
+
+    import fi_design.measured as measured
+
+    cols = {"time_s": np.arange(10) * 1e-3, "position_m": np.linspace(0, 1e-3, 10)}
+    whole = measured.columns_csv(cols, comment="c")
+    monkeypatch.setattr(measured, "CHUNK_ROWS", 3)
+    out = io.StringIO()
+    measured.write_columns_csv(out, cols, comment="c")
+    assert out.getvalue() == whole and whole.count("\n") == 12

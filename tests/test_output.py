@@ -126,3 +126,100 @@ def test_replace_failure_leaves_no_temporary(tmp_path, monkeypatch):
 def test_missing_directory_on_write(tmp_path):
     with pytest.raises(OutputError, match="cannot create"):
         write_atomic(tmp_path / "nope" / "a.json", "x")
+
+
+# --------------------------------------------------------------------------- claims: the file
+# found when a run checked its output is the one it may replace (issue 23)
+
+
+def _run(fn, *args, **kwargs):
+    """``fn`` in a context of its own, as each command of the CLI runs."""
+    import contextvars
+
+    return contextvars.copy_context().run(fn, *args, **kwargs)
+
+
+def test_a_file_that_appears_during_the_run_is_not_replaced(tmp_path):
+    out = tmp_path / "out.json"
+
+    def run():
+        check_output(out)  # absent at the check
+        out.write_text("another program's file")  # appears while the run works
+        with pytest.raises(OutputError, match="appeared .* --force"):
+            write_atomic(out, "this run's result")
+
+    _run(run)
+    assert out.read_text() == "another program's file"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.json"]
+
+
+def test_with_force_a_file_found_at_the_check_is_replaced(tmp_path):
+    out = tmp_path / "out.json"
+    out.write_text("old")
+
+    def run():
+        check_output(out, force=True)
+        write_atomic(out, "new")
+        write_atomic(out, "newer")  # the run may rewrite its own file
+
+    _run(run)
+    assert out.read_text() == "newer"
+
+
+def test_concurrent_writers_of_one_path_one_wins_and_the_other_says_so(tmp_path):
+    """Two runs checked the same output with --force; the first to finish writes it, the
+    second refuses to replace a file written after its check (and says by whom: another run)."""
+    import contextvars
+
+    out = tmp_path / "out.json"
+    out.write_text("before both runs")
+    first, second = contextvars.copy_context(), contextvars.copy_context()
+    first.run(check_output, out, force=True)
+    second.run(check_output, out, force=True)
+    first.run(write_atomic, out, "first")
+    with pytest.raises(OutputError, match="written by another run"):
+        second.run(write_atomic, out, "second")
+    assert out.read_text() == "first"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.json"]
+
+
+def test_without_a_check_a_library_write_replaces(tmp_path):
+    """write_atomic alone (a script) keeps its documented meaning: it replaces."""
+    out = tmp_path / "out.json"
+    out.write_text("old")
+    _run(write_atomic, out, "new")
+    assert out.read_text() == "new"
+
+
+@pytest.mark.parametrize("signum", ["SIGTERM", pytest.param("SIGINT", marks=pytest.mark.slow)])
+def test_a_signal_while_the_pdf_is_written_leaves_no_temporary_file(tmp_path, signum):
+    """SIGTERM (and SIGINT) while WeasyPrint writes the PDF left `.out.pdf.XXXX.tmp` behind."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from conftest import BIN, EXAMPLES
+
+    if not sys.platform.startswith("linux"):
+        pytest.skip("POSIX signals")
+    out = tmp_path / "out.pdf"
+    proc = subprocess.Popen([str(BIN / "fi-design"), str(EXAMPLES / "paper_setup.yaml"),
+                             "--no-simulation", "--report", str(out)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:
+            if any(p.name.endswith(".tmp") for p in tmp_path.iterdir()):
+                proc.send_signal(getattr(signal, signum))
+                break
+            time.sleep(0.002)
+        else:
+            pytest.fail("the temporary file of the PDF was never seen")
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode != 0, err
+    assert "Traceback" not in err
+    assert [p.name for p in tmp_path.iterdir()] == [], "a temporary or partial file is left"

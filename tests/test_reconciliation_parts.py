@@ -115,3 +115,56 @@ def test_a_failed_run_scores_far_above_the_nominal_misfit(paper_spec):
     assert float(rf @ rf) == pytest.approx(FAIL_FACTOR ** 2 * max(chi2, cmp.n_points))
     assert float(rf @ rf) > 50 * chi2
     assert n > 3000
+
+
+def _fast_record(spec, rate: float):
+    """The spec's own motion at ``rate``, with sensor noise: a record logged fast."""
+    from fi_design.measured import measurement_from_arrays
+    from fi_design.simulation import simulate
+    from fi_design.specfile import with_values
+
+    res = simulate(with_values(spec, {"simulation.output_rate": rate}))
+    rng = np.random.default_rng(5)
+    n = len(res.time)
+    return measurement_from_arrays(res.time, res.reference,
+                                   res.position + 0.2e-6 * rng.standard_normal(n),
+                                   res.force + 2e-3 * rng.standard_normal(n),
+                                   res.deflection + 0.02e-6 * rng.standard_normal(n))
+
+
+def test_a_record_logged_faster_than_the_model_needs_is_thinned():
+    """A 10 kHz record of an 8 Hz loop is compared at 1 kHz (every 10th sample, as recorded);
+    the conclusion says so. Every run of the model had a sample per record sample, and every
+    evaluation of a fit kept its run: 17 GB for two million samples."""
+    from fi_design.reconciliation import reconcile
+    from fi_design.specfile import load_spec
+
+    from conftest import EXAMPLES
+
+    spec = load_spec(EXAMPLES / "measured_stage.yaml")
+    record = _fast_record(spec, 10_000.0)
+    result = reconcile(spec, record, candidates=["viscous_friction"])
+    assert result.measurement.n == math.ceil(record.n / 10)
+    assert f"({record.n} samples at 1e+04 Hz) was compared at every 10th sample" \
+        in result.conclusion
+    assert result.effect == "none"
+
+
+def test_the_thinning_and_its_bound():
+    from fi_design.errors import DataError
+    from fi_design.measured import measurement_from_arrays
+    from fi_design.reconciliation.records import MAX_SAMPLES, for_the_model
+
+    n = 300_000  # 30 s at 10 kHz
+    t = np.arange(n) * 1e-4
+    m = measurement_from_arrays(t, np.zeros(n), 1e-3 * np.sin(t))
+    kept, note = for_the_model(m, 8.0)  # 1 kHz needed: 30 000 samples
+    assert kept.n == 30_000 and "every 10th sample" in note
+    kept, note = for_the_model(m, 0.5)  # 1 kHz still (the floor)
+    assert kept.n == 30_000
+    with pytest.raises(DataError, match=f"at most {MAX_SAMPLES}") as err:
+        for_the_model(m, 200.0)  # 4 kHz at least: 120 000 samples
+    assert "at most 25 s of the record" in str(err.value)
+    at_1khz = measurement_from_arrays(t[::10], np.zeros(n // 10), 1e-3 * np.sin(t[::10]))
+    same, note = for_the_model(at_1khz, 8.0)
+    assert same is at_1khz and note == ""

@@ -43,6 +43,12 @@ def test_the_guard_is_needed():
     ("", "m", ["empty"]), ("inf mm", "m", ["not a finite number"]), (30, "deg", ["ambiguous"]),
     (6, "dB", ["ambiguous"]), ("6", "dB", ["cannot read"]), ("30", "deg", ["no unit"]),
     ([1, 2], "m", ["expected a number or a string"]), (float("nan"), "m", ["finite"]),
+    # pint reads these as other numbers (125 kg, 0 mm, 6667 N/m, 15 N): refused, showing the text
+    ("1,25 kg", "kg", ["'1,25 kg'", "comma", "'1.25 kg'"]),
+    ("0,3 mm", "m", ["'0,3 mm'", "comma"]), ("6,667 N/m", "N/m", ["'6,667 N/m'", "comma"]),
+    ("2,5 Hz", "Hz", ["'2,5 Hz'", "comma"]), ("3 5 N", "N", ["'3 5 N'", "two numbers"]),
+    ("2. 5 N", "N", ["two numbers"]), ("3 -5 N", "N", ["two numbers"]),
+    pytest.param(10 ** 401, "kg", ["402 digits", "too large"], id="401-digit-integer"),
 ])
 def test_bad_values_name_the_path(value, unit, words):
     with pytest.raises(UnitError) as err:

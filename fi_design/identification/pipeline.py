@@ -16,8 +16,10 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import DataError
+from ..arguments import choice, integer, number
+from ..errors import ArgumentError, DataError
 from ..measured import Measurement, measurement_from_arrays
+from ..specfile import as_spec
 from .dynamic import dynamic_parameters
 from .events import excitation
 from .preprocess import JITTER, check_record, joint_model, prepare, processing
@@ -75,10 +77,13 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     ------
     DataError
         No ``force_N`` column, too few samples, a constant position, sampling
-        the filter cannot take, too few sliding samples; the message names
-        the column and what is needed.
-    ValueError
-        An unknown ``form``.
+        the filter cannot take, motion in one direction only, too few sliding
+        samples; the message names the column and what is needed.
+    ArgumentError
+        An unknown ``form``, a ``spec`` that is not a spec, path or mapping,
+        a cut-off, decimation or threshold that is not a positive number.
+    SpecError
+        A ``spec`` given as a path or mapping that does not validate.
 
     Examples
     --------
@@ -93,8 +98,15 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     >>> round(r.value("mass"), 1), round(r.value("coulomb"), 1), round(r.value("offset"), 1)
     (2.0, 3.0, 0.5)
     """
-    if form not in FORMS:
-        raise ValueError(f"form must be one of {FORMS}, got {form!r}")
+    form = choice(form, "form", FORMS)
+    if not isinstance(measured, Measurement):
+        raise ArgumentError(f"measured must be a Measurement (fi_design.load_measurement), got "
+                            f"{type(measured).__name__}")
+    spec = None if spec is None else as_spec(spec)
+    cutoff = None if cutoff is None else number(cutoff, "cutoff", "Hz", positive=True)
+    decimation = None if decimation is None else integer(decimation, "decimation", minimum=1)
+    velocity_threshold = None if velocity_threshold is None else \
+        number(velocity_threshold, "velocity_threshold", "m/s", positive=True)
     say = progress or (lambda message, fraction: None)
     check_record(measured)
     say("filtering", 0.0)

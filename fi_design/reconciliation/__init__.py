@@ -15,6 +15,7 @@ module             job
 ``lattice``        the lattice of the measured positions (quantization read
                    from the data: step, share of samples on it, a binomial test)
 ``noise``          noise per channel; autocorrelation time and effective samples
+``records``        evidence in the record; thinned to the rate the model needs
 ``comparison``     replay on the record, segments, the weighted residual
 ``signatures``     what each effect would leave in the nominal residual
 ``spaces``         each candidate's coordinates, bounds, starts and references

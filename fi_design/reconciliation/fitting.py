@@ -105,6 +105,38 @@ class Evaluation(NamedTuple):
     run: ModelRun
 
 
+class Evaluations:
+    """The evaluations of one fit by coordinates: every residual, the run of the best only.
+
+    A fit evaluates tens to hundreds of points; a run holds every record
+    sample of every channel, so keeping all of them made a reconciliation
+    take about 20 kB per record sample (17 GB for two million samples). The
+    residual (a few thousand entries at most) is kept for every point, the
+    run only for the point with the smallest misfit so far, where a fit
+    ends; a run asked for elsewhere is simulated again (the same inputs give
+    the same run).
+    """
+
+    def __init__(self) -> None:
+        self.residuals: dict[tuple, np.ndarray] = {}
+        self.best: tuple | None = None  # (key, chi2, run)
+
+    def residual(self, key: tuple) -> np.ndarray | None:
+        """The residual at ``key``, None when not evaluated."""
+        return self.residuals.get(key)
+
+    def run(self, key: tuple) -> ModelRun | None:
+        """The run at ``key`` when it is the best so far, else None."""
+        return self.best[2] if self.best is not None and self.best[0] == key else None
+
+    def add(self, key: tuple, residual: np.ndarray, run: ModelRun) -> None:
+        """Keep the residual; keep the run while it is the best."""
+        self.residuals[key] = residual
+        chi2 = float(residual @ residual)
+        if self.best is None or chi2 < self.best[1]:
+            self.best = (key, chi2, run)
+
+
 def effect_entry(name: str, values: dict):
     """A spec effect entry from SI values inside the catalogue bounds (no re-validation)."""
     return _spec.EFFECT_MODELS[name].model_construct(type=name, **values)
@@ -190,7 +222,7 @@ class Objective:
         self.nuisance = command_coord(cmp)
         self.coords = list(space.coords) + ([self.nuisance] if self.nuisance else [])
         self.k = len(space.coords)
-        self.cache: dict[tuple, Evaluation] = {}
+        self.cache = Evaluations()
         self.n_sims = 0
         self.n_failed = 0
 
@@ -229,20 +261,23 @@ class Objective:
         return self.base + [effect_entry(self.space.name, self.values(u))]
 
     def evaluate(self, u: np.ndarray) -> Evaluation:
-        """Residual and run at u (cached)."""
+        """Residual and run at u (cached; see :class:`Evaluations`)."""
         key = tuple(np.round(np.asarray(u, float), 12))
-        hit = self.cache.get(key)
-        if hit is None:
+        residual, run = self.cache.residual(key), self.cache.run(key)
+        if residual is None or run is None:
             self.n_sims += 1
             run = self.cmp.run(self.entries(u), quantize=self.space.quantize,
                                command_correction=self.command(u))
             self.n_failed += int(not run.ok)
-            hit = Evaluation(self.cmp.residuals(run), run)
-            self.cache[key] = hit
-        return hit
+            if residual is None:
+                residual = self.cmp.residuals(run)
+                self.cache.add(key, residual, run)
+        return Evaluation(residual, run)
 
     def __call__(self, u: np.ndarray) -> np.ndarray:
-        return self.evaluate(u).residual
+        key = tuple(np.round(np.asarray(u, float), 12))
+        residual = self.cache.residual(key)
+        return residual if residual is not None else self.evaluate(u).residual
 
     def jac(self, u: np.ndarray) -> np.ndarray:
         """d(residual)/du by forward differences (backward at the upper bound)."""
@@ -454,7 +489,7 @@ class JointObjective:
         self.nuisance = command_coord(cmp)
         self.coords = [c for sp in spaces for c in sp.coords] + \
             ([self.nuisance] if self.nuisance else [])
-        self.cache: dict[tuple, Evaluation] = {}
+        self.cache = Evaluations()
         self.n_sims = 0
 
     def entries(self, u: np.ndarray) -> list:
@@ -471,17 +506,22 @@ class JointObjective:
         return next((ob.space.quantize for ob in self.obs if ob.space.quantize), None)
 
     def evaluate(self, u: np.ndarray) -> Evaluation:
-        """Residual and run at u (cached)."""
+        """Residual and run at u (cached; see :class:`Evaluations`)."""
         key = tuple(np.round(np.asarray(u, float), 12))
-        if key not in self.cache:
+        residual, run = self.cache.residual(key), self.cache.run(key)
+        if residual is None or run is None:
             self.n_sims += 1
             run = self.cmp.run(self.entries(u), quantize=self.quantize(),
                                command_correction=self.command(u))
-            self.cache[key] = Evaluation(self.cmp.residuals(run), run)
-        return self.cache[key]
+            if residual is None:
+                residual = self.cmp.residuals(run)
+                self.cache.add(key, residual, run)
+        return Evaluation(residual, run)
 
     def __call__(self, u: np.ndarray) -> np.ndarray:
-        return self.evaluate(u).residual
+        key = tuple(np.round(np.asarray(u, float), 12))
+        residual = self.cache.residual(key)
+        return residual if residual is not None else self.evaluate(u).residual
 
     def jac(self, u: np.ndarray) -> np.ndarray:
         """d(residual)/du by forward differences."""

@@ -18,10 +18,13 @@ from typing import Callable
 import numpy as np
 
 from .. import effects as _effects
-from ..display import number
-from ..errors import DataError, SimulationError
+from .. import display
+from ..arguments import integer, number
+from ..errors import ArgumentError, DataError, SimulationError
 from ..measured import Measurement
+from ..model import resolve
 from ..replay import DRIVES
+from ..specfile import as_spec
 from .comparison import MAX_POINTS, Comparison, ModelRun
 from .diagnosis import diagnose
 from .fitting import (Baseline, FitOutcome, JointObjective, fit, fit_baseline, joint_fit,
@@ -35,6 +38,7 @@ from .signatures import Evidence, scan
 from .significance import (NESTED, NULL_SEED, THRESHOLD, block_jackknife, judge,
                            noise_only_refit, numerical_error, passes_primary, prefer_simpler)
 from .spaces import Space, candidate_spaces
+from .records import check_excitation, for_the_model
 from .specout import make_entry
 
 ProgressCallback = Callable[[str, float], None]
@@ -90,7 +94,14 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     Raises
     ------
     DataError
-        The trace is too short for the comparison.
+        The trace is too short for the comparison, holds no excitation
+        (neither the stage nor its reference moves), or is too long even
+        thinned to the lowest rate the model allows (:mod:`.records`; a
+        record logged faster than the model needs is thinned, and the
+        conclusion says so).
+    ArgumentError
+        ``measured`` is not a Measurement, ``spec`` not a spec, path or
+        mapping, or a number argument is not a number in its range.
     SimulationError
         The arguments are inconsistent (an isolated plant without isolator,
         an unknown effect or drive, ``drive="force"`` without a force column).
@@ -105,11 +116,18 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     """
     started = _time.perf_counter()
     say = progress or _silent
+    spec = as_spec(spec)
+    threshold = number(threshold, "threshold", "-", positive=True)
+    max_points = integer(max_points, "max_points", minimum=100)
+    settle_window = None if settle_window is None else \
+        number(settle_window, "settle_window", "s", positive=True)
     args = _check_arguments(spec, measured, isolated, candidates, max_effects, drive)
     iso = args.isolated
     say("reading the record", 0.0)
     lattice = find_lattice(measured.position, estimate_noise(measured.position))
     noise = noise_levels(spec, measured, iso, lattice, force_is_input=drive == "force")
+    check_excitation(measured, noise.position)
+    measured, thinning = for_the_model(measured, resolve(spec).crossover)
     cmp = Comparison(spec, measured, iso, noise, lattice, settle_window, drive)
     say("nominal model", 0.02)
     nominal = _nominal(cmp, list(spec.effects), max_points)
@@ -126,6 +144,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     ambiguous = _ambiguous(first, search.chosen, threshold)
     conclusion = _conclusion(final.steps, first, nominal.chi2, final.chi2, cmp.n_points,
                              ambiguous, diagnosis)
+    conclusion = f"{conclusion} {thinning}" if thinning else conclusion
     say("done", 1.0)
     steps = final.steps
     return ReconcileResult(
@@ -162,8 +181,12 @@ def _check_arguments(spec, measured, isolated, candidates, max_effects,
         if name not in _effects.CATALOGUE:
             raise SimulationError(f"unknown effect {name!r}; known: "
                                   + ", ".join(_effects.EFFECT_NAMES))
-    if max_effects < 1:
+    if not isinstance(measured, Measurement):
+        raise ArgumentError(f"measured must be a Measurement (fi_design.load_measurement), got "
+                            f"{type(measured).__name__}")
+    if isinstance(max_effects, int) and max_effects < 1:
         raise SimulationError("max_effects must be at least 1")
+    integer(max_effects, "max_effects", minimum=1, maximum=len(_effects.EFFECT_NAMES))
     if drive not in DRIVES:
         raise SimulationError(f"drive must be one of {DRIVES}, got {drive!r}")
     if drive == "force" and measured.force is None:
@@ -452,20 +475,21 @@ def _conclusion(steps, candidates, chi2_nom, chi2_cor, n, ambiguous, diagnosis) 
     if not steps:
         if before <= 1.0 + 3.0 * math.sqrt(2.0 / n):
             return (f"The nominal model agrees with the measurement within noise (misfit "
-                    f"{number(before, 3)} noise units): no effect is missing.")
+                    f"{display.number(before, 3)} noise units): no effect is missing.")
         best = next((c for c in candidates if c.success), None)
         tail = ""
         if best is not None:
             why = best.reasons[0] if best.reasons else "not significant"
             tail = f" The best candidate, {best.name}, is not a finding: {why}."
-        return (f"The model misses the measurement by {number(before, 3)} noise units, but no catalogue "
+        return (f"The model misses the measurement by {display.number(before, 3)} noise units, "
+                "but no catalogue "
                 f"effect explains the gap beyond what noise and the fit's freedom give: the "
                 f"answer is none.{tail}")
     lines = [f"{s.name} ({_effects.values_text(s.name, s.parameters, s.uncertainty)}; misfit "
-             f"{number(s.misfit_before, 3)} -> {number(s.misfit_after, 3)})" for s in steps]
+             f"{display.number(s.misfit_before, 3)} -> {display.number(s.misfit_after, 3)})" for s in steps]
     text = (f"The measurement shows {', then '.join(lines)}. With "
-            f"{'them' if len(steps) > 1 else 'it'} the misfit drops from {number(before, 3)} to "
-            f"{number(after, 3)} noise units.")
+            f"{'them' if len(steps) > 1 else 'it'} the misfit drops from {display.number(before, 3)} to "
+            f"{display.number(after, 3)} noise units.")
     if ambiguous:
         text += (" Also consistent with the data, not decisively worse: "
                  + ", ".join(ambiguous) + ".")

@@ -44,10 +44,29 @@ def make_axis(path: str, values: Sequence[float], log: bool = False,
     SpecError
         Unknown path, a path to a section or to a value without a number.
     """
+    from .points import MAX_POINTS
+
     unit = path_unit(path, spec)
     if unit == "":
         raise SpecError("is not a numeric value; only numbers can be swept", path=path)
-    return Axis(path=path, values=np.asarray(values, dtype=float), unit=unit, log=log)
+    try:
+        array = np.asarray(values, dtype=float).ravel()
+    except (TypeError, ValueError, OverflowError):
+        raise SpecError(f"the values must be numbers in {unit} (SI), got {_shown(values)}; read "
+                        "text with units by parse_axis", path=path) from None
+    if array.size == 0:
+        raise SpecError("no values to sweep", path=path)
+    if not np.all(np.isfinite(array)):
+        raise SpecError(f"the values must be finite numbers, got {_shown(values)}", path=path)
+    if array.size > MAX_POINTS:
+        raise SpecError(f"{array.size} values; a study holds at most {MAX_POINTS} points",
+                        path=path)
+    return Axis(path=path, values=array, unit=unit, log=log)
+
+
+def _shown(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:28] + "..." + text[-8:]
 
 
 def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> Axis:
@@ -96,7 +115,7 @@ def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> 
 
     if ":" not in rng and "," in rng:
         values = [number(w, f"value {i + 1}") for i, w in enumerate(rng.split(","))]
-        return Axis(path=path, values=np.array(values), unit=unit, log=log)
+        return make_axis(path, values, log=log, spec=spec)
     parts = rng.split(":")
     if len(parts) != 3:
         raise SpecError(f"range {rng!r}: expected START:STOP:N (three parts separated by ':'), "
@@ -107,8 +126,13 @@ def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> 
     except ValueError:
         raise SpecError(f"range {rng!r}: N must be a whole number, got {parts[2].strip()!r}",
                         path=path) from None
+    from .points import MAX_POINTS
+
     if n < 1:
         raise SpecError(f"range {rng!r}: N must be at least 1, got {n}", path=path)
+    if n > MAX_POINTS:
+        raise SpecError(f"range {rng!r}: N = {n} points; a study holds at most {MAX_POINTS} "
+                        "(a few ms to a few tens of ms each)", path=path)
     if n > 1 and start == stop:
         raise SpecError(f"range {rng!r}: START equals STOP; give N = 1 or a wider range",
                         path=path)

@@ -20,6 +20,10 @@ __all__ = ["PAPER_MAPS", "paper_axes", "paper_study"]
 
 
 #: The paper's four maps (Figure 4), ranges as factors on the design point.
+#: Most points per axis of a map: four maps of 150 x 150 are 90 000 points, within a study's
+#: :data:`~.points.MAX_POINTS`.
+MAX_RESOLUTION = 150
+
 PAPER_MAPS: tuple[MapDefinition, ...] = (
     MapDefinition("A", "static vs Coulomb friction, without isolator",
                   "friction.static", (0.25, 1.5), False,
@@ -125,11 +129,18 @@ def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
     SpecError
         Resolution below 2, an unknown map letter, or maps C/D for a spec
         without isolator.
+    ArgumentError
+        A resolution that is not a whole number or above :data:`MAX_RESOLUTION`.
     """
     from .. import __version__
 
-    if resolution < 2:
+    from ..arguments import integer
+    from ..specfile import as_spec
+
+    spec = as_spec(spec)
+    if isinstance(resolution, int) and resolution < 2:
         raise SpecError(f"the resolution must be at least 2 points per axis, got {resolution}")
+    resolution = integer(resolution, "resolution", minimum=2, maximum=MAX_RESOLUTION)
     keys = [k.upper() for k in maps]
     known = {d.key: d for d in PAPER_MAPS}
     bad = [k for k in keys if k not in known]

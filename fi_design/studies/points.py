@@ -32,7 +32,8 @@ from ..results.studies import PointResult, RunInfo, spec_digest
 from ..specfile import with_values
 from .cache import METHOD, PointCache, open_cache, point_key
 
-__all__ = ["MEASURES", "MAX_CHUNK", "TARGET_CHUNKS", "Task", "ProgressCallback", "Evaluation",
+__all__ = ["MEASURES", "MAX_CHUNK", "MAX_POINTS", "TARGET_CHUNKS", "Task", "ProgressCallback",
+           "Evaluation",
            "evaluate_point", "run_chunk", "warm_up", "chunk_size", "evaluate", "point_result",
            "grid", "verdict_grid"]
 
@@ -194,6 +195,9 @@ def warm_up() -> None:
 
 #: Largest number of points in one chunk (bounds the work lost by an interruption).
 MAX_CHUNK = 64
+#: Most points (grid cells, samples) of one study: a few ms to a few tens of ms each, so
+#: 100 000 points are about an hour on two cores.
+MAX_POINTS = 100_000
 #: Chunks per study when the chunk size is chosen automatically.
 TARGET_CHUNKS = 16
 

@@ -11,6 +11,7 @@ line's text.
 from __future__ import annotations
 
 import math
+import numbers
 import os
 import time as _time
 from collections.abc import Sequence
@@ -28,7 +29,7 @@ from ..results.studies import (POINT_VERDICTS, HuntingProbability, PointResult, 
 from ..specfile import path_unit, with_values
 from .axes import design_value, is_number
 from .cache import PointCache
-from .points import ProgressCallback, evaluate, point_result
+from .points import MAX_POINTS, ProgressCallback, evaluate, point_result
 
 __all__ = ["DISTRIBUTIONS", "parse_scatter", "parse_position_friction", "wilson_interval",
            "robustness"]
@@ -215,13 +216,16 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
     ------
     SpecError
         No scatter and no position-dependent friction, a path twice, fewer
-        than one sample, an unknown distribution, a confidence outside (0, 1).
+        than one sample or more than :data:`~.points.MAX_POINTS`, an unknown
+        distribution, a confidence outside (0, 1).
     ArgumentError
         A scatter that is not a :class:`Scatter`.
     """
     from .. import __version__
+    from ..specfile import as_spec
 
     start = _time.perf_counter()
+    spec = as_spec(spec)
     items = tuple(scatter)
     if not all(isinstance(s, Scatter) for s in items):
         raise ArgumentError("scatter must be a list of Scatter values; read text such as "
@@ -233,8 +237,13 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
     dupes = sorted({p for p in paths if paths.count(p) > 1})
     if dupes:
         raise SpecError("scattered twice", path=dupes[0])
+    if isinstance(samples, bool) or not isinstance(samples, numbers.Integral):
+        raise ArgumentError(f"samples must be a whole number, got {samples!r}")
     if samples < 1:
         raise SpecError(f"samples must be at least 1, got {samples}")
+    if samples > MAX_POINTS:
+        raise SpecError(f"samples = {samples}; a study holds at most {MAX_POINTS} (each sample "
+                        "a few ms to a few tens of ms per plant)")
     if distribution not in DISTRIBUTIONS:
         raise SpecError(f"unknown distribution {distribution!r}; choose from "
                         f"{', '.join(DISTRIBUTIONS)}")

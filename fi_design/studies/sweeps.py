@@ -20,7 +20,7 @@ from ..results.design import DesignResult
 from ..results.studies import Axis, DesignMap, SweepResult
 from .axes import design_value, make_axis
 from .cache import PointCache
-from .points import ProgressCallback, evaluate, grid, point_result, verdict_grid
+from .points import MAX_POINTS, ProgressCallback, evaluate, grid, point_result, verdict_grid
 
 __all__ = ["AxisLike", "sweep", "design_map"]
 
@@ -83,18 +83,26 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
     Raises
     ------
     SpecError
-        Unknown path, a path to a non-numeric value, the same path twice, or
-        an isolated sweep of a spec without isolator.
+        Unknown path, a path to a non-numeric value, the same path twice, an
+        isolated sweep of a spec without isolator, or a grid of more than
+        :data:`~.points.MAX_POINTS` points.
     ArgumentError
         An axis that is neither an :class:`~.axes.Axis` nor a ``(path, values)``
         pair.
     """
     from .. import __version__
+    from ..specfile import as_spec
 
+    spec = as_spec(spec)
     ax = _as_axis(x, spec, "x")
     ay = _as_axis(y, spec, "y") if y is not None else None
     if ay is not None and ay.path == ax.path:
         raise SpecError("x and y sweep the same value", path=ax.path)
+    n_points = len(ax.values) * (1 if ay is None else len(ay.values))
+    if n_points > MAX_POINTS:
+        raise SpecError(f"{len(ax.values)} x {len(ay.values)} = {n_points} points; a study holds "
+                        f"at most {MAX_POINTS} (a few ms to a few tens of ms each)",
+                        path=f"{ax.path}, {ay.path}")
     iso = spec.has_isolator if isolated is None else bool(isolated)
     if iso and not spec.has_isolator:
         raise SpecError("the spec has no isolator: sweep without it (isolated=False / "

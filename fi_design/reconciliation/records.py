@@ -1,0 +1,110 @@
+"""The record as the reconciliation uses it: evidence checked, thinned to what the model needs.
+
+A reconciliation replays the model on the record tens to hundreds of times;
+every run has a sample for every record sample, and the comparison strides
+them to :data:`~.comparison.MAX_POINTS` per channel anyway. A record logged
+at 10 kHz for minutes (millions of samples) is thinned to the rate the model
+needs, :func:`model_rate`: plain subsampling, so that every sample kept has
+its sensor noise and quantization as recorded. The noise levels and the
+position lattice are read from the whole record first. A record that still
+holds more than :data:`MAX_SAMPLES` samples at the lowest rate the model
+can be compared at is refused, naming the limit.
+
+A record in which neither the stage nor its reference moves holds no
+evidence: there is nothing a model could disagree with, and "agrees within
+noise" would be an answer without a test. It is refused.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import DataError
+from ..measured import Measurement, thinned
+
+#: A record at or below this rate is used as recorded [Hz].
+RATE_FLOOR = 1000.0
+#: The rate the model needs, in crossovers: about a hundred samples per loop period.
+CROSSOVER_SAMPLES = 100.0
+#: The lowest rate a record may be thinned to, in crossovers (above the D term's roll-off).
+MIN_CROSSOVER_SAMPLES = 20.0
+#: Most samples of the record a reconciliation works on (a few kB each while it searches).
+MAX_SAMPLES = 100_000
+#: Movement that counts as excitation, in position-noise levels.
+EXCITATION = 10.0
+
+
+def model_rate(crossover: float) -> float:
+    """The sample rate the model needs [Hz]: 100 x the crossover, at least 1 kHz."""
+    return max(RATE_FLOOR, CROSSOVER_SAMPLES * crossover)
+
+
+def check_excitation(measured: Measurement, position_noise: float) -> None:
+    """Refuse a record in which neither the stage nor its reference moves.
+
+    Parameters
+    ----------
+    measured : Measurement
+        The record.
+    position_noise : float
+        The position noise level [m].
+
+    Raises
+    ------
+    DataError
+        The reference and the position stay within :data:`EXCITATION` noise
+        levels; the message says what was read.
+    """
+    band = EXCITATION * position_noise
+    ref, pos = float(np.ptp(measured.reference)), float(np.ptp(measured.position))
+    if ref <= band and pos <= band:
+        raise DataError(
+            f"no excitation: the reference spans {ref:.3g} m and the position {pos:.3g} m, "
+            f"within {EXCITATION:g} noise levels ({band:.3g} m); a record in which nothing "
+            "moves cannot show where the model is wrong: record a move (or a hold that hunts)",
+            column="position_m", source=measured.source)
+
+
+def for_the_model(measured: Measurement, crossover: float) -> tuple[Measurement, str]:
+    """The record thinned to the rate the model needs, and a note saying so ("" if unchanged).
+
+    Parameters
+    ----------
+    measured : Measurement
+        The record as read.
+    crossover : float
+        The loop's crossover [Hz].
+
+    Returns
+    -------
+    Measurement, str
+
+    Raises
+    ------
+    DataError
+        Even at :data:`MIN_CROSSOVER_SAMPLES` samples per crossover the record
+        holds more than :data:`MAX_SAMPLES` samples.
+    """
+    rate = 1.0 / measured.sample_period
+    step = max(1, int(math.floor(rate / model_rate(crossover) + 1e-9)))
+    if math.ceil(measured.n / step) > MAX_SAMPLES:
+        step = int(math.ceil(measured.n / MAX_SAMPLES))
+        least = MIN_CROSSOVER_SAMPLES * crossover
+        if rate / step < least:
+            longest = MAX_SAMPLES / least
+            raise DataError(
+                f"{measured.n} samples over {measured.duration:.4g} s: compared at the lowest "
+                f"rate the model allows ({MIN_CROSSOVER_SAMPLES:g} x the {crossover:.3g} Hz "
+                f"crossover = {least:.4g} Hz) that is "
+                f"{math.ceil(measured.duration * least)} samples; a reconciliation holds at "
+                f"most {MAX_SAMPLES}: reconcile at most {longest:.4g} s of the record at a "
+                "time", column="time_s", source=measured.source)
+    if step == 1:
+        return measured, ""
+    kept = thinned(measured, step)
+    return kept, (f"The record ({measured.n} samples at {rate:.4g} Hz) was compared at every "
+                  f"{step}th sample ({kept.n} samples at {rate / step:.4g} Hz): the model needs "
+                  f"{model_rate(crossover):.4g} Hz; noise and lattice were read from every "
+                  "sample.")

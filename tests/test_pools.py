@@ -1,0 +1,113 @@
+"""The command line's worker pools: started before any progress thread, ended with their parent,
+and on failure only their own workers are stopped."""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from conftest import BIN, EXAMPLES
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"),
+                                reason="the pools fork their workers on Linux only")
+
+
+def _sleep(seconds: float) -> None:
+    time.sleep(seconds)
+
+
+def test_the_error_path_ends_only_the_pools_own_workers():
+    """A failure inside the design's pool stopped every child process of the interpreter."""
+    from fi_design.pools import confirmation_pool
+
+    ctx = multiprocessing.get_context("fork")
+    bystander = ctx.Process(target=_sleep, args=(30,))
+    bystander.start()
+    before = set(multiprocessing.active_children())
+    try:
+        with pytest.raises(RuntimeError, match="the work failed"):
+            with confirmation_pool() as pool:
+                workers = [p for p in multiprocessing.active_children() if p not in before]
+                assert workers, "the pool starts its workers when entered"
+                raise RuntimeError("the work failed")
+        assert bystander.is_alive(), "a child process that is not the pool's was stopped"
+        for worker in workers:
+            worker.join(timeout=5)
+            assert not worker.is_alive()
+    finally:
+        bystander.terminate()
+        bystander.join()
+
+
+def test_the_design_pool_starts_before_the_spinner(paper_spec_path, tmp_path, monkeypatch):
+    """Fork and threads do not mix: when the spinner (a thread on a terminal) starts, the
+    confirmation's workers must already be running."""
+    from typer.testing import CliRunner
+
+    import fi_design.console as console
+    from fi_design.cli import app
+
+    seen = []
+    real = console.Status.__enter__
+
+    def enter(self):
+        seen.append((self._text, len(multiprocessing.active_children())))
+        return real(self)
+
+    monkeypatch.setattr(console.Status, "__enter__", enter)
+    result = CliRunner().invoke(app, [str(paper_spec_path), "--json", str(tmp_path / "o.json")])
+    assert result.exit_code == 0, result.output
+    design = [n for text, n in seen if text.startswith("running the design")]
+    assert design and design[0] >= 1, seen
+
+
+def _children(pid: int) -> set[int]:
+    out = set()
+    for task in os.listdir(f"/proc/{pid}/task"):
+        with open(f"/proc/{pid}/task/{task}/children") as fh:
+            out.update(int(c) for c in fh.read().split())
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().split(")")[-1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+def test_sigterm_ends_a_sweep_and_its_workers(tmp_path):
+    """After SIGTERM to `fi-design sweep`, its worker processes outlived it; now they end with
+    it, and it exits 143 without writing the output."""
+    out = tmp_path / "sweep.json"
+    proc = subprocess.Popen(
+        [str(BIN / "fi-design"), "sweep", str(EXAMPLES / "paper_setup.yaml"), "--x",
+         "controller.crossover=2 Hz:30 Hz:400", "--jobs", "2", "--no-cache", "--json", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        workers: set[int] = set()
+        while time.monotonic() < deadline and len(workers) < 2:
+            time.sleep(0.1)
+            workers = _children(proc.pid)
+        assert len(workers) >= 2, "the sweep did not start its workers"
+        time.sleep(1.0)  # the workers are inside their chunks
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert "terminated" in err
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(_alive(w) for w in workers):
+        time.sleep(0.1)
+    assert not [w for w in workers if _alive(w)], "workers outlived their parent"
+    assert not out.exists()
