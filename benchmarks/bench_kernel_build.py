@@ -22,9 +22,13 @@ falls on all of them):
 
 "first run": a fresh process loading the spec, the kernel and simulating both
 paper plants once (20 s each, outputs at 1 kHz), timed from its first
-statement; "warm run": the same process started again. "simulation": the
+statement, and of that the kernel's load alone (``compiled()``: load the
+extension, or import numba and compile or load its cache); "warm run": the
+same process started again. "simulation": the
 kernel's own time per plant in that process (best of ``--repeat``), which
-tells whether a build runs slower code.
+tells whether a build runs slower code; ``--speed`` compares the two builds' run
+time in one process instead, alternating between them (``compiled()`` chosen
+anew each time), which a shared machine's drifting load disturbs less.
 
 Prints a Markdown section for BENCHMARKS.md.
 """
@@ -52,13 +56,16 @@ from fi_design.specfile import load_spec
 from fi_design.simulation import simulate
 from fi_design.kernel.build import compiled
 spec = load_spec(sys.argv[1])
+t1 = time.perf_counter()
+compiled()
+kernel = time.perf_counter() - t1
 simulate(spec, isolated=True)
 simulate(spec, isolated=False)
 first = time.perf_counter() - t0
 best = {iso: min(simulate(spec, isolated=iso).wall_time for _ in range(int(sys.argv[2])))
         for iso in (True, False)}
 print(json.dumps({"backend": compiled().backend, "numba": "numba" in sys.modules,
-                  "first": first, "isolated": best[True], "non_isolated": best[False]}))
+                  "first": first, "kernel": kernel, "isolated": best[True], "non_isolated": best[False]}))
 """
 
 
@@ -95,11 +102,38 @@ def one_round(repeat: int) -> dict:
     return rows
 
 
+def speed(rounds: int, repeat: int) -> None:
+    """Both builds' kernel time per plant in this process, alternating (needs the extension)."""
+    from fi_design.kernel.build import BACKEND_ENV, compiled
+    from fi_design.simulation import simulate
+    from fi_design.specfile import load_spec
+
+    spec = load_spec(SPEC)
+    times: dict = {}
+    for _ in range(rounds):
+        for way in ("aot", "jit"):
+            os.environ[BACKEND_ENV] = way
+            compiled.cache_clear()
+            assert compiled().backend == way
+            for iso in (True, False):
+                best = min(simulate(spec, isolated=iso).wall_time for _ in range(repeat))
+                times.setdefault((way, iso), []).append(best)
+    print("| build | isolated [ms] | non-isolated [ms] |")
+    print("| --- | ---: | ---: |")
+    for way, label in (("aot", "pycc"), ("jit", "numba's JIT")):
+        print(f"| {label} | {1e3 * statistics.median(times[(way, True)]):.2f} | "
+              f"{1e3 * statistics.median(times[(way, False)]):.2f} |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--repeat", type=int, default=10)
+    ap.add_argument("--speed", action="store_true")
     args = ap.parse_args()
+    if args.speed:
+        speed(args.rounds, args.repeat)
+        return
     rounds = [one_round(args.repeat) for _ in range(args.rounds)]
     for r in rounds:  # each way ran the build it names
         assert r["pycc"]["first"]["backend"] == "aot" and not r["pycc"]["first"]["numba"]
@@ -116,13 +150,14 @@ def main() -> None:
 
     print(f"Measured {time.strftime('%Y-%m-%d')} on this machine, median of {args.rounds} rounds; "
           "paper setup, both plants, 20 s each.\n")
-    print("| build | at install [s] | first run [s] | warm run [s] | simulation, isolated / "
-          "non-isolated [ms] |")
+    print("| build | at install [s] | first run [s] (kernel load) | warm run [s] (kernel load) "
+          "| simulation, isolated / non-isolated [ms] |")
     print("| --- | ---: | ---: | ---: | ---: |")
     for way in rounds[0]:
         install = med(way, "install")
-        print(f"| {way} | {install:.1f} | {med(way, 'first', 'first'):.2f} | "
-              f"{med(way, 'warm', 'first'):.2f} | {1e3 * med(way, 'warm', 'isolated'):.2f} / "
+        print(f"| {way} | {install:.1f} | {med(way, 'first', 'first'):.2f} "
+              f"({med(way, 'first', 'kernel'):.2f}) | {med(way, 'warm', 'first'):.2f} "
+              f"({med(way, 'warm', 'kernel'):.2f}) | {1e3 * med(way, 'warm', 'isolated'):.2f} / "
               f"{1e3 * med(way, 'warm', 'non_isolated'):.2f} |")
 
 
