@@ -9,7 +9,8 @@ both source trees in fresh processes, alternating baseline and current
 (A B A B ...) so that a drifting machine load falls on both:
 
 - the kernel's compile time with an empty numba cache (``NUMBA_CACHE_DIR``
-  pointing at a new empty folder; the time of ``import fi_design.kernel``
+  pointing at a new empty folder; the time of importing the kernel's source
+  (``fi_design.kernel.integrator``, ``fi_design.kernel`` before it was a package)
   plus the first simulation, which compiles every function);
 - the run time of one 20 s simulation of each plant of
   ``examples/paper_setup.yaml`` (the kernel alone, ``SimulationResult.wall_time``,
@@ -35,7 +36,10 @@ ROOT = Path(__file__).resolve().parents[1]
 SNIPPET = r"""
 import json, sys, time
 t0 = time.perf_counter()
-import fi_design.kernel  # noqa: F401  (compiles, or loads the cache)
+try:  # compiles, or loads the cache
+    import fi_design.kernel.integrator  # noqa: F401
+except ModuleNotFoundError:  # a baseline from before the kernel package
+    import fi_design.kernel  # noqa: F401
 from fi_design.simulation import simulate
 from fi_design.specfile import load_spec
 spec = load_spec(sys.argv[1])

@@ -47,7 +47,7 @@ def best(fn, repeat: int) -> float:
 
 def kernel_only(spec, isolated: bool):
     """Time only the compiled integrator (the same call simulate() makes)."""
-    from fi_design.compiled import run
+    from fi_design.kernel import run
     from fi_design.trajectory import from_moves
     from fi_design.model import resolve
     from fi_design.simulation import tolerances
@@ -70,7 +70,7 @@ def plain_solve_ivp(spec, isolated: bool, t_end: float, method: str):
     """The same equations in a plain solve_ivp call: modes from the state, no events."""
     from scipy.integrate import solve_ivp
 
-    from fi_design import equations as plant
+    from fi_design.kernel import equations as plant
     from fi_design.trajectory import from_moves
     from fi_design.model import resolve
     from fi_design.simulation import tolerances
@@ -106,7 +106,7 @@ def python_control_run(spec, isolated: bool, t_end: float):
     """The same equations through control.input_output_response (LSODA, modes from the state)."""
     import control
 
-    from fi_design import equations as plant
+    from fi_design.kernel import equations as plant
     from fi_design.trajectory import from_moves
     from fi_design.model import resolve
     from fi_design.simulation import tolerances
@@ -193,13 +193,14 @@ def main() -> None:
 
     if not args.skip_cold:
         with tempfile.TemporaryDirectory() as out:
-            build = fresh(f"from fi_design.aot import build; build({out!r})", dict(os.environ))
-        load = fresh("from fi_design.compiled import kernel; assert kernel().backend == 'aot'",
-                     dict(os.environ))
+            build = fresh(f"from fi_design.kernel.build import build; build({out!r})",
+                          dict(os.environ))
+        load = fresh("from fi_design.kernel.build import compiled; "
+                     "assert compiled().backend == 'aot'", dict(os.environ))
         with tempfile.TemporaryDirectory() as cache:
             env = dict(os.environ, NUMBA_CACHE_DIR=cache, FI_DESIGN_KERNEL="jit")
-            cold = fresh("from fi_design.compiled import kernel; kernel().integrate", env)
-            warm = fresh("from fi_design.compiled import kernel; kernel().integrate", env)
+            cold = fresh("from fi_design.kernel.build import compiled; compiled().integrate", env)
+            warm = fresh("from fi_design.kernel.build import compiled; compiled().integrate", env)
             base = fresh("import numpy", env)
         print("| start-up (fresh processes) | time [s] |")
         print("| --- | ---: |")

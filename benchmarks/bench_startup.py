@@ -151,8 +151,8 @@ import scipy.signal
 mark("scipy.signal (python-control and the metric's peak finder need it)")
 import control
 mark("the rest of python-control (matplotlib.pyplot among it)")
-from fi_design.compiled import kernel
-kernel()
+from fi_design.kernel.build import compiled
+compiled()
 mark("the simulation kernel (the extension built at install)")
 from fi_design.guideline import design
 design(spec, confirm=False)

@@ -474,6 +474,9 @@ def recommend_command(
     json_out: JsonOut = None,
     report_out: Optional[Path] = output_option("--report", "OUT.html|OUT.pdf",
         "Write the report of the search (HTML, or PDF for a .pdf name)."),
+    write_spec: Optional[Path] = output_option("--write-spec", "OUT.yaml",
+        "Write the spec with the recommended stroke, stiffness (and crossover) in it, comments "
+        "kept; the design command on it passes."),
     force: Force = False,
 ) -> None:
     """Search the isolator's stroke and stiffness (and the rule's crossover) for a design that passes.
@@ -486,22 +489,30 @@ def recommend_command(
     what it violates and what would open the space.
     """
     outs = check_outputs((spec,), force, json=(json_out, (".json",)),
-                         report=(report_out, (".html", ".pdf")))
+                         report=(report_out, (".html", ".pdf")),
+                         spec=(write_spec, (".yaml", ".yml")))
     check_spec_path(spec)
     spec_obj = load(spec)
 
     from .console import Status, make_console, print_recommendation
     from .pools import confirmation_pool
-    from .recommend import recommend
+    from .recommend import recommend, recommended_spec_text
 
     console, err = make_console(), make_console(stderr=True)
-    with Status(err, "searching the design space ...") as status, \
-            confirmation_pool(True) as pool:
+    # the pool's workers fork before the spinner's thread starts (fork and threads do not mix)
+    with confirmation_pool(True) as pool, \
+            Status(err, "searching the design space ...") as status:
         result = recommend(spec_obj, executor=pool, progress=status)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
+    if outs["spec"] is not None and result.feasible:
+        payloads["spec"] = recommended_spec_text(result)
     print_recommendation(console, result, spec_path=spec)
     write_outputs(console, outs, payloads)
     write_report(console, outs["report"], result)
+    if outs["spec"] is not None and not result.feasible:
+        err.print(f"[bold red]{outs['spec']} not written:[/] no design of the searched space "
+                  "passes the sign-off (the nearest one is shown above)")
+        raise typer.Exit(EXIT_VERDICT)
 
 
 # --------------------------------------------------------------------------- reconcile

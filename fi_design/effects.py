@@ -36,7 +36,7 @@ class Parameter:
     description : str
         What it is, in one line.
     kernel_field : str
-        Name of the :class:`fi_design.plant.PlantParameters` field it sets.
+        Name of the :class:`fi_design.kernel.layout.PlantParameters` field it sets.
     bounds : tuple of float
         Search range for the reconciliation fit, SI. When ``relative`` is true,
         factors applied to the nominal value instead.

@@ -32,7 +32,7 @@ from . import effects as _effects
 from . import spec as _spec
 from .errors import ArgumentError, SimulationError, SpecError
 from .pid import at_crossover, control_law
-from .plant import PlantParameters
+from .kernel.layout import PlantParameters
 from .results.controller import ControlLaw
 
 __all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "apply_effects"]
@@ -382,7 +382,7 @@ class Model:
 
         Returns
         -------
-        fi_design.plant.PlantParameters
+        fi_design.kernel.layout.PlantParameters
             The controller from the nominal masses; the effects then change
             the true plant (a mass error does not retune the controller).
 

@@ -47,7 +47,7 @@ from .specfile import with_values
 
 log = logging.getLogger(__name__)
 
-__all__ = ["recommend", "GRID"]
+__all__ = ["recommend", "recommended_values", "recommended_spec_text", "GRID"]
 
 #: Points of the design-space map: strokes x stiffnesses.
 GRID = (6, 6)
@@ -475,3 +475,71 @@ def _advice(feasible, chosen, cells, base, xo, rule, binding) -> str:
             f"{chosen['stiffness']:.4g} N/m, {fc:.4g} Hz) fails on "
             f"{_WORDS.get(chosen['status'], chosen['status'])}. What would open the space: "
             + "; or ".join(opener) + ".")
+
+
+# --------------------------------------------------------------------------- the written spec
+
+
+def recommended_values(result: RecommendResult) -> dict[str, Any]:
+    """The spec values of a recommended design, by dotted path, as the spec file takes them.
+
+    Parameters
+    ----------
+    result : RecommendResult
+        The search.
+
+    Returns
+    -------
+    dict
+        ``isolator.stroke``, ``isolator.stiffness`` (every digit, with units),
+        ``isolator.damping`` when the spec gives a damping (its ratio kept),
+        and ``controller.crossover`` for a spec tuned by the rule; for a spec
+        without isolator the ``isolator`` section as a whole.
+    """
+    from .specedit import spec_quantity
+
+    d = result.design
+    iso = {"stroke": spec_quantity("isolator.stroke", d.stroke),
+           "stiffness": spec_quantity("isolator.stiffness", d.stiffness)}
+    if d.damping is not None:
+        iso["damping"] = spec_quantity("isolator.damping", d.damping)
+    values: dict[str, Any] = ({f"isolator.{k}": v for k, v in iso.items()}
+                              if result.spec.isolator is not None else {"isolator": iso})
+    if result.rule:
+        values["controller.crossover"] = spec_quantity("controller.crossover", d.crossover)
+    return values
+
+
+def recommended_spec_text(result: RecommendResult) -> str:
+    """YAML text of the input spec with the recommended design written in.
+
+    The input's text is edited (comments and layout kept,
+    :func:`fi_design.specedit.edited_spec_text`) and read back; the design
+    command on it runs the same computation that signed the design off.
+
+    Parameters
+    ----------
+    result : RecommendResult
+        A feasible search (the nearest design of an infeasible one is not
+        written: it does not pass).
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    ArgumentError
+        The search found no design that passes.
+    """
+    from .specedit import edited_spec_text
+
+    if not result.feasible:
+        raise ArgumentError("no design of the searched space passes: there is no "
+                            "recommendation to write (the nearest one fails the sign-off)")
+    header = ["isolator and crossover written by fi-design recommend: the design of most "
+              "margin that the sign-off passes;",
+              f"{result.advice}"]
+    comments = {path: "recommended" for path in recommended_values(result)}
+    return edited_spec_text(result.spec, recommended_values(result), comments=comments,
+                            header=header, source="<spec with the recommended design>")

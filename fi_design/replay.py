@@ -22,10 +22,10 @@ from typing import NamedTuple
 import numpy as np
 
 from .errors import DataError
+from .kernel.build import compiled
+from .kernel.layout import P_SIGMA2_NEG, PlantParameters, state_index
 from .measured import Measurement
 from .pid import ControlLaw
-from .compiled import kernel
-from .plant import P_SIGMA2_NEG, PlantParameters, state_index
 
 #: Span of samples the local velocity estimate fits [s].
 VELOCITY_SPAN = 0.01
@@ -248,7 +248,7 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
     Returns
     -------
     y0 : ndarray
-        Initial state (layout of :func:`fi_design.plant.state_index`).
+        Initial state (layout of :func:`fi_design.kernel.layout.state_index`).
     params : PlantParameters
         ``params`` with ``x1_initial``, the discrete controller's states
         ``dx1``, ``dx2`` and the command held before t = 0 (``u_initial``).
@@ -265,17 +265,17 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
     sigma2 = params.sigma2 if sgn > 0 else p[P_SIGMA2_NEG]
     friction = 0.0
     if v1 != 0.0 and not params.switch_model:
-        g, _, _ = kernel().stribeck(v1, x1, sgn, p)
+        g, _, _ = compiled().stribeck(v1, x1, sgn, p)
         y0[idx["z"]] = sgn * g / params.sigma0
         friction = sgn * g + sigma2 * v1
     elif v1 != 0.0:
-        friction = sgn * kernel().stribeck(v1, x1, sgn, p)[0] + sigma2 * v1
+        friction = sgn * compiled().stribeck(v1, x1, sgn, p)[0] + sigma2 * v1
     elif command is not None:
         # at rest: the bristles carry the static load, up to the breakaway force
         load = command - params.offset
         if iso and deflection is not None:
             load = params.k * deflection
-        breakaway = kernel().stribeck(0.0, x1, 1.0 if load >= 0.0 else -1.0, p)[0]
+        breakaway = compiled().stribeck(0.0, x1, 1.0 if load >= 0.0 else -1.0, p)[0]
         friction = max(-breakaway, min(breakaway, load))
         if not params.switch_model:
             y0[idx["z"]] = friction / params.sigma0

@@ -7,10 +7,10 @@ applied), integrates with the fast RODAS4 kernel
 (``method="reference"``), and returns a :class:`SimulationResult` with the
 traces at the output rate and the hunting metrics.
 
-The two methods share the right-hand side and Jacobian of
-:mod:`fi_design.equations` and the mode logic of :mod:`fi_design.kernel`
-(the reference locates mode changes with solve_ivp's own event finder), so
-the comparison tests the integrator, not a second transcription of the model.
+The two methods share the right-hand side, Jacobian and mode switch of
+:mod:`fi_design.kernel.equations` (the reference locates mode changes with
+solve_ivp's own event finder), so the comparison tests the integrator, not a
+second transcription of the model.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from .arguments import number
 from .errors import ArgumentError, SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from .model import Model, as_model
-from .plant import PlantParameters, state_index
+from .kernel.layout import PlantParameters, state_index
 from .replay import (DRIVES, command_state, initial_state, record_state, reference_state,
                      replay_fit)
 from .results import frozen_array
@@ -212,15 +212,16 @@ def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=No
     x_bound = 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(y0[0]))
     start = _time.perf_counter()
     if method == "fast":
-        from .compiled import kernel, run
+        from .kernel import run
+        from .kernel.build import compiled
 
-        kernel()  # loads the built kernel (or compiles it) before the clock starts
+        compiled()  # loads the built kernel (or compiles it) before the clock starts
         start = _time.perf_counter()
         out = run(params.to_array(), y0, ref.breaks, ref.coeffs, ref.land, t_end, t_out, tol,
                   tolerances(params, tol), 0.05, settings.max_steps, x_bound,
                   input_time, input_force)
     else:
-        from .refsolve import solve_reference
+        from .kernel.reference import solve_reference
 
         out = solve_reference(params, y0, ref, t_end, t_out, tol, tolerances(params, tol),
                               x_bound, input_time=input_time, input_force=input_force)
@@ -302,11 +303,11 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
 
 def _anchor(law, params, record, index, ref, command):
     """Initial state and parameters for a replay starting at sample ``index``."""
-    from .compiled import kernel
+    from .kernel.build import compiled
 
     st = record_state(record, index)
     r, rd, rdd = reference_state(record, index)
-    ff = kernel().feedforward(rd, rdd, 0.0, params.to_array())[0]
+    ff = compiled().feedforward(rd, rdd, 0.0, params.to_array())[0]
     defl = None if record.deflection is None or not params.isolated else \
         float(record.deflection[index])
     return initial_state(params, law, st, deflection=defl, command=command,
@@ -319,7 +320,7 @@ def _merge(pieces, t_out):
     ``pieces`` holds ``(first sample, samples kept, Integration)`` per window;
     samples after a failed window stay NaN (window -1).
     """
-    from .plant import Integration
+    from .kernel.layout import Integration
 
     n = len(t_out)
     states = np.full((n, pieces[0][2].states.shape[1]), np.nan)

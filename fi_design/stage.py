@@ -27,7 +27,7 @@ move therefore says little about the stage. This module answers per plant:
    exists (continuation); the family is then run just above to make sure no
    other cycle is entered there.
 
-The kernel's watch (:func:`fi_design.kernel.integrate`) locates the section
+The kernel's watch (:func:`fi_design.kernel.integrator.integrate`) locates the section
 crossings like mode events (the step is redone to end on them, never
 interpolated), and a continuous-time controller without delay keeps its
 whole state in the state vector, so a run can continue exactly from where
@@ -47,10 +47,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import spec as _spec
-from .compiled import kernel, run
 from .errors import ArgumentError
-from .plant import (N_WATCH, W_ARM, W_BAND, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_REPEAT,
-                    W_REST_ANYWHERE, W_START, PlantParameters, state_index)
+from .kernel import run
+from .kernel.build import compiled
+from .kernel.layout import (N_WATCH, W_ARM, W_BAND, W_LEVEL, W_MAX_CROSSINGS, W_QUIET,
+                            W_REPEAT, W_REST_ANYWHERE, W_START, PlantParameters, state_index)
 from .results.stage import Cycle, CycleTrace, MoveOutcome, StageHunting, length_text
 from .model import Model, as_model
 from .simulation import tolerances
@@ -298,7 +299,7 @@ def rest_is_final(params: PlantParameters, y: np.ndarray, level: float) -> bool:
         force = p.sigma0 * (z + level - x1)
         x_cart = level
     sign = 1.0 if force >= 0.0 else -1.0
-    g0 = kernel().stribeck(0.0, x_cart, sign, _kernel_arrays(p, 1.0)[0])[0]
+    g0 = compiled().stribeck(0.0, x_cart, sign, _kernel_arrays(p, 1.0)[0])[0]
     return abs(force) < g0
 
 

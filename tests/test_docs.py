@@ -87,9 +87,8 @@ def test_readme_run_command_succeeds_on_every_run(readme, tmp_path, monkeypatch)
     assert (tmp_path / "report.html").is_file()
 
 
-#: Files owned by the kernel work (the lead's issue 19), whose first docstring lines still cite
-#: the developers' design document; they change there.
-_CITING_ELSEWHERE = {"fi_design/plant.py", "fi_design/equations.py"}
+#: Files allowed to cite the developers' design document: none.
+_CITING_ELSEWHERE: set[str] = set()
 
 
 def test_the_documentation_stands_alone():

@@ -68,7 +68,7 @@ def test_code_digest_covers_the_package_and_its_templates():
     assert "fi_design/templates/report.html.jinja" in files
     assert "fi_design/templates/report.css" in files
     assert "fi_design/example_spec.yaml" in files
-    assert not any("__pycache__" in k or "_kernel_aot" in k for k in files)
+    assert not any("__pycache__" in k or "/_aot." in k for k in files)
     digest = provenance.code_digest()
     assert len(digest) == 64 and digest == provenance.current_source().code_sha256
 
@@ -77,7 +77,7 @@ def test_code_digest_is_the_same_for_the_installed_layout(tmp_path):
     """An installed wheel has the templates inside the package; the digest does not change."""
     package = tmp_path / "site" / "fi_design"
     shutil.copytree(ROOT / "fi_design", package,
-                    ignore=shutil.ignore_patterns("__pycache__", "_kernel_aot.*"))
+                    ignore=shutil.ignore_patterns("__pycache__", "_aot.*"))
     shutil.copytree(ROOT / "templates", package / "templates")
     assert provenance.code_files(package).keys() == provenance.code_files().keys()
     assert provenance.code_digest(package) == provenance.code_digest()

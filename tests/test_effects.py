@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from fi_design import effects as fx
-from fi_design.plant import PlantParameters
+from fi_design.kernel.layout import PlantParameters
 from fi_design.model import resolve
 from fi_design.simulation import simulate
 from fi_design.spec import EFFECT_MODELS

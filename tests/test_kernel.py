@@ -12,9 +12,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fi_design import kernel
-from fi_design.equations import jacobian
-from fi_design.plant import MODE_SIGN
+from fi_design.kernel import integrator
+from fi_design.kernel.equations import jacobian
+from fi_design.kernel.layout import MODE_SIGN
 from fi_design.trajectory import from_moves
 from fi_design.model import resolve
 
@@ -35,10 +35,10 @@ def test_structured_solve_equals_dense_solve(paper_spec, isolated):
         M = np.empty((n - 3, n - 3))
         piv = np.empty(n - 3, dtype=np.int64)
         w = np.empty((4, max(n - 3, 3)))
-        assert kernel.struct_factor(J, sigma, M, piv, w)
+        assert integrator.struct_factor(J, sigma, M, piv, w)
         b = rng.normal(size=n)
         x = b.copy()
-        kernel.struct_solve(J, M, piv, w, x, np.empty(n))
+        integrator.struct_solve(J, M, piv, w, x, np.empty(n))
         exact = np.linalg.solve(sigma * np.eye(n) - J, b)
         assert np.allclose(x, exact, rtol=1e-9, atol=1e-12 * np.max(np.abs(exact)))
 
@@ -47,7 +47,7 @@ def test_structured_solve_equals_dense_solve(paper_spec, isolated):
 @given(t=st.floats(0.0, 25.0))
 def test_reference_lookup_matches_the_vectorised_evaluation(paper_spec, t):
     ref = from_moves(paper_spec.motion.moves, 20.0)
-    r, rd, rdd, _, _ = kernel.reference_at(t, np.array(ref.breaks), np.array(ref.coeffs), 0)
+    r, rd, rdd, _, _ = integrator.reference_at(t, np.array(ref.breaks), np.array(ref.coeffs), 0)
     assert r == pytest.approx(float(ref(t)), abs=1e-15)
     assert rd == pytest.approx(float(ref(t, 1)), abs=1e-12)
     assert rdd == pytest.approx(float(ref(t, 2)), abs=1e-9)
@@ -97,29 +97,29 @@ def test_dense_output_is_as_accurate_as_the_steps(paper_spec):
 def test_cache_falls_back_to_a_user_directory(tmp_path):
     """With no writable __pycache__ beside the source, numba caches in the user cache dir."""
     src = tmp_path / "pkg"
-    shutil.copytree(os.path.dirname(kernel.__file__), src / "fi_design",
+    shutil.copytree(os.path.dirname(os.path.dirname(integrator.__file__)), src / "fi_design",
                     ignore=shutil.ignore_patterns("__pycache__"))
-    (src / "fi_design" / "__pycache__").write_text("a file, so no cache directory here")
+    (src / "fi_design" / "kernel" / "__pycache__").write_text("a file, so no cache directory")
     cache = tmp_path / "xdg"
     env = dict(os.environ, PYTHONPATH=str(src), XDG_CACHE_HOME=str(cache))
     env.pop("NUMBA_CACHE_DIR", None)
-    subprocess.run([sys.executable, "-c", "import fi_design.kernel"], check=True, env=env,
-                   cwd=tmp_path)
-    assert list(cache.rglob("kernel.integrate-*.nbi"))
+    subprocess.run([sys.executable, "-c", "import fi_design.kernel.integrator"], check=True,
+                   env=env, cwd=tmp_path)
+    assert list(cache.rglob("integrator.integrate-*.nbi"))
 
 
 def test_the_installed_kernel_is_the_ahead_of_time_build_of_these_sources():
     """An install compiles the kernel ahead of time (hatch_build.py); CI must get that build."""
-    from fi_design import compiled
+    from fi_design.kernel import build
 
-    k = compiled.kernel()
+    k = build.compiled()
     if k.backend != "aot":
         if os.environ.get("CI"):
             pytest.fail(f"the kernel runs on numba's JIT in CI: {k.reason}")
         pytest.skip(f"the ahead-of-time kernel is not in use here: {k.reason}")
-    from fi_design import _kernel_aot
+    from fi_design.kernel import _aot
 
-    assert _kernel_aot.source_digest() == compiled.source_digest()
+    assert _aot.source_digest() == build.source_digest()
     # the simulation path runs without loading numba at all
     out = subprocess.run([sys.executable, "-c",
                           "import sys; from fi_design.specfile import load_spec; "
@@ -138,10 +138,10 @@ def test_the_jit_build_of_the_same_source_agrees(paper_spec, tmp_path):
     from fi_design.simulation import simulate
 
     code = ("import sys, numpy as np; from fi_design.specfile import load_spec; "
-            "from fi_design.simulation import simulate; from fi_design import compiled; "
+            "from fi_design.simulation import simulate; from fi_design.kernel import build; "
             "s = load_spec(sys.argv[1]); "
             "np.save(sys.argv[2], np.array([simulate(s, isolated=i).position for i in (True, "
-            "False)])); print(compiled.backend())")
+            "False)])); print(build.backend())")
     env = dict(os.environ, FI_DESIGN_KERNEL="jit")
     out = subprocess.run([sys.executable, "-c", code, str(os.path.join(
         os.path.dirname(__file__), "..", "examples", "paper_setup.yaml")),

@@ -1,7 +1,7 @@
 """Invariants of the LuGre friction model, over bounded random parameters (hypothesis).
 
 - Friction is odd in the velocity when it is symmetric: with v, z and the sliding sign
-  reversed, the bristle rate and the friction force reverse (fi_design.equations.lugre), and so
+  reversed, the bristle rate and the friction force reverse (fi_design.kernel.equations.lugre), and so
   does the steady-state force g(v) sign(v) + sigma2 v.
 - The bristle deflection stays within Fs / sigma0: at that bound the LuGre bristle equation
   dz/dt = v - sigma0 |v| z / g(v) (with g(v) <= Fs) points inward, and a stage started from
@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from fi_design import equations
+from fi_design.kernel import equations
 from fi_design.model import resolve
 from fi_design.simulation import simulate
 

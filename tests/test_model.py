@@ -171,7 +171,7 @@ def test_at_refuses_isolator_values_without_an_isolator(paper_spec):
 
 def test_steady_state_friction_is_the_kernels_stribeck_curve(paper_spec):
     """One friction law: the model's numpy curve equals the compiled kernel's g(v) per direction."""
-    from fi_design.compiled import kernel
+    from fi_design.kernel.build import compiled
 
     spec = variant(paper_spec, **{"friction.coulomb_negative": "1.5 N",
                                   "friction.viscous_negative": "30 N*s/m"})
@@ -181,7 +181,7 @@ def test_steady_state_friction_is_the_kernels_stribeck_curve(paper_spec):
     ours = m.friction.steady_state(v)
     for vi, fi in zip(v, ours):
         sgn = 1.0 if vi > 0 else -1.0
-        g = kernel().stribeck(vi, 0.0, sgn, p)[0]
+        g = compiled().stribeck(vi, 0.0, sgn, p)[0]
         s2 = 20.0 if vi > 0 else 30.0
         assert fi == pytest.approx(sgn * g + s2 * vi, rel=1e-13)
     # g(v) = Fc + (Fs - Fc) exp(-(v/vs)^2), Fs scaled by Fc_neg / Fc going back

@@ -113,3 +113,56 @@ def test_no_isolator_gets_one_and_keeps_a_crossover_the_model_does_not_limit(rep
     # no parasitic mode, no sampling: the linear model sets no limit, so the crossover stays
     assert r.design.crossover == pytest.approx(8.0)
     assert r.feasible and not r.stage_hunting.hunts
+
+
+def test_the_written_spec_keeps_comments_and_the_design_command_passes_it(
+        paper_recommendation, paper_spec, tmp_path):
+    """--write-spec: the input's text with the recommended values (comments kept); the design
+    command on it runs the computation that signed the design off, and passes."""
+    from fi_design.guideline import design
+    from fi_design.recommend import recommended_spec_text
+    from fi_design.specfile import load_spec
+
+    text = recommended_spec_text(paper_recommendation)
+    assert "# m1: actuated, carries the encoder" in text      # the input's comments stay
+    assert "written by fi-design recommend" in text
+    written = tmp_path / "written.yaml"
+    written.write_text(text, encoding="utf-8")
+    spec = load_spec(written)
+    d = paper_recommendation.design
+    assert spec.isolator.stroke == d.stroke and spec.isolator.stiffness == d.stiffness
+    assert spec.controller.crossover == d.crossover
+    r = design(spec)
+    assert r.verdict.status != "FAIL", [x.text for x in r.verdict.reasons]
+    assert not r.simulation.stage["isolated"].hunts
+
+
+def test_recommend_command_writes_a_spec_that_passes_or_says_why_not(repo_root, tmp_path):
+    import yaml
+    from typer.testing import CliRunner
+
+    from fi_design.cli import app
+
+    runner = CliRunner()
+    raw = yaml.safe_load((repo_root / "examples" / "no_isolator.yaml").read_text())
+    raw.setdefault("requirements", {})["robustness"] = {"samples": 20}
+    raw["requirements"]["recommend"] = {"stroke": ["0.3 mm", "1 mm"]}
+    src = tmp_path / "bare.yaml"
+    src.write_text(yaml.safe_dump(raw))
+    out, js = tmp_path / "with_isolator.yaml", tmp_path / "rec.json"
+    r = runner.invoke(app, ["recommend", str(src), "--write-spec", str(out), "--json", str(js)])
+    assert r.exit_code == 0, r.output
+    assert "Binds it" in r.output and "Design space at" in r.output
+    assert json.loads(js.read_text())["feasible"] is True
+    again = runner.invoke(app, [str(out), "--no-recommend", "--fail-on", "fail"])
+    assert again.exit_code == 0, again.output                  # the written spec passes
+    # nothing passes (the paper stage with strokes of 0.05 to 0.1 mm): the spec is not
+    # written, the command says why and exits 3
+    raw = yaml.safe_load((repo_root / "examples" / "paper_setup.yaml").read_text())
+    raw["requirements"]["robustness"] = {"samples": 20}
+    raw["requirements"]["recommend"] = {"stroke": ["0.05 mm", "0.1 mm"]}
+    src.write_text(yaml.safe_dump(raw))
+    none = tmp_path / "none.yaml"
+    r = runner.invoke(app, ["recommend", str(src), "--write-spec", str(none)])
+    assert r.exit_code == 3 and not none.exists()
+    assert "not written" in r.output and "What would open the space" in r.output

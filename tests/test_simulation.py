@@ -16,9 +16,9 @@ import pytest
 import yaml
 from scipy.integrate import solve_ivp
 
-from fi_design import equations as plant
+from fi_design.kernel import equations as plant
 from fi_design.errors import SimulationError
-from fi_design.plant import MODE_SIGN, PlantParameters
+from fi_design.kernel.layout import MODE_SIGN, PlantParameters
 from fi_design.simulation import simulate
 from fi_design.specfile import load_spec
 from conftest import variant

@@ -160,7 +160,7 @@ def test_canudas_de_wit_1995_pid_example_hunts_with_its_published_cycle():
 
 def test_rest_within_the_band_is_final_only_below_static_friction(paper_spec):
     """Without isolator the bristles carry sigma0 (z + r - x1) once the loop pulls x1 to r."""
-    from fi_design.plant import state_index
+    from fi_design.kernel.layout import state_index
     from fi_design.model import resolve
 
     p = resolve(paper_spec).plant(False)
@@ -174,7 +174,7 @@ def test_rest_within_the_band_is_final_only_below_static_friction(paper_spec):
 
 
 def test_isolated_rest_is_final_while_the_flexure_force_stays_below_fs(paper_spec):
-    from fi_design.plant import state_index
+    from fi_design.kernel.layout import state_index
     from fi_design.model import resolve
 
     p = resolve(paper_spec).plant(True)
@@ -223,8 +223,8 @@ def test_moves_hunting_just_below_the_fold_hunt_in_the_independent_simulator(pap
 
 def test_the_watch_lands_on_the_section_and_leaves_the_trajectory_alone(paper_spec):
     """Section crossings are stepped to (x1 = r to round-off) and agree with the trace."""
-    from fi_design.compiled import run
-    from fi_design.plant import N_WATCH, W_ARM, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_START
+    from fi_design.kernel import run
+    from fi_design.kernel.layout import N_WATCH, W_ARM, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_START
     from fi_design.model import resolve
     from fi_design.simulation import tolerances
     from fi_design.stage import _family_reference

@@ -396,22 +396,15 @@ def test_figures(paper_spec, kernel):
     assert plots.display_unit("N/m") == ("N/mm", 1e-3)
 
 
-def test_code_digest_covers_existing_modules_and_changes_with_them(tmp_path, monkeypatch):
-    """The cache key's code digest reads every module that decides an outcome (a renamed
-    module must not silently drop out of it) and changes when one of them changes."""
-    from pathlib import Path
+def test_code_digest_is_every_file_of_the_package(monkeypatch):
+    """The cache key's code digest is the package's own (no hand-kept list of modules that
+    could miss one, as it once missed the kernel's numba settings), and changes with it."""
+    from fi_design import provenance
 
-    package = Path(cachemod.__file__).resolve().parents[1]
-    missing = [n for n in cachemod.CODE_MODULES if not (package / n).is_file()]
-    assert not missing
-    assert {"simulation.py", "kernel.py", "equations.py", "plant.py", "trajectory.py",
-            "studies/points.py"} <= set(cachemod.CODE_MODULES)
     monkeypatch.setattr(cachemod, "_CODE_DIGEST", None)
-    before = cachemod.code_digest()
-    for n in cachemod.CODE_MODULES:
-        (tmp_path / n).parent.mkdir(exist_ok=True)
-        (tmp_path / n).write_bytes((package / n).read_bytes())
-    (tmp_path / "simulation.py").write_bytes(b"# edited\n" + (package / "simulation.py").read_bytes())
-    monkeypatch.setattr(cachemod, "__file__", str(tmp_path / "studies" / "cache.py"))
+    assert cachemod.code_digest() == provenance.code_digest()
+    assert {"fi_design/kernel/jit.py", "fi_design/model.py", "fi_design/studies/points.py"} \
+        <= provenance.code_files().keys()
+    monkeypatch.setattr(provenance, "code_digest", lambda package=None: "edited")
     monkeypatch.setattr(cachemod, "_CODE_DIGEST", None)
-    assert cachemod.code_digest() != before
+    assert cachemod.code_digest() == "edited"

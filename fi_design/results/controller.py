@@ -171,7 +171,7 @@ class ControlLaw:
         """Gains of the kernel's continuous law v = kp e + I + kd e' - kdm x', u' = wt (v - u).
 
         Returns ``kp`` [N/m], ``ki`` [N/(m s)], ``kd`` and ``kdm`` [N s/m],
-        ``wt`` [rad/s] of :mod:`fi_design.plant`: the D term's low-pass moved
+        ``wt`` [rad/s] of :mod:`fi_design.kernel.layout`: the D term's low-pass moved
         onto the whole output (kp + ki/wf on e, kp/wf + kd on e' or kd on -x'),
         which is the same transfer function; the rule's own gains exactly.
         """

@@ -16,7 +16,7 @@ from . import Result, dataclass_dict
 if TYPE_CHECKING:  # pragma: no cover
     from ..spec import Spec
 
-# The kernel's PlantParameters (fi_design.plant) and a replay's ReplayFit (fi_design.replay) are
+# The kernel's PlantParameters (fi_design.kernel.layout) and a replay's ReplayFit (fi_design.replay) are
 # typed Any here: the results layer imports no physics, not even for a type.
 
 __all__ = ["HuntingMetrics", "SimulationResult"]
@@ -127,7 +127,7 @@ class SimulationResult(Result):
         the kernel was already compiled).
     metrics : HuntingMetrics
         Hunting metric and verdict of this trace.
-    parameters : fi_design.plant.PlantParameters
+    parameters : fi_design.kernel.layout.PlantParameters
         The kernel parameters used.
     drive : str
         ``"closed"`` (the model's controller closes the loop) or ``"force"``

@@ -2,7 +2,7 @@
 
 Every point's outcome is stored under a key that hashes everything that
 decides it (:func:`point_key`): the spec's values, the point's values, the
-plant, the fi_design version, a digest of the simulation code
+plant, the fi_design version, a digest of the package's code
 (:func:`code_digest`) and the solver method. A repeated study, or one resumed
 after an interruption, takes finished points from here.
 """
@@ -18,19 +18,16 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from .. import provenance
 from ..cachedir import CACHE_ENV, cache_dir
 from ..errors import CacheError
 
-__all__ = ["CACHE_ENV", "METHOD", "CODE_MODULES", "PointCache", "default_cache_dir",
-           "open_cache", "code_digest", "point_key"]
+__all__ = ["CACHE_ENV", "METHOD", "PointCache", "default_cache_dir", "open_cache", "code_digest",
+           "point_key"]
 
 #: Environment variable naming the cache directory (tests and CI point it at a temporary one).
 #: Solver method the studies use (part of the cache key).
 METHOD = "fast"
-#: Source files (in the package) that decide a point's outcome; their digest is in every key.
-CODE_MODULES = ("kernel.py", "equations.py", "plant.py", "simulation.py", "metrics.py", "pid.py",
-                "trajectory.py", "effects.py", "spec.py", "specfile.py", "stage.py",
-                "studies/points.py")
 
 
 def default_cache_dir() -> Path:
@@ -169,10 +166,12 @@ _CODE_DIGEST: str | None = None
 
 
 def code_digest() -> str:
-    """SHA-256 over the source of the modules that decide a point's outcome.
+    """SHA-256 over every source file of the package (:func:`fi_design.provenance.code_digest`).
 
-    Part of every cache key, so editing the model, the solver or the metric
-    never reuses outcomes computed by older code (even without a version bump).
+    Part of every cache key, so editing the model, the solver, the metric or
+    anything they read never reuses outcomes computed by older code (even
+    without a version bump). No hand-kept list of the modules that matter: a
+    new or renamed module is covered as it is. Computed once per process.
 
     Returns
     -------
@@ -181,11 +180,7 @@ def code_digest() -> str:
     """
     global _CODE_DIGEST
     if _CODE_DIGEST is None:
-        package = Path(__file__).resolve().parents[1]
-        h = hashlib.sha256()
-        for name in CODE_MODULES:
-            h.update((package / name).read_bytes())
-        _CODE_DIGEST = h.hexdigest()
+        _CODE_DIGEST = provenance.code_digest()
     return _CODE_DIGEST
 
 

@@ -188,9 +188,9 @@ def warm_up() -> None:
     import scipy.signal  # noqa: F401  (the metric's peak finder, imported on first use)
 
     from .. import simulation  # noqa: F401
-    from ..compiled import kernel
+    from ..kernel.build import compiled
 
-    kernel()  # the extension built at install, or numba's JIT (compiles or loads its cache)
+    compiled()  # the extension built at install, or numba's JIT (compiles or loads its cache)
 
 
 #: Largest number of points in one chunk (bounds the work lost by an interruption).

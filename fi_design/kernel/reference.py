@@ -1,11 +1,13 @@
 """Reference solution with scipy's solve_ivp on the same equations.
 
 A deliberately plain path for tests and benchmarks: the right-hand side and
-Jacobian are those of :mod:`fi_design.equations`; mode changes (sliding direction,
-limiter contact, quantization level, switch-model sticking) are located by
-solve_ivp's own event finder and handled by the Python code below, written
-independently of the kernel's event logic; time events (reference
-breakpoints, controller samples, delayed outputs) split the integration.
+Jacobian are those of :mod:`fi_design.kernel.equations`; mode changes (sliding
+direction, limiter contact, quantization level, switch-model sticking) are
+located by solve_ivp's own event finder, independently of the fast
+integrator's event location, and switched by the same compiled
+:func:`~fi_design.kernel.equations.switch_mode` the integrator calls; time
+events (reference breakpoints, controller samples, delayed outputs) split the
+integration.
 A continuous delay is integrated by the method of steps: chunks no longer
 than the delay, each reading the applied force from the dense output of the
 chunks before it.
@@ -20,10 +22,16 @@ import math
 
 import numpy as np
 
-from .compiled import kernel
-from .plant import (MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK, Integration, PlantParameters,
-                    state_index)
-from .trajectory import Trajectory
+from ..trajectory import Trajectory
+from .build import compiled
+from .layout import (EV_LEVEL, EV_LIMIT, EV_SIGN, EV_UNSTICK, MODE_LEVEL, MODE_LIMIT, MODE_SIGN,
+                     MODE_STICK, Integration, PlantParameters, state_index)
+
+#: The solver's terminal events: the mode event (``EV_*``) each is and its direction
+#: (:func:`fi_design.kernel.equations.switch_mode`).
+EVENTS = {"sign": (EV_SIGN, 0), "unstick": (EV_UNSTICK, 0), "limit+": (EV_LIMIT, 1),
+          "limit-": (EV_LIMIT, -1), "limit0": (EV_LIMIT, 0), "level+": (EV_LEVEL, 1),
+          "level-": (EV_LEVEL, -1)}
 
 
 class _History:
@@ -47,12 +55,6 @@ class _History:
         return self.output(t, np.ascontiguousarray(sol(t), dtype=float), modes)
 
 
-def _breakaway(F: float, p) -> float:
-    """Switch model: > 0 once the drive force exceeds static friction in its direction [N]."""
-    k = kernel()
-    return max(F - k.static_friction(1.0, p), -F - k.static_friction(-1.0, p))
-
-
 def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, t_out,
                     rtol: float, atol, x_bound: float, method: str = "Radau",
                     input_time=None, input_force=None):
@@ -60,14 +62,15 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
 
     ``input_time``, ``input_force``: a known input force added to the
     command, held between its samples [s, N] (None for none). Returns a
-    :class:`fi_design.plant.Integration`: code 0 on success, 3 on a solver
+    :class:`fi_design.kernel.layout.Integration`: code 0 on success, 3 on a solver
     failure, 4 on divergence.
     """
     from scipy.integrate import solve_ivp
 
-    k = kernel()  # the compiled equations
+    k = compiled()  # the compiled equations and mode switch
     actuator, controller_output, drive_force = k.actuator, k.controller_output, k.drive_force
     feedforward, jacobian, natural_modes, rhs = k.feedforward, k.jacobian, k.natural_modes, k.rhs
+    breakaway = k.breakaway
     p = params.to_array()
     n = len(y0)
     iso = bool(params.isolated)
@@ -155,7 +158,7 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
         if not stuck:
             evs.append(("sign", lambda tt, yy: sgn * yy[iv2], -1))
         if sw and stuck:
-            evs.append(("unstick", lambda tt, yy: _breakaway(drive(tt, yy), p), 1))
+            evs.append(("unstick", lambda tt, yy: breakaway(drive(tt, yy), p), 1))
         if iso:
             lim = modes[MODE_LIMIT]
             if lim == 0:
@@ -221,7 +224,7 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
             fa_hold = fifo.pop(0)[1]
         if sw and modes[MODE_STICK] == 1:
             F = drive(t, y)
-            if _breakaway(F, p) > 0:
+            if breakaway(F, p) > 0:
                 modes[MODE_STICK] = 0
                 modes[MODE_SIGN] = 1 if F > 0 else -1
         write_outputs(t, t, None)
@@ -264,7 +267,7 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
                 if len(te):
                     y = ye[0].copy()
                     t1 = float(te[0])
-                    _switch(name, y, p, modes, params, iv2, iu, *r_of(t1), fa_at(t1), fa_state)
+                    switch(name, y, p, modes, iv2, iu, *r_of(t1), fa_at(t1), fa_state)
                     n_ev += 1
                     zero_run = zero_run + 1 if t1 - t <= 1e-12 * max(1.0, t) else 0
                     break
@@ -279,31 +282,12 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
                        n_events=n_ev, t_reached=t)
 
 
-def _switch(name, y, p, modes, params, iv2, iu, r, rd, fa, fa_state) -> None:
-    """Mode change at an event located by solve_ivp."""
-    drive_force = kernel().drive_force
-    if name == "sign":
-        if params.switch_model:
-            y[iv2] = 0.0
-            F = drive_force(y, p, modes, r, rd, fa, fa_state)
-            if _breakaway(F, p) <= 0:
-                modes[MODE_STICK] = 1
-            else:
-                modes[MODE_SIGN] = 1 if F > 0 else -1
-        else:
-            modes[MODE_SIGN] = -modes[MODE_SIGN]
-    elif name == "unstick":
-        F = drive_force(y, p, modes, r, rd, fa, fa_state)
-        modes[MODE_STICK] = 0
-        modes[MODE_SIGN] = 1 if F > 0 else -1
-    elif name == "limit+":
-        modes[MODE_LIMIT] = 1
-    elif name == "limit-":
-        modes[MODE_LIMIT] = -1
-    elif name == "limit0":
-        modes[MODE_LIMIT] = 0
-    elif name in ("level+", "level-"):
-        step = 1 if name == "level+" else -1
-        modes[MODE_LEVEL] += step
-        if params.sample_period == 0 and not math.isinf(params.wt):
-            y[iu] += -params.wt * (params.kd + params.kdm) * params.quantization * step
+def switch(name: str, y, p, modes, iv2: int, iu: int, r: float, rd: float, fa: float,
+           fa_state: bool) -> None:
+    """Switch the modes (and jump the state) at the solver's event ``name`` (:data:`EVENTS`).
+
+    The compiled :func:`fi_design.kernel.equations.switch_mode`, the fast
+    integrator's own; the arguments are those of that function.
+    """
+    kind, direction = EVENTS[name]
+    compiled().switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state)

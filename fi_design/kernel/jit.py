@@ -2,10 +2,11 @@
 
 Normally every kernel function gets an explicit signature: numba compiles it
 once, at import, with no literal or layout re-specialisation, and caches it on
-disk. While :mod:`fi_design.aot` builds the ahead-of-time extension (the
-variable :data:`AOT_BUILD_ENV` is set), the functions stay lazy instead:
-the extension compiler types them from the integrator's own signature and
-compiles them into the extension, so nothing is compiled twice.
+disk. While :mod:`fi_design.kernel.build` builds the ahead-of-time
+extension (the variable :data:`AOT_BUILD_ENV` is set), the functions stay
+lazy instead: the extension compiler types them from the signatures
+recorded in :data:`SIGNATURES` and compiles them into the extension, so
+nothing is compiled twice.
 """
 
 from __future__ import annotations

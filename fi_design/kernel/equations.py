@@ -1,27 +1,30 @@
-"""The nonlinear plant's equations: right-hand side and Jacobian (DESIGN.md sections 2, 8).
+"""The nonlinear plant's equations: right-hand side, Jacobian and the mode switch.
 
 Plain functions on floats, compiled with numba and shared by the fast
-integrator (:mod:`fi_design.kernel`) and the scipy reference path
-(:mod:`fi_design.refsolve`), so both integrate the same equations. The
-parameter array, the states and the modes are laid out in
-:mod:`fi_design.plant`, whose module docstring gives the equations in words.
+integrator (:mod:`fi_design.kernel.integrator`) and the scipy reference
+solver (:mod:`fi_design.kernel.reference`), so both integrate the same
+equations and switch modes the same way (:func:`switch_mode`). The parameter
+array, the states and the modes are laid out in
+:mod:`fi_design.kernel.layout`, whose module docstring gives the equations in
+words.
 
-Every function has an explicit signature: numba compiles it once, at import,
-and caches it on disk; the ahead-of-time build (:mod:`fi_design.aot`)
-compiles the same source into an extension module instead.
+Every function has an explicit signature (:mod:`fi_design.kernel.jit`):
+numba compiles it once, at import, and caches it on disk; the build
+(:mod:`fi_design.kernel.build`) compiles the same source into an extension
+module instead.
 """
 
 from __future__ import annotations
 
 import math
 
-from ._jit import A1, A2, I1, b1, f8, i8, kernel_function
-from .plant import (
-    MODE_SIGN, MODE_LIMIT, MODE_LEVEL, MODE_STICK, N_CORE_ISO, N_CORE_RIGID, TWO_PI, P_C,
-    P_CABLE_F0, P_CABLE_K, P_CSTOP, P_FC, P_FC_NEG, P_FF_C, P_FF_F, P_FF_M, P_FLIMIT, P_FS,
-    P_ISO, P_K, P_KD, P_KDM, P_KI, P_KP, P_KSTOP, P_M1, P_M2, P_OFFSET, P_PDF_A, P_PDF_L,
-    P_PDF_PHI, P_QUANT, P_RIP_A, P_RIP_P, P_RIP_PHI, P_S, P_SIGMA0, P_SIGMA1, P_SIGMA2,
-    P_SIGMA2_NEG, P_SWITCH, P_TS, P_VS, P_WT, P_X10)
+from .jit import A1, A2, I1, b1, f8, i8, kernel_function
+from .layout import (
+    EV_LEVEL, EV_LIMIT, EV_SIGN, EV_UNSTICK, MODE_SIGN, MODE_LIMIT, MODE_LEVEL, MODE_STICK,
+    N_CORE_ISO, N_CORE_RIGID, TWO_PI, P_C, P_CABLE_F0, P_CABLE_K, P_CSTOP, P_FC, P_FC_NEG,
+    P_FF_C, P_FF_F, P_FF_M, P_FLIMIT, P_FS, P_ISO, P_K, P_KD, P_KDM, P_KI, P_KP, P_KSTOP, P_M1,
+    P_M2, P_OFFSET, P_PDF_A, P_PDF_L, P_PDF_PHI, P_QUANT, P_RIP_A, P_RIP_P, P_RIP_PHI, P_S,
+    P_SIGMA0, P_SIGMA1, P_SIGMA2, P_SIGMA2_NEG, P_SWITCH, P_TS, P_VS, P_WT, P_X10)
 
 
 # --------------------------------------------------------------------------- pieces
@@ -414,3 +417,83 @@ def natural_modes(y, p, modes):
     q = p[P_QUANT]
     if q > 0.0:
         modes[MODE_LEVEL] = int(math.floor(y[0] / q + 0.5))
+
+
+# --------------------------------------------------------------------------- mode switch
+
+
+@kernel_function((f8, f8))
+def limit_mode(d, s):
+    """Limiter state of the joint deflection ``d`` [m] with stroke ``s`` [m]: -1, 0 or +1."""
+    if d > s:
+        return 1
+    if d < -s:
+        return -1
+    return 0
+
+
+@kernel_function((f8, A1))
+def breakaway(F, p):
+    """Switch model: > 0 once the drive force ``F`` [N] exceeds static friction its way [N]."""
+    return max(F - static_friction(1.0, p), -F - static_friction(-1.0, p))
+
+
+@kernel_function((i8, i8, A1, A1, I1, i8, i8, f8, f8, f8, b1))
+def switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state):
+    """Switch the modes for a located event at the state ``y`` (jumps included).
+
+    The one mode switch of both solvers: the fast integrator and the
+    reference solver locate a crossing each their own way, then call this.
+
+    Parameters
+    ----------
+    kind : int
+        The event (``EV_SIGN``, ``EV_UNSTICK``, ``EV_LIMIT``, ``EV_LEVEL``).
+    direction : int
+        Which way the crossing goes: for ``EV_LIMIT`` out of the free range
+        the limiter engaged, +1 (d > s) or -1 (d < -s), ignored when leaving
+        a limiter; for ``EV_LEVEL`` +1 up a level, -1 down; ignored otherwise.
+    y : ndarray
+        State at the crossing (changed in place: the switch model's stopped
+        cart, the filtered controller's jump).
+    p : ndarray
+        Parameter array.
+    modes : ndarray of int64
+        Modes (changed in place).
+    iv2, iu : int
+        Index of the cart velocity and of the controller output u in ``y``.
+    r, rd, fa, fa_state
+        Reference [m, m/s] and command as for :func:`rhs` (the switch
+        model's drive force).
+
+    Notes
+    -----
+    A quantization level change with a filtered continuous controller makes
+    its output u jump by the derivative terms' impulse, -wt (kd + kdm) q per
+    level. A sampled controller (``sample_period`` > 0) reads the position at
+    its samples and holds its output in u: nothing jumps.
+    """
+    if kind == EV_SIGN:
+        if p[P_SWITCH] != 0.0:
+            y[iv2] = 0.0
+            F = drive_force(y, p, modes, r, rd, fa, fa_state)
+            if breakaway(F, p) <= 0.0:
+                modes[MODE_STICK] = 1
+            else:
+                modes[MODE_SIGN] = 1 if F > 0.0 else -1
+        else:
+            modes[MODE_SIGN] = -modes[MODE_SIGN]
+    elif kind == EV_UNSTICK:
+        F = drive_force(y, p, modes, r, rd, fa, fa_state)
+        modes[MODE_STICK] = 0
+        modes[MODE_SIGN] = 1 if F > 0.0 else -1
+    elif kind == EV_LIMIT:
+        if modes[MODE_LIMIT] == 0:
+            modes[MODE_LIMIT] = 1 if direction > 0 else -1
+        else:
+            modes[MODE_LIMIT] = 0
+    elif kind == EV_LEVEL:
+        step = 1 if direction > 0 else -1
+        modes[MODE_LEVEL] += step
+        if p[P_TS] == 0.0 and not math.isinf(p[P_WT]):
+            y[iu] += -p[P_WT] * (p[P_KD] + p[P_KDM]) * p[P_QUANT] * step

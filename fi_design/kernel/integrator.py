@@ -3,7 +3,7 @@
 Method (Hairer and Wanner, *Solving ODEs II*, section IV.7): RODAS4, a
 six-stage, L-stable, stiffly accurate Rosenbrock method of order 4 with an
 embedded order-3 error estimate and a continuous extension of order 3 for
-dense output. It uses the analytic Jacobian of :mod:`fi_design.plant`
+dense output. It uses the analytic Jacobian of :mod:`fi_design.kernel.equations`
 (one LU decomposition per step, six back-substitutions) and the explicit time
 derivative of the right-hand side, which the reference motion makes
 non-autonomous.
@@ -40,8 +40,8 @@ history overflow) end the run with a status code and the time reached; the
 caller reports them, never silent garbage.
 
 Compilation: this module is the kernel's source. Installing the package
-compiles it ahead of time into an extension module (:mod:`fi_design.aot`),
-which :mod:`fi_design.compiled` runs; this module is then never imported.
+compiles it ahead of time into an extension module (:mod:`fi_design.kernel.build`),
+which :func:`fi_design.kernel.run` calls; this module is then never imported.
 Where that build is missing or older than the source, numba compiles it
 here instead: every function has an explicit signature, so it compiles once,
 at import, and numba caches it on disk (``cache=True``) in the package's
@@ -56,21 +56,20 @@ import math
 
 import numpy as np
 
-from ._jit import A1, A2, I1, b1, f8, i8, kernel_function
-from .equations import (actuator, control_law, controller_output, drive_force, feedforward,
-                        jacobian, measured_position, natural_modes, rhs, static_friction)
-from .plant import (DIVERGED, HISTORY_OVERFLOW, MAX_PERIOD, MODE_LEVEL, MODE_LIMIT, MODE_SIGN,
-                    MODE_STICK, N_CORE_ISO, N_CORE_RIGID, N_STATS, NOT_FINITE, OK, P_DA, P_DB,
-                    P_DC, P_DELAY, P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F, P_FF_M, P_ISO,
-                    P_KD, P_KDM, P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT,
-                    ST_CROSSINGS, ST_EVENTS, ST_H, ST_LIMIT_EVENTS, ST_OUT, ST_PERIOD,
-                    ST_REJECTED, ST_STEPS, ST_STOP, ST_T, ST_ZERO_EVENTS, STEP_UNDERFLOW,
-                    STOP_CROSSINGS, STOP_END, STOP_QUIET, STOP_REPEAT, TOO_MANY_STEPS, W_ARM,
-                    W_BAND, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_REPEAT, W_REST_ANYWHERE,
-                    W_START)
-
-# Event kinds (EV_SECTION: the watch's Poincare section, no mode change).
-EV_NONE, EV_SIGN, EV_LIMIT, EV_LEVEL, EV_UNSTICK, EV_SECTION = 0, 1, 2, 3, 4, 5
+from .equations import (actuator, breakaway, control_law, controller_output, drive_force,
+                        feedforward, jacobian, limit_mode, measured_position, natural_modes, rhs,
+                        switch_mode)
+from .jit import A1, A2, I1, b1, f8, i8, kernel_function
+from .layout import (DIVERGED, EV_LEVEL, EV_LIMIT, EV_NONE, EV_SECTION, EV_SIGN, EV_UNSTICK,
+                     HISTORY_OVERFLOW, MAX_PERIOD, MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK,
+                     N_CORE_ISO, N_CORE_RIGID, N_STATS, NOT_FINITE, OK, P_DA, P_DB, P_DC, P_DELAY,
+                     P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F, P_FF_M, P_ISO, P_KD, P_KDM,
+                     P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT,
+                     ST_CROSSINGS, ST_EVENTS, ST_H, ST_LIMIT_EVENTS, ST_OUT, ST_PERIOD,
+                     ST_REJECTED, ST_STEPS, ST_STOP, ST_T, ST_ZERO_EVENTS, STEP_UNDERFLOW,
+                     STOP_CROSSINGS, STOP_END, STOP_QUIET, STOP_REPEAT, TOO_MANY_STEPS, W_ARM,
+                     W_BAND, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_REPEAT, W_REST_ANYWHERE,
+                     W_START)
 
 HIST = 8192  # delay history ring size
 HT, HU, HDU, HUR, HDUR = range(5)  # rows of the history: time, value and rate in, out
@@ -363,21 +362,6 @@ def history_at(tq, hist, head, count, u_before):
 # --------------------------------------------------------------------------- events
 
 
-@kernel_function((f8, f8))
-def _limit_mode(d, s):
-    if d > s:
-        return 1
-    if d < -s:
-        return -1
-    return 0
-
-
-@kernel_function((f8, A1))
-def breakaway(F, p):
-    """Switch model: > 0 once the drive force ``F`` [N] exceeds static friction its way [N]."""
-    return max(F - static_friction(1.0, p), -F - static_friction(-1.0, p))
-
-
 @kernel_function((f8, f8, A1, A1, A1, A1, i8, i8, i8, f8, A1, I1, f8, f8, f8, b1, A1))
 def _root(g0, g1, y0, y1, k2, k3, kind, idx, idx2, offset, p, modes, r, rd, fa, fa_state, ybuf):
     """Locate the zero of a switching function on the dense output, theta in [0, 1].
@@ -458,7 +442,7 @@ def find_event(y0, y1, k2, k3, p, modes, iv2, r, rd, fa, fa_state, ybuf, skip):
         s = p[P_S]
         lim = modes[MODE_LIMIT]
         d1 = y1[0] - y1[2]
-        l1 = _limit_mode(d1, s)
+        l1 = limit_mode(d1, s)
         if l1 != lim:
             d0 = y0[0] - y0[2]
             # boundary crossed first when leaving `lim` towards l1
@@ -468,7 +452,7 @@ def find_event(y0, y1, k2, k3, p, modes, iv2, r, rd, fa, fa_state, ybuf, skip):
                 off = -s
             g0 = d0 - off
             g1 = d1 - off
-            if _limit_mode(d0, s) != lim or g0 == 0.0 or (g0 > 0.0) == (g1 > 0.0):
+            if limit_mode(d0, s) != lim or g0 == 0.0 or (g0 > 0.0) == (g1 > 0.0):
                 th = 0.0
             else:
                 th = _root(g0, g1, y0, y1, k2, k3, 1, 0, 2, off, p, modes, r, rd, fa, fa_state,
@@ -498,43 +482,19 @@ def find_event(y0, y1, k2, k3, p, modes, iv2, r, rd, fa, fa_state, ybuf, skip):
 
 @kernel_function((i8, A1, A1, I1, i8, i8, f8, f8, f8, b1, A1))
 def apply_event(kind, y, p, modes, iv2, iu, r, rd, fa, fa_state, y_trial):
-    """Switch the mode for event ``kind`` at the current state (jumps included).
+    """Switch the modes for event ``kind`` at the current state ``y`` (jumps included).
 
     ``y_trial`` is the end of the trial step that detected the event: it tells
-    the direction of limiter and quantization crossings. A quantization level
-    change with a filtered continuous controller makes its output u jump by
-    the derivative terms' impulse, -wt (kd + kdm) q per level.
+    the direction of limiter and quantization crossings, which
+    :func:`fi_design.kernel.equations.switch_mode` then applies.
     """
-    if kind == EV_SIGN:
-        if p[P_SWITCH] != 0.0:
-            y[iv2] = 0.0
-            F = drive_force(y, p, modes, r, rd, fa, fa_state)
-            if breakaway(F, p) <= 0.0:
-                modes[MODE_STICK] = 1
-            else:
-                modes[MODE_SIGN] = 1 if F > 0.0 else -1
-        else:
-            modes[MODE_SIGN] = -modes[MODE_SIGN]
-    elif kind == EV_UNSTICK:
-        F = drive_force(y, p, modes, r, rd, fa, fa_state)
-        modes[MODE_STICK] = 0
-        modes[MODE_SIGN] = 1 if F > 0.0 else -1
-    elif kind == EV_LIMIT:
-        s = p[P_S]
-        lim = modes[MODE_LIMIT]
-        target = _limit_mode(y_trial[0] - y_trial[2], s)
-        if lim == 0:
-            modes[MODE_LIMIT] = target
-        else:
-            modes[MODE_LIMIT] = 0
+    direction = 0
+    if kind == EV_LIMIT:
+        direction = limit_mode(y_trial[0] - y_trial[2], p[P_S])
     elif kind == EV_LEVEL:
-        q = p[P_QUANT]
-        lev = modes[MODE_LEVEL]
-        l1 = int(math.floor(y_trial[0] / q + 0.5))
-        step = 1 if l1 > lev else -1
-        modes[MODE_LEVEL] = lev + step
-        if not math.isinf(p[P_WT]):
-            y[iu] += -p[P_WT] * (p[P_KD] + p[P_KDM]) * q * step
+        level = int(math.floor(y_trial[0] / p[P_QUANT] + 0.5))
+        direction = 1 if level > modes[MODE_LEVEL] else -1
+    switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state)
 
 
 # --------------------------------------------------------------------------- commands
@@ -542,7 +502,7 @@ def apply_event(kind, y, p, modes, iv2, iu, r, rd, fa, fa_state, y_trial):
 
 @kernel_function((f8, A1, A1, A2, A1, A1, I1, f8, A2, i8, i8))
 def stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold, hist, head, count):
-    """The ``fa`` argument of :func:`fi_design.plant.rhs` at time ``ts``, and its rate.
+    """The ``fa`` argument of :func:`fi_design.kernel.equations.rhs` at time ``ts``, and its rate.
 
     Continuous controller without delay: the command's parts beyond the
     controller output (feedforward, input force). With a delay: the whole
@@ -629,7 +589,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     Parameters
     ----------
     p : ndarray, float64
-        Plant parameters (:class:`fi_design.plant.PlantParameters`).
+        Plant parameters (:class:`fi_design.kernel.layout.PlantParameters`).
     y0 : ndarray, float64, shape (n,)
         Initial state (7 isolated, 5 rigid).
     breaks, coeffs : ndarray
@@ -667,7 +627,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
         Output: counters (``ST_*``).
     watch : ndarray, shape (N_WATCH,)
         What to watch for once the motion is over (``W_*`` in
-        :mod:`fi_design.plant`): from ``watch[W_START]`` on, the upward
+        :mod:`fi_design.kernel.layout`): from ``watch[W_START]`` on, the upward
         crossings of x1 - r = 0 (r = ``watch[W_LEVEL]``, the held reference)
         are located like mode events (the step is redone to end on them) and
         recorded, and the run stops early when the stage has come to rest (the

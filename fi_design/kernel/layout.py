@@ -1,11 +1,14 @@
-"""The nonlinear plant's layout: its parameters, states and modes (DESIGN.md sections 2, 8).
+"""The nonlinear plant's layout: its parameters, states, modes and the kernel's arrays.
 
 One table each for the kernel's parameter array (:class:`PlantParameters`)
-and the state vector; the equations themselves (right-hand side, Jacobian)
-are in :mod:`fi_design.equations`, compiled with numba and shared by the fast
-integrator (:mod:`fi_design.kernel`) and the scipy reference path. This
-module is plain Python: the simulation reads the layout without loading any
-compiled code.
+and the state vector; the modes and the mode events; what an integration
+returns (:class:`Integration`, the status codes, the statistics array) and
+the watch array (``W_*``) with its stop reasons. The equations themselves
+(right-hand side, Jacobian, the mode switch) are in
+:mod:`fi_design.kernel.equations`, compiled with numba and shared by the
+fast integrator (:mod:`fi_design.kernel.integrator`) and the scipy reference
+solver (:mod:`fi_design.kernel.reference`). This module is plain Python: the
+simulation reads the layout without loading any compiled code.
 
 Units of the kernel parameters (:class:`PlantParameters`, whose field order is
 the kernel's parameter-array layout; the ``P_*`` indices are derived from it by
@@ -77,6 +80,9 @@ Modes (int array, frozen during a step so the right-hand side is smooth):
 values of a direction and the switch model's friction sign), ``MODE_LIMIT``
 limiter state (-1, 0, +1), ``MODE_LEVEL`` quantization level n (the
 controller sees n q), ``MODE_STICK`` switch model: 1 while the cart sticks.
+A mode event (``EV_*``) changes them: both solvers locate the crossing their
+own way and switch with the one compiled
+:func:`fi_design.kernel.equations.switch_mode`.
 """
 
 from __future__ import annotations
@@ -258,6 +264,12 @@ if (ISOLATED_STATES[-3:] != LEAVES or RIGID_STATES[-3:] != LEAVES
 MODE_SIGN, MODE_LIMIT, MODE_LEVEL, MODE_STICK = 0, 1, 2, 3
 N_MODES = 4
 
+# Mode events: the cart's velocity reverses (LuGre: the sliding sign flips; switch model: the
+# cart sticks or slides on), the switch model's cart breaks away, the joint enters or leaves a
+# limiter, the measured position crosses to another quantization level. EV_SECTION is the
+# watch's Poincare section (no mode change).
+EV_NONE, EV_SIGN, EV_LIMIT, EV_LEVEL, EV_UNSTICK, EV_SECTION = 0, 1, 2, 3, 4, 5
+
 TWO_PI = 2.0 * math.pi
 
 
@@ -302,7 +314,7 @@ N_STATS = 11
 # --------------------------------------------------------------------------- the watch
 
 # Layout of the kernel's watch array: what a run watches for once the motion is over, and
-# when it stops early (see ``fi_design.kernel.integrate``). Times in s, lengths in m.
+# when it stops early (see ``fi_design.kernel.integrator.integrate``). Times in s, lengths in m.
 # W_START: time from which the watch is on (inf: off); W_LEVEL: the held reference r, the
 # Poincare section is x1 - r = 0 crossed upwards; W_BAND: band [m] of the quiet rule;
 # W_QUIET: stop once x1 has stayed within W_BAND of one position (and, unless

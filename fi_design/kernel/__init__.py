@@ -1,0 +1,85 @@
+"""The simulation kernel: the nonlinear plant, its fast integrator and its reference solver.
+
+One module a job:
+
+- :mod:`~fi_design.kernel.layout`: the parameter array, the states, the
+  modes and mode events, what an integration returns, the watch array
+  (plain Python: reading it loads no compiled code);
+- :mod:`~fi_design.kernel.equations`: right-hand side, Jacobian, friction,
+  controller and the mode switch (compiled);
+- :mod:`~fi_design.kernel.integrator`: the RODAS4 integrator with events,
+  the delay history, the discrete controller and the watch (compiled);
+- :mod:`~fi_design.kernel.jit`: how numba compiles a kernel function, and
+  the signature types;
+- :mod:`~fi_design.kernel.build`: the one seam between the source and
+  machine code: the ahead-of-time build at install, the digest that ties it
+  to the package's files, and the choice of build at run time;
+- :mod:`~fi_design.kernel.reference`: scipy's ``solve_ivp`` on the same
+  compiled equations and mode switch, for tests and benchmarks.
+
+:func:`run` is the fast integrator's Python entry point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .layout import (N_STATS, N_WATCH, ST_CROSSINGS, ST_EVENTS, ST_PERIOD, ST_REJECTED, ST_STEPS,
+                     ST_STOP, ST_T, STATUS_TEXT, STOP_TEXT, W_QUIET, W_START, Integration)
+
+__all__ = ["run"]
+
+
+def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
+        max_steps=2_000_000, x_bound=10.0, input_time=None, input_force=None, watch=None,
+        crossings: int = 0) -> Integration:
+    """Allocate outputs and call the integrator (:func:`fi_design.kernel.integrator.integrate`).
+
+    Returns a :class:`fi_design.kernel.layout.Integration`; see ``integrate``
+    for the arguments (``input_time``, ``input_force``: the known input
+    force's samples [s, N], None for none; ``watch``: the watch array,
+    ``W_*`` in :mod:`fi_design.kernel.layout`, None for none; ``crossings``:
+    room for this many section crossings). This thin wrapper is the
+    integrator's only Python-level entry point, in whichever build
+    :func:`fi_design.kernel.build.compiled` chose; :mod:`fi_design.simulation`
+    wraps it in a result.
+    """
+    from .build import compiled  # not at import: `python -m fi_design.kernel.build` runs it
+
+    # fresh writable copies: compiled code types read-only arrays differently
+    p = np.array(params, dtype=np.float64)
+    y = np.array(y0, dtype=np.float64)
+    t_out = np.array(t_out, dtype=np.float64)
+    in_t = np.zeros(0) if input_time is None else np.array(input_time, dtype=np.float64)
+    in_f = np.zeros(0) if input_force is None else np.array(input_force, dtype=np.float64)
+    n = y.shape[0]
+    m = t_out.shape[0]
+    out_y = np.full((m, n), np.nan)
+    out_r = np.full(m, np.nan)
+    out_fa = np.full(m, np.nan)
+    out_cmd = np.full(m, np.nan)
+    stats = np.zeros(N_STATS)
+    if watch is None:
+        w = np.zeros(N_WATCH)
+        w[W_START] = np.inf
+        w[W_QUIET] = np.inf
+    else:
+        w = np.array(watch, dtype=np.float64)
+    k = max(int(crossings), 1)
+    cross_t = np.full(k, np.nan)
+    cross_y = np.full((k, n), np.nan)
+    cross_e = np.full((k, 2), np.nan)
+    y_end = np.full(n, np.nan)
+    status = compiled().integrate(
+        p, y, np.array(breaks, dtype=np.float64), np.array(coeffs, dtype=np.float64, order="C"),
+        bool(land), float(t_end), t_out, float(rtol), np.array(atol, dtype=np.float64),
+        float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r, out_fa, out_cmd,
+        stats, w, cross_t, cross_y, cross_e, y_end)
+    c = int(stats[ST_CROSSINGS])
+    return Integration(code=int(status), status=STATUS_TEXT[int(status)], states=out_y,
+                       reference=out_r, applied_force=out_fa, command=out_cmd,
+                       n_steps=int(stats[ST_STEPS]), n_rejected=int(stats[ST_REJECTED]),
+                       n_events=int(stats[ST_EVENTS]), t_reached=float(stats[ST_T]),
+                       final_state=y_end, stop=STOP_TEXT[int(stats[ST_STOP])],
+                       crossing_times=cross_t[:c], crossing_states=cross_y[:c],
+                       crossing_extremes=cross_e[:c], period_crossings=int(stats[ST_PERIOD]))
