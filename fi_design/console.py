@@ -162,8 +162,6 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     spec_path : pathlib.Path, optional
         The spec file, named in the heading.
     """
-    from rich import box
-    from rich.table import Table
     from rich.text import Text
 
     data = result.to_dict()

@@ -286,7 +286,6 @@ def _search_round(cmp, spaces, baseline: Baseline, earlier: list, base: list, th
                   max_points, index, max_effects, say) -> RoundResult:
     judged: dict[str, Candidate] = {}
     outcomes: dict[str, FitOutcome] = {}
-    n = cmp.n_points
     for j, sp in enumerate(spaces):
         say(f"fitting {sp.name}", 0.05 + 0.9 * (index + j / max(len(spaces), 1)) / max_effects)
         t0 = _time.perf_counter()
