@@ -68,3 +68,38 @@ def test_public_functions_stay_callable_after_their_modules_are_imported():
             "bad = [n for n in names if not callable(getattr(fi_design, n))]\n"
             "assert not bad, bad\n")
     subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)
+
+
+# --------------------------------------------------------------------------- module sizes
+
+
+def _lines(path) -> int:
+    return len(path.read_text(encoding="utf-8").splitlines())
+
+
+#: The one module allowed above :data:`MAX_LINES`: the kernel's integrator (one compiled loop).
+LONG_MODULES = {"fi_design/kernel/integrator.py"}
+MAX_LINES = 800
+#: Modules of the presentation packages stay smaller still: one result family each.
+MAX_FAMILY_LINES = 600
+
+
+@pytest.mark.parametrize("package", ["plots", "console"])
+def test_presentation_is_a_package_by_result_family(package):
+    """plots and console served every result family from one module each (1,400 and 1,150
+    lines); they are packages with one module per family, re-exported by name."""
+    folder = ROOT / "fi_design" / package
+    assert (folder / "__init__.py").is_file(), f"fi_design/{package} is not a package"
+    assert not (ROOT / "fi_design" / f"{package}.py").exists()
+    modules = sorted(folder.glob("*.py"))
+    assert len(modules) >= 5, [m.name for m in modules]
+    long = {m.name: _lines(m) for m in modules if _lines(m) > MAX_FAMILY_LINES}
+    assert not long, long
+    init = (folder / "__init__.py").read_text(encoding="utf-8")
+    assert "import *" not in init
+
+
+def test_no_module_is_over_800_lines_but_the_integrator():
+    sizes = {str(p.relative_to(ROOT)): _lines(p) for p in (ROOT / "fi_design").rglob("*.py")}
+    long = {p: n for p, n in sizes.items() if n > MAX_LINES and p not in LONG_MODULES}
+    assert not long, long

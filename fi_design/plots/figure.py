@@ -1,0 +1,228 @@
+"""Report figures and their rendering: the page style, fixed margins, SVG and PNG bytes.
+
+What every result family's figures share: :data:`REPORT_RC` and
+:func:`report_figure` (the A4 text width, fixed margins), :func:`styled`,
+plain tick labels on log axes, the thinning of long traces
+(:func:`decimate`), cell edges of a map, and the two renderings
+(:func:`figure_svg` for inlining in HTML, :func:`figure_bytes` for files),
+both reproducible. matplotlib is imported inside the functions.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import ArgumentError
+
+
+#: Width of a full-width report figure [in]: the A4 text width (170 mm), so 1 pt is 1 pt.
+REPORT_WIDTH = 6.7
+
+
+#: matplotlib settings of the report figures: fonts readable on paper, light grid.
+REPORT_RC = {
+    "font.size": 8.5, "axes.titlesize": 9.0, "axes.labelsize": 8.5, "xtick.labelsize": 8.0,
+    "ytick.labelsize": 8.0, "legend.fontsize": 7.5, "axes.grid": True, "grid.color": "0.88",
+    "grid.linewidth": 0.6, "axes.linewidth": 0.7, "lines.linewidth": 1.3,
+    "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False,
+    "figure.dpi": 100,
+}
+
+
+def report_figure(height: float, width: float = REPORT_WIDTH, *, left: float = 0.62,
+                   right: float = 0.12, top: float = 0.12, bottom: float = 0.45,
+                   hspace: float = 0.35) -> Any:
+    """A report figure with fixed margins [in].
+
+    Fixed margins rather than a layout engine: the report's figures have known
+    contents, and a layout engine draws every figure twice (it doubled the
+    report's figure time).
+    """
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height))
+    fig.subplots_adjust(left=left / width, right=1.0 - right / width, top=1.0 - top / height,
+                        bottom=bottom / height, hspace=hspace)
+    return fig
+
+
+def styled(draw):
+    """Run a figure function under :data:`REPORT_RC` (fonts are fixed when artists are made)."""
+    import functools
+
+    @functools.wraps(draw)
+    def wrapper(*args, **kwargs):
+        import matplotlib
+
+        with matplotlib.rc_context(REPORT_RC):
+            return draw(*args, **kwargs)
+
+    return wrapper
+
+
+def plain_tick(value: float, _pos: Any = None) -> str:
+    """Tick label of a log axis as a plain number (``0.001``, ``10``, ``1000``).
+
+    Plain text instead of matplotlib's mathtext powers of ten: readable, and
+    much faster to draw.
+
+    Parameters
+    ----------
+    value : float
+        Tick value.
+
+    Returns
+    -------
+    str
+    """
+    if value <= 0:
+        return ""
+    if 1e-4 <= value < 1e5:
+        return f"{value:g}" if value >= 1 else f"{value:.{max(0, -math.floor(math.log10(value) + 1e-9))}f}"
+    return f"{value:.0e}".replace("e+0", "e").replace("e-0", "e-")
+
+
+def log_x(ax: Any, numticks: int = 12) -> None:
+    """Logarithmic x axis with plain decade labels and no minor ticks (they are slow to draw)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
+
+    ax.set_xscale("log")
+    ax.xaxis.set_major_locator(LogLocator(base=10.0, subs=(1.0,), numticks=numticks))
+    ax.xaxis.set_major_formatter(FuncFormatter(plain_tick))
+    ax.xaxis.set_minor_locator(NullLocator())
+
+
+def nice_ticks(lo: float, hi: float) -> list[float]:
+    """1-2-5 ticks between ``lo`` and ``hi`` (for log axes).
+
+    Parameters
+    ----------
+    lo, hi : float
+        The axis range (above zero).
+
+    Returns
+    -------
+    list of float
+    """
+    out = []
+    for exp in range(math.floor(math.log10(lo)) - 1, math.ceil(math.log10(hi)) + 1):
+        for m in (1.0, 2.0, 5.0):
+            v = m * 10.0 ** exp
+            if lo * 0.999 <= v <= hi * 1.001:
+                out.append(float(f"{v:.6g}"))
+    return out
+
+
+def cell_edges(values: np.ndarray, log: bool) -> np.ndarray:
+    """Cell edges around centres (geometric midpoints on a log axis)."""
+    v = np.asarray(values, dtype=float)
+    if len(v) == 1:
+        return np.array([v[0] * 0.9, v[0] * 1.1]) if log else np.array([v[0] - 0.5, v[0] + 0.5])
+    if log:
+        lv = np.log(v)
+        mid = (lv[1:] + lv[:-1]) / 2
+        return np.exp(np.concatenate([[2 * lv[0] - mid[0]], mid, [2 * lv[-1] - mid[-1]]]))
+    mid = (v[1:] + v[:-1]) / 2
+    return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
+
+
+def decimate(t: np.ndarray, y: np.ndarray, buckets: int = 700) -> tuple[np.ndarray, np.ndarray]:
+    """Thin a trace for plotting, keeping each bucket's minimum and maximum.
+
+    Parameters
+    ----------
+    t, y : numpy.ndarray, shape (n,)
+        Sample times and values.
+    buckets : int, optional
+        Number of buckets; at most two samples survive per bucket.
+
+    Returns
+    -------
+    t, y : numpy.ndarray
+        The kept samples, in time order (the input when it is short already).
+    """
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    n = len(t)
+    if n <= 2 * buckets:
+        return t, y
+    edges = np.linspace(0, n, buckets + 1).astype(int)
+    keep = [0, n - 1]
+    for a, b in zip(edges[:-1], edges[1:]):
+        seg = y[a:b]
+        if len(seg) and np.any(np.isfinite(seg)):
+            keep += [a + int(np.nanargmin(seg)), a + int(np.nanargmax(seg))]
+        elif len(seg):  # no value here (a failed run): keep one NaN so the line breaks
+            keep.append(a)
+    idx = np.unique(np.array(keep))
+    return t[idx], y[idx]
+
+
+def figure_svg(fig: Any, prefix: str, text_as_paths: bool = False) -> str:
+    """A figure as SVG text for inlining in HTML: no XML prolog, unique ids, scalable.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    prefix : str
+        Prepended to every ``id`` (and the references to it), so several
+        figures can share one HTML page; letters, digits and ``-`` only.
+    text_as_paths : bool, optional
+        Draw text as glyph outlines (equations: exact, with any font);
+        default False.
+
+    Returns
+    -------
+    str
+        An ``<svg>`` element with a ``viewBox`` (CSS sizes it), reproducible
+        (fixed id salt, no date). By default text stays text
+        (``svg.fonttype: none``): searchable, and about twice as fast for
+        WeasyPrint to draw as glyph outlines; viewers draw it with their own
+        sans-serif font.
+    """
+    import re
+
+    import matplotlib
+
+    buf = io.BytesIO()
+    with matplotlib.rc_context({"svg.hashsalt": "fi_design",
+                                "svg.fonttype": "path" if text_as_paths else "none"}):
+        fig.savefig(buf, format="svg", metadata={"Date": None})
+    text = buf.getvalue().decode("utf-8")
+    text = text[text.index("<svg"):]
+    text = re.sub(r'\bid="([^"]+)"', lambda m: f'id="{prefix}-{m.group(1)}"', text)
+    text = re.sub(r'href="#([^"]+)"', lambda m: f'href="#{prefix}-{m.group(1)}"', text)
+    text = re.sub(r"url\(#([^)]+)\)", lambda m: f"url(#{prefix}-{m.group(1)})", text)
+    text = re.sub(r"<metadata>.*?</metadata>\s*", "", text, flags=re.DOTALL)
+    return text.strip()
+
+
+def figure_bytes(fig: Any, fmt: str = "svg") -> bytes:
+    """Render a figure to SVG or PNG bytes, reproducibly (no date, fixed SVG ids).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    fmt : {"svg", "png"}
+        Output format.
+
+    Returns
+    -------
+    bytes
+    """
+    import matplotlib
+
+    fmt = fmt.lower().lstrip(".")
+    if fmt not in ("svg", "png"):
+        raise ArgumentError(f"unsupported figure format {fmt!r}; use svg or png")
+    buf = io.BytesIO()
+    meta = {"Date": None} if fmt == "svg" else {"Software": None}
+    with matplotlib.rc_context({"svg.hashsalt": "fi_design", "svg.fonttype": "path"}):
+        fig.savefig(buf, format=fmt, dpi=150 if fmt == "png" else None, metadata=meta)
+    return buf.getvalue()

@@ -1,0 +1,201 @@
+"""Hunting as a property of the stage: the move family, the cycles, the boundary in crossover.
+
+Read from a design's confirmation (its ``stage``: every move's outcome, the
+converged cycle, the branch and fold on the crossover axis).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .confirmation import PLANT_COLOURS, SETTLE_ZOOM, motion_end, plant_names
+from .figure import decimate, log_x, report_figure, styled
+
+
+#: Markers of the move outcomes: (marker, filled).
+MOVE_MARKS = {"hunts": ("o", True), "settles": ("o", False), "rests": ("s", False),
+              "stuck": ("s", True), "undetermined": ("D", False)}
+
+
+@styled
+def moves_figure(confirmation: Any) -> Any:
+    """How each plant ends after every move of its family (stage-level hunting).
+
+    x: the move distance (log); y: the peak-to-peak amplitude of the cycle a
+    move ends in, 0 for a move that comes to rest. Filled circles hunt, open
+    circles settle, squares rest off target (open: within a loop's static
+    error; filled: stuck), diamonds could not be judged; a star marks the
+    spec's own motion. Negative moves are drawn at their distance with a
+    lighter colour.
+
+    Parameters
+    ----------
+    confirmation : fi_design.results.design.Confirmation
+        The simulated confirmation (its ``stage``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = report_figure(2.7, top=0.35)
+    ax = fig.add_subplot()
+    names = plant_names(confirmation)
+    top = 0.0
+    for key in ("isolated", "non_isolated"):
+        st = confirmation.stage[key]
+        col = PLANT_COLOURS[key]
+        ax.plot([], [], "o", color=col, label=names[key])
+        for m in st.moves:
+            d = abs(m.distance) * 1e3
+            if d <= 0:
+                continue
+            amp = (m.amplitude or 0.0) * 1e3 if m.hunts else 0.0
+            top = max(top, amp)
+            mk, filled = MOVE_MARKS.get(m.outcome, ("x", True))
+            if m.label == "spec":
+                mk, filled = "*", m.hunts
+            alpha = 1.0 if m.distance > 0 else 0.45
+            ax.plot([d], [amp], mk, ms=7 if m.label == "spec" else 4.5, color=col,
+                    mfc=col if filled else "white", mew=1.0, alpha=alpha, ls="none")
+    log_x(ax)
+    ax.set_xlabel("move distance [mm]")
+    ax.set_ylabel("cycle peak to peak [mm]")
+    ax.set_ylim(-0.08 * max(top, 0.1), 1.15 * max(top, 0.1))
+    from matplotlib.lines import Line2D
+
+    handles, labels = ax.get_legend_handles_labels()
+    for word, (mk, filled) in (("hunts", MOVE_MARKS["hunts"]), ("settles", MOVE_MARKS["settles"]),
+                               ("rests off target", MOVE_MARKS["rests"]),
+                               ("spec's motion", ("*", False))):
+        handles.append(Line2D([], [], marker=mk, ls="none", ms=5, color="0.25",
+                              mfc="0.25" if filled else "white", mew=0.9))
+        labels.append(word)
+    fig.legend(handles, labels, loc="upper center", ncols=len(labels), bbox_to_anchor=(0.5, 1.0))
+    return fig
+
+
+@styled
+def cycle_figure(confirmation: Any, spec: Any) -> Any:
+    """The hunting cycles themselves, beside the settling of the spec's own motion.
+
+    Left: phase portrait of each plant's converged cycle, x1 - r [mm] against
+    the stage velocity v1 [mm/s]. Middle: the joint deflection x1 - x2 over
+    one period of the isolated stage's cycle, with its stroke (the limiter
+    beyond). Right: x1 - r of the plant as specified after the spec's own
+    motion [µm], with the settle band: the move the spec names may settle
+    while others hunt.
+
+    Parameters
+    ----------
+    confirmation : fi_design.results.design.Confirmation
+        The simulated confirmation (``stage`` and ``results``).
+    spec : fi_design.spec.Spec
+        The design spec (settle band).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    h = spec.requirements.hunting
+    names = plant_names(confirmation)
+    fig = report_figure(2.8, top=0.5, right=0.1)
+    fig.subplots_adjust(wspace=0.42)
+    ax_p, ax_d, ax_s = fig.subplots(1, 3, width_ratios=(1.15, 1.0, 1.0))
+    for key in ("isolated", "non_isolated"):
+        c = confirmation.stage[key].cycle
+        if c is None or c.trace is None:
+            continue
+        tr = c.trace
+        ax_p.plot(np.asarray(tr.error) * 1e3, np.asarray(tr.velocity) * 1e3,
+                  color=PLANT_COLOURS[key], lw=1.1,
+                  label=f"{names[key]}: cycle of {c.amplitude * 1e3:.3g} mm, {c.period:.3g} s")
+    ax_p.axvline(0.0, color="0.6", lw=0.6)
+    ax_p.set_xlabel("x1 - r [mm]")
+    ax_p.set_ylabel("v1 [mm/s]")
+    ax_p.set_title("phase portrait", loc="left", fontsize=7.5)
+    if ax_p.get_legend_handles_labels()[0]:
+        fig.legend(*ax_p.get_legend_handles_labels(), loc="upper center", ncols=2,
+                   bbox_to_anchor=(0.5, 1.0))
+    c = confirmation.stage["isolated"].cycle
+    stroke = confirmation.landing.stroke if confirmation.landing is not None else None
+    if c is not None and c.trace is not None and c.trace.deflection is not None:
+        ax_d.plot(c.trace.time, np.asarray(c.trace.deflection) * 1e6,
+                  color=PLANT_COLOURS["isolated"], lw=1.1)
+        ax_d.set_xlim(0, float(c.trace.time[-1]))
+    else:
+        ax_d.text(0.5, 0.5, "no cycle with the isolator", transform=ax_d.transAxes,
+                  ha="center", va="center", fontsize=7.5, color="0.35")
+    if stroke is not None:
+        for sign in (1, -1):
+            ax_d.axhline(sign * stroke * 1e6, color="0.3", lw=0.8, ls="--")
+        ax_d.set_ylim(-1.4 * stroke * 1e6, 1.4 * stroke * 1e6)
+    ax_d.set_xlabel("time in the period [s]")
+    ax_d.set_ylabel("x1 - x2 [µm]")
+    ax_d.set_title("joint deflection, isolated cycle", loc="left", fontsize=7.5)
+    band = h.settle_band * 1e6
+    zoom = SETTLE_ZOOM * band
+    ax_s.axhspan(-band, band, color="#dcefe0", lw=0, zorder=0)
+    own = "non_isolated" if confirmation.suggested_isolator else "isolated"
+    res = confirmation.results[own]
+    t0 = motion_end(res.time, res.reference)
+    after = res.time >= t0
+    tz, ez = decimate(res.time[after], res.error[after] * 1e6)
+    ax_s.plot(tz, np.clip(ez, -1.5 * zoom, 1.5 * zoom), color=PLANT_COLOURS[own], lw=1.0)
+    ax_s.set_ylim(-zoom, zoom)
+    ax_s.set_xlim(t0, float(res.time[-1]))
+    ax_s.set_xlabel("time [s]")
+    ax_s.set_ylabel("x1 - r [µm]")
+    ax_s.set_title(f"spec's motion, ±{band:g} µm band", loc="left", fontsize=7.5)
+    return fig
+
+
+@styled
+def boundary_figure(confirmation: Any) -> Any:
+    """The stage-level boundary on the crossover axis.
+
+    For each plant, the peak-to-peak amplitude of its hunting cycle as the
+    crossover rises (the points the bisection found the cycle at), ending at
+    the cycle's fold: from there on no move of the family hunts (dotted). The
+    design crossover is dashed.
+
+    Parameters
+    ----------
+    confirmation : fi_design.results.design.Confirmation
+        The simulated confirmation (``stage``: the crossover its plants were
+        judged at, their branches and folds).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = report_figure(2.6, top=0.35)
+    ax = fig.add_subplot()
+    names = plant_names(confirmation)
+    for n, key in enumerate(("isolated", "non_isolated")):
+        st = confirmation.stage[key]
+        col = PLANT_COLOURS[key]
+        b = st.boundary or {}
+        pts = [p for p in b.get("branch") or [] if p[1] is not None]
+        if pts:
+            f, a = np.array([p[0] for p in pts]), np.array([p[1] for p in pts]) * 1e3
+            ax.plot(f, a, "o-", color=col, ms=3, lw=1.1, label=f"{names[key]}: cycle")
+        m = st.hunting_free_from
+        if m is not None and b.get("kind") == "fold":
+            ax.axvline(m, color=col, lw=0.9, ls=":")
+            ax.text(m, 0.62 - 0.1 * n, f"no move hunts from {m:.4g} Hz ", color=col,
+                    fontsize=7, transform=ax.get_xaxis_transform(), va="top", ha="right")
+    fc = confirmation.stage["isolated"].crossover
+    ax.axvline(fc, color="0.3", lw=0.9, ls="--")
+    ax.text(fc, 0.04, f" design {fc:g} Hz", color="0.3", fontsize=7,
+            transform=ax.get_xaxis_transform(), va="bottom", ha="left")
+    folds = [st.hunting_free_from for st in confirmation.stage.values()
+             if st.hunting_free_from is not None]
+    ax.set_xlim(0.0, 1.08 * max(folds + [fc]))
+    ax.set_ylim(bottom=0.0)
+    ax.set_xlabel("crossover fc [Hz]")
+    ax.set_ylabel("cycle peak to peak [mm]")
+    fig.legend(*ax.get_legend_handles_labels(), loc="upper center", ncols=2,
+               bbox_to_anchor=(0.5, 1.0))
+    return fig
