@@ -343,7 +343,7 @@ def test_report_and_console_show_the_status_the_analysis_gave(paper_spec):
     assert [r["status"] for r in rows] == [c.status.value for c in doctored.crossover.cases]
     assert rows[0]["status"] == "FAIL"
     cases = doctored.to_dict()["crossover"]["cases"]
-    table = console_module._cases_table(cases, {c.name: c.number for c in result.loop.cases})
+    table = console_module.cases_table(cases, {c.name: c.number for c in result.loop.cases})
     out = Console(width=200, record=True)
     out.print(table)
     lines = [ln for ln in out.export_text().splitlines() if "cart sliding, joint free" in ln]

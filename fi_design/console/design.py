@@ -1,0 +1,320 @@
+"""The design's summary: the checks, the gains, the crossover and limit cases, the verdict.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ..display import number, percent, quantity
+from .common import heading, status_text, table
+from .confirmation import moves_strips, simulation_table
+
+if TYPE_CHECKING:  # pragma: no cover
+    from rich.console import Console
+
+
+def checks_table(checks, title: str = "Checks", cases: Any = None):
+    """A rich table of :class:`~fi_design.results.Check` values, status coloured.
+
+    Checks are grouped by their ``step``: a bold heading row starts each group.
+    Each check's name in words sits above its message in the first column,
+    which wraps, so the table reads at 80 columns as at 200; value and limit
+    share the unit the report shows them in (13.33 N/mm, 31.55 MPa, 47.31°),
+    the limit with the requirement's sense (``≥ 30``).
+
+    Parameters
+    ----------
+    checks : sequence of fi_design.results.Check
+        The checks, in report order.
+    title : str, optional
+        Table title.
+    cases : mapping, optional
+        The design's limit cases by name, which name the case of a margin check
+        (:func:`fi_design.report.check_label`).
+
+    Returns
+    -------
+    rich.table.Table
+        Columns check (with its message), status, value, limit, unit.
+    """
+    from rich.text import Text
+
+    from ..report.checks import check_row
+
+    t = table(title)
+    t.add_column("Check", ratio=1, min_width=24, overflow="fold")
+    t.add_column("Status", no_wrap=True)
+    t.add_column("Value", justify="right", no_wrap=True)
+    t.add_column("Limit", justify="right", no_wrap=True)
+    t.add_column("Unit", no_wrap=True)
+    step = None
+    for c in checks:
+        if (c.step or "") != step:
+            step = c.step or ""
+            if step:
+                t.add_row(Text(step, style="bold underline"))
+        row = check_row(c, cases)
+        cell = Text(row["label"], style="bold")
+        if row["message"]:
+            cell.append("\n")
+            cell.append(Text(row["message"], style="dim"))
+        limit = number(row["limit"])
+        if row["sense"] and row["limit"] is not None:
+            limit = f"{row['sense']} {limit}"
+        t.add_row(cell, status_text(c.status), number(row["value"]), limit,
+                  Text(row["unit"] or ""))
+    return t
+
+
+def print_design(console: "Console", result, spec_path: Path | None = None) -> None:
+    """Print the readable summary of a :class:`~fi_design.guideline.DesignResult`.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to print.
+    result : fi_design.guideline.DesignResult
+        The design result.
+    spec_path : pathlib.Path, optional
+        The spec file, named in the heading.
+    """
+    from rich.text import Text
+
+    data = result.to_dict()
+    name = _spec_name(result)
+    heading(console, name or "fi-design", spec_path)
+
+    gap = data.get("friction_gap") or {}
+    if gap:
+        risk = gap.get("hunting_risk")
+        console.print(Text(
+            f"Friction gap Fs - Fc = {number(gap.get('gap'))} N (threshold "
+            f"{number(gap.get('threshold'))} N): "
+            + ("hunting is a risk" if risk else "hunting unlikely" if risk is not None else "")))
+
+    loop = getattr(result, "loop", None)
+    console.print(checks_table(result.checks,
+                               cases={c.name: c for c in getattr(loop, "cases", ())}))
+
+    pid = data.get("pid") or {}
+    if pid:
+        console.print(_gains_table(pid))
+
+    xo = data.get("crossover") or {}
+    if xo:
+        line = (f"Crossover: desired {number(xo.get('desired'))} Hz, achievable "
+                f"{number(xo.get('achievable'))} Hz")
+        if xo.get("limit_kind") == "scan_limit":   # the search cap: a bound, not a result
+            line = (f"Crossover: desired {number(xo.get('desired'))} Hz; the linear model limits "
+                    f"it nowhere below {number(xo.get('achievable'))} Hz (the search cap)")
+        elif xo.get("limited_by"):
+            line += f", limited by {xo['limited_by']}"
+        console.print(Text(line))
+        cases = xo.get("cases") or []
+        if cases:
+            console.print(cases_table(cases, {c.name: c.number for c in result.loop.cases}))
+
+    stiff = data.get("stiffness") or {}
+    if stiff.get("maximum") is not None:
+        if stiff.get("suggested"):
+            text = (f"Drive stiffness (suggestion for an isolator with a "
+                    f"{number(1e3 * stiff['stroke'], 3)} mm stroke): k_max = "
+                    f"{number(stiff['maximum'])} N/m, start from k = {number(stiff.get('chosen'))} N/m")
+        else:
+            text = (f"Drive stiffness: k_max = {number(stiff['maximum'])} N/m, chosen k = "
+                    f"{number(stiff.get('chosen'))} N/m")
+            if stiff.get("source"):
+                text += f" ({stiff['source']})"
+            if stiff.get("force_at_stroke") is not None:
+                text += f", flexure force at full stroke {number(stiff['force_at_stroke'], 3)} N"
+        console.print(Text(text))
+
+    sim = data.get("simulation")
+    if isinstance(sim, dict) and "isolated" in sim:
+        h = result.spec.requirements.hunting
+        console.print(simulation_table(sim, (h.window_start, h.window_start + h.window_length),
+                                        data.get("stage_hunting")))
+        for line in moves_strips(data.get("stage_hunting") or {},
+                                 bool(sim.get("suggested_isolator"))):
+            console.print(line)
+
+    conclusion = getattr(result, "conclusion", "") or data.get("conclusion", "")
+    if conclusion:
+        console.print(Text("Conclusion: ", style="bold").append(Text(str(conclusion),
+                                                                        style="")))
+    if getattr(result, "verdict", None) is not None:
+        print_verdict(console, result)   # the input warnings are among its reasons
+        return
+    for w in getattr(result, "warnings", ()) or ():
+        console.print(Text("warning: ", style="bold yellow").append(Text(_warning_text(w))))
+
+
+def _gains_table(pid: dict) -> Any:
+    """Step 4's gains in the form the spec's ``controller.gains`` takes (``pid.hand_off``).
+
+    With the hardware's own gains, the rule's at the same crossover in the same
+    form beside them. The roll-off is ``controller.roll_off``: a low-pass on the
+    D term only; the sampling and delay are the ones the analysis used.
+    """
+    from rich.text import Text
+
+    hand = pid["hand_off"]
+    rows = [("hardware" if pid.get("source") == "gains" else "rule", hand)]
+    if pid.get("source") == "gains":
+        rows.append(("rule", {**hand, **pid["rule_in_hardware_form"],
+                              "roll_off": pid["rule_in_hardware_form"]["roll_off"]
+                              / (2 * math.pi)}))
+    t = table("PID gains (step 4) as controller.gains takes them: kp + ki/s + kd s / (1 + "
+               "s/(2 pi roll_off)), the roll-off on the D term only")
+    t.add_column("")
+    for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "roll_off [Hz]"):
+        t.add_column(Text(col), justify="right", no_wrap=True)
+    for label, g in rows:
+        t.add_row(label, number(g["kp"]), number(g["ki"]), number(g["kd"]),
+                  "none" if g["roll_off"] is None else number(g["roll_off"]))
+    sampled = ("continuous" if hand["sample_rate"] is None
+               else f"sampled at {quantity(hand['sample_rate'], 'Hz')}")
+    delay = "no delay" if not hand["delay"] else f"delay {quantity(hand['delay'], 's')}"
+    t.caption = Text(f"D on the {hand['derivative_on']}, {sampled}, {delay}, tuned on "
+                     f"{quantity(pid['tuning_mass'], 'kg')} (controller.derivative_on, "
+                     "sample_rate and delay); --write-spec writes them into a spec",
+                     style="dim")
+    t.caption_justify = "left"
+    return t
+
+
+#: Border and title style of the verdict box per status; a stage that does not settle gets a
+#: heavy frame, so the box differs in shape too (monochrome terminals, logs).
+_VERDICT_LOOK = {"PASS": ("green", "ROUNDED"), "PASS_WITH_WARNINGS": ("yellow", "ROUNDED"),
+                 "NOT_CONFIRMED": ("yellow", "DOUBLE"),
+                 "FAIL": ("red", "HEAVY")}
+
+
+def print_verdict(console: "Console", result) -> None:
+    """Print the sign-off verdict of a design as a framed box: status, reasons, figures.
+
+    The box names what the stage as specified does (settles, hunts, ...), lists
+    the reasons (FAIL, WARN, PASS), then the robustness under friction scatter,
+    the margins with units and the recommendation. A green rounded frame for
+    PASS, yellow for PASS_WITH_WARNINGS, a double yellow one for NOT_CONFIRMED (not
+    simulated: it does not pass), a heavy red one for FAIL.
+
+    Parameters
+    ----------
+    console : rich.console.Console
+        Where to print.
+    result : fi_design.results.design.DesignResult
+        The design, with its verdict.
+    """
+    from rich import box
+    from rich.panel import Panel
+    from rich.table import Table
+    from rich.text import Text
+
+    v = result.verdict
+    colour, frame = _VERDICT_LOOK[v.status]
+    body = Table.grid(padding=(0, 1))
+    body.add_column(no_wrap=True)
+    body.add_column(ratio=1)
+    body.add_row("", Text(v.headline, style="bold"))
+    for r in v.reasons:
+        body.add_row(status_text(r.severity), Text(r.text))
+    rob, mar = result.robustness, result.margins
+    if rob is not None:
+        body.add_row(Text("Scatter", style="bold"), Text(
+            f"does not settle in {percent(rob.hunting_probability)} of {rob.valid} samples "
+            f"({percent(rob.interval[0])} to {percent(rob.interval[1])} at "
+            f"{percent(rob.confidence)}), limit {percent(rob.limit)}"))
+    if mar is not None:
+        items = []
+        if mar.crossover_factor is not None:
+            items.append(f"crossover {'>= ' if mar.crossover_factor_bound else ''}"
+                         f"{mar.crossover_factor:.3g}x the hunting-free "
+                         f"{number(mar.hunting_free_crossover, 4)} Hz")
+        if mar.end_stop_clearance is not None:
+            items.append(f"end stop {quantity(mar.end_stop_clearance, 'm', 3)} away at rest")
+        if mar.stiffness_factor is not None:
+            items.append(f"k_max / k = {mar.stiffness_factor:.3g}")
+        if mar.stiffness_range is not None:
+            lo, hi = mar.stiffness_range
+            items.append(f"k {lo:.4g}-{hi:.4g} N/m for t = {1e3 * mar.thickness:.3g} \u00b1 "
+                         f"{1e3 * mar.thickness_tolerance:.2g} mm")
+        if mar.static_error is not None:
+            items.append(f"static error {quantity(mar.static_error, 'm', 3)} of "
+                         f"{quantity(mar.static_error_bound, 'm', 3)} (Fc + |offset|) / kp")
+        if items:
+            body.add_row(Text("Margins", style="bold"), Text("; ".join(items)))
+    if result.recommendation is not None:
+        body.add_row(Text("Advice", style="bold"), Text(result.recommendation.text))
+    console.print(Panel(body, title=Text(f"Verdict: {v.status}", style=f"bold {colour}"),
+                        title_align="left", border_style=colour, box=getattr(box, frame)))
+
+
+def _spec_name(result) -> str:
+    spec = getattr(result, "spec", None)
+    return getattr(spec, "name", "") if spec is not None else ""
+
+
+def _warning_text(w: Any) -> str:
+    if isinstance(w, (tuple, list)) and len(w) == 2:
+        return f"{w[0]}: {w[1]}"
+    return str(w)
+
+
+#: Columns of the limit-case table: JSON key -> short header with unit (others are appended).
+CASE_COLUMNS = {
+    "crossover": "fc [Hz]",
+    "phase_margin_deg": "PM [deg]",
+    "gain_margin_db": "GM [dB]",
+    "modulus_margin": "MM [-]",
+    "delay_margin": "DM [s]",
+}
+
+
+#: What the short headers of the limit-case table mean (the table's caption).
+CASE_CAPTION = ("fc: gain crossover; PM, GM, MM, DM: phase, gain, modulus and delay margin "
+                "(inf: no crossing); an unstable case fails with 'stability'")
+
+
+_CASE_SKIP = {"name", "description", "passed", "failed", "crossovers", "stable", "in_band",
+              "status"}
+
+
+def cases_table(cases: list, numbers: dict) -> Any:
+    """Table of the linear limit cases (paper Figure 2) from their JSON form and numbers."""
+    from rich.text import Text
+
+    keys = [k for k in CASE_COLUMNS if any(k in c for c in cases)]
+    for case in cases:
+        keys += [k for k, v in case.items() if k not in keys and k not in _CASE_SKIP
+                 and not isinstance(v, (dict, list))]
+    t = table("Linear limit cases at the desired crossover (paper Figure 2)")
+    t.caption = Text(CASE_CAPTION, style="dim")
+    t.caption_justify = "left"
+    t.add_column("#", justify="right", no_wrap=True)
+    t.add_column("Limit case", ratio=1, min_width=12)
+    for k in keys:
+        t.add_column(Text(CASE_COLUMNS.get(k, _header(k))), justify="right", no_wrap=True)
+    t.add_column("Status", min_width=6)
+    for i, case in enumerate(cases, 1):
+        case_no = str(numbers.get(case.get("name"), i))
+        label = case.get("description") or case.get("name") or ""
+        cells = [Text("inf" if case.get(k) is None and "margin" in k else number(case.get(k)))
+                 for k in keys]
+        status = status_text(case["status"])  # as the analysis judged it
+        if case.get("failed"):
+            status.append(" " + ", ".join(map(str, case["failed"])))
+        t.add_row(case_no, Text(str(label)), *cells, status)
+    return t
+
+
+def _header(key: str) -> str:
+    """``crossover_hz`` -> ``Crossover [Hz]``; other keys capitalised."""
+    units = {"_hz": "Hz", "_deg": "deg", "_db": "dB", "_s": "s", "_m": "m", "_n": "N",
+             "_rad_s": "rad/s"}
+    for suffix, unit in units.items():
+        if key.endswith(suffix):
+            return f"{key[: -len(suffix)].replace('_', ' ').capitalize()} [{unit}]"
+    return key.replace("_", " ").capitalize()
