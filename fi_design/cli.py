@@ -41,7 +41,7 @@ import typer
 from .cliparts import (DEFAULT_COMMAND, EXIT_VERDICT, Drive, ExecutorKind, Force, Jobs,
                        JsonOut, Measure, NoCache, NoIsolator, Scheduler, SpecArg, app, at_most,
                        check_drive, check_measure, check_outputs, check_spec_path,
-                       command_line, json_text, load,
+                       json_text, load,
                        output_option, run_study, study_pool, write_outputs, write_report,
                        write_study)
 
@@ -632,11 +632,7 @@ def identify_command(
     if outs["spec"] is not None:
         payloads["spec"] = identified_spec_text(result)
     write_outputs(console, outs, payloads)
-    if outs["report"] is not None:
-        from .identreport import render_identification_report
-
-        render_identification_report(result, outs["report"], command=command_line())
-        console.print(f"wrote {outs['report']}", markup=False)
+    write_report(console, outs["report"], result)
 
 
 def main() -> None:

@@ -400,8 +400,28 @@ def test_cli_on_emps_json_spec_and_report(emps_path, tmp_path):
     assert "crosses over" in design.output
 
 
+def test_the_identification_report_is_registered_like_every_other(symmetric_record):
+    """The identification report had a render function of its own; its context builder is
+    registered with report.build_context, so render_report and the CLI's write_report take it."""
+    from fi_design import report
+    from fi_design.errors import SpecError
+
+    spec = load_spec(EXAMPLES / "industrial_axis.yaml")
+    result = identify(symmetric_record, spec)
+    ctx = report.build_context(result, date="2026-01-01", figures=False)
+    assert [s["id"] for s in ctx["sections"]] == ["summary", "parameters", "map", "residual",
+                                                  "identifiability", "processing", "appendix"]
+    assert ctx["meta"]["title"] == "Friction identification from a measured record"
+    assert ctx["meta"]["document_id"].endswith("-IDENTIFY")
+    assert all(f["svg"] is None for s in ctx["sections"] if s["id"] != "appendix"
+               for f in ctx[s["id"]]["figures"])
+    assert report.build_context.dispatch(type(result)) is report.identification_context
+    with pytest.raises(SpecError, match="--spec"):
+        report.build_context(identify(symmetric_record), figures=False)
+
+
 def test_report_escapes_user_text(symmetric_record, tmp_path):
-    from fi_design.identreport import render_identification_report
+    from fi_design import render_report
 
     spec = load_spec({"name": "<script>alert(1)</script> axis", "stage": {"mass": 90.0},
                       "cart": {"mass": 10.0},
@@ -410,8 +430,7 @@ def test_report_escapes_user_text(symmetric_record, tmp_path):
                                      "derivative_on": "measurement", "sample_rate": 1000.0},
                       "motion": {"moves": [{"distance": 0.1, "velocity": 0.1,
                                             "acceleration": 1.0}]}})
-    html = render_identification_report(identify(symmetric_record, spec),
-                                        tmp_path / "r.html").read_text()
+    html = render_report(identify(symmetric_record, spec), tmp_path / "r.html").read_text()
     assert "<script>alert" not in html and "&lt;script&gt;" in html
 
 

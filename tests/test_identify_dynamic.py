@@ -299,9 +299,9 @@ def test_written_spec_report_and_json_carry_the_dynamic_parameters(sweep, tmp_pa
     d = json.loads(json.dumps(r.to_dict(), allow_nan=False))
     assert {b["kind"] for b in d["dynamic"]["branches"]} == {"breakaway"}
     assert d["dynamic"]["sweep"]["stribeck_velocity"] == pytest.approx(r.value("stribeck_velocity"))
-    from fi_design.identreport import render_identification_report
+    from fi_design import render_report
 
-    html = render_identification_report(r, tmp_path / "r.html").read_text()
+    html = render_report(r, tmp_path / "r.html").read_text()
     assert "Breakaways and presliding cycles" in html and "Fit of the Stribeck curve" in html
 
 

@@ -401,7 +401,7 @@ def test_the_identified_friction_curve_is_the_models_friction_law(identified, fo
 
 def test_the_identification_report_draws_the_results_curve(identified, monkeypatch):
     from fi_design.identification import IdentificationResult
-    from fi_design.identreport import force_velocity_figure
+    from fi_design.plots import force_velocity_figure
 
     monkeypatch.setattr(IdentificationResult, "friction_curve",
                         lambda self, v: np.full(np.shape(v), 123.0))

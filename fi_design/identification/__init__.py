@@ -114,7 +114,7 @@ Modules, one job each:
 from .events import Excitation, excitation
 from .pipeline import identify, predict_force, segment
 from .preprocess import processing
-from .results import (DYNAMIC, FORMS, NAMES, UNITS, BranchFit, Dynamic, Fit, ForcePrediction,
+from ..results.identification import (DYNAMIC, FORMS, NAMES, UNITS, BranchFit, Dynamic, Fit, ForcePrediction,
                       IdentificationResult, Masses, Parameter, Processing, Samples, SweepFit)
 from .specwrite import identified_spec, identified_spec_text, spec_values
 

@@ -14,7 +14,7 @@ import numpy as np
 from ..measured import Measurement
 from ..results import dataclass_dict
 from .preprocess import lowpass
-from .results import Processing
+from ..results.identification import Processing
 
 #: A rest: the stage moves less than REST_BAND (or 10 x the position noise) for DWELL.
 DWELL = 0.05

@@ -26,7 +26,7 @@ from .preprocess import JITTER, check_record, joint_model, prepare, processing
 from .regression import (IMPLAUSIBLE, Solution, check_directions, direction_words, equations,
                          fit_statistics, force_rss, form_note, rigid_parameters, split_masses,
                          solve, symmetric_view, threshold_note)
-from .results import FORMS, NAMES, ForcePrediction, IdentificationResult
+from ..results.identification import FORMS, NAMES, ForcePrediction, IdentificationResult
 
 ProgressCallback = Callable[[str, float], None]
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import DataError
 from ..measured import Measurement
-from .results import Processing
+from ..results.identification import Processing
 
 #: Fewest samples a record must have.
 MIN_SAMPLES = 200

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import DataError
 from ..results import frozen_array
 from .preprocess import Joint, Prepared
-from .results import UNITS, Fit, Masses, Parameter, Processing, Samples
+from ..results.identification import UNITS, Fit, Masses, Parameter, Processing, Samples
 
 #: Fewest used (decimated, sliding) samples per direction of motion.
 MIN_DIRECTION_SAMPLES = 10

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 from .regression import IMPLAUSIBLE
-from .results import DYNAMIC, IdentificationResult
+from ..results.identification import DYNAMIC, IdentificationResult
 
 
 def spec_values(result: IdentificationResult) -> dict[str, float]:

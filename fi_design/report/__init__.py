@@ -9,8 +9,10 @@ How a report is made
    function with one builder per result type: :mod:`.design` (a
    :class:`~fi_design.guideline.DesignResult`, optionally with a
    :class:`~fi_design.studies.DesignMap` computed by the caller), :mod:`.study`
-   (sweeps, the paper's study, robustness), :mod:`.gap` (a reconciliation:
-   :func:`gap_context`). All arithmetic, comparison and wording
+   (sweeps, the paper's study, robustness), :mod:`.recommend` (a design
+   search), :mod:`.gap` (a reconciliation: :func:`gap_context`) and
+   :mod:`.identify` (friction identified from a record:
+   :func:`identification_context`). All arithmetic, comparison and wording
    happens in these builders; the golden tests compare the contexts (with
    ``figures=False``).
 2. Figures come from :mod:`fi_design.plots` (``matplotlib.figure.Figure``,
@@ -22,8 +24,8 @@ How a report is made
    HTML, or the PDF through WeasyPrint (A4, page numbers, the document id and
    revision in the running header), atomically.
 
-Other commands' reports (friction identification, ...) are lists of
-:class:`Section` values with :class:`Table` and :class:`FigureBlock` values
+The reports of studies, reconciliations, design searches and identifications
+are lists of :class:`Section` values with :class:`Table` and :class:`FigureBlock` values
 (:func:`figure_block`), written by :func:`render_document` with the same title
 block, layout and appendix::
 
@@ -41,13 +43,14 @@ solver wall times are left out.
 
 from __future__ import annotations
 
-from . import design, recommend, study  # noqa: F401  (register the context builders)
+from . import design, identify, recommend, study  # noqa: F401  (register the context builders)
 from .blocks import FigureBlock, Section, Table, figure_block
 from .checks import check_label, check_row
 from .context import build_context, document_context
 from .equations import math_text
 from .filters import display_scale, num, qty, tex_num, tex_qty, unit_text
 from .gap import gap_context, gap_sections, render_gap_report
+from .identify import identification_context, identification_sections
 from .meta import report_date
 from .render import (FORMATS, environment, output_format, render_document, render_html,
                      render_report, template_dir, write_document)
@@ -55,7 +58,7 @@ from .render import (FORMATS, environment, output_format, render_document, rende
 __all__ = [
     "FORMATS", "FigureBlock", "Section", "Table", "build_context", "check_label", "check_row",
     "display_scale", "document_context", "environment", "figure_block", "gap_context",
-    "gap_sections", "math_text", "num", "output_format", "qty", "render_document",
+    "gap_sections", "identification_context", "identification_sections", "math_text", "num", "output_format", "qty", "render_document",
     "render_gap_report", "render_html", "render_report", "report_date", "template_dir",
     "tex_num", "tex_qty", "unit_text", "write_document",
 ]

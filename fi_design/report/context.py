@@ -3,7 +3,10 @@
 :func:`build_context` is a :func:`functools.singledispatch` function: each
 report module registers the builder of its result type (the design report in
 :mod:`fi_design.report.design`, the parameter studies in
-:mod:`fi_design.report.study`, the reconciliation in :mod:`fi_design.report.gap`). :func:`document_context` builds the context of
+:mod:`fi_design.report.study`, the design search in
+:mod:`fi_design.report.recommend`, the reconciliation in
+:mod:`fi_design.report.gap`, the identification in
+:mod:`fi_design.report.identify`). :func:`document_context` builds the context of
 a generic report from :class:`~fi_design.report.blocks.Section` values (the
 parameter studies, the reconciliation and other commands' reports).
 """
@@ -29,8 +32,10 @@ def build_context(result: Any, *, date: Any = None, command: str | None = None,
     :class:`~fi_design.guideline.DesignResult` (which also takes
     ``design_map``), :class:`~fi_design.studies.SweepResult`,
     :class:`~fi_design.studies.StudyResult`,
-    :class:`~fi_design.studies.RobustnessResult` and
-    :class:`~fi_design.results.reconciliation.ReconcileResult`. Any other object with
+    :class:`~fi_design.studies.RobustnessResult`,
+    :class:`~fi_design.results.recommend.RecommendResult`,
+    :class:`~fi_design.results.reconciliation.ReconcileResult` and
+    :class:`~fi_design.results.identification.IdentificationResult`. Any other object with
     ``report_sections()`` (a list of :class:`Section`) and ``report_title`` is
     reported through :func:`document_context`.
 

@@ -19,6 +19,7 @@ TITLES = {
     "robustness": "Robustness of the hunting verdict",
     "reconcile": "Model and measurement reconciliation",
     "recommend": "Friction isolator recommendation (design search)",
+    "identify": "Friction identification from a measured record",
 }
 
 

@@ -175,7 +175,8 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
 
     Parameters
     ----------
-    result : DesignResult, SweepResult, StudyResult, RobustnessResult, ReconcileResult or object
+    result : DesignResult, SweepResult, StudyResult, RobustnessResult, RecommendResult,
+             ReconcileResult, IdentificationResult or object
         What to report (:func:`~fi_design.report.context.build_context`). An
         object with ``report_sections()`` and ``report_title`` is rendered as
         a generic document.

@@ -1,121 +1,33 @@
 """The identification report: friction and mass identified from a measured record.
 
-Built from :class:`fi_design.identification.IdentificationResult` as generic
-report sections (:class:`fi_design.report.Section`, :class:`~fi_design.report.Table`,
-:func:`~fi_design.report.figure_block`) and rendered with
-:func:`fi_design.report.render_document`: the title block, layout, escaping
-and appendix of the other reports. Sections: the identified parameters, the
-force-velocity map with the fitted friction curve (both directions), the force
-residual over time, the fit statistics, what is and is not identifiable, and
-the processing. The figures are drawn here with matplotlib's ``Figure`` API
-(never pyplot); the fitted curve is the result's own
-(:meth:`fi_design.identification.IdentificationResult.friction_curve`, the
-model's steady-state friction law).
+Built from :class:`fi_design.results.identification.IdentificationResult` as
+generic report sections (:class:`~fi_design.report.blocks.Section`,
+:func:`identification_sections`) and registered with :func:`build_context`
+like every other report (:func:`identification_context`), so
+:func:`fi_design.render_report` writes it: the same title block, layout,
+escaping and appendix as the design report. Sections: the identified
+parameters, the force-velocity map with the fitted friction curve (both
+directions), the force residual over time, the fit statistics, what is and is
+not identifiable, and the processing. The figures come from
+:mod:`fi_design.plots.identification`; the fitted curve is the result's own
+(:meth:`~fi_design.results.identification.IdentificationResult.friction_curve`).
 """
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
 from typing import Any
 
-import numpy as np
+from ..errors import SpecError
+from ..results.identification import IdentificationResult
+from .blocks import FigureBlock, Section, Table, figure_block
+from .context import build_context, document_context
+from .filters import num, qty
+from .meta import TITLES
 
-from .plots import report_figure, styled
-
-#: Colours: used samples, samples left out, the fitted curve.
-COLOURS = {"used": "C0", "unused": "0.75", "fit": "C3"}
-#: Most points drawn per scatter (evenly thinned beyond): keeps the SVG small.
-MAX_POINTS = 2500
-
-
-def _thin(mask: np.ndarray) -> np.ndarray:
-    """Indices of ``mask``, evenly thinned to at most :data:`MAX_POINTS`."""
-    idx = np.nonzero(mask)[0]
-    step = max(1, int(np.ceil(len(idx) / MAX_POINTS)))
-    return idx[::step]
-
-
-def _figure(height: float) -> Any:
-    """A report-width figure with the design report's fixed margins [in]."""
-    return report_figure(height, top=0.3)
-
-
-@styled
-def force_velocity_figure(result: Any) -> Any:
-    """The force-velocity map: measured friction (force minus inertia) and the fitted curve.
-
-    Parameters
-    ----------
-    result : fi_design.identification.IdentificationResult
-        The identification.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    s = result.samples
-    v = np.asarray(s.velocity) * 1e3
-    f = np.asarray(s.friction)
-    used = np.asarray(s.used)
-    th = result.processing.velocity_threshold * 1e3
-    fig = _figure(3.4)
-    ax = fig.subplots()
-    ax.axvspan(-th, th, color="0.93", lw=0, zorder=0)
-    out, inn = _thin(~used), _thin(used)
-    ax.plot(v[out], f[out], ".", ms=2, color=COLOURS["unused"], label="left out")
-    ax.plot(v[inn], f[inn], ".", ms=2, color=COLOURS["used"], label="used in the fit")
-    top = float(np.max(np.abs(v))) if len(v) else 1.0
-    for side in (-1.0, 1.0):
-        vv = side * np.unique(np.concatenate([np.linspace(1e-9, top, 200),
-                                              np.geomspace(1e-4 * top, top, 200)]))
-        ax.plot(vv, result.friction_curve(vv / 1e3), color=COLOURS["fit"], lw=1.4,
-                label="identified friction + offset" if side > 0 else None)
-    ax.axhline(0.0, color="0.5", lw=0.6)
-    ax.axvline(0.0, color="0.5", lw=0.6)
-    ax.set_xlabel("velocity of the bearing side [mm/s]")
-    ax.set_ylabel("force - mass x acceleration [N]")
-    ax.text(0.0, 1.0, f" |v| < {th:.3g} mm/s: left out", transform=ax.get_xaxis_transform(),
-            ha="center", va="top", fontsize=7, color="0.35")
-    ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3, borderaxespad=0.1,
-              markerscale=4)
-    return fig
-
-
-@styled
-def residual_figure(result: Any) -> Any:
-    """Measured minus modelled actuator force over time, used samples.
-
-    Parameters
-    ----------
-    result : fi_design.identification.IdentificationResult
-        The identification.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    s = result.samples
-    used = np.asarray(s.used)
-    t = np.asarray(s.time)
-    r = np.asarray(s.residual)
-    rms = result.fit.force_rms_residual
-    fig = _figure(2.6)
-    ax = fig.subplots()
-    ax.axhspan(-2 * rms, 2 * rms, color="0.92", lw=0, zorder=0)
-    inn = _thin(used)
-    ax.plot(t[inn], r[inn], ".", ms=2, color=COLOURS["used"], label="force residual")
-    ax.axhline(0.0, color="0.5", lw=0.6)
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("measured - modelled force [N]")
-    ax.set_xlim(float(t[0]), float(t[-1]))
-    ax.set_title(f"grey band: ±2 RMS ({2 * rms:.3g} N)", loc="right", fontsize=7, color="0.35")
-    return fig
+__all__ = ["identification_context", "identification_sections", "conclusion"]
 
 
 def _value_text(p: Any, digits: int = 5) -> str:
-    from .report import num
-
     return "not identifiable" if p.value is None else num(p.value, digits)
 
 
@@ -135,7 +47,7 @@ def identification_sections(result: Any, figures: bool = True) -> list:
         Parameters, force-velocity map, residual, fit statistics,
         identifiability, processing.
     """
-    from .report import FigureBlock, Section, Table, figure_block, num, qty
+    from .. import plots
 
     def fig(make, caption, name):
         if not figures:
@@ -170,7 +82,7 @@ def identification_sections(result: Any, figures: bool = True) -> list:
                     "included. The curve is the identified Coulomb plus viscous friction of "
                     "each direction, with the Stribeck term where static friction and the "
                     "Stribeck velocity are identified.",),
-        figures=(fig(force_velocity_figure, "Measured friction (points; grey: left out of the "
+        figures=(fig(plots.force_velocity_figure, "Measured friction (points; grey: left out of the "
                                             "fit) and the identified friction curve of both "
                                             "directions (red). Shaded: the velocity band left "
                                             "out.", "ident-map"),))
@@ -184,7 +96,7 @@ def identification_sections(result: Any, figures: bool = True) -> list:
         "residual", "Force residual and fit statistics",
         paragraphs=(f"Standard errors: {f.error_method}.",),
         tables=(Table(("Statistic", "Value"), stats, caption="Fit statistics"),),
-        figures=(fig(residual_figure, "Measured minus modelled actuator force at the used "
+        figures=(fig(plots.residual_figure, "Measured minus modelled actuator force at the used "
                                       "samples (filtered, decimated).", "ident-residual"),))
     e = result.excitation
     exc_rows = (("breakaways after a stop", str(e.breakaways)),
@@ -250,8 +162,6 @@ def identification_sections(result: Any, figures: bool = True) -> list:
 
 def _event_row(b: Any) -> tuple:
     """A row of the events table."""
-    from .report import num
-
     def pm(value, se, digits=4):
         if value is None:
             return "–"
@@ -268,8 +178,6 @@ def _event_row(b: Any) -> tuple:
 
 def conclusion(result: Any) -> str:
     """A one-paragraph summary of an identification."""
-    from .report import num
-
     p = result.parameters
     parts = [f"{name} = {num(x.value, 4)} ± {num(x.std_error, 2)} {x.unit}"
              for name, x in p.items() if x.value is not None]
@@ -284,37 +192,35 @@ def conclusion(result: Any) -> str:
     return text
 
 
-def render_identification_report(result: Any, path: str | os.PathLike, *, date: Any = None,
-                                  command: str | None = None) -> Path:
-    """Write the identification report (HTML or PDF).
+
+@build_context.register
+def identification_context(result: IdentificationResult, *, date: Any = None,
+                           command: str | None = None, figures: bool = True) -> dict:
+    """The report context of an identification.
 
     Parameters
     ----------
-    result : fi_design.identification.IdentificationResult
+    result : fi_design.results.identification.IdentificationResult
         The identification, with its spec.
-    path : str or os.PathLike
-        ``.html`` or ``.pdf``.
     date : str or datetime.date, optional
         Report date (default today).
     command : str, optional
         The command line, shown in the title block.
+    figures : bool, optional
+        Draw the figures (default).
 
     Returns
     -------
-    pathlib.Path
-        The written file.
+    dict
+        For :func:`~fi_design.report.render.render_html`.
 
     Raises
     ------
     fi_design.errors.SpecError
         The identification has no spec (the title block needs one).
     """
-    from .errors import SpecError
-    from .report import render_document
-
     if result.spec is None:
         raise SpecError("the identification report needs the stage's spec (give --spec)")
-    return render_document(path, title="Friction identification from a measured record",
-                           spec=result.spec, sections=identification_sections(result),
-                           date=date, command=command, kind="identify",
-                           conclusion=conclusion(result))
+    return document_context(TITLES["identify"], result.spec,
+                            identification_sections(result, figures), date=date,
+                            command=command, kind="identify", conclusion=conclusion(result))

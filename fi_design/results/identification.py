@@ -1,5 +1,8 @@
 """Result types of an identification (JSON: docs/interfaces.md): values, not behaviour.
 
+Produced by :func:`fi_design.identification.identify`; the identification
+report and the console read them.
+
 :class:`IdentificationResult` holds one :class:`Parameter` per name of
 :data:`NAMES` (value, standard error, unit, identifiable, note), the
 statistics of the inverse-dynamics fit (:class:`Fit`), the processing
@@ -18,12 +21,12 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
-from ..measured import Measurement
-from ..model import FrictionLaw
-from ..results import dataclass_dict
+from . import dataclass_dict
+from .friction import FrictionLaw
 
-if TYPE_CHECKING:
-    from .events import Excitation
+if TYPE_CHECKING:  # pragma: no cover
+    from ..identification.events import Excitation
+    from ..measured import Measurement
 
 #: Parameters of an identification, in the order of its JSON (docs/interfaces.md).
 NAMES = ("mass", "coulomb", "coulomb_negative", "viscous", "viscous_negative", "offset",
