@@ -227,7 +227,7 @@ def test_the_watch_lands_on_the_section_and_leaves_the_trajectory_alone(paper_sp
     from fi_design.kernel.layout import N_WATCH, W_ARM, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_START
     from fi_design.model import resolve
     from fi_design.simulation import tolerances
-    from fi_design.stage import _family_reference
+    from fi_design.stage.moves import _family_reference
 
     p = resolve(paper_spec).plant(False)
     ref, end = _family_reference(paper_spec, 0.01, 12.0)
