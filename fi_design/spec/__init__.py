@@ -1,0 +1,46 @@
+"""The design spec: validated, immutable, in SI.
+
+A spec mirrors the YAML file key for key (docs/interfaces.md), so one dotted
+path (``friction.static``, ``isolator.stroke``) names a quantity in the file, in
+error messages, in ``fi-design sweep --x PATH=...`` and in JSON. Every physical
+field accepts an SI number or a string with units; after validation it holds an
+SI float (frequencies in Hz, phase margins in degrees, gain margins in dB).
+
+Defaults live here and only here: the ``Field`` defaults of the sections, plus
+four that depend on other values, computed by the functions of
+:mod:`.defaults` (:func:`bristle_damping`, :func:`joint_damping`,
+:func:`limiter_damping`, :func:`proposed_stiffness`). ``fi-design schema``
+prints them all.
+
+The package, one job a module: :mod:`.fields` (quantities with units, plain
+text, the strict base model), :mod:`.sections` (every section of the file),
+:mod:`.document` (the :class:`Spec` itself, its effects list and the checks
+across sections) and :mod:`.defaults` (derived defaults and warnings).
+"""
+
+from __future__ import annotations
+
+from .defaults import (CROSSOVER_AGREEMENT, JOINT_DAMPING_RATIO, antiresonance, bristle_damping,
+                       default_joint_damping, default_limiter_damping, design_crossover,
+                       drive_stiffness, gains_crossover, joint_damping, limiter_damping,
+                       proposed_stiffness, stiffness_limit, tuning_mass, warnings_for)
+from .document import EFFECT_MODELS, EffectEntry, Spec
+from .fields import OptQ, Q, StrictModel, Text
+from .sections import (MAX_OUTPUT_SAMPLES, MAX_SCAN_POINTS, MAX_STEPS, REPORT_KINDS, Body, Bounds,
+                       Controller, CrossoverScan, DocumentIds, Family, Feedforward, Flexure,
+                       Friction, Gains, Hunting, Isolator, Limiter, Material, Measurement, Motion,
+                       Move, ParasiticMode, RecommendBounds, ReportInfo, Requirements, Revision,
+                       Ripple, Robustness, Simulation, move_duration, scan_points)
+
+__all__ = [
+    "Body", "Bounds", "CROSSOVER_AGREEMENT", "Controller", "CrossoverScan", "DocumentIds",
+    "EFFECT_MODELS", "EffectEntry", "Family", "Feedforward", "Flexure", "Friction", "Gains",
+    "Hunting", "Isolator", "JOINT_DAMPING_RATIO", "Limiter", "MAX_OUTPUT_SAMPLES",
+    "MAX_SCAN_POINTS", "MAX_STEPS", "Material", "Measurement", "Motion", "Move", "OptQ",
+    "ParasiticMode", "Q", "REPORT_KINDS", "RecommendBounds", "ReportInfo", "Requirements",
+    "Revision", "Ripple", "Robustness", "Simulation", "Spec", "StrictModel", "Text",
+    "antiresonance", "bristle_damping", "default_joint_damping", "default_limiter_damping",
+    "design_crossover", "drive_stiffness", "gains_crossover", "joint_damping",
+    "limiter_damping", "move_duration", "proposed_stiffness", "scan_points", "stiffness_limit",
+    "tuning_mass", "warnings_for",
+]

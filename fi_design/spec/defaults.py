@@ -1,0 +1,230 @@
+"""Derived defaults: values that depend on other values of the spec, and its warnings.
+
+Four defaults depend on other values (:func:`bristle_damping`,
+:func:`joint_damping`, :func:`limiter_damping`, :func:`proposed_stiffness`);
+the design crossover of a spec that gives gains is the one they achieve
+(:func:`gains_crossover`). :func:`warnings_for` lists suspicious values.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from typing import TYPE_CHECKING
+
+from ..display import number
+from .sections import Limiter, ParasiticMode
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .document import Spec
+
+
+# --------------------------------------------------------------------------- derived defaults
+
+#: How closely a given crossover must agree with the crossover of given gains [-].
+CROSSOVER_AGREEMENT = 0.10
+
+
+def tuning_mass(spec: Spec) -> float:
+    """Mass the controller is tuned on [kg]: m1 + m2 (``total``) or m1 (``stage``)."""
+    return spec.total_mass if spec.controller.tuning_mass == "total" else spec.stage.mass
+
+
+def gains_crossover(spec: Spec) -> float:
+    """Crossover of the hardware's gains on the tuning mass [Hz].
+
+    The frequency where |C(j w)| = m w^2, i.e. where the loop of the gains
+    around a free tuning mass m crosses 0 dB (the rule's definition of the
+    crossover, docs/model.md), with C(s) = kp + ki / s + kd s / (1 + s / wf)
+    and wf the D term's roll-off (none when not given). |C| / (m w^2) falls
+    with w for every such C, so ``log |C| - log(m w^2)`` has one root in
+    ``log w``, found by scipy's ``brentq`` between 1e-6 and 1e9 rad/s (an end
+    of that range when the root lies beyond it).
+    """
+    from scipy.optimize import brentq
+
+    ctl = spec.controller
+    g = ctl.gains
+    m = tuning_mass(spec)
+    wf = 2.0 * math.pi * ctl.roll_off if ctl.roll_off is not None else math.inf
+
+    def excess(x: float) -> float:
+        w = math.exp(x)
+        d = 1j * w * g.kd if math.isinf(wf) else 1j * w * g.kd / (1.0 + 1j * w / wf)
+        return math.log(abs(g.kp + g.ki / (1j * w) + d)) - math.log(m * w * w)
+
+    lo, hi = math.log(1e-6), math.log(1e9)
+    if excess(hi) >= 0.0:
+        return math.exp(hi) / (2.0 * math.pi)
+    if excess(lo) <= 0.0:
+        return math.exp(lo) / (2.0 * math.pi)
+    return math.exp(brentq(excess, lo, hi, xtol=1e-15, rtol=4.0 * sys.float_info.epsilon)) \
+        / (2.0 * math.pi)
+
+
+def design_crossover(spec: Spec) -> float:
+    """The loop's crossover [Hz]: ``controller.crossover``, else the gains' own.
+
+    With explicit gains a given crossover names the crossover they were tuned
+    for (it must agree with where they cross the tuning mass over within
+    :data:`CROSSOVER_AGREEMENT`): the rule's gains written as
+    ``controller.gains`` beside the rule's ``crossover`` give the same design,
+    crossover scan included. Without it, the gains' own crossover
+    (:func:`gains_crossover`).
+    """
+    ctl = spec.controller
+    return ctl.crossover if ctl.crossover is not None else gains_crossover(spec)
+
+
+def bristle_damping(spec: Spec) -> float:
+    """Bristle damping sigma1 [N s/m]: the given value, else sqrt(sigma0 (m1 + m2))."""
+    f = spec.friction
+    if f.bristle_damping is not None:
+        return f.bristle_damping
+    return math.sqrt(f.bristle_stiffness * spec.total_mass)
+
+
+def limiter_damping(spec: Spec) -> float:
+    """Limiter contact damping c_stop [N s/m]: given, else 2 * 0.2 * sqrt(k_stop m1)."""
+    lim = spec.isolator.limiter if spec.isolator else Limiter()
+    if lim.damping is not None:
+        return lim.damping
+    return default_limiter_damping(lim.stiffness, spec.stage.mass)
+
+
+def default_limiter_damping(stiffness: float, stage_mass: float) -> float:
+    """The default limiter damping 2 * 0.2 * sqrt(k_stop m1) [N s/m] (damping ratio 0.2).
+
+    Parameters
+    ----------
+    stiffness : float
+        Contact stiffness k_stop [N/m].
+    stage_mass : float
+        Stage mass m1 [kg].
+    """
+    return 2.0 * 0.2 * math.sqrt(stiffness * stage_mass)
+
+
+def stiffness_limit(spec: Spec, stroke: float | None = None) -> float:
+    """Maximum drive stiffness k_max = Fs / (safety * stroke) [N/m] (guideline step 3)."""
+    s = stroke if stroke is not None else spec.isolator.stroke
+    return spec.friction.static / (spec.requirements.stiffness_safety * s)
+
+
+def proposed_stiffness(spec: Spec, stroke: float | None = None) -> float:
+    """Drive stiffness proposed when the spec gives none [N/m]: k_max / 2.
+
+    Half the maximum keeps the flexure force at full stroke at Fs / 2, leaving
+    room for friction scatter along the rail, while the joint stays stiff
+    enough to push the cart at Coulomb friction within the stroke as long as
+    Fc < Fs / 2.
+    """
+    return 0.5 * stiffness_limit(spec, stroke)
+
+
+def drive_stiffness(spec: Spec) -> float:
+    """The joint stiffness k used for analysis [N/m]: given, else :func:`proposed_stiffness`."""
+    iso = spec.isolator
+    if iso is None:
+        raise ValueError("spec has no isolator")
+    return iso.stiffness if iso.stiffness is not None else proposed_stiffness(spec)
+
+
+#: Damping ratio of the joint mode when the spec gives no joint damping [-].
+JOINT_DAMPING_RATIO = 0.05
+
+
+def joint_damping(spec: Spec, stiffness: float | None = None) -> float:
+    """Joint damping c [N s/m]: given, else 2 * 0.05 * sqrt(k m1 m2 / (m1 + m2))."""
+    iso = spec.isolator
+    if iso is None:
+        raise ValueError("spec has no isolator")
+    if iso.damping is not None:
+        return iso.damping
+    k = stiffness if stiffness is not None else drive_stiffness(spec)
+    return default_joint_damping(k, spec.stage.mass, spec.cart.mass)
+
+
+def default_joint_damping(stiffness: float, stage_mass: float, cart_mass: float) -> float:
+    """The default joint damping [N s/m]: :data:`JOINT_DAMPING_RATIO` of the joint mode.
+
+    ``2 zeta sqrt(k m1 m2 / (m1 + m2))``: the joint's mode, stage against
+    cart on the drive stiffness, damped at the ratio zeta.
+
+    Parameters
+    ----------
+    stiffness : float
+        Drive stiffness k [N/m].
+    stage_mass, cart_mass : float
+        m1 and m2 [kg].
+    """
+    m1, m2 = stage_mass, cart_mass
+    return 2.0 * JOINT_DAMPING_RATIO * math.sqrt(stiffness * m1 * m2 / (m1 + m2))
+
+
+def antiresonance(mode: ParasiticMode) -> float:
+    """Antiresonance of a collocated parasitic mode [Hz]: given, else frequency / sqrt(2)."""
+    return mode.antiresonance if mode.antiresonance is not None else mode.frequency / math.sqrt(2.0)
+
+
+# --------------------------------------------------------------------------- warnings
+
+
+def warnings_for(spec: Spec) -> list[tuple[str, str]]:
+    """Suspicious but legal input, as ``(path, message)`` pairs.
+
+    A warning fires on the user's own values, and on a default only where the
+    default is a poor fit for this spec (and then says so): a bristle damping
+    the user gave that breaks the LuGre dissipativity condition sigma1 < sigma2
+    Fc / (Fs - Fc) (the warning recommends a value within the bound and says
+    what it costs: the presliding mode then rings; the default sqrt(sigma0
+    (m1 + m2)), damping ratio 0.5 of the presliding mode, breaks the bound
+    deliberately and is not warned about when left out), a stroke within
+    five presliding ranges, a hunting window that starts before the last
+    move ends, and a loop without the hardware's sampling and delay (a
+    continuous controller without delay: the margins and the hunting depend
+    on both).
+    """
+    out: list[tuple[str, str]] = []
+    f = spec.friction
+    gap = f.static - f.coulomb
+    if f.model == "lugre" and gap > 0 and f.bristle_damping is not None:
+        s1 = f.bristle_damping
+        default = math.sqrt(f.bristle_stiffness * spec.total_mass)
+        bound = f.viscous * f.coulomb / gap
+        if s1 >= bound:
+            within = 0.9 * bound
+            ratio = within / (2.0 * default)  # sigma1 / (2 sqrt(sigma0 m)) of the presliding mode
+            advice = (f"a value below the bound, e.g. {number(within, 3)} N s/m, keeps it "
+                      f"dissipative but damps the presliding mode at a ratio of only "
+                      f"{number(ratio, 2)}, where the default sqrt(sigma0 (m1 + m2)) = "
+                      f"{number(default)} N s/m damps it at 0.5" if bound > 0 else
+                      "only sigma1 = 0 meets it without viscous or Coulomb friction")
+            out.append(("friction.bristle_damping",
+                        f"sigma1 = {number(s1)} N s/m (given) is not below sigma2 Fc / (Fs - Fc) "
+                        f"= {number(bound)} N s/m: the LuGre model is not guaranteed dissipative "
+                        f"(Barabanov and Ortega); {advice}; leave the key out for the default"))
+    if spec.isolator is not None:
+        presl = f.static / f.bristle_stiffness
+        if spec.isolator.stroke < 5 * presl:
+            out.append(("isolator.stroke",
+                        f"stroke {spec.isolator.stroke * 1e3:.3g} mm is within 5x the presliding "
+                        f"range Fs/sigma0 = {presl * 1e6:.3g} um: the joint can hardly isolate"))
+    t_end = spec.motion.end_time
+    h = spec.requirements.hunting
+    if t_end > h.window_start:
+        whose = ("" if "window_start" in h.model_fields_set
+                 else " (the default window start: set requirements.hunting.window_start and "
+                      "motion.duration for this motion)")
+        out.append(("requirements.hunting.window_start",
+                    f"the last move ends at {t_end:.3g} s, inside the hunting window that starts "
+                    f"at {h.window_start:g} s{whose}"))
+    ctl = spec.controller
+    delayed = any(e.type == "time_delay" for e in spec.effects)
+    if ctl.sample_rate is None and ctl.delay == 0 and not delayed:
+        out.append(("controller.sample_rate",
+                    "the loop is continuous-time without delay: the hardware samples and "
+                    "computes with a delay, which takes phase margin and moves the crossover "
+                    "where hunting stops; give controller.sample_rate and controller.delay of "
+                    "the hardware to judge the loop it has"))
+    return out

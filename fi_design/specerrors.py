@@ -1,0 +1,200 @@
+"""From pydantic's validation errors to messages: the dotted path, the value, the unit.
+
+:func:`describe` turns one validation error of a spec into ``(path, message)``:
+the dotted field path (``friction.static``, ``effects[0].delay``), what was
+read and why it is refused, with a suggestion for a misspelt key. Reading
+a file (:mod:`fi_design.specfile`) and changing values at dotted paths
+(:mod:`fi_design.specpaths`) both report through it.
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from typing import Any
+
+from .spec import Spec
+
+
+def clean_loc(loc: tuple, raw: dict) -> tuple:
+    """Drop union tags that pydantic inserts (``effects.0.time_delay.delay``).
+
+    The tag is the entry's own ``type`` right after its index, even where a
+    parameter has the effect's name (``effects.0.stribeck_velocity.stribeck_velocity``).
+    """
+    out: list = []
+    node: Any = raw
+    tagged = False
+    for part in loc:
+        if isinstance(node, dict) and isinstance(part, str) and not tagged and len(out) >= 2 \
+                and isinstance(out[-1], int) and out[-2] == "effects" \
+                and node.get("type") == part:
+            tagged = True
+            continue
+        tagged = False
+        out.append(part)
+        if isinstance(node, dict):
+            node = node.get(part)
+        elif isinstance(node, list) and isinstance(part, int) and part < len(node):
+            node = node[part]
+        else:
+            node = None
+    return tuple(out)
+
+
+def dotted(loc: tuple) -> str:
+    """A location as a dotted path: ``("motion", "moves", 0, "distance")`` is
+    ``motion.moves[0].distance``."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def _model_at(loc: tuple, raw: Any = None):
+    """The pydantic model class that holds the field at ``loc`` (None if unknown).
+
+    An entry of ``effects`` is the model of its ``type`` in ``raw`` (the
+    mapping as written), so its keys and units are that effect's.
+    """
+    import typing
+
+    from .spec import EFFECT_MODELS
+
+    model: Any = Spec
+    node: Any = raw
+    for n, part in enumerate(loc[:-1]):
+        node = node.get(part) if isinstance(node, dict) and not isinstance(part, int) else \
+            node[part] if isinstance(node, list) and isinstance(part, int) \
+            and part < len(node) else None
+        if isinstance(part, int):
+            if n >= 1 and loc[n - 1] == "effects":
+                kind = node.get("type") if isinstance(node, dict) else None
+                model = EFFECT_MODELS.get(kind) if isinstance(kind, str) else None
+                if model is None:
+                    return None
+            continue
+        if not (isinstance(model, type) and hasattr(model, "model_fields")):
+            return None
+        info = model.model_fields.get(part)
+        if info is None:
+            return None
+        model = _inner_model(info.annotation, typing)
+    return model if isinstance(model, type) and hasattr(model, "model_fields") else None
+
+
+def _inner_model(ann, typing):
+    if isinstance(ann, type) and hasattr(ann, "model_fields"):
+        return ann
+    for arg in typing.get_args(ann):
+        m = _inner_model(arg, typing)
+        if m is not None:
+            return m
+    return None
+
+
+def describe(err: dict, raw: dict) -> tuple[str, str]:
+    """One pydantic validation error of a spec as ``(dotted path, message)``.
+
+    Parameters
+    ----------
+    err : dict
+        One entry of ``ValidationError.errors()``.
+    raw : dict
+        The data that was validated (to read the value and the section at the path).
+
+    Returns
+    -------
+    (str, str)
+        The dotted path (empty for the top level) and the message: what was
+        read, why it is refused, with a suggestion for a misspelt key.
+    """
+    from . import effects as _effects
+
+    loc = clean_loc(err["loc"], raw)
+    path = dotted(loc)
+    kind = err["type"]
+    msg = err["msg"]
+    if kind == "missing":
+        model = _model_at(loc, raw)
+        desc = ""
+        if model is not None and loc and loc[-1] in model.model_fields:
+            desc = model.model_fields[loc[-1]].description or ""
+        return path, "required field is missing" + (f" ({desc})" if desc else "")
+    if kind == "extra_forbidden":
+        model = _model_at(loc, raw)
+        key = loc[-1] if loc else ""
+        hint = ""
+        if model is not None:
+            close = difflib.get_close_matches(str(key), list(model.model_fields), n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else \
+                f"; allowed: {', '.join(model.model_fields)}"
+        return path, f"unknown key '{key}'{hint}"
+    if kind == "unknown_effect":
+        given = err.get("input", {}).get("type") if isinstance(err.get("input"), dict) else None
+        if not isinstance(err.get("input"), dict):
+            return path, _not_an_effect_entry(err.get("input"))
+        close = difflib.get_close_matches(str(given), list(_effects.EFFECT_NAMES), n=1)
+        hint = f" (did you mean '{close[0]}'?)" if close else ""
+        return path + ".type", (f"unknown effect '{given}'{hint}; known: "
+                                f"{', '.join(_effects.EFFECT_NAMES)}")
+    if kind == "value_error":
+        text = msg.removeprefix("Value error, ")
+        named = _NAMED.match(text) if not path else None
+        if named and named.group(1).split(".")[0].split("[")[0] in Spec.model_fields:
+            return named.group(1), named.group(2)
+        return path, text
+    if kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
+        unit = _unit_at(loc, raw)
+        bound = list(err.get("ctx", {}).values())[0]
+        words = {"greater_than": "greater than", "greater_than_equal": "at least",
+                 "less_than": "less than", "less_than_equal": "at most"}[kind]
+        shown = f" {unit}" if unit not in ("", "1") else ""
+        return path, f"must be {words} {bound:g}{shown}, got {_shown(err['input'])}"
+    if kind in ("finite_number",):
+        return path, "must be a finite number"
+    if isinstance(err.get("input"), int) and len(str(abs(err["input"]))) > 300:
+        digits = len(str(abs(err["input"])))
+        return path, f"the number {_shown(err['input'])} ({digits} digits) is too large"
+    if kind in ("float_type", "float_parsing"):
+        return path, f"expected a number or a string with units, got {_shown(err['input'])}"
+    if kind in ("model_type", "model_attributes_type", "dict_type"):
+        model = _model_at(loc + ("x",), raw)
+        keys = ", ".join(model.model_fields) if model is not None else ""
+        return path, (f"expected a mapping{' with keys ' + keys if keys else ''}, got "
+                      f"{_shown(err['input'])}")
+    return path, msg
+
+
+def _shown(value: Any) -> str:
+    """A value read from the spec, for a message: its repr, cut to 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:28] + "..." + text[-8:]
+
+
+def _not_an_effect_entry(given: Any) -> str:
+    """The message for an ``effects`` entry that is not a mapping (``- time_delay``)."""
+    from . import effects as _effects
+
+    name = given if isinstance(given, str) and given in _effects.CATALOGUE else "time_delay"
+    required = [p.name for p in _effects.get(name).parameters if p.required]
+    example = "{type: " + name + "".join(f", {p}: ..." for p in required) + "}"
+    return (f"an effect is a mapping with its type and parameters, e.g. {example}; got "
+            f"{given!r}")
+
+
+#: A top-level validator's message that names its field: ``"controller.crossover: ..."``.
+_NAMED = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]=]*): (.+)$", re.S)
+
+
+def _unit_at(loc: tuple, raw: Any = None) -> str:
+    model = _model_at(loc, raw)
+    if model is None or not loc or loc[-1] not in model.model_fields:
+        return ""
+    desc = model.model_fields[loc[-1]].description or ""
+    if "[" in desc and "]" in desc:
+        return desc[desc.rindex("[") + 1: desc.rindex("]")]
+    return ""
