@@ -207,7 +207,7 @@ def simulate_command(
 def schema_command(
     markdown: Annotated[bool, typer.Option(
         "--markdown", help="Print the spec reference as Markdown tables instead "
-                           "(the README's table).")] = False,
+                           "(the tables of docs/spec.md).")] = False,
 ) -> None:
     """Print the JSON Schema of the spec file."""
     if markdown:

@@ -1,4 +1,5 @@
-"""Documentation meta-tests: README covers the CLI and the schema, the API is documented.
+"""Documentation meta-tests: the generated pages cover the CLI and the schema, the API is
+documented, the README and the architecture page say what a newcomer needs.
 
 Like sqlite-utils' tests/test_docs.py (every command and option in the docs)
 and python-control's docstrings_test.py (every public parameter documented).
@@ -21,6 +22,7 @@ from fi_design.cli import DEFAULT_COMMAND, app
 from conftest import ROOT
 
 README = ROOT / "README.md"
+CLI_PAGE = ROOT / "docs" / "cli.md"
 COMMANDS = get_command(app).commands  # type: ignore[attr-defined]
 
 
@@ -29,34 +31,56 @@ def readme() -> str:
     return README.read_text(encoding="utf-8")
 
 
+@pytest.fixture(scope="module")
+def cli_page() -> str:
+    return CLI_PAGE.read_text(encoding="utf-8")
+
+
+def test_the_generated_pages_match_the_code():
+    """docs/cli.md is the command-line app as --help gives it, and docs/spec.md and
+    docs/effects.md hold the tables of the schema and the catalogue: regenerated, they are
+    what the repository holds."""
+    from fi_design import docpages
+
+    assert CLI_PAGE.read_text(encoding="utf-8") == docpages.cli_reference(), (
+        "docs/cli.md is out of date with the command line; regenerate it with "
+        "`python -m fi_design.docpages`")
+    assert docpages.update(ROOT, check=True) == []
+
+
 @pytest.mark.parametrize("name", sorted(COMMANDS))
-def test_every_command_documented(readme, name):
-    if name == DEFAULT_COMMAND:
-        assert "fi-design SPEC.yaml" in readme or f"fi-design {name}" in readme
-    else:
-        assert f"fi-design {name}" in readme, f"`fi-design {name}` is not described in README.md"
+def test_every_command_documented(cli_page, readme, name):
+    assert f"## fi-design {name}\n" in cli_page, f"`fi-design {name}` is not in docs/cli.md"
+    head = "fi-design SPEC.yaml" if name == DEFAULT_COMMAND else f"fi-design {name}"
+    assert head in readme, f"`{head}` is not in the README's commands in brief"
+    assert COMMANDS[name].help and COMMANDS[name].help.strip(), f"{name} has no help text"
 
 
 @pytest.mark.parametrize("name,option", sorted(
     (name, opt) for name, cmd in COMMANDS.items() for p in cmd.params
     for opt in getattr(p, "opts", []) if opt.startswith("--")))
-def test_every_option_documented(readme, name, option):
-    assert option in readme, f"option {option} of `fi-design {name}` is not in README.md"
+def test_every_option_documented(cli_page, name, option):
+    """Every option is in its command's section of docs/cli.md, with a help text of its own."""
+    section = cli_page.split(f"## fi-design {name}\n", 1)[1].split("\n## ", 1)[0]
+    row = next((ln for ln in section.splitlines() if ln.startswith("| `") and
+                re.search(rf"(^|[ ,`]){re.escape(option)}([ ,`]|$)", ln.split("|")[1])), None)
+    assert row, f"option {option} of `fi-design {name}` is not in docs/cli.md"
+    assert row.split("|")[2].strip(), f"option {option} of `fi-design {name}` has no help"
 
 
-def test_group_options_documented(readme):
+def test_group_options_documented(cli_page):
     for opt in ("--version", "--debug", "FI_DESIGN_DEBUG"):
-        assert opt in readme
+        assert opt in cli_page
 
 
 def test_exit_codes_documented(readme):
-    section = readme.lower()
-    assert "exit code" in section
-    for code in ("0", "1", "2"):
-        assert re.search(rf"\|\s*`?{code}`?\s*\|", readme), f"exit code {code} missing"
+    commands = (ROOT / "docs" / "commands.md").read_text(encoding="utf-8")
+    assert "exit code" in commands.lower() and "exit codes" in readme.lower()
+    for code in ("0", "1", "2", "3", "130"):
+        assert re.search(rf"\|\s*`?{code}`?[ ,|]", commands), f"exit code {code} missing"
 
 
-@pytest.mark.parametrize("name", ["README.md", "docs/interfaces.md", "docs/effects.md"])
+@pytest.mark.parametrize("name", ["docs/spec.md", "docs/effects.md"])
 def test_generated_reference_tables_match_the_code(name):
     assert docs.update_readme(README.parent / name, check=True), (
         f"the reference tables in {name} are out of date with the code; regenerate them with "
@@ -103,7 +127,8 @@ def test_the_documentation_stands_alone():
     citing = [str(f.relative_to(ROOT)) for f in files if f.is_file()
               and "DESIGN.md" in f.read_text(encoding="utf-8", errors="replace")]
     assert set(citing) <= _CITING_ELSEWHERE, citing
-    for page in ("model.md", "effects.md", "interfaces.md"):
+    for page in ("model.md", "effects.md", "interfaces.md", "spec.md", "cli.md",
+                 "commands.md", "library.md", "architecture.md"):
         assert f"docs/{page}" in (ROOT / "README.md").read_text(encoding="utf-8")
     for name in [None] + sorted(get_command(app).commands):
         r = CliRunner().invoke(app, ([name] if name else []) + ["--help"],
@@ -111,12 +136,51 @@ def test_the_documentation_stands_alone():
         assert r.exit_code == 0 and "DESIGN.md" not in r.output, (name, r.output)
 
 
-def test_readme_python_example_runs(readme, monkeypatch):
-    blocks = re.findall(r"```python\n(.*?)```", readme, flags=re.DOTALL)
-    assert blocks, "README.md should show the library API in a ```python block"
+@pytest.mark.parametrize("page", ["README.md", "docs/library.md", "docs/measured.md"])
+def test_python_examples_run(page, monkeypatch):
+    text = (ROOT / page).read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.DOTALL)
+    assert blocks, f"{page} should show the library API in a ```python block"
     monkeypatch.chdir(ROOT)
     for code in blocks:
-        exec(compile(code, "README.md", "exec"), {"__name__": "readme_example"})
+        exec(compile(code, page, "exec"), {"__name__": "readme_example"})
+
+
+def test_the_readme_is_what_a_newcomer_needs(readme):
+    """The README had grown to 1,200 lines; it says what the tool is, the two commands, the
+    commands and the library in brief, hunting as a property of the stage, and links the
+    rest."""
+    assert len(readme.splitlines()) <= 250
+    heads = re.findall(r"^## (.+)$", readme, flags=re.MULTILINE)
+    for head in ("Quick start", "The commands in brief", "Hunting as a property of the stage",
+                 "The library in brief", "Documentation"):
+        assert head in heads, head
+    assert "docs/figures/" in readme
+    for link in re.findall(r"\]\((docs/[^)#]+)", readme):
+        if link not in ("docs/examples.md",):  # written beside this work, merged with it
+            assert (ROOT / link).exists(), link
+
+
+def test_the_architecture_page_names_every_layer():
+    """docs/architecture.md draws the layers that import-linter keeps: every module of the
+    exhaustive layers contract is named on the page, in the order of the contract."""
+    import tomllib
+
+    contracts = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    layers = next(c for c in contracts["tool"]["importlinter"]["contracts"]
+                  if c.get("containers") == ["fi_design"] and c["type"] == "layers")["layers"]
+    page = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    diagram = page.split("```\n", 2)[1]
+    assert len(diagram.splitlines()) <= 12
+    # the modules only: no layer names in the left column, no remarks in parentheses
+    diagram = "\n".join(re.sub(r"\([^)]*\)", "", ln[15:]) for ln in diagram.splitlines())
+    positions = []
+    for layer in layers:
+        for module in (m.strip() for m in layer.split("|")):
+            found = re.search(rf"(?<![\w.]){re.escape(module)}(?![\w.])", diagram)
+            assert found, f"{module} is not in the diagram of docs/architecture.md"
+            positions.append(found.start())
+    assert positions == sorted(positions), "the diagram lists the layers out of order"
 
 
 # --------------------------------------------------------------------------- docstrings
