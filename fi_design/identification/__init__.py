@@ -111,11 +111,12 @@ Modules, one job each:
 - :mod:`.pipeline`: :func:`identify`, :func:`predict_force`, :func:`segment`.
 """
 
-from .events import Excitation, excitation
+from .events import excitation
 from .pipeline import identify, predict_force, segment
 from .preprocess import processing
-from ..results.identification import (DYNAMIC, FORMS, NAMES, UNITS, BranchFit, Dynamic, Fit, ForcePrediction,
-                      IdentificationResult, Masses, Parameter, Processing, Samples, SweepFit)
+from ..results.identification import (DYNAMIC, FORMS, NAMES, UNITS, BranchFit, Dynamic, Excitation,
+                                      Fit, ForcePrediction, IdentificationResult, Masses,
+                                      Parameter, Processing, Samples, SweepFit)
 from .specwrite import identified_spec, identified_spec_text, spec_values
 
 __all__ = ["identify", "IdentificationResult", "Parameter", "Fit", "Processing", "Excitation",

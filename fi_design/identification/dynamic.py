@@ -76,11 +76,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .events import Excitation
 from .lugrefit import (Branch, LsqFit, Sliding, extended, fit_branches, fit_stribeck,
                        friction_force)
 from .preprocess import Joint, Trace, trace
-from ..results.identification import DYNAMIC, UNITS, BranchFit, Dynamic, Parameter, Processing, SweepFit
+from ..results.identification import (DYNAMIC, UNITS, BranchFit, Dynamic, Excitation, Parameter,
+                                      Processing, SweepFit)
 
 #: Branch samples creeping faster than this fraction of the creep speed at the onset are left out.
 CREEP_FRACTION = 1.0 / 3.0

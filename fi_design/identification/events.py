@@ -7,14 +7,11 @@ from those events.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..measured import Measurement
-from ..results import dataclass_dict
+from ..results.identification import Excitation, Processing
 from .preprocess import lowpass
-from ..results.identification import Processing
 
 #: A rest: the stage moves less than REST_BAND (or 10 x the position noise) for DWELL.
 DWELL = 0.05
@@ -22,74 +19,9 @@ DWELL = 0.05
 REST_BAND = 1e-6
 #: A presliding reversal: the excursion between two reversals stays below this [m].
 PRESLIDING_BAND = 50e-6
-#: Fewest events (breakaways, presliding reversals) that count as an excitation.
-MIN_EVENTS = 3
 #: Creeping slower than this fraction of the velocity threshold for DWELL also counts as a rest
 #: (a stuck bearing moves by its presliding displacement, often more than REST_BAND).
 STOP_FRACTION = 0.1
-
-
-@dataclass(frozen=True)
-class Excitation:
-    """What the record holds for LuGre's dynamic parameters.
-
-    Attributes
-    ----------
-    breakaways : int
-        Rests of at least ``dwell`` after sliding (the bearing side moves less
-        than ``rest_band``, or creeps slower than :data:`STOP_FRACTION` of the
-        velocity threshold), followed by motion: see :func:`excitation`.
-    rest_time : float
-        Total time at rest (or creeping) [s].
-    reversals : int
-        Reversals of the direction of motion (resolved above the noise).
-    presliding_reversals : int
-        Reversals whose excursion to the next reversal stays below
-        ``presliding_band``.
-    low_speed_time : float
-        Time the bearing side moves, but slower than the velocity threshold,
-        between the edges of the record [s]: where static friction and the
-        Stribeck effect act.
-    dwell : float
-        Shortest rest counted [s].
-    rest_band : float
-        Largest motion during a rest [m].
-    presliding_band : float
-        Largest excursion of a presliding reversal [m].
-    events : tuple of (float, float)
-        Per breakaway: the start of the rest and the time the bearing moves
-        again [s].
-    presliding_segments : tuple of tuple of float
-        Per run of consecutive presliding reversals: the times of its
-        reversals [s] (each pair of neighbours bounds a half cycle).
-    """
-
-    breakaways: int
-    rest_time: float
-    reversals: int
-    presliding_reversals: int
-    low_speed_time: float
-    dwell: float
-    rest_band: float
-    presliding_band: float
-    events: tuple[tuple[float, float], ...] = ()
-    presliding_segments: tuple[tuple[float, ...], ...] = ()
-
-    @property
-    def breakaway(self) -> bool:
-        """Whether the record excites static friction and the Stribeck velocity."""
-        return self.breakaways >= MIN_EVENTS
-
-    @property
-    def presliding(self) -> bool:
-        """Whether the record excites the bristle stiffness."""
-        return self.presliding_reversals >= MIN_EVENTS
-
-    def to_dict(self) -> dict:
-        """Plain JSON data, with the two verdicts."""
-        d = dataclass_dict(self)
-        d.update(breakaway=self.breakaway, presliding=self.presliding)
-        return d
 
 
 def excitation(measured: Measurement, proc: Processing, *, spec=None,

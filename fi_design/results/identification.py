@@ -8,7 +8,7 @@ report and the console read them.
 statistics of the inverse-dynamics fit (:class:`Fit`), the processing
 settings (:class:`Processing`), the stage and cart mass (:class:`Masses`),
 what the record holds for LuGre's dynamic parameters
-(:class:`~fi_design.identification.events.Excitation`) and the fitted
+(:class:`Excitation`) and the fitted
 samples (:class:`Samples`); ``to_dict()`` is the JSON of ``--json``.
 """
 
@@ -25,7 +25,6 @@ from . import dataclass_dict
 from .friction import FrictionLaw
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..identification.events import Excitation
     from ..measured import Measurement
 
 #: Parameters of an identification, in the order of its JSON (docs/interfaces.md).
@@ -39,6 +38,75 @@ UNITS = MappingProxyType({"mass": "kg", "coulomb": "N", "coulomb_negative": "N",
 FORMS = ("symmetric", "per_direction")
 #: LuGre parameters that need a dynamic excitation.
 DYNAMIC = ("static", "stribeck_velocity", "bristle_stiffness")
+
+
+#: Fewest events (breakaways, presliding reversals) that count as an excitation.
+MIN_EVENTS = 3
+
+
+@dataclass(frozen=True)
+class Excitation:
+    """What the record holds for LuGre's dynamic parameters.
+
+    Attributes
+    ----------
+    breakaways : int
+        Rests of at least ``dwell`` after sliding (the bearing side moves less
+        than ``rest_band``, or creeps slower than
+        :data:`fi_design.identification.events.STOP_FRACTION` of the velocity
+        threshold), followed by motion: see
+        :func:`fi_design.identification.events.excitation`.
+    rest_time : float
+        Total time at rest (or creeping) [s].
+    reversals : int
+        Reversals of the direction of motion (resolved above the noise).
+    presliding_reversals : int
+        Reversals whose excursion to the next reversal stays below
+        ``presliding_band``.
+    low_speed_time : float
+        Time the bearing side moves, but slower than the velocity threshold,
+        between the edges of the record [s]: where static friction and the
+        Stribeck effect act.
+    dwell : float
+        Shortest rest counted [s].
+    rest_band : float
+        Largest motion during a rest [m].
+    presliding_band : float
+        Largest excursion of a presliding reversal [m].
+    events : tuple of (float, float)
+        Per breakaway: the start of the rest and the time the bearing moves
+        again [s].
+    presliding_segments : tuple of tuple of float
+        Per run of consecutive presliding reversals: the times of its
+        reversals [s] (each pair of neighbours bounds a half cycle).
+    """
+
+    breakaways: int
+    rest_time: float
+    reversals: int
+    presliding_reversals: int
+    low_speed_time: float
+    dwell: float
+    rest_band: float
+    presliding_band: float
+    events: tuple[tuple[float, float], ...] = ()
+    presliding_segments: tuple[tuple[float, ...], ...] = ()
+
+    @property
+    def breakaway(self) -> bool:
+        """Whether the record excites static friction and the Stribeck velocity."""
+        return self.breakaways >= MIN_EVENTS
+
+    @property
+    def presliding(self) -> bool:
+        """Whether the record excites the bristle stiffness."""
+        return self.presliding_reversals >= MIN_EVENTS
+
+    def to_dict(self) -> dict:
+        """Plain JSON data, with the two verdicts."""
+        d = dataclass_dict(self)
+        d.update(breakaway=self.breakaway, presliding=self.presliding)
+        return d
 
 
 @dataclass(frozen=True)
