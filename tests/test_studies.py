@@ -547,3 +547,20 @@ def test_code_digest_is_every_file_of_the_package(monkeypatch):
     monkeypatch.setattr(provenance, "code_digest", lambda package=None: "edited")
     monkeypatch.setattr(cachemod, "_CODE_DIGEST", None)
     assert cachemod.code_digest() == "edited"
+
+
+def test_stage_cell_is_the_largest_cycle_over_the_family(paper_spec):
+    """A stage-level cell reads the largest cycle any move of the family ends in, not the
+    first one found (without isolator at 8 Hz 23 of 25 moves hunt; their cycles differ in
+    the fourth digit, where the run left them)."""
+    from fi_design.stage import stage_hunts
+    from fi_design.studies.points import evaluate_point
+
+    moves, _ = stage_hunts(paper_spec, False)
+    amps = [m.amplitude for m in moves if m.hunts]
+    first = next(m.amplitude for m in moves if m.hunts)
+    assert len(amps) >= 2 and max(amps) > first * (1 + 1e-5)
+    out = evaluate_point(paper_spec, {}, False, measure="stage")
+    assert out["verdict"] == "hunting"
+    assert out["amplitude"] == pytest.approx(max(amps), rel=1e-12)
+    assert f"{len(amps)} of {len(moves)} moves hunt" in out["message"]
