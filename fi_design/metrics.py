@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .display import quantity
 from .results import frozen_array
 from .results.simulation import VERDICTS, HuntingMetrics
 
@@ -104,14 +105,14 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
                   f"[{w0:g} s, {w1:g} s)" + (f", period {period:.3g} s" if period else ""))
     elif settled:
         verdict = "settled"
-        reason = f"|x1 - r| stays within {settle_band * 1e6:g} um at the end of the window"
+        reason = f"|x1 - r| stays within {quantity(settle_band, 'm', 3)} at the end of the window"
     elif np.ptp(ew) <= settle_band:
         verdict = "stuck"
-        reason = (f"the stage rests {abs(final_error) * 1e6:.3g} um from its target: no peaks, "
+        reason = (f"the stage rests {quantity(abs(final_error), 'm', 3)} from its target: no peaks, "
                   "but not settled either (the integrator has not broken it loose in the window)")
     else:
         verdict = "undetermined"
-        reason = (f"no peaks counted, but the error still moves by {np.ptp(ew) * 1e6:.3g} um in "
+        reason = (f"no peaks counted, but the error still moves by {quantity(np.ptp(ew), 'm', 3)} in "
                   "the window: a cycle or creep too slow to judge in this window")
     return HuntingMetrics(
         hunting_cycles=cycles, peak_times=frozen_array(peaks_t), peak_heights=frozen_array(peaks_h),

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from . import spec as _spec
+from .display import quantity
 from .errors import ArgumentError
 from .results.recommend import DesignCandidate, RecommendResult
 from .specfile import with_values
@@ -290,7 +291,7 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
         if land.on_limiter or land.force >= land.static_friction:
             c["status"] = "end_stop"
             c["violations"].append(
-                f"the cart rests with the joint {land.deflection * 1e6:.3g} um deflected"
+                f"the cart rests with the joint {quantity(land.deflection, 'm', 3)} deflected"
                 + (", on its limiter" if land.on_limiter else "")
                 + f": flexure force {land.force:.3g} N against Fs = {land.static_friction:.3g} N")
 

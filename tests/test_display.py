@@ -89,3 +89,21 @@ def test_verdict_sentence_gives_its_lengths_in_one_unit(paper_confirmed_design):
                   if r.source == "end_stop_clearance")
     units = {u for _, u in LENGTH.findall(reason)}
     assert len(units) == 1 and " um" not in reason, reason
+
+
+def test_sentences_of_the_metric_and_the_stage_give_lengths_in_micrometres_and_millimetres():
+    """The hunting metric's reasons and the stage's sentences write µm, never "um"."""
+    import numpy as np
+
+    from fi_design.metrics import hunting_metrics
+    from fi_design.results.stage import length_range, length_text
+
+    t = np.linspace(0.0, 20.0, 2001)
+    settled = hunting_metrics(t, 2e-6 * np.exp(-t), settle_band=1e-5)
+    resting = hunting_metrics(t, np.full_like(t, 3e-5), settle_band=1e-5)
+    for reason in (settled.reason, resting.reason):
+        assert " um" not in reason and LENGTH.search(reason), reason
+    assert "10 µm" in settled.reason and "30 µm" in resting.reason
+    assert length_text(1.8026e-3) == "1.8 mm" and length_text(2.2e-5) == "22 µm"
+    assert length_range(4e-4, 5e-2) == "0.4 to 50 mm"
+    assert length_range(1e-5, 5e-5) == "10 to 50 µm"

@@ -76,6 +76,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..display import quantity
 from .lugrefit import (Branch, LsqFit, Sliding, extended, fit_branches, fit_stribeck,
                        friction_force)
 from .preprocess import Joint, Trace, trace
@@ -318,8 +319,8 @@ def _breakaway(ctx: _Context, event, vs: _Fixed | None):
 
 
 def _span_note(span: float, tr: Trace) -> str:
-    return (f"its presliding displacement spans {span * 1e6:.3g} um, {MIN_SPAN:g} position "
-            f"resolutions ({MIN_SPAN * tr.resolution * 1e6:.3g} um) needed")
+    return (f"its presliding displacement spans {quantity(span, 'm', 3)}, {MIN_SPAN:g} position "
+            f"resolutions ({quantity(MIN_SPAN * tr.resolution, 'm', 3)}) needed")
 
 
 def _empty(base: dict, why: str):
@@ -442,7 +443,7 @@ def _stiffness(ctx: _Context, events, runs, level: _Fixed | None, vs: _Fixed | N
                    + (" ..." if len(held) > 3 else "") + ")")
         else:
             why = (f"the record holds no presliding excitation ({exc.presliding_reversals} "
-                   f"reversal(s) with an excursion below {exc.presliding_band * 1e6:.3g} um) "
+                   f"reversal(s) with an excursion below {quantity(exc.presliding_band, 'm', 3)}) "
                    "and no breakaway with a resolved loading branch")
         return Parameter(None, None, UNITS[name], False,
                          f"not identifiable: {why}; {_EXPERIMENT[name]} would identify it")
@@ -557,7 +558,7 @@ def _stribeck(ctx: _Context, level: _Fixed | None, relax):
             f"({proc.velocity_threshold:.3g} m/s) for {len(idx)} samples "
             f"({len(idx) / proc.sample_rate:.3g} s; steady: away from stops and reversals by "
             f"the filter's reach, the speed changing by less than {STEADY_RATE:.0%} over the "
-            f"relaxation distance {relax * 1e6:.3g} um, {relax_from}); at least "
+            f"relaxation distance {quantity(relax, 'm', 3)}, {relax_from}); at least "
             f"{2 * MIN_STEADY_SAMPLES} spanning the Stribeck velocity are needed: "
             f"{_EXPERIMENT[name]} would identify it"), None
     if level is not None:
@@ -597,7 +598,7 @@ def _stribeck(ctx: _Context, level: _Fixed | None, relax):
             f"{len(idx)} samples sliding steadily at {speed.min() * 1e3:.3g} to "
             f"{speed.max() * 1e3:.3g} mm/s ({below} below {STEADY_BELOW:g} vs, {above} above "
             f"{STEADY_ABOVE:g} vs; steady: the speed changing by less than {STEADY_RATE:.0%} "
-            f"over the relaxation distance {relax * 1e6:.3g} um, {relax_from}), Fc fixed at the "
+            f"over the relaxation distance {quantity(relax, 'm', 3)}, {relax_from}), Fc fixed at the "
             "identified Coulomb friction and "
             + ("Fs at the identified static friction, both errors propagated"
                if level is not None else

@@ -40,6 +40,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..display import quantity
 from ..results.reconciliation import Lattice
 
 #: Tolerance of an exact lattice, as a fraction of the step (the file's number formatting).
@@ -152,7 +153,7 @@ def _exact_lattice(x: np.ndarray, span: float) -> Lattice | None:
     jitter = 1.4826 * float(np.median(np.abs(e)))
     return Lattice(step=q, step_error=est.error, offset=x0, fraction=on / len(x), chance=chance,
                    tested=len(x), p_value=p, jitter=jitter, exact=True,
-                   detail=f"every sample is a whole number of {q * 1e6:.4g} um steps "
+                   detail=f"every sample is a whole number of {quantity(q, 'm')} steps "
                           f"({100 * on / len(x):.1f} % within 1 % of a step; chance "
                           f"{100 * chance:.0f} %)")
 
@@ -209,8 +210,8 @@ def _noisy_lattice(x: np.ndarray, span: float) -> Lattice:
         return Lattice(step=None, detail="no lattice in the measured position")
     return Lattice(step=q, step_error=est.error, offset=x0, fraction=k / m, chance=0.5,
                    tested=m, p_value=p, jitter=jitter, exact=False,
-                   detail=f"the samples lie on a lattice of {q * 1e6:.4g} um steps with "
-                          f"{jitter * 1e6:.3g} um of noise around it ({100 * k / m:.1f} % of "
+                   detail=f"the samples lie on a lattice of {quantity(q, 'm')} steps with "
+                          f"{quantity(jitter, 'm', 3)} of noise around it ({100 * k / m:.1f} % of "
                           f"{m} tested steps on it; chance at most 50 %)")
 
 

@@ -12,11 +12,12 @@ from __future__ import annotations
 from typing import Any
 
 from ..results.design import DesignResult
+from ..results.stage import length_range
 from ..results.studies import DesignMap
 from .blocks import figure_entry
 from .checks import verdict
 from .context import build_context
-from .filters import display_scale, num, qty
+from .filters import num, qty
 from .inputs import spec_inputs
 from .meta import spec_listing, title_block, versions
 from .steps import guideline_steps
@@ -168,12 +169,6 @@ def _plant_rows(sim: Any) -> list[dict]:
     return rows
 
 
-def _length_range(lo: float, hi: float) -> str:
-    """Two lengths [m] in the unit of the larger: ``0.396 to 50 mm``."""
-    shown, factor = display_scale("m", hi)
-    return f"{num(lo * factor, 3)} to {num(hi * factor, 3)} {shown}"
-
-
 def _stage_rows(sim: Any) -> list[dict]:
     """One row per plant of the stage-level answer (every move of its family)."""
     if sim.suggested_isolator:
@@ -193,7 +188,7 @@ def _stage_rows(sim: Any) -> list[dict]:
             "css": "pass" if st.acceptable else ("fail" if st.hunts else "warn"),
             "moves": f"{len(st.hunting_moves)} of {len(st.moves)}",
             "entered": ("" if not dist else qty(dist[0], "m") if len(dist) == 1
-                        else _length_range(dist[0], dist[-1])),
+                        else length_range(dist[0], dist[-1])),
             "amplitude": None if c is None else c.amplitude,
             "period": None if c is None else c.period,
             "multiplier": None if c is None else c.multiplier,

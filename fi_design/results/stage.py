@@ -16,21 +16,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..display import display_scale, number, quantity
 from . import Result, dataclass_dict, to_jsonable
 
 __all__ = ["MOVE_OUTCOMES", "MoveOutcome", "CycleTrace", "Cycle", "StageHunting", "length_text",
            "length_range"]
 
 def length_text(x: float) -> str:
-    """A length [m] in words: in um below a millimetre, in mm from there (3 digits)."""
-    x = float(x)
-    return f"{x * 1e6:.3g} um" if abs(x) < 1e-3 else f"{x * 1e3:.3g} mm"
+    """A length [m] for a sentence, 3 digits (:func:`fi_design.display.quantity`)."""
+    return quantity(float(x), "m", 3)
 
 
 def length_range(lo: float, hi: float) -> str:
-    """Two lengths [m] in one unit, the larger's: ``"0.396 to 50 mm"``."""
-    unit, scale = ("um", 1e6) if max(abs(lo), abs(hi)) < 1e-3 else ("mm", 1e3)
-    return f"{lo * scale:.3g} to {hi * scale:.3g} {unit}"
+    """Two lengths [m] in the unit of the larger: ``"0.396 to 50 mm"``."""
+    shown, factor = display_scale("m", max(abs(lo), abs(hi)))
+    return f"{number(lo * factor, 3)} to {number(hi * factor, 3)} {shown}"
 
 
 #: How a move can end: at rest at the target, in a sustained cycle, at rest

@@ -318,21 +318,26 @@ def cycle_fold(model: Model, isolated: bool, cycle: Cycle, *, top: float | None 
             branch.append([float(fc), found.amplitude, found.period])
         return True
 
-    hi = None
-    f = lo
-    while f < top:
-        f = min(top, f * FOLD_STEP)
-        if progress is not None:
-            progress(f"following the cycle to {f:.3g} Hz")
-        if not exists(f):
-            hi = f
-            break
-    if hi is None:
-        return {"fold": None, "bracket": [lo, top], "kind": "bound", "tests": tests,
-                "state": state, "crossings": q, "branch": sorted(branch)}
-    while hi - lo > max(FOLD_RESOLUTION, FOLD_RELATIVE * hi):
-        mid = 0.5 * (lo + hi)
-        if not exists(mid):
-            hi = mid
-    return {"fold": hi, "bracket": [lo, hi], "kind": "fold", "tests": tests, "state": state,
-            "crossings": q, "branch": sorted(branch)}
+    while True:
+        hi = None
+        f = lo
+        while f < top:
+            f = min(top, f * FOLD_STEP)
+            if progress is not None:
+                progress(f"following the cycle to {f:.3g} Hz")
+            if not exists(f):
+                hi = f
+                break
+        if hi is None:
+            return {"fold": None, "bracket": [lo, top], "kind": "bound", "tests": tests,
+                    "state": state, "crossings": q, "branch": sorted(branch)}
+        while hi - lo > max(FOLD_RESOLUTION, FOLD_RELATIVE * hi):
+            mid = 0.5 * (lo + hi)
+            if not exists(mid):
+                hi = mid
+        # a test started far from the cycle may have missed it (a step or the first
+        # midpoint): the upper end is tried again from the nearest cycle, and the search
+        # goes on from there when the cycle is found after all
+        if not exists(hi):
+            return {"fold": hi, "bracket": [lo, hi], "kind": "fold", "tests": tests,
+                    "state": state, "crossings": q, "branch": sorted(branch)}

@@ -63,11 +63,11 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
     measure : {"move", "stage"}
         ``"move"``: the paper's hunting metric on the spec's move
         (``hunting_cycles`` counted in the window, ``amplitude`` its peak to
-        peak). ``"stage"``: the moves of the family are run until one ends in
-        a sustained cycle (verdict ``hunting``, ``amplitude`` the cycle's peak
-        to peak, ``hunting_cycles`` None) or all come to rest (``settled``,
-        amplitude 0); a move that sticks or cannot be judged makes the point
-        ``stuck`` or ``undetermined``.
+        peak). ``"stage"``: every move of the family is run; when some end in
+        a sustained cycle the verdict is ``hunting`` and ``amplitude`` the
+        largest of their cycles' peak to peak (``hunting_cycles`` None); when
+        all come to rest, ``settled`` with amplitude 0; a move that sticks or
+        cannot be judged makes the point ``stuck`` or ``undetermined``.
 
     Returns
     -------
@@ -108,7 +108,7 @@ def _stage_point(point: _spec.Spec, isolated: bool) -> dict:
     from ..stage import stage_hunts
 
     try:
-        moves, _ = stage_hunts(point, isolated, first_only=True)
+        moves, _ = stage_hunts(point, isolated)
     except FiDesignError as exc:
         return _outcome("failed", "failed", message=str(exc))
     except Exception as exc:  # noqa: BLE001 -- one bad point must not stop a sweep
@@ -120,11 +120,14 @@ def _stage_point(point: _spec.Spec, isolated: bool) -> dict:
     if broken is not None:
         return _outcome("failed", "failed", message=f"the {broken.distance * 1e3:.4g} mm move: "
                                                     f"{broken.reason}")
-    hunt = next((m for m in moves if m.hunts), None)
-    if hunt is not None:
+    hunting = [m for m in moves if m.hunts]
+    if hunting:
+        # the cell's value: the largest cycle any move of the family ends in
+        hunt = max(hunting, key=lambda m: m.amplitude or 0.0)
         return _outcome("ok", "hunting", amplitude=_num(hunt.amplitude),
                         period=_num(hunt.period), final_error=final,
-                        message=f"the {hunt.distance * 1e3:.4g} mm move ends in {hunt.reason}")
+                        message=f"{len(hunting)} of {len(moves)} moves hunt; the largest cycle, "
+                                f"after the {hunt.distance * 1e3:.4g} mm move: {hunt.reason}")
     for word, verdict in (("stuck", "stuck"), ("undetermined", "undetermined")):
         bad = next((m for m in moves if m.outcome == word), None)
         if bad is not None:

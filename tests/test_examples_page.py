@@ -1,0 +1,34 @@
+"""docs/examples.md: the examples' stage-level table and figures, written by docs/make_examples_page.py."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+
+import pytest
+
+from conftest import EXAMPLES, ROOT
+
+PAGE = ROOT / "docs" / "examples.md"
+SCRIPT = ROOT / "docs" / "make_examples_page.py"
+
+
+def test_the_page_has_a_row_for_every_example_and_its_figures_exist():
+    text = PAGE.read_text(encoding="utf-8")
+    block = text.split("stage-table:begin", 1)[1].split("<!-- stage-table:end -->", 1)[0]
+    named = set(re.findall(r"^\| `([\w-]+)` \|", block, flags=re.M))
+    assert named == {p.stem for p in EXAMPLES.glob("*.yaml")}
+    figures = re.findall(r"\]\((figures/[\w.-]+\.png)\)", text)
+    assert len(figures) >= 4
+    for fig in figures:
+        path = PAGE.parent / fig
+        assert path.is_file() and path.stat().st_size > 10_000, fig
+
+
+@pytest.mark.slow
+def test_the_table_is_what_the_code_gives():
+    """Reruns the sign-off of every example (minutes) and compares the table."""
+    p = subprocess.run([sys.executable, str(SCRIPT), "--check"], capture_output=True, text=True,
+                       timeout=3600, cwd=ROOT)
+    assert p.returncode == 0, p.stderr[-2000:]
