@@ -358,6 +358,7 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
     restart = _restartable(params)
     start, offset, elapsed = move_end, 0.0, 0.0
     cur_ref, cur_y0, cur_end = ref, y0, t_end
+    rested_at = None  # when the stage last came to rest inside the band, not for good [s]
     while True:
         out = _integrate(params, cur_y0, cur_ref, cur_end,
                          _watch_array(w, start, level, repeat=repeat), w.tolerance, w.max_steps)
@@ -369,6 +370,7 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
                                     failed=True), None, 0, level)
         if out.stop == "quiet" and not _rest_ends_run(params, y, level, w.band):
             # the integrator will break the cart loose again: keep going
+            rested_at = offset + out.t_reached if abs(y[0] - level) <= w.band else None
             if offset + out.t_reached >= t_end * (1 - 1e-12):
                 break
             if restart:
@@ -406,6 +408,16 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
                                                                   - level),
                                 amp, period, elapsed, why),
                     np.array(out.crossing_states[-1]), q, level)
+    if (rested_at is not None and out.stop == "end" and n == 0 and abs(e) <= w.band
+            and t_end - rested_at <= w.quiet):
+        # at rest inside the band, and still inside it at the horizon, too soon after for
+        # another quiet time and without a crossing: the cart creeps with its force at the
+        # static friction (not at rest for good by the static balance, but nothing breaks
+        # it loose within the horizon)
+        why = (f"within the band for the rest of the {w.horizon:.3g} s horizon, "
+               f"{length_text(abs(e))} from the target; the cart creeps at its static friction")
+        return _Run(MoveOutcome(distance, label, "settles", e, None, None, elapsed, why), None,
+                    0, level)
     if abs(e) > w.band:
         word = "stuck" if _integrates(params) else "rests"
         why = (f"{length_text(abs(e))} from the target after {elapsed:.3g} s, neither at rest "
