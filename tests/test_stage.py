@@ -155,6 +155,23 @@ def test_canudas_de_wit_1995_pid_example_hunts_with_its_published_cycle():
     assert c.stable
 
 
+def test_a_multiplier_the_two_perturbations_disagree_on_is_not_reported(paper_spec):
+    """Without isolator at Fs 4 N, Fc 3.0 N the return map's finite differences straddle a
+    stick event: the multiplier reads 1.14 at one perturbation and 0.51 at ten times it.
+    Four moves end in the cycle, so it attracts; the multiplier is not reported. At Fc
+    3.02 N the two agree (0.48) and the cycle is stable by its multiplier."""
+    from fi_design.specfile import with_values
+
+    st = stage_hunting(with_values(paper_spec, {"friction.coulomb": 3.0}), False,
+                       boundary=False)
+    assert st.hunting_moves and st.cycle.stable
+    assert st.cycle.multiplier is None and st.cycle.multiplier_check is not None
+    near = stage_hunting(with_values(paper_spec, {"friction.coulomb": 3.02}), False,
+                         boundary=False).cycle
+    assert near.multiplier == pytest.approx(near.multiplier_check, rel=0.1)
+    assert near.multiplier < 1.0 and near.stable
+
+
 # --------------------------------------------------------------------------- rest
 
 

@@ -226,7 +226,9 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "ask of the resting cart stays below its static friction) or once its state repeats "
             "at the Poincar\u00e9 section x1 - r = 0: a sustained cycle. The cycle is then "
             "converged as a periodic orbit by Newton's method on the return map, whose Floquet "
-            "multiplier below 1 shows it attracts; the crossover from which no move hunts is "
+            "multiplier below 1 shows it attracts (a multiplier that two perturbation sizes "
+            "disagree on is not shown: the moves that end in the cycle show it attracts); the "
+            "crossover from which no move hunts is "
             "the cycle's fold, found by bisection."),
         "stage": _stage_rows(sim),
         "spec_intro": (

@@ -133,7 +133,10 @@ class Cycle(Result):
         Whether the cycle attracts (largest multiplier below 1; a cycle found
         by a long simulation attracted it).
     multiplier : float or None
-        Largest Floquet multiplier in magnitude [-]; None when not computed.
+        Largest Floquet multiplier in magnitude [-]; None when not computed, or
+        when the two perturbation sizes disagree by more than 10 % (they
+        straddle a stick or slip event, where the return map is not smooth);
+        the cycle's moves then show whether it attracts.
     multiplier_check : float or None
         The same from a ten times larger perturbation [-] (they agree when the
         finite differences are trustworthy).

@@ -19,8 +19,8 @@ from ..kernel.layout import W_ARM, PlantParameters, state_index
 from ..model import Model
 from ..results.stage import Cycle, CycleTrace
 from ..simulation import tolerances
-from .moves import (FOLD_RELATIVE, FOLD_RESOLUTION, FOLD_STEP, ORBIT_RTOL, PERTURBATION, REPEAT,
-                    Watch, _guess_period, _hold, _integrate, _rest_ends_run, _restartable,
+from .moves import (FOLD_RELATIVE, FOLD_RESOLUTION, FOLD_STEP, MULTIPLIER_AGREEMENT, ORBIT_RTOL,
+                    PERTURBATION, REPEAT, Watch, _guess_period, _hold, _integrate, _rest_ends_run, _restartable,
                     _watch_array, watch_settings)
 
 log = logging.getLogger(__name__)
@@ -133,6 +133,11 @@ def converge_cycle(params: PlantParameters, level: float, state: np.ndarray, cro
                           end, 10.0 * PERTURBATION)
     mult = None if jac is None else float(np.max(np.abs(np.linalg.eigvals(jac))))
     mult_check = None if check is None else float(np.max(np.abs(np.linalg.eigvals(check))))
+    if (mult is not None and mult_check is not None
+            and abs(mult - mult_check) > MULTIPLIER_AGREEMENT * max(mult, mult_check)):
+        # the two perturbations straddle a stick or slip event (the return map is not
+        # smooth there): neither estimate is trusted
+        mult = None
     return _finish_cycle(params, level, s, crossings, crossover, period_out, mult, mult_check,
                          "shooting", residual, tol, max_steps, trace)
 

@@ -37,6 +37,9 @@ REPEAT = 1e-3
 ORBIT_RTOL = 1e-9
 #: Finite-difference perturbation of the return map, in physical scales [-].
 PERTURBATION = 1e-6
+#: The Floquet multiplier at PERTURBATION and at ten times it must agree this closely, or
+#: the multiplier is not reported (relative to the larger) [-].
+MULTIPLIER_AGREEMENT = 0.1
 #: Bisection of the fold: stop when the bracket is this narrow [Hz] ...
 FOLD_RESOLUTION = 0.01
 #: ... or this narrow relative to the crossover [-].
