@@ -82,9 +82,9 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
     console.print(Text(f"Design space at {number(d.crossover)} Hz: columns stroke [{unit}], "
                        "rows drive stiffness", style="dim"))
     console.print(grid)
-    console.print(Text("\u2713 passes, \u00b7 not signed off (ranked below), \u25cf some move "
-                       "hunts, r scatter, e end stop, m margins, f flexure, k above k_max, "
-                       "b bounds; the chosen point reversed", style="dim"))
+    console.print(Text("\u2713 passes, \u00b7 no move hunts, less margin (not signed off), "
+                       "\u25cf some move hunts, r scatter, e end stop, m margins, f flexure, k above "
+                       "k_max, b bounds; the chosen point reversed", style="dim"))
     console.print(Text("Advice: ", style="bold").append(result.advice))
     console.print(f"{result.evaluations} stage-level evaluations in {result.wall_time:.1f} s",
                   markup=False, highlight=False)

@@ -173,6 +173,11 @@ def boundary_figure(confirmation: Any) -> Any:
     fig = report_figure(2.6, top=0.35)
     ax = fig.add_subplot()
     names = plant_names(confirmation)
+    fc = confirmation.stage["isolated"].crossover
+    folds = [st.hunting_free_from for st in confirmation.stage.values()
+             if st.hunting_free_from is not None]
+    x_top = 1.08 * max(folds + [fc])
+    top_mm = 0.0
     for n, key in enumerate(("isolated", "non_isolated")):
         st = confirmation.stage[key]
         col = PLANT_COLOURS[key]
@@ -181,19 +186,20 @@ def boundary_figure(confirmation: Any) -> Any:
         if pts:
             f, a = np.array([p[0] for p in pts]), np.array([p[1] for p in pts]) * 1e3
             ax.plot(f, a, "o-", color=col, ms=3, lw=1.1, label=f"{names[key]}: cycle")
+            top_mm = max(top_mm, float(np.max(a)))
         m = st.hunting_free_from
         if m is not None and b.get("kind") == "fold":
             ax.axvline(m, color=col, lw=0.9, ls=":")
-            ax.text(m, 0.62 - 0.1 * n, f"no move hunts from {m:.4g} Hz ", color=col,
-                    fontsize=7, transform=ax.get_xaxis_transform(), va="top", ha="right")
-    fc = confirmation.stage["isolated"].crossover
+            # in the headroom above the curves, on the side of the line with more room
+            left = m < 0.6 * x_top
+            ax.text(m, 0.96 - 0.1 * n, f" no move hunts from {m:.4g} Hz ", color=col,
+                    fontsize=7, transform=ax.get_xaxis_transform(), va="top",
+                    ha="left" if left else "right")
     ax.axvline(fc, color="0.3", lw=0.9, ls="--")
     ax.text(fc, 0.04, f" design {fc:g} Hz", color="0.3", fontsize=7,
             transform=ax.get_xaxis_transform(), va="bottom", ha="left")
-    folds = [st.hunting_free_from for st in confirmation.stage.values()
-             if st.hunting_free_from is not None]
-    ax.set_xlim(0.0, 1.08 * max(folds + [fc]))
-    ax.set_ylim(bottom=0.0)
+    ax.set_xlim(0.0, x_top)
+    ax.set_ylim(0.0, 1.35 * top_mm if top_mm > 0 else None)
     ax.set_xlabel("crossover fc [Hz]")
     ax.set_ylabel("cycle peak to peak [mm]")
     fig.legend(*ax.get_legend_handles_labels(), loc="upper center", ncols=2,

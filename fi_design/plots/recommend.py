@@ -21,7 +21,7 @@ CANDIDATE_LOOK = {
     "flexure": ("#b2abd2", "flexure cannot be built"),
     "k_max": ("0.55", "k > k_max"),
     "bounds": ("0.75", "outside the bounds"),
-    "not_evaluated": ("#e5f5e0", "not signed off (ranked below)"),
+    "not_evaluated": ("#e5f5e0", "no move hunts, less margin (not signed off)"),
     "failed": ("black", "simulation failed"),
 }
 

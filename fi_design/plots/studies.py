@@ -16,6 +16,10 @@ from .labels import axis_label, display_unit, quantity_name
 VERDICT_MARKS = {"stuck": "s", "undetermined": "?", "failed": "×"}
 
 
+#: A stage map's colour scale turns logarithmic when its cycles span more than this [-].
+LOG_SPAN = 20.0
+
+
 def _physical_edges(edges: np.ndarray, values: np.ndarray) -> np.ndarray:
     """Cell edges clipped to the physical range: none below zero when every value is >= 0."""
     out = np.array(edges, dtype=float)
@@ -98,14 +102,25 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
     y = result.y
     yu, yf = display_unit(y.unit)
     ys = np.asarray(y.values) * yf
+    log_scale = False
     if stage:
-        from matplotlib.colors import Normalize
+        from matplotlib.colors import LogNorm, Normalize
 
         top_mm = float(np.nanmax(cycles)) if np.any(np.isfinite(cycles)) else 0.0
         top_mm = max(top_mm, 1e-3) if vmax is None else max(float(vmax), 1e-3)
         cmap = colormaps["YlOrRd"].with_extremes(under="white", bad="0.8")
-        norm = Normalize(vmin=0.0, vmax=top_mm)
-        data = np.ma.masked_invalid(np.where(cycles > 0, cycles, -1.0))
+        small = cycles[np.isfinite(cycles) & (cycles > 0)]
+        low = float(np.min(small)) if len(small) else top_mm
+        # cycles spanning more than a decade (76 mm at 1 Hz beside 0.2 mm near the
+        # fold) on a log scale, so that the small ones do not look like no cycle at all
+        log_scale = top_mm > LOG_SPAN * low
+        if log_scale:
+            low = max(low, top_mm / 1e3)
+            norm = LogNorm(vmin=low, vmax=top_mm)
+            data = np.ma.masked_invalid(np.where(cycles > 0, np.maximum(cycles, low), 0.1 * low))
+        else:
+            norm = Normalize(vmin=0.0, vmax=top_mm)
+            data = np.ma.masked_invalid(np.where(cycles > 0, cycles, -1.0))
         top = top_mm
     else:
         top = int(np.nanmax(cycles)) if np.any(np.isfinite(cycles)) else 0
@@ -132,8 +147,9 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
                 ax.text(xs[i], ys[j], mark, ha="center", va="center", fontsize=8,
                         color="0.1")
             elif annotate and np.isfinite(c) and c > 0:
+                dark = norm(c) > 0.6 if log_scale else c >= 0.6 * top
                 ax.text(xs[i], ys[j], f"{c:.2g}" if stage else f"{int(c)}", ha="center",
-                        va="center", fontsize=6, color="black" if c < 0.6 * top else "white")
+                        va="center", fontsize=6, color="white" if dark else "black")
     dx, dy = result.design_point
     if dx is not None and dy is not None:
         ax.plot([dx * xf], [dy * yf], marker="X", color="red", ms=10, mec="white", mew=1.0,
@@ -151,7 +167,7 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
     if colorbar:
         if stage:
             cb = ax.figure.colorbar(mesh, ax=ax, extend="min")
-            cb.set_label("Cycle peak to peak, any move [mm] (white: every move settles)")
+            cb.set_label("Cycle peak to peak [mm]" + (", log scale" if log_scale else ""))
         else:
             cb = ax.figure.colorbar(mesh, ax=ax, ticks=_ticks(top))
             w0, w1 = _window(result)
@@ -229,11 +245,15 @@ def design_map_figure(result: Any) -> Any:
     return fig
 
 
-def _legend_text(result: Any) -> str:
-    marks = ", ".join(f"{m} {v}" for v, m in VERDICT_MARKS.items()
-                      if np.any(np.asarray(result.verdict) == v))
-    extra = "hatched: invalid spec" if np.any(np.asarray(result.verdict) == "invalid") else ""
-    parts = [p for p in (marks, extra) if p]
+def _legend_text(result: Any, verdicts: Any = None) -> str:
+    """The figure's key: what white, the marks and the hatching mean (``verdicts``: of every
+    map of a study; default the result's own)."""
+    verdicts = np.asarray(result.verdict if verdicts is None else verdicts)
+    marks = ", ".join(f"{m} {v}" for v, m in VERDICT_MARKS.items() if np.any(verdicts == v))
+    extra = "hatched: invalid spec" if np.any(verdicts == "invalid") else ""
+    white = ("white: every move settles (colour: the largest cycle any move ends in)"
+             if getattr(result, "measure", "move") == "stage" and result.y is not None else "")
+    parts = [p for p in (white, marks, extra) if p]
     return ("red cross: design point" if result.y is not None else "dashed: design point") + \
         ("; " + "; ".join(parts) if parts else "")
 
@@ -269,6 +289,9 @@ def study_figure(study: Any, *, title: str | None = None) -> Any:
     if title != "":
         fig.suptitle(f"{study.spec.name}: hunting maps (paper Figure 4)" if title is None
                      else title, fontsize=12)
+    if n:
+        every = np.concatenate([np.ravel(m.result.verdict) for m in study.maps])
+        fig.supxlabel(_legend_text(study.maps[0].result, every), fontsize=8, color="0.35")
     return fig
 
 

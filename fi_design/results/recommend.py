@@ -22,10 +22,10 @@ __all__ = ["CANDIDATE_STATUSES", "DesignCandidate", "RecommendResult"]
 #: Status of a point of the design space, from best to worst: meets every constraint;
 #: hunts under friction scatter more often than the limit; the cart rests on its end stop
 #: (or pushes with more than Fs) after the spec's motion; another check of the sign-off
-#: fails; some move ends in a hunting cycle at the crossover; a limit case misses its margins; the flexure cannot be built
-#: (stress, leaf or support frequency, thickness range); the stiffness exceeds k_max;
-#: outside the bounds of requirements.recommend; not evaluated (ranked below a feasible
-#: one); the simulation failed.
+#: fails; some move ends in a hunting cycle at the crossover; a limit case misses its
+#: margins; the flexure cannot be built (stress, leaf or support frequency, thickness
+#: range); the stiffness exceeds k_max; outside the bounds of requirements.recommend; no
+#: move hunts, but not signed off (less margin than a feasible one); the simulation failed.
 CANDIDATE_STATUSES = ("feasible", "robustness", "end_stop", "checks", "hunts", "margins",
                       "flexure", "k_max", "bounds", "not_evaluated", "failed")
 
