@@ -89,6 +89,9 @@ def _stop(pool: Any, workers: list) -> None:
             worker.terminate()
     for worker in workers:
         worker.join(timeout=5)
+        if worker.is_alive():  # busy in a signal handler or starved of CPU: no more waiting
+            worker.kill()
+            worker.join(timeout=5)
 
 
 @contextlib.contextmanager
