@@ -275,8 +275,13 @@ def test_open_loop_noise_only_record_answers_none(outcome):
     assert result.entries == () and not any(c.eligible for c in result.candidates)
 
 
+@pytest.mark.slow
 def test_cli_open_loop_names_a_hidden_effect(tmp_path):
-    """``fi-design reconcile --drive force`` on a record with friction varying along the rail."""
+    """``fi-design reconcile --drive force`` on a record with friction varying along the rail.
+
+    Slow (about two minutes): the default run reconciles an open-loop record in
+    test_open_loop_noise_only_record_answers_none and the real record's open-loop replay
+    in tests/test_reconciliation_emps.py."""
     import json
 
     from typer.testing import CliRunner
