@@ -162,7 +162,7 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
     """
     from . import linear
     from .guideline import step2_crossover
-    from .studies.points import evaluate
+    from .studies.points import STAGE_FIRST, evaluate
 
     if min(grid) < 1:
         raise ArgumentError(f"grid needs at least one point per axis, got {grid}")
@@ -260,7 +260,7 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
     say(f"simulating every move of the family at {len(todo)} design points ...")
     tasks = [(_values(c["stroke"], c["stiffness"], c["damping"], c["crossover"] if rule else None),
               True) for c in todo]
-    ev = evaluate(base, tasks, executor=executor, measure="stage")
+    ev = evaluate(base, tasks, executor=executor, measure=STAGE_FIRST)
     evaluations = len(tasks)
     for c, out in zip(todo, ev.outcomes):
         if out["status"] != "ok":

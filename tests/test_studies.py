@@ -564,3 +564,21 @@ def test_stage_cell_is_the_largest_cycle_over_the_family(paper_spec):
     assert out["verdict"] == "hunting"
     assert out["amplitude"] == pytest.approx(max(amps), rel=1e-12)
     assert f"{len(amps)} of {len(moves)} moves hunt" in out["message"]
+
+
+def test_a_robustness_sample_stops_at_the_first_hunting_move_with_the_same_verdict(paper_spec):
+    """Robustness samples and the recommendation's screen stop a family at its first hunting
+    move: the verdict is that of the whole family, the cycle no larger than its largest."""
+    from fi_design.studies.points import STAGE_FIRST, evaluate_point
+
+    seen = set()
+    for values in ({}, {"controller.crossover": 11.0}, {"controller.crossover": 12.0},
+                   {"friction.static": 1.8}):
+        full = evaluate_point(paper_spec, values, True, "stage")
+        first = evaluate_point(paper_spec, values, True, STAGE_FIRST)
+        assert first["verdict"] == full["verdict"], values
+        seen.add(full["verdict"])
+        if full["verdict"] == "hunting":
+            assert 0 < first["amplitude"] <= full["amplitude"] * (1 + 1e-9)
+            assert "the moves stop at the first" in first["message"]
+    assert seen == {"hunting", "settled"}

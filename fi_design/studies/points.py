@@ -46,6 +46,10 @@ _OUTCOME_FIELDS = ("status", "verdict", "hunting_cycles", "amplitude", "period",
 
 #: What a point measures: the stage over its move family, or the spec's own move.
 MEASURES = ("stage", "move")
+#: The stage over its move family, stopping at the first move that hunts: a yes or no
+#: answer without the largest cycle (robustness samples, the recommendation's screen).
+STAGE_FIRST = "stage_first"
+_MEASURES = MEASURES + (STAGE_FIRST,)
 
 
 def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
@@ -60,7 +64,7 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
         Dotted path to value, applied with :func:`~fi_design.specfile.with_values`.
     isolated : bool
         Simulate the isolated plant (True) or the stage without isolator.
-    measure : {"move", "stage"}
+    measure : {"move", "stage", "stage_first"}
         ``"move"``: the paper's hunting metric on the spec's move
         (``hunting_cycles`` counted in the window, ``amplitude`` its peak to
         peak). ``"stage"``: every move of the family is run; when some end in
@@ -68,6 +72,8 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
         largest of their cycles' peak to peak (``hunting_cycles`` None); when
         all come to rest, ``settled`` with amplitude 0; a move that sticks or
         cannot be judged makes the point ``stuck`` or ``undetermined``.
+        ``"stage_first"``: the same, but the moves stop at the first that
+        hunts (``amplitude`` is that move's cycle).
 
     Returns
     -------
@@ -78,14 +84,14 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
     """
     from ..simulation import simulate
 
-    if measure not in MEASURES:
+    if measure not in _MEASURES:
         raise ArgumentError(f"measure must be one of {MEASURES}, got {measure!r}")
     try:
         point = with_values(spec, values) if values else spec
     except SpecError as exc:
         return _outcome("invalid", "invalid", message=str(exc))
-    if measure == "stage":
-        return _stage_point(point, isolated)
+    if measure != "move":
+        return _stage_point(point, isolated, first_only=measure == STAGE_FIRST)
     try:
         res = simulate(point, isolated, METHOD)
     except FiDesignError as exc:  # a request the simulation refuses: deterministic
@@ -103,12 +109,12 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
                     message=m.reason)
 
 
-def _stage_point(point: _spec.Spec, isolated: bool) -> dict:
+def _stage_point(point: _spec.Spec, isolated: bool, first_only: bool = False) -> dict:
     """The stage-level outcome of one point (see :func:`evaluate_point`)."""
     from ..stage import stage_hunts
 
     try:
-        moves, _ = stage_hunts(point, isolated)
+        moves, _ = stage_hunts(point, isolated, first_only=first_only)
     except FiDesignError as exc:
         return _outcome("failed", "failed", message=str(exc))
     except Exception as exc:  # noqa: BLE001 -- one bad point must not stop a sweep
@@ -126,8 +132,10 @@ def _stage_point(point: _spec.Spec, isolated: bool) -> dict:
         hunt = max(hunting, key=lambda m: m.amplitude or 0.0)
         return _outcome("ok", "hunting", amplitude=_num(hunt.amplitude),
                         period=_num(hunt.period), final_error=final,
-                        message=f"{len(hunting)} of {len(moves)} moves hunt; the largest cycle, "
-                                f"after the {hunt.distance * 1e3:.4g} mm move: {hunt.reason}")
+                        message=(f"the {hunt.distance * 1e3:.4g} mm move hunts (the moves stop "
+                                 f"at the first that does): {hunt.reason}" if first_only else
+                                 f"{len(hunting)} of {len(moves)} moves hunt; the largest cycle, "
+                                 f"after the {hunt.distance * 1e3:.4g} mm move: {hunt.reason}"))
     for word, verdict in (("stuck", "stuck"), ("undetermined", "undetermined")):
         bad = next((m for m in moves if m.outcome == word), None)
         if bad is not None:
@@ -266,14 +274,14 @@ def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | No
         Where finished points are looked up and stored (:func:`~.cache.open_cache`).
     chunksize : int, optional
         Points per chunk (:func:`chunk_size`).
-    measure : {"move", "stage"}
+    measure : {"move", "stage", "stage_first"}
         What a point measures (:func:`evaluate_point`).
 
     Returns
     -------
     Evaluation
     """
-    if measure not in MEASURES:
+    if measure not in _MEASURES:
         raise ArgumentError(f"measure must be one of {MEASURES}, got {measure!r}")
     start = _time.perf_counter()
     store = open_cache(cache)

@@ -29,7 +29,7 @@ from ..results.studies import (POINT_VERDICTS, HuntingProbability, PointResult, 
 from ..specfile import path_unit, with_values
 from .axes import design_value, is_number
 from .cache import PointCache
-from .points import MAX_POINTS, ProgressCallback, evaluate, point_result
+from .points import MAX_POINTS, STAGE_FIRST, ProgressCallback, evaluate, point_result
 
 __all__ = ["DISTRIBUTIONS", "parse_scatter", "parse_position_friction", "wilson_interval",
            "robustness"]
@@ -202,9 +202,10 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
         As for :func:`~.sweeps.sweep`.
     measure : {"stage", "move"}, optional
         ``"stage"`` (default): per point, whether any move of the family ends
-        in a sustained cycle and that cycle's peak-to-peak amplitude
-        (:mod:`fi_design.stage`); ``"move"``: the paper's hunting metric on
-        the spec's own move.
+        in a sustained cycle (:mod:`fi_design.stage`; the moves stop at the
+        first that does, so the amplitude is that move's cycle, not the
+        largest); ``"move"``: the paper's hunting metric on the spec's own
+        move.
 
     Returns
     -------
@@ -285,8 +286,10 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
         sample_values.append(tuple(v for _, v in vals))
         tasks.append(tuple(vals))
     all_tasks = [(vals, iso) for iso in plants for vals in tasks]
+    # a sample asks only whether some move does not settle: its moves stop at the first
+    # that hunts
     ev = evaluate(base, all_tasks, executor=executor, progress=progress, cache=cache,
-                  chunksize=chunksize, measure=measure)
+                  chunksize=chunksize, measure=STAGE_FIRST if measure == "stage" else measure)
     points = tuple(point_result((n % samples,), sample_values[n % samples], iso, out)
                    for n, ((_, iso), out) in enumerate(zip(all_tasks, ev.outcomes)))
     from ..pid import control_law
