@@ -26,8 +26,11 @@ grid (log-spaced, the map of the result), the cheap constraints (k_max,
 flexure, margins) go first; the points left are judged at the stage level
 (one move family each, on the caller's executor); the hunting-free crossover
 is found only for the points that do not hunt, and the robustness only for the
-best of them, in the order of the objective, until one passes. What excludes
-the neighbours of the chosen point is what binds it.
+best of them, in the order of the objective, until one passes. The stiffness of
+the point that passes is then refined between its neighbours on the map, at its
+stroke: rounds of four log-spaced points (each judged like the map's, with its
+fold), the best that the sign-off passes kept, the interval narrowed around it.
+What excludes the neighbours of the chosen point on the map is what binds it.
 """
 
 from __future__ import annotations
@@ -58,6 +61,12 @@ STROKE_SPAN = 3.0
 BARE_STROKES = (1e-4, 1e-3)
 #: Lowest stiffness searched, as a fraction of the smallest k_max [-].
 STIFFNESS_SPAN = 1.0 / 30.0
+#: Crossover factors are compared to this many decimals (the fold's bisection resolution,
+#: 0.1 %, makes closer factors equal) [-].
+FACTOR_DIGITS = 3
+#: Refinement of the stiffness around the best point of the map: rounds, points per round.
+REFINE_ROUNDS = 2
+REFINE_POINTS = 4
 #: Strokes tried with the flexure's stock when the target stiffness rounds [-].
 _FLEX_TOL = 1e-9
 
@@ -212,48 +221,47 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
         return limits[k]
 
     # ------------------------------------------------------------ the map, cheap constraints
+    def screen(s: float, k: float) -> dict:
+        """A design point with the cheap constraints checked (status None: they pass)."""
+        kmax = _spec.stiffness_limit(base, s)
+        cell = {"stroke": s, "nominal": k, "stiffness": k, "damping": None,
+                "crossover": fc_design, "status": None, "violations": []}
+        if k > kmax * (1 + 1e-9):
+            cell["status"] = "k_max"
+            cell["violations"].append(f"k = {k:.4g} N/m exceeds k_max = Fs / stroke = "
+                                      f"{kmax:.4g} N/m")
+            return cell
+        if bounds.stiffness is not None and not bounds.stiffness[0] <= k <= \
+                bounds.stiffness[1] * (1 + 1e-9):
+            cell["status"] = "bounds"
+            cell["violations"].append("outside requirements.recommend.stiffness")
+            return cell
+        fc, why = crossover_for(k)
+        if fc is None:
+            cell["status"] = "margins"
+            cell["violations"].append(why)
+            return cell
+        cell["crossover"] = fc
+        cell["limit"] = why
+        kk = k
+        if base.isolator.flexure is not None:
+            fx = _flexure(base, s, k, kmax, fc)
+            if not fx.feasible:
+                cell["status"] = "flexure"
+                cell["violations"].append(f"the flexure: {fx.reason}")
+                return cell
+            kk = float(fx.drive_stiffness)
+        cell["stiffness"] = kk
+        if zeta is not None:
+            cell["damping"] = 2.0 * zeta * math.sqrt(kk * mred)
+        probe = _candidate_spec(base, s, kk, cell["damping"], fc if rule else None)
+        if not _meets_margins(probe, fc):
+            cell["status"] = "margins"
+            cell["violations"].append(f"a limit case misses its margins at {fc:.4g} Hz")
+        return cell
+
     say("screening the design space: stiffness limit, flexure, loop margins ...")
-    cells: list[dict] = []
-    for s in strokes:
-        kmax = _spec.stiffness_limit(base, float(s))
-        for k in stiffs:
-            cell = {"stroke": float(s), "nominal": float(k), "stiffness": float(k),
-                    "damping": None, "crossover": fc_design, "status": None, "violations": []}
-            cells.append(cell)
-            if k > kmax * (1 + 1e-9):
-                cell["status"] = "k_max"
-                cell["violations"].append(f"k = {k:.4g} N/m exceeds k_max = Fs / stroke = "
-                                          f"{kmax:.4g} N/m")
-                continue
-            if bounds.stiffness is not None and not bounds.stiffness[0] <= k <= \
-                    bounds.stiffness[1] * (1 + 1e-9):
-                cell["status"] = "bounds"
-                cell["violations"].append("outside requirements.recommend.stiffness")
-                continue
-            fc, why = crossover_for(float(k))
-            if fc is None:
-                cell["status"] = "margins"
-                cell["violations"].append(why)
-                continue
-            cell["crossover"] = fc
-            cell["limit"] = why
-            kk = float(k)
-            if base.isolator.flexure is not None:
-                fx = _flexure(base, float(s), kk, kmax, fc)
-                if not fx.feasible:
-                    cell["status"] = "flexure"
-                    cell["violations"].append(f"the flexure: {fx.reason}")
-                    continue
-                kk = float(fx.drive_stiffness)
-            cell["stiffness"] = kk
-            if zeta is not None:
-                cell["damping"] = 2.0 * zeta * math.sqrt(kk * mred)
-            probe = _candidate_spec(base, float(s), kk, cell["damping"],
-                                    fc if rule else None)
-            if not _meets_margins(probe, fc):
-                cell["status"] = "margins"
-                cell["violations"].append(f"a limit case misses its margins at {fc:.4g} Hz")
-                continue
+    cells = [screen(float(s), float(k)) for s in strokes for k in stiffs]
     todo = [c for c in cells if c["status"] is None]
 
     # ------------------------------------------------------------ the stage at the crossover
@@ -272,42 +280,52 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
     quiet = [c for c in todo if c["status"] is None]
 
     # ------------------------------------------------------------ the hunting-free crossover
+    def judge(points: list[dict]) -> int:
+        """The stage-level answer with its fold and the landing of points that do not hunt;
+        the stage-level evaluations it took."""
+        specs = [_candidate_spec(base, c["stroke"], c["stiffness"], c["damping"],
+                                 c["crossover"] if rule else None) for c in points]
+        n = 0
+        for c, st, cs in zip(points, _map(executor, _stage_answer, specs), specs):
+            n += 1 + int((st.boundary or {}).get("tests", 0))
+            c["stage"], c["spec"] = st, cs
+            c["free_from"] = st.hunting_free_from
+            if not st.acceptable:  # a move the first-found screen did not try hunts
+                c["status"] = "hunts"
+                c["violations"].append(f"at {c['crossover']:.4g} Hz some move hunts")
+                continue
+            c["factor"] = (c["crossover"] / st.hunting_free_from
+                           if st.hunting_free_from else None)
+            land = _landing(cs)
+            c["clearance"] = land.stroke - abs(land.deflection)
+            if land.on_limiter or land.force >= land.static_friction:
+                c["status"] = "end_stop"
+                c["violations"].append(
+                    f"the cart rests with the joint {quantity(land.deflection, 'm', 3)} deflected"
+                    + (", on its limiter" if land.on_limiter else "")
+                    + f": flexure force {land.force:.3g} N against Fs = "
+                      f"{land.static_friction:.3g} N")
+        return n
+
     say(f"finding the hunting-free crossover of {len(quiet)} design points ...")
-    specs = [_candidate_spec(base, c["stroke"], c["stiffness"], c["damping"],
-                             c["crossover"] if rule else None) for c in quiet]
-    answers = _map(executor, _stage_answer, specs)
-    for c, st, cs in zip(quiet, answers, specs):
-        evaluations += 1 + int((st.boundary or {}).get("tests", 0))
-        c["stage"], c["spec"] = st, cs
-        c["free_from"] = st.hunting_free_from
-        if not st.acceptable:  # a move the first-found screen did not try hunts
-            c["status"] = "hunts"
-            c["violations"].append(f"at {c['crossover']:.4g} Hz some move hunts")
-            continue
-        c["factor"] = (c["crossover"] / st.hunting_free_from
-                       if st.hunting_free_from else None)
-        land = _landing(cs)
-        c["clearance"] = land.stroke - abs(land.deflection)
-        if land.on_limiter or land.force >= land.static_friction:
-            c["status"] = "end_stop"
-            c["violations"].append(
-                f"the cart rests with the joint {quantity(land.deflection, 'm', 3)} deflected"
-                + (", on its limiter" if land.on_limiter else "")
-                + f": flexure force {land.force:.3g} N against Fs = {land.static_friction:.3g} N")
+    evaluations += judge(quiet)
 
     # ------------------------------------------------------------ the sign-off, best first
     from .guideline import design
 
-    ranked = sorted((c for c in quiet if c["status"] is None),
-                    key=lambda c: (-(c.get("factor") or 0.0), c["stiffness"]))
-    chosen = None
-    for c in ranked:
+    def margin(c: dict) -> tuple:
+        """The objective, smaller is better: the crossover factor (to the fold's resolution:
+        folds bisected to 0.1 % are equal within it), then the stiffness."""
+        return -round(c.get("factor") or 0.0, FACTOR_DIGITS), c["stiffness"]
+
+    def sign_off(c: dict) -> bool:
+        """The design command's verdict on a point (robustness included); True: it passes."""
         say(f"signing off the design {c['stroke'] * 1e3:.3g} mm, {c['stiffness']:.4g} N/m, "
             f"{c['crossover']:.4g} Hz (friction scatter included) ...")
         r = design(c["spec"], executor=executor)
         rob = r.robustness
-        evaluations += 0 if rob is None else rob.samples
         c["robustness"] = rob
+        c["samples"] = 0 if rob is None else rob.samples
         c["p"] = None if rob is None else rob.hunting_probability
         c["stage"] = r.simulation.stage["isolated"]
         if r.verdict.status == "FAIL":
@@ -315,10 +333,42 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
             c["status"] = {"robustness": "robustness", "simulation": "hunts",
                            "landing_force": "end_stop"}.get(fails[0].source, "checks")
             c["violations"] += [x.text for x in fails]
-            continue
+            return False
         c["status"] = "feasible"
-        chosen = c
-        break
+        return True
+
+    chosen = None
+    for c in sorted((c for c in quiet if c["status"] is None), key=margin):
+        passed = sign_off(c)
+        evaluations += c["samples"]
+        if passed:
+            chosen = c
+            break
+
+    # ------------------------------------------------------------ refined along the stiffness
+    grid_chosen = chosen
+    if chosen is not None and len(stiffs) > 1:
+        ki = cells.index(chosen) % len(stiffs)
+        lo = math.log(stiffs[max(ki - 1, 0)])
+        hi = math.log(stiffs[min(ki + 1, len(stiffs) - 1)])
+        for _ in range(REFINE_ROUNDS):
+            say(f"refining the stiffness between {math.exp(lo):.4g} and {math.exp(hi):.4g} N/m "
+                "...")
+            trial = [screen(chosen["stroke"], float(math.exp(x)))
+                     for x in np.linspace(lo, hi, REFINE_POINTS + 2)[1:-1]]
+            ok = [c for c in trial if c["status"] is None]
+            evaluations += judge(ok)
+            for c in sorted((c for c in ok if c["status"] is None
+                             and margin(c) < margin(chosen)), key=margin):
+                passed = sign_off(c)
+                evaluations += c["samples"]
+                if passed:
+                    chosen = c
+                    break
+            step = (hi - lo) / (REFINE_POINTS + 1)
+            at = math.log(chosen["nominal"])
+            lo, hi = max(lo, at - step), min(hi, at + step)
+
     for c in cells:
         if c["status"] is None:
             c["status"] = "not_evaluated"
@@ -331,7 +381,7 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
     land = chosen.get("clearance")
     cands = tuple(_to_candidate(c) for c in cells)
     best = _to_candidate(chosen)
-    binding = _binding(cells, chosen, strokes, stiffs, rule, bounds) if feasible else ()
+    binding = _binding(cells, grid_chosen, strokes, stiffs, rule, bounds) if feasible else ()
     st = chosen.get("stage")
     margins = {"crossover_factor": chosen.get("factor"),
                "stiffness_factor": _spec.stiffness_limit(base, chosen["stroke"])
