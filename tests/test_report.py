@@ -363,6 +363,14 @@ def test_html_figures_and_equations_inline(design_html):
     assert len(equations) >= 12
 
 
+def test_figures_are_numbered_in_the_order_they_appear(design_html):
+    """The stage-level boundary (Figure 8) stood before Figures 6 and 7: the numbers follow
+    the page."""
+    numbers = [int(n) for n in re.findall(r'class="fignum">Figure (\d+)\.', design_html)]
+    assert len(numbers) >= 8
+    assert numbers == list(range(1, len(numbers) + 1)), numbers
+
+
 def test_html_is_reproducible(paper_confirmed_design, design_html):
     again = report.render_html(report.build_context(paper_confirmed_design, date="2027-12-31",
                                                     command=COMMAND))

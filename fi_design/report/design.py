@@ -249,6 +249,11 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "over one period against its stroke (middle), and the settling after the spec's "
             f"own motion in the \u00b1{num(h.settle_band * 1e6)} \u00b5m settle band (right).",
             fig_no()),
+        "boundary": figure_entry(
+            (lambda: plots.boundary_figure(sim)) if figures else None, "boundary",
+            "The stage-level boundary: the peak to peak of each plant's hunting cycle as the "
+            "crossover rises, up to the cycle's fold (dotted), from which no move of the "
+            "family hunts; dashed, the design crossover.", fig_no()),
         "error": figure_entry(
             (lambda: plots.error_figure(sim, spec)) if figures else None, "error",
             _error_caption(sim, spec), fig_no()),
@@ -256,11 +261,6 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             (lambda: plots.deflection_figure(sim, spec)) if figures else None, "deflection",
             "Joint deflection of the isolated stage after the spec's own motion, against the "
             "stroke; beyond the dashed lines the limiter carries the cart.", fig_no()),
-        "boundary": figure_entry(
-            (lambda: plots.boundary_figure(sim)) if figures else None, "boundary",
-            "The stage-level boundary: the peak to peak of each plant's hunting cycle as the "
-            "crossover rises, up to the cycle's fold (dotted), from which no move of the "
-            "family hunts; dashed, the design crossover.", fig_no()),
         "landing": None if land is None else {
             "deflection": land.deflection, "stroke": land.stroke, "force": land.force,
             "static_friction": land.static_friction, "rule_force": land.rule_force,
