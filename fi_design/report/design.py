@@ -141,13 +141,17 @@ def _error_caption(sim: Any, spec: Any) -> str:
 _MODEL_NAMES = {"lugre": "LuGre", "switch": "switch (Karnopp-type)"}
 
 
-def _plant_rows(sim: Any) -> list[dict]:
+def _plant_labels(sim: Any) -> dict[str, str]:
+    """The two plants' row labels: which one the spec specifies, which one is compared."""
     if sim.suggested_isolator:
-        names = {"isolated": "suggested isolator (recommendation)",
-                 "non_isolated": "without isolator (as specified)"}
-    else:
-        names = {"isolated": "with isolator (as specified)",
-                 "non_isolated": "without isolator (comparison)"}
+        return {"isolated": "suggested isolator (recommendation)",
+                "non_isolated": "without isolator (as specified)"}
+    return {"isolated": "with isolator (as specified)",
+            "non_isolated": "without isolator (comparison)"}
+
+
+def _plant_rows(sim: Any) -> list[dict]:
+    names = _plant_labels(sim)
     rows = []
     for key, name in names.items():
         v = getattr(sim, key)
@@ -171,12 +175,7 @@ def _plant_rows(sim: Any) -> list[dict]:
 
 def _stage_rows(sim: Any) -> list[dict]:
     """One row per plant of the stage-level answer (every move of its family)."""
-    if sim.suggested_isolator:
-        names = {"isolated": "suggested isolator (recommendation)",
-                 "non_isolated": "without isolator (as specified)"}
-    else:
-        names = {"isolated": "with isolator (as specified)",
-                 "non_isolated": "without isolator (comparison)"}
+    names = _plant_labels(sim)
     rows = []
     for key, name in names.items():
         st = sim.stage[key]
