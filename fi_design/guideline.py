@@ -41,7 +41,7 @@ import numpy as np
 
 from .errors import ArgumentError
 from .display import number, quantity
-from .flexure import size_flexure
+from .mechanism.checks import flexure_checks
 from .model import Model, as_model
 from .results import Check, Status, frozen_array
 from .results.controller import ControlLaw
@@ -203,12 +203,15 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
     for m in model.modes:
         need = sep * fc
         ok = m.frequency >= need
-        modes.append(ModeSeparation(m.name, m.frequency, need, m.collocated, ok))
-        checks.append(Check(
-            f"parasitic_separation.{m.name}", ok, m.frequency, need, "Hz",
-            f"parasitic mode '{m.name}' at {m.frequency:.4g} Hz "
-            + ("lies above" if ok else "lies below")
-            + f" {sep:g} x the desired crossover ({need:.4g} Hz)", step=step))
+        modes.append(ModeSeparation(m.name, m.frequency, need, m.collocated, ok,
+                                    source=m.source, direction=m.direction,
+                                    coupling=m.coupling))
+        if m.source == "given":  # a computed mode is judged with its guide (step 3)
+            checks.append(Check(
+                f"parasitic_separation.{m.name}", ok, m.frequency, need, "Hz",
+                f"parasitic mode '{m.name}' (given) at {m.frequency:.4g} Hz "
+                + ("lies above" if ok else "lies below")
+                + f" {sep:g} x the desired crossover ({need:.4g} Hz)", step=step))
 
     return CrossoverResult(
         desired=fc, achievable=ach.frequency, limited_by=ach.limited_by, limit_kind=ach.kind,
@@ -330,60 +333,24 @@ def step3_stiffness(model: Model | Spec) -> StiffnessResult:
 
 def step3_flexure(model: Model | Spec,
                   stiffness: StiffnessResult | None = None) -> FlexureResult | None:
-    """Guideline step 3, second half: size the leaf-spring guide of ``isolator.flexure``.
+    """Guideline step 3, second half: the isolator's leaf-spring guide as a mechanism.
 
     Parameters
     ----------
     model : fi_design.model.Model or fi_design.spec.Spec
         The resolved model (a spec is resolved).
     stiffness : StiffnessResult, optional
-        Step 3's stiffness result (computed when omitted).
+        Unused; kept for callers that pass step 3's stiffness result.
 
     Returns
     -------
     FlexureResult or None
-        None when the spec has no ``isolator.flexure`` section. The required
-        parasitic frequency is ``parasitic_separation`` x the desired crossover.
+        None when the spec has no ``isolator.flexure`` section; else the guide
+        the spec draws, or the one sized for the joint's stiffness and stroke
+        (:attr:`fi_design.model.Model.flexure`): six stiffnesses, gravity,
+        stress and modes.
     """
-    model = as_model(model)
-    spec = model.spec
-    if model.joint is None or spec.isolator is None or spec.isolator.flexure is None:
-        return None
-    st = stiffness if stiffness is not None else step3_stiffness(model)
-    return size_flexure(spec.isolator.flexure, target_stiffness=st.chosen,
-                        maximum_stiffness=st.maximum, stroke=st.stroke,
-                        stage_mass=model.m1,
-                        required_frequency=model.requirements.parasitic_separation
-                        * model.crossover)
-
-
-def _flexure_checks(fx: FlexureResult | None) -> tuple[Check, ...]:
-    if fx is None:
-        return ()
-    step = "step 3 flexure"
-    if not fx.feasible:
-        return (Check("flexure", False, None, None, "-",
-                      f"no {fx.leaves}-leaf guide within the bounds fits: {fx.reason}",
-                      step=step),)
-    dims = (f"{fx.leaves} leaves L x b x t = {fx.length * 1e3:.3g} x {fx.width * 1e3:.3g} x "
-            f"{fx.thickness * 1e3:.3g} mm")
-    return (
-        Check("flexure.stiffness", fx.drive_stiffness <= fx.maximum_stiffness * (1 + 1e-9),
-              fx.drive_stiffness, fx.maximum_stiffness, "N/m",
-              f"{dims}: drive stiffness {_g(fx.drive_stiffness)} N/m (target "
-              f"{_g(fx.target_stiffness)} N/m, k_max {_g(fx.maximum_stiffness)} N/m)", step=step),
-        Check("flexure.stress", fx.stress <= fx.allowed_stress, fx.stress, fx.allowed_stress,
-              "Pa", f"bending stress at full stroke {fx.stress / 1e6:.3g} MPa, allowed "
-              f"{fx.allowed_stress / 1e6:.4g} MPa (margin x{fx.stress_margin:.3g})", step=step),
-        Check("flexure.support_frequency", fx.support_frequency >= fx.required_frequency,
-              fx.support_frequency, fx.required_frequency, "Hz",
-              f"support-direction frequency {fx.support_frequency:.4g} Hz with the stage "
-              f"mass, required {fx.required_frequency:.4g} Hz", step=step),
-        Check("flexure.bending_frequency", fx.bending_frequency >= fx.required_frequency,
-              fx.bending_frequency, fx.required_frequency, "Hz",
-              f"leaf bending resonance {fx.bending_frequency:.4g} Hz (clamped-guided, "
-              f"conservative), required {fx.required_frequency:.4g} Hz", step=step),
-    )
+    return as_model(model).flexure
 
 
 # --------------------------------------------------------------------------- step 4
@@ -608,7 +575,9 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
             fut.cancel()
         raise
     advice = isolator_advice(model, gap, xo) if not model.has_isolator else None
-    checks = gap.checks + xo.checks + st.checks + _flexure_checks(fx) + pid.checks
+    checks = (gap.checks + xo.checks + st.checks
+              + flexure_checks(fx, xo.desired, model.requirements.parasitic_separation)
+              + pid.checks)
     result = DesignResult(
         spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,
         loop=loop_responses(model, xo), isolator_advice=advice, checks=checks,
@@ -732,12 +701,17 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
                      "of static friction.")
         if fx is not None:
             if fx.feasible:
+                low = fx.lowest_mode
                 parts.append(
-                    f"A {fx.leaves}-leaf spring guide (L x b x t = {fx.length * 1e3:.3g} x "
-                    f"{fx.width * 1e3:.3g} x {fx.thickness * 1e3:.3g} mm) realises it with a "
-                    f"stress margin of {fx.stress_margin:.3g} and parasitic frequencies of "
-                    f"{fx.bending_frequency:.4g} Hz (leaf) and {fx.support_frequency:.4g} Hz "
-                    f"(support), above the {fx.required_frequency:.4g} Hz required.")
+                    f"A {fx.leaves}-leaf spring guide (L x b x t = "
+                    f"{quantity(fx.length, 'm', 3, shown=('mm', 1e3))} x "
+                    f"{quantity(fx.width, 'm', 3, shown=('mm', 1e3))} x "
+                    f"{quantity(fx.thickness, 'm', 3, shown=('mm', 1e3))}, "
+                    f"{fx.guide.orientation}) "
+                    + ("as drawn" if fx.drawn else "sized from stock")
+                    + f" has a net drive stiffness of {_g(fx.drive_stiffness)} N/m with "
+                    f"gravity, a stress margin of {fx.stress_margin:.3g} and its lowest "
+                    f"parasitic mode ({low.name}) at {_g(low.frequency)} Hz.")
             else:
                 parts.append(f"No leaf-spring guide within the given bounds fits ({fx.reason}).")
     elif advice is not None:

@@ -25,10 +25,9 @@ friction slope is sigma2 (with direction-dependent friction the smaller of
 linearises it at rest, where ``dz/dt = v`` and the friction force is
 ``sigma0 x2 + (sigma1 + sigma2) v2``.
 
-Parasitic flexure modes (``spec.isolator.parasitic_modes``) multiply every
-isolated case: a non-collocated mode by ``wr^2 / (s^2 + 2 zeta wr s + wr^2)``;
-a collocated one also by ``(s^2 + 2 zeta wa s + wa^2) / wa^2``, its
-antiresonance ``wa`` below ``wr`` (:func:`fi_design.spec.antiresonance`).
+Parasitic modes (``model.modes``) enter every isolated case: a mode the spec
+gives multiplies it by :func:`mode_factor`; a mode computed from the flexure
+guide adds its modal term :func:`mode_term` (modal superposition).
 
 The controller is the loop's :class:`fi_design.pid.ControlLaw` (the rule's
 PID or the hardware's gains), the same description the simulation uses. The
@@ -63,17 +62,18 @@ import control
 import numpy as np
 
 from .errors import SpecError
+from .mechanism.modes import mode_factor, mode_term
 from .model import Model, as_model
 from .results import Status, frozen_array
 from .results.controller import ControlLaw, PidGains
 from .results.linear import CRITERIA, AchievableCrossover, CaseMargins, LoopAnalysis
-from .spec import Spec, antiresonance
+from .spec import Spec
 
 __all__ = [
     "ISOLATED_CASES", "RIGID_CASES", "CASE_DESCRIPTIONS", "CASE_NUMBERS", "SCAN_LIMIT",
     "SCAN_START", "BAND_FACTOR",
     "LimitCase", "CaseMargins", "LoopAnalysis", "AchievableCrossover",
-    "limit_cases", "mode_factor", "delay_time", "delay_polynomials", "controller_polynomials",
+    "limit_cases", "mode_factor", "mode_term", "delay_time", "delay_polynomials", "controller_polynomials",
     "controller_tf", "delay_tf", "loop_polynomials", "loop_transfer_function", "sensitivity",
     "complementary_sensitivity", "loop_margins", "analyse", "achievable_crossover",
 ]
@@ -175,30 +175,6 @@ def _two_mass(m1: float, m2: float, k: float, c: float, cart_stiffness: float,
     return sys, num, den
 
 
-def mode_factor(mode) -> tuple[np.ndarray, np.ndarray]:
-    """Numerator and denominator of one parasitic mode's factor (unit DC gain).
-
-    Parameters
-    ----------
-    mode : fi_design.spec.ParasiticMode
-        Frequency [Hz], damping ratio [-], collocated or not.
-
-    Returns
-    -------
-    num, den : numpy.ndarray
-        Descending powers of s [rad/s]: ``wr^2 / (s^2 + 2 zeta wr s + wr^2)``,
-        times ``(s^2 + 2 zeta wa s + wa^2) / wa^2`` when collocated.
-    """
-    wr = 2.0 * math.pi * mode.frequency
-    z = mode.damping_ratio
-    den = np.array([1.0, 2.0 * z * wr, wr * wr])
-    num = np.array([wr * wr])
-    if mode.collocated:
-        wa = 2.0 * math.pi * antiresonance(mode)
-        num = (wr * wr / (wa * wa)) * np.array([1.0, 2.0 * z * wa, wa * wa])
-    return num, den
-
-
 def limit_cases(model: Model | Spec) -> tuple[LimitCase, ...]:
     """The linear limit cases of a model.
 
@@ -230,10 +206,18 @@ def limit_cases(model: Model | Spec) -> tuple[LimitCase, ...]:
             "sliding_limited": _rigid(M, s2, 0.0),
             "stuck_limited": _rigid(M, s1 + s2, s0),
         }
-    factors = [mode_factor(m) for m in model.modes]
+    factors = [mode_factor(m) for m in model.modes if m.source == "given"]
+    terms = [mode_term(m, m1) for m in model.modes
+             if m.source != "given" and m.participation != 0.0]
     out = []
     for i, (name, (sys, num, den)) in enumerate(raw.items(), start=1):
         num, den = np.asarray(num, float), np.asarray(den, float)
+        for tn, td in terms:
+            num, den = np.polyadd(np.polymul(num, td), np.polymul(den, tn)), np.polymul(den, td)
+            # the modal term r/m1 / (s^2 + 2 zeta w s + w^2) as states (x, x')
+            term = control.ss([[0.0, 1.0], [-td[2], -td[1]]], [[0.0], [1.0]], [[tn[0], 0.0]],
+                              0.0)
+            sys = control.parallel(sys, term)
         for fn, fd in factors:
             num, den = np.polymul(num, fn), np.polymul(den, fd)
             sys = control.series(sys, control.ss(control.tf(fn, fd)))

@@ -26,16 +26,21 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 from . import effects as _effects
 from . import spec as _spec
 from .errors import ArgumentError, SimulationError, SpecError
 from .pid import at_crossover, control_law
 from .kernel.layout import PlantParameters
+from .mechanism.geometry import StageBody, stage_body
 from .results.controller import ControlLaw
 from .results.friction import FrictionLaw
+from .results.mechanism import Mode
+from .results.steps import FlexureResult
 
-__all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "apply_effects"]
+__all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "apply_effects",
+           "given_mode"]
 
 #: Friction models of the spec (``friction.model``).
 FRICTION_MODELS = ("lugre", "switch")
@@ -122,8 +127,12 @@ class Model:
         The isolator's joint; None for a stage without isolator.
     limiter : Limiter or None
         The isolator's end stop; None without isolator.
-    modes : tuple of fi_design.spec.ParasiticMode
-        Parasitic flexure modes (empty without isolator).
+    given_modes : tuple of fi_design.results.mechanism.Mode
+        The parasitic modes the spec gives (``isolator.parasitic_modes``,
+        measured values): they override the guide's computed modes.
+    body : StageBody
+        The stage as a rigid body (its inertia and the sensor's and
+        actuator's offsets), for the flexure guide.
     law : fi_design.results.controller.ControlLaw
         The loop's controller: the rule's PID at the crossover or the
         hardware's gains, with sampling, delay, saturation and feedforward.
@@ -142,10 +151,60 @@ class Model:
     offset: float
     joint: Joint | None
     limiter: Limiter | None
-    modes: tuple[_spec.ParasiticMode, ...]
+    given_modes: tuple[Mode, ...]
+    body: StageBody
     law: ControlLaw
     effects: tuple = ()
     changed: tuple[str, ...] = ()
+
+    # ---- the flexure guide and the modes the loop sees
+
+    @property
+    def flexure_spec(self):
+        """The spec's ``isolator.flexure`` (a guide drawn or to size), or None."""
+        iso = self.spec.isolator
+        return None if self.joint is None or iso is None else iso.flexure
+
+    @cached_property
+    def flexure(self) -> FlexureResult | None:
+        """The isolator's leaf-spring guide as a mechanism, or None without a flexure section.
+
+        A guide drawn in the spec is evaluated; one given by bounds is sized
+        for the joint's stiffness and stroke (:func:`fi_design.mechanism.sizing.size_guide`:
+        k_max, the stress, ``requirements.buckling_factor`` and every parasitic mode at
+        ``parasitic_separation`` x the crossover). Worked out on first use and
+        kept by :meth:`at` while the joint stays.
+        """
+        flex = self.flexure_spec
+        if flex is None:
+            return None
+        from .mechanism.sizing import drawn_guide, size_guide
+
+        req = self.requirements
+        common = dict(stroke=self.joint.stroke, cart_mass=self.m2,
+                      maximum_stiffness=_spec.stiffness_limit(self.spec, self.joint.stroke),
+                      required_frequency=req.parasitic_separation * self.crossover,
+                      required_buckling=req.buckling_factor)
+        if flex.drawn:
+            return drawn_guide(flex, self.body, **common)
+        return size_guide(flex, self.body, target_stiffness=self.joint.stiffness, **common)
+
+    @cached_property
+    def modes(self) -> tuple[Mode, ...]:
+        """The parasitic modes the loop sees, by frequency.
+
+        The guide's computed ones (its stage's five and its leaves' own); a
+        given mode (``isolator.parasitic_modes``, measured) with a direction
+        replaces the computed mode of that direction, and given modes without
+        a direction replace them all. Without a guide, the given ones.
+        """
+        given = self.given_modes
+        fx = self.flexure if self.joint is not None else None
+        if fx is None or fx.mechanics is None or any(m.direction == "given" for m in given):
+            return given
+        replaced = {m.direction for m in given}
+        kept = tuple(m for m in fx.mechanics.parasitic_modes if m.direction not in replaced)
+        return tuple(sorted(kept + given, key=lambda m: m.frequency))
 
     # ---- views
 
@@ -240,7 +299,12 @@ class Model:
             friction = replace(friction, model=friction_model)
         entries = model.effects if effects is None else _checked_effects(effects, model.joint)
         changed = self.changed + tuple(p for p in paths if p not in self.changed)
-        return replace(model, law=law, friction=friction, effects=entries, changed=changed)
+        out = replace(model, law=law, friction=friction, effects=entries, changed=changed)
+        if model is self:  # the joint stays: so do the guide and its modes, once worked out
+            for name in ("flexure", "modes"):
+                if name in self.__dict__:
+                    out.__dict__[name] = self.__dict__[name]
+        return out
 
     def _with_joint(self, stiffness, stroke, damping) -> "Model":
         """The model with the joint's values changed (an isolator added when it has none)."""
@@ -271,7 +335,7 @@ class Model:
         if j is not None:
             return replace(self, joint=joint)
         lim = _spec.Limiter()  # the spec's defaults: no modes, the default end stop
-        return replace(self, joint=joint, modes=(),
+        return replace(self, joint=joint, given_modes=(),
                        limiter=Limiter(lim.stiffness,
                                        _spec.default_limiter_damping(lim.stiffness, self.m1)))
 
@@ -359,16 +423,41 @@ def resolve(spec: _spec.Spec) -> Model:
     iso = spec.isolator
     joint = limiter = None
     modes: tuple = ()
+    body = stage_body(spec.stage)
     if iso is not None:
         k = _spec.drive_stiffness(spec)
+        given = iso.stiffness is not None
+        if iso.flexure is not None and iso.flexure.drawn and not given:
+            k = _drawn_stiffness(iso.flexure, body, spec)
         joint = Joint(stiffness=k, damping=_spec.joint_damping(spec, k), stroke=iso.stroke,
-                      stiffness_given=iso.stiffness is not None,
+                      stiffness_given=given or (iso.flexure is not None and iso.flexure.drawn),
                       damping_given=iso.damping is not None)
         limiter = Limiter(stiffness=iso.limiter.stiffness, damping=_spec.limiter_damping(spec))
-        modes = tuple(iso.parasitic_modes)
+        modes = tuple(given_mode(m) for m in iso.parasitic_modes)
     return Model(spec=spec, m1=spec.stage.mass, m2=spec.cart.mass, friction=friction,
-                 offset=f.offset, joint=joint, limiter=limiter, modes=modes,
+                 offset=f.offset, joint=joint, limiter=limiter, given_modes=modes, body=body,
                  law=control_law(spec), effects=tuple(spec.effects))
+
+
+def _drawn_stiffness(flexure, body: StageBody, spec: _spec.Spec) -> float:
+    """The net drive stiffness of a guide the spec draws, gravity included [N/m]."""
+    from .mechanism.geometry import leaf_guide
+    from .mechanism.sizing import net_stiffness
+
+    g = leaf_guide(flexure, body, length=flexure.length, width=flexure.width,
+                   thickness=flexure.thickness, cart_mass=spec.cart.mass)
+    # a guide the weight buckles has a negative net stiffness: step 3 fails it, and the
+    # simulation shows the stage leaning on its end stop
+    return float(net_stiffness(g, g.length, g.width, g.thickness))
+
+
+def given_mode(mode: _spec.ParasiticMode) -> Mode:
+    """A parasitic mode of the spec as the loop's :class:`~fi_design.results.mechanism.Mode`."""
+    return Mode(name=mode.name, frequency=mode.frequency, damping_ratio=mode.damping_ratio,
+                direction=mode.direction or "given", coupling=1.0,
+                participation=1.0 if mode.collocated else -1.0, source="given",
+                collocated=mode.collocated,
+                antiresonance=_spec.antiresonance(mode) if mode.collocated else None)
 
 
 def as_model(spec_or_model) -> Model:

@@ -419,11 +419,14 @@ def _meets_margins(spec: _spec.Spec, fc: float) -> bool:
 
 
 def _flexure(base: _spec.Spec, stroke: float, k: float, kmax: float, fc: float) -> Any:
-    from .flexure import size_flexure
+    from .mechanism.geometry import stage_body
+    from .mechanism.sizing import size_guide
 
-    return size_flexure(base.isolator.flexure, target_stiffness=k, maximum_stiffness=kmax,
-                        stroke=stroke, stage_mass=base.stage.mass,
-                        required_frequency=base.requirements.parasitic_separation * fc)
+    req = base.requirements
+    return size_guide(base.isolator.flexure, stage_body(base.stage), target_stiffness=k,
+                      maximum_stiffness=kmax, stroke=stroke, cart_mass=base.cart.mass,
+                      required_frequency=req.parasitic_separation * fc,
+                      required_buckling=req.buckling_factor)
 
 
 def _map(executor: Any, fn: Callable, items: Sequence) -> list:

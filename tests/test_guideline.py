@@ -56,9 +56,19 @@ def test_json_contract_for_the_paper_setup(paper_design, paper_spec):
     assert d["stiffness"]["chosen"] == 6667.0
     fl = d["flexure"]
     assert fl["feasible"] is True
-    for key in ("length", "width", "thickness", "stress", "stress_margin", "support_frequency",
-                "bending_frequency", "drive_stiffness"):
+    for key in ("length", "width", "thickness", "stress", "stress_margin",
+                "net_drive_stiffness", "spacing"):
         assert isinstance(fl[key], float), key
+    assert fl["orientation"] == "standing" and fl["leaves"] == 2
+    assert set(fl["stiffness"]) == set(fl["stiffness_at_stroke"]) == {"x", "y", "z", "rx", "ry",
+                                                                      "rz"}
+    assert set(fl["gravity"]) == {"orientation", "axial_load", "geometric_stiffness",
+                                  "buckling_load", "buckling_factor", "sag"}
+    assert fl["gravity"]["geometric_stiffness"] < 0          # standing: softer
+    assert len(fl["modes"]) == 8                               # six stage, two leaf modes
+    for m in fl["modes"]:
+        assert {"name", "frequency", "direction", "coupling", "source"} <= set(m)
+        assert m["source"] == "computed" and 0 <= m["coupling"] <= 1
     assert d["checks"]
     for c in d["checks"]:
         assert set(c) >= {"name", "passed", "value", "limit", "unit", "message", "status",
@@ -85,8 +95,8 @@ def test_paper_verdict(paper_design):
     assert {f"phase_margin.{n}" for n in ("sliding_free", "stuck_free", "sliding_limited",
                                           "stuck_limited")} <= set(names)
     assert "parasitic_separation.stage tilt" in names and "drive_stiffness" in names
-    assert {"flexure.stiffness", "flexure.stress", "flexure.support_frequency",
-            "flexure.bending_frequency", "pid"} <= set(names)
+    assert {"flexure.stiffness", "flexure.stress", "flexure.buckling", "flexure.modes",
+            "pid"} <= set(names)
     gap = next(c for c in r.checks if c.name == "friction_gap")
     # a 3 N gap is a risk, which the isolator is there to answer: information, not a warning
     assert gap.status == Status.INFO and gap.passed is None and "isolator" in gap.message

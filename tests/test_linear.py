@@ -252,10 +252,22 @@ def test_paper_achievable_crossover_and_its_boundary(paper_spec):
 
 
 def test_nothing_limits_an_ideal_loop(paper_spec):
-    spec = variant(paper_spec, **{"isolator.parasitic_modes": []})
+    spec = variant(paper_spec, **{"isolator.parasitic_modes": [], "isolator.flexure": None})
     ach = linear.achievable_crossover(spec)
     assert ach.kind == "scan_limit" and ach.frequency == linear.SCAN_LIMIT
     assert ach.limited_by == "nothing up to the scan limit 1000 Hz"
+
+
+def test_without_given_modes_the_guide_s_own_modes_limit_the_crossover(paper_spec):
+    """No mode typed for another flexure: the sized guide's computed modes bound the crossover
+    by the parasitic separation (its lowest parasitic mode, the stage's lateral one)."""
+    spec = variant(paper_spec, **{"isolator.parasitic_modes": []})
+    model = resolve(spec)
+    low = min(model.modes, key=lambda m: m.frequency)
+    assert all(m.source == "computed" for m in model.modes) and low.direction == "y"
+    ach = linear.achievable_crossover(spec)
+    assert ach.kind == "mode" and ach.frequency == pytest.approx(low.frequency / 3)
+    assert f"'{low.name}'" in ach.limited_by
 
 
 def test_a_delay_lowers_the_achievable_crossover(paper_spec):

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from fi_design.errors import SpecError
-from fi_design.model import Model, resolve
+from fi_design.model import Model, given_mode, resolve
 
 from conftest import variant
 
@@ -46,7 +46,8 @@ def test_resolve_fills_the_defaults_design_md_gives(paper_spec):
     assert m.limiter.stiffness == 1e6
     assert m.limiter.damping == pytest.approx(2 * 0.2 * math.sqrt(1e6 * m1), rel=1e-15)
     assert (m.m1, m.m2, m.offset, m.crossover) == (m1, m2, f.offset, 8.0)
-    assert m.modes == bare.isolator.parasitic_modes and m.effects == bare.effects
+    assert m.modes == tuple(given_mode(x) for x in bare.isolator.parasitic_modes)
+    assert all(x.source == "given" for x in m.modes) and m.effects == bare.effects
 
 
 def test_the_kernel_parameters_are_the_resolved_values(paper_spec):

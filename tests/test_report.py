@@ -93,7 +93,7 @@ def test_display_scale_shares_a_unit_between_value_and_limit():
     assert row["unit"] == "MPa"
     assert row["value"] == pytest.approx(31.55) and row["limit"] == pytest.approx(300.0)
     assert row["sense"] == "\u2264" and row["status"] == "PASS" and row["css"] == "pass"
-    assert row["label"] == "Flexure bending stress at full stroke"
+    assert row["label"] == "Flexure stress at full stroke"
 
 
 def _check(name, value, limit, unit, passed=True):

@@ -55,7 +55,7 @@ SENSE = {
     "friction_gap": "<", "crossover_achievable": "\u2264", "phase_margin": "\u2265",
     "gain_margin": "\u2265", "modulus_margin": "\u2265", "parasitic_separation": "\u2265",
     "drive_stiffness": "\u2264", "flexure.stiffness": "\u2264", "flexure.stress": "\u2264",
-    "flexure.support_frequency": "\u2265", "flexure.bending_frequency": "\u2265",
+    "flexure.buckling": "\u2265", "flexure.modes": "\u2265", "flexure.sag": "<",
     "simulation_isolated": "=", "min_crossover_isolated": "\u2264", "landing_force": "<",
     "simulation_non_isolated": "=", "min_crossover_non_isolated": "\u2264", "robustness": "\u2264",
 }
@@ -103,10 +103,11 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
         "robustness": "Probability of not settling under friction scatter",
         "friction_model_cross_check": "Cross-check with the other friction model",
     }
-    flex = {"stiffness": "Flexure drive stiffness within k_max",
-            "stress": "Flexure bending stress at full stroke",
-            "support_frequency": "Flexure support-direction frequency",
-            "bending_frequency": "Flexure leaf bending resonance"}
+    flex = {"stiffness": "Flexure net drive stiffness within k_max",
+            "stress": "Flexure stress at full stroke",
+            "buckling": "Flexure buckling load over the stage's weight",
+            "modes": "Flexure's lowest parasitic mode above the crossover",
+            "sag": "Joint sag under the cart's weight within the stroke"}
     if head == "flexure" and tail in flex:
         return flex[tail]
     if head == "pid" and tail == "tuning_mass":
@@ -269,10 +270,11 @@ def key_figures(result: Any) -> list[dict]:
     if m.stiffness_range is not None:
         lo, hi = m.stiffness_range
         rows.append(_figure(
-            f"Drive stiffness of the flexure, t = {qty(m.thickness, 'm')} \u00b1 "
+            f"Net drive stiffness of the flexure, t = {qty(m.thickness, 'm')} \u00b1 "
             f"{qty(m.thickness_tolerance, 'm')}", f"{num(lo)} \u2013 {num(hi)}", "N/m",
             f"\u2264 {num(result.stiffness.maximum)}",
-            f"k (1 \u2213 \u0394t/t)\u00b3; k_max / k \u2265 {num(m.stiffness_factor_worst, 3)}",
+            f"the elastic part goes with t\u00b3, gravity's does not; k_max / k \u2265 "
+            f"{num(m.stiffness_factor_worst, 3)}",
             "pass" if m.stiffness_factor_worst >= 1 else "fail"))
     if m.static_error is not None:
         ok = m.static_error <= m.static_error_bound + spec.requirements.hunting.settle_band

@@ -18,6 +18,7 @@ from .blocks import figure_entry
 from .checks import verdict
 from .context import build_context
 from .filters import num, qty
+from .guide import guide_section
 from .inputs import spec_inputs
 from .meta import spec_listing, title_block, versions
 from .steps import guideline_steps
@@ -443,6 +444,11 @@ def _design_sections(ctx: dict) -> list[dict]:
         {"id": "verdict", "title": "Verdict", "template": "verdict.html.jinja"},
         {"id": "inputs", "title": "Inputs", "template": "inputs.html.jinja"},
         {"id": "steps", "title": "The four guideline steps", "template": "steps.html.jinja"},
+    ]
+    if ctx.get("guide") is not None:
+        sections.append({"id": "guide", "title": "The isolator's leaf-spring guide",
+                         "template": "guide.html.jinja"})
+    sections += [
         {"id": "linear", "title": "Linear analysis", "template": "linear.html.jinja"},
         {"id": "nonlinear", "title": "Nonlinear confirmation", "template": "nonlinear.html.jinja"},
     ]
@@ -499,6 +505,10 @@ def design_context(result: DesignResult, *, date: Any = None, command: str | Non
         "verdict": verdict(result),
         "inputs": spec_inputs(spec, result.model),
         "steps": guideline_steps(result, figures),
+    }
+    ctx["guide"] = guide_section(result, figures, fig_no()) if result.flexure is not None \
+        else None
+    ctx |= {
         "linear": _linear(result, figures, fig_no),
         "nonlinear": _nonlinear(result, figures, fig_no),
     }

@@ -140,32 +140,38 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
         ]
     fx = result.flexure
     if fx is not None and fx.feasible:
-        E = spec.isolator.flexure.material.youngs_modulus
+        m, gd = fx.mechanics, fx.guide
         eqs.append(eq(
-            f"k = \\frac{{n E b t^3}}{{L^3}} = \\frac{{{fx.leaves} \\times {tex_qty(E, 'Pa')} "
-            f"\\times {tex_qty(fx.width, 'm')} \\times ({tex_qty(fx.thickness, 'm')})^3}}"
-            f"{{({tex_qty(fx.length, 'm')})^3}} = {tex_qty(fx.drive_stiffness, 'N/m')}"))
-        rel = "\\leq" if fx.stress <= fx.allowed_stress else ">"
+            f"k_e \\approx \\frac{{n E b t^3}}{{L^3}} = \\frac{{{gd.leaves} \\times "
+            f"{tex_qty(gd.youngs_modulus, 'Pa')} \\times {tex_qty(gd.width, 'm')} \\times "
+            f"({tex_qty(gd.thickness, 'm')})^3}}{{({tex_qty(gd.length, 'm')})^3}},\\quad "
+            f"k = k_e + k_g = {tex_qty(m.stiffness.x, 'N/m')} "
+            f"{'-' if m.gravity.geometric_stiffness < 0 else '+'} "
+            f"{tex_qty(abs(m.gravity.geometric_stiffness), 'N/m')} = "
+            f"{tex_qty(m.net_drive_stiffness, 'N/m')}"))
+        rel = "\\leq" if m.stress <= gd.allowed_stress else ">"
         eqs.append(eq(
-            f"\\sigma = \\frac{{3 E t s}}{{L^2}} = {tex_qty(fx.stress, 'Pa')}\\ "
-            f"{rel}\\ \\sigma_\\mathrm{{allow}} = "
-            f"{tex_qty(fx.allowed_stress, 'Pa')}"))
+            f"\\sigma = \\frac{{3 E t s}}{{L^2}} + \\frac{{|N|}}{{b t}} = "
+            f"{tex_qty(m.stress, 'Pa')}\\ {rel}\\ \\sigma_\\mathrm{{allow}} = "
+            f"{tex_qty(gd.allowed_stress, 'Pa')}"))
+        low = fx.lowest_mode
         results += [
-            {"quantity": "leaves n", "value": fx.leaves, "unit": "1"},
-            {"quantity": "leaf length L", "value": fx.length, "unit": "m"},
-            {"quantity": "leaf width b", "value": fx.width, "unit": "m"},
-            {"quantity": "leaf thickness t" + ("" if fx.thickness_step is None else
-                                               f" (stock, in steps of {qty(fx.thickness_step, 'm')})"),
-             "value": fx.thickness, "unit": "m"},
-            {"quantity": "thickness tolerance \u00b1\u0394t", "value": fx.thickness_tolerance,
-             "unit": "m"},
-            {"quantity": "drive stiffness at \u00b1\u0394t, k (1 \u2213 \u0394t/t)\u00b3",
-             "value": list(fx.stiffness_range), "unit": "N/m"},
-            {"quantity": "bending stress at full stroke", "value": fx.stress, "unit": "Pa"},
-            {"quantity": "stress margin allowed / actual", "value": fx.stress_margin, "unit": "1"},
-            {"quantity": "support-direction frequency (with m1)", "value": fx.support_frequency,
-             "unit": "Hz"},
-            {"quantity": "leaf bending resonance (clamped-guided)", "value": fx.bending_frequency,
+            {"quantity": "leaf-spring guide (section The isolator's leaf-spring guide)",
+             "value": (f"{gd.leaves} leaves L \u00d7 b \u00d7 t = {qty(gd.length, 'm')} \u00d7 "
+                       f"{qty(gd.width, 'm')} \u00d7 {qty(gd.thickness, 'm')}, "
+                       f"{gd.orientation.replace('_', ' ')}"
+                       + (", as drawn" if fx.drawn else ", sized")), "unit": ""},
+            {"quantity": "leaf thickness stock" if fx.thickness_step is not None else
+             "leaf thickness", "value": fx.thickness, "unit": "m"},
+            {"quantity": "net drive stiffness at \u00b1\u0394t", "value":
+             list(fx.stiffness_range), "unit": "N/m"},
+            {"quantity": "stress at full stroke", "value": m.stress, "unit": "Pa"},
+            {"quantity": "stress margin allowed / actual", "value": m.stress_margin,
+             "unit": "1"},
+            {"quantity": "buckling factor (load / weight)",
+             "value": "no compression" if m.gravity.buckling_factor is None
+             else m.gravity.buckling_factor, "unit": "1"},
+            {"quantity": f"lowest parasitic mode ({low.name})", "value": low.frequency,
              "unit": "Hz"},
             {"quantity": "required parasitic frequency", "value": fx.required_frequency,
              "unit": "Hz"},

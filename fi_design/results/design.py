@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 from ..provenance import Source, current_source
 from . import Check, Result, Status, to_jsonable
 from .confirmation import Confirmation, IsolatorAdvice, Landing, PlantVerdict
+from .mechanism import FeMechanics
 from .steps import (CaseResponse, CrossoverResult, FlexureResult, FrictionGapResult,
                     LoopResponses, ModeSeparation, PidResult, StiffnessResult)
 from .verdict import (VERDICT_STATUSES, Margins, Reason, Recommendation, RobustnessCheck,
@@ -46,8 +47,9 @@ class DesignResult(Result):
         Step 2.
     stiffness : StiffnessResult
         Step 3 (a suggestion without isolator).
-    flexure : fi_design.flexure.FlexureResult or None
-        Step 3 leaf-spring sizing; None without ``isolator.flexure``.
+    flexure : fi_design.results.steps.FlexureResult or None
+        Step 3: the leaf-spring guide as a mechanism, drawn or sized; None
+        without ``isolator.flexure``.
     pid : PidResult
         Step 4.
     loop : LoopResponses
@@ -86,6 +88,9 @@ class DesignResult(Result):
     model : fi_design.model.Model or None
         The resolved model every step read (not in JSON); ``spec`` is the
         spec it was resolved from.
+    flexure_fe : fi_design.results.mechanism.FeMechanics or None
+        The guide as a finite-element model, the independent check of the
+        closed forms (JSON: ``flexure.fe``); None when it did not run.
     """
 
     spec: Spec = field(repr=False)
@@ -108,6 +113,7 @@ class DesignResult(Result):
     recommendation: Recommendation | None = None
     fi_design_source: Source = field(default_factory=current_source)
     model: "Model | None" = field(default=None, repr=False)
+    flexure_fe: FeMechanics | None = None
 
     @property
     def passed(self) -> bool:
@@ -147,7 +153,9 @@ class DesignResult(Result):
             "friction_gap": self.friction_gap.to_dict(),
             "crossover": self.crossover.to_dict(),
             "stiffness": self.stiffness.to_dict(),
-            "flexure": None if self.flexure is None else self.flexure.to_dict(),
+            "flexure": None if self.flexure is None else {
+                **self.flexure.to_dict(),
+                **({} if self.flexure_fe is None else {"fe": self.flexure_fe.to_dict()})},
             "pid": self.pid.to_dict(),
             "isolator_advice": to_jsonable(self.isolator_advice),
             "checks": [to_jsonable(c) for c in self.checks],

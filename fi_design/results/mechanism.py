@@ -72,6 +72,9 @@ class LeafGuide(Result):
         of mass [m]; both measure and push along x.
     damping_ratio : float
         Modal damping ratio of the computed modes [-].
+    cart_mass : float
+        Mass of the bearing cart m2 [kg]: on a vertical drive axis the joint
+        carries its weight.
     """
 
     leaves: int
@@ -91,6 +94,7 @@ class LeafGuide(Result):
     sensor_offset: tuple[float, float] = (0.0, 0.0)
     actuator_offset: tuple[float, float] = (0.0, 0.0)
     damping_ratio: float = 0.01
+    cart_mass: float = 0.0
 
     @property
     def shear_modulus(self) -> float:
@@ -164,8 +168,9 @@ class Gravity(Result):
         Buckling load over the weight [-]; None where the weight does not
         compress the guide.
     sag : float
-        Static deflection of the joint under the weight along x [m]: m1 g / k
-        for a vertical drive axis, else 0.
+        Static deflection of the joint along x under the weight it carries [m]:
+        on a vertical drive axis the actuator holds the stage and the joint
+        the cart, m2 g / k; 0 in the other orientations.
     """
 
     orientation: str

@@ -13,6 +13,7 @@ import numpy as np
 from . import Check, Result, to_jsonable
 from .controller import ControlLaw, PidGains
 from .linear import CaseMargins
+from .mechanism import GuideMechanics
 
 __all__ = ["FrictionGapResult", "ModeSeparation", "CrossoverResult", "StiffnessResult", "FlexureResult", "RULE_FORM", "CONTROLLER_FORM", "HAND_OFF_FORM", "PidResult", "CaseResponse", "LoopResponses"]
 
@@ -61,6 +62,12 @@ class ModeSeparation(Result):
         Collocated (antiresonance first) or not.
     passed : bool
         ``frequency >= required``.
+    source : str
+        ``computed`` (from the flexure guide) or ``given`` (the spec's).
+    direction : str
+        Dominant direction (x, y, z, rx, ry, rz, leaf; ``given`` for the spec's).
+    coupling : float
+        How strongly it shows in the measured drive coordinate, 0 to 1.
     """
 
     name: str
@@ -68,6 +75,9 @@ class ModeSeparation(Result):
     required: float
     collocated: bool
     passed: bool
+    source: str = "given"
+    direction: str = "given"
+    coupling: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -156,78 +166,127 @@ class StiffnessResult(Result):
 
 @dataclass(frozen=True)
 class FlexureResult(Result):
-    """A sized parallel leaf-spring guide, or why none fits.
+    """The isolator's leaf-spring guide: drawn in the spec or sized from stock, or why none fits.
 
     Attributes
     ----------
     feasible : bool
-        A design within the bounds meets every constraint.
+        A guide exists (drawn, or sized within the bounds meeting every
+        constraint). A drawn guide is always "feasible"; the checks judge it.
     reason : str
-        Empty when feasible; else the binding constraint in words.
-    leaves : int
-        Number of leaves n.
-    length, width, thickness : float or None
-        Leaf dimensions L, b, t [m]; None when infeasible.
-    drive_stiffness : float or None
-        Drive stiffness of the design [N/m].
-    target_stiffness : float
-        Stiffness aimed at (step 3's chosen stiffness) [N/m].
+        Empty when feasible; else the binding constraint of the sizing in words.
+    drawn : bool
+        True when the spec draws the guide (one value per leaf dimension).
+    mechanics : fi_design.results.mechanism.GuideMechanics or None
+        The guide as a mechanism: six stiffnesses, gravity, stress, modes.
+    modes_at_stroke : tuple of fi_design.results.mechanism.Mode
+        The stage's modes with the joint at full stroke (the support
+        directions softer).
+    target_stiffness : float or None
+        Net drive stiffness the sizing aimed at [N/m]; None for a drawn guide.
     maximum_stiffness : float
-        k_max the drive stiffness must not exceed [N/m].
-    support_stiffness : float or None
-        Undeflected support stiffness [N/m].
+        k_max the net drive stiffness must not exceed [N/m].
     stroke : float
-        Required one-sided stroke [m].
+        One-sided stroke [m].
+    required_frequency : float
+        Every parasitic mode must reach this: separation x crossover [Hz].
+    required_buckling : float
+        ``requirements.buckling_factor`` [-].
     stroke_limit : float or None
         Largest stroke within the allowed stress [m].
-    stress : float or None
-        Peak bending stress at full stroke [Pa].
-    allowed_stress : float
-        Allowed stress of the material [Pa].
-    stress_margin : float or None
-        allowed_stress / stress [-]; above 1 is within the limit.
-    support_frequency : float or None
-        First parasitic (support-direction) frequency with the stage mass [Hz].
-    bending_frequency : float or None
-        Leaf's own first bending resonance, clamped-guided (conservative) [Hz].
-    required_frequency : float
-        Parasitic frequencies must reach this: separation x crossover [Hz].
-    frequency_margin : float or None
-        min(support, bending frequency) / required_frequency [-].
-    leaf_mass : float or None
-        Mass of all leaves [kg].
     thickness_step : float or None
         Stock step the thickness was chosen from [m]; None: unrounded.
     thickness_tolerance : float
         Thickness tolerance of the stock, +- [m].
     stiffness_range : tuple of float or None
-        Drive stiffness at the thickness tolerance, ``k (1 -+ dt / t)^3``
-        (lowest, highest) [N/m]; None when infeasible.
+        Drive stiffness at the thickness tolerance (lowest, highest) [N/m].
     """
 
     feasible: bool
     reason: str
-    leaves: int
-    length: float | None
-    width: float | None
-    thickness: float | None
-    drive_stiffness: float | None
-    target_stiffness: float
-    maximum_stiffness: float
-    support_stiffness: float | None
-    stroke: float
-    stroke_limit: float | None
-    stress: float | None
-    allowed_stress: float
-    stress_margin: float | None
-    support_frequency: float | None
-    bending_frequency: float | None
-    required_frequency: float
-    frequency_margin: float | None
-    leaf_mass: float | None
+    drawn: bool
+    mechanics: GuideMechanics | None
+    modes_at_stroke: tuple = ()
+    target_stiffness: float | None = None
+    maximum_stiffness: float = 0.0
+    stroke: float = 0.0
+    required_frequency: float = 0.0
+    required_buckling: float = 1.0
+    stroke_limit: float | None = None
     thickness_step: float | None = None
     thickness_tolerance: float = 0.0
     stiffness_range: tuple[float, float] | None = None
+
+    # ---- views of the guide
+
+    @property
+    def guide(self):
+        """The guide's geometry (LeafGuide), or None."""
+        return None if self.mechanics is None else self.mechanics.guide
+
+    @property
+    def leaves(self) -> int | None:
+        """Number of leaves, or None."""
+        return None if self.guide is None else self.guide.leaves
+
+    @property
+    def length(self) -> float | None:
+        """Leaf length L [m], or None."""
+        return None if self.guide is None else self.guide.length
+
+    @property
+    def width(self) -> float | None:
+        """Leaf width b [m], or None."""
+        return None if self.guide is None else self.guide.width
+
+    @property
+    def thickness(self) -> float | None:
+        """Leaf thickness t [m], or None."""
+        return None if self.guide is None else self.guide.thickness
+
+    @property
+    def drive_stiffness(self) -> float | None:
+        """Net drive stiffness (gravity included) [N/m], or None."""
+        return None if self.mechanics is None else self.mechanics.net_drive_stiffness
+
+    @property
+    def stress(self) -> float | None:
+        """Peak stress at full stroke [Pa], or None."""
+        return None if self.mechanics is None else self.mechanics.stress
+
+    @property
+    def allowed_stress(self) -> float | None:
+        """Allowed stress [Pa], or None."""
+        return None if self.guide is None else self.guide.allowed_stress
+
+    @property
+    def stress_margin(self) -> float | None:
+        """Allowed over actual stress [-], or None."""
+        return None if self.mechanics is None else self.mechanics.stress_margin
+
+    @property
+    def lowest_mode(self):
+        """The lowest parasitic mode, undeflected or at full stroke (Mode), or None."""
+        if self.mechanics is None:
+            return None
+        cands = [m for m in self.mechanics.parasitic_modes]
+        cands += [m for m in self.modes_at_stroke if not m.drive]
+        return min(cands, key=lambda m: m.frequency) if cands else None
+
+    def to_dict(self) -> dict:
+        """JSON ``flexure``: the guide as in its mechanics, with the sizing's terms."""
+        out = {"feasible": self.feasible, "reason": self.reason, "drawn": self.drawn,
+               "target_stiffness": self.target_stiffness,
+               "maximum_stiffness": self.maximum_stiffness,
+               "required_frequency": self.required_frequency,
+               "required_buckling": self.required_buckling,
+               "stroke_limit": self.stroke_limit, "thickness_step": self.thickness_step,
+               "thickness_tolerance": self.thickness_tolerance,
+               "stiffness_range": to_jsonable(self.stiffness_range)}
+        if self.mechanics is not None:
+            out.update(self.mechanics.to_dict())
+            out["modes_at_stroke"] = [m.to_dict() for m in self.modes_at_stroke]
+        return out
 
 
 #: What the top-level gains of ``pid`` in the JSON are (the rule's, roll-off on the whole PID).

@@ -30,7 +30,7 @@ from .sections import (MAX_OUTPUT_SAMPLES, MAX_SCAN_POINTS, MAX_STEPS, REPORT_KI
                        Controller, CrossoverScan, DocumentIds, Family, Feedforward, Flexure,
                        Friction, Gains, Hunting, Isolator, Limiter, Material, Measurement, Motion,
                        Move, ParasiticMode, RecommendBounds, ReportInfo, Requirements, Revision,
-                       Ripple, Robustness, Simulation, move_duration, scan_points)
+                       Ripple, Robustness, Simulation, Stage, move_duration, scan_points)
 
 __all__ = [
     "Body", "Bounds", "CROSSOVER_AGREEMENT", "Controller", "CrossoverScan", "DocumentIds",
@@ -38,7 +38,7 @@ __all__ = [
     "Hunting", "Isolator", "JOINT_DAMPING_RATIO", "Limiter", "MAX_OUTPUT_SAMPLES",
     "MAX_SCAN_POINTS", "MAX_STEPS", "Material", "Measurement", "Motion", "Move", "OptQ",
     "ParasiticMode", "Q", "REPORT_KINDS", "RecommendBounds", "ReportInfo", "Requirements",
-    "Revision", "Ripple", "Robustness", "Simulation", "Spec", "StrictModel", "Text",
+    "Revision", "Ripple", "Robustness", "Simulation", "Spec", "Stage", "StrictModel", "Text",
     "antiresonance", "bristle_damping", "default_joint_damping", "default_limiter_damping",
     "design_crossover", "drive_stiffness", "gains_crossover", "joint_damping",
     "limiter_damping", "move_duration", "proposed_stiffness", "scan_points", "stiffness_limit",

@@ -148,8 +148,9 @@ def joint_damping(spec: Spec, stiffness: float | None = None) -> float:
 def default_joint_damping(stiffness: float, stage_mass: float, cart_mass: float) -> float:
     """The default joint damping [N s/m]: :data:`JOINT_DAMPING_RATIO` of the joint mode.
 
-    ``2 zeta sqrt(k m1 m2 / (m1 + m2))``: the joint's mode, stage against
-    cart on the drive stiffness, damped at the ratio zeta.
+    ``2 zeta sqrt(|k| m1 m2 / (m1 + m2))``: the joint's mode, stage against
+    cart on the drive stiffness, damped at the ratio zeta (the magnitude of a
+    negative stiffness, a guide the weight has buckled).
 
     Parameters
     ----------
@@ -159,7 +160,7 @@ def default_joint_damping(stiffness: float, stage_mass: float, cart_mass: float)
         m1 and m2 [kg].
     """
     m1, m2 = stage_mass, cart_mass
-    return 2.0 * JOINT_DAMPING_RATIO * math.sqrt(stiffness * m1 * m2 / (m1 + m2))
+    return 2.0 * JOINT_DAMPING_RATIO * math.sqrt(abs(stiffness) * m1 * m2 / (m1 + m2))
 
 
 def antiresonance(mode: ParasiticMode) -> float:

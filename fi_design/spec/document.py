@@ -11,7 +11,7 @@ from pydantic import Discriminator, Field, PrivateAttr, Tag, create_model, model
 from .. import effects as _effects
 from .defaults import CROSSOVER_AGREEMENT, gains_crossover, tuning_mass
 from .fields import OptQ, Q, StrictModel, Text
-from .sections import (MAX_OUTPUT_SAMPLES, Body, Controller, Friction, Isolator, Measurement,
+from .sections import (MAX_OUTPUT_SAMPLES, Body, Controller, Stage, Friction, Isolator, Measurement,
                        Motion, ReportInfo, Requirements, Simulation)
 
 
@@ -60,7 +60,7 @@ class Spec(StrictModel):
     """A friction-isolator design spec, values in SI (the keys: docs/interfaces.md)."""
 
     name: Text = Field("Unnamed stage", description="Project or stage name.")
-    stage: Body = Field(description="The actuated stage (m1, carries the sensor).")
+    stage: Stage = Field(description="The actuated stage (m1, carries the sensor).")
     cart: Body = Field(description="The bearing cart (m2, friction acts on it).")
     friction: Friction
     isolator: Isolator | None = Field(None, description="Omit for a stage without isolator.")
@@ -100,6 +100,14 @@ class Spec(StrictModel):
             raise ValueError(f"effect listed twice: {', '.join(dupes)}")
         if "joint_damping" in names and self.isolator is None:
             raise ValueError("effect joint_damping needs an isolator")
+        flex = self.isolator.flexure if self.isolator is not None else None
+        if flex is not None and self.stage.size is None and self.stage.inertia is not None:
+            if flex.spacing is None:
+                raise ValueError("isolator.flexure.spacing: needed when the stage is given by "
+                                 "its inertia (without stage.size, which sets its default)")
+            if flex.leaves == 4 and flex.lateral_spacing is None:
+                raise ValueError("isolator.flexure.lateral_spacing: needed for 4 leaves when the "
+                                 "stage is given by its inertia (without stage.size)")
         ctl = self.controller
         if ctl.gains is not None and ctl.crossover is not None:
             achieved = gains_crossover(self)

@@ -22,6 +22,42 @@ class Body(StrictModel):
     mass: Q("kg") = Field(gt=0, description="Mass [kg].")
 
 
+Offset = tuple[Q("m"), Q("m")]
+
+
+class Stage(Body):
+    """The stage: the actuated rigid body the isolator's guide carries."""
+
+    size: Union[tuple[Q("m"), Q("m"), Q("m")], None] = Field(
+        None, description="Edge lengths [x, y, z] of the stage as a uniform box of its mass [m], "
+                          "for its inertia on the flexure guide; x the drive direction, z along "
+                          "the guide's leaves. Default: a steel cube of the stage's mass.")
+    inertia: Union[tuple[Q("kg*m**2"), Q("kg*m**2"), Q("kg*m**2")], None] = Field(
+        None, description="Moments of inertia [Ixx, Iyy, Izz] about the centre of mass "
+                          "[kg m^2], in place of size.")
+    centre_of_mass_height: OptQ("m") = Field(
+        None, ge=0, description="Distance of the centre of mass beyond the guide's clamp, along "
+                                "the leaves [m]. Default: half the stage's z size.")
+    sensor_offset: Offset = Field(
+        (0.0, 0.0), description="Where the position sensor measures x: [y, z] from the centre "
+                                "of mass [m]; a tilt shows in x by the offset. Default [0, 0].")
+    actuator_offset: Offset = Field(
+        (0.0, 0.0), description="Where the actuator pushes along x: [y, z] from the centre of "
+                                "mass [m]. Default [0, 0].")
+
+    @model_validator(mode="after")
+    def _body(self) -> "Stage":
+        if self.size is not None and self.inertia is not None:
+            raise ValueError("give size or inertia, not both")
+        for name in ("size", "inertia"):
+            value = getattr(self, name)
+            if value is not None and not all(v > 0 for v in value):
+                raise ValueError(f"{name} must be positive in all three directions")
+        if self.inertia is not None and self.centre_of_mass_height is None:
+            raise ValueError("inertia needs centre_of_mass_height (the size gives it otherwise)")
+        return self
+
+
 class Friction(StrictModel):
     """Friction of the bearing, acting on the cart (LuGre, Canudas de Wit et al. 1995)."""
 
@@ -75,9 +111,18 @@ class Limiter(StrictModel):
 
 
 class ParasiticMode(StrictModel):
-    """A parasitic resonance of the flexure, added to the linear limit cases."""
+    """A parasitic resonance of the flexure (a measured value), added to the linear limit cases.
+
+    With a flexure guide the guide's modes are computed; a given mode with a
+    ``direction`` replaces the computed mode of that direction, and given modes
+    without one replace all computed modes (they are the measured set).
+    """
 
     name: Text = Field("mode", description="Label used in reports.")
+    direction: Literal["x", "y", "z", "rx", "ry", "rz", "leaf"] | None = Field(
+        None, description="Dominant direction (x, y, z, rx, ry, rz of the flexure guide, or "
+                          "leaf): the computed mode it replaces. Default none: with a flexure "
+                          "guide, the given modes replace all computed ones.")
     frequency: Q("Hz") = Field(gt=0, description="Resonance frequency [Hz].")
     damping_ratio: float = Field(0.01, ge=0, lt=1, description="Modal damping ratio [-]. "
                                                                "Default 0.01.")
@@ -102,21 +147,52 @@ class Material(StrictModel):
     allowed_stress: Q("Pa") = Field(gt=0, description="Allowed bending stress [Pa] (fatigue "
                                                       "limit with safety).")
     density: Q("kg/m**3") = Field(gt=0, description="Density [kg/m^3].")
+    poisson_ratio: float = Field(0.3, gt=0, lt=0.5, description="Poisson's ratio [-] (the shear "
+                                                                "modulus E / (2 (1 + nu))). "
+                                                                "Default 0.3.")
 
 
 Bounds = tuple[Q("m"), Q("m")]
+#: A leaf dimension: one value (the guide as drawn) or [min, max] (bounds step 3 sizes within).
+Dimension = Union[Bounds, Q("m")]
 
 
 class Flexure(StrictModel):
-    """Parallel leaf-spring guide to size in step 3."""
+    """The isolator's parallel leaf-spring guide: drawn (one value per dimension) or sized.
+
+    Each of length, width and thickness is one value (the guide as drawn) or
+    [min, max] (step 3 sizes the guide within the bounds). The guide carries
+    the stage; its stiffness in six directions, its weight and its modes
+    follow from the geometry.
+    """
 
     material: Material
-    leaves: int = Field(2, ge=2, le=8, description="Number of parallel leaves. Default 2.")
-    length: Bounds = Field((5e-3, 100e-3), description="Leaf length range [m]. Default "
-                                                       "5 mm to 100 mm.")
-    width: Bounds = Field((2e-3, 50e-3), description="Leaf width range [m]. Default 2 mm to 50 mm.")
-    thickness: Bounds = Field((0.05e-3, 2e-3), description="Leaf thickness range [m]. Default "
-                                                           "0.05 mm to 2 mm.")
+    leaves: Literal[2, 4] = Field(2, description="Number of leaves: 2 (one per row) or 4 (two "
+                                                 "side by side per row). Default 2.")
+    length: Dimension = Field((5e-3, 100e-3), description="Leaf length L [m], or [min, max] to "
+                                                          "size. Default 5 mm to 100 mm.")
+    width: Dimension = Field((2e-3, 50e-3), description="Leaf width b [m], or [min, max] to "
+                                                        "size. Default 2 mm to 50 mm.")
+    thickness: Dimension = Field((0.05e-3, 2e-3), description="Leaf thickness t [m], or "
+                                                              "[min, max] to size. Default "
+                                                              "0.05 mm to 2 mm.")
+    spacing: OptQ("m") = Field(None, gt=0, description="Distance between the two rows of leaves "
+                                                       "along the drive direction [m]. Default: "
+                                                       "the stage's x size.")
+    lateral_spacing: OptQ("m") = Field(None, gt=0, description="With 4 leaves: centre distance "
+                                                               "of the two leaves of a row [m]. "
+                                                               "Default: the stage's y size "
+                                                               "less a leaf width, at least one "
+                                                               "leaf width.")
+    orientation: Literal["standing", "hanging", "flat", "vertical_axis"] = Field(
+        "standing", description="The guide against gravity: 'standing' (leaves vertical, the "
+                                "stage on top, compressed by its weight; default), 'hanging' "
+                                "(the stage below, in tension), 'flat' (leaves horizontal, the "
+                                "weight across their width), 'vertical_axis' (the drive axis "
+                                "vertical: the joint carries the cart's weight).")
+    damping_ratio: float = Field(0.01, gt=0, lt=1, description="Modal damping ratio of the "
+                                                               "guide's computed modes [-]. "
+                                                               "Default 0.01.")
     thickness_step: OptQ("m") = Field(0.05e-3, gt=0, description="Stock thicknesses: the leaves "
                                                                  "are sized in multiples of this "
                                                                  "[m]; null sizes an unrounded "
@@ -129,12 +205,24 @@ class Flexure(StrictModel):
     @model_validator(mode="after")
     def _ordered(self) -> "Flexure":
         for name in ("length", "width", "thickness"):
-            lo, hi = getattr(self, name)
+            lo, hi = self.bounds(name)
             if not 0 < lo <= hi:
-                raise ValueError(f"{name} must be [min, max] with 0 < min <= max")
-        if self.thickness_tolerance >= self.thickness[0]:
+                raise ValueError(f"{name} must be positive, or [min, max] with 0 < min <= max")
+        if self.thickness_tolerance >= self.bounds("thickness")[0]:
             raise ValueError("thickness_tolerance must be below the smallest thickness")
+        if self.drawn and self.bounds("thickness")[0] >= self.bounds("width")[0]:
+            raise ValueError("a leaf is thinner than it is wide: thickness must be below width")
         return self
+
+    def bounds(self, name: str) -> tuple[float, float]:
+        """[min, max] of a leaf dimension [m] (a drawn value is both)."""
+        value = getattr(self, name)
+        return (value, value) if isinstance(value, float) else value
+
+    @property
+    def drawn(self) -> bool:
+        """Whether the spec draws the guide (one value per dimension) instead of sizing it."""
+        return all(isinstance(getattr(self, n), float) for n in ("length", "width", "thickness"))
 
 
 class Isolator(StrictModel):
@@ -149,8 +237,10 @@ class Isolator(StrictModel):
     limiter: Limiter = Field(default_factory=Limiter)
     parasitic_modes: tuple[ParasiticMode, ...] = Field((), description="Parasitic resonances of "
                                                                         "the flexure.")
-    flexure: Flexure | None = Field(None, description="Optional: size a parallel leaf-spring "
-                                                      "guide that realises the stiffness.")
+    flexure: Flexure | None = Field(None, description="Optional: the parallel leaf-spring guide "
+                                                      "that realises the joint, drawn or to "
+                                                      "size; its six stiffnesses, weight and "
+                                                      "modes enter the design.")
 
 
 class Gains(StrictModel):
@@ -405,6 +495,9 @@ class Requirements(StrictModel):
     modulus_margin: float | None = Field(None, gt=0, le=1, description="Minimum modulus margin "
                                                                        "min|1 + L| [-]; null: "
                                                                        "not required.")
+    buckling_factor: float = Field(3.0, ge=1, description="The flexure guide's buckling load "
+                                                          "must be at least this times the "
+                                                          "weight it carries [-]. Default 3.")
     stiffness_safety: float = Field(1.0, ge=1, description="k_max = Fs / (safety * stroke). "
                                                            "Default 1 (the paper's rule).")
     hunting: Hunting = Field(default_factory=Hunting)

@@ -1,0 +1,83 @@
+"""Step 3's judgement of the leaf-spring guide: stiffness, stress, buckling, modes, sag.
+
+The one place the guide is judged (:func:`flexure_checks`); the design's
+checks, the verdict, the report and the console read these checks.
+"""
+
+from __future__ import annotations
+
+from ..display import number, quantity
+from ..results import Check
+from ..results.steps import FlexureResult
+
+__all__ = ["flexure_checks"]
+
+
+def _g(x: float) -> str:
+    return number(x, 4)
+
+
+def _mm(x: float) -> str:
+    return quantity(x, "m", 3, shown=("mm", 1e3))
+
+
+def flexure_checks(fx: FlexureResult | None, crossover: float,
+                   separation: float) -> tuple[Check, ...]:
+    """Step 3's checks of the guide: stiffness, stress, buckling, modes, sag.
+
+    Parameters
+    ----------
+    fx : FlexureResult or None
+        The guide (:func:`step3_flexure`).
+    crossover : float
+        The loop's crossover [Hz]; every parasitic mode must lie at
+        ``separation`` times it.
+    separation : float
+        ``requirements.parasitic_separation`` [-].
+    """
+    if fx is None:
+        return ()
+    step = "step 3 flexure"
+    if not fx.feasible:
+        return (Check("flexure", False, None, None, "-",
+                      f"no leaf-spring guide within the bounds fits: {fx.reason}", step=step),)
+    m, g = fx.mechanics, fx.guide
+    dims = (f"{g.leaves} leaves L x b x t = {_mm(g.length)} x {_mm(g.width)} x "
+            f"{_mm(g.thickness)}, {g.orientation}"
+            + (" (as drawn)" if fx.drawn else " (sized)"))
+    k, kmax = m.net_drive_stiffness, fx.maximum_stiffness
+    grav = m.gravity
+    out = [Check("flexure.stiffness", 0.0 < k <= kmax * (1 + 1e-9), k, kmax, "N/m",
+                 f"{dims}: net drive stiffness {_g(k)} N/m (elastic {_g(m.stiffness.x)} N/m, "
+                 f"gravity {_g(grav.geometric_stiffness)} N/m), k_max {_g(kmax)} N/m"
+                 + ("" if k > 0 else ": the weight has buckled the guide"), step=step),
+           Check("flexure.stress", m.stress <= g.allowed_stress, m.stress, g.allowed_stress,
+                 "Pa", f"stress at full stroke {quantity(m.stress, 'Pa')}, allowed "
+                 f"{quantity(g.allowed_stress, 'Pa')} (margin x{m.stress_margin:.3g})",
+                 step=step)]
+    if grav.buckling_factor is not None:
+        f, need = grav.buckling_factor, fx.required_buckling
+        out.append(Check(
+            "flexure.buckling", f >= need, f, need, "-",
+            f"buckling load {_g(grav.buckling_load)} N against the stage's weight "
+            f"{_g(g.weight)} N standing on the leaves: factor {f:.3g}"
+            + (f", at least {need:g} required" if f >= need else
+               (f": the guide buckles under the stage" if f <= 1.0 else
+                f", below the {need:g} required")), step=step))
+    low = fx.lowest_mode
+    need = separation * crossover
+    if low is not None:
+        at_stroke = any(low is x for x in fx.modes_at_stroke)
+        out.append(Check(
+            "flexure.modes", low.frequency >= need, low.frequency, need, "Hz",
+            f"lowest parasitic mode of the guide: {low.name} at {_g(low.frequency)} Hz"
+            + (" at full stroke" if at_stroke else "")
+            + (f", above {separation:g} x the crossover" if low.frequency >= need else
+               f", below {separation:g} x the crossover ({_g(need)} Hz)"), step=step))
+    if grav.sag > 0.0:
+        out.append(Check(
+            "flexure.sag", grav.sag < fx.stroke, grav.sag, fx.stroke, "m",
+            f"on the vertical axis the joint carries the cart's weight: it sags "
+            f"{_mm(grav.sag)} of its {_mm(fx.stroke)} stroke"
+            + ("" if grav.sag < fx.stroke else ": it rests on its end stop"), step=step))
+    return tuple(out)

@@ -1,0 +1,256 @@
+"""The parallel leaf-spring guide in closed form: six-by-six stiffness, gravity and modes.
+
+The guide's leaves (:mod:`.leaf`) meet the stage at its clamp, the origin of
+the guide's frame (x drive, y along the leaves' width, z along their length
+towards the stage). A leaf whose centre line lies at ``r_i = (x_i, y_i, 0)``
+moves with the clamp's translation ``u`` and rotation ``theta`` as
+``u + theta x r_i``; its stiffness enters the clamp's as ``T_i^T K_i T_i``
+with ``T_i = [[I, -[r_i]x], [0, I]]``. Moved to the stage's centre of mass,
+``com_height`` beyond the clamp, the same transformation gives the stiffness
+there.
+
+Gravity: the stage's weight W = m1 g loads the leaves axially when the guide
+stands (compression, ``-W / n`` per leaf) or hangs (tension), which adds
+each leaf's geometric stiffness (:func:`.leaf.geometric_block`), and it acts
+at the centre of mass, away from the clamp: the load stiffness of a constant
+force F at r, ``K_theta = -sym(F r^T) + (F . r) I`` on the rotations
+(standing: ``-W h`` in rx and ry, the inverted pendulum). The buckling factor
+is the lowest positive load factor lambda with ``K + lambda K_g`` singular.
+
+Modes: the six natural modes of the rigid stage (mass m1, inertia about its
+centre of mass) on the guide's stiffness with gravity's, mass normalised.
+The sensor reads x at ``(y_s, z_s)`` from the centre of mass, ``c = (1, 0,
+0, 0, z_s, -y_s)``; the actuator pushes along x at ``(y_a, z_a)``, ``b = (1,
+0, 0, 0, z_a, -y_a)``; a mode's participation in the drive coordinate is
+``m1 (c . phi)(b . phi)``.
+
+Every function broadcasts over arrays of the leaves' length, width and
+thickness (keyword ``length``, ``width``, ``thickness``), for the sizing.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..results.mechanism import DIRECTIONS, GRAVITY, LeafGuide, Mode, Stiffness6
+from . import leaf
+
+__all__ = ["EFFECTIVE_MASS", "MODE_NAMES", "leaf_force", "weight_vector", "clamp_stiffness",
+           "clamp_geometric_stiffness", "at_centre", "mass_matrix", "stiffness6",
+           "drive_stiffness", "buckling_factor", "stage_modes", "leaf_modes"]
+
+#: Effective modal mass of a clamped-clamped beam's first bending mode over its mass [-];
+#: half of it is taken to act on the stage's clamp (the other half on the cart's).
+EFFECTIVE_MASS = 0.690
+
+#: Names of the stage's modes by dominant direction.
+MODE_NAMES = {"x": "stage x (drive)", "y": "stage y (lateral)", "z": "stage z (axial)",
+              "rx": "stage rx (roll)", "ry": "stage ry (pitch)", "rz": "stage rz (yaw)"}
+
+
+def _skew(r) -> np.ndarray:
+    x, y, z = r
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def _shift(r) -> np.ndarray:
+    """T with ``T q`` the motion of the point r for the rigid motion q at the origin."""
+    T = np.eye(6)
+    T[:3, 3:] = -_skew(r)
+    return T
+
+
+def _dims(guide: LeafGuide, length, width, thickness):
+    return (guide.length if length is None else np.asarray(length, float),
+            guide.width if width is None else np.asarray(width, float),
+            guide.thickness if thickness is None else np.asarray(thickness, float))
+
+
+def leaf_force(guide: LeafGuide) -> float:
+    """Axial force in each leaf from the stage's weight [N], tension positive."""
+    w = guide.weight / guide.leaves
+    return {"standing": -w, "hanging": w}.get(guide.orientation, 0.0)
+
+
+def weight_vector(guide: LeafGuide) -> np.ndarray:
+    """The weight the guide carries, as a force on the stage in the guide's frame [N].
+
+    Standing along -z, hanging along +z, flat along -y; on a vertical drive
+    axis the actuator carries the stage's weight, not the guide: zero.
+    """
+    w = guide.weight
+    return {"standing": np.array([0.0, 0.0, -w]), "hanging": np.array([0.0, 0.0, w]),
+            "flat": np.array([0.0, -w, 0.0])}.get(guide.orientation, np.zeros(3))
+
+
+def _sum_leaves(guide: LeafGuide, block: np.ndarray) -> np.ndarray:
+    K = np.zeros(block.shape)
+    for x, y in guide.leaf_positions():
+        T = _shift((x, y, 0.0))
+        K = K + T.T @ block @ T
+    return K
+
+
+def clamp_stiffness(guide: LeafGuide, *, deflection: float = 0.0, length=None, width=None,
+                    thickness=None) -> np.ndarray:
+    """Elastic stiffness of the guide at the stage's clamp.
+
+    Parameters
+    ----------
+    guide : LeafGuide
+        The guide.
+    deflection : float, optional
+        Drive deflection the axial stiffness is taken at [m]
+        (:func:`.leaf.axial_factor`). Default 0 (undeflected).
+    length, width, thickness : float or numpy.ndarray, optional
+        Leaf dimensions in place of the guide's [m]; arrays broadcast.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 6, 6)
+    """
+    L, b, t = _dims(guide, length, width, thickness)
+    G = guide.shear_modulus
+    block = leaf.stiffness_block(guide.youngs_modulus, G, L, b, t,
+                                 axial=leaf.axial_factor(deflection, t))
+    return _sum_leaves(guide, block)
+
+
+def clamp_geometric_stiffness(guide: LeafGuide, *, length=None, width=None,
+                              thickness=None) -> np.ndarray:
+    """Gravity's stiffness at the stage's clamp: the leaves' geometric stiffness and the load's.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 6, 6)
+        Proportional to the weight; zero without gravity's load on the guide.
+    """
+    L, b, t = _dims(guide, length, width, thickness)
+    shape = np.broadcast(L, b, t).shape
+    K = _sum_leaves(guide, leaf.geometric_block(np.full(shape, leaf_force(guide)), L))
+    F = weight_vector(guide)
+    r = np.array([0.0, 0.0, guide.com_height])
+    sym = 0.5 * (np.outer(F, r) + np.outer(r, F))
+    K[..., 3:, 3:] += -sym + float(F @ r) * np.eye(3)
+    return K
+
+
+def at_centre(K: np.ndarray, com_height: float) -> np.ndarray:
+    """A stiffness at the clamp moved to the stage's centre of mass, ``T^T K T``."""
+    T = _shift((0.0, 0.0, -com_height))
+    return T.T @ K @ T
+
+
+def mass_matrix(guide: LeafGuide) -> np.ndarray:
+    """The rigid stage's mass matrix at its centre of mass, diag(m1, m1, m1, Ixx, Iyy, Izz)."""
+    m = guide.stage_mass
+    return np.diag([m, m, m, *guide.stage_inertia])
+
+
+def stiffness6(K: np.ndarray) -> Stiffness6 | np.ndarray:
+    """The six stiffnesses of a stiffness matrix: 1 / the diagonal of its compliance.
+
+    Parameters
+    ----------
+    K : numpy.ndarray, shape (6, 6) or (..., 6, 6)
+
+    Returns
+    -------
+    Stiffness6 for one matrix, else an array (..., 6).
+    """
+    d = 1.0 / np.diagonal(np.linalg.inv(K), axis1=-2, axis2=-1)
+    if d.ndim == 1:
+        return Stiffness6(*(float(v) for v in d))
+    return d
+
+
+def drive_stiffness(K: np.ndarray):
+    """x stiffness at the centre of mass with the other directions free [N/m]."""
+    return 1.0 / np.linalg.inv(K)[..., 0, 0]
+
+
+def buckling_factor(K: np.ndarray, Kg: np.ndarray):
+    """Lowest positive load factor lambda with ``K + lambda Kg`` singular [-].
+
+    Parameters
+    ----------
+    K, Kg : numpy.ndarray, shape (..., 6, 6)
+        Elastic and geometric stiffness (at one reference point).
+
+    Returns
+    -------
+    float or numpy.ndarray
+        inf where no positive factor exists (the load does not destabilise).
+    """
+    mu = np.linalg.eigvals(np.linalg.solve(K, -Kg))  # K^-1 (-Kg) phi = phi / lambda
+    real = np.where(np.abs(mu.imag) <= 1e-9 * np.abs(mu).max(axis=-1, keepdims=True) + 1e-300,
+                    mu.real, 0.0)
+    top = real.max(axis=-1)
+    out = np.where(top > 0.0, 1.0 / np.where(top > 0.0, top, 1.0), np.inf)
+    return float(out) if out.ndim == 0 else out
+
+
+def _rows(guide: LeafGuide) -> tuple[np.ndarray, np.ndarray]:
+    ys, zs = guide.sensor_offset
+    ya, za = guide.actuator_offset
+    return (np.array([1.0, 0.0, 0.0, 0.0, zs, -ys]), np.array([1.0, 0.0, 0.0, 0.0, za, -ya]))
+
+
+def stage_modes(guide: LeafGuide, K: np.ndarray) -> tuple[Mode, ...]:
+    """The stage's six modes on a stiffness at its centre of mass, by frequency.
+
+    Parameters
+    ----------
+    guide : LeafGuide
+        The stage's mass, inertia, sensor and actuator offsets, the damping.
+    K : numpy.ndarray, shape (6, 6)
+        Stiffness at the centre of mass (gravity's included) [SI].
+
+    Returns
+    -------
+    tuple of Mode
+        Frequency (0 for a mode the weight has made unstable), dominant
+        direction by kinetic energy, participation and coupling; ``drive``
+        for the x mode.
+    """
+    M = mass_matrix(guide)
+    s = 1.0 / np.sqrt(np.diag(M))
+    A = K * s[:, None] * s[None, :]
+    w2, psi = np.linalg.eigh(0.5 * (A + A.T))
+    phi = psi * s[:, None]  # mass normalised: phi^T M phi = I
+    c, b = _rows(guide)
+    part = guide.stage_mass * (c @ phi) * (b @ phi)
+    total = float(np.sum(np.abs(part))) or 1.0
+    energy = phi ** 2 * np.diag(M)[:, None]
+    out = []
+    for i in range(6):
+        d = DIRECTIONS[int(np.argmax(energy[:, i]))]
+        out.append(Mode(name=MODE_NAMES[d], frequency=math.sqrt(max(w2[i], 0.0)) / (2 * math.pi),
+                        damping_ratio=guide.damping_ratio, direction=d,
+                        coupling=float(abs(part[i]) / total), participation=float(part[i]),
+                        source="computed", drive=d == "x"))
+    return tuple(out)
+
+
+def leaf_modes(guide: LeafGuide, stage: tuple[Mode, ...]) -> tuple[Mode, ...]:
+    """The leaves' own first modes: bending in the drive direction and torsion.
+
+    The bending mode moves the stage's clamp through the leaves' reaction: its
+    participation is the share :data:`EFFECTIVE_MASS` / 2 of the leaves' mass
+    over the stage's; torsion does not show in x.
+    """
+    g = guide
+    n_leaf = leaf_force(g)
+    total = sum(abs(m.participation) for m in stage) or 1.0
+    r = 0.5 * EFFECTIVE_MASS * g.leaf_mass / g.stage_mass
+    bend = float(leaf.bending_frequency(g.youngs_modulus, g.density, g.length, g.width,
+                                        g.thickness, n_leaf))
+    tors = float(leaf.torsion_frequency(g.shear_modulus, g.density, g.length, g.width,
+                                        g.thickness))
+    return (Mode(name="leaf bending", frequency=bend, damping_ratio=g.damping_ratio,
+                 direction="leaf", coupling=min(1.0, r / total), participation=r,
+                 source="computed"),
+            Mode(name="leaf torsion", frequency=tors, damping_ratio=g.damping_ratio,
+                 direction="leaf", coupling=0.0, participation=0.0, source="computed"))

@@ -1,0 +1,279 @@
+"""The isolator as a mechanism: the closed forms against analytic limits and published figures.
+
+The finite-element check of the same closed forms is in tests/test_mechanism_fe.py.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from fi_design.mechanism import guide as gd
+from fi_design.mechanism import leaf, mechanics
+from fi_design.mechanism.sizing import evaluate, size_guide, stock_thicknesses
+from fi_design.mechanism.geometry import stage_body
+from fi_design.results.mechanism import GRAVITY, LeafGuide, box_inertia, steel_cube
+from fi_design.spec import Flexure, Stage
+
+E, NU, RHO, SIGMA = 200e9, 0.3, 7800.0, 300e6
+
+
+def make_guide(L=50.7e-3, b=23.9e-3, t=0.45e-3, *, leaves=2, spacing=30e-3, lateral=0.0,
+               orientation="standing", m1=1.6, size=None, h=None, sensor=(0.0, 0.0),
+               actuator=(0.0, 0.0), m2=0.4) -> LeafGuide:
+    size = steel_cube(m1) if size is None else size
+    return LeafGuide(leaves=leaves, length=L, width=b, thickness=t, spacing=spacing,
+                     lateral_spacing=lateral, youngs_modulus=E, poisson_ratio=NU, density=RHO,
+                     allowed_stress=SIGMA, orientation=orientation, stage_mass=m1,
+                     stage_inertia=box_inertia(m1, size),
+                     com_height=0.5 * size[2] if h is None else h, sensor_offset=sensor,
+                     actuator_offset=actuator, cart_mass=m2)
+
+
+def at_centre(g):
+    K = gd.at_centre(gd.clamp_stiffness(g), g.com_height)
+    Kg = gd.at_centre(gd.clamp_geometric_stiffness(g), g.com_height)
+    return K, Kg
+
+
+# --------------------------------------------------------------------------- analytic limits
+
+
+def test_drive_stiffness_of_slender_leaves_is_n_E_b_t3_over_L3():
+    g = make_guide(L=60e-3, b=10e-3, t=0.2e-3, orientation="flat")
+    K = gd.clamp_stiffness(g)
+    exact = 2 * E * 10e-3 * 0.2e-3 ** 3 / 60e-3 ** 3
+    # the clamp held against rotation: the clamped-guided leaves, shear in x negligible (t << L)
+    assert K[0, 0] == pytest.approx(exact, rel=1e-4)
+    # at the centre of mass with the other directions free: the pitch the axial stiffness holds
+    assert mechanics(g, 0.3e-3).stiffness.x == pytest.approx(exact, rel=2e-3)
+    # axial: n E b t / L
+    assert K[2, 2] == pytest.approx(2 * E * 10e-3 * 0.2e-3 / 60e-3, rel=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(L=st.floats(30e-3, 0.2), b=st.floats(3e-3, 40e-3), t=st.floats(0.05e-3, 0.3e-3),
+       scale=st.floats(0.5, 2.0))
+def test_drive_stiffness_scales_like_the_leaf_formula(L, b, t, scale):
+    g = make_guide(L, b, t, orientation="flat")
+    k = gd.clamp_stiffness(g)[0, 0]
+    # width linear, thickness cubed, length inverse cubed (slender leaves: shear below 0.1 %)
+    assert gd.clamp_stiffness(g, width=scale * b)[0, 0] == pytest.approx(scale * k, rel=2e-3)
+    assert gd.clamp_stiffness(g, thickness=scale * t)[0, 0] == pytest.approx(scale ** 3 * k,
+                                                                            rel=2e-3)
+    assert gd.clamp_stiffness(g, length=scale * L)[0, 0] == pytest.approx(k / scale ** 3,
+                                                                         rel=2e-3)
+
+
+def test_gravity_softens_a_standing_guide_and_stiffens_a_hanging_one():
+    for orientation, sign in (("standing", -1.0), ("hanging", 1.0)):
+        g = make_guide(orientation=orientation)
+        m = mechanics(g, 0.3e-3)
+        expected = sign * 1.2 * 1.6 * GRAVITY / 50.7e-3      # 6/5 m1 g / L
+        assert m.gravity.geometric_stiffness == pytest.approx(expected, rel=0.01)
+        assert m.net_drive_stiffness == pytest.approx(m.stiffness.x + expected, rel=1e-3)
+        assert m.gravity.axial_load == pytest.approx(sign * 1.6 * GRAVITY)
+    for orientation in ("flat", "vertical_axis"):
+        m = mechanics(make_guide(orientation=orientation), 0.3e-3)
+        assert m.gravity.axial_load == 0.0 and m.gravity.buckling_factor is None
+        assert abs(m.gravity.geometric_stiffness) < 1e-6 * m.stiffness.x
+
+
+def test_buckling_of_a_low_stage_is_the_euler_sway_load():
+    # a low, flat stage: its centre of mass 1 mm above the clamp, the sway mode alone
+    g = make_guide(L=40e-3, b=10e-3, t=0.2e-3, size=(0.06, 0.06, 0.002), m1=5.0)
+    euler = 2 * math.pi ** 2 * E * (10e-3 * 0.2e-3 ** 3 / 12) / 40e-3 ** 2
+    m = mechanics(g, 0.1e-3)
+    assert leaf.sway_buckling_load(2, E, 40e-3, 10e-3, 0.2e-3) == pytest.approx(euler)
+    # one cubic element per leaf: 10 E I / L^2 against pi^2 E I / L^2, 1.3 % above
+    assert m.gravity.buckling_load == pytest.approx(euler, rel=0.02)
+    assert m.gravity.buckling_load > euler
+
+
+def test_the_drive_mode_is_a_point_mass_on_the_net_stiffness():
+    g = make_guide()
+    m = mechanics(g, 0.3e-3)
+    drive = next(x for x in m.modes if x.drive)
+    assert drive.direction == "x"
+    assert drive.frequency == pytest.approx(
+        math.sqrt(m.net_drive_stiffness / 1.6) / (2 * math.pi), rel=5e-3)
+
+
+def test_axial_stiffness_at_stroke_follows_the_beam_constraint_model():
+    # the figure of the issue: 42 % of the axial stiffness left at 0.9 mm on 0.1 mm leaves
+    assert float(leaf.axial_factor(0.9e-3, 0.1e-3)) == pytest.approx(0.419, abs=1e-3)
+    g = make_guide(L=28.7e-3, b=8.71e-3, t=0.1e-3, orientation="flat")
+    m = mechanics(g, 0.9e-3)
+    assert m.stiffness_at_stroke.z / m.stiffness.z == pytest.approx(0.419, abs=2e-3)
+    assert m.stiffness_at_stroke.x == pytest.approx(m.stiffness.x, rel=1e-3)
+
+
+def test_the_beam_constraint_model_against_a_beam_column_solution():
+    """The elastokinematic axial compliance of a deflected clamped-guided leaf, (u/L)^2 / 700
+    normalised, from the beam-column equation EI w'''' = N w'' solved by scipy."""
+    from scipy.integrate import quad
+    from scipy.linalg import solve
+
+    EI, L, u = 1.0, 1.0, 0.05
+
+    def shortening(N):
+        # w = A + B x + C cosh(k x) + D sinh(k x), w(0) = w'(0) = 0, w(L) = u, w'(L) = 0
+        k = math.sqrt(N / EI)
+        M = np.array([[1, 0, 1, 0], [0, 1, 0, k],
+                      [1, L, math.cosh(k * L), math.sinh(k * L)],
+                      [0, 1, k * math.sinh(k * L), k * math.cosh(k * L)]])
+        A, B, C, D = solve(M, [0, 0, u, 0])
+        slope = lambda x: B + C * k * math.sinh(k * x) + D * k * math.cosh(k * x)
+        return 0.5 * quad(lambda x: slope(x) ** 2, 0, L)[0]
+
+    dN = 1e-2
+    compliance = (shortening(dN) - shortening(2 * dN)) / dN   # -d(shortening)/dN
+    assert compliance == pytest.approx((u / L) ** 2 / 700 * L ** 3 / EI, rel=0.01)
+
+
+def test_a_leaf_bends_clamped_clamped_and_the_weight_shifts_it():
+    f = float(leaf.bending_frequency(E, RHO, 50.7e-3, 23.9e-3, 0.45e-3))
+    I, A = 23.9e-3 * 0.45e-3 ** 3 / 12, 23.9e-3 * 0.45e-3
+    assert f == pytest.approx(4.7300407 ** 2 / (2 * math.pi * 50.7e-3 ** 2)
+                              * math.sqrt(E * I / (RHO * A)), rel=1e-7)
+    assert float(leaf.bending_frequency(E, RHO, 50.7e-3, 23.9e-3, 0.45e-3, -7.8)) < f
+    assert float(leaf.bending_frequency(E, RHO, 50.7e-3, 23.9e-3, 0.45e-3, 7.8)) > f
+
+
+def test_the_paper_flexure_reproduces_the_published_figures():
+    """DESIGN's FE figures of the paper's flexure: 2 leaves 50.7 x 23.9 x 0.45 mm, 30 mm apart,
+    a 1.6 kg steel cube standing on them."""
+    m = mechanics(make_guide(), 0.3e-3)
+    assert m.stiffness.x == pytest.approx(6660, rel=0.01)
+    assert m.gravity.geometric_stiffness == pytest.approx(-371, rel=0.01)
+    assert m.gravity.buckling_factor == pytest.approx(17.7, rel=0.03)
+    freq = {x.direction: x.frequency for x in m.modes if x.direction != "leaf"}
+    published = {"x": 10.0, "y": 128, "rz": 261, "ry": 722, "rx": 1086, "z": 1158}
+    for d, f in published.items():
+        assert freq[d] == pytest.approx(f, rel=0.01), d
+    leaf_bend = next(x for x in m.modes if x.name == "leaf bending")
+    assert leaf_bend.frequency == pytest.approx(910, rel=0.01)
+    hanging = mechanics(make_guide(orientation="hanging"), 0.3e-3)
+    assert hanging.gravity.geometric_stiffness == pytest.approx(370, rel=0.01)
+
+
+def test_a_tilt_couples_into_the_drive_coordinate_by_the_offset():
+    centred = mechanics(make_guide(), 0.3e-3)
+    offset = mechanics(make_guide(sensor=(0.0, 0.03), actuator=(0.0, -0.02)), 0.3e-3)
+    pitch = lambda m: next(x for x in m.modes if x.direction == "ry")
+    yaw = lambda m: next(x for x in m.modes if x.direction == "rz")
+    # centred, the pitch mode shows in x only through the centre of mass above the clamp
+    assert abs(pitch(centred).participation) < 0.01
+    # sensor above and actuator below the centre of mass: the pitch mode is non-collocated
+    p = pitch(offset).participation
+    Iyy = box_inertia(1.6, steel_cube(1.6))[1]
+    assert p == pytest.approx(1.6 * 0.03 * -0.02 / Iyy, rel=0.05)
+    assert p < 0 and 0 < pitch(offset).coupling <= 1
+    assert yaw(offset).participation == pytest.approx(0.0, abs=1e-9)   # y offsets are zero
+    assert sum(x.coupling for x in offset.modes if x.direction != "leaf") == pytest.approx(1.0)
+
+
+def test_four_leaves_stand_stiffer_in_roll_than_two():
+    two = mechanics(make_guide(), 0.3e-3)
+    four = mechanics(make_guide(b=11.95e-3, leaves=4, lateral=40e-3), 0.3e-3)
+    assert four.stiffness.x == pytest.approx(two.stiffness.x, rel=0.01)   # same total width
+    assert four.stiffness.rx > 5 * two.stiffness.rx    # the pairs' axial stiffness holds roll
+
+
+# --------------------------------------------------------------------------- the buckled guide
+
+
+def test_a_thin_guide_buckles_under_the_stage():
+    """The issue's recommended guide: 2 leaves 28.7 x 8.71 x 0.1 mm under the 1.6 kg stage."""
+    m = mechanics(make_guide(L=28.7e-3, b=8.71e-3, t=0.1e-3), 0.9e-3)
+    assert m.gravity.buckling_factor == pytest.approx(0.22, rel=0.05)
+    assert m.buckles
+    assert m.gravity.geometric_stiffness == pytest.approx(-656, rel=0.02)
+    assert m.net_drive_stiffness < 0
+    hanging = mechanics(make_guide(L=28.7e-3, b=8.71e-3, t=0.1e-3, orientation="hanging"),
+                        0.9e-3)
+    assert not hanging.buckles and hanging.net_drive_stiffness > hanging.stiffness.x
+
+
+# --------------------------------------------------------------------------- sizing
+
+
+def make_flexure(**kw):
+    base = dict(material={"youngs_modulus": E, "allowed_stress": SIGMA, "density": RHO},
+                length=(10e-3, 60e-3), width=(5e-3, 30e-3), thickness=(0.1e-3, 1e-3))
+    return Flexure(**{**base, **kw})
+
+
+BODY = stage_body(Stage(mass=1.6))
+PAPER = dict(target_stiffness=6667.0, maximum_stiffness=4.0 / 0.3e-3, stroke=0.3e-3,
+             required_frequency=24.0, required_buckling=3.0, cart_mass=0.4)
+
+
+def test_the_paper_sizing_meets_every_constraint():
+    r = size_guide(make_flexure(), BODY, **PAPER)
+    assert r.feasible and r.reason == "" and not r.drawn
+    m = r.mechanics
+    assert m.net_drive_stiffness == pytest.approx(6667.0, rel=0.01)
+    assert m.net_drive_stiffness <= r.maximum_stiffness
+    assert m.stress <= SIGMA and m.gravity.buckling_factor >= 3.0
+    assert r.lowest_mode.frequency >= 24.0
+    assert r.thickness * 1e3 in [round(x * 1e3, 6) for x in stock_thicknesses((0.1e-3, 1e-3),
+                                                                             0.05e-3)]
+    # the reported values are the mechanism of the chosen leaves
+    again = mechanics(r.guide, 0.3e-3)
+    assert again.net_drive_stiffness == pytest.approx(m.net_drive_stiffness, rel=1e-12)
+    lo, hi = r.stiffness_range
+    assert lo < m.net_drive_stiffness < hi
+
+
+@settings(max_examples=25, deadline=None)
+@given(k_target=st.floats(100.0, 3e4), headroom=st.floats(1.0, 4.0),
+       stroke=st.floats(0.05e-3, 2e-3), f_req=st.floats(5.0, 300.0),
+       orientation=st.sampled_from(["standing", "hanging", "flat"]))
+def test_sized_guides_meet_their_constraints(k_target, headroom, stroke, f_req, orientation):
+    r = size_guide(make_flexure(orientation=orientation), BODY, target_stiffness=k_target,
+                   maximum_stiffness=k_target * headroom, stroke=stroke,
+                   required_frequency=f_req, required_buckling=3.0, points=31)
+    if r.feasible:
+        m = r.mechanics
+        assert 0 < m.net_drive_stiffness <= r.maximum_stiffness * (1 + 1e-9)
+        assert m.stress <= SIGMA * (1 + 1e-9)
+        assert m.gravity.buckling_factor is None or m.gravity.buckling_factor >= 3.0
+        assert r.lowest_mode.frequency >= f_req * (1 - 1e-9)
+    else:
+        assert r.reason and r.mechanics is None
+
+
+@pytest.mark.parametrize("kwargs, bounds, words", [
+    # the longest (10 mm), thinnest (0.5 mm) leaf bends 0.3 mm at 3 x 200e9 x 5e-4 x 3e-4 / 1e-4
+    (dict(), dict(length=(5e-3, 10e-3), thickness=(0.5e-3, 1e-3)),
+     ["stress: every leaf within the bounds", "above the allowed 300 MPa"]),
+    # flat: no gravity to soften the leaves (standing, near-buckling leaves reach any k)
+    (dict(maximum_stiffness=5.0, target_stiffness=2.5), dict(orientation="flat"),
+     ["stiffness with stress", "above k_max = 5 N/m"]),
+    (dict(maximum_stiffness=5.0, target_stiffness=2.5), dict(),
+     ["buckling:", "standing", "below the 3 required"]),
+    (dict(maximum_stiffness=300.0, target_stiffness=150.0, stroke=0.9e-3), dict(),
+     ["buckling:", "standing", "below the 3 required"]),
+    (dict(required_frequency=5000.0), dict(),
+     ["parasitic modes:", "below the required 5000 Hz"]),
+])
+def test_an_infeasible_sizing_names_the_binding_constraint(kwargs, bounds, words):
+    r = size_guide(make_flexure(**bounds), BODY, **{**PAPER, **kwargs})
+    assert not r.feasible and r.mechanics is None and r.length is None
+    for w in words:
+        assert w in r.reason, r.reason
+
+
+def test_evaluate_on_a_grid_matches_the_single_guide():
+    g = make_guide(orientation="standing")
+    L = np.array([[40e-3], [50.7e-3]])
+    t = np.array([[0.3e-3, 0.45e-3]])
+    grid = evaluate(g, 0.3e-3, L, 23.9e-3, t)
+    one = mechanics(make_guide(L=50.7e-3, t=0.45e-3), 0.3e-3)
+    assert grid.net[1, 1] == pytest.approx(one.net_drive_stiffness, rel=1e-12)
+    assert grid.buckling[1, 1] == pytest.approx(one.gravity.buckling_factor, rel=1e-9)
+    assert grid.stress[1, 1] == pytest.approx(one.stress, rel=1e-12)
