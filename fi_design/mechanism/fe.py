@@ -67,7 +67,12 @@ What it computes
   largest share are the stage's modes, named by the master's direction with
   the largest share; the others are the leaves' own modes, named by the
   leaves' motion (bending across the thickness, lateral bending across the
-  width, torsion, axial), the lowest of each kind found reported. The
+  width, torsion, axial). The n leaves' copies of one mode (in phase, out of
+  phase, within 5 %) count as one, represented by the copy the stage moves
+  most in, the one the loop can see; the lowest of each kind is reported
+  (``leaf bending``, ``leaf torsion``) and a higher one (``leaf bending 2``)
+  when its coupling reaches 1 %, as a leaf mode mixed with a stage mode does.
+  The
   participation ``m1 (c . phi)(b . phi)`` uses the master's components with
   the sensor row ``c = (1, 0, 0, 0, z_s, -y_s)`` and actuator column
   ``b = (1, 0, 0, 0, z_a, -y_a)``; the coupling is its modulus over the sum
@@ -103,6 +108,13 @@ _LEAF_KINDS = ("leaf bending", "leaf lateral bending", "leaf axial", "leaf later
 
 #: A leaf is compressed by the weight when its axial force is below -this fraction of it [-].
 _COMPRESSED = 1e-6
+
+#: The leaves' modes of one kind within this fraction above the lowest are one mode of the n
+#: leaves (in phase, out of phase): the one the stage moves most in is reported [-].
+_SAME_MODE = 0.05
+
+#: A leaf mode beyond the first of its kind is reported when its coupling reaches this [-].
+_VISIBLE = 0.01
 
 #: A mode is a stage mode only with at least this share of its kinetic energy in the stage [-].
 _STAGE_SHARE = 0.5
@@ -362,7 +374,7 @@ def _modes(model: _Model, KG: sparse.csc_matrix, guide: LeafGuide) -> tuple[Mode
     modes = [mode(i, f"stage {DIRECTIONS[d]}", DIRECTIONS[d])
              for i in stage for d in [int(np.argmax(energy[:, i]))]]
     leaf_energy = (model.T @ phi) ** 2 * model.M_full_diag[:, None]
-    kinds: dict[str, int] = {}
+    clusters: dict[str, list[list[int]]] = {}
     for i in range(phi.shape[1]):
         if i in stage:
             continue
@@ -370,6 +382,16 @@ def _modes(model: _Model, KG: sparse.csc_matrix, guide: LeafGuide) -> tuple[Mode
         by_kind: dict[str, float] = {}
         for d, kind in enumerate(_LEAF_KINDS):
             by_kind[kind] = by_kind.get(kind, 0.0) + per_dof[d]
-        kinds.setdefault(max(by_kind, key=by_kind.get), i)
-    modes += [mode(i, kind, "leaf") for kind, i in sorted(kinds.items(), key=lambda kv: kv[1])]
+        found = clusters.setdefault(max(by_kind, key=by_kind.get), [])
+        if found and freq[i] <= (1.0 + _SAME_MODE) * freq[found[-1][0]]:
+            found[-1].append(i)
+        else:
+            found.append([i])
+    leaves = []
+    for kind, found in clusters.items():
+        for order, members in enumerate(found):
+            i = max(members, key=lambda j: share[j])
+            if order == 0 or abs(participation[i]) >= _VISIBLE * total:
+                leaves.append(mode(i, kind if order == 0 else f"{kind} {order + 1}", "leaf"))
+    modes += sorted(leaves, key=lambda m: m.frequency)
     return tuple(modes)
