@@ -148,6 +148,22 @@ def test_a_guide_with_a_high_centre_of_mass_buckles_at_the_same_sway_load():
     assert high < low
 
 
+@pytest.mark.parametrize("height", [1e-3, 20e-3, 60e-3, 200e-3])
+def test_narrow_leaves_topple_sideways_by_the_weight_above_the_clamp(height):
+    """The rigid stage's pendulum term: bars 2 mm wide, 1 mm thick, both at y = 0, are weaker
+    sideways (rolling the stage, nothing to push-pull) than in the drive direction. Sideways
+    the pair is a cantilever column whose top carries a rigid body loaded a height h above it:
+    EI w'' = W (delta + h theta - w) gives kL tan(kL) = L / h, W = n E I_w k^2 with
+    I_w = t b^3 / 12; from kL = pi/2 (a plain cantilever) at h = 0 down to ~sqrt(L / h)."""
+    from scipy.optimize import brentq
+
+    g = guide(width=2e-3, thickness=1e-3, mass=1.0, com_height=height)
+    kL = brentq(lambda x: x * math.tan(x) - g.length / height, 1e-9, math.pi / 2 - 1e-12)
+    toppling = g.leaves * E * g.thickness * g.width**3 / 12.0 * (kL / g.length) ** 2
+    assert toppling < euler_sway(g)
+    assert fe_mechanics(g).buckling_factor * g.weight == pytest.approx(toppling, rel=0.002)
+
+
 @pytest.mark.parametrize("orientation, sign", [("standing", -1.0), ("hanging", 1.0)])
 def test_geometric_stiffness_is_about_1_2_weight_over_length(orientation, sign):
     """A guided leaf under an axial tension P: k = 12 E I / L^3 + 6 P / (5 L) - P^2 L / (700 E I)
