@@ -124,10 +124,13 @@ _STAGE_SHARE = 0.5
 class _Model:
     """The assembled guide, reduced to the free leaf nodes and the stage's master node.
 
-    ``K``, ``M``: reduced stiffness and mass (sparse, n_red x n_red) [SI];
-    ``T``: full leaf displacements from reduced ones (sparse, n_full x n_red);
+    ``K``, ``M``: reduced stiffness and mass, the stage's included (sparse, n_red x n_red) [SI];
+    ``T``: the leaves' nodal displacements from the reduced ones (sparse, n_full x n_red);
+    ``K_full``: the leaves' stiffness over all their nodes (sparse, n_full x n_full);
+    ``M_full_diag``: the diagonal of the leaves' mass over all their nodes (n_full,);
     ``master``: index of the master's first degree of freedom in the reduced set;
-    ``slaves``: (first full DOF, r_s from the centre of mass [m]) per leaf top node.
+    ``slaves``: (first full DOF, r_s from the centre of mass [m]) per leaf top node;
+    ``elements``, ``prop``: the pyfe3d BeamC elements and their BeamProp.
     """
 
     K: sparse.csc_matrix
@@ -139,7 +142,6 @@ class _Model:
     slaves: tuple[tuple[int, np.ndarray], ...]
     elements: tuple
     prop: object
-    coords: np.ndarray
 
 
 def fe_mechanics(guide: LeafGuide, *, elements_per_leaf: int = 16) -> FeMechanics:
@@ -178,7 +180,7 @@ def fe_mechanics(guide: LeafGuide, *, elements_per_leaf: int = 16) -> FeMechanic
     model = _assemble(guide, elements_per_leaf)
     KG, axial = _prestress(model, guide)
     compliance = _compliance(model.K, model.master)
-    stiffness = Stiffness6(*(1.0 / np.diag(compliance)))
+    stiffness = Stiffness6(*(float(1.0 / c) for c in np.diag(compliance)))
     kx_stressed = 1.0 / _compliance(model.K + KG, model.master)[0, 0]
     buckling = None
     if axial.min() < -_COMPRESSED * guide.weight:
@@ -284,7 +286,7 @@ def _assemble(guide: LeafGuide, ne: int) -> _Model:
     K = (T.T @ K_full @ T).tocsc()
     M = (T.T @ M_full @ T + sparse.diags(stage)).tocsc()
     return _Model(K=K, M=M, T=T, K_full=K_full, M_full_diag=M_full.diagonal(), master=master,
-                  slaves=tuple(slaves), elements=tuple(elements), prop=prop, coords=coords)
+                  slaves=tuple(slaves), elements=tuple(elements), prop=prop)
 
 
 def _prestress(model: _Model, guide: LeafGuide) -> tuple[sparse.csc_matrix, np.ndarray]:
