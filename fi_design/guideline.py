@@ -314,17 +314,25 @@ def step3_stiffness(model: Model | Spec) -> StiffnessResult:
     s = model.joint.stroke
     kmax = stiffness_limit(spec, s)
     k = model.joint.stiffness
-    if model.joint.stiffness_given:
+    iso = spec.isolator
+    drawn = (iso is not None and iso.stiffness is None and iso.flexure is not None
+             and iso.flexure.drawn and "isolator.stiffness" not in model.changed)
+    if drawn:
+        source = "the flexure guide as drawn (isolator.flexure), net of gravity"
+    elif model.joint.stiffness_given:
         source = "given in the spec (isolator.stiffness)"
     else:
         source = ("proposed: k_max / 2, so the flexure force at full stroke is Fs / 2, leaving "
                   "room for friction scatter")
-    ok = k <= kmax * (1 + 1e-12)
-    msg = (f"k = {_g(k)} N/m ({source.split(':')[0].split(' (')[0]}) "
-           + ("is at or below" if ok else "exceeds")
-           + f" k_max = Fs / {'stroke' if safety == 1 else f'({safety:g} x stroke)'} = "
-           f"{_g(kmax)} N/m; flexure force at full "
-           f"stroke {k * s:.3g} N against Fs = {Fs:.3g} N")
+    ok = 0.0 < k <= kmax * (1 + 1e-12)
+    rule = f"k_max = Fs / {'stroke' if safety == 1 else f'({safety:g} x stroke)'} = {_g(kmax)} N/m"
+    if k <= 0.0:
+        msg = (f"k = {_g(k)} N/m ({source.split(':')[0].split(' (')[0]}) is not positive: "
+               f"the joint has no drive stiffness left to centre the cart ({rule})")
+    else:
+        msg = (f"k = {_g(k)} N/m ({source.split(':')[0].split(' (')[0]}) "
+               + ("is at or below " if ok else "exceeds ") + rule
+               + f"; flexure force at full stroke {k * s:.3g} N against Fs = {Fs:.3g} N")
     check = Check("drive_stiffness", ok, k, kmax, "N/m", msg, step=step)
     return StiffnessResult(maximum=kmax, chosen=k, source=source, stroke=s, static=Fs,
                            safety=safety, force_at_stroke=k * s, suggested=False,
@@ -492,7 +500,8 @@ def _sha256(spec: Spec) -> str:
 
 def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool = True,
            executor: Executor | None = None,
-           progress: Callable[[str], None] | None = None) -> DesignResult:
+           progress: Callable[[str], None] | None = None,
+           fe_check: bool = False) -> DesignResult:
     """Run the four guideline steps on a spec and confirm them by simulation.
 
     The spec is resolved once (:func:`fi_design.model.resolve`) and every
@@ -523,6 +532,12 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
     progress : callable, optional
         ``progress(text)`` with a short message as the work proceeds (the
         confirmation's own messages too when it runs here).
+    fe_check : bool, optional
+        Also build the flexure guide as a finite-element model
+        (:func:`fi_design.mechanism.fe.fe_mechanics`, pyfe3d; a fraction of a
+        second), the independent check of its closed forms, as
+        ``flexure_fe``. Default False; skipped without a guide or without
+        pyfe3d.
 
     Returns
     -------
@@ -575,6 +590,7 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
             fut.cancel()
         raise
     advice = isolator_advice(model, gap, xo) if not model.has_isolator else None
+    fe = _fe_check(fx) if fe_check else None
     checks = (gap.checks + xo.checks + st.checks
               + flexure_checks(fx, xo.desired, model.requirements.parasitic_separation)
               + pid.checks)
@@ -584,7 +600,7 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
         warnings=tuple(warnings_for(spec)),
         conclusion=_conclusion(model, gap, xo, st, fx, pid, advice, checks),
         fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None,
-        model=model)
+        model=model, flexure_fe=fe)
     sim = study = None
     if confirm:
         if progress is not None:
@@ -640,6 +656,19 @@ def _simulation_sentence(model: Model, sim: Confirmation) -> str:
     if not sim.models_agree:
         text += " The other friction model disagrees on the spec's own move (see the checks)."
     return text
+
+
+def _fe_check(fx: FlexureResult | None):
+    """The guide as a finite-element model, or None without a guide or without pyfe3d."""
+    if fx is None or fx.mechanics is None:
+        return None
+    try:
+        from .mechanism.fe import fe_mechanics
+
+        return fe_mechanics(fx.guide)
+    except ImportError:
+        log.info("pyfe3d is not installed: the flexure's FE check did not run")
+        return None
 
 
 def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: StiffnessResult,

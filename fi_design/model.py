@@ -203,7 +203,10 @@ class Model:
         if fx is None or fx.mechanics is None or any(m.direction == "given" for m in given):
             return given
         replaced = {m.direction for m in given}
-        kept = tuple(m for m in fx.mechanics.parasitic_modes if m.direction not in replaced)
+        # a mode the weight has made unstable (0 Hz: a buckled guide, which step 3 fails) is
+        # no resonance of the loop
+        kept = tuple(m for m in fx.mechanics.parasitic_modes
+                     if m.direction not in replaced and m.frequency > 0.0)
         return tuple(sorted(kept + given, key=lambda m: m.frequency))
 
     # ---- views

@@ -24,7 +24,7 @@ __all__ = ["design"]
 
 def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
            executor: Any = None, progress: Callable[[str], None] | None = None,
-           recommend: bool = True) -> DesignResult:
+           recommend: bool = True, fe_check: bool = False) -> DesignResult:
     """Run the guideline on a spec, confirm it by simulation, and recommend when it fails.
 
     Parameters
@@ -44,6 +44,9 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         When the simulated verdict is FAIL, search the design space for a
         design that passes (:func:`fi_design.recommend.recommend`: seconds to
         a minute) and return it as ``recommendation``. Default True.
+    fe_check : bool, optional
+        Also check the flexure guide with a finite-element model (see
+        :func:`fi_design.guideline.design`). Default False.
 
     Returns
     -------
@@ -54,7 +57,8 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     fi_design.errors.SpecError
         When ``spec`` is a path or mapping that does not validate.
     """
-    result = guideline.design(spec, confirm=confirm, executor=executor, progress=progress)
+    result = guideline.design(spec, confirm=confirm, executor=executor, progress=progress,
+                              fe_check=fe_check)
     if not (recommend and result.simulation is not None and result.verdict.status == "FAIL"):
         return result
     from .recommend import recommend as search

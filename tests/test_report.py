@@ -35,8 +35,8 @@ NNBSP = "\u202f"
 NBSP = "\u00a0"
 
 #: Sections of the design report, in the order the issue asks for.
-DESIGN_SECTIONS = ["verdict", "inputs", "steps", "linear", "nonlinear", "assumptions",
-                   "references", "appendix"]
+DESIGN_SECTIONS = ["verdict", "inputs", "steps", "guide", "linear", "nonlinear",
+                   "assumptions", "references", "appendix"]
 
 runner = CliRunner()
 
@@ -353,8 +353,8 @@ def test_html_is_self_contained(design_html):
 def test_html_figures_and_equations_inline(design_html):
     p = _parse(design_html)
     figures = [a["id"] for t, a in p.tags if t == "figure"]
-    assert figures == ["fig-bode", "fig-nyquist", "fig-sensitivity", "fig-moves", "fig-cycle",
-                       "fig-boundary", "fig-error", "fig-deflection"]
+    assert figures == ["fig-guide", "fig-bode", "fig-nyquist", "fig-sensitivity", "fig-moves",
+                       "fig-cycle", "fig-boundary", "fig-error", "fig-deflection"]
     svgs = re.findall(r"<figure[^>]*>\s*<svg", design_html)
     assert len(svgs) == len(figures)
     ids = re.findall(r'\sid="([^"]+)"', design_html)
@@ -602,7 +602,7 @@ def test_design_map_section(paper_confirmed_design):
     small = design_map(paper_confirmed_design, resolution=(3, 2))
     assert small.sweep.shape == (2, 3) and not small.suggested
     ctx = report.build_context(paper_confirmed_design, date=DATE, design_map=small)
-    assert [s["id"] for s in ctx["sections"]][5] == "map"
+    assert [s["id"] for s in ctx["sections"]][6] == "map"
     assert "fi_design.studies.sweep: crossover 1 to 20 Hz" in ctx["map"]["intro"]
     text = report.render_html(ctx)
     assert 'id="fig-map"' in text and re.search(r'id="fig-map">\s*<svg', text)

@@ -61,7 +61,7 @@ def mechanics(guide: LeafGuide, stroke: float) -> GuideMechanics:
     net = float(_guide.drive_stiffness(K + Kg))
     force = _guide.leaf_force(guide)
     compressed = force < 0.0
-    factor = _guide.buckling_factor(Kc, Kgc) if compressed else None
+    factor = _guide.buckling_factor(guide) if compressed else None
     sag = guide.cart_mass * 9.80665 / net if guide.orientation == "vertical_axis" else 0.0
     gravity = Gravity(orientation=guide.orientation, axial_load=force * guide.leaves,
                       geometric_stiffness=net - elastic,

@@ -10,12 +10,13 @@ with ``T_i = [[I, -[r_i]x], [0, I]]``. Moved to the stage's centre of mass,
 there.
 
 Gravity: the stage's weight W = m1 g loads the leaves axially when the guide
-stands (compression, ``-W / n`` per leaf) or hangs (tension), which adds
-each leaf's geometric stiffness (:func:`.leaf.geometric_block`), and it acts
-at the centre of mass, away from the clamp: the load stiffness of a constant
-force F at r, ``K_theta = -sym(F r^T) + (F . r) I`` on the rotations
-(standing: ``-W h`` in rx and ry, the inverted pendulum). The buckling factor
-is the lowest positive load factor lambda with ``K + lambda K_g`` singular.
+stands (compression, ``-W / n`` per leaf) or hangs (tension), which changes
+each leaf's bending stiffness (:func:`.leaf.geometric_block`, exact in the
+drive plane), and it acts at the centre of mass, away from the clamp: the
+load stiffness of a constant force F at r, ``K_theta = -sym(F r^T) + (F . r) I``
+on the rotations (standing: ``-W h`` in rx and ry, the inverted pendulum).
+The buckling factor is the lowest load factor lambda under which the
+stiffness with lambda times the weight turns singular (:func:`buckling_factor`).
 
 Modes: the six natural modes of the rigid stage (mass m1, inertia about its
 centre of mass) on the guide's stiffness with gravity's, mass normalised.
@@ -118,22 +119,33 @@ def clamp_stiffness(guide: LeafGuide, *, deflection: float = 0.0, length=None, w
     return _sum_leaves(guide, block)
 
 
-def clamp_geometric_stiffness(guide: LeafGuide, *, length=None, width=None,
+def clamp_geometric_stiffness(guide: LeafGuide, *, load: float = 1.0, length=None, width=None,
                               thickness=None) -> np.ndarray:
     """Gravity's stiffness at the stage's clamp: the leaves' geometric stiffness and the load's.
+
+    Parameters
+    ----------
+    guide : LeafGuide
+        The guide.
+    load : float, optional
+        Factor on the weight (the buckling factor's search). Default 1.
+    length, width, thickness : float or numpy.ndarray, optional
+        Leaf dimensions in place of the guide's [m].
 
     Returns
     -------
     numpy.ndarray, shape (..., 6, 6)
-        Proportional to the weight; zero without gravity's load on the guide.
+        Zero without gravity's load on the guide.
     """
     L, b, t = _dims(guide, length, width, thickness)
-    shape = np.broadcast(L, b, t).shape
-    K = _sum_leaves(guide, leaf.geometric_block(np.full(shape, leaf_force(guide)), L))
+    lam = np.asarray(load, float)
+    shape = np.broadcast(L, b, t, lam).shape
+    K = _sum_leaves(guide, leaf.geometric_block(guide.youngs_modulus, L, b, t,
+                                                np.broadcast_to(lam * leaf_force(guide), shape)))
     F = weight_vector(guide)
     r = np.array([0.0, 0.0, guide.com_height])
     sym = 0.5 * (np.outer(F, r) + np.outer(r, F))
-    K[..., 3:, 3:] += -sym + float(F @ r) * np.eye(3)
+    K[..., 3:, 3:] += lam[..., None, None] * (-sym + float(F @ r) * np.eye(3))
     return K
 
 
@@ -171,24 +183,59 @@ def drive_stiffness(K: np.ndarray):
     return 1.0 / np.linalg.inv(K)[..., 0, 0]
 
 
-def buckling_factor(K: np.ndarray, Kg: np.ndarray):
-    """Lowest positive load factor lambda with ``K + lambda Kg`` singular [-].
+def _stable(K: np.ndarray) -> np.ndarray:
+    """Whether each stiffness matrix is positive definite (its smallest scaled eigenvalue)."""
+    d = 1.0 / np.sqrt(np.abs(np.diagonal(K, axis1=-2, axis2=-1)))
+    A = K * d[..., :, None] * d[..., None, :]
+    return np.linalg.eigvalsh(0.5 * (A + np.swapaxes(A, -1, -2)))[..., 0] > 0.0
+
+
+def buckling_factor(guide: LeafGuide, *, length=None, width=None, thickness=None,
+                    rtol: float = 1e-4):
+    """Lowest factor on the weight at which the guide's stiffness turns singular [-].
+
+    The stiffness with lambda times the weight (the leaves' beam-column
+    stiffness under lambda times their force, exact, and the load stiffness)
+    loses positive definiteness at the buckling load. Bracketed from the
+    linear eigenproblem of the consistent geometric stiffness (a close upper
+    estimate), then bisected to ``rtol``.
 
     Parameters
     ----------
-    K, Kg : numpy.ndarray, shape (..., 6, 6)
-        Elastic and geometric stiffness (at one reference point).
+    guide : LeafGuide
+        The guide; its weight must compress the leaves.
+    length, width, thickness : float or numpy.ndarray, optional
+        Leaf dimensions in place of the guide's [m]; arrays broadcast.
+    rtol : float, optional
+        Relative resolution of the factor.
 
     Returns
     -------
     float or numpy.ndarray
-        inf where no positive factor exists (the load does not destabilise).
+        inf where the weight does not compress the guide.
     """
-    mu = np.linalg.eigvals(np.linalg.solve(K, -Kg))  # K^-1 (-Kg) phi = phi / lambda
-    real = np.where(np.abs(mu.imag) <= 1e-9 * np.abs(mu).max(axis=-1, keepdims=True) + 1e-300,
-                    mu.real, 0.0)
-    top = real.max(axis=-1)
-    out = np.where(top > 0.0, 1.0 / np.where(top > 0.0, top, 1.0), np.inf)
+    dims = dict(length=length, width=width, thickness=thickness)
+    K = clamp_stiffness(guide, **dims)
+    if leaf_force(guide) >= 0.0:
+        out = np.full(K.shape[:-2], np.inf)
+        return float(out) if out.ndim == 0 else out
+    # the linear estimate: K + lambda Kg1 singular, Kg1 the first-order part per unit load
+    Kg1 = clamp_geometric_stiffness(guide, load=1e-6, **dims) * 1e6
+    mu = np.linalg.eigvals(np.linalg.solve(K, -Kg1))
+    top = np.where(np.abs(mu.imag) <= 1e-9 * np.abs(mu).max(axis=-1, keepdims=True) + 1e-300,
+                   mu.real, 0.0).max(axis=-1)
+    hi = 1.1 / np.where(top > 0.0, top, 1e-300)
+    for _ in range(8):  # widen where the exact stiffness still holds at the estimate
+        ok = _stable(K + clamp_geometric_stiffness(guide, load=hi, **dims))
+        if not ok.any():
+            break
+        hi = np.where(ok, 2.0 * hi, hi)
+    lo = np.zeros_like(hi)
+    while np.any(hi - lo > rtol * hi):
+        mid = 0.5 * (lo + hi)
+        ok = _stable(K + clamp_geometric_stiffness(guide, load=mid, **dims))
+        lo, hi = np.where(ok, mid, lo), np.where(ok, hi, mid)
+    out = 0.5 * (lo + hi)
     return float(out) if out.ndim == 0 else out
 
 
@@ -222,6 +269,7 @@ def stage_modes(guide: LeafGuide, K: np.ndarray) -> tuple[Mode, ...]:
     phi = psi * s[:, None]  # mass normalised: phi^T M phi = I
     c, b = _rows(guide)
     part = guide.stage_mass * (c @ phi) * (b @ phi)
+    part = np.where(np.abs(part) < 1e-12, 0.0, part)  # round-off of a mode x does not see
     total = float(np.sum(np.abs(part))) or 1.0
     energy = phi ** 2 * np.diag(M)[:, None]
     out = []

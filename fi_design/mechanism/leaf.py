@@ -19,10 +19,11 @@ leaves lose lateral stiffness to shear) and Saint-Venant's torsion constant
 ``J = b t^3 / 3 (1 - 0.63 t / b)``. Clamped-guided (the clamp not rotating),
 the drive stiffness is ``12 E I_t / L^3 = E b t^3 / L^3`` per leaf.
 
-An axial force N (tension positive) adds the consistent geometric stiffness
-``N / (30 L) [[36, -3 L], [-3 L, 4 L^2]]`` to each bending plane (``+3 L``
-in the lateral plane): ``6 N / (5 L)`` in the drive direction, the
-``-1.2 m1 g / L`` of a standing guide.
+An axial force N (tension positive) changes the bending stiffness: in the
+drive plane exactly, by the beam-column's stability functions
+(:func:`beam_column`; to first order ``6 N / (5 L)`` in the drive direction,
+the ``-1.2 m1 g / L`` of a standing guide, which a hanging slender leaf
+outgrows), in the stiff lateral plane by the consistent geometric stiffness.
 
 Every function broadcasts over arrays of L, b, t, so the sizing can evaluate
 a whole grid of leaves at once; matrices have the shape ``(..., 6, 6)``.
@@ -35,7 +36,7 @@ import math
 import numpy as np
 
 __all__ = ["SHEAR_FACTOR", "CLAMPED_CLAMPED_ROOT", "CLAMPED_GUIDED_ROOT", "torsion_constant",
-           "stiffness_block", "geometric_block", "axial_factor", "bending_stress",
+           "stiffness_block", "beam_column", "geometric_block", "axial_factor", "bending_stress",
            "stroke_limit", "bending_frequency", "torsion_frequency", "sway_buckling_load"]
 
 #: Shear correction factor of a rectangular section [-].
@@ -102,29 +103,98 @@ def stiffness_block(E, G, length, width, thickness, axial=1.0):
     return K
 
 
-def geometric_block(force, length):
-    """Consistent geometric stiffness of one leaf under an axial force, at its stage end.
+def beam_column(E, I, length, force):
+    """Drive-plane stiffness of a beam-column at its end, the other end clamped (exact).
+
+    The stability functions of a prismatic beam under an axial force N
+    (Livesley): with ``q = N L^2 / (E I)`` (tension positive) and ``u =
+    sqrt(|q|)``, the end's deflection w and slope give
+
+    ``k_ww = (2 s (1 + c) + q) E I / L^3``, ``k_wr = -s (1 + c) E I / L^2``,
+    ``k_rr = s E I / L``
+
+    with s and c the stability functions (trigonometric in compression,
+    hyperbolic in tension; 4 and 1/2 without force, the Euler beam). Near
+    ``q = 0`` their series: ``k_ww L^3 / E I = 12 + 6 q / 5 - q^2 / 700``,
+    the consistent geometric stiffness and its next term.
 
     Parameters
     ----------
-    force : float or numpy.ndarray
-        Axial force N in the leaf [N], tension positive.
+    E : float
+        [Pa].
+    I : float or numpy.ndarray
+        Second moment of area of the bending plane [m^4].
     length : float or numpy.ndarray
         L [m].
+    force : float or numpy.ndarray
+        N [N], tension positive.
+
+    Returns
+    -------
+    k_ww, k_wr, k_rr : numpy.ndarray
+        [N/m], [N], [N m] (the coupling negative in the guide's drive plane,
+        w along x and the slope the rotation ry).
+
+    Examples
+    --------
+    >>> [round(float(k), 6) for k in beam_column(1.0, 1.0, 1.0, 0.0)]
+    [12.0, -6.0, 4.0]
+    """
+    EI, L = E * np.asarray(I, float), np.asarray(length, float)
+    q = np.asarray(force, float) * L ** 2 / EI
+    q, EI, L = np.broadcast_arrays(q, EI, L)
+    small = np.abs(q) < 1e-3
+    u = np.sqrt(np.where(small, 1.0, np.abs(q)))
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        # compression: trigonometric
+        sn, cs = np.sin(u), np.cos(u)
+        s_c = u * (sn - u * cs) / (2.0 - 2.0 * cs - u * sn)
+        c_c = (u - sn) / (sn - u * cs)
+        # tension: hyperbolic, divided through by cosh u (no overflow)
+        th, sech = np.tanh(u), 1.0 / np.cosh(np.minimum(u, 700.0))
+        s_t = u * (u - th) / (2.0 * sech - 2.0 + u * th)
+        c_t = (th - u * sech) / (u - th)
+    s = np.where(q > 0.0, s_t, s_c)
+    c = np.where(q > 0.0, c_t, c_c)
+    kww = np.where(small, 12.0 + 1.2 * q - q * q / 700.0, 2.0 * s * (1.0 + c) + q)
+    kwr = np.where(small, -(6.0 + q / 10.0 - q * q / 1400.0), -s * (1.0 + c))
+    krr = np.where(small, 4.0 + 2.0 * q / 15.0 - 11.0 * q * q / 6300.0, s)
+    return kww * EI / L ** 3, kwr * EI / L ** 2, krr * EI / L
+
+
+def geometric_block(E, length, width, thickness, force):
+    """Gravity's stiffness of one leaf under an axial force, at its stage end.
+
+    The drive plane (x, ry) exactly (:func:`beam_column` under the force less
+    without it); the lateral plane (y, rx), where the leaf is stiff, by the
+    consistent geometric stiffness ``N / (30 L) [[36, 3 L], [3 L, 4 L^2]]``.
+
+    Parameters
+    ----------
+    E : float
+        [Pa].
+    length, width, thickness : float or numpy.ndarray
+        L, b, t [m].
+    force : float or numpy.ndarray
+        Axial force N in the leaf [N], tension positive.
 
     Returns
     -------
     numpy.ndarray, shape (..., 6, 6)
-        ``N / (30 L) [[36, -+3 L], [-+3 L, 4 L^2]]`` in the planes (x, ry) and
-        (y, rx); zero in z and rz.
+        Zero in z and rz.
     """
     N, L = np.asarray(force, float), np.asarray(length, float)
-    K = _zeros(N, L)
+    It = np.asarray(width, float) * np.asarray(thickness, float) ** 3 / 12.0
+    K = _zeros(N, L, It)
+    kww, kwr, krr = beam_column(E, It, L, N)
+    k0ww, k0wr, k0rr = beam_column(E, It, L, 0.0)
+    K[..., 0, 0] = kww - k0ww
+    K[..., 0, 4] = K[..., 4, 0] = kwr - k0wr
+    K[..., 4, 4] = krr - k0rr
     c = N / (30.0 * L)
-    for u, r, sign in ((0, 4, -1.0), (1, 3, 1.0)):
-        K[..., u, u] = 36.0 * c
-        K[..., u, r] = K[..., r, u] = sign * 3.0 * L * c
-        K[..., r, r] = 4.0 * L ** 2 * c
+    K[..., 1, 1] = 36.0 * c
+    K[..., 1, 3] = K[..., 3, 1] = 3.0 * L * c
+    K[..., 3, 3] = 4.0 * L ** 2 * c
     return K
 
 

@@ -178,8 +178,7 @@ def evaluate(guide: LeafGuide, stroke: float, length, width, thickness) -> GridM
     Ks = _guide.at_centre(_guide.clamp_stiffness(guide, deflection=stroke, **dims), h)
     net = _guide.drive_stiffness(K + Kg)
     force = _guide.leaf_force(guide)
-    buckling = (np.asarray(_guide.buckling_factor(Kc, Kgc)) if force < 0.0
-                else np.full(L.shape, np.inf))
+    buckling = np.broadcast_to(_guide.buckling_factor(guide, **dims), L.shape)
     E, G, rho = guide.youngs_modulus, guide.shear_modulus, guide.density
     low = np.minimum(_parasitic_low(guide, K + Kg), _parasitic_low(guide, Ks + Kg))
     low = np.minimum(low, _leaf.bending_frequency(E, rho, L, b, t, force))

@@ -85,15 +85,15 @@ def guide_figure(mech: Any, body_size: tuple[float, float, float] | None = None)
     side.add_patch(Rectangle((-0.5 * sx, stage_z), sx, sz, fc=_STAGE, ec="0.3", lw=0.8))
     zc = sgn * (L + h)
     side.plot([0.0], [zc], marker="o", ms=5, mfc="white", mec="k", mew=1.0)
-    side.text(0.03 * span, zc, "  centre of mass", fontsize=7.0, va="center")
+    side.text(-0.03 * span, zc, "centre of mass", fontsize=7.0, va="center", ha="right")
     ys, zs = (_mm(v) for v in g.sensor_offset)
     ya, za = (_mm(v) for v in g.actuator_offset)
-    side.plot([0.5 * sx], [zc + sgn * zs], marker=">", ms=6, color="k")
-    side.text(0.5 * sx + 0.02 * span, zc + sgn * zs, " sensor", fontsize=7.0, va="center")
+    side.plot([0.5 * sx], [zc + sgn * zs], marker="<", ms=6, color="k")
+    side.text(0.5 * sx + 0.02 * span, zc + sgn * zs, "sensor", fontsize=7.0, va="center")
     side.annotate("", xy=(-0.5 * sx, zc + sgn * za), xytext=(-0.5 * sx - 0.12 * span,
                                                             zc + sgn * za),
                   arrowprops=dict(arrowstyle="-|>", lw=1.2, color="k"))
-    side.text(-0.5 * sx - 0.12 * span, zc + sgn * za + 0.04 * span, "actuator", fontsize=7.0,
+    side.text(-0.5 * sx - 0.12 * span, zc + sgn * za - 0.05 * span, "actuator", fontsize=7.0,
               ha="left")
     weight = f"m\u2081g = {number(g.weight, 3)} N"
     arrow = dict(arrowstyle="-|>", lw=1.4, color=_GRAVITY)

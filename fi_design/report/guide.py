@@ -112,10 +112,10 @@ def guide_section(result: Any, figures: bool, number: int) -> dict | None:
                           "undeflected": getattr(mech.stiffness, d),
                           "at_stroke": getattr(mech.stiffness_at_stroke, d),
                           "fe": None if fe_stiff is None else getattr(fe_stiff, d)})
-    fe_freq = {}
+    fe_freq = {}  # the FE model's stage modes by direction, its leaf modes by name
     if fe is not None:
         for m in fe.modes:
-            fe_freq.setdefault(m.direction, m.frequency)
+            fe_freq.setdefault(m.name if m.direction == "leaf" else m.direction, m.frequency)
     in_loop = result.model.modes if getattr(result, "model", None) is not None else ()
     modes = []
     for m in mech.modes:
@@ -128,8 +128,7 @@ def guide_section(result: Any, figures: bool, number: int) -> dict | None:
             "required": need if parasitic else None,
             "margin": m.frequency / need if parasitic and need > 0 else None,
             "css": "" if not parasitic else ("pass" if m.frequency >= need else "fail"),
-            "fe": fe_freq.get(m.direction) if m.direction != "leaf" or m.name == "leaf bending"
-            else None})
+            "fe": fe_freq.get(m.name if m.direction == "leaf" else m.direction)})
     for m in result.crossover.parasitic_modes:
         if m.source == "given":
             modes.append({"name": m.name, "direction": m.direction, "frequency": m.frequency,
