@@ -185,6 +185,7 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
             suggested) -> list[Check]:
     """The confirmation's checks: the spec's own plant judged, the other one information."""
     fc = model.crossover
+    margin = model.requirements.hunting_margin
     step = "simulation (paper section 2.3)"
     integrates = iso.static_error_bound is None
     if suggested:
@@ -232,13 +233,20 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
         elif m is None:
             out.append(Check(f"min_crossover_{key}", False, m, fc, "Hz", text + (
                 ": a crossover that ends hunting was not found"), step, status=Status.WARN))
+        elif fc >= margin * m:
+            out.append(Check(f"min_crossover_{key}", True, m, fc / margin, "Hz", text + (
+                f", at least {margin:g} x above it (requirements.hunting_margin)"
+                if margin > 1 else ""), step))
         elif fc >= m:
-            out.append(Check(f"min_crossover_{key}", True, m, fc, "Hz", text, step))
+            out.append(Check(f"min_crossover_{key}", False, m, fc / margin, "Hz", text + (
+                f": the design crossover lies only {fc / m:.3g} x above it, within the "
+                f"hunting margin of {margin:g} (requirements.hunting_margin): a little more "
+                "friction gap or a little less loop gain brings the cycle back"), step))
         else:
-            out.append(Check(f"min_crossover_{key}", False, m, fc, "Hz", text + (
+            out.append(Check(f"min_crossover_{key}", False, m, fc / margin, "Hz", text + (
                 ": the design crossover lies below it, where the cycle exists"
                 + ("" if st.hunts else " although no move of the family enters it")),
-                step, status=Status.WARN))
+                step, status=Status.FAIL if st.hunts else Status.WARN))
     stn = stage["non_isolated"]
     if not stn.hunts:
         out.append(Check("isolator_needed", None, None, None, "-",

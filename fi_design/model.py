@@ -142,6 +142,9 @@ class Model:
     changed : tuple of str
         The spec paths whose values :meth:`at` changed, in order (empty: the
         spec as resolved). A study that varies the spec does not see them.
+    mode_scale : float
+        Factor on the frequencies of the guide's computed modes [-] (1: as
+        computed; a reserve check lowers them).
     """
 
     spec: _spec.Spec
@@ -156,6 +159,7 @@ class Model:
     law: ControlLaw
     effects: tuple = ()
     changed: tuple[str, ...] = ()
+    mode_scale: float = 1.0
 
     # ---- the flexure guide and the modes the loop sees
 
@@ -193,10 +197,11 @@ class Model:
     def modes(self) -> tuple[Mode, ...]:
         """The parasitic modes the loop sees, by frequency.
 
-        The guide's computed ones (its stage's five and its leaves' own); a
-        given mode (``isolator.parasitic_modes``, measured) with a direction
-        replaces the computed mode of that direction, and given modes without
-        a direction replace them all. Without a guide, the given ones.
+        The guide's computed ones (its stage's five and its leaves' own) and
+        the given ones (``isolator.parasitic_modes``, measured): a given mode
+        with a guide direction replaces the computed mode of that direction, a
+        ``structure`` mode adds to them, and given modes without a direction
+        replace them all. Without a guide, the given ones.
         """
         given = self.given_modes
         fx = self.flexure if self.joint is not None else None
@@ -205,7 +210,9 @@ class Model:
         replaced = {m.direction for m in given}
         # a mode the weight has made unstable (0 Hz: a buckled guide, which step 3 fails) is
         # no resonance of the loop
-        kept = tuple(m for m in fx.mechanics.parasitic_modes
+        kept = tuple(m if self.mode_scale == 1.0 else replace(m, frequency=m.frequency
+                                                                * self.mode_scale)
+                     for m in fx.mechanics.parasitic_modes
                      if m.direction not in replaced and m.frequency > 0.0)
         return tuple(sorted(kept + given, key=lambda m: m.frequency))
 
@@ -245,7 +252,9 @@ class Model:
 
     def at(self, *, crossover: float | None = None, stiffness: float | None = None,
            stroke: float | None = None, damping: float | None = None,
-           friction_model: str | None = None, effects=None) -> "Model":
+           friction_model: str | None = None, effects=None,
+           masses: tuple[float, float] | None = None, delay: float | None = None,
+           mode_scale: float | None = None) -> "Model":
         """The same model with some values changed, checked like the spec checks them.
 
         Parameters
@@ -270,6 +279,15 @@ class Model:
             applied in order: an entry of a type listed before sets its
             values again (or, for an additive parameter, adds to them), as
             the reconciliation stacks a candidate on the spec's effects.
+        masses : (float, float), optional
+            The true stage and cart masses m1, m2 [kg]: the plant changes, the
+            controller keeps its tuning; the flexure guide (its geometry kept)
+            carries the new stage, and a joint the guide defines follows its
+            net stiffness.
+        delay : float, optional
+            The loop's computational delay [s].
+        mode_scale : float, optional
+            Factor on the guide's computed modes' frequencies [-].
 
         Returns
         -------
@@ -302,12 +320,50 @@ class Model:
             friction = replace(friction, model=friction_model)
         entries = model.effects if effects is None else _checked_effects(effects, model.joint)
         changed = self.changed + tuple(p for p in paths if p not in self.changed)
-        out = replace(model, law=law, friction=friction, effects=entries, changed=changed)
+        if delay is not None:
+            d = _finite(delay, "controller.delay", "s")
+            if d < 0.0:
+                raise SpecError(f"must be at least 0 s, got {delay!r}", path="controller.delay")
+            law = replace(law, delay=d)
+        scale = model.mode_scale if mode_scale is None else _positive(mode_scale, "mode_scale",
+                                                                     "-")
+        out = replace(model, law=law, friction=friction, effects=entries, changed=changed,
+                      mode_scale=scale)
+        if masses is not None:
+            return out._with_masses(*masses)
         if model is self:  # the joint stays: so do the guide and its modes, once worked out
-            for name in ("flexure", "modes"):
+            for name in ("flexure",) + (("modes",) if mode_scale is None else ()):
                 if name in self.__dict__:
                     out.__dict__[name] = self.__dict__[name]
         return out
+
+    def _with_masses(self, m1: float, m2: float) -> "Model":
+        """The model with the true masses changed: the guide as built carries the new stage."""
+        m1 = _positive(m1, "stage.mass", "kg")
+        m2 = _positive(m2, "cart.mass", "kg")
+        b = self.body
+        f = m1 / b.mass
+        body = replace(b, mass=m1, inertia=tuple(i * f for i in b.inertia))
+        out = replace(self, m1=m1, m2=m2, body=body)
+        fx = self.flexure
+        if fx is not None and fx.mechanics is not None:
+            from .mechanism.sizing import reevaluate
+
+            g = replace(fx.guide, stage_mass=m1, stage_inertia=body.inertia, cart_mass=m2)
+            moved = reevaluate(fx, g)
+            out.__dict__["flexure"] = moved
+            if self.joint is not None and self._guide_defines_stiffness:
+                out = replace(out, joint=replace(self.joint,
+                                                 stiffness=moved.mechanics.net_drive_stiffness))
+                out.__dict__["flexure"] = moved
+        return out
+
+    @property
+    def _guide_defines_stiffness(self) -> bool:
+        """Whether the joint's stiffness is the drawn guide's own (not the spec's number)."""
+        iso = self.spec.isolator
+        return (iso is not None and iso.stiffness is None and iso.flexure is not None
+                and iso.flexure.drawn and "isolator.stiffness" not in self.changed)
 
     def _with_joint(self, stiffness, stroke, damping) -> "Model":
         """The model with the joint's values changed (an isolator added when it has none)."""

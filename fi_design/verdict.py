@@ -66,8 +66,14 @@ def run_robustness(model: Model, suggestion: tuple[float, float] | None = None,
                    executor: Any = None) -> Any:
     """Simulate the samples of ``requirements.robustness`` (the study, not yet judged).
 
-    Static and Coulomb friction scatter by the given fractions (and ripple
-    along the rail when set); every sample is judged at the stage level
+    Every sample draws Coulomb friction and the gap Fs - Fc together (static
+    friction never below Coulomb friction: no sample is lost), the true masses
+    (the controller keeps its nominal tuning), the drive stiffness (the
+    flexure's stock tolerance by default) and the loop delay, by the fractions
+    of ``requirements.robustness`` (and a ripple along the rail when set); the
+    parasitic modes do not enter the nonlinear simulation, so they do not
+    scatter here (the recommendation's reserve checks them). Every sample is
+    judged at the stage level
     (every move of its family, :mod:`fi_design.stage`), with and without the
     isolator, in chunks on ``executor`` (or here). A spec without isolator is
     studied with the suggested isolator added, so the same samples show what
@@ -91,24 +97,55 @@ def run_robustness(model: Model, suggestion: tuple[float, float] | None = None,
         None when ``samples`` is 0 or nothing scatters.
     """
     from .confirm import with_isolator
+    from .specfile import with_values
     from .studies import PositionFriction, Scatter, robustness
 
     spec = model.spec
     cfg = model.requirements.robustness
-    scatter = [Scatter(path, spread) for path, spread in (("friction.static", cfg.static),
-                                                         ("friction.coulomb", cfg.coulomb))
-               if spread > 0]
     ripple = None if cfg.ripple is None else PositionFriction(cfg.ripple.amplitude,
                                                               cfg.ripple.wavelength)
-    if cfg.samples == 0 or (not scatter and ripple is None):
+    if cfg.samples == 0:
         return None
     target = spec
     if not model.has_isolator and suggestion is not None:
         target = with_isolator(spec, *suggestion)
+    scatter = [Scatter("friction.coulomb", cfg.coulomb)] if cfg.coulomb > 0 else []
+    values: dict[str, Any] = {}
+    if cfg.mass > 0:  # the true masses: the controller keeps its nominal tuning
+        entries = [e.model_dump(exclude_none=True) for e in target.effects
+                   if e.type != "mass_error"]
+        entries.append({"type": "mass_error", "stage_mass": target.stage.mass,
+                        "cart_mass": target.cart.mass})
+        values["effects"] = entries
+        scatter += [Scatter("effects[type=mass_error].stage_mass", cfg.mass),
+                    Scatter("effects[type=mass_error].cart_mass", cfg.mass)]
+    k_spread = _stiffness_spread(model, cfg)
+    if k_spread > 0 and target.isolator is not None:
+        if target.isolator.stiffness is None:  # a drawn guide: its net stiffness, as measured
+            values["isolator.stiffness"] = model.joint.stiffness if model.joint else None
+        scatter.append(Scatter("isolator.stiffness", k_spread))
+    if cfg.delay > 0 and target.controller.delay > 0:
+        scatter.append(Scatter("controller.delay", cfg.delay))
+    if values:
+        target = with_values(target, {k: v for k, v in values.items() if v is not None})
+    gap = cfg.gap if target.friction.static > target.friction.coulomb else None
+    if not scatter and ripple is None and gap is None:
+        return None
     return robustness(target, scatter, cfg.samples, seed=cfg.seed,
                       distribution=cfg.distribution, position_friction=ripple,
                       confidence=cfg.confidence, executor=executor, progress=progress,
-                      cache=None)
+                      cache=None, friction_gap=gap)
+
+
+def _stiffness_spread(model: Model, cfg) -> float:
+    """The drive stiffness's scatter: the spec's, else the flexure's stock thickness tolerance
+    (k goes with t^3), else 5 % [-]."""
+    if cfg.stiffness is not None:
+        return cfg.stiffness
+    fx = model.flexure if model.joint is not None else None
+    if fx is not None and fx.mechanics is not None and fx.thickness:
+        return 3.0 * fx.thickness_tolerance / fx.thickness
+    return 0.05
 
 
 def robustness_check(model: Model, study: Any) -> RobustnessCheck:
@@ -155,7 +192,8 @@ def robustness_check(model: Model, study: Any) -> RobustnessCheck:
         plant=own, samples=mine.samples, valid=mine.valid, hunting=mine.unsettled,
         hunting_probability=p, interval=(mine.unsettled_low, mine.unsettled_high),
         confidence=mine.confidence,
-        limit=limit, status=status, scatter={s.path: s.spread for s in study.scatter},
+        limit=limit, status=status,
+        scatter={(s.meaning or s.path): s.spread for s in study.scatter},
         distribution=study.distribution, ripple=ripple, seed=study.seed,
         counts=dict(mine.counts), comparison=comparison, study=study)
 
@@ -183,7 +221,11 @@ def robustness_as_check(r: RobustnessCheck) -> Check:
 
 
 def _scatter_words(r: RobustnessCheck) -> str:
-    names = {"friction.static": "Fs", "friction.coulomb": "Fc"}
+    names = {"friction.static": "Fs", "friction.coulomb": "Fc",
+             "the gap Fs - Fc": "the gap Fs \u2212 Fc",
+             "effects[type=mass_error].stage_mass": "m1",
+             "effects[type=mass_error].cart_mass": "m2", "isolator.stiffness": "k",
+             "controller.delay": "the delay"}
     spread = sorted(set(r.scatter.values()))
     if len(spread) == 1 and spread[0] > 0:
         parts = [f"+-{100 * spread[0]:.3g} % on " + " and ".join(names.get(k, k)

@@ -390,15 +390,20 @@ def test_the_loop_sees_the_guide_s_modes_through_the_sensor_offset(paper_spec):
         assert far == pytest.approx(1 + pitch.participation * (1 / 20) ** 2, rel=0.01)
 
 
-def test_a_given_mode_with_a_direction_replaces_the_computed_one(paper_spec):
+def test_given_modes_replace_or_join_the_computed_ones(paper_spec):
     from fi_design.model import resolve
 
     model = resolve(paper_spec)
-    dirs = [m.direction for m in model.modes]
-    assert dirs.count("ry") == 1
-    tilt = next(m for m in model.modes if m.direction == "ry")
-    assert tilt.source == "given" and tilt.frequency == 150.0
-    assert {"y", "rz", "rx", "z", "leaf"} <= set(dirs)
+    # the paper's measured tilt is the stage structure's: it joins the guide's modes
+    tilt = next(m for m in model.modes if m.source == "given")
+    assert tilt.direction == "structure" and tilt.frequency == 150.0
+    assert [m.direction for m in model.modes].count("ry") == 1
+    assert {"y", "rz", "rx", "z", "ry", "leaf"} <= {m.direction for m in model.modes}
+    # with a guide direction it replaces the computed mode of that direction
+    ry = resolve(_paper_variant(paper_spec, **{"isolator.parasitic_modes": [
+        {"name": "tilt", "frequency": "150 Hz", "direction": "ry"}]}))
+    pitch = [m for m in ry.modes if m.direction == "ry"]
+    assert len(pitch) == 1 and pitch[0].source == "given"
     # without a direction, the given modes are the measured set: no computed mode stays
     plain = _paper_variant(paper_spec, **{"isolator.parasitic_modes": [
         {"name": "tilt", "frequency": "150 Hz"}]})

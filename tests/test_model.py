@@ -46,8 +46,10 @@ def test_resolve_fills_the_defaults_design_md_gives(paper_spec):
     assert m.limiter.stiffness == 1e6
     assert m.limiter.damping == pytest.approx(2 * 0.2 * math.sqrt(1e6 * m1), rel=1e-15)
     assert (m.m1, m.m2, m.offset, m.crossover) == (m1, m2, f.offset, 8.0)
-    assert m.modes == tuple(given_mode(x) for x in bare.isolator.parasitic_modes)
-    assert all(x.source == "given" for x in m.modes) and m.effects == bare.effects
+    # the measured structure mode joins the sized guide's own modes
+    assert m.given_modes == tuple(given_mode(x) for x in bare.isolator.parasitic_modes)
+    assert set(m.given_modes) <= set(m.modes) and m.effects == bare.effects
+    assert {x.source for x in m.modes} == {"given", "computed"}
 
 
 def test_the_kernel_parameters_are_the_resolved_values(paper_spec):

@@ -38,7 +38,7 @@ from . import mechanics
 from .geometry import StageBody, leaf_guide
 
 __all__ = ["GRID_POINTS", "STIFFNESS_TIE", "GridMechanics", "stock_thicknesses",
-           "stiffness_range", "net_stiffness", "evaluate", "drawn_guide", "size_guide"]
+           "stiffness_range", "net_stiffness", "evaluate", "reevaluate", "drawn_guide", "size_guide"]
 
 #: Grid points of a searched continuous dimension (length).
 GRID_POINTS = 161
@@ -213,6 +213,23 @@ def _result(guide: LeafGuide, stroke: float, *, drawn: bool, flexure, **terms) -
         thickness_step=None if drawn else step, thickness_tolerance=tol,
         stiffness_range=stiffness_range(guide, tol),
         **terms)
+
+
+def reevaluate(fx: FlexureResult, guide: LeafGuide) -> FlexureResult:
+    """The same result for a changed guide (another stage mass, say), its terms kept.
+
+    Parameters
+    ----------
+    fx : FlexureResult
+        A feasible result.
+    guide : LeafGuide
+        The guide to evaluate in its place.
+    """
+    from dataclasses import replace
+
+    mech = mechanics(guide, fx.stroke)
+    return replace(fx, mechanics=mech, modes_at_stroke=_modes_at_stroke(guide, fx.stroke),
+                   stiffness_range=stiffness_range(guide, fx.thickness_tolerance))
 
 
 def drawn_guide(flexure, body: StageBody, *, stroke: float, maximum_stiffness: float,

@@ -121,7 +121,7 @@ def guide_section(result: Any, figures: bool, number: int) -> dict | None:
     for m in mech.modes:
         parasitic = not m.drive
         source = m.source if not parasitic or any(x is m for x in in_loop) else \
-            "computed, replaced by the given mode"
+            "computed, replaced by a given mode"
         modes.append({
             "name": m.name, "direction": m.direction, "frequency": m.frequency,
             "coupling": m.coupling, "source": source,

@@ -445,11 +445,16 @@ class Scatter(Result):
         nominal value when ``relative``, else in the path's unit [SI].
     relative : bool
         Whether ``spread`` is a fraction of the nominal value.
+    meaning : str
+        What scatters when it is not the value at ``path`` itself (``the gap
+        Fs - Fc`` for static friction drawn as Coulomb friction plus a drawn
+        gap); empty otherwise.
     """
 
     path: str
     spread: float
     relative: bool = True
+    meaning: str = ""
 
 
 

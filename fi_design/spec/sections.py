@@ -111,18 +111,23 @@ class Limiter(StrictModel):
 
 
 class ParasiticMode(StrictModel):
-    """A parasitic resonance of the flexure (a measured value), added to the linear limit cases.
+    """A parasitic resonance (a measured value), added to the linear limit cases.
 
-    With a flexure guide the guide's modes are computed; a given mode with a
-    ``direction`` replaces the computed mode of that direction, and given modes
-    without one replace all computed modes (they are the measured set).
+    With a flexure guide the guide's own modes are computed. A given mode with
+    a guide ``direction`` (x, y, z, rx, ry, rz, leaf) replaces the computed
+    mode of that direction for the spec's guide; ``structure`` marks a mode of
+    the stage's or frame's own structure, which the guide does not set: it is
+    added to the computed modes and kept for every guide a recommendation
+    tries. Given modes without a direction replace all computed modes of the
+    spec's guide (they are the measured set).
     """
 
     name: Text = Field("mode", description="Label used in reports.")
-    direction: Literal["x", "y", "z", "rx", "ry", "rz", "leaf"] | None = Field(
-        None, description="Dominant direction (x, y, z, rx, ry, rz of the flexure guide, or "
-                          "leaf): the computed mode it replaces. Default none: with a flexure "
-                          "guide, the given modes replace all computed ones.")
+    direction: Literal["x", "y", "z", "rx", "ry", "rz", "leaf", "structure"] | None = Field(
+        None, description="The guide's direction it replaces (x, y, z, rx, ry, rz, leaf), or "
+                          "structure: a mode of the stage's or frame's structure, added to the "
+                          "guide's computed modes and kept for any guide. Default none: with "
+                          "a flexure guide, the given modes replace all computed ones.")
     frequency: Q("Hz") = Field(gt=0, description="Resonance frequency [Hz].")
     damping_ratio: float = Field(0.01, ge=0, lt=1, description="Modal damping ratio [-]. "
                                                                "Default 0.01.")
@@ -426,22 +431,38 @@ class Ripple(StrictModel):
 
 
 class Robustness(StrictModel):
-    """Friction scatter under which the design must stay hunting-free (part of the verdict).
+    """The scatter under which the design must stay hunting-free (part of the verdict).
 
-    The design command draws 'samples' variants of the spec with static and
-    Coulomb friction scattered (and, optionally, a ripple along the rail with
-    a random phase per sample), simulates the stage as specified in each, and
-    compares the probability of hunting with 'hunting_probability'.
+    The design command draws 'samples' variants of the stage (friction, and
+    optionally the masses, the joint's stiffness and the loop delay), each a
+    draw of every scattered value together, simulates the stage as specified
+    after every move of its family, and compares the probability that some
+    move does not settle with 'hunting_probability'. Friction is drawn
+    jointly: Coulomb friction Fc and the gap Fs - Fc, each clipped at zero, so
+    static friction is never below Coulomb friction and no draw is dropped.
     """
 
-    static: Q("1") = Field(0.2, ge=0, lt=1, description="Scatter of static friction Fs, a "
-                                                        "fraction of its value [-]: the standard "
-                                                        "deviation of a normal draw, the "
-                                                        "half-width of a uniform one. Default "
-                                                        "20 %.")
     coulomb: Q("1") = Field(0.2, ge=0, lt=1, description="Scatter of Coulomb friction Fc, a "
-                                                         "fraction of its value [-]. Default "
-                                                         "20 %.")
+                                                         "fraction of its value [-]: the "
+                                                         "standard deviation of a normal draw, "
+                                                         "the half-width of a uniform one. "
+                                                         "Default 20 %.")
+    gap: Q("1") = Field(0.2, ge=0, lt=1, description="Scatter of the friction gap Fs - Fc, a "
+                                                     "fraction of its value [-]; static "
+                                                     "friction is Fc plus the drawn gap. "
+                                                     "Default 20 %.")
+    mass: Q("1") = Field(0.05, ge=0, lt=0.5, description="Scatter of the true stage and cart "
+                                                         "masses, each a fraction of its value "
+                                                         "[-]; the controller keeps its tuning. "
+                                                         "Default 5 %.")
+    stiffness: OptQ("1") = Field(None, ge=0, lt=0.5,
+                                     description="Scatter of the joint's drive stiffness, a "
+                                                 "fraction [-]. Default: the flexure's stock "
+                                                 "thickness tolerance (k goes with t^3), 5 % "
+                                                 "without a flexure section.")
+    delay: Q("1") = Field(0.2, ge=0, lt=1, description="Scatter of the loop delay "
+                                                       "(controller.delay), a fraction of its "
+                                                       "value [-]. Default 20 %.")
     distribution: Literal["normal", "uniform"] = Field(
         "normal", description="Distribution of the scatter: 'normal' (default) or 'uniform'.")
     ripple: Ripple | None = Field(None, description="Optional friction ripple along the rail "
@@ -481,6 +502,34 @@ class RecommendBounds(StrictModel):
         return self
 
 
+class Reserve(StrictModel):
+    """Reserves a recommended design keeps beyond the requirements (``fi-design recommend``).
+
+    The recommendation's loop meets the margins with these added, its
+    crossover stays at most 'crossover' times the achievable one, and it
+    passes (no move hunts, margins met) with the masses, the computed modes and
+    the delay off by these fractions and the drive stiffness at its stock
+    tolerance.
+    """
+
+    gain_margin: Q("dB") = Field(1.0, ge=0, description="Gain margin beyond "
+                                                        "requirements.gain_margin [dB]. "
+                                                        "Default 1 dB.")
+    phase_margin: Q("deg") = Field(5.0, ge=0, lt=90, description="Phase margin beyond "
+                                                                 "requirements.phase_margin "
+                                                                 "[deg]. Default 5 deg.")
+    crossover: float = Field(0.95, gt=0, le=1, description="The crossover at most this times "
+                                                          "the achievable one [-]. Default "
+                                                          "0.95.")
+    mass: float = Field(0.15, ge=0, lt=0.5, description="The design passes with the masses "
+                                                        "this fraction off, either way [-]. "
+                                                        "Default 15 %.")
+    modes: float = Field(0.10, ge=0, lt=0.5, description="... and with the computed modes this "
+                                                         "fraction lower [-]. Default 10 %.")
+    delay: float = Field(0.5, ge=0, description="... and with the loop delay this fraction "
+                                                "longer [-]. Default 50 %.")
+
+
 class Requirements(StrictModel):
     """Design requirements and metric settings."""
 
@@ -495,6 +544,14 @@ class Requirements(StrictModel):
     modulus_margin: float | None = Field(None, gt=0, le=1, description="Minimum modulus margin "
                                                                        "min|1 + L| [-]; null: "
                                                                        "not required.")
+    hunting_margin: float = Field(1.2, ge=1, description="The design crossover must lie at "
+                                                         "least this factor above the "
+                                                         "stage-level hunting-free crossover "
+                                                         "(the fold of the hunting cycle) [-]. "
+                                                         "Default 1.2.")
+    reserve: Reserve = Field(default_factory=lambda: Reserve(),
+                             description="Reserves a recommended design keeps beyond the "
+                                         "requirements.")
     buckling_factor: float = Field(3.0, ge=1, description="The flexure guide's buckling load "
                                                           "must be at least this times the "
                                                           "weight it carries [-]. Default 3.")

@@ -168,7 +168,8 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
                position_friction: PositionFriction | None = None, confidence: float = 0.95,
                executor: Executor | None = None, progress: ProgressCallback | None = None,
                cache: PointCache | str | os.PathLike | bool | None = None,
-               chunksize: int | None = None, measure: str = "stage") -> RobustnessResult:
+               chunksize: int | None = None, measure: str = "stage",
+               friction_gap: float | None = None) -> RobustnessResult:
     """Probability of hunting when spec values scatter around the design.
 
     Every sample draws each scattered value independently (normal: nominal
@@ -206,12 +207,18 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
         first that does, so the amplitude is that move's cycle, not the
         largest); ``"move"``: the paper's hunting metric on the spec's own
         move.
+    friction_gap : float, optional
+        Draw friction jointly: static friction is the sample's Coulomb
+        friction (its own draw, or the nominal) plus the nominal gap Fs - Fc
+        scattered by this fraction, the gap clipped at zero, so Fs never falls
+        below Fc and no sample is lost. ``friction.static`` must not scatter
+        on its own then; a drawn Coulomb friction is clipped at zero.
 
     Returns
     -------
     RobustnessResult
-        Samples the spec refuses (e.g. Fs drawn below Fc) are counted as
-        ``invalid`` and left out of the trials.
+        Samples the spec refuses (e.g. Fs drawn below Fc by independent
+        draws) are counted as ``invalid`` and left out of the trials.
 
     Raises
     ------
@@ -231,9 +238,12 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
     if not all(isinstance(s, Scatter) for s in items):
         raise ArgumentError("scatter must be a list of Scatter values; read text such as "
                             "'friction.static=10%' with parse_scatter")
-    if not items and position_friction is None:
+    if not items and position_friction is None and friction_gap is None:
         raise SpecError("nothing scatters: give at least one scatter (e.g. "
                         "'friction.static=10%') or position-dependent friction")
+    if friction_gap is not None and "friction.static" in [s.path for s in items]:
+        raise SpecError("scatters on its own and as Coulomb friction plus the gap; give one",
+                        path="friction.static")
     paths = [s.path for s in items]
     dupes = sorted({p for p in paths if paths.count(p) > 1})
     if dupes:
@@ -276,6 +286,21 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
         np.zeros(shape)
     phases = rng.uniform(-math.pi, math.pi, samples) if position_friction is not None else \
         np.zeros(0)
+    if friction_gap is not None:  # Fs = Fc + the gap, each drawn and clipped at zero
+        gap_unit = rng.standard_normal(samples) if distribution == "normal" else \
+            rng.uniform(-1.0, 1.0, samples)
+        f = base.friction
+        if "friction.coulomb" in paths:
+            i = paths.index("friction.coulomb")
+            draws[:, i] = np.maximum(draws[:, i], 0.0)
+            fc = draws[:, i]
+        else:
+            fc = np.full(samples, f.coulomb)
+        static = fc + (f.static - f.coulomb) * np.maximum(1.0 + friction_gap * gap_unit, 0.0)
+        items = items + (Scatter("friction.static", friction_gap, True,
+                                 meaning="the gap Fs - Fc"),)
+        paths = paths + ["friction.static"]
+        draws = np.column_stack([draws, static])
     plants = ([True] if spec.has_isolator else []) + [False]
     tasks: list = []
     sample_values = []
