@@ -475,34 +475,37 @@ def recommend_command(
     report_out: Optional[Path] = output_option("--report", "OUT.html|OUT.pdf",
         "Write the report of the search (HTML, or PDF for a .pdf name)."),
     write_spec: Optional[Path] = output_option("--write-spec", "OUT.yaml",
-        "Write the spec with the recommended stroke, stiffness (and crossover) in it, comments "
-        "kept; the design command on it passes."),
+        "Write the spec with the recommended guide, stroke (and crossover) in it, in its own "
+        "units, comments kept, a revision added; the design command on it passes."),
+    jobs: Jobs = 0,
+    executor: ExecutorKind = "local",
+    scheduler: Scheduler = None,
     force: Force = False,
 ) -> None:
-    """Search the isolator's stroke and stiffness (and the rule's crossover) for a design that passes.
+    """Search a buildable isolator (and the rule's crossover) for the stiffest design that passes.
 
-    Every point of a stroke x stiffness grid is judged by the sign-off's own
-    constraints: k_max, the flexure, the loop margins with the parasitic
-    modes, every move of the family, the hunting-free crossover, the end stop
-    and the friction scatter. Prints the design with the most margin, what
-    binds it and the design space; with none feasible, the nearest design,
-    what it violates and what would open the space.
+    Sizes leaf-spring guides from stock over strokes and stiffnesses, judges
+    every one after every move of its family at the loop's crossover with the
+    fold of its cycle, and signs off the stiffest joint that keeps
+    requirements.hunting_margin with the reserves of requirements.reserve.
+    Prints the design beside the spec's, its guide, what binds it and the
+    least change of the spec that passes; with none feasible, the nearest
+    design and what it violates.
     """
     outs = check_outputs((spec,), force, json=(json_out, (".json",)),
                          report=(report_out, (".html", ".pdf")),
                          spec=(write_spec, (".yaml", ".yml")))
     check_spec_path(spec)
+    pool = study_pool(executor, jobs, scheduler)
     spec_obj = load(spec)
 
     from .console import Status, make_console, print_recommendation
-    from .pools import confirmation_pool
     from .recommend import recommend, recommended_spec_text
 
     console, err = make_console(), make_console(stderr=True)
     # the pool's workers fork before the spinner's thread starts (fork and threads do not mix)
-    with confirmation_pool(True) as pool, \
-            Status(err, "searching the design space ...") as status:
-        result = recommend(spec_obj, executor=pool, progress=status)
+    with pool as ex, Status(err, "searching the design space ...") as status:
+        result = recommend(spec_obj, executor=ex, progress=status)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
     if outs["spec"] is not None and result.feasible:
         payloads["spec"] = recommended_spec_text(result)

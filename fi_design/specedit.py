@@ -24,7 +24,7 @@ from .errors import ArgumentError, SpecError
 from .spec import Spec
 from .specfile import load_spec, origin, parse_yaml, path_unit, yaml_loader
 
-__all__ = ["edited_spec_text", "spec_quantity", "REMOVE"]
+__all__ = ["edited_spec_text", "spec_quantity", "written_unit", "REMOVE"]
 
 
 class _Remove:
@@ -70,8 +70,39 @@ def spec_quantity(path: str, value: float, digits: int | None = None) -> Any:
     return f"{number} {unit}"
 
 
+def written_unit(spec: Spec, path: str) -> str | None:
+    """The unit the spec's file wrote at a path: ``"mm"`` for ``0.3 mm`` or ``[10 mm, 60 mm]``.
+
+    Parameters
+    ----------
+    spec : Spec
+        A spec read from a file or mapping.
+    path : str
+        Dotted path without list indices (``"isolator.flexure.length"``).
+
+    Returns
+    -------
+    str or None
+        None where the value is a bare number, absent, or the spec has no
+        written form.
+    """
+    org = origin(spec)
+    node: Any = None if org is None else org.raw
+    for part in path.split("."):
+        if not isinstance(node, Mapping) or part not in node:
+            return None
+        node = node[part]
+    if isinstance(node, (list, tuple)) and node:
+        node = node[0]
+    if not isinstance(node, str):
+        return None
+    m = re.match(r"\s*[-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?\s*(.+?)\s*$", node)
+    return m.group(1) if m else None
+
+
 def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
                      comments: Mapping[str, str] | None = None,
+                     replace_comments: bool = False,
                      header: str | Sequence[str] | None = None,
                      source: str = "<written spec>") -> str:
     """The spec's YAML with values replaced at dotted paths; comments and layout kept.
@@ -92,6 +123,9 @@ def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
     comments : mapping of str to str, optional
         Dotted path to an end-of-line comment for that key; a comment the key
         already had is kept after it.
+    replace_comments : bool, optional
+        The given comments replace the keys' own (which state the values
+        replaced) instead of going before them. Default False.
     header : str or sequence of str, optional
         Comment lines put at the top of the file (``#`` added where missing).
     source : str, optional
@@ -144,7 +178,7 @@ def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
     for path, note in (comments or {}).items():
         parent, key = _parent(document, path)
         if key in parent:
-            old = _eol_comment(parent, key)
+            old = "" if replace_comments else _eol_comment(parent, key)
             _set_comment(parent, key, note + (f"; {old}" if old else ""))
     buf = io.StringIO()
     yaml.dump(document, buf)

@@ -175,6 +175,41 @@ def _convert(text: str, unit: str, path: str | None) -> float:
                         f" got {q.dimensionality})", path=path) from None
 
 
+def from_si(value: float, unit: str, shown: str) -> float:
+    """An SI value in another unit of the same dimension (the unit a user wrote).
+
+    Parameters
+    ----------
+    value : float
+        The value in ``unit`` (SI, Hz, deg or dB as the spec's fields hold them).
+    unit : str
+        Its unit.
+    shown : str
+        The unit to express it in (``"mm"``, ``"N/mm"``).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    UnitError
+        ``shown`` is not a unit of that dimension.
+
+    Examples
+    --------
+    >>> from_si(0.0003, "m", "mm")
+    0.3
+    """
+    import pint
+
+    ureg = registry()
+    try:
+        return float(ureg.Quantity(value, unit).to(shown).magnitude)
+    except (pint.errors.PintError, ValueError, TypeError, AttributeError) as exc:
+        raise UnitError(f"cannot express {unit} in {shown!r} ({exc})") from None
+
+
 def _has_angle(q) -> bool:
     """True if the quantity's units contain an angle (radian, degree, revolution, ...)."""
     ureg = registry()

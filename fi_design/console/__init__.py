@@ -26,13 +26,13 @@ from .design import (CASE_CAPTION, CASE_COLUMNS, cases_table, checks_table, prin
                      print_verdict)
 from .identification import print_identification
 from .progress import FractionBar, ProgressBar, Status
-from .recommend import CANDIDATE_GLYPHS, print_recommendation
+from .recommend import print_recommendation
 from .reconciliation import print_reconcile
 from .studies import (MAX_MAP_COLUMNS, grid_caption, print_robustness, print_study, print_sweep,
                       sweep_grid_table, sweep_grid_tables)
 
 __all__ = [
-    "CANDIDATE_GLYPHS", "CASE_CAPTION", "CASE_COLUMNS", "FractionBar", "MAX_MAP_COLUMNS",
+    "CASE_CAPTION", "CASE_COLUMNS", "FractionBar", "MAX_MAP_COLUMNS",
     "MOVE_GLYPHS", "ProgressBar", "Status", "cases_table", "checks_table", "grid_caption",
     "heading", "make_console", "moves_strips", "print_design", "print_identification",
     "print_recommendation", "print_reconcile", "print_robustness", "print_simulation",

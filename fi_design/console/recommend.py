@@ -1,28 +1,31 @@
-"""The design search's summary: the design, what binds it, the design space as a map.
+"""The design search's summary: the design and its guide, the least change, what binds it.
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional
 
-from ..display import number, quantity, scale
+from ..display import number, percent, quantity
 from .common import heading, table
 
 if TYPE_CHECKING:  # pragma: no cover
     from rich.console import Console
 
 
-#: One character per design-space status in :func:`print_recommendation`'s map.
-CANDIDATE_GLYPHS = {"feasible": ("\u2713", "bold green"), "robustness": ("r", "yellow"),
-                    "end_stop": ("e", "yellow"), "checks": ("c", "yellow"),
-                    "hunts": ("\u25cf", "red"), "margins": ("m", "magenta"),
-                    "flexure": ("f", "magenta"), "k_max": ("k", "dim"), "bounds": ("b", "dim"),
-                    "not_evaluated": ("\u00b7", "green"), "failed": ("\u00d7", "bold red")}
+def _mm(x: float | None) -> str:
+    return "-" if x is None else quantity(x, "m", 3, shown=("mm", 1e3))
+
+
+def _margin(x: float | None) -> str:
+    if x is None:
+        return "-"
+    return "no cycle found" if math.isinf(x) else number(x, 3)
 
 
 def print_recommendation(console: "Console", result, spec_path: Optional[Path] = None) -> None:
-    """Print a design search: the design, what binds it, the design space as a map.
+    """Print a design search: the design beside the spec's, its guide, reserves, least change.
 
     Parameters
     ----------
@@ -33,58 +36,70 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
     spec_path : pathlib.Path, optional
         The spec file, named in the heading.
     """
-    from rich import box
-    from rich.table import Table
     from rich.text import Text
 
     heading(console, f"Recommendation for {result.spec.name}", spec_path)
     d, sd, m = result.design, result.spec_design, result.margins
-    head = "a design that passes" if result.feasible else "no design passes; the nearest"
+    req = result.spec.requirements
+    head = "the stiffest buildable joint that keeps the hunting margin" if result.feasible \
+        else "no design passes; the nearest"
     t = table(f"The search found {head}")
     t.add_column("")
     t.add_column(Text("as specified" + (" (suggested)" if sd.get("suggested") else "")),
                  justify="right")
     t.add_column(Text("recommended" if result.feasible else "nearest"), justify="right")
     t.add_row("Stroke", quantity(sd["stroke"], "m", 3), quantity(d.stroke, "m", 3))
-    t.add_row("Drive stiffness", f"{number(sd['stiffness'])} N/m", f"{number(d.stiffness)} N/m")
+    guide = "-" if d.length is None else \
+        f"{_mm(d.length)} x {_mm(d.width)} x {_mm(d.thickness)}"
+    fx = result.flexure
+    t.add_row("Leaves L x b x t", "", guide + ("" if fx is None or fx.guide is None else
+                                               f", {fx.leaves} {fx.guide.orientation}"))
+    t.add_row("Drive stiffness (net of gravity)", f"{number(sd['stiffness'])} N/m",
+              f"{number(d.stiffness)} N/m")
+    t.add_row("Lowest parasitic mode", "", "-" if d.lowest_mode is None
+              else f"{number(d.lowest_mode)} Hz")
+    if fx is not None and fx.mechanics is not None and \
+            fx.mechanics.gravity.buckling_factor is not None:
+        t.add_row("Buckling load / weight", "", number(fx.mechanics.gravity.buckling_factor, 3))
     t.add_row("Joint damping", "", "default ratio" if d.damping is None
               else f"{number(d.damping, 3)} N s/m")
     t.add_row("Crossover", f"{number(sd['crossover'])} Hz", f"{number(d.crossover)} Hz")
     t.add_row("No move hunts from", "", "-" if d.hunting_free_from is None
               else f"{number(d.hunting_free_from)} Hz")
-    t.add_row("Crossover factor", "", "-" if m.get("crossover_factor") is None
-              else number(m["crossover_factor"], 3))
+    t.add_row(f"Hunting margin (required {number(req.hunting_margin, 3)})", "",
+              _margin(m.get("hunting_margin")))
     t.add_row("k_max / k", "", number(m.get("stiffness_factor"), 3))
-    t.add_row("End-stop clearance at rest", "", quantity(m.get("end_stop_clearance"), "m", 3))
+    t.add_row("End-stop clearance at rest", "", "-" if m.get("end_stop_clearance") is None
+              else quantity(m["end_stop_clearance"], "m", 3))
     t.add_row("Not settling under scatter", "", "-" if d.unsettled_probability is None
-              else f"{number(100 * d.unsettled_probability, 3)} %")
+              else percent(d.unsettled_probability, 3))
     console.print(t)
+    if result.reserves:
+        bad = [r for r in result.reserves if not r["passed"]]
+        words = ", ".join(r["name"] for r in result.reserves)
+        console.print(Text("Reserves: ", style="bold").append(
+            f"passes with {words}" if not bad else
+            "; ".join(f"{r['name']}: {r['why']}" for r in bad)))
     if result.binding:
         console.print(Text("Binds it: ", style="bold").append("; ".join(result.binding)))
     for v in result.violates:
         console.print(Text("Violates: ", style="bold red").append(v))
-    # the design space at a glance: rows of stiffness (top: stiff), columns of stroke
-    grid = Table(box=box.SIMPLE_HEAD, pad_edge=False)
-    grid.add_column(Text("k [N/m]"), justify="right", no_wrap=True)
-    unit, f = scale("m", result.strokes)
-    for s in result.strokes:
-        grid.add_column(Text(number(s * f, 3)), justify="center", no_wrap=True)
-    nk = len(result.stiffnesses)
-    for j in reversed(range(nk)):
-        cells = []
-        for i in range(len(result.strokes)):
-            c = result.candidates[i * nk + j]
-            glyph, style = CANDIDATE_GLYPHS.get(c.status, ("?", ""))
-            if c is not None and c.stroke == d.stroke and c.stiffness == d.stiffness:
-                style += " reverse"
-            cells.append(Text(glyph, style=style))
-        grid.add_row(number(result.stiffnesses[j], 3), *cells)
-    console.print(Text(f"Design space at {number(d.crossover)} Hz: columns stroke [{unit}], "
-                       "rows drive stiffness", style="dim"))
-    console.print(grid)
-    console.print(Text("\u2713 passes, \u00b7 no move hunts, less margin (not signed off), "
-                       "\u25cf some move hunts, r scatter, e end stop, m margins, f flexure, k above "
-                       "k_max, b bounds; the chosen point reversed", style="dim"))
+    lc = result.least_change
+    if lc is not None:
+        if lc.feasible:
+            edits = ", ".join(f"{p} = {v}" for p, v in lc.changes.items())
+            console.print(Text("Least change that passes: ", style="bold").append(
+                f"{lc.text} ({edits})"))
+        else:
+            console.print(Text("Least change: ", style="bold").append(lc.text))
+    if result.pareto:
+        front = [p for p in result.pareto if p["hunting_margin"] is not None][:6]
+        if front:
+            console.print(Text("Trade-off (Pareto front, stiffest first): ", style="dim").append(
+                "; ".join(f"{number(p['stiffness'], 3)} N/m at {_mm(p['stroke'])} keeps "
+                          f"{number(p['hunting_margin'], 3)}" for p in front), style="dim"))
+    for a in result.assumptions:
+        console.print(Text("Assumed: ", style="dim").append(a, style="dim"))
     console.print(Text("Advice: ", style="bold").append(result.advice))
     console.print(f"{result.evaluations} stage-level evaluations in {result.wall_time:.1f} s",
                   markup=False, highlight=False)

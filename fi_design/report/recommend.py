@@ -13,20 +13,35 @@ from .meta import TITLES
 __all__ = ["recommend_context"]
 
 
+def _mm(x: float | None) -> str:
+    return "" if x is None else qty(x, "m")
+
+
 def _design_rows(result: RecommendResult) -> tuple[tuple[str, str, str], ...]:
     d, sd, m = result.design, result.spec_design, result.margins
+    req = result.spec.requirements
+    fx = result.flexure
+    hm = m.get("hunting_margin")
     rows = [("Stroke", qty(sd["stroke"], "m"), qty(d.stroke, "m")),
-            ("Drive stiffness", qty(sd["stiffness"], "N/m"), qty(d.stiffness, "N/m")),
-            ("Joint damping", "", "default ratio" if d.damping is None
-             else qty(d.damping, "N*s/m")),
-            ("Crossover", qty(sd["crossover"], "Hz"), qty(d.crossover, "Hz")),
-            ("No move hunts from", "", qty(d.hunting_free_from, "Hz")),
-            ("Crossover factor", "", num(m.get("crossover_factor"), 3)),
-            ("k_max / k", "", num(m.get("stiffness_factor"), 3)),
-            ("End-stop clearance at rest", "", qty(m.get("end_stop_clearance"), "m")),
-            ("Not settling under friction scatter", "",
-             "" if d.unsettled_probability is None
-             else qty(100 * d.unsettled_probability, "%"))]
+            ("Leaves L \u00d7 b \u00d7 t", "", "" if d.length is None else
+             f"{_mm(d.length)} \u00d7 {_mm(d.width)} \u00d7 {_mm(d.thickness)}"),
+            ("Drive stiffness (net of gravity)", qty(sd["stiffness"], "N/m"),
+             qty(d.stiffness, "N/m")),
+            ("Lowest parasitic mode", "", qty(d.lowest_mode, "Hz"))]
+    if fx is not None and fx.mechanics is not None and \
+            fx.mechanics.gravity.buckling_factor is not None:
+        rows.append(("Buckling load / weight", "", num(fx.mechanics.gravity.buckling_factor, 3)))
+    rows += [("Joint damping", "", "default ratio" if d.damping is None
+              else qty(d.damping, "N*s/m")),
+             ("Crossover", qty(sd["crossover"], "Hz"), qty(d.crossover, "Hz")),
+             ("No move hunts from", "", qty(d.hunting_free_from, "Hz")),
+             (f"Hunting margin (required {num(req.hunting_margin, 3)})", "",
+              "no cycle found" if hm is not None and hm == float("inf") else num(hm, 3)),
+             ("k_max / k", "", num(m.get("stiffness_factor"), 3)),
+             ("End-stop clearance at rest", "", qty(m.get("end_stop_clearance"), "m")),
+             ("Not settling under scatter", "",
+              "" if d.unsettled_probability is None
+              else qty(100 * d.unsettled_probability, "%"))]
     return tuple(rows)
 
 
@@ -61,15 +76,36 @@ def recommend_context(result: RecommendResult, *, date: Any = None, command: str
         paras.append("What binds it: " + "; ".join(result.binding) + ".")
     if result.violates:
         paras.append("What the nearest design violates: " + " ".join(result.violates))
+    paras += [f"Assumed: {a}." for a in result.assumptions]
+    tables = [table]
+    if result.reserves:
+        tables.append(Table(("Reserve corner", "Passes", "Why not"),
+                            tuple((r["name"], "yes" if r["passed"] else "no", r["why"])
+                                  for r in result.reserves),
+                            caption="The design with the reserve's deviations "
+                                    "(requirements.reserve)"))
+    lc = result.least_change
+    least_paras: list[str] = []
+    if lc is not None:
+        if lc.feasible:
+            least_paras.append(f"The least change of the spec that passes: {lc.text}.")
+            tables.append(Table(("Spec path", "New value"), tuple(lc.changes.items()),
+                                caption="The least change"))
+        else:
+            least_paras.append(f"Least change: {lc.text}.")
+        least_paras += [f"Tried first: {t}." for t in lc.tried]
     figs: tuple[FigureBlock, ...] = ()
     if figures:
         import matplotlib
 
         with matplotlib.rc_context(plots.REPORT_RC):
             fig = plots.recommend_figure(result)
-        figs = (figure_block(fig, "The design space: every point of the search, coloured by "
-                                  "what it fails first; dashed, k_max = Fs / stroke; the "
-                                  "spec's design a cross, the recommended one a star.",
+        figs = (figure_block(fig, "Left, the design space: every guide the search built or "
+                                  "judged, coloured by what it fails first; dashed, k_max = "
+                                  "Fs / stroke; the spec's design a cross, the recommended one "
+                                  "a star. Right, the trade-off: the hunting margin of every "
+                                  "judged guide against its net drive stiffness, the Pareto "
+                                  "front joined, the required margin dashed.",
                              name="design-space"),)
     counts: dict[str, int] = {}
     for c in result.candidates:
@@ -77,18 +113,19 @@ def recommend_context(result: RecommendResult, *, date: Any = None, command: str
     space = Table(("Status", "Points"), tuple((plots.CANDIDATE_LOOK.get(k, (None, k))[1], num(v))
                                               for k, v in counts.items()),
                   caption="Points of the design space")
-    method = (f"{len(result.strokes)} strokes from {qty(result.strokes[0], 'm')} to "
-              f"{qty(result.strokes[-1], 'm')} and {len(result.stiffnesses)} stiffnesses from "
-              f"{qty(result.stiffnesses[0], 'N/m')} to {qty(result.stiffnesses[-1], 'N/m')} "
-              "(log-spaced); each point is judged by the constraints of the sign-off, the cheap "
-              "ones first: k_max, the flexure, the loop margins at the highest crossover they "
-              "allow, then every move of the family at that crossover, then the hunting-free "
-              "crossover, and the full sign-off (friction scatter included) for the best points "
-              f"in the order of the objective until one passes. {result.evaluations} stage-level "
-              f"evaluations in {num(result.wall_time, 3)} s.")
-    sections = [Section("recommendation", head, paragraphs=tuple(paras), tables=(table,)),
-                Section("design-space", "The design space", paragraphs=(method,),
-                        tables=(space,), figures=figs)]
+    method = (f"Strokes from {qty(result.strokes[0], 'm')} to {qty(result.strokes[-1], 'm')} "
+              "(log-spaced, widened towards the envelope while the best design lay on the "
+              "range's edge), at each up to k_max = Fs / stroke; each point a guide sized from "
+              "stock (stress, buckling, every parasitic mode at the separation times the "
+              f"crossover), judged at {qty(result.crossover, 'Hz')} ({result.crossover_limit}) "
+              "after every move of its family with the fold of its cycle; the stiffest that "
+              "keeps the hunting margin refined, then signed off with its reserves, stiffest "
+              f"first. {result.evaluations} stage-level evaluations in "
+              f"{num(result.wall_time, 3)} s.")
+    sections = [Section("recommendation", head, paragraphs=tuple(paras + least_paras),
+                        tables=tuple(tables)),
+                Section("design-space", "The design space and the trade-off",
+                        paragraphs=(method,), tables=(space,), figures=figs)]
     return document_context(TITLES["recommend"], result.spec, sections, date=date,
                             command=command, kind="recommend", conclusion=result.advice,
                             source=result.fi_design_source)

@@ -1,9 +1,10 @@
 """The result of the design search (:func:`fi_design.recommend.recommend`).
 
-A recommendation is a design the tool itself would sign off: the isolator's
-stroke and drive stiffness and, for a spec tuned by the rule, the controller
-crossover, found by a search over the design space (:class:`DesignCandidate`
-per point), with what binds it and the design space as a map.
+A recommendation is a design the tool itself would sign off, found by search:
+a leaf-spring guide drawn from stock with its stroke and, for a spec tuned by
+the rule, the loop's crossover; the stiffest joint that keeps the hunting
+margin, with its reserves. Beside it, the least change of the spec that
+passes. Every point the search judged is a :class:`DesignCandidate`.
 """
 
 from __future__ import annotations
@@ -17,17 +18,17 @@ from . import Result, to_jsonable
 if TYPE_CHECKING:  # pragma: no cover
     from ..spec import Spec
 
-__all__ = ["CANDIDATE_STATUSES", "DesignCandidate", "RecommendResult"]
+__all__ = ["CANDIDATE_STATUSES", "DesignCandidate", "LeastChange", "RecommendResult"]
 
-#: Status of a point of the design space, from best to worst: meets every constraint;
-#: hunts under friction scatter more often than the limit; the cart rests on its end stop
-#: (or pushes with more than Fs) after the spec's motion; another check of the sign-off
-#: fails; some move ends in a hunting cycle at the crossover; a limit case misses its
-#: margins; the flexure cannot be built (stress, leaf or support frequency, thickness
-#: range); the stiffness exceeds k_max; outside the bounds of requirements.recommend; no
-#: move hunts, but not signed off (less margin than a feasible one); the simulation failed.
-CANDIDATE_STATUSES = ("feasible", "robustness", "end_stop", "checks", "hunts", "margins",
-                      "flexure", "k_max", "bounds", "not_evaluated", "failed")
+#: Status of a point of the design space, from best to worst: meets every constraint; fails
+#: the robustness of the sign-off; fails a reserve corner (masses, stiffness, modes, delay);
+#: the cart rests on its end stop or another check of the sign-off fails; no move hunts but
+#: the crossover lies within the hunting margin of the fold; some move hunts at the crossover;
+#: a limit case misses its margins with the reserve; no guide can be built (stress, buckling,
+#: modes, stock); the stiffness exceeds k_max; outside requirements.recommend; judged but not
+#: signed off (a stiffer one passed first); the simulation failed.
+CANDIDATE_STATUSES = ("feasible", "robustness", "reserve", "checks", "margin", "hunts",
+                      "margins", "flexure", "k_max", "bounds", "not_evaluated", "failed")
 
 
 @dataclass(frozen=True)
@@ -39,8 +40,8 @@ class DesignCandidate(Result):
     stroke : float
         Isolator stroke, one-sided [m].
     stiffness : float
-        Drive stiffness [N/m] (as built: the stock thickness of a sized
-        flexure rounds it).
+        Net drive stiffness of its guide, gravity included [N/m] (the target
+        where no guide could be built).
     damping : float or None
         Joint damping [N s/m]; None: the default ratio of the joint mode.
     crossover : float
@@ -49,14 +50,18 @@ class DesignCandidate(Result):
         One of :data:`CANDIDATE_STATUSES`.
     violations : tuple of str
         What it violates, in words (empty when feasible).
+    length, width, thickness : float or None
+        Its guide's leaf dimensions [m]; None where none could be built.
+    lowest_mode : float or None
+        Its guide's lowest parasitic mode [Hz].
     hunting_free_from : float or None
         Stage-level hunting-free crossover of this isolator [Hz] (the fold
-        of its cycle); None when not computed or not found in the search.
-    crossover_factor : float or None
-        crossover / hunting_free_from [-]: the objective's first figure.
+        of its cycle); None when not computed, or when no cycle was found.
+    hunting_margin : float or None
+        crossover / hunting_free_from [-] (0: some move hunts at the
+        crossover; inf: no cycle at any crossover searched).
     unsettled_probability : float or None
-        Probability that a friction-scatter sample does not settle [-]; None
-        when not computed.
+        Probability that a scatter sample does not settle [-].
     end_stop_clearance : float or None
         Stroke minus the joint deflection at rest after the spec's motion [m].
     """
@@ -67,10 +72,45 @@ class DesignCandidate(Result):
     crossover: float
     status: str
     violations: tuple[str, ...] = ()
+    length: float | None = None
+    width: float | None = None
+    thickness: float | None = None
+    lowest_mode: float | None = None
     hunting_free_from: float | None = None
-    crossover_factor: float | None = None
+    hunting_margin: float | None = None
     unsettled_probability: float | None = None
     end_stop_clearance: float | None = None
+
+    @property
+    def crossover_factor(self) -> float | None:
+        """The same as :attr:`hunting_margin` (the crossover over the hunting-free one)."""
+        return self.hunting_margin
+
+
+@dataclass(frozen=True)
+class LeastChange(Result):
+    """The smallest edit of the spec that passes the sign-off.
+
+    Attributes
+    ----------
+    changes : dict
+        Dotted spec path to the new value, with its unit (as the spec file
+        takes it), one or two of them.
+    feasible : bool
+        Whether an edit of at most two values passes.
+    binding : tuple of str
+        What the edit runs into, in words.
+    text : str
+        The edit in one sentence.
+    tried : tuple of str
+        The edits tried, in order, with why each failed.
+    """
+
+    changes: dict
+    feasible: bool
+    binding: tuple[str, ...] = ()
+    text: str = ""
+    tried: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -86,29 +126,47 @@ class RecommendResult(Result):
     design : DesignCandidate
         The recommended design, or the nearest one.
     binding : tuple of str
-        What stops the design from more margin: the constraints of its
-        neighbours in the design space, and the crossover's own limit.
+        What stops a stiffer joint: each constraint physical (k_max at the
+        stroke, the hunting margin, the guide's stress, buckling or modes, the
+        envelope of strokes), never the end of a searched range.
     violates : tuple of str
         With none feasible: what the nearest design violates.
     advice : str
-        One sentence a person acts on (what binds, or what would open the
-        space when nothing is feasible).
+        One sentence a person acts on.
+    flexure : FlexureResult or None
+        The recommended guide as a mechanism (sized at full resolution).
+    least_change : LeastChange or None
+        The smallest edit of the spec that passes.
     stage_hunting : StageHunting or None
         The design's stage-level hunting answer at its crossover.
     robustness : RobustnessCheck or None
-        The design's robustness under the spec's friction scatter.
+        The design's robustness under the spec's scatter.
+    reserves : tuple of dict
+        The reserve corners of the design (``name``, ``passed``, ``why``).
+    forces : dict or None
+        The design's forces over its move family (end-stop impacts, the
+        actuator's peak), from its sign-off.
     margins : dict
-        ``crossover_factor`` (crossover / hunting-free crossover),
-        ``stiffness_factor`` (k_max / k), ``end_stop_clearance`` [m].
+        ``hunting_margin`` (crossover / hunting-free crossover),
+        ``stiffness_factor`` (k_max / k), ``end_stop_clearance`` [m],
+        ``achievable_factor`` (the achievable crossover over the design's).
+    pareto : tuple of dict
+        The trade-off: the judged designs no other beats on both joint
+        stiffness and hunting margin (``stroke`` m, ``stiffness`` N/m,
+        ``hunting_margin``, ``lowest_mode`` Hz), stiffest first.
     strokes : tuple of float
-        The stroke axis of the design-space map [m].
+        The strokes searched [m], ascending.
     stiffnesses : tuple of float
-        The stiffness axis of the map [N/m] (nominal, before stock rounding).
+        Every target stiffness searched [N/m], ascending.
     candidates : tuple of DesignCandidate
-        Every point of the map, strokes outer, stiffnesses inner.
+        Every point judged.
     spec_design : dict
         The spec's own ``stroke`` [m], ``stiffness`` [N/m] and ``crossover``
         [Hz] (the suggested isolator for a spec without one).
+    crossover_limit : str
+        Why the crossover is what it is.
+    assumptions : tuple of str
+        What the search assumed (an isolator or guide the spec does not give).
     rule : bool
         Whether the crossover was searched (a spec tuned by the rule) or
         kept (explicit gains).
@@ -126,13 +184,20 @@ class RecommendResult(Result):
     binding: tuple[str, ...]
     violates: tuple[str, ...]
     advice: str
+    flexure: Any
+    least_change: LeastChange | None
     stage_hunting: Any
     robustness: Any
+    reserves: tuple[dict, ...]
+    forces: dict | None
     margins: dict
+    pareto: tuple[dict, ...]
     strokes: tuple[float, ...]
     stiffnesses: tuple[float, ...]
     candidates: tuple[DesignCandidate, ...]
     spec_design: dict
+    crossover_limit: str
+    assumptions: tuple[str, ...]
     rule: bool
     evaluations: int
     wall_time: float
@@ -150,16 +215,23 @@ class RecommendResult(Result):
         return self.design.crossover
 
     def to_dict(self) -> dict:
-        """The contract: ``feasible``, ``isolator``, ``crossover``, ``binding``,
-        ``stage_hunting``, ``robustness``, ``margins``; the nearest design's
-        ``violates``, the ``advice`` and the map's ``candidates``."""
+        """The contract: ``feasible``, ``isolator``, ``crossover``, ``flexure``, ``binding``,
+        ``least_change``, ``stage_hunting``, ``robustness``, ``reserves``, ``forces``,
+        ``margins``, ``pareto``; the nearest design's ``violates``, the ``advice`` and every
+        judged ``candidate``."""
         return {
             "feasible": self.feasible, "isolator": to_jsonable(self.isolator),
-            "crossover": self.crossover, "binding": list(self.binding),
-            "violates": list(self.violates), "advice": self.advice,
+            "crossover": self.crossover,
+            "flexure": None if self.flexure is None else self.flexure.to_dict(),
+            "binding": list(self.binding), "violates": list(self.violates),
+            "advice": self.advice,
+            "least_change": None if self.least_change is None else self.least_change.to_dict(),
             "stage_hunting": to_jsonable(self.stage_hunting),
-            "robustness": to_jsonable(self.robustness), "margins": to_jsonable(self.margins),
+            "robustness": to_jsonable(self.robustness),
+            "reserves": to_jsonable(self.reserves), "forces": to_jsonable(self.forces),
+            "margins": to_jsonable(self.margins), "pareto": to_jsonable(self.pareto),
             "design": self.design.to_dict(), "spec_design": to_jsonable(self.spec_design),
+            "crossover_limit": self.crossover_limit, "assumptions": list(self.assumptions),
             "rule": self.rule,
             "map": {"strokes": list(self.strokes), "stiffnesses": list(self.stiffnesses),
                     "candidates": [c.to_dict() for c in self.candidates]},

@@ -1,0 +1,251 @@
+"""What a recommended design must meet: a buildable guide, the loop's reserves, the stage's answer.
+
+Each function judges one thing and says why in words:
+
+- :func:`crossover_cap` -- how high the loop may be tuned: the reserve's
+  fraction of the achievable crossover of the spec's own loop (its drive,
+  sampling, delay and the stage structure's measured modes) with the margins
+  plus their reserve; never raised where the linear model sets no limit;
+- :func:`guide_for` -- a guide from stock for a net drive stiffness and
+  stroke (stress, buckling, every parasitic mode at the separation times the
+  crossover);
+- :func:`loop_meets` -- the candidate's four limit cases, its own modes in,
+  meet the margins plus their reserve at the crossover;
+- :func:`stage_answer` -- the stage after every move of its family at the
+  crossover, with the fold of its cycle (a task for the executor);
+- :func:`reserve_corners` -- the candidate still passes (margins met, no move
+  hunting) with the masses, the stiffness, the computed modes and the delay
+  off by the reserve's fractions.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .. import spec as _spec
+from ..specfile import with_values
+
+__all__ = ["SEARCH_POINTS", "reserve_spec", "crossover_cap", "guide_for", "loop_meets",
+           "stage_answer", "reserve_corners"]
+
+#: Lengths of the guide's sizing grid during the search (the chosen design is sized again at
+#: full resolution).
+SEARCH_POINTS = 41
+
+
+def reserve_spec(spec: _spec.Spec) -> _spec.Spec:
+    """The spec with its margin requirements raised by ``requirements.reserve``."""
+    req = spec.requirements
+    r = req.reserve
+    return with_values(spec, {"requirements.phase_margin": req.phase_margin + r.phase_margin,
+                              "requirements.gain_margin": req.gain_margin + r.gain_margin})
+
+
+def crossover_cap(base: _spec.Spec, rule: bool) -> tuple[float, str]:
+    """The crossover the recommendation tunes to [Hz], and why.
+
+    The loop's limit is the hardware's: the spec's drive (sampling, delay),
+    its stage and its measured modes, without the flexure guide the search
+    replaces (each candidate's own guide must then keep its modes at the
+    separation times this crossover). Where that loop sets no limit below the
+    search cap, the desired crossover is kept.
+
+    Parameters
+    ----------
+    base : Spec
+        The spec as written (its own isolator, or none).
+    rule : bool
+        Whether the spec tunes by the rule (with explicit gains the crossover
+        stays the gains').
+
+    Returns
+    -------
+    (float, str)
+    """
+    from .. import linear
+    from ..model import resolve
+
+    fc = _spec.design_crossover(base)
+    if not rule:
+        return fc, "the hardware's gains: the crossover stays theirs"
+    bounds = base.requirements.recommend.crossover
+    reserve = base.requirements.reserve.crossover
+    loop = base
+    if base.isolator is not None and base.isolator.flexure is not None:
+        loop = with_values(base, {"isolator.flexure": None})
+    ach = linear.achievable_crossover(resolve(reserve_spec(loop)))
+    if ach.frequency is None:
+        return fc, (f"no crossover meets the margins with their reserve ({ach.limited_by}): "
+                    "the desired one is kept")
+    if ach.kind == "scan_limit":
+        cap, why = fc, (f"kept at the desired {fc:.4g} Hz: the linear model sets no limit "
+                        "below its search cap (give the hardware's sampling, delay and "
+                        "measured modes to let the search raise it)")
+    else:
+        cap = reserve * ach.frequency
+        why = (f"{reserve:g} x the achievable {ach.frequency:.4g} Hz with the margins' reserve, "
+               f"which is limited by {ach.limited_by}")
+    if bounds is not None:
+        if cap > bounds[1]:
+            cap, why = bounds[1], "the upper bound of requirements.recommend.crossover"
+        elif cap < bounds[0]:
+            why += f"; below requirements.recommend.crossover ({bounds[0]:.4g} Hz)"
+    return float(cap), why
+
+
+def guide_for(base: _spec.Spec, stiffness: float, stroke: float, crossover: float, *,
+              points: int = SEARCH_POINTS) -> Any:
+    """A leaf-spring guide from stock for a net drive stiffness and stroke.
+
+    Returns
+    -------
+    fi_design.results.steps.FlexureResult
+        Sized within the base's flexure bounds: k_max, the stress, the
+        buckling factor and every parasitic mode at the separation times the
+        crossover.
+    """
+    from ..mechanism.geometry import stage_body
+    from ..mechanism.sizing import size_guide
+
+    req = base.requirements
+    return size_guide(base.isolator.flexure, stage_body(base.stage), target_stiffness=stiffness,
+                      maximum_stiffness=_spec.stiffness_limit(base, stroke), stroke=stroke,
+                      required_frequency=req.parasitic_separation * crossover,
+                      required_buckling=req.buckling_factor, cart_mass=base.cart.mass,
+                      points=points)
+
+
+def loop_meets(spec: _spec.Spec) -> tuple[bool, str]:
+    """Whether the spec's four limit cases meet the margins plus their reserve, and why not.
+
+    The spec's own modes (a candidate: its guide's computed ones and the
+    structure's measured ones) are in the loop; every mode lies at the
+    separation times the crossover.
+    """
+    from .. import linear
+    from ..model import resolve
+
+    model = resolve(reserve_spec(spec))
+    res = linear.analyse(model)
+    bad = [c for c in res.cases if not c.passed]
+    if bad:
+        c = bad[0]
+        return False, (f"case {linear.CASE_NUMBERS[c.name]} ({c.description}) misses its "
+                       f"{', '.join(c.failed)} with the reserve")
+    sep = model.requirements.parasitic_separation
+    low = [m for m in model.modes if m.frequency < sep * model.crossover]
+    if low:
+        m = min(low, key=lambda x: x.frequency)
+        return False, (f"the mode '{m.name}' at {m.frequency:.4g} Hz lies below {sep:g} x the "
+                       f"{model.crossover:.4g} Hz crossover")
+    return True, ""
+
+
+def stage_answer(spec: _spec.Spec, crossover: float | None = None,
+                 fold: str = "unless hunting") -> dict:
+    """The stage after every move of its family, and the fold of its cycle (plain data).
+
+    A task for the executor: the isolated plant of ``spec`` (at
+    ``crossover`` when given), every move run (stopping at the first that
+    hunts), the hunting-free crossover found by the fold of the cycle: with
+    ``fold="unless hunting"`` only where no move hunts (a hunting point has no
+    margin to measure), with ``"always"`` also above a hunting crossover.
+
+    Returns
+    -------
+    dict
+        ``hunts`` (bool), ``acceptable`` (bool), ``outcome`` (str), ``free_from``
+        (Hz or None: no fold found), ``amplitude`` (m or None), ``period`` (s
+        or None), ``tests`` (stage evaluations the fold took).
+    """
+    from ..stage import stage_hunting
+
+    quick = stage_hunting(spec, True, crossover=crossover, first_only=True, boundary=False,
+                          trace=False)
+    if fold != "always" and (quick.hunts or not quick.acceptable):  # no margin to measure
+        st = quick
+    else:
+        st = stage_hunting(spec, True, crossover=crossover, first_only=True, trace=False)
+    c = st.cycle
+    return {"hunts": st.hunts, "acceptable": st.acceptable, "outcome": st.outcome,
+            "free_from": st.hunting_free_from, "amplitude": None if c is None else c.amplitude,
+            "period": None if c is None else c.period,
+            "tests": int((st.boundary or {}).get("tests", 0))}
+
+
+def _settles(model: Any) -> bool:
+    from ..stage import stage_hunting
+
+    return stage_hunting(model, True, first_only=True, boundary=False, trace=False).acceptable
+
+
+def reserve_corners(spec: _spec.Spec) -> tuple[dict, ...]:
+    """The candidate with the reserve's deviations: does it still pass?
+
+    Each corner: the masses ``+-reserve.mass`` (the controller keeps its
+    tuning, the guide as built carries the stage), the drive stiffness at the
+    stock's thickness tolerance, the computed modes ``-reserve.modes``, the
+    loop delay ``+reserve.delay`` (of the delay and half the sample period;
+    none without either). A corner passes when the four limit cases meet the
+    margins (the requirements, not the reserve) and no move of the family
+    hunts.
+
+    Returns
+    -------
+    tuple of dict
+        ``name``, ``passed`` (bool), ``why`` (str, empty when passed).
+    """
+    from .. import linear
+    from ..model import resolve
+
+    model = resolve(spec)
+    r = model.requirements.reserve
+    m1, m2 = model.m1, model.m2
+    corners = [(f"masses +{100 * r.mass:.3g} %", model.at(masses=(m1 * (1 + r.mass),
+                                                                 m2 * (1 + r.mass)))),
+               (f"masses -{100 * r.mass:.3g} %", model.at(masses=(m1 * (1 - r.mass),
+                                                                 m2 * (1 - r.mass))))]
+    fx = model.flexure
+    if fx is not None and fx.stiffness_range is not None:
+        lo, hi = fx.stiffness_range
+        t = quantity_mm(fx.thickness_tolerance)
+        corners += [(f"leaves {t} thinner", model.at(stiffness=lo)),
+                     (f"leaves {t} thicker", model.at(stiffness=hi))]
+    if any(m.source == "computed" for m in model.modes):
+        corners.append((f"computed modes -{100 * r.modes:.3g} %",
+                        model.at(mode_scale=1.0 - r.modes)))
+    if model.law.delay > 0.0 or model.law.sample_period > 0.0:
+        corners.append((f"delay +{100 * r.delay:.3g} %",
+                        model.at(delay=(model.law.delay + 0.5 * model.law.sample_period)
+                                 * (1 + r.delay) - 0.5 * model.law.sample_period)))
+    out = []
+    for name, m in corners:
+        res = linear.analyse(m)
+        bad = [c for c in res.cases if not c.passed]
+        if bad:
+            out.append({"name": name, "passed": False,
+                        "why": f"case {linear.CASE_NUMBERS[bad[0].name]} misses its "
+                               f"{', '.join(bad[0].failed)}"})
+        elif not _settles(m):
+            out.append({"name": name, "passed": False, "why": "some move hunts"})
+        else:
+            out.append({"name": name, "passed": True, "why": ""})
+    return tuple(out)
+
+
+def quantity_mm(x: float) -> str:
+    """A length in mm for a sentence."""
+    from ..display import quantity
+
+    return quantity(x, "m", 3, shown=("mm", 1e3))
+
+
+def hunting_margin(crossover: float, free_from: float | None, hunts: bool) -> float:
+    """The crossover over the hunting-free crossover [-]: 0 when it hunts at the crossover, inf
+    when no cycle was found at any crossover."""
+    if hunts:
+        return 0.0
+    if free_from is None:
+        return math.inf
+    return crossover / free_from

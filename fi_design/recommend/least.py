@@ -1,0 +1,156 @@
+"""The least change of the spec that passes: one or two of its own values.
+
+Beside the best design (a new guide, stroke and crossover) a user asks what
+the smallest edit of the spec is that the sign-off passes. Tried in order,
+each with the design command's own verdict, until one passes:
+
+1. the crossover alone (a spec tuned by the rule): the hunting margin above
+   the fold of the spec's own isolator, if the loop's cap allows it;
+2. the drive stiffness alone, at the spec's stroke and crossover: the
+   stiffest that keeps the hunting margin (bisection);
+3. the stroke and the stiffness, at the spec's crossover: a longer stroke
+   (two and four times the spec's), each with its stiffest stiffness.
+
+The spec's other values stay as written (its flexure section sizes the
+guide for the new stiffness, its measured modes stay).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+from .. import spec as _spec
+from ..display import quantity
+from ..results.recommend import LeastChange
+from ..specfile import with_values
+from . import constraints as _c
+
+__all__ = ["least_change", "BISECTION_STEPS", "STROKE_FACTORS"]
+
+#: Bisection steps of the stiffness.
+BISECTION_STEPS = 4
+#: Strokes tried for the stroke-and-stiffness change, as factors on the spec's [-].
+STROKE_FACTORS = (2.0, 4.0)
+
+
+def _margin_ok(spec: _spec.Spec, margin: float) -> tuple[bool, dict]:
+    ans = _c.stage_answer(spec)
+    fc = _spec.design_crossover(spec)
+    m = _c.hunting_margin(fc, ans["free_from"], ans["hunts"])
+    return (not ans["hunts"] and ans["acceptable"] and m >= margin), ans
+
+
+def _stiffest(spec: _spec.Spec, stroke: float, margin: float) -> tuple[float | None, int]:
+    """The stiffest drive stiffness at a stroke that keeps the margin (bisection on log k)."""
+    kmax = _spec.stiffness_limit(spec, stroke)
+    lo, hi = math.log(kmax / 40.0), math.log(kmax)
+    at = lambda k: with_values(spec, {"isolator.stroke": stroke, "isolator.stiffness": k})
+    n = 1
+    if _margin_ok(at(kmax), margin)[0]:
+        return kmax, n
+    n += 1
+    if not _margin_ok(at(math.exp(lo)), margin)[0]:
+        return None, n
+    for _ in range(BISECTION_STEPS):
+        mid = 0.5 * (lo + hi)
+        n += 1
+        if _margin_ok(at(math.exp(mid)), margin)[0]:
+            lo = mid
+        else:
+            hi = mid
+    return math.exp(lo), n
+
+
+def _passes(spec: _spec.Spec, executor: Any) -> tuple[bool, str]:
+    from ..guideline import design
+
+    r = design(spec, executor=executor)
+    if r.verdict.status == "FAIL":
+        fails = [x.text for x in r.verdict.reasons if x.severity == "FAIL"]
+        return False, fails[0] if fails else "the sign-off fails"
+    return True, ""
+
+
+def least_change(search: Any, *, executor: Any = None,
+                 progress: Callable[[str], None] | None = None) -> LeastChange | None:
+    """The smallest edit of the spec that passes the sign-off.
+
+    Parameters
+    ----------
+    search : fi_design.recommend.search._Search
+        The search (its base spec, crossover cap and margin).
+    executor : concurrent.futures-style executor, optional
+        Runs the sign-off's simulations.
+    progress : callable, optional
+        ``progress(text)``.
+
+    Returns
+    -------
+    LeastChange or None
+        None for a spec without isolator (any change adds one: the best
+        design is the answer).
+    """
+    say = progress or (lambda text: None)
+    spec = search.spec
+    if spec.isolator is None:
+        return None
+    margin = search.margin
+    tried: list[str] = []
+    fc0 = _spec.design_crossover(spec)
+    s0 = spec.isolator.stroke
+
+    def done(changes: dict, text: str, binding: tuple[str, ...]) -> LeastChange:
+        from .write import written
+
+        shown = {p: written(spec, p, v) for p, v in changes.items()}
+        return LeastChange(changes=shown, feasible=True, binding=binding, text=text,
+                           tried=tuple(tried))
+
+    # 1. the crossover alone
+    if search.rule:
+        say("the least change: the crossover alone ...")
+        ans = _c.stage_answer(spec, fold="always")
+        fold = ans["free_from"]
+        if fold is not None:
+            fc = 1.01 * margin * fold
+            if fc <= search.fc:
+                cand = with_values(spec, {"controller.crossover": fc})
+                ok, why = _passes(cand, executor)
+                if ok:
+                    return done({"controller.crossover": fc},
+                                f"tune the loop to {fc:.4g} Hz ({margin:g} x the hunting-free "
+                                f"{fold:.4g} Hz)", (f"the crossover's cap {search.fc:.4g} Hz",))
+                tried.append(f"the crossover alone, {fc:.4g} Hz: {why}")
+            else:
+                tried.append(f"the crossover alone: {margin:g} x the hunting-free {fold:.4g} Hz "
+                             f"is {margin * fold:.4g} Hz, above the loop's cap of "
+                             f"{search.fc:.4g} Hz ({search.fc_why})")
+        else:
+            tried.append("the crossover alone: the spec's isolator hunts up to the top of the "
+                         "crossover search")
+    # 2. the stiffness alone, 3. the stroke and the stiffness, at the spec's crossover
+    options = [(s0, "the stiffness alone")] + [
+        (s0 * f, "the stroke and the stiffness") for f in STROKE_FACTORS
+        if s0 * f <= search.envelope[1]]
+    for stroke, what in options:
+        say(f"the least change: {what} ({quantity(stroke, 'm')}) ...")
+        k, n = _stiffest(spec, stroke, margin)
+        search.evaluations += n
+        if k is None:
+            tried.append(f"{what} at {quantity(stroke, 'm')}: no stiffness keeps the hunting "
+                         f"margin at {fc0:.4g} Hz")
+            continue
+        values = {"isolator.stiffness": k} if stroke == s0 else \
+            {"isolator.stroke": stroke, "isolator.stiffness": k}
+        cand = with_values(spec, values)
+        ok, why = _passes(cand, executor)
+        if ok:
+            words = (f"a drive stiffness of {k:.4g} N/m" if stroke == s0 else
+                     f"a {quantity(stroke, 'm')} stroke at {k:.4g} N/m")
+            return done(values, words + f", the loop at {fc0:.4g} Hz",
+                        (f"the hunting margin {margin:g} at {fc0:.4g} Hz",))
+        tried.append(f"{what} at {quantity(stroke, 'm')}, {k:.4g} N/m: {why}")
+    return LeastChange(changes={}, feasible=False, binding=(), text="no edit of one or two "
+                       "values passes: build the recommended design", tried=tuple(tried))

@@ -1,0 +1,140 @@
+"""What makes one design better than another, what binds the best one, and the trade-off.
+
+The objective (DESIGN.md's revision of the recommendation): the stiffest
+joint that keeps the hunting margin. "Lower is better" holds for hunting
+only; the guide's support stiffness, its modes, gravity and handling all want
+the joint stiff. Among designs the margin admits, the stiffer one wins, then
+the one with more margin (:func:`order`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from ..display import quantity
+
+__all__ = ["order", "nearest", "pareto", "binding", "advice", "STATUS_WORDS"]
+
+#: The statuses in words, for what binds.
+STATUS_WORDS = {
+    "robustness": "the robustness under scatter", "reserve": "a reserve corner",
+    "checks": "a check of the sign-off", "margin": "the hunting margin",
+    "hunts": "hunting at the crossover", "margins": "the loop's margins with their reserve",
+    "flexure": "building the guide", "k_max": "k_max = Fs / stroke",
+    "bounds": "the bounds of requirements.recommend",
+}
+
+#: How far each status is from feasible (the nearest design has the smallest).
+_DISTANCE = {"feasible": 0, "robustness": 1, "reserve": 1, "checks": 2, "margin": 2,
+             "margins": 3, "hunts": 3, "flexure": 4, "k_max": 5, "bounds": 6,
+             "not_evaluated": 7, "failed": 8, None: 7}
+
+
+def order(p: Any) -> tuple:
+    """The objective as a sort key, larger is better: stiffness, then hunting margin."""
+    m = p.margin if p.margin is not None else 0.0
+    return (round(math.log(p.stiffness), 3), min(m, 1e9))
+
+
+def nearest(points: list) -> Any:
+    """With none feasible: the point closest to feasible, then the stiffest."""
+    return min(points, key=lambda p: (_DISTANCE.get(p.status, 7), -(p.margin or 0.0) if
+                                      p.margin is not None and p.margin < 1e9 else 0.0,
+                                      -p.stiffness))
+
+
+def pareto(points: list) -> tuple[dict, ...]:
+    """The judged designs no other beats on both joint stiffness and hunting margin.
+
+    Returns
+    -------
+    tuple of dict
+        ``stroke`` [m], ``stiffness`` [N/m], ``hunting_margin`` [-] (None:
+        no cycle at any crossover), ``lowest_mode`` [Hz], ``status``;
+        stiffest first.
+    """
+    judged = [p for p in points if p.candidate is not None and p.margin]  # hunting: no design
+    front = []
+    for p in judged:
+        mp = min(p.margin, 1e9)
+        if not any(q is not p and q.stiffness >= p.stiffness and min(q.margin, 1e9) >= mp
+                   and (q.stiffness > p.stiffness or min(q.margin, 1e9) > mp) for q in judged):
+            front.append(p)
+    front.sort(key=lambda p: -p.stiffness)
+    return tuple({"stroke": p.stroke, "stiffness": p.stiffness,
+                  "hunting_margin": None if math.isinf(p.margin) else p.margin,
+                  "lowest_mode": p.lowest_mode, "status": p.status} for p in front)
+
+
+def _why(p: Any) -> str:
+    word = STATUS_WORDS.get(p.status, p.status)
+    return word + (f" ({p.violations[0]})" if p.violations else "")
+
+
+def binding(search: Any, chosen: Any) -> tuple[str, ...]:
+    """What stops a stiffer joint than the chosen one, each a physical limit.
+
+    At the chosen stroke: the next stiffer point judged (the hunting margin,
+    the guide, k_max); across strokes: why the stiffest design of each
+    neighbouring stroke is softer; the envelope of strokes when the chosen one
+    lies at it; the crossover's own limit.
+    """
+    out: list[str] = []
+    row = sorted((p for p in search.points if p.stroke == chosen.stroke),
+                 key=lambda p: p.target)
+    stiffer = [p for p in row if p.target > chosen.target * (1 + 1e-9)]
+    from .. import spec as _spec
+
+    kmax = _spec.stiffness_limit(search.base, chosen.stroke)
+    if chosen.stiffness >= 0.97 * kmax:
+        out.append(f"k_max = Fs / stroke = {kmax:.4g} N/m at "
+                   f"{quantity(chosen.stroke, 'm')} stroke")
+    elif stiffer:
+        out.append(f"at {quantity(chosen.stroke, 'm')} stroke a stiffer joint "
+                   f"({stiffer[0].target:.4g} N/m) fails on {_why(stiffer[0])}")
+    strokes = sorted({p.stroke for p in search.points})
+    i = strokes.index(chosen.stroke)
+    for j, side in ((i - 1, "shorter"), (i + 1, "longer")):
+        if 0 <= j < len(strokes):
+            others = [p for p in search.points if p.stroke == strokes[j]]
+            good = [p for p in others if p.status in ("feasible", "not_evaluated", "reserve",
+                                                      "robustness", "checks")]
+            top = max(good, key=lambda p: p.stiffness) if good else None
+            fail = min((p for p in others if top is None or p.target > top.target),
+                       key=lambda p: p.target, default=None)
+            if fail is not None:
+                out.append(f"a {side} stroke ({quantity(strokes[j], 'm')}) allows a softer "
+                           f"joint at most: {fail.target:.4g} N/m fails on {_why(fail)}")
+    lo, hi = search.envelope
+    if chosen.stroke <= lo * (1 + 1e-9):
+        out.append(f"the stroke at {search.why_lo}")
+    if chosen.stroke >= hi * (1 - 1e-9):
+        out.append(f"the stroke at {search.why_hi}")
+    if search.rule:
+        out.append(f"the crossover {search.fc:.4g} Hz: {search.fc_why}")
+    return tuple(out)
+
+
+def advice(search: Any, chosen: Any, feasible: bool, binding: tuple[str, ...],
+           least: Any) -> str:
+    """One sentence a person acts on."""
+    c = chosen.candidate
+    if feasible:
+        text = (f"Build {c.length * 1e3:.3g} x {c.width * 1e3:.3g} x {c.thickness * 1e3:.3g} mm "
+                f"leaves for a {quantity(chosen.stroke, 'm')} stroke (k = {chosen.stiffness:.4g}"
+                f" N/m with gravity)"
+                + (f" and tune the loop to {search.fc:.4g} Hz" if search.rule else "")
+                + (f": no move hunts from {chosen.free_from:.4g} Hz, "
+                   f"{chosen.margin:.3g} x below the crossover" if chosen.free_from else
+                   ": no move of the family hunts")
+                + (f"; it is bound by {binding[0]}" if binding else "") + ".")
+        if least is not None and least.feasible:
+            text += f" The least change that passes: {least.text}."
+        return text
+    text = (f"No design of the searched space passes; the nearest "
+            f"({quantity(chosen.stroke, 'm')}, {chosen.stiffness:.4g} N/m, "
+            f"{search.fc:.4g} Hz) fails on {_why(chosen)}.")
+    if least is not None and least.feasible:
+        text += f" The least change that passes: {least.text}."
+    return text

@@ -1,0 +1,346 @@
+"""The search: the stiffest buildable joint that keeps the hunting margin and passes the sign-off.
+
+Over strokes (log-spaced, first a factor of :data:`~.space.STROKE_SPAN` either
+way of the spec's, widened up to the envelope of :func:`~.space.stroke_envelope`
+while the best design lies on the range's edge) and, per stroke, target
+stiffnesses up to k_max = Fs / stroke, each point is:
+
+1. built: a guide from stock for that net drive stiffness and stroke, at the
+   crossover of :func:`~.constraints.crossover_cap` (stress, buckling, every
+   parasitic mode at the separation times the crossover); a point no guide
+   realises is out (``flexure``);
+2. judged: the stage after every move of its family at the crossover, and
+   the fold of its cycle (:func:`~.constraints.stage_answer`, on the
+   caller's executor): its hunting margin, the crossover over the fold;
+3. ordered (:mod:`.objective`): the stiffest joint whose margin reaches
+   ``requirements.hunting_margin``; at its stroke the stiffness is refined by
+   bisection towards the next stiffer point, which fails the margin;
+4. signed off, stiffest first until one passes: the loop's margins with their
+   reserve (its own modes in), the reserve corners (masses, stiffness, modes,
+   delay) and the design command's verdict (robustness included).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time as _time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .. import spec as _spec
+from ..display import quantity
+from ..results.recommend import DesignCandidate, RecommendResult
+from . import constraints as _c
+from . import objective as _o
+from .space import STROKE_SPAN, Candidate, base_spec, damping_ratio, stroke_envelope
+
+log = logging.getLogger(__name__)
+
+__all__ = ["STROKES", "STIFFNESSES", "REFINE_STEPS", "WIDEN_ROUNDS", "recommend"]
+
+#: Strokes of the first range.
+STROKES = 5
+#: Target stiffnesses per stroke, log-spaced from k_max / :data:`STIFFNESS_SPAN` to k_max.
+STIFFNESSES = 6
+STIFFNESS_SPAN = 40.0
+#: The stiffest target, a fraction of k_max [-]: a drawing's rounding stays within k_max.
+TOP = 0.99
+#: Bisection steps of the stiffness at the best stroke.
+REFINE_STEPS = 3
+#: Lengths of the chosen guide's sizing grid (the search's is coarser).
+FULL_POINTS = 161
+#: Rounds of widening the stroke range towards the envelope.
+WIDEN_ROUNDS = 3
+
+
+@dataclass
+class _Point:
+    """A point of the search as it is worked on (the result keeps DesignCandidate)."""
+
+    stroke: float
+    target: float
+    crossover: float
+    status: str | None = None
+    violations: list = field(default_factory=list)
+    candidate: Candidate | None = None
+    lowest_mode: float | None = None
+    free_from: float | None = None
+    hunts: bool = False
+    margin: float | None = None
+    p: float | None = None
+    clearance: float | None = None
+
+    @property
+    def stiffness(self) -> float:
+        return self.candidate.stiffness if self.candidate is not None else self.target
+
+    def result(self) -> DesignCandidate:
+        c = self.candidate
+        return DesignCandidate(
+            stroke=self.stroke, stiffness=self.stiffness,
+            damping=None if c is None else c.damping, crossover=self.crossover,
+            status=self.status or "not_evaluated", violations=tuple(self.violations),
+            length=None if c is None else c.length, width=None if c is None else c.width,
+            thickness=None if c is None else c.thickness, lowest_mode=self.lowest_mode,
+            hunting_free_from=self.free_from, hunting_margin=self.margin,
+            unsettled_probability=self.p, end_stop_clearance=self.clearance)
+
+
+def _map(executor: Any, fn: Callable, items: list) -> list:
+    """``fn`` over ``items`` (tuples of arguments), on the executor when there is one."""
+    if executor is None or len(items) < 2:
+        return [fn(*x) for x in items]
+    futures = [executor.submit(fn, *x) for x in items]
+    return [f.result() for f in futures]
+
+
+class _Search:
+    """The state of one search (internal): the base, the crossover, the points judged."""
+
+    def __init__(self, spec: _spec.Spec, executor: Any, say: Callable[[str], None]):
+        self.spec = spec
+        self.executor = executor
+        self.say = say
+        self.base, self.assumed = base_spec(spec)
+        self.rule = spec.controller.gains is None
+        self.fc, self.fc_why = _c.crossover_cap(spec, self.rule)
+        self.margin = self.base.requirements.hunting_margin
+        self.zeta = damping_ratio(self.base)
+        m1, m2 = self.base.stage.mass, self.base.cart.mass
+        self.mred = m1 * m2 / (m1 + m2)
+        self.points: list[_Point] = []
+        self.evaluations = 0
+        lo, hi, self.why_lo, self.why_hi = stroke_envelope(self.base)
+        self.envelope = (lo, hi)
+
+    # ---- points
+
+    def build(self, stroke: float, target: float) -> _Point:
+        p = _Point(stroke=stroke, target=target, crossover=self.fc)
+        self.points.append(p)
+        kmax = _spec.stiffness_limit(self.base, stroke)
+        b = self.base.requirements.recommend
+        if target > kmax * (1 + 1e-9):
+            p.status = "k_max"
+            p.violations.append(f"k = {target:.4g} N/m exceeds k_max = {kmax:.4g} N/m")
+            return p
+        if b.stiffness is not None and not b.stiffness[0] <= target <= b.stiffness[1]:
+            p.status = "bounds"
+            p.violations.append("outside requirements.recommend.stiffness")
+            return p
+        fx = _c.guide_for(self.base, target, stroke, self.fc)
+        if not fx.feasible:
+            p.status = "flexure"
+            p.violations.append(f"no guide: {fx.reason}")
+            return p
+        k = fx.drive_stiffness
+        c = None if self.zeta is None else 2.0 * self.zeta * math.sqrt(k * self.mred)
+        p.candidate = Candidate(stroke=stroke, length=fx.length, width=fx.width,
+                                thickness=fx.thickness, stiffness=k, crossover=self.fc,
+                                damping=c)
+        p.lowest_mode = fx.lowest_mode.frequency if fx.lowest_mode is not None else None
+        return p
+
+    def judge(self, points: list[_Point]) -> None:
+        todo = [p for p in points if p.status is None]
+        if not todo:
+            return
+        self.say(f"simulating the move family of {len(todo)} guides at {self.fc:.4g} Hz "
+                 "and finding their hunting-free crossover ...")
+        specs = [(p.candidate.spec(self.base, self.rule),) for p in todo]
+        for p, ans in zip(todo, _map(self.executor, _c.stage_answer, specs)):
+            self.evaluations += 1 + ans["tests"]
+            p.hunts, p.free_from = ans["hunts"], ans["free_from"]
+            p.margin = _c.hunting_margin(self.fc, p.free_from, p.hunts)
+            if p.hunts or not ans["acceptable"]:
+                p.status = "hunts"
+                p.violations.append(f"at {self.fc:.4g} Hz some move of the family "
+                                    f"{'hunts' if p.hunts else ans['outcome'].replace('_', ' ')}")
+            elif p.margin < self.margin:
+                p.status = "margin"
+                p.violations.append(
+                    f"no move hunts, but the crossover lies only {p.margin:.3g} x above the "
+                    f"hunting-free {p.free_from:.4g} Hz (the margin asks {self.margin:g} x)")
+
+    def stroke_row(self, strokes) -> None:
+        pts = []
+        for s in strokes:
+            kmax = _spec.stiffness_limit(self.base, s)
+            for k in np.geomspace(kmax / STIFFNESS_SPAN, TOP * kmax, STIFFNESSES):
+                pts.append(self.build(float(s), float(k)))
+        self.judge(pts)
+
+    def best(self) -> _Point | None:
+        ok = [p for p in self.points if p.status is None]
+        return max(ok, key=_o.order) if ok else None
+
+    # ---- the search
+
+    def run(self) -> None:
+        lo, hi = self.envelope
+        s0 = min(max(self.base.isolator.stroke, lo), hi)
+        s_lo, s_hi = max(lo, s0 / STROKE_SPAN), min(hi, s0 * STROKE_SPAN)
+        self.say(f"building guides and judging the stage for strokes {quantity(s_lo, 'm')} to "
+                 f"{quantity(s_hi, 'm')} at {self.fc:.4g} Hz ...")
+        strokes = list(np.geomspace(s_lo, s_hi, STROKES))
+        self.stroke_row(strokes)
+        for _ in range(WIDEN_ROUNDS):
+            b = self.best()
+            if b is None:
+                break
+            done = sorted({p.stroke for p in self.points})
+            if b.stroke == done[0] and done[0] > lo * (1 + 1e-9):
+                new = [max(lo, done[0] / 1.8), max(lo, done[0] / 1.8 ** 2)]
+            elif b.stroke == done[-1] and done[-1] < hi * (1 - 1e-9):
+                new = [min(hi, done[-1] * 1.8), min(hi, done[-1] * 1.8 ** 2)]
+            else:
+                break
+            new = [s for s in dict.fromkeys(new) if s not in done]
+            self.say(f"the best design lies on the edge of the strokes: widening to "
+                     f"{', '.join(quantity(s, 'm') for s in new)} ...")
+            self.stroke_row(new)
+        self.refine()
+
+    def refine(self) -> None:
+        """Bisect the stiffness at the best stroke towards the next stiffer point."""
+        b = self.best()
+        if b is None:
+            return
+        row = sorted((p for p in self.points if p.stroke == b.stroke), key=lambda p: p.target)
+        stiffer = [p for p in row if p.target > b.target]
+        if not stiffer:
+            return
+        lo, hi = math.log(b.target), math.log(stiffer[0].target)
+        for _ in range(REFINE_STEPS):
+            mid = 0.5 * (lo + hi)
+            p = self.build(b.stroke, math.exp(mid))
+            self.judge([p])
+            if p.status is None:
+                lo = mid
+            else:
+                hi = mid
+
+    # ---- the sign-off
+
+    def sign_off(self, p: _Point) -> tuple[bool, Any]:
+        """The guide at full resolution, the loop with its reserve, the reserve corners, the
+        design command's verdict. Returns (passed, (guide, corners, design result))."""
+        from ..guideline import design
+
+        fx = _c.guide_for(self.base, p.stiffness, p.stroke, self.fc, points=FULL_POINTS)
+        if fx.feasible and abs(fx.drive_stiffness / p.stiffness - 1.0) < 0.02:
+            p.candidate = Candidate(stroke=p.stroke, length=fx.length, width=fx.width,
+                                    thickness=fx.thickness, stiffness=fx.drive_stiffness,
+                                    crossover=self.fc, damping=p.candidate.damping)
+            p.lowest_mode = fx.lowest_mode.frequency
+        else:
+            fx = _c.guide_for(self.base, p.stiffness, p.stroke, self.fc)
+        spec = p.candidate.spec(self.base, self.rule)
+        ok, why = _c.loop_meets(spec)
+        if not ok:
+            p.status = "margins"
+            p.violations.append(why)
+            return False, (fx, None, None)
+        self.say(f"checking the reserves of {quantity(p.stroke, 'm')}, "
+                 f"{p.stiffness:.4g} N/m ...")
+        corners = _c.reserve_corners(spec)
+        self.evaluations += len(corners)
+        bad = [c for c in corners if not c["passed"]]
+        if bad:
+            p.status = "reserve"
+            p.violations += [f"with {c['name']}: {c['why']}" for c in bad]
+            return False, (fx, corners, None)
+        self.say(f"signing off {quantity(p.stroke, 'm')}, {p.stiffness:.4g} N/m at "
+                 f"{self.fc:.4g} Hz (scatter included) ...")
+        r = design(spec, executor=self.executor)
+        rob = r.robustness
+        p.p = None if rob is None else rob.hunting_probability
+        self.evaluations += 0 if rob is None else rob.samples
+        land = r.simulation.landing if r.simulation is not None else None
+        if land is not None:
+            p.clearance = land.stroke - abs(land.deflection)
+        if r.verdict.status == "FAIL":
+            fails = [x for x in r.verdict.reasons if x.severity == "FAIL"]
+            p.status = "robustness" if fails and fails[0].source == "robustness" else "checks"
+            p.violations += [x.text for x in fails]
+            return False, (fx, corners, r)
+        p.status = "feasible"
+        return True, (fx, corners, r)
+
+
+def recommend(spec: _spec.Spec, *, executor: Any = None,
+              progress: Callable[[str], None] | None = None) -> RecommendResult:
+    """Search a buildable isolator (and the rule's crossover) that the sign-off passes.
+
+    Parameters
+    ----------
+    spec : Spec
+        The design spec; without an isolator the search is for one to add,
+        without a flexure section for a steel leaf-spring guide.
+    executor : concurrent.futures-style executor, optional
+        Runs the stage-level evaluations and the robustness samples; None
+        runs them here. The library creates no pool.
+    progress : callable, optional
+        ``progress(text)`` as the search proceeds.
+
+    Returns
+    -------
+    RecommendResult
+        The stiffest joint that keeps ``requirements.hunting_margin`` with its
+        reserves and passes the sign-off, its guide, what binds it, the least
+        change of the spec that passes, and the trade-off; or the nearest
+        design and what it violates.
+    """
+    from ..guideline import step2_crossover
+    from .least import least_change
+
+    start = _time.perf_counter()
+    say = progress or (lambda text: None)
+    srch = _Search(spec, executor, say)
+    srch.run()
+    chosen, signed = None, (None, None, None)
+    for p in sorted((p for p in srch.points if p.status is None), key=_o.order, reverse=True):
+        passed, out = srch.sign_off(p)
+        if passed:
+            chosen, signed = p, out
+            break
+    feasible = chosen is not None
+    if not feasible:
+        chosen = _o.nearest(srch.points)
+    for p in srch.points:
+        if p.status is None:
+            p.status = "not_evaluated"
+    fx, corners, report = signed
+    if fx is None and chosen.candidate is not None:
+        fx = _c.guide_for(srch.base, chosen.stiffness, chosen.stroke, srch.fc)
+    st = report.simulation.stage["isolated"] if report is not None else None
+    rob = report.robustness if report is not None else None
+    binding = _o.binding(srch, chosen) if feasible else ()
+    least = least_change(srch, executor=executor, progress=say)
+    xo = step2_crossover(srch.base)
+    kmax = _spec.stiffness_limit(srch.base, chosen.stroke)
+    margins = {"hunting_margin": chosen.margin, "stiffness_factor": kmax / chosen.stiffness,
+               "end_stop_clearance": chosen.clearance,
+               "achievable_factor": (xo.achievable / srch.fc if xo.achievable else None)}
+    spec_design = {"stroke": srch.base.isolator.stroke,
+                   "stiffness": _spec.drive_stiffness(srch.base),
+                   "crossover": _spec.design_crossover(srch.base),
+                   "suggested": spec.isolator is None}
+    advice = _o.advice(srch, chosen, feasible, binding, least)
+    log.info("recommendation for %r: feasible %s, %d evaluations", spec.name, feasible,
+             srch.evaluations)
+    return RecommendResult(
+        spec=spec, feasible=feasible, design=chosen.result(), binding=binding,
+        violates=() if feasible else tuple(chosen.violations), advice=advice, flexure=fx,
+        least_change=least, stage_hunting=st, robustness=rob,
+        reserves=tuple(corners or ()), forces=None, margins=margins,
+        pareto=_o.pareto(srch.points),
+        strokes=tuple(sorted({p.stroke for p in srch.points})),
+        stiffnesses=tuple(sorted({p.target for p in srch.points})),
+        candidates=tuple(p.result() for p in srch.points), spec_design=spec_design,
+        crossover_limit=srch.fc_why, assumptions=srch.assumed, rule=srch.rule,
+        evaluations=srch.evaluations, wall_time=_time.perf_counter() - start)

@@ -1,0 +1,161 @@
+"""The design space of a recommendation: the base, the stroke envelope, the crossover, a candidate.
+
+A candidate is a buildable isolator: a leaf-spring guide drawn from stock
+(leaves, length, width, thickness) with its stroke, at a crossover. It is
+written into the spec as values at dotted paths (:meth:`Candidate.values`),
+so the design command on the written spec runs the same computation: the
+guide drawn, its drive stiffness its own (net of gravity), its own computed
+modes (the spec's measured modes that belong to the spec's own guide are
+dropped; a ``structure`` mode stays, the stage's structure does not change
+with the guide).
+
+:func:`base_spec` gives the spec the search starts from: with the spec's
+isolator, or the guideline's suggestion when it has none, and with the spec's
+flexure section, or an assumed steel leaf-spring guide (:data:`ASSUMED_FLEXURE`)
+when it has none, so that every candidate is a mechanism that can be built.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from .. import spec as _spec
+from ..specfile import with_values
+
+__all__ = ["ASSUMED_FLEXURE", "STROKE_FLOOR", "STROKE_SPAN", "Candidate", "base_spec",
+           "stroke_envelope", "damping_ratio"]
+
+#: The guide assumed for a spec without ``isolator.flexure``: two spring-steel leaves standing
+#: under the stage, sized from 0.05 mm stock within the spec's default bounds.
+ASSUMED_FLEXURE = {"material": {"youngs_modulus": 200e9, "allowed_stress": 300e6,
+                                "density": 7800.0},
+                   "leaves": 2, "orientation": "standing"}
+
+#: Shortest stroke a recommendation proposes [m]: an end-stop gap below it is hard to set and
+#: to keep (tolerances, thermal drift).
+STROKE_FLOOR = 0.05e-3
+
+#: First stroke range searched: a factor either way of the spec's stroke [-]; widened to the
+#: envelope when the best design lies on its edge.
+STROKE_SPAN = 3.0
+
+
+def base_spec(spec: _spec.Spec) -> tuple[_spec.Spec, tuple[str, ...]]:
+    """The spec the search starts from, and what it assumed.
+
+    Returns
+    -------
+    (Spec, tuple of str)
+        The spec with an isolator (its own, or the guideline's suggestion)
+        and a flexure section (its own, or :data:`ASSUMED_FLEXURE`); the
+        assumptions in words.
+    """
+    assumed = []
+    base = spec
+    if base.isolator is None:
+        from ..guideline import suggested_isolator
+
+        s, k = suggested_isolator(spec)
+        base = with_values(base, {"isolator": {"stroke": s, "stiffness": k}})
+        assumed.append("no isolator in the spec: the search starts from the guideline's "
+                       "suggestion")
+    if base.isolator.flexure is None:
+        base = with_values(base, {"isolator.flexure": ASSUMED_FLEXURE})
+        assumed.append("no isolator.flexure in the spec: a guide of two spring-steel leaves "
+                       "(E 200 GPa, 300 MPa allowed, from 0.05 mm stock) standing under the "
+                       "stage is assumed")
+    return base, tuple(assumed)
+
+
+def damping_ratio(spec: _spec.Spec) -> float | None:
+    """The joint damping ratio the spec's damping gives (None: the default ratio applies)."""
+    iso = spec.isolator
+    if iso is None or iso.damping is None:
+        return None
+    from ..model import resolve
+
+    model = resolve(spec)
+    k, m1, m2 = model.joint.stiffness, model.m1, model.m2
+    return iso.damping / (2.0 * math.sqrt(abs(k) * m1 * m2 / (m1 + m2)))
+
+
+def stroke_envelope(base: _spec.Spec) -> tuple[float, float, str, str]:
+    """The strokes a guide can be built for, and what bounds them [m].
+
+    The shortest: ``requirements.recommend.stroke`` or :data:`STROKE_FLOOR`.
+    The longest: the bound, else the stroke at which the longest, thinnest
+    leaf of the flexure's bounds reaches its allowed stress.
+
+    Returns
+    -------
+    (lo, hi, why_lo, why_hi)
+    """
+    b = base.requirements.recommend
+    flex = base.isolator.flexure
+    if b.stroke is not None:
+        return (b.stroke[0], b.stroke[1], "the shortest stroke of requirements.recommend.stroke",
+                "the longest stroke of requirements.recommend.stroke")
+    from ..mechanism.leaf import stroke_limit
+
+    L1 = flex.bounds("length")[1]
+    t0 = flex.bounds("thickness")[0]
+    step = flex.thickness_step
+    if step is not None:
+        t0 = max(t0, math.ceil(t0 / step - 1e-9) * step)
+    m = flex.material
+    hi = float(stroke_limit(m.allowed_stress, m.youngs_modulus, t0, L1))
+    return (STROKE_FLOOR, max(hi, STROKE_FLOOR),
+            f"the shortest stroke worth a limiter ({STROKE_FLOOR * 1e3:g} mm)",
+            "the stress of the longest, thinnest leaf the flexure's bounds allow")
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A buildable isolator at a crossover (SI).
+
+    Attributes
+    ----------
+    stroke : float
+        One-sided stroke [m].
+    length, width, thickness : float
+        The guide's leaf dimensions [m].
+    stiffness : float
+        The guide's net drive stiffness [N/m] (gravity included).
+    crossover : float
+        The loop's crossover [Hz].
+    damping : float or None
+        Joint damping [N s/m] (the spec's damping ratio kept), or None for
+        the default ratio.
+    """
+
+    stroke: float
+    length: float
+    width: float
+    thickness: float
+    stiffness: float
+    crossover: float
+    damping: float | None = None
+
+    def values(self, base: _spec.Spec, rule: bool) -> dict[str, Any]:
+        """The candidate as spec values at dotted paths (SI), for :func:`with_values`."""
+        iso = base.isolator
+        out: dict[str, Any] = {
+            "isolator.stroke": self.stroke, "isolator.stiffness": None,
+            "isolator.flexure.length": self.length, "isolator.flexure.width": self.width,
+            "isolator.flexure.thickness": self.thickness,
+        }
+        if self.damping is not None:
+            out["isolator.damping"] = self.damping
+        kept = [m.model_dump(exclude_none=True) for m in iso.parasitic_modes
+                if m.direction == "structure"]
+        if len(kept) != len(iso.parasitic_modes):
+            out["isolator.parasitic_modes"] = kept
+        if rule:
+            out["controller.crossover"] = self.crossover
+        return out
+
+    def spec(self, base: _spec.Spec, rule: bool) -> _spec.Spec:
+        """The base spec with the candidate written in, validated."""
+        return with_values(base, self.values(base, rule))
