@@ -36,6 +36,8 @@ error its outcome is ``static_error``, not ``stuck``
 
 from __future__ import annotations
 
+import math
+
 from . import spec as _spec
 from .display import quantities, quantity
 from .errors import ArgumentError
@@ -44,6 +46,7 @@ from .results import Check, Status
 from .results.design import Confirmation, Landing, PlantVerdict
 from .results.simulation import SimulationResult
 from .simulation import simulate
+from .stage.forces import move_forces
 from .stage import stage_hunting
 
 PLANTS = ("isolated", "non_isolated")
@@ -157,6 +160,9 @@ def confirm(spec: _spec.Spec | Model, suggestion: tuple[float, float] | None = N
             "resolution": max(widths) if widths else None,
             "search": [cfg.start, max(cfg.stop, res_iso.crossover)]}
     land = landing(model_iso, res_iso)
+    say("the forces over the move family ...")
+    own = model if suggested else model_iso
+    forces = move_forces(own, not suggested)
     say("cross-checking with the other friction model ...")
     other_iso = PlantVerdict.of("isolated", simulate(_other_model(model_iso), isolated=True),
                                 bound)
@@ -164,12 +170,49 @@ def confirm(spec: _spec.Spec | Model, suggestion: tuple[float, float] | None = N
                                 bound)
     agree = _hunts(other_iso) == _hunts(iso) and _hunts(other_non) == _hunts(non)
     checks = _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
-                     suggested)
+                     suggested) + _force_checks(own, forces)
     return Confirmation(isolated=iso, non_isolated=non, stage=stage,
-                        min_hunting_free_crossover=mins, landing=land,
+                        min_hunting_free_crossover=mins, landing=land, forces=forces,
                         cross_check={"isolated": other_iso, "non_isolated": other_non},
                         models_agree=agree, suggested_isolator=suggested, checks=tuple(checks),
                         results={"isolated": res_iso, "non_isolated": res_non})
+
+
+def _force_checks(model: Model, forces) -> list[Check]:
+    """The forces over the move family, judged: the end stop's contact force against
+    ``requirements.end_stop_force``, the actuator's peak against ``controller.force_limit``."""
+    step = "simulation (paper section 2.3)"
+    out = []
+    n = len(forces.moves)
+    if forces.stop_stiffness is not None:
+        limit = model.requirements.end_stop_force
+        peak = forces.peak_stop_force
+        stop = (f"the end stop ({forces.stop_stiffness:.3g} N/m, {forces.stop_damping:.3g} "
+                "N s/m" + (", the spec's defaults: an assumption, the contact force goes with "
+                           "the square root of the stiffness" if forces.stop_default else "")
+                + ")")
+        text = (f"{forces.moves_on_stop} of {n} moves run the joint onto {stop}, up to "
+                f"{forces.most_impacts} times a move; the largest contact force {peak:.3g} N"
+                if forces.moves_on_stop else f"no move of the family reaches {stop}")
+        if limit is None:
+            out.append(Check("end_stop_force", None, peak, None, "N", text, step))
+        else:
+            ok = peak <= limit
+            out.append(Check("end_stop_force", ok, peak, limit, "N", text + (
+                f", within requirements.end_stop_force" if ok else
+                f", above requirements.end_stop_force = {limit:.3g} N"), step))
+    peak = forces.peak_actuator_force
+    flim = model.law.force_limit
+    text = f"the largest actuator force over the {n} moves is {peak:.3g} N"
+    if flim is None or not math.isfinite(flim):
+        out.append(Check("actuator_force", None, peak, None, "N", text, step))
+    else:
+        ok = peak < 0.999 * flim
+        out.append(Check("actuator_force", ok, peak, flim, "N", text + (
+            f", below controller.force_limit = {flim:.3g} N" if ok else
+            f": the actuator saturates at controller.force_limit = {flim:.3g} N"), step,
+            status=None if ok else Status.WARN))
+    return out
 
 
 def _plant_text(v: PlantVerdict, label: str, fc: float) -> str:

@@ -67,7 +67,8 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
              crossover: float | None = None, reference: Trajectory | None = None,
              initial_position: float = 0.0, duration: float | None = None,
              effects=None, rtol: float | None = None, record=None, drive: str = "closed",
-             window: float = WINDOW, initial_command: float | None = None) -> SimulationResult:
+             window: float = WINDOW, initial_command: float | None = None,
+             rate: float | None = None) -> SimulationResult:
     """Simulate the stage and evaluate the hunting metric.
 
     Parameters
@@ -115,6 +116,9 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
         first ``force_N`` less ``disturbance_N`` sample. A single sample holds
         the force sensor's noise: a caller that estimated the command better
         (the reconciliation fits it) passes it here.
+    rate : float, optional
+        Output rate of the traces [Hz]; default ``simulation.output_rate`` (the
+        spec's motion and a given reference only).
 
     Returns
     -------
@@ -161,7 +165,8 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
     else:
         ref = reference
         t_end = float(ref.breaks[-1]) if duration is None else duration
-    rate = model.spec.simulation.output_rate
+    if rate is None:
+        rate = model.spec.simulation.output_rate
     n_out = int(math.floor(t_end * rate + 1e-9)) + 1
     t_out = np.arange(n_out) / rate
     y0 = np.zeros(params.n_states)

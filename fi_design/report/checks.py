@@ -58,6 +58,7 @@ SENSE = {
     "flexure.buckling": "\u2265", "flexure.modes": "\u2265", "flexure.sag": "<",
     "simulation_isolated": "=", "min_crossover_isolated": "\u2264", "landing_force": "<",
     "simulation_non_isolated": "=", "min_crossover_non_isolated": "\u2264", "robustness": "\u2264",
+    "end_stop_force": "\u2264", "actuator_force": "<",
 }
 
 
@@ -102,6 +103,8 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
         "landing_force": "Flexure force on the resting cart",
         "robustness": "Probability of not settling under friction scatter",
         "friction_model_cross_check": "Cross-check with the other friction model",
+        "end_stop_force": "End-stop contact force over the move family",
+        "actuator_force": "Actuator's peak force over the move family",
     }
     flex = {"stiffness": "Flexure net drive stiffness within k_max",
             "stress": "Flexure stress at full stroke",

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from .forces import StageForces
 from . import Check, Result, to_jsonable
 from .simulation import HuntingMetrics, SimulationResult
 
@@ -195,6 +196,9 @@ class Confirmation(Result):
         The simulation's checks for the design summary.
     results : dict of SimulationResult
         The two full simulations (traces for plots; not in the JSON).
+    forces : StageForces or None
+        The forces over the move family of the spec's own plant: end-stop
+        impacts and the actuator's peak.
     """
 
     isolated: PlantVerdict
@@ -207,3 +211,4 @@ class Confirmation(Result):
     suggested_isolator: bool
     checks: tuple[Check, ...]
     results: dict = field(repr=False)  # traces for plots; not in the JSON
+    forces: StageForces | None = None

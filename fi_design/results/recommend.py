@@ -143,7 +143,7 @@ class RecommendResult(Result):
         The design's robustness under the spec's scatter.
     reserves : tuple of dict
         The reserve corners of the design (``name``, ``passed``, ``why``).
-    forces : dict or None
+    forces : fi_design.results.forces.StageForces or None
         The design's forces over its move family (end-stop impacts, the
         actuator's peak), from its sign-off.
     margins : dict
@@ -189,7 +189,7 @@ class RecommendResult(Result):
     stage_hunting: Any
     robustness: Any
     reserves: tuple[dict, ...]
-    forces: dict | None
+    forces: Any
     margins: dict
     pareto: tuple[dict, ...]
     strokes: tuple[float, ...]

@@ -552,6 +552,10 @@ class Requirements(StrictModel):
     reserve: Reserve = Field(default_factory=lambda: Reserve(),
                              description="Reserves a recommended design keeps beyond the "
                                          "requirements.")
+    end_stop_force: OptQ("N") = Field(None, gt=0, description="Largest contact force the "
+                                                              "isolator's end stop may see over "
+                                                              "the move family [N]; null: "
+                                                              "reported, not judged.")
     buckling_factor: float = Field(3.0, ge=1, description="The flexure guide's buckling load "
                                                           "must be at least this times the "
                                                           "weight it carries [-]. Default 3.")
