@@ -27,7 +27,7 @@ from .. import spec as _spec
 from ..specfile import with_values
 
 __all__ = ["SEARCH_POINTS", "reserve_spec", "crossover_cap", "guide_for", "loop_meets",
-           "stage_answer", "reserve_corners"]
+           "stage_answer", "margin_screen", "reserve_corners", "hunting_margin"]
 
 #: Lengths of the guide's sizing grid during the search (the chosen design is sized again at
 #: full resolution).
@@ -172,6 +172,35 @@ def stage_answer(spec: _spec.Spec, crossover: float | None = None,
             "free_from": st.hunting_free_from, "amplitude": None if c is None else c.amplitude,
             "period": None if c is None else c.period,
             "tests": int((st.boundary or {}).get("tests", 0))}
+
+
+def margin_screen(spec: _spec.Spec, margin: float, crossover: float | None = None) -> dict:
+    """Whether the stage keeps the hunting margin, by two quick stage-level answers (a task).
+
+    No move of the family may hunt at the crossover, nor at the crossover over
+    the margin: the cycle's fold then lies at least ``margin`` times below the
+    crossover (the cycle exists below its fold and not above it; a band where
+    it came and went would show in the sign-off, which finds the fold itself).
+    Each answer stops at the first move that hunts.
+
+    Returns
+    -------
+    dict
+        ``keeps`` (bool), ``hunts`` (at the crossover), ``outcome`` (str: the
+        crossover's stage outcome, or ``hunts_below`` when only the lower one
+        hunts), ``tests`` (stage answers run).
+    """
+    from ..stage import stage_hunting
+
+    fc = _spec.design_crossover(spec) if crossover is None else crossover
+    at = stage_hunting(spec, True, crossover=fc, first_only=True, boundary=False, trace=False)
+    if at.hunts or not at.acceptable:
+        return {"keeps": False, "hunts": at.hunts, "outcome": at.outcome, "tests": 1}
+    below = stage_hunting(spec, True, crossover=fc / margin, first_only=True, boundary=False,
+                          trace=False)
+    keeps = not below.hunts
+    return {"keeps": keeps, "hunts": False,
+            "outcome": "settles" if keeps else "hunts_below", "tests": 2}
 
 
 def _settles(model: Any) -> bool:

@@ -36,10 +36,8 @@ STROKE_FACTORS = (2.0, 4.0)
 
 
 def _margin_ok(spec: _spec.Spec, margin: float) -> tuple[bool, dict]:
-    ans = _c.stage_answer(spec)
-    fc = _spec.design_crossover(spec)
-    m = _c.hunting_margin(fc, ans["free_from"], ans["hunts"])
-    return (not ans["hunts"] and ans["acceptable"] and m >= margin), ans
+    ans = _c.margin_screen(spec, margin)
+    return ans["keeps"], ans
 
 
 def _stiffest(spec: _spec.Spec, stroke: float, margin: float) -> tuple[float | None, int]:

@@ -71,6 +71,7 @@ class _Point:
     free_from: float | None = None
     hunts: bool = False
     margin: float | None = None
+    folded: bool = False
     p: float | None = None
     clearance: float | None = None
 
@@ -146,25 +147,48 @@ class _Search:
         return p
 
     def judge(self, points: list[_Point]) -> None:
+        """Screen the points' hunting margin (two quick stage answers each, on the executor)."""
         todo = [p for p in points if p.status is None]
         if not todo:
             return
-        self.say(f"simulating the move family of {len(todo)} guides at {self.fc:.4g} Hz "
-                 "and finding their hunting-free crossover ...")
-        specs = [(p.candidate.spec(self.base, self.rule),) for p in todo]
-        for p, ans in zip(todo, _map(self.executor, _c.stage_answer, specs)):
-            self.evaluations += 1 + ans["tests"]
-            p.hunts, p.free_from = ans["hunts"], ans["free_from"]
-            p.margin = _c.hunting_margin(self.fc, p.free_from, p.hunts)
-            if p.hunts or not ans["acceptable"]:
+        self.say(f"simulating the move family of {len(todo)} guides at {self.fc:.4g} Hz and "
+                 f"{self.fc / self.margin:.4g} Hz ...")
+        tasks = [(p.candidate.spec(self.base, self.rule), self.margin) for p in todo]
+        for p, ans in zip(todo, _map(self.executor, _c.margin_screen, tasks)):
+            self.evaluations += ans["tests"]
+            p.hunts = ans["hunts"]
+            if p.hunts:
+                p.margin = 0.0
                 p.status = "hunts"
-                p.violations.append(f"at {self.fc:.4g} Hz some move of the family "
-                                    f"{'hunts' if p.hunts else ans['outcome'].replace('_', ' ')}")
-            elif p.margin < self.margin:
+                p.violations.append(f"at {self.fc:.4g} Hz some move of the family hunts")
+            elif ans["outcome"] not in ("settles", "hunts_below"):
+                p.status = "hunts"
+                p.violations.append(f"at {self.fc:.4g} Hz some move of the family ends "
+                                    f"{ans['outcome'].replace('_', ' ')}")
+            elif not ans["keeps"]:
                 p.status = "margin"
                 p.violations.append(
-                    f"no move hunts, but the crossover lies only {p.margin:.3g} x above the "
-                    f"hunting-free {p.free_from:.4g} Hz (the margin asks {self.margin:g} x)")
+                    f"no move hunts at {self.fc:.4g} Hz, but some does at "
+                    f"{self.fc / self.margin:.4g} Hz: the hunting-free crossover lies less than "
+                    f"{self.margin:g} x below the crossover")
+
+    def fold(self, points: list[_Point]) -> None:
+        """The hunting-free crossover (the fold of the cycle) of points, and their margin."""
+        todo = [p for p in points if p.candidate is not None and not p.folded and not p.hunts]
+        if not todo:
+            return
+        self.say(f"finding the hunting-free crossover of {len(todo)} guides ...")
+        tasks = [(p.candidate.spec(self.base, self.rule),) for p in todo]
+        for p, ans in zip(todo, _map(self.executor, _c.stage_answer, tasks)):
+            self.evaluations += 1 + ans["tests"]
+            p.folded = True
+            p.free_from = ans["free_from"]
+            p.margin = _c.hunting_margin(self.fc, p.free_from, ans["hunts"])
+            if p.status is None and p.margin < self.margin:  # the fold: a band the screen missed
+                p.status = "margin"
+                p.violations.append(
+                    f"the crossover lies only {p.margin:.4g} x above the hunting-free "
+                    f"{p.free_from:.4g} Hz (the margin asks {self.margin:g} x)")
 
     def stroke_row(self, strokes) -> None:
         pts = []
@@ -178,6 +202,23 @@ class _Search:
         ok = [p for p in self.points if p.status is None]
         return max(ok, key=_o.order) if ok else None
 
+    def stiffest_per_stroke(self) -> list[_Point]:
+        out = []
+        for s in sorted({p.stroke for p in self.points}):
+            ok = [p for p in self.points if p.stroke == s and p.status is None]
+            if ok:
+                out.append(max(ok, key=lambda p: p.stiffness))
+        return out
+
+    def confirm(self) -> None:
+        """Fold the stiffest screened design of every stroke until each one's margin stands
+        (the screen sees which moves enter the cycle, the fold where the cycle exists)."""
+        while True:
+            todo = [p for p in self.stiffest_per_stroke() if not p.folded]
+            if not todo:
+                return
+            self.fold(todo)
+
     # ---- the search
 
     def run(self) -> None:
@@ -186,8 +227,8 @@ class _Search:
         s_lo, s_hi = max(lo, s0 / STROKE_SPAN), min(hi, s0 * STROKE_SPAN)
         self.say(f"building guides and judging the stage for strokes {quantity(s_lo, 'm')} to "
                  f"{quantity(s_hi, 'm')} at {self.fc:.4g} Hz ...")
-        strokes = list(np.geomspace(s_lo, s_hi, STROKES))
-        self.stroke_row(strokes)
+        self.stroke_row(list(np.geomspace(s_lo, s_hi, STROKES)))
+        self.confirm()
         for _ in range(WIDEN_ROUNDS):
             b = self.best()
             if b is None:
@@ -203,6 +244,7 @@ class _Search:
             self.say(f"the best design lies on the edge of the strokes: widening to "
                      f"{', '.join(quantity(s, 'm') for s in new)} ...")
             self.stroke_row(new)
+            self.confirm()
         self.refine()
 
     def refine(self) -> None:
@@ -219,6 +261,8 @@ class _Search:
             mid = 0.5 * (lo + hi)
             p = self.build(b.stroke, math.exp(mid))
             self.judge([p])
+            if p.status is None:
+                self.fold([p])
             if p.status is None:
                 lo = mid
             else:
@@ -304,6 +348,9 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
     srch.run()
     chosen, signed = None, (None, None, None)
     for p in sorted((p for p in srch.points if p.status is None), key=_o.order, reverse=True):
+        srch.fold([p])
+        if p.status is not None:
+            continue
         passed, out = srch.sign_off(p)
         if passed:
             chosen, signed = p, out
