@@ -358,6 +358,28 @@ def test_result_arrays_are_read_only(paper_fast):
     assert d["metrics"]["verdict"] == "settled" and "position" not in d
 
 
+def test_to_dict_without_traces_never_converts_them(paper_fast):
+    """`simulate --record --json` of a 2e6-row record peaked at 1.09 GB: to_dict turned every
+    trace into a list of Python floats, then dropped it. Left out, it costs nothing."""
+    import dataclasses
+    import tracemalloc
+
+    n = 200_000
+    big = {name: np.zeros(n) for name in ("time", "reference", "position", "cart_position",
+                                          "velocity", "cart_velocity", "force",
+                                          "applied_force", "bristle")}
+    r = dataclasses.replace(paper_fast[True], **big)
+    tracemalloc.start()
+    try:
+        d = r.to_dict()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert "position" not in d and d["metrics"]["verdict"] == "settled"
+    assert peak < 1e6  # [bytes]; the 9 traces as lists of floats are about 60 MB
+    assert len(r.to_dict(traces=True)["position"]) == n
+
+
 def _effects(*entries):
     from fi_design.spec import EFFECT_MODELS
 
