@@ -134,9 +134,12 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
                 f"; allowed: {', '.join(model.model_fields)}"
         return path, f"unknown key '{key}'{hint}"
     if kind == "unknown_effect":
-        given = err.get("input", {}).get("type") if isinstance(err.get("input"), dict) else None
         if not isinstance(err.get("input"), dict):
             return path, _not_an_effect_entry(err.get("input"))
+        given = err["input"].get("type")
+        if given is None:  # no `type:` key, or one without a value
+            return path + ".type", (f"required field is missing (the effect's type, one of: "
+                                    f"{', '.join(_effects.EFFECT_NAMES)})")
         close = difflib.get_close_matches(str(given), list(_effects.EFFECT_NAMES), n=1)
         hint = f" (did you mean '{close[0]}'?)" if close else ""
         return path + ".type", (f"unknown effect '{given}'{hint}; known: "
