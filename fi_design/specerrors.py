@@ -96,6 +96,36 @@ def _inner_model(ann, typing):
     return None
 
 
+def real_errors(errors: list[dict]) -> list[dict]:
+    """The validation errors without those another one causes.
+
+    A sequence with a minimum length (``motion.moves``) whose items fail is
+    also "too short" to pydantic, which counts the items that passed; the
+    entries as written are enough, so only the items' own errors are real.
+
+    Parameters
+    ----------
+    errors : list of dict
+        ``ValidationError.errors()``.
+
+    Returns
+    -------
+    list of dict
+        The same errors, in order, without the consequential ones.
+    """
+    def caused(err: dict) -> bool:
+        if err["type"] != "too_short":
+            return False
+        given, least = err.get("input"), (err.get("ctx") or {}).get("min_length")
+        loc = tuple(err["loc"])
+        inner = any(tuple(o["loc"])[:len(loc)] == loc and len(o["loc"]) > len(loc)
+                    for o in errors)
+        return inner and least is not None and hasattr(given, "__len__") and len(given) >= least
+
+    kept = [e for e in errors if not caused(e)]
+    return kept or errors
+
+
 def describe(err: dict, raw: dict) -> tuple[str, str]:
     """One pydantic validation error of a spec as ``(dotted path, message)``.
 
