@@ -20,7 +20,9 @@ The count alone is blind in two ways, and the verdict here is not:
   verdict ``undetermined`` ("too slow to judge in this window").
 
 Only a stage whose error stays inside the settle band at the end of the
-window is ``settled``.
+window is ``settled``; a run that ends, or a window that closes, before the
+motion does is never settled: ``undetermined`` ("not finished"), since a
+stage on its ramp follows the reference within the band.
 """
 
 from __future__ import annotations
@@ -56,7 +58,8 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     settle_band : float
         Band for ``settled`` and the settling time [m].
     motion_end : float
-        End of the last move [s]; the settling time counts from here.
+        End of the last move [s]; the settling time counts from here. A
+        trace or window that ends before it is not finished: ``undetermined``.
     success : bool
         Whether the trace is complete; an incomplete one is ``undetermined``.
     failure : str
@@ -93,12 +96,20 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     finite = np.isfinite(e)
     final_error = float(e[finite][-1]) if finite.any() else float("nan")
 
+    t_last = float(t[-1]) if len(t) else 0.0
+    moving = motion_end > min(w1, t_last)  # the motion outlasts the window or the run
     tail = inside & (t >= w1 - window_length / 4.0)
-    settled = bool(success and tail.any() and np.all(np.abs(e[tail]) <= settle_band))
+    settled = bool(success and not moving and tail.any()
+                   and np.all(np.abs(e[tail]) <= settle_band))
     settling_time = _settling_time(t, e, settle_band, motion_end) if success else None
 
     if not success:
         verdict, reason = "undetermined", f"the simulation did not complete: {failure}"
+    elif moving:
+        what = "run" if t_last <= w1 else "counting window"
+        verdict = "undetermined"
+        reason = (f"not finished: the motion runs until {motion_end:.4g} s, past the end of the "
+                  f"{what} at {min(w1, t_last):.4g} s; the stage is still moving")
     elif len(ew) < 2:
         verdict, reason = "undetermined", "the trace does not cover the counting window"
     elif cycles > 0:

@@ -127,3 +127,19 @@ def test_a_stick_plateau_with_round_off_counts_once():
     assert m.period == pytest.approx(period, abs=2e-3)
     middles = 10.0 + slip + (half - slip) / 2.0 + period * np.arange(4)
     assert m.peak_times == pytest.approx(middles, abs=0.05)
+
+
+@pytest.mark.parametrize("motion_end", [250.0, 20.5, 25.0])
+def test_a_motion_that_outlasts_the_run_or_window_is_not_finished(motion_end):
+    """A stage on its ramp follows the reference within the band: no cycles, error zero. The
+    move ends at 250 s (a 5 m move at 20 mm/s) in a 20 s run: never settled."""
+    e = 1e-9 * np.sin(T)
+    done = hunting_metrics(T, e, motion_end=2.0)
+    assert done.verdict == "settled"
+    m = hunting_metrics(T, e, motion_end=motion_end)
+    assert m.verdict == "undetermined" and not m.settled
+    assert m.reason.startswith("not finished") and f"{motion_end:.4g} s" in m.reason
+    assert m.settling_time is None
+    longer = np.arange(40001) / 1000.0  # a 40 s run, the window [10 s, 20 s) inside the move
+    w = hunting_metrics(longer, 1e-9 * np.sin(longer), motion_end=motion_end)
+    assert w.verdict == "undetermined" and "counting window at 20 s" in w.reason

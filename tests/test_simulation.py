@@ -380,6 +380,18 @@ def test_to_dict_without_traces_never_converts_them(paper_fast):
     assert len(r.to_dict(traces=True)["position"]) == n
 
 
+def test_a_move_that_outlasts_the_run_is_not_finished(paper_spec):
+    """`distance: 5` (5 m at 50 mm/s: 100 s) in a 20 s run read "settled, final error 0 mm"
+    while the stage was on its ramp."""
+    spec = variant(paper_spec, **{"motion.moves": [{"distance": 5, "velocity": "50 mm/s",
+                                                    "acceleration": "1 m/s^2"}]})
+    r = simulate(spec)
+    assert r.success and abs(r.reference[-1] - 1.0) < 0.01  # at 20 s: 1 m of 5 m, on the ramp
+    m = r.metrics
+    assert m.verdict == "undetermined" and not m.settled
+    assert "not finished" in m.reason and "100 s" in m.reason
+
+
 def _effects(*entries):
     from fi_design.spec import EFFECT_MODELS
 
