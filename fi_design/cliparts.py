@@ -167,7 +167,9 @@ class DefaultCommandGroup(TyperGroup):
 
     def _invoke(self, ctx: Any) -> Any:
         from .interrupts import signals_to_exceptions
+        from .output import begin_run
 
+        begin_run()
         try:
             with signals_to_exceptions(_signal_exception):
                 return super().invoke(ctx)

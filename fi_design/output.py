@@ -301,7 +301,8 @@ def _remove_held(made: list[Path]) -> None:
 
 
 def written() -> tuple[Path, ...]:
-    """The files this run has moved into place (in the current :mod:`contextvars` context).
+    """The files this run has moved into place (in the current :mod:`contextvars` context,
+    since :func:`begin_run`).
 
     Returns
     -------
@@ -309,6 +310,16 @@ def written() -> tuple[Path, ...]:
         In the order they were written.
     """
     return _WRITTEN.get()
+
+
+def begin_run() -> None:
+    """Start the list of :func:`written` files afresh in the current context.
+
+    A copied context starts with the values of the one it was copied from:
+    the command line calls this at the start of every command, in the
+    command's own context, so that its files are the command's only.
+    """
+    _WRITTEN.set(())
 
 
 def _move(tmp: Path, out: Path, parent: Path) -> None:

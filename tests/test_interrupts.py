@@ -160,3 +160,22 @@ def app():
     from fi_design.cli import app as the_app
 
     return the_app
+
+
+def test_an_interrupt_between_two_outputs_names_the_one_written(paper_spec_path, tmp_path,
+                                                                 monkeypatch):
+    from fi_design import output
+
+    real = output.write_atomic
+
+    def write_atomic(path, data):
+        _sigint_here()
+        return real(path, data)
+
+    monkeypatch.setattr(output, "write_atomic", write_atomic)
+    csv, js = tmp_path / "trace.csv", tmp_path / "out.json"
+    result = runner.invoke(app(), ["simulate", str(paper_spec_path), "--csv", str(csv),
+                                   "--json", str(js)])
+    assert result.exit_code == 130, result.output
+    assert f"interrupted; it had written {csv} and no temporary file is left" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["trace.csv"]
