@@ -29,20 +29,20 @@ def paper_isolated(paper_spec):
     return stage_hunting(paper_spec, True)
 
 
-def _canudas_spec():
+def _canudas_spec(model: str = "lugre", hunting: dict | None = None, duration: str = "20 s"):
     from fi_design.specfile import load_spec
 
     return load_spec({
         "name": "Canudas de Wit et al. 1995, unit mass under PID",
         "stage": {"mass": "0.5 kg"}, "cart": {"mass": "0.5 kg"},
-        "friction": {"static": "1.5 N", "coulomb": "1 N", "stribeck_velocity": "1 mm/s",
+        "friction": {"model": model, "static": "1.5 N", "coulomb": "1 N", "stribeck_velocity": "1 mm/s",
                      "viscous": "0.4 N*s/m", "bristle_stiffness": "1e5 N/m",
                      "bristle_damping": f"{math.sqrt(1e5)} N*s/m"},
         "controller": {"gains": {"kp": "3 N/m", "ki": "4 N/(m*s)", "kd": "6 N*s/m"},
                        "derivative_on": "measurement"},
         "motion": {"moves": [{"distance": "1 m", "velocity": "1 m/s",
-                              "acceleration": "10 m/s^2"}], "duration": "20 s"},
-        "requirements": {"hunting": {"horizon": "1000 s"}}})
+                              "acceleration": "10 m/s^2"}], "duration": duration},
+        "requirements": {"hunting": {"horizon": "1000 s", **(hunting or {})}}})
 
 
 def _upward_crossings(t, e):
@@ -153,6 +153,27 @@ def test_canudas_de_wit_1995_pid_example_hunts_with_its_published_cycle():
     assert c.period == pytest.approx(24.4, abs=0.05)
     assert c.amplitude == pytest.approx(0.1278, abs=0.0005)
     assert c.stable
+
+
+def test_canudas_de_wit_1995_switch_model_counts_one_peak_per_stick_plateau():
+    """The same case with Karnopp (switch) friction over [100 s, 200 s): four cycles.
+
+    The stage sticks for about 9 s at each extreme, where x1 - r rounds to
+    neighbouring floats near r = 1 m; the metric counted those rounding steps as
+    peaks (32 peaks, period 2.6 s). Its period must agree with the cycle converged on
+    the section (an independent route: shooting on section crossings, no peaks) and
+    lie near the LuGre run's published 24.4 s.
+    """
+    from fi_design.simulation import simulate
+
+    window = {"window_start": "100 s", "window_length": "100 s"}
+    m = simulate(_canudas_spec("switch", window, "200 s"), False).metrics
+    cycle = stage_hunting(_canudas_spec("switch"), False, family=[1.0], boundary=False).cycle
+    assert cycle.period == pytest.approx(23.73, abs=0.05)
+    assert m.verdict == "hunting" and m.hunting_cycles == 4
+    assert m.period == pytest.approx(cycle.period, rel=2e-3)
+    assert m.period == pytest.approx(24.4, rel=0.05)
+    assert np.ptp(m.peak_heights) < 1e-4  # one level per side: the plateau, not its steps
 
 
 def test_a_multiplier_the_two_perturbations_disagree_on_is_not_reported(paper_spec):
