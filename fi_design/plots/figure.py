@@ -5,13 +5,19 @@ What every result family's figures share: :data:`REPORT_RC` and
 plain tick labels on log axes, the thinning of long traces
 (:func:`decimate`), cell edges of a map, and the two renderings
 (:func:`figure_svg` for inlining in HTML, :func:`figure_bytes` for files),
-both reproducible. matplotlib is imported inside the functions.
+both reproducible, and :func:`figure_markup`, which places a figure as inline
+SVG or, inside :func:`raster_figures` (a PDF), as a PNG image.
+matplotlib is imported inside the functions.
 """
 
 from __future__ import annotations
 
+import base64
+import contextlib
+import contextvars
 import io
 import math
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -200,6 +206,71 @@ def figure_svg(fig: Any, prefix: str, text_as_paths: bool = False) -> str:
     text = re.sub(r"url\(#([^)]+)\)", lambda m: f"url(#{prefix}-{m.group(1)})", text)
     text = re.sub(r"<metadata>.*?</metadata>\s*", "", text, flags=re.DOTALL)
     return text.strip()
+
+
+#: Resolution of the figures a PDF report carries as images [dots per inch].
+RASTER_DPI = 250
+
+_RASTER: contextvars.ContextVar[float | None] = contextvars.ContextVar("fi_design_raster",
+                                                                       default=None)
+
+
+@contextlib.contextmanager
+def raster_figures(dpi: float = RASTER_DPI) -> Iterator[None]:
+    """Within this block, :func:`figure_markup` places figures as PNG images of ``dpi``.
+
+    A PDF report is laid out by WeasyPrint, which parses, styles and draws every
+    element of an inline SVG in Python: the report's figures and equations as
+    images take a fraction of that time. The HTML report keeps its scalable SVG.
+
+    Parameters
+    ----------
+    dpi : float, optional
+        Resolution [dots per inch] (default :data:`RASTER_DPI`).
+    """
+    token = _RASTER.set(float(dpi))
+    try:
+        yield
+    finally:
+        _RASTER.reset(token)
+
+
+def raster_dpi() -> float | None:
+    """The resolution of :func:`raster_figures` in force [dots per inch], or None (SVG)."""
+    return _RASTER.get()
+
+
+def png_img(png: bytes, width_pt: float | None = None, alt: str = "") -> str:
+    """An ``<img>`` element carrying ``png`` as a data URL, ``width_pt`` wide [pt] if given."""
+    from markupsafe import escape
+
+    style = "" if width_pt is None else f' style="width:{width_pt:.2f}pt"'
+    data = base64.b64encode(png).decode("ascii")
+    return f'<img src="data:image/png;base64,{data}" alt="{escape(alt)}"{style}>'
+
+
+def figure_markup(fig: Any, prefix: str) -> str:
+    """A figure for a report page: inline SVG (:func:`figure_svg`), or a PNG image inside
+    :func:`raster_figures`.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    prefix : str
+        Prefix of the SVG's ids (see :func:`figure_svg`).
+
+    Returns
+    -------
+    str
+        An ``<svg>`` or ``<img>`` element; CSS sizes either to the text width.
+    """
+    dpi = raster_dpi()
+    if dpi is None:
+        return figure_svg(fig, prefix)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi, metadata={"Software": None})
+    return png_img(buf.getvalue())
 
 
 def figure_bytes(fig: Any, fmt: str = "svg") -> bytes:
