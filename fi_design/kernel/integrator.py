@@ -67,9 +67,9 @@ from .layout import (DIVERGED, EV_LEVEL, EV_LIMIT, EV_NONE, EV_SECTION, EV_SIGN,
                      P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT,
                      ST_CROSSINGS, ST_EVENTS, ST_H, ST_LIMIT_EVENTS, ST_OUT, ST_PERIOD,
                      ST_REJECTED, ST_STEPS, ST_STOP, ST_T, ST_ZERO_EVENTS, STEP_UNDERFLOW,
-                     STOP_CROSSINGS, STOP_END, STOP_QUIET, STOP_REPEAT, TOO_MANY_STEPS, W_ARM,
-                     W_BAND, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_REPEAT, W_REST_ANYWHERE,
-                     W_START)
+                     STOP_CROSSINGS, STOP_END, STOP_MATCH, STOP_QUIET, STOP_REPEAT,
+                     TOO_MANY_STEPS, W_ARM, W_BAND, W_LEVEL, W_MATCH, W_MAX_CROSSINGS, W_QUIET,
+                     W_REPEAT, W_REST_ANYWHERE, W_START, N_WATCH)
 
 HIST = 8192  # delay history ring size
 HT, HU, HDU, HUR, HDUR = range(5)  # rows of the history: time, value and rate in, out
@@ -625,13 +625,15 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
         feedforward and input force, before delay and saturation).
     stats : ndarray, shape (N_STATS,)
         Output: counters (``ST_*``).
-    watch : ndarray, shape (N_WATCH,)
+    watch : ndarray, shape (N_WATCH + k n,)
         What to watch for once the motion is over (``W_*`` in
         :mod:`fi_design.kernel.layout`): from ``watch[W_START]`` on, the upward
         crossings of x1 - r = 0 (r = ``watch[W_LEVEL]``, the held reference)
         are located like mode events (the step is redone to end on them) and
         recorded, and the run stops early when the stage has come to rest (the
-        quiet rule) or its motion repeats at the section (the repeat rule).
+        quiet rule), its motion repeats at the section (the repeat rule) or its
+        state at the section matches a known one (the match rule: the known
+        states follow the ``N_WATCH`` values).
         ``watch[W_START] = inf`` turns it off.
     cross_t : ndarray, shape (K,)
         Output: times of the crossings [s] (the first ``stats[ST_CROSSINGS]``).
@@ -729,6 +731,8 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     repeat = watch[W_REPEAT]
     rest_anywhere = watch[W_REST_ANYWHERE] != 0.0
     arm = watch[W_ARM]
+    match = watch[W_MATCH]
+    n_known = (watch.shape[0] - N_WATCH) // n
     max_cross = min(int(watch[W_MAX_CROSSINGS]), cross_t.shape[0])
     n_cross = 0
     armed = False
@@ -1114,7 +1118,24 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 e_lo = math.inf
                 e_hi = -math.inf
                 pending = EV_NONE
-                if n_cross >= max_cross:
+                if match > 0.0 and n_known > 0:
+                    c = n_cross - 1
+                    for kk in range(n_known):
+                        worst = 0.0
+                        for j in range(n):
+                            dj = cross_y[c, j] - watch[N_WATCH + kk * n + j]
+                            if j == 0 or (iso and j == 2):
+                                dj -= level
+                            dj = abs(dj) * rtol / atol[j]
+                            if dj > worst:
+                                worst = dj
+                        if worst <= match:
+                            stop = STOP_MATCH
+                            period = kk
+                            break
+                if stop != STOP_END:
+                    pass
+                elif n_cross >= max_cross:
                     stop = STOP_CROSSINGS
                 elif repeat > 0.0:
                     c = n_cross - 1
