@@ -328,13 +328,13 @@ def _relative(params: PlantParameters, states: np.ndarray, level: float) -> np.n
 
 def _watch_array(w: Watch, start: float, level: float, *, repeat: float = REPEAT,
                  quiet: bool = True, max_crossings: int = CROSSINGS,
-                 known: np.ndarray | None = None, match: float = MATCH) -> np.ndarray:
+                 known: np.ndarray | None = None, match: float | None = None) -> np.ndarray:
     """The kernel's watch array; ``known`` (k, n) section states (positions relative to
-    their level) for the match rule."""
+    their level) for the match rule, within ``match`` (default :data:`MATCH`)."""
     k = 0 if known is None else len(known)
     arr = np.zeros(N_WATCH + (0 if k == 0 else known.size))
     if k:
-        arr[W_MATCH] = match
+        arr[W_MATCH] = MATCH if match is None else match
         arr[N_WATCH:] = np.ravel(known)
     arr[W_START] = start
     arr[W_LEVEL] = level
