@@ -28,7 +28,7 @@ from .confirmation import (PLANT_COLOURS, SETTLE_ZOOM, deflection_figure, error_
                            motion_end, plant_names)
 from .figure import (RASTER_DPI, REPORT_RC, REPORT_WIDTH, cell_edges, decimate, figure_bytes,
                      figure_markup, figure_svg, log_x, nice_ticks, plain_tick, png_img,
-                     raster_dpi, raster_figures, report_figure, styled)
+                     raster_dpi, raster_figures, report_figure, rgb_png, styled)
 from .hunting import MOVE_MARKS, boundary_figure, cycle_figure, moves_figure
 from .identification import force_velocity_figure, residual_figure
 from .labels import QUANTITY_NAMES, axis_label, display_unit, quantity_name
@@ -50,7 +50,7 @@ __all__ = [
     "error_figure", "figure_bytes", "figure_markup", "figure_svg", "force_velocity_figure", "gap_overlay_figure",
     "gap_residual_figure", "log_x", "motion_end", "moves_figure", "nice_ticks", "nyquist_figure",
     "out_of_band_crossovers", "plain_tick", "plant_names", "png_img", "raster_dpi",
-    "raster_figures", "quantity_name", "recommend_figure",
+    "raster_figures", "rgb_png", "quantity_name", "recommend_figure",
     "report_figure", "residual_figure", "robustness_figure", "sensitivity_figure",
     "structure_figure", "study_figure", "styled", "sweep_figure",
 ]

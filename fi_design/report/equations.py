@@ -9,7 +9,6 @@ report contexts.
 
 from __future__ import annotations
 
-import io
 import os
 import re
 
@@ -149,24 +148,20 @@ _INK = "#1d2329"
 
 def _draw_img(tex: str, dpi: float) -> str:
     """The ``<img>`` element of a formula at ``dpi`` (no cache)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.patches import PathPatch
 
-    from ..plots import png_img
+    from ..plots import png_img, rgb_png
 
     outline, box = _outline(tex)
     width, height = box.width + 2 * _MARGIN, box.height + 2 * _MARGIN
-    fig = Figure(figsize=(width / 72.0, height / 72.0), dpi=dpi)
-    fig.patch.set_alpha(0.0)
+    fig = Figure(figsize=(width / 72.0, height / 72.0), dpi=dpi, facecolor="white")
     ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
     ax.set_axis_off()
     ax.set_xlim(box.x0 - _MARGIN, box.x1 + _MARGIN)
     ax.set_ylim(box.y0 - _MARGIN, box.y1 + _MARGIN)
     ax.add_patch(PathPatch(outline, facecolor=_INK, edgecolor="none", linewidth=0.0))
-    buf = io.BytesIO()
-    FigureCanvasAgg(fig).print_png(buf, metadata={"Software": None})
-    return png_img(buf.getvalue(), width_pt=width, alt=math_text(tex))
+    return png_img(rgb_png(fig, dpi), width_pt=width, alt=math_text(tex))
 
 
 def _draw(tex: str) -> str:
