@@ -172,7 +172,11 @@ print_design(Console(file=io.StringIO(), width=100), result)
 mark("the console summary")
 from fi_design.report import build_context, render_html
 html = render_html(build_context(result))
-mark("the report: context, figures (matplotlib) and HTML")
+mark("the HTML report: context, figures (matplotlib, SVG) and HTML")
+from fi_design.plots import raster_figures
+with raster_figures():
+    html = render_html(build_context(result))
+mark("the PDF's context, figures (matplotlib, PNG) and HTML")
 import weasyprint
 mark("WeasyPrint's import")
 weasyprint.HTML(string=html).write_pdf()
