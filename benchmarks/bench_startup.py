@@ -161,7 +161,8 @@ from fi_design.confirm import confirm
 confirm(spec, None)
 mark("the confirmation (with and without isolator, crossover scans)")
 from fi_design import verdict
-study = verdict.run_robustness(spec, None)
+from fi_design.model import resolve
+study = verdict.run_robustness(resolve(spec), None)
 mark(f"the robustness study ({study.samples} samples, both plants)")
 result = design(spec)
 mark("design(spec) again, all of it in this process")
