@@ -243,9 +243,12 @@ def main() -> None:
         t0 = time.perf_counter()
         pc = python_control_run(spec, iso, spec.motion.duration)
         out["control"] = (time.perf_counter() - t0, pc)
-        t0 = time.perf_counter()
-        x = engineer_lsoda(spec, iso, spec.motion.duration)
-        out["yardstick"] = (time.perf_counter() - t0, x)
+        yard = []
+        for _ in range(3):  # best of 3, as the fast kernel is timed best of --repeat
+            t0 = time.perf_counter()
+            x = engineer_lsoda(spec, iso, spec.motion.duration)
+            yard.append(time.perf_counter() - t0)
+        out["yardstick"] = (min(yard), x)
 
         errors = {k: 1e6 * float(np.max(np.abs(x - tight.position))) for k, (_, x) in out.items()}
         total_fast += t_fast
@@ -263,8 +266,8 @@ def main() -> None:
               f"traces and metrics | {1e3 * t_fast:.2f} | 1 | {e_fast:.3f} |")
         print(f"| {name} | the kernel call alone (`kernel.run`) | {1e3 * t_kernel:.2f} | "
               f"{t_kernel / t_fast:.2f} | |")
-        for label, key in (("the yardstick: LSODA, rtol 1e-6, atol 1e-10, plain Python "
-                            "right-hand side, no Jacobian", "yardstick"),
+        for label, key in (("the yardstick (best of 3): LSODA, rtol 1e-6, atol 1e-10, plain "
+                            "Python right-hand side, no Jacobian", "yardstick"),
                            ("plain solve_ivp LSODA, rtol 1e-6, analytic Jacobian", "LSODA"),
                            ("plain solve_ivp Radau, rtol 1e-6, analytic Jacobian", "Radau"),
                            ("python-control input_output_response (LSODA, no events)",
