@@ -309,3 +309,27 @@ def test_the_watch_lands_on_the_section_and_leaves_the_trajectory_alone(paper_sp
     assert np.allclose(watched.crossing_times, tc[:len(watched.crossing_times)], atol=1e-5)
     # the section only splits steps: the trajectory is the same within the tolerance
     assert np.nanmax(np.abs(watched.states[:, 0] - plain.states[:, 0])) < 1e-6
+
+
+def test_a_move_entering_a_known_cycle_stops_there_with_the_same_answer(paper_spec,
+                                                                       monkeypatch):
+    """The match rule (a move stops once its section state is within MATCH of a cycle an
+    earlier move repeated) changes when a move stops, not how the stage ends: against the
+    family run with the rule off, every move has the same outcome and every hunting move's
+    cycle the same amplitude and period within the repeat tolerance's reach."""
+    from fi_design.stage import moves
+
+    spec = paper_spec
+    fast, runs = stage_hunts(spec, True, crossover=5.0)
+    monkeypatch.setattr(moves, "MATCH", 0.0)  # the kernel's rule off: every move to its repeat
+    slow, _ = stage_hunts(spec, True, crossover=5.0)
+    assert [m.outcome for m in fast] == [m.outcome for m in slow]
+    matched = [(f, s) for f, s in zip(fast, slow) if "enters the cycle" in f.reason]
+    assert len(matched) >= 5, [m.reason for m in fast]
+    for f, s in zip(fast, slow):
+        if f.hunts:
+            assert f.amplitude == pytest.approx(s.amplitude, rel=2e-3)
+            assert f.period == pytest.approx(s.period, rel=2e-3)
+    # and it stopped earlier: the point of the rule
+    assert sum(f.time for f, _ in matched) < 0.8 * sum(s.time for _, s in matched)
+    assert all(r.cycle_states is not None for r in runs if r.outcome.hunts)
