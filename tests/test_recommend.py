@@ -17,12 +17,21 @@ import pytest
 from fi_design.recommend import recommend
 from fi_design.stage import stage_hunts
 
-from conftest import variant
+from conftest import remember, variant
 
 
 @pytest.fixture(scope="module")
-def paper_recommendation(paper_spec):
-    return recommend(paper_spec)
+def paper_search(paper_spec):
+    """The design search on the paper setup and what it said as it went, run once."""
+    said: list[str] = []
+    found = recommend(paper_spec, progress=said.append)
+    remember("recommend", paper_spec, found)
+    return found, said
+
+
+@pytest.fixture(scope="module")
+def paper_recommendation(paper_search):
+    return paper_search[0]
 
 
 def test_paper_recommendation_passes_where_the_spec_fails(paper_recommendation, paper_spec):
@@ -47,14 +56,13 @@ def test_paper_recommendation_passes_where_the_spec_fails(paper_recommendation, 
     assert {"crossover", "binding", "stage_hunting", "robustness", "margins"} <= set(data)
 
 
-def test_the_recommendation_has_the_most_margin_the_search_found(paper_spec):
+def test_the_recommendation_has_the_most_margin_the_search_found(paper_search):
     """The map's best point that passes is refined along the stiffness between its map
     neighbours; the answer has the largest crossover factor of every point judged (factors
     equal to the fold's 0.1 % resolution are ties), and of ties the softest joint (on the
     paper setup the corner of the map: the longest stroke and the lowest stiffness, as the
     paper has it)."""
-    said: list[str] = []
-    r = recommend(paper_spec, progress=said.append)
+    r, said = paper_search
     d = r.design
     judged = [c for c in r.candidates if c.crossover_factor is not None
               and c.status in ("feasible", "not_evaluated")]

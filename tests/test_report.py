@@ -581,7 +581,7 @@ def test_cli_map_needs_a_report(monkeypatch, paper_spec_path):
     assert r.exit_code == 2 and "--report" in r.output
 
 
-def test_cli_writes_the_html_report_with_force(tmp_path, paper_spec_path):
+def test_cli_writes_the_html_report_with_force(tmp_path, paper_spec_path, shared_designs):
     out = tmp_path / "report.html"
     out.write_text("old")
     r = runner.invoke(app, [str(paper_spec_path), "--report", str(out), "--force"])
