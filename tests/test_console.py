@@ -8,6 +8,7 @@ width would set it.
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import pytest
 from rich.console import Console
@@ -136,8 +137,11 @@ def test_a_wide_map_prints_whole_axis_values_in_blocks(paper_spec_path):
         assert values == pytest.approx([2 + 18 * i / 19 for i in range(20)], rel=6e-3), headers
 
 
-def test_a_map_too_wide_to_print_names_its_file(paper_spec_path, tmp_path):
-    csv = tmp_path / "line.csv"
+def test_a_map_too_wide_to_print_names_its_file(paper_spec_path, tmp_path, monkeypatch):
+    # a path relative to the working folder: a temporary folder's full path (longer under
+    # pytest-xdist) is cut across lines at 80 columns
+    monkeypatch.chdir(tmp_path)
+    csv = Path("line.csv")
     out = _run(["sweep", str(paper_spec_path), "--x", "controller.crossover=2 Hz:20 Hz:70",
                 "--csv", str(csv), "-j", "1"], 80)
     flat = " ".join(out.split())
