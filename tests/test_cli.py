@@ -209,10 +209,12 @@ def test_mistyped_command_gets_a_hint():
 
 
 def test_installed_entry_point(tmp_path, paper_spec_path):
+    """The console script in a process of its own, simulation included; the design search
+    (--no-recommend here) runs in this file's CliRunner run and in test_console's."""
     exe = BIN / "fi-design"
     assert exe.exists(), f"{exe}: the package is not installed (pip install -e .)"
     out = tmp_path / "r.json"
-    p = subprocess.run([str(exe), str(paper_spec_path), "--json", str(out)],
+    p = subprocess.run([str(exe), str(paper_spec_path), "--json", str(out), "--no-recommend"],
                        capture_output=True, text=True, timeout=300, cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     assert "Conclusion" in p.stdout
