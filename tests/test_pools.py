@@ -56,7 +56,8 @@ def test_the_error_path_ends_only_the_pools_own_workers():
         bystander.join()
 
 
-def test_the_design_pool_starts_before_the_spinner(paper_spec_path, tmp_path, monkeypatch):
+def test_the_design_pool_starts_before_the_spinner(paper_spec_path, tmp_path, monkeypatch,
+                                                   shared_designs):
     """Fork and threads do not mix: when the spinner (a thread on a terminal) starts, the
     confirmation's workers must already be running."""
     from typer.testing import CliRunner

@@ -379,7 +379,8 @@ def quick_specs(tmp_path_factory):
     ("no_isolator", ["--fail-on", "fail"], 3),
     ("no_isolator", ["--fail-on", "warn"], 3),
 ])
-def test_fail_on_exit_codes(quick_specs, tmp_path, name, option, code):
+def test_fail_on_exit_codes(quick_specs, tmp_path, name, option, code, shared_designs):
+    """Each spec's design computed once (:func:`shared_designs`), its exit code per option."""
     out = tmp_path / "r.json"
     r = runner.invoke(app, [str(quick_specs[name]), "--json", str(out), *option])
     assert r.exit_code == code, r.output
