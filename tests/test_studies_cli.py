@@ -129,7 +129,8 @@ def test_robustness_reproducible_with_seed(paper_spec_path, tmp_path):
     a, b = outs
     assert a["draws"] == b["draws"] and a["points"] == b["points"]
     assert a["isolated"]["probability"] == b["isolated"]["probability"]
-    assert a["scatter"][1] == {"path": "friction.coulomb", "spread": 0.1, "relative": False}
+    assert a["scatter"][1] == {"path": "friction.coulomb", "spread": 0.1, "relative": False,
+                               "meaning": ""}
 
 
 @pytest.mark.parametrize("args,words", [
