@@ -105,6 +105,9 @@ def write_figures(result) -> list[Path]:
     figures = {"moves": plots.moves_figure(result.simulation),
                "cycle": plots.cycle_figure(result.simulation, result.spec),
                "boundary": plots.boundary_figure(result.simulation)}
+    if result.flexure is not None and result.flexure.mechanics is not None:
+        body = result.model.body
+        figures["guide"] = plots.guide_figure(result.flexure.mechanics, body.size)
     if result.recommendation is not None and result.recommendation.search is not None:
         figures["design_space"] = plots.recommend_figure(result.recommendation.search)
     written = []
