@@ -16,9 +16,10 @@ from typing import Any
 
 from ..display import NBSP, quantity, scale
 from ..results import Status
+from ..results.stage import STATIC_ERROR_FORMULA
 from .filters import display_scale, num, qty
 
-__all__ = ["STEP_SOURCES", "SENSE", "STATUS_TEXT", "BEHAVIOUR", "check_label", "check_row",
+__all__ = ["PERCENT_CHECKS", "STEP_SOURCES", "SENSE", "STATUS_TEXT", "BEHAVIOUR", "check_label", "check_row",
            "key_figures", "verdict"]
 
 #: The verdict's status as printed.
@@ -48,6 +49,7 @@ STEP_SOURCES = {
     "step 4 PID": "step 4; paper \u00a72.2",
     "simulation (paper section 2.3)": "simulation; paper \u00a72.3, Fig. 5",
     "robustness under friction scatter": "simulation under friction scatter",
+    "positioning": "requirements.positioning, every move simulated",
 }
 
 #: Requirement sense of each check (by name, or by the name's part before the first dot).
@@ -58,7 +60,12 @@ SENSE = {
     "flexure.buckling": "\u2265", "flexure.modes": "\u2265", "flexure.sag": "<",
     "simulation_isolated": "=", "min_crossover_isolated": "\u2264", "landing_force": "<",
     "simulation_non_isolated": "=", "min_crossover_non_isolated": "\u2264", "robustness": "\u2264",
+    "positioning": "\u2264",
 }
+
+
+#: Checks whose value is a probability [-], shown in % wherever it is printed.
+PERCENT_CHECKS = frozenset({"robustness"})
 
 
 def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
@@ -103,6 +110,9 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
         "robustness": "Probability of not settling under friction scatter",
         "friction_model_cross_check": "Cross-check with the other friction model",
     }
+    if head == "positioning":
+        return {"settle_time": "Settle time after every move",
+                "static_error": "Static error after every move"}.get(tail, name)
     flex = {"stiffness": "Flexure net drive stiffness within k_max",
             "stress": "Flexure stress at full stroke",
             "buckling": "Flexure buckling load over the stage's weight",
@@ -113,7 +123,7 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
     if head == "pid" and tail == "tuning_mass":
         return "PID tuning mass"
     if head == "pid" and tail == "integrator":
-        return "Loop without integrator: static error up to Fc / kp"
+        return f"Loop without integrator: static error up to {STATIC_ERROR_FORMULA}"
     return labels.get(head, name.replace("_", " ").capitalize())
 
 
@@ -146,6 +156,8 @@ def check_row(check: Any, cases: Mapping[str, Any] | None = None) -> dict:
     shown, factor = display_scale(check.unit, ref)
     if check.unit == "cycles":
         shown = "cycles"
+    if check.name in PERCENT_CHECKS:  # a probability reads in %, as the key figures give it
+        shown, factor = "%", 100.0
 
     def conv(x):
         if x is None or not isinstance(x, (int, float)) or isinstance(x, bool):
@@ -217,7 +229,7 @@ def key_figures(result: Any) -> list[dict]:
             bad = next(m for m in st.moves if m.outcome in ("stuck", "rests", "undetermined"))
             note = f"after the {qty(abs(bad.distance), 'm')} move: {bad.reason}"
         need = ("no move hunts" if st.static_error_bound is None
-                else f"every move rests within {qty(st.static_error_bound, 'm')}")
+                else f"every move rests within {qty(st.static_error_bound, 'm', 3)}")
         short = {"stuck": "sticks", "static_error": "static error",
                  "settles": "settles"}.get(st.outcome, BEHAVIOUR[st.outcome][1])
         rows.append(_figure(f"Every move of the family at {qty(fc, 'Hz')}", short, "", need,
@@ -228,11 +240,21 @@ def key_figures(result: Any) -> list[dict]:
                 f"{_pct(rob.interval[1])} %; {rob.hunting} of {rob.valid} valid samples")
         if rob.comparison is not None and rob.comparison["hunting_probability"] is not None:
             other = ("without the isolator" if rob.comparison["plant"] == "non_isolated"
-                     else "with the suggested isolator")
+                     else "with the rule's isolator")
             note += f"; {other}: {_pct(rob.comparison['hunting_probability'])} %"
         rows.append(_figure("Probability of not settling under friction scatter",
                             _pct(rob.hunting_probability), "%", f"\u2264 {_pct(rob.limit)}",
                             note, css))
+    pos = result.positioning
+    if pos is not None:
+        for c in result.checks:
+            if not c.name.startswith("positioning."):
+                continue
+            unit = "s" if c.name.endswith("settle_time") else "m"
+            rows.append(_figure(check_label(c.name), "never" if c.value is None else c.value,
+                                unit if c.value is not None else "", f"\u2264 {qty(c.limit, unit)}",
+                                f"requirements.positioning, band \u00b1{qty(pos.band, 'm')}",
+                                c.status.value.lower(), 3))
     if m is None:
         return rows
     if m.crossover_factor is not None:
@@ -279,8 +301,8 @@ def key_figures(result: Any) -> list[dict]:
     if m.static_error is not None:
         ok = m.static_error <= m.static_error_bound + spec.requirements.hunting.settle_band
         rows.append(_figure("Static error at rest (loop without integrator)", m.static_error,
-                            "m", f"\u2264 {qty(m.static_error_bound, 'm')}",
-                            "(Fc + |offset|) / kp", "pass" if ok else "fail", 3))
+                            "m", f"\u2264 {qty(m.static_error_bound, 'm', 3)}",
+                            STATIC_ERROR_FORMULA, "pass" if ok else "fail", 3))
     return rows
 
 
@@ -299,7 +321,8 @@ def verdict(result: Any) -> dict:
         (as printed), ``css`` (pass, warn, fail), ``behaviour`` (the stamp),
         ``behaviour_css``, ``headline``, ``reasons`` (``severity``, ``css``,
         ``text``), ``figures`` (:func:`key_figures`), ``notes`` (margins not
-        reported, and why), ``recommendation`` (text or None), ``counts`` and
+        reported, and why), ``recommendation`` (text or None), ``next_step``
+        (after a FAIL, the command that searches a design that passes), ``counts`` and
         ``total`` of the checks, ``groups`` (``step``, ``title``, ``rows`` of
         :func:`check_row`) and ``conclusion``.
     """
@@ -318,7 +341,7 @@ def verdict(result: Any) -> dict:
     if v.status == "FAIL" and behaviour_css in ("settles", "static-error"):
         behaviour_css, stamp = NOMINAL
     return {
-        "status": v.status, "overall": STATUS_TEXT[v.status], "css": css,
+        "status": str(v.status), "overall": STATUS_TEXT[v.status], "css": css,
         "behaviour": stamp, "behaviour_css": behaviour_css, "headline": v.headline,
         "reasons": [{"severity": r.severity, "css": r.severity.lower(), "text": r.text}
                     for r in v.reasons],
@@ -326,6 +349,7 @@ def verdict(result: Any) -> dict:
         "notes": list(result.margins.notes) if result.margins is not None else [],
         "recommendation": None if result.recommendation is None
         else result.recommendation.text,
+        "next_step": v.next_step,
         "counts": [{"status": s, "count": n, "css": s.lower()} for s, n in counts.items()],
         "total": len(rows),
         "groups": groups,
@@ -343,5 +367,6 @@ def _step_title(step: str) -> str:
         "simulation (paper section 2.3)": "Nonlinear confirmation (simulated hunting)",
         "step 3 refinement: landing": "Step 3 refinement \u2013 where the cart comes to rest",
         "robustness under friction scatter": "Robustness under friction scatter",
+        "positioning": "Positioning after every move (requirements.positioning)",
     }
     return titles.get(step, step[:1].upper() + step[1:] if step else "Other")
