@@ -542,3 +542,13 @@ def test_the_docs_quote_a_fresh_run(example_designs, repo_root):
         assert len(distinct([float(said), got])) == 1, (said, got)
     m = re.search(rf"`margins.hunting_free_crossover`, ({NUM}) Hz", library)
     assert m and len(distinct([float(m.group(1)), r.margins.hunting_free_crossover])) == 1
+
+
+def test_the_docs_name_the_one_static_error_bound(repo_root):
+    """The bound was stated as Fc / kp, (Fc + |offset|) / kp and (Fs + |offset|) / kp."""
+    from fi_design.results.stage import STATIC_ERROR_FORMULA
+
+    for page in [repo_root / "README.md", *sorted((repo_root / "docs").glob("*.md"))]:
+        text = page.read_text(encoding="utf-8")
+        for m in re.finditer(r"\(F[sc] \+ \|offset\|\) / kp|\bF[sc] / kp\b", text):
+            assert m.group(0) == STATIC_ERROR_FORMULA, (page.name, m.group(0))

@@ -221,8 +221,8 @@ def key_figures(result: Any) -> list[dict]:
         c = st.cycle
         if st.hunts:
             note = (f"{len(st.hunting_moves)} of {len(st.moves)} moves end in "
-                    + (f"a cycle of {qty(c.amplitude, 'm')} peak to peak, period "
-                       f"{qty(c.period, 's')}" if c is not None else "a cycle"))
+                    + (f"a cycle of {qty(c.amplitude, 'm', 3)} peak to peak, period "
+                       f"{qty(c.period, 's', 3)}" if c is not None else "a cycle"))
         elif st.outcome in ("settles", "static_error"):
             note = f"all {len(st.moves)} moves of the family come to rest"
         else:

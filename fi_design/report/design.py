@@ -244,13 +244,17 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "How the stage ends after each move of its family: the cycle's peak to peak for a "
             "move that hunts (filled), 0 for one that comes to rest (open); the star is the "
             "spec's own motion.", fig_no()),
-        "cycle": figure_entry(
+        # the cycles' and the boundary's figures only where a plant hunts or a boundary was
+        # found: no empty phase portrait, no boundary axis for a loop without integrator
+        "cycle": None if not any(st.cycle is not None for st in sim.stage.values()) else
+        figure_entry(
             (lambda: plots.cycle_figure(sim, spec)) if figures else None, "cycle",
             "The hunting cycles: phase portraits (left), the isolated stage's joint deflection "
             "over one period against its stroke (middle), and the settling after the spec's "
             f"own motion in the \u00b1{num(h.settle_band * 1e6)} \u00b5m settle band (right).",
             fig_no()),
-        "boundary": figure_entry(
+        "boundary": None if not any((st.boundary or {}).get("branch")
+                                    for st in sim.stage.values()) else figure_entry(
             (lambda: plots.boundary_figure(sim)) if figures else None, "boundary",
             "The stage-level boundary: the peak to peak of each plant's hunting cycle as the "
             "crossover rises, up to the cycle's fold (dotted), from which no move of the "
@@ -267,6 +271,8 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "deflection": land.deflection, "stroke": land.stroke, "force": land.force,
             "static_friction": land.static_friction, "rule_force": land.rule_force,
             "on_limiter": "yes" if land.on_limiter else "no",
+            # the one judged statement of the landing: the check's
+            "text": next(c.message for c in result.checks if c.name == "landing_force"),
         },
         "models_agree": sim.models_agree,
         "cross_check": (
