@@ -433,8 +433,8 @@ def simulated_isolator_advice(spec: Any, gap: Any, simulation: Confirmation, rul
             f"{iso.summary()}: an isolator is needed, and that one is a start"), *isolator)
     return IsolatorAdvice(True, (
         f"the stage as specified {own.summary()}, and {rule} {iso.summary()} too: an "
-        "isolator is needed, but not that one; the design search finds one that passes "
-        f"({recommend_command(spec)})"), *isolator)
+        "isolator is needed, but not that one; the design search looks for one that "
+        f"passes ({recommend_command(spec)})"), *isolator)
 
 
 # --------------------------------------------------------------------------- verdict
@@ -620,8 +620,8 @@ def recommend_command(spec: Any) -> str:
 
 def _next_step(model: Model) -> str:
     """What to run after a FAIL: the design search, with this spec's path."""
-    return (f"{recommend_command(model.spec)} runs the design search and writes the design "
-            "that passes into a copy of the spec")
+    return (f"{recommend_command(model.spec)} runs the design search and writes its design "
+            "into a copy of the spec")
 
 
 #: Warnings that are neither a check nor a spec value, as the headline counts them.

@@ -552,3 +552,27 @@ def test_the_docs_name_the_one_static_error_bound(repo_root):
         text = page.read_text(encoding="utf-8")
         for m in re.finditer(r"\(F[sc] \+ \|offset\|\) / kp|\bF[sc] / kp\b", text):
             assert m.group(0) == STATIC_ERROR_FORMULA, (page.name, m.group(0))
+
+
+@pytest.mark.slow
+def test_a_failing_design_with_its_recommendation_reads_as_one():
+    """With the design search on (the default), the advice box and the conclusion agree:
+    the conclusion never advises the rule's isolator the report shows hunting, and the
+    recommendation is the search's design (a minute on two cores)."""
+    from fi_design.signoff import design
+    from fi_design.specfile import load_spec
+
+    r = design(load_spec(EXAMPLES / "no_isolator.yaml"))
+    rec = r.recommendation
+    assert r.verdict.status == "FAIL" and rec is not None
+    assert "not that one" in r.isolator_advice.reason and "start from" not in r.conclusion
+    doc = console_text(r)
+    assert rec.text in doc.replace("\n", " ") or rec.text[:40] in doc
+    if rec.feasible:
+        from fi_design.specpaths import with_values
+
+        values = {"isolator": {k: v for k, v in rec.isolator.items() if v is not None}}
+        if rec.crossover is not None:
+            values["controller.crossover"] = rec.crossover
+        again = design(with_values(r.spec, values), recommend=False)
+        assert again.simulation.stage["isolated"].acceptable
