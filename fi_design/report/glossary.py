@@ -30,8 +30,9 @@ GLOSSARY = (
                               "cycle returns to the same state there every period",
      r"Poincar"),
     ("Floquet multiplier", "how much a small disturbance of the cycle grows per period (the "
-                           "largest eigenvalue of the return map at the Poincar\u00e9 section): "
-                           "below 1 the cycle attracts the motion, above 1 it repels it",
+                           "largest eigenvalue of the Jacobian of the return map at the "
+                           "Poincar\u00e9 section): below 1 the cycle attracts the motion, "
+                           "above 1 it repels it",
      r"Floquet"),
     ("fold", "the crossover at which the hunting cycle meets its unstable twin and vanishes: "
              "above the fold no move of the family can end in that cycle, so it is the lowest "
