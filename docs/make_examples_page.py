@@ -43,8 +43,10 @@ def _plant_cells(st) -> list[str]:
 
     cycle = "-" if st.cycle is None else (f"{quantity(st.cycle.amplitude, 'm', 3)}, "
                                           f"{quantity(st.cycle.period, 's', 3)}")
+    free = ("not computed (no integrator)" if st.boundary is None
+            else _hz(st.hunting_free_from))
     return [st.outcome.replace("_", " "), f"{len(st.hunting_moves)}/{len(st.moves)}", cycle,
-            _hz(st.hunting_free_from)]
+            free]
 
 
 def _suggested(result) -> str:
@@ -71,7 +73,7 @@ def table(results: dict) -> str:
         for key, label in (("isolated", "with isolator"), ("non_isolated", "without")):
             st = stage[key]
             if key == "isolated" and result.simulation.suggested_isolator:
-                label = "with the suggested isolator"
+                label = "with the rule's isolator (for comparison)"
             first = key == "isolated"
             rows.append("| " + " | ".join(
                 [f"`{name}`" if first else "", label, f"{st.crossover:.3g}",

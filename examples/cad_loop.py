@@ -13,10 +13,7 @@ Run from anywhere:  python examples/cad_loop.py
 
 from __future__ import annotations
 
-import copy
 from pathlib import Path
-
-import yaml
 
 import fi_design
 
@@ -29,19 +26,15 @@ def main() -> None:
     print(f"{base_spec.name}: Fs = {base_spec.friction.static:.3g} N, "
           f"m1 + m2 = {base_spec.total_mass:.3g} kg")
 
-    # The same file as a plain mapping, to modify and re-validate: values may be
-    # strings with units, exactly as in YAML.
-    with open(HERE / "paper_setup.yaml", encoding="utf-8") as fh:
-        mapping = yaml.safe_load(fh)
-
     print(f"{'stroke [mm]':>12} {'k_max [N/m]':>12} {'k [N/m]':>10} {'achievable fc [Hz]':>19}"
           f"  status")
     for stroke_mm in (0.1, 0.2, 0.3, 0.5):
-        variant = copy.deepcopy(mapping)
-        variant["isolator"]["stroke"] = f"{stroke_mm} mm"
-        variant["isolator"].pop("stiffness", None)  # let step 3 choose k
-        variant["isolator"].pop("damping", None)    # default: damping ratio 0.05 of the joint
-        spec = fi_design.load_spec(variant)         # raises fi_design.SpecError on bad values
+        # values at dotted paths, as the YAML file takes them (strings with units or SI
+        # numbers), validated again: fi_design.SpecError names the path of a bad one
+        spec = fi_design.with_values(base_spec, {
+            "isolator.stroke": f"{stroke_mm} mm",
+            "isolator.stiffness": None,   # let step 3 choose k
+            "isolator.damping": None})    # default: the joint mode's damping ratio
         result = fi_design.design(spec, confirm=False).to_dict()  # linear steps only
         stiffness = result["stiffness"]
         crossover = result["crossover"]

@@ -11,6 +11,7 @@ reports.
 The public API (imported lazily, so ``import fi_design`` stays fast):
 
 - :func:`load_spec` -- read and validate a YAML spec or a mapping;
+- :func:`with_values` -- the spec with values replaced at dotted paths, validated again;
 - :func:`design` -- the four guideline steps, the simulated confirmation and
   the sign-off verdict, with a recommendation that passes when it fails;
 - :func:`recommend` -- search the isolator and crossover for a design that passes;
@@ -46,6 +47,7 @@ except PackageNotFoundError:  # running from a source tree without install
 
 _API = {
     "load_spec": "fi_design.specfile",
+    "with_values": "fi_design.specpaths",
     "Spec": "fi_design.spec",
     "design": "fi_design.signoff",
     "recommend": "fi_design.recommend",

@@ -121,7 +121,8 @@ def design_command(
     with confirmation_pool(not no_simulation) as pool, \
             Status(err, "running the design guideline ...") as status:
         result = design(spec_obj, confirm=not no_simulation, executor=pool, progress=status,
-                        recommend=not no_recommend, fe_check=outs["report"] is not None)
+                        recommend=not no_recommend, fe_check=outs["report"] is not None,
+                        sensitivity=outs["report"] is not None)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
     if outs["spec"] is not None:
         from .handoff import gains_spec_text

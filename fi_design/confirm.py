@@ -29,7 +29,8 @@ reason to pass.
 
 A loop without integrator (``controller.gains.ki: 0`` or
 ``integrator_ratio: .inf``) cannot hunt by the paper's mechanism: it comes to
-rest with a static error of up to (Fc + |offset|) / kp. At rest within that
+rest with a static error of up to (Fs + |offset|) / kp, what static friction can hold
+against it (:attr:`fi_design.model.Model.static_error_bound`). At rest within that
 error its outcome is ``static_error``, not ``stuck``
 (:class:`~fi_design.results.design.PlantVerdict`).
 """
@@ -39,12 +40,13 @@ from __future__ import annotations
 import math
 
 from . import spec as _spec
-from .display import quantities, quantity
+from .display import number, quantities, quantity
 from .errors import ArgumentError
 from .model import Model, as_model
 from .results import Check, Status
 from .results.design import Confirmation, Landing, PlantVerdict
 from .results.simulation import SimulationResult
+from .results.stage import STATIC_ERROR_FORMULA
 from .simulation import simulate
 from .stage.forces import move_forces
 from .stage import stage_hunting
@@ -91,9 +93,10 @@ def with_isolator(spec: _spec.Spec, stroke: float, stiffness: float) -> _spec.Sp
 def static_error_bound(model: Model | _spec.Spec) -> float | None:
     """The static error a loop without integrator may leave against friction [m].
 
-    ``(max(Fc, Fc_negative) + |offset|) / kp``: the cart comes to rest once the
-    loop's force no longer overcomes the sliding friction (and the load
-    offset); None when the loop integrates.
+    :attr:`fi_design.model.Model.static_error_bound`, ``(Fs + |offset|) / kp``
+    with the larger static friction of the two directions: the cart stays put
+    while the loop's force stays below static friction; None when the loop
+    integrates. The one bound every statement of the design names.
 
     Parameters
     ----------
@@ -104,9 +107,7 @@ def static_error_bound(model: Model | _spec.Spec) -> float | None:
     -------
     float or None
     """
-    model = as_model(model)
-    f = model.friction
-    return model.law.static_error(max(f.coulomb(1), f.coulomb(-1)) + abs(model.offset))
+    return as_model(model).static_error_bound
 
 
 def _other_model(model: Model) -> Model:
@@ -219,9 +220,9 @@ def _plant_text(v: PlantVerdict, label: str, fc: float) -> str:
     m = v.metrics
     if v.outcome == "static_error":
         rest, bound = quantities((abs(m.final_error), v.static_error_bound), "m", 3)
-        return (f"{label} at {fc:g} Hz: at rest {rest} from its target, within the static "
-                f"error (Fc + |offset|) / kp = {bound} of a loop without integrator (not stuck)")
-    return f"{label} at {fc:g} Hz: {m.verdict} ({m.reason})"
+        return (f"{label} at {number(fc, 4)} Hz: at rest {rest} from its target, within the static "
+                f"error {STATIC_ERROR_FORMULA} = {bound} of a loop without integrator")
+    return f"{label} at {number(fc, 4)} Hz: {m.verdict} ({m.reason})"
 
 
 def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
@@ -230,11 +231,10 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
     fc = model.crossover
     margin = model.requirements.hunting_margin
     step = "simulation (paper section 2.3)"
-    integrates = iso.static_error_bound is None
     if suggested:
         own_key, labels = "non_isolated", {
             "non_isolated": "the stage as specified (without isolator)",
-            "isolated": "with the suggested isolator (a recommendation, not the hardware)"}
+            "isolated": "with the rule's isolator (for comparison, not the hardware)"}
     else:
         own_key, labels = "isolated", {
             "isolated": "the isolated design as specified",
@@ -260,19 +260,11 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
         st = stage[key]
         m = mins[key]
         judged = key == own_key
-        b = st.boundary or {}
-        how = (f"the fold of its cycle, bisected to {b['resolution']:.2g} Hz"
-               if b.get("kind") == "fold" else b.get("note", "not computed"))
-        text = (f"{labels[key]}: " + ("no move of the family hunts from "
-                                      f"{m:.4g} Hz up" if m is not None
-                                      else "hunts for some move up to the top of the search")
-                + f" ({how}); design crossover {fc:g} Hz")
-        if not judged:
+        text = f"{labels[key]}: {st.boundary_text()}; design crossover {number(fc, 4)} Hz"
+        if st.boundary is None:  # not computed: a loop without integrator
+            out.append(Check(f"min_crossover_{key}", None, None, None, "Hz", text, step))
+        elif not judged:
             out.append(Check(f"min_crossover_{key}", None, m, None, "Hz", text, step))
-        elif not integrates:
-            out.append(Check(f"min_crossover_{key}", None, m, fc, "Hz", text + (
-                "; the loop has no integrator, so it rests with a static error rather than "
-                "hunting"), step))
         elif m is None:
             out.append(Check(f"min_crossover_{key}", False, m, fc, "Hz", text + (
                 ": a crossover that ends hunting was not found"), step, status=Status.WARN))
@@ -291,20 +283,27 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
                 + ("" if st.hunts else " although no move of the family enters it")),
                 step, status=Status.WARN))
     stn = stage["non_isolated"]
-    if not stn.hunts:
+    if stn.acceptable:
         out.append(Check("isolator_needed", None, None, None, "-",
-                         f"the stage without isolator does not hunt after any move at {fc:g} "
-                         f"Hz ({stn.outcome.replace('_', ' ')}): the isolator is not needed at "
-                         "this crossover", step))
+                         f"the stage without isolator {stn.summary()}: the isolator is not "
+                         "needed at this crossover", step))
     if land is not None:
         ok = (not land.on_limiter) and land.force < land.static_friction
-        where = "the suggested isolator's cart" if suggested else "the cart"
-        out.append(Check(
-            "landing_force", None if suggested else ok, land.force, land.static_friction, "N",
-            f"{where} lands at {quantity(land.deflection, 'm', 3)} joint deflection "
-            f"({'on the limiter' if land.on_limiter else 'inside the stroke'}): flexure force "
-            f"k min(|d|, s) = {land.force:.3g} N against Fs = {land.static_friction:.3g} N "
-            f"(the rule's bound k s = {land.rule_force:.3g} N)", "step 3 refinement: landing"))
+        where = "the rule's isolator's cart" if suggested else "the cart"
+        d = quantity(land.deflection, 'm', 3)
+        if land.on_limiter:
+            text = (f"{where} lands at {d} joint deflection, on the limiter (stroke "
+                    f"{quantity(land.stroke, 'm', 3)}): the end stop, not the flexure, holds "
+                    "the cart, so the controller pushes on the friction again and hunting can "
+                    f"return (the flexure alone would push with k s = {land.rule_force:.3g} N "
+                    f"against Fs = {land.static_friction:.3g} N)")
+        else:
+            text = (f"{where} lands at {d} joint deflection (inside the stroke): flexure force "
+                    f"k min(|d|, s) = {land.force:.3g} N against Fs = "
+                    f"{land.static_friction:.3g} N (the rule's bound k s = "
+                    f"{land.rule_force:.3g} N)")
+        out.append(Check("landing_force", None if suggested else ok, land.force,
+                         land.static_friction, "N", text, "step 3 refinement: landing"))
     if not agree:
         other = {"isolated": other_iso, "non_isolated": other_non}
         own_differs = _hunts(other[own_key]) != _hunts(plants[own_key])

@@ -45,10 +45,12 @@ from .mechanism.checks import flexure_checks
 from .model import Model, as_model
 from .results import Check, Status, frozen_array
 from .results.controller import ControlLaw
+from .results.stage import STATIC_ERROR_FORMULA
 from .results.design import (CaseResponse, Confirmation, CrossoverResult, DesignResult,
                              FlexureResult, FrictionGapResult, IsolatorAdvice, LoopResponses,
                              ModeSeparation, PidResult, StiffnessResult)
 from .spec import Spec, proposed_stiffness, stiffness_limit, warnings_for
+from .verdict import friction_gap_judged
 
 if TYPE_CHECKING:  # pragma: no cover
     from .execution import Executor
@@ -57,7 +59,7 @@ __all__ = [
     "SUGGESTED_STROKE", "FrictionGapResult", "ModeSeparation", "CrossoverResult",
     "StiffnessResult", "PidResult", "IsolatorAdvice", "DesignResult", "step1_friction_gap",
     "step2_crossover", "step3_stiffness", "step3_flexure", "step4_pid", "isolator_advice",
-    "design",
+    "friction_gap_judged", "design",
 ]
 
 log = logging.getLogger(__name__)
@@ -306,8 +308,9 @@ def step3_stiffness(model: Model | Spec) -> StiffnessResult:
         s = SUGGESTED_STROKE
         kmax = stiffness_limit(spec, s)
         k = proposed_stiffness(spec, s)
-        msg = (f"no isolator in the spec; for a {s * 1e3:.3g} mm stroke k_max = {_g(kmax)} N/m, "
-               f"start from k = {_g(k)} N/m (k_max / 2)")
+        msg = (f"no isolator in the spec; for a {s * 1e3:.3g} mm stroke (the paper's) the rule "
+               f"gives k_max = {_g(kmax)} N/m and k = k_max / 2 = {_g(k)} N/m: the isolator "
+               "simulated beside the stage for comparison")
         check = Check("drive_stiffness", None, k, kmax, "N/m", msg, step=step)
         return StiffnessResult(maximum=kmax, chosen=k, source="suggested: k_max / 2 for the "
                                "paper's 0.3 mm stroke (no isolator in the spec)", stroke=s,
@@ -395,7 +398,8 @@ def step4_pid(model: Model | Spec) -> PidResult:
         The gains and the loop's controller, with an informational check;
         tuning on the stage mass alone gives a WARN (the paper found the
         maximum moving mass best); a loop without integrator an INFO with its
-        static error Fc / kp (no hunting by the paper's mechanism).
+        static error bound (Fs + |offset|) / kp (no hunting by the paper's
+        mechanism; :attr:`fi_design.model.Model.static_error_bound`).
     """
     model = as_model(model)
     ctl = model.spec.controller
@@ -415,14 +419,17 @@ def step4_pid(model: Model | Spec) -> PidResult:
                f"{law.crossover:.4g} Hz on {law.tuning_mass:.4g} kg; the rule there would give "
                f"kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), kd = {_g(r['kd'])} N s/m "
                f"with a D roll-off of {r['roll_off'] / (2 * math.pi):.4g} Hz")
-        checks = [Check("pid", None, law.kp, r["kp"], "N/m", msg, step=step)]
-    static = law.static_error(model.friction.Fc)
+        # the rule's gains are a recommendation beside the hardware's, not a limit: they are in
+        # the message and the gains table, never in the limit column
+        checks = [Check("pid", None, law.kp, None, "N/m", msg, step=step)]
+    static = model.static_error_bound
     if static is not None:
         checks.append(Check(
             "pid.integrator", None, static, None, "m",
             f"the loop has no integrator: no hunting by the paper's mechanism (integral action "
-            f"building up through stiction), a static error instead of up to Fc / kp = "
-            f"{quantity(static, 'm', 3)} against the Coulomb friction", step=step))
+            f"building up through stiction), a static error instead, of up to "
+            f"{STATIC_ERROR_FORMULA} = {quantity(static, 'm', 3)}: what static friction can "
+            "hold against the loop", step=step))
     if ctl.tuning_mass == "stage" and model.has_isolator:
         checks.append(Check(
             "pid.tuning_mass", None, g.tuning_mass, model.total_mass, "kg",
@@ -447,8 +454,14 @@ def suggested_isolator(model: Model | Spec) -> tuple[float, float]:
 
 
 def isolator_advice(model: Model | Spec, gap: FrictionGapResult, crossover: CrossoverResult,
-                    ) -> IsolatorAdvice:
-    """For a stage without isolator: does one look needed, and where to start.
+                    simulation: Confirmation | None = None) -> IsolatorAdvice:
+    """For a stage without isolator: is one needed, and which one.
+
+    Before the simulation the linear steps can only say whether one looks
+    needed. Once the stage is simulated the advice reads the judged
+    stage-level answers, so it never advises what the same report shows
+    failing: the stage as specified, and the rule's first isolator
+    (:func:`suggested_isolator`) simulated beside it.
 
     Parameters
     ----------
@@ -458,23 +471,35 @@ def isolator_advice(model: Model | Spec, gap: FrictionGapResult, crossover: Cros
         Step 1.
     crossover : CrossoverResult
         Step 2.
+    simulation : Confirmation, optional
+        The simulated confirmation (:func:`fi_design.confirm.confirm`).
 
     Returns
     -------
     IsolatorAdvice
-        Needed when the friction gap is a hunting risk and the reachable
-        crossover is limited; not needed below the gap threshold; undecided
-        when the linear model sets no crossover limit within the scan.
+        Without simulation: needed when the friction gap is a hunting risk
+        and the reachable crossover is limited, not needed below the gap
+        threshold, undecided when the linear model sets no crossover limit.
+        With it: not needed when the stage as specified comes to rest after
+        every move; needed otherwise, starting from the rule's isolator when
+        every move comes to rest with it, else from the design search's
+        recommendation (``fi-design recommend``), the rule's isolator failing
+        too.
     """
     model = as_model(model)
     s, k = suggested_isolator(model)
     kmax = stiffness_limit(model.spec, s)
-    start = (f"start from a {s * 1e3:.3g} mm stroke (the paper's) and k = {_g(k)} N/m "
-             f"(Fs / (2 x stroke); k_max = {_g(kmax)} N/m)")
+    rule = (f"the rule's first isolator (a {s * 1e3:.3g} mm stroke, the paper's, and k = {_g(k)} "
+            f"N/m = Fs / (2 x stroke); k_max = {_g(kmax)} N/m)")
+    if simulation is not None:
+        from .verdict import simulated_isolator_advice
+
+        return simulated_isolator_advice(model.spec, gap, simulation, rule, (s, k, kmax))
+    start = f"{rule} is the one to simulate first"
     if not gap.hunting_risk:
         return IsolatorAdvice(False, f"the friction gap {gap.gap:.3g} N is below the "
-                              f"{gap.threshold:.3g} N threshold: an isolator is not needed",
-                              s, k, kmax)
+                              f"{gap.threshold:.3g} N threshold: an isolator looks not needed "
+                              "(the simulation decides)", s, k, kmax)
     if crossover.limit_kind == "scan_limit":
         return IsolatorAdvice(None, (
             f"the friction gap {gap.gap:.3g} N is a hunting risk, but the linear model limits "
@@ -484,8 +509,8 @@ def isolator_advice(model: Model | Spec, gap: FrictionGapResult, crossover: Cros
             f"isolator, {start}"), s, k, kmax)
     return IsolatorAdvice(True, (
         f"the friction gap {gap.gap:.3g} N is a hunting risk and the crossover is limited to "
-        f"{_g(crossover.achievable)} Hz ({crossover.limited_by}): an isolator is recommended; "
-        f"{start}"), s, k, kmax)
+        f"{_g(crossover.achievable)} Hz ({crossover.limited_by}): an isolator looks needed "
+        f"(the simulation decides); {start}"), s, k, kmax)
 
 
 # --------------------------------------------------------------------------- the design
@@ -503,7 +528,7 @@ def _sha256(spec: Spec) -> str:
 def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool = True,
            executor: Executor | None = None,
            progress: Callable[[str], None] | None = None,
-           fe_check: bool = False) -> DesignResult:
+           fe_check: bool = False, sensitivity: bool = False) -> DesignResult:
     """Run the four guideline steps on a spec and confirm them by simulation.
 
     The spec is resolved once (:func:`fi_design.model.resolve`) and every
@@ -540,6 +565,13 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
         second), the independent check of its closed forms, as
         ``flexure_fe``. Default False; skipped without a guide or without
         pyfe3d.
+    sensitivity : bool, optional
+        Also find the hunting-free crossover of the spec's own plant with the
+        unidentified LuGre values sigma0, sigma1 and vs divided and multiplied
+        by 3 (:func:`fi_design.studies.crossover_sensitivity`: six stage-level
+        answers, about a second each on the paper setup, on ``executor``), as
+        ``sensitivity``; the report's validation section shows it. Default
+        False; skipped for a loop without integrator.
 
     Returns
     -------
@@ -563,6 +595,7 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
     from . import __version__
     from . import verdict as _verdict
     from .confirm import confirm as run_confirmation
+    from .stage import positioning, positioning_checks
 
     if not isinstance(spec, Model):
         from .specfile import as_spec
@@ -618,13 +651,30 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
         sim = pending[0].result() if pending else \
             run_confirmation(model, suggestion, progress=progress)
         own = "isolated" if model.has_isolator else "non_isolated"
-        text = _conclusion(model, gap, xo, st, fx, pid, advice, checks,
-                           hunts=sim.stage[own].hunts)
-        result = replace(result, simulation=sim, checks=result.checks + sim.checks,
-                         conclusion=text + _simulation_sentence(model, sim))
+        # the stage-level answer decides: step 1 and the advice now read it
+        n_gap = len(gap.checks)
+        gap = _verdict.friction_gap_judged(gap, sim.stage[own], model.law.integrator)
+        checks = gap.checks + checks[n_gap:]
+        if not model.has_isolator:
+            advice = isolator_advice(model, gap, xo, sim)
+        text = _conclusion(model, gap, xo, st, fx, pid, advice, checks, simulated=True)
+        pos = positioning(model, sim.stage[own])
+        result = replace(result, friction_gap=gap, isolator_advice=advice,
+                         simulation=sim, positioning=pos,
+                         checks=checks + sim.checks + (() if pos is None
+                                                       else positioning_checks(pos)),
+                         conclusion=text + _verdict.simulation_sentence(sim))
     rob = None if study is None else _verdict.robustness_check(model, study)
     if rob is not None:  # a check like the others: the tally counts it
         result = replace(result, checks=result.checks + (_verdict.robustness_as_check(rob),))
+    if sensitivity and sim is not None:
+        from .studies import crossover_sensitivity
+
+        if progress is not None:
+            progress("the hunting-free crossover over sigma0, sigma1 and vs ...")
+        own = "isolated" if model.has_isolator else "non_isolated"
+        result = replace(result, sensitivity=crossover_sensitivity(
+            model, sim.stage[own].hunting_free_from, executor=executor))
     margins = _verdict.margins(model, xo, st, fx, pid, sim)
     result = replace(
         result, robustness=rob, margins=margins,
@@ -632,32 +682,6 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
     log.info("design of %r: %s, %d checks, %d failed", spec.name, result.verdict.status,
              len(result.checks), len(result.failed_checks))
     return result
-
-
-def _simulation_sentence(model: Model, sim: Confirmation) -> str:
-    """The conclusion's sentences on the simulated stage (the spec's own plant first)."""
-    mins = sim.min_hunting_free_crossover
-
-    def f(x):
-        return "beyond the search" if x is None else f"from {x:.4g} Hz"
-
-    if sim.suggested_isolator:
-        own, other = "non_isolated", "isolated"
-        labels = ("The stage as specified, without isolator,",
-                  "with the suggested isolator (a recommendation, not the hardware) it")
-    else:
-        own, other = "isolated", "non_isolated"
-        labels = ("The isolated stage as specified", "without the isolator it")
-    model = "LuGre" if sim.isolated.friction_model == "lugre" else sim.isolated.friction_model
-    text = (f" Simulated with {model} friction after every move of its family: "
-            + sim.stage[own].describe(labels[0]) + "; "
-            + sim.stage[other].describe(labels[1]) + ". No move hunts "
-            + f"{f(mins[own])} as specified and {f(mins[other])} "
-            + ("with the suggested isolator" if sim.suggested_isolator else "without the isolator")
-            + " (the folds of the cycles).")
-    if not sim.models_agree:
-        text += " The other friction model disagrees on the spec's own move (see the checks)."
-    return text
 
 
 def _fe_check(fx: FlexureResult | None):
@@ -675,29 +699,22 @@ def _fe_check(fx: FlexureResult | None):
 
 def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: StiffnessResult,
                 fx: FlexureResult | None, pid: PidResult, advice: IsolatorAdvice | None,
-                checks: tuple[Check, ...], hunts: bool = False) -> str:
+                checks: tuple[Check, ...], simulated: bool = False) -> str:
     from .linear import CASE_NUMBERS
 
     parts = []
+    where = "at or above" if gap.hunting_risk else "below"
+    first = (f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, {where} the "
+             f"{gap.threshold:.3g} N threshold of step 1 (the paper's rule for its own stage)")
     if gap.hunting_risk and not pid.controller.integrator:
-        parts.append(f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, at or above "
-                     f"the {gap.threshold:.3g} N threshold, but the loop has no integrator to "
-                     "push the cart through stiction, so it cannot hunt by the paper's "
-                     "mechanism.")
+        first += (", but the loop has no integrator to push the cart through stiction, so it "
+                  "cannot hunt by the paper's mechanism")
     elif gap.hunting_risk:
-        parts.append(f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, at or above "
-                     f"the {gap.threshold:.3g} N threshold, so stick-slip can make the "
-                     "integrating controller hunt.")
-    elif hunts:
-        parts.append(f"Static friction exceeds Coulomb friction by only {gap.gap:.3g} N, below "
-                     f"the {gap.threshold:.3g} N threshold where the guideline expects no "
-                     "hunting; yet the stage's own simulation hunts (below): the threshold is a "
-                     "rule of thumb, the simulation decides.")
+        first += ", so stick-slip can make the integrating controller hunt"
     else:
-        parts.append(f"Static friction exceeds Coulomb friction by only {gap.gap:.3g} N, below "
-                     f"the {gap.threshold:.3g} N threshold, so hunting is unlikely"
-                     + (" and the isolator may not be needed." if model.has_isolator
-                        else "."))
+        first += ", so hunting is less likely"
+    parts.append(first + ("; the simulation of every move decides (below)." if simulated
+                          else "."))
     n = len(xo.cases)
     bad = [c for c in xo.cases if not c.passed]
     pms = [c.phase_margin_deg for c in xo.cases if c.in_band] or [math.inf]
@@ -711,17 +728,18 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
         ach = (f"the linear model limits the crossover nowhere up to the scan limit of "
                f"{xo.achievable:.4g} Hz")
     else:
-        ach = f"the achievable crossover is {xo.achievable:.3g} Hz, limited by {xo.limited_by}"
+        ach = (f"the achievable crossover is {number(xo.achievable, 4)} Hz, limited by "
+               f"{xo.limited_by}")
     at = ("the desired crossover" if pid.controller.source == "rule"
           else "the hardware's crossover")
     if not bad:
         every = "both" if n == 2 else f"all {n}"
-        parts.append(f"At {at} of {xo.desired:.3g} Hz {every} linear limit "
+        parts.append(f"At {at} of {number(xo.desired, 4)} Hz {every} linear limit "
                      f"cases are stable with {margins}; {ach}.")
     else:
         which = ", ".join(f"case {CASE_NUMBERS[c.name]} ({c.description}: "
                           f"{', '.join(c.failed)})" for c in bad)
-        parts.append(f"At {at} of {xo.desired:.3g} Hz the margins fail in "
+        parts.append(f"At {at} of {number(xo.desired, 4)} Hz the margins fail in "
                      f"{which}; {ach}.")
     if model.has_isolator:
         ok = st.chosen <= st.maximum * (1 + 1e-12)
@@ -754,18 +772,22 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
                      f"takes, has kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s) and kd = "
                      f"{_g(law.kd)} N s/m ({_controller_words(law)}).")
     else:
+        r = law.rule_in_this_form()
         parts.append(f"The hardware's controller (kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
                      f"N/(m s), kd = {_g(law.kd)} N s/m; {_controller_words(law)}) crosses over "
-                     f"at {law.crossover:.3g} Hz on {law.tuning_mass:.3g} kg; the rule would tune "
-                     f"kp = {_g(g.kp)} N/m, ki = {_g(g.ki)} N/(m s), kd = {_g(g.kd)} N s/m there.")
+                     f"at {number(law.crossover, 4)} Hz on {_g(law.tuning_mass)} kg; the rule "
+                     f"would tune kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), kd = "
+                     f"{_g(r['kd'])} N s/m with a D roll-off of "
+                     f"{_g(r['roll_off'] / (2 * math.pi))} Hz there.")
     if pid.static_error is not None:
         parts.append(f"The loop has no integrator, so it cannot hunt by the paper's mechanism; "
-                     f"it leaves a static error of up to Fc / kp = "
+                     f"it leaves a static error of up to {STATIC_ERROR_FORMULA} = "
                      f"{quantity(pid.static_error, 'm', 3)} instead.")
-    failed = [c.name for c in checks if c.status == Status.FAIL]
+    failed = [c for c in checks if c.status == Status.FAIL]
     if failed:
-        parts.append(f"{len(failed)} check(s) fail ({', '.join(failed)}): revise the design "
-                     "before the nonlinear confirmation.")
+        steps = ", ".join(dict.fromkeys(c.step for c in failed))
+        parts.append(f"{len(failed)} check(s) of the four steps fail ({steps}; see the checks): "
+                     "revise the design.")
     else:
         parts.append("No check of the four steps fails.")
     return " ".join(parts)

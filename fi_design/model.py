@@ -229,6 +229,19 @@ class Model:
         return self.joint is not None
 
     @property
+    def static_error_bound(self) -> float | None:
+        """The largest position error a loop without integrator can rest at [m].
+
+        ``(Fs + |offset|) / kp`` with the larger static friction of the two
+        directions (:data:`fi_design.results.stage.STATIC_ERROR_FORMULA`): the
+        cart stays put while the loop's force, kp e plus the load offset, stays
+        below static friction, so any rest within it is the loop's static
+        error, not a stuck stage. None when the loop integrates.
+        """
+        f = self.friction
+        return self.law.static_error(max(f.static(1.0), f.static(-1.0)) + abs(self.offset))
+
+    @property
     def crossover(self) -> float:
         """The loop's (design) crossover [Hz]: the rule's fc, or the gains' own."""
         return self.law.crossover

@@ -24,7 +24,8 @@ __all__ = ["design"]
 
 def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
            executor: Any = None, progress: Callable[[str], None] | None = None,
-           recommend: bool = True, fe_check: bool = False) -> DesignResult:
+           recommend: bool = True, fe_check: bool = False,
+           sensitivity: bool = False) -> DesignResult:
     """Run the guideline on a spec, confirm it by simulation, and recommend when it fails.
 
     Parameters
@@ -47,6 +48,11 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     fe_check : bool, optional
         Also check the flexure guide with a finite-element model (see
         :func:`fi_design.guideline.design`). Default False.
+    sensitivity : bool, optional
+        Also find how the hunting-free crossover moves with the unidentified
+        LuGre values sigma0, sigma1 and vs (see
+        :func:`fi_design.guideline.design`; a few seconds). Default False;
+        the design command runs it for a report.
 
     Returns
     -------
@@ -58,7 +64,7 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         When ``spec`` is a path or mapping that does not validate.
     """
     result = guideline.design(spec, confirm=confirm, executor=executor, progress=progress,
-                              fe_check=fe_check)
+                              fe_check=fe_check, sensitivity=sensitivity)
     if not (recommend and result.simulation is not None and result.verdict.status == "FAIL"):
         return result
     from .recommend import recommend as search

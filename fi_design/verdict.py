@@ -24,7 +24,7 @@ The verdict judges the spec's own plant: the isolated stage when the spec has
 an isolator, else the stage without. It fails when a check fails, when that
 plant hunts, sticks away from its target or cannot be determined at the
 design crossover (a loop without integrator resting within its expected
-static error (Fc + |offset|) / kp is neither), or when it hunts under scatter
+static error (Fs + |offset|) / kp is neither), or when it hunts under scatter
 more often than ``requirements.robustness.hunting_probability``. It passes
 with warnings when nothing fails but something needs review: a warning
 check, a warning on the user's own input, a loop without the hardware's
@@ -35,15 +35,19 @@ resting within the friction scatter of its end stop, or no simulation.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from typing import Any
 
 from .model import Model
-from .display import percent, quantities, quantity
+from .display import number, percent, quantities, quantity
 from .results import Check, Status
 from .results.design import (Confirmation, CrossoverResult, FlexureResult, Margins, PidResult,
-                             Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict)
+                             Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict,
+                             VerdictStatus)
 
-__all__ = ["run_robustness", "robustness_check", "robustness_as_check", "margins",
+__all__ = ["recommend_command", "friction_gap_judged", "simulated_isolator_advice",
+           "simulation_sentence",
+           "run_robustness", "robustness_check", "robustness_as_check", "margins",
            "recommendation", "judge"]
 
 #: Plant judged for a spec with / without isolator.
@@ -308,7 +312,8 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
                 notes.append(f"no move of the family hunts from {m:g} Hz, the bottom of the "
                              "search: the crossover factor is a lower bound")
         if st.static_error_bound is not None and st.outcome in ("static_error", "stuck"):
-            rest = [abs(mv.final_error) for mv in st.moves if mv.outcome in ("rests", "stuck")]
+            rest = [abs(mv.final_error) for mv in st.moves
+                    if mv.outcome in ("settles", "rests", "stuck")]
             out["static_error"] = max(rest) if rest else 0.0
             out["static_error_bound"] = st.static_error_bound
         land = simulation.landing
@@ -325,7 +330,7 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
             out["thickness_tolerance"] = flexure.thickness_tolerance
     else:
         notes.append("no isolator in the spec: no end-stop clearance or stiffness margin (the "
-                     "recommendation gives the suggested isolator's)")
+                     "isolator the design simulates for comparison is not the hardware)")
     return Margins(notes=tuple(notes), **out)
 
 
@@ -348,6 +353,132 @@ def recommendation(search: Any) -> Recommendation:
                           crossover=search.crossover, feasible=search.feasible, search=search)
 
 
+# --------------------------------------------------------------------------- statements
+
+
+def friction_gap_judged(gap: FrictionGapResult, stage: Any, integrator: bool
+                        ) -> FrictionGapResult:
+    """Step 1 once the stage is simulated: a screening rule, the stage-level answer decides.
+
+    The threshold (``requirements.friction_gap``, 1 N by default) is the
+    paper's rule for its own stage. Once every move of the family is
+    simulated, step 1 no longer passes or warns on its own: its check becomes
+    INFO and names what the simulation found, so it never reads as a pass
+    (or a risk) that the same report refutes.
+
+    Parameters
+    ----------
+    gap : FrictionGapResult
+        Step 1 before the simulation.
+    stage : fi_design.results.stage.StageHunting
+        The stage-level answer of the spec's own plant.
+    integrator : bool
+        Whether the loop integrates.
+
+    Returns
+    -------
+    FrictionGapResult
+        The same values with the check re-worded (status INFO).
+    """
+    c = gap.checks[0]
+    where = ("at or above" if gap.hunting_risk else "below")
+    if gap.hunting_risk and not integrator:
+        rule = "stick-slip can make an integrating controller hunt, but this loop has none"
+    elif gap.hunting_risk:
+        rule = "stick-slip can make an integrating controller hunt"
+    else:
+        rule = "stick-slip, and so hunting, is less likely"
+    msg = (f"Fs - Fc = {gap.gap:.3g} N is {where} the {gap.threshold:.3g} N threshold, the "
+           f"paper's rule of thumb for its own stage: {rule}; a screening rule, not a "
+           f"requirement: the simulation of every move decides, and the stage as specified "
+           f"{stage.summary()}")
+    return replace(gap, checks=(replace(c, passed=None, status=Status.INFO, message=msg),)
+                   + gap.checks[1:])
+
+
+def simulation_sentence(sim: Confirmation) -> str:
+    """The conclusion's sentences on the simulated stage, the spec's own plant first.
+
+    Parameters
+    ----------
+    sim : Confirmation
+        The simulated confirmation.
+
+    Returns
+    -------
+    str
+        Each plant's stage-level answer and how the hunting-free crossover was found.
+    """
+    if sim.suggested_isolator:
+        own, other = "non_isolated", "isolated"
+        labels = ("The stage as specified, without isolator,",
+                  "with the rule's first isolator (simulated for comparison, not the "
+                  "hardware) it")
+        names = ("as specified", "with that isolator")
+    else:
+        own, other = "isolated", "non_isolated"
+        labels = ("The isolated stage as specified", "without the isolator it")
+        names = ("as specified", "without the isolator")
+    fm = "LuGre" if sim.isolated.friction_model == "lugre" else sim.isolated.friction_model
+    text = (f" Simulated with {fm} friction after every move of its family: "
+            + sim.stage[own].describe(labels[0]) + "; "
+            + sim.stage[other].describe(labels[1]) + ".")
+    bounds = [f"{name}, {sim.stage[key].boundary_text()}"
+              for key, name in zip((own, other), names) if sim.stage[key].boundary is not None]
+    if bounds:
+        text += " The lowest crossover from which no move hunts: " + "; ".join(bounds) + "."
+    elif sim.stage[own].static_error_bound is not None:
+        text += (" The loop has no integrator: no crossover bounds hunting, so none is "
+                 "computed.")
+    if not sim.models_agree:
+        text += " The other friction model disagrees on the spec's own move (see the checks)."
+    return text
+
+
+def simulated_isolator_advice(spec: Any, gap: Any, simulation: Confirmation, rule: str,
+                              isolator: tuple[float, float, float]) -> Any:
+    """For a stage without isolator, once simulated: is one needed, and is the rule's a start.
+
+    The advice reads the judged stage-level answers, so it never advises what the same
+    report shows failing: not needed when the stage as specified comes to rest after every
+    move; needed otherwise, starting from the rule's isolator (simulated beside it) when every
+    move comes to rest with it, else from the design search (``fi-design recommend``).
+
+    Parameters
+    ----------
+    spec : fi_design.spec.Spec
+        The spec (its file names the command of the design search).
+    gap : FrictionGapResult
+        Step 1.
+    simulation : Confirmation
+        The simulated confirmation.
+    rule : str
+        The rule's isolator in words.
+    isolator : (float, float, float)
+        Its stroke [m], stiffness [N/m] and k_max [N/m].
+
+    Returns
+    -------
+    fi_design.results.design.IsolatorAdvice
+    """
+    from .results.design import IsolatorAdvice
+
+    own, iso = simulation.stage["non_isolated"], simulation.stage["isolated"]
+    if own.acceptable:
+        return IsolatorAdvice(False, (
+            f"the stage as specified {own.summary()}: no isolator is needed at "
+            "this crossover" + (f", whatever the {gap.gap:.3g} N friction gap of step 1 "
+                                "suggests" if gap.hunting_risk else "")), *isolator)
+    if iso.acceptable:
+        return IsolatorAdvice(True, (
+            f"the stage as specified {own.summary()}; with {rule} it "
+            f"{iso.summary()}: an isolator is needed, and that one is a start"), *isolator)
+    return IsolatorAdvice(True, (
+        f"the stage as specified {own.summary()}, and {rule} {iso.summary()} too: an "
+        "isolator is needed, but not that one; the design search looks for one that "
+        f"passes ({recommend_command(spec)})"), *isolator)
+
+
 # --------------------------------------------------------------------------- verdict
 
 
@@ -366,8 +497,9 @@ def _behaviour_reason(st: Any, label: str) -> Reason:
     if st.outcome == "settles":
         return Reason("PASS", "simulation", text + " No move ends in a hunting cycle.")
     if st.outcome == "static_error":
-        return Reason("PASS", "simulation", text + " Not stuck, and no hunting by the paper's "
-                                                   "mechanism.")
+        return Reason("PASS", "simulation", text + " Every rest is the loop's static error, "
+                                                   "and without an integrator the stage "
+                                                   "cannot hunt by the paper's mechanism.")
     return Reason("FAIL", "simulation", text[0].upper() + text[1:])
 
 
@@ -472,27 +604,84 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
               "NOT_CONFIRMED" if simulation is None else
               "PASS_WITH_WARNINGS" if any(r.severity == "WARN" for r in reasons) else "PASS")
     nwarn = sum(r.severity == "WARN" for r in reasons)
-    what = (f"{label} {_BEHAVIOUR.get(behaviour, behaviour)} at {fc:.4g} Hz"
+    what = (f"{label} {_BEHAVIOUR.get(behaviour, behaviour)} at {number(fc, 4)} Hz"
             if behaviour is not None else f"{label} was not simulated")
     if behaviour == "hunts":
         st = simulation.stage[own]
         c = st.cycle
         what += (f" ({len(st.hunting_moves)} of {len(st.moves)} moves"
                  + (f", a {c.amplitude * 1e3:.3g} mm cycle of {c.period:.3g} s)" if c else ")"))
+    steps = {c.name: c.step for c in checks}
     on = []
     for r in reasons:
-        word = _SOURCES.get(r.source, r.source.replace("_", " "))
+        word = _SOURCES.get(r.source) or _STEP_WORDS.get(steps.get(r.source, ""),
+                                                        steps.get(r.source) or r.source)
         if r.severity == "FAIL" and word not in on:
             on.append(word)
-    warned = f"{nwarn} warning{'s' if nwarn != 1 else ''} to review"
+    warned = _warnings_words([r for r in reasons if r.severity == "WARN"], steps)
     listed = ", ".join(on[:-1]) + " and on " + on[-1] if len(on) > 1 else "".join(on)
     tail = {"FAIL": f"It fails on {listed}" + (f"; {warned}" if nwarn else ""),
             "PASS_WITH_WARNINGS": f"Nothing fails; {warned}",
             "NOT_CONFIRMED": "Nothing of the linear steps fails, but without the simulation "
                              "it does not pass" + (f"; {warned}" if nwarn > 1 else ""),
             "PASS": "Nothing fails, nothing to review"}[status]
-    return Verdict(status=status, reasons=tuple(reasons), plant=own, behaviour=behaviour,
-                   headline=f"{what}. {tail}.")
+    return Verdict(status=VerdictStatus(status), reasons=tuple(reasons), plant=own,
+                   behaviour=behaviour, headline=f"{what}. {tail}.",
+                   next_step=_next_step(model) if status == "FAIL" else "")
+
+
+def _warnings_words(warned: Sequence[Reason], steps: dict) -> str:
+    """``"3 warnings to review (1 check, 2 on the spec's values)"``: counted as the checks
+    table and the reasons count them."""
+    n = len(warned)
+    checks = sum(r.source in steps for r in warned)
+    inputs = sum(r.source == "input" for r in warned)
+    parts = [f"{k} {word}{'s' if k != 1 else ''}" for k, word in
+             ((checks, "check"), (inputs, "on the spec's value")) if k]
+    others = [r.source for r in warned if r.source not in steps and r.source != "input"]
+    parts += [f"1 on {_OTHER_WORDS.get(s, s.replace('_', ' '))}" for s in others]
+    return (f"{n} warning{'s' if n != 1 else ''} to review"
+            + (f" ({', '.join(parts)})" if parts else ""))
+
+
+def recommend_command(spec: Any) -> str:
+    """The design search as a command on this spec: ``fi-design recommend PATH --write-spec
+    OUT.yaml`` (``SPEC.yaml`` for a spec not read from a file)."""
+    from .specfile import origin
+
+    import os
+
+    org = origin(spec)
+    if org is None or org.path is None:
+        path = "SPEC.yaml"
+    else:  # as a command in the working directory: relative below it, absolute elsewhere
+        rel = os.path.relpath(os.path.abspath(org.path))
+        path = str(org.path) if rel.startswith("..") else rel
+    return f"fi-design recommend {path} --write-spec OUT.yaml"
+
+
+def _next_step(model: Model) -> str:
+    """What to run after a FAIL: the design search, with this spec's path."""
+    return (f"{recommend_command(model.spec)} runs the design search and writes its design "
+            "into a copy of the spec")
+
+
+#: Warnings that are neither a check nor a spec value, as the headline counts them.
+_OTHER_WORDS = {"end_stop_clearance": "the end-stop clearance",
+                "robustness": "friction scatter", "confirmation": "the missing simulation"}
+
+
+#: The guideline steps as a FAIL headline names them (never a check's internal name).
+_STEP_WORDS = {
+    "step 1 friction gap": "step 1 (the friction gap)",
+    "step 2 crossover": "step 2 (the crossover and the loop's margins)",
+    "step 3 drive stiffness": "step 3 (the drive stiffness)",
+    "step 3 flexure": "step 3 (the leaf-spring guide)",
+    "step 4 PID": "step 4 (the PID)",
+    "simulation (paper section 2.3)": "the simulation",
+    "step 3 refinement: landing": "where the cart comes to rest",
+    "positioning": "positioning (requirements.positioning)",
+}
 
 
 #: Sources of reasons in the headline's words (others: the check's name).

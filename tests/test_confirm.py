@@ -100,7 +100,8 @@ def test_design_json_contract_simulation(paper_confirmed_design):
     names = {c["name"] for c in d["checks"]}
     assert {"simulation_isolated", "spec_move_isolated", "min_crossover_isolated",
             "landing_force"} <= names
-    assert "No move hunts from" in d["conclusion"]
+    assert "The lowest crossover from which no move hunts" in d["conclusion"]
+    assert f"hunts from {m['isolated']:.4g} Hz up" in d["conclusion"]
     json.dumps(d, allow_nan=False)
 
 
@@ -145,7 +146,8 @@ def test_spec_without_isolator_is_confirmed_against_the_suggestion(repo_root):
     assert sim.non_isolated.metrics.verdict == "hunting"
     assert sim.isolated.metrics.verdict == "settled"
     assert sim.stage["non_isolated"].hunts and r.verdict.status == "FAIL"
-    assert "suggested isolator" in r.conclusion
+    # the isolator simulated beside it is the rule's, for comparison, never a recommendation
+    assert "the rule's first isolator (simulated for comparison" in r.conclusion
 
 
 def test_a_cycle_that_outlives_the_search_gives_no_hunting_free_crossover(paper_spec):

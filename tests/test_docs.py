@@ -141,14 +141,40 @@ def test_the_documentation_stands_alone():
 
 @pytest.mark.parametrize("page", ["README.md", "docs/library.md", "docs/measured.md"])
 def test_python_examples_run(page, monkeypatch, shared_designs):
-    """The documentation's Python blocks run (a design of a spec file computed once a process:
-    README.md and docs/library.md show the same one)."""
+    """Every ```python block runs; one followed by "prints" and a ```text block prints that
+    text (the sweep example promised a boundary in Hz and printed nan)."""
+    import contextlib
+    import io
+
     text = (ROOT / page).read_text(encoding="utf-8")
-    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.DOTALL)
+    blocks = re.findall(r"```python\n(.*?)```((?:(?!```python).)*)", text, flags=re.DOTALL)
     assert blocks, f"{page} should show the library API in a ```python block"
     monkeypatch.chdir(ROOT)
-    for code in blocks:
-        exec(compile(code, page, "exec"), {"__name__": "readme_example"})
+    for code, after in blocks:
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            exec(compile(code, page, "exec"), {"__name__": "readme_example"})
+        shown = re.match(r"\s*\n[^`]*\bprints\b[^`]*```text\n(.*?)```", after, flags=re.DOTALL)
+        if shown:
+            assert out.getvalue().strip() == shown.group(1).strip(), out.getvalue()
+
+
+def test_the_interfaces_page_names_every_command():
+    table = (ROOT / "docs" / "interfaces.md").read_text(encoding="utf-8").split(
+        "## Commands and exit codes", 1)[1]
+    for name in COMMANDS:
+        if name in ("design",):
+            continue
+        assert re.search(rf"`(fi-design )?{name}\b", table), name
+
+
+def test_the_documented_commands_name_files_that_exist():
+    """A documented example named a record that is not in the repository."""
+    for page in ("README.md", "docs/commands.md", "docs/measured.md"):
+        text = (ROOT / page).read_text(encoding="utf-8")
+        for block in re.findall(r"```sh\n(.*?)```", text, flags=re.DOTALL):
+            for path in re.findall(r"(?<![\w/])(examples/[\w.-]+)", block):
+                assert (ROOT / path).exists(), (page, path)
 
 
 def test_the_readme_is_what_a_newcomer_needs(readme):

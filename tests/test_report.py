@@ -36,7 +36,7 @@ NBSP = "\u00a0"
 
 #: Sections of the design report, in the order the issue asks for.
 DESIGN_SECTIONS = ["verdict", "inputs", "steps", "guide", "linear", "nonlinear",
-                   "assumptions", "references", "appendix"]
+                   "validation", "assumptions", "glossary", "references", "appendix"]
 
 runner = CliRunner()
 

@@ -161,7 +161,8 @@ def test_pd_loop_at_rest_within_its_static_error_is_not_stuck(cases):
     assert plant.metrics.verdict == "stuck"                 # the metric alone would say so
     law = r.pid.controller
     assert not law.integrator
-    bound = r.spec.friction.coulomb / law.kp                # no offset, symmetric friction
+    # one bound for every statement: what static friction can hold (no offset, symmetric)
+    bound = r.spec.friction.static / law.kp
     assert plant.static_error_bound == pytest.approx(bound, rel=1e-12)
     assert abs(plant.metrics.final_error) <= bound
     assert plant.outcome == "static_error" and r.passed
@@ -258,11 +259,12 @@ def test_warnings_only_pass_with_warnings(cases):
     r = cases["settling_isolated"]
     warns = [x for x in r.verdict.reasons if x.severity == "WARN"]
     # one of 80 scatter samples hunts: 1.25 %, within the limit, but the Wilson interval
-    # reaches above 5 % (the samples do not demonstrate it)
-    assert r.passed and [x.source for x in warns] == ["robustness", "input", "input"]
+    # reaches above 5 % (the samples do not demonstrate it); the spec gives sigma1 at its
+    # default value: no warning on it (the default breaks the dissipativity bound
+    # deliberately, and the assumptions say so)
+    assert r.passed and [x.source for x in warns] == ["robustness", "input"]
     assert r.robustness.hunting_probability <= 0.05 < r.robustness.interval[1]
-    assert "friction.bristle_damping" in warns[1].text   # the given sigma1 breaks its bound
-    assert "controller.sample_rate" in warns[2].text     # no sampling and delay: say so
+    assert "controller.sample_rate" in warns[1].text     # no sampling and delay: say so
     assert r.verdict.at_or_below("PASS_WITH_WARNINGS") and not r.verdict.at_or_below("FAIL")
 
 

@@ -41,7 +41,7 @@ def moves_strips(stages: dict, suggested: bool = False) -> list:
     """
     from rich.text import Text
 
-    names = {"isolated": "suggested isolator" if suggested else "with isolator",
+    names = {"isolated": "rule's isolator" if suggested else "with isolator",
              "non_isolated": "without isolator"}
     out = []
     for key in ("isolated", "non_isolated"):
@@ -86,7 +86,7 @@ def simulation_table(sim: dict, window: tuple[float, float] | None = None,
     """
     from rich.text import Text
 
-    label = "suggested isolator" if sim.get("suggested_isolator") else "with isolator"
+    label = "rule's isolator" if sim.get("suggested_isolator") else "with isolator"
     model = sim["isolated"].get("friction_model") or "lugre"
     other = sim.get("cross_check") or {}
     other_model = next((v.get("friction_model") for v in other.values() if v),
@@ -161,7 +161,7 @@ def simulation_table(sim: dict, window: tuple[float, float] | None = None,
         ("Floquet multiplier", lambda k, v: cycle(k, "multiplier")),
         ("Joint on its limiter", lambda k, v: cycle(k, "on_limiter")),
         ("No move hunts from", lambda k, v: free_from(k)),
-        ("Spec's motion: verdict", lambda k, v: verdict_text(v.get("verdict", ""))),
+        ("Spec's motion: outcome", lambda k, v: verdict_text(v.get("outcome") or v.get("verdict", ""))),
         (f"Hunting cycles {counted}", lambda k, v: str(v.get("hunting_cycles"))),
         ("Amplitude, peak to peak", lambda k, v: quantity(v.get("amplitude"), "m", 3)),
         ("Period", lambda k, v: period(v)),
@@ -170,7 +170,8 @@ def simulation_table(sim: dict, window: tuple[float, float] | None = None,
     ]
     if other:
         rows.append((f"Cross-check, {_MODEL_NAMES.get(other_model, other_model)} model",
-                     lambda k, v: verdict_text((other.get(k) or {}).get("verdict", ""))))
+                     lambda k, v: verdict_text((other.get(k) or {}).get("outcome")
+                                               or (other.get(k) or {}).get("verdict", ""))))
     for title, cell in rows:
         t.add_row(Text(title), *[cell(key, sim[key]) for key, _ in plants])
     return t
@@ -218,7 +219,7 @@ def print_simulation(console: "Console", result) -> None:
             rows.append(("re-anchored windows [-]", str(int(result.window.max()) + 1)))
     else:
         rows += [
-            ("verdict", m.verdict),
+            ("verdict of the spec's own motion", m.verdict),
             ("hunting cycles in the window [-]", str(m.hunting_cycles)),
             ("amplitude (peak to peak)", quantity(m.amplitude, "m")),
             ("period [s]", number(m.period, 4)),
@@ -236,3 +237,8 @@ def print_simulation(console: "Console", result) -> None:
     console.print(t)
     if result.replay is None:
         console.print(Text(m.reason))
+        console.print(Text(
+            f"This is the spec's own motion only, judged by the paper's metric ({m.verdict}); "
+            "hunting is a property of the stage, and one move can settle where others hunt: "
+            "the design command (fi-design SPEC.yaml) judges every move of the family and "
+            "signs off.", style="dim"))

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..display import number, percent, quantity
+from ..results.stage import STATIC_ERROR_FORMULA
 from .common import heading, status_text, table
 from .confirmation import moves_strips, simulation_table
 
@@ -89,10 +90,11 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     gap = data.get("friction_gap") or {}
     if gap:
         risk = gap.get("hunting_risk")
+        where = "at or above" if risk else "below"
         console.print(Text(
-            f"Friction gap Fs - Fc = {number(gap.get('gap'))} N (threshold "
-            f"{number(gap.get('threshold'))} N): "
-            + ("hunting is a risk" if risk else "hunting unlikely" if risk is not None else "")))
+            f"Friction gap Fs - Fc = {number(gap.get('gap'))} N, {where} the "
+            f"{number(gap.get('threshold'))} N threshold of step 1 (the paper's rule for its own "
+            "stage" + ("; the simulation decides)" if data.get("simulation") else ")")))
 
     loop = getattr(result, "loop", None)
     console.print(checks_table(result.checks,
@@ -119,9 +121,9 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     stiff = data.get("stiffness") or {}
     if stiff.get("maximum") is not None:
         if stiff.get("suggested"):
-            text = (f"Drive stiffness (suggestion for an isolator with a "
-                    f"{number(1e3 * stiff['stroke'], 3)} mm stroke): k_max = "
-                    f"{number(stiff['maximum'])} N/m, start from k = {number(stiff.get('chosen'))} N/m")
+            text = (f"Drive stiffness by the rule for a {number(1e3 * stiff['stroke'], 3)} mm "
+                    f"stroke (no isolator in the spec): k_max = {number(stiff['maximum'])} N/m, "
+                    f"k = k_max / 2 = {number(stiff.get('chosen'))} N/m")
         else:
             text = (f"Drive stiffness: k_max = {number(stiff['maximum'])} N/m, chosen k = "
                     f"{number(stiff.get('chosen'))} N/m")
@@ -140,6 +142,7 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
                                  bool(sim.get("suggested_isolator"))):
             console.print(line)
 
+    _print_terms(console, result, data)
     conclusion = getattr(result, "conclusion", "") or data.get("conclusion", "")
     if conclusion:
         console.print(Text("Conclusion: ", style="bold").append(Text(str(conclusion),
@@ -149,6 +152,24 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
         return
     for w in getattr(result, "warnings", ()) or ():
         console.print(Text("warning: ", style="bold yellow").append(Text(_warning_text(w))))
+
+
+#: The terms the console defines under its tables, where the summary uses them.
+CONSOLE_TERMS = ("limit case", "Floquet multiplier", "fold", "landing")
+
+
+def _print_terms(console: "Console", result, data: dict) -> None:
+    """One dim line per term of :data:`CONSOLE_TERMS` that the summary prints."""
+    from rich.text import Text
+
+    from ..report.glossary import glossary
+
+    text = " ".join([str(data.get("conclusion", ""))] + [c.message for c in result.checks]
+                    + ["limit case"]   # the limit-case table
+                    + (["Floquet multiplier"] if data.get("simulation") else []))
+    for g in glossary(text):
+        if g["term"] in CONSOLE_TERMS:
+            console.print(Text(f"  {g['term']}: {g['definition']}", style="dim"))
 
 
 def _gains_table(pid: dict) -> Any:
@@ -243,11 +264,13 @@ def print_verdict(console: "Console", result) -> None:
                          f"{1e3 * mar.thickness_tolerance:.2g} mm")
         if mar.static_error is not None:
             items.append(f"static error {quantity(mar.static_error, 'm', 3)} of "
-                         f"{quantity(mar.static_error_bound, 'm', 3)} (Fc + |offset|) / kp")
+                         f"{quantity(mar.static_error_bound, 'm', 3)} {STATIC_ERROR_FORMULA}")
         if items:
             body.add_row(Text("Margins", style="bold"), Text("; ".join(items)))
     if result.recommendation is not None:
         body.add_row(Text("Advice", style="bold"), Text(result.recommendation.text))
+    if v.next_step:
+        body.add_row(Text("Next", style="bold"), Text(v.next_step))
     console.print(Panel(body, title=Text(f"Verdict: {v.status}", style=f"bold {colour}"),
                         title_align="left", border_style=colour, box=getattr(box, frame)))
 

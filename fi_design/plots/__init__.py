@@ -31,7 +31,7 @@ from .figure import (RASTER_DPI, REPORT_RC, REPORT_WIDTH, cell_edges, decimate, 
                      figure_markup, figure_svg, log_x, nice_ticks, plain_tick, png_img,
                      raster_dpi, raster_figures, report_figure, rgb_png, styled)
 from .guide import guide_figure
-from .hunting import MOVE_MARKS, boundary_figure, cycle_figure, moves_figure
+from .hunting import MOVE_MARKS, boundary_figure, cycle_figure, moves_figure, positioning_figure
 from .identification import force_velocity_figure, residual_figure
 from .labels import QUANTITY_NAMES, axis_label, display_unit, quantity_name
 from .loop import (BAND_FACTOR, CASE_COLOURS, CASE_STYLES, bode_figure, case_label, design_band,
@@ -50,7 +50,7 @@ __all__ = [
     "candidate_scores_figure", "case_label", "cell_edges", "cycle_figure", "decimate",
     "deflection_figure", "design_band", "design_map_figure", "display_unit", "draw_sweep",
     "error_figure", "figure_bytes", "figure_markup", "figure_svg", "force_velocity_figure", "gap_overlay_figure",
-    "gap_residual_figure", "guide_figure", "log_x", "motion_end", "moves_figure", "nice_ticks", "nyquist_figure",
+    "gap_residual_figure", "guide_figure", "log_x", "motion_end", "moves_figure", "nice_ticks", "positioning_figure", "nyquist_figure",
     "out_of_band_crossovers", "plain_tick", "plant_names", "png_img", "raster_dpi",
     "raster_figures", "rgb_png", "quantity_name", "recommend_figure",
     "report_figure", "residual_figure", "robustness_figure", "sensitivity_figure",

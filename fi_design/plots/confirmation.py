@@ -19,7 +19,7 @@ PLANT_COLOURS = {"isolated": "C0", "non_isolated": "C3"}
 
 def plant_names(confirmation: Any) -> dict:
     """Legend name of each plant: ``"with isolator"`` (or the suggested one), ``"without isolator"``."""
-    label = "suggested isolator" if confirmation.suggested_isolator else "with isolator"
+    label = "rule's isolator" if confirmation.suggested_isolator else "with isolator"
     return {"isolated": label, "non_isolated": "without isolator"}
 
 
@@ -78,7 +78,7 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
     fig = report_figure(4.3, top=0.3, hspace=0.55, right=0.1)
     fig.subplots_adjust(wspace=0.32)
     axes = fig.subplots(2, 2, sharex="col", sharey="col", width_ratios=(1.55, 1.0))
-    label = "suggested isolator" if confirmation.suggested_isolator else "with isolator"
+    label = "rule's isolator" if confirmation.suggested_isolator else "with isolator"
     band = h.settle_band * 1e6
     zoom = SETTLE_ZOOM * band
     end = float(confirmation.results["isolated"].time[-1])

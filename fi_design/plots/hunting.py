@@ -205,3 +205,58 @@ def boundary_figure(confirmation: Any) -> Any:
     fig.legend(*ax.get_legend_handles_labels(), loc="upper center", ncols=2,
                bbox_to_anchor=(0.5, 1.0))
     return fig
+
+
+@styled
+def positioning_figure(positioning: Any) -> Any:
+    """Settle time and static error against move distance (``requirements.positioning``).
+
+    Left: the time after each move until |x1 - r| stays within the band, a
+    dashed line at the required settle time; a move that never settles is
+    drawn as a cross at the top. Right: the error each move rests at, a
+    dashed line at the allowed static error and a dotted one at the band.
+    Negative moves lighter; a star marks the spec's own motion.
+
+    Parameters
+    ----------
+    positioning : fi_design.results.positioning.PositioningResult
+        The requirement judged over the move family.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = report_figure(2.6, top=0.2)
+    ax_t, ax_e = fig.subplots(1, 2)
+    col = PLANT_COLOURS[positioning.plant]
+    times = [m.settle_time for m in positioning.moves if m.settle_time is not None]
+    t_top = max(times + [positioning.settle_time_limit or 0.0, 1e-3]) * 1.15
+    errors = [m.static_error for m in positioning.moves if m.static_error is not None]
+    e_top = max(errors + [positioning.static_error_limit or 0.0, positioning.band]) * 1e6 * 1.15
+    for m in positioning.moves:
+        d = abs(m.distance) * 1e3
+        if d <= 0:
+            continue
+        alpha = 1.0 if m.distance > 0 else 0.45
+        mk = "*" if m.label == "spec" else "o"
+        face = col if m.passed else "white"
+        ms = 7 if m.label == "spec" else 4.5
+        if m.settle_time is None:
+            ax_t.plot([d], [t_top], "x", ms=5, color="0.2", alpha=alpha)
+        else:
+            ax_t.plot([d], [m.settle_time], mk, ms=ms, color=col, mfc=face, alpha=alpha)
+        if m.static_error is not None:
+            ax_e.plot([d], [m.static_error * 1e6], mk, ms=ms, color=col, mfc=face, alpha=alpha)
+    if positioning.settle_time_limit is not None:
+        ax_t.axhline(positioning.settle_time_limit, color="0.3", ls="--", lw=0.9)
+    if positioning.static_error_limit is not None:
+        ax_e.axhline(positioning.static_error_limit * 1e6, color="0.3", ls="--", lw=0.9)
+    ax_e.axhline(positioning.band * 1e6, color="0.5", ls=":", lw=0.9)
+    for ax in (ax_t, ax_e):
+        log_x(ax)
+        ax.set_xlabel("move distance [mm]")
+    ax_t.set_ylim(0.0, t_top * 1.05)
+    ax_e.set_ylim(0.0, e_top * 1.05)
+    ax_t.set_ylabel("settle time [s]")
+    ax_e.set_ylabel("rest error |x1 \u2212 r| [\u00b5m]")
+    return fig

@@ -16,9 +16,10 @@ from typing import Any
 
 from ..display import NBSP, quantity, scale
 from ..results import Status
+from ..results.stage import STATIC_ERROR_FORMULA
 from .filters import display_scale, num, qty
 
-__all__ = ["STEP_SOURCES", "SENSE", "STATUS_TEXT", "BEHAVIOUR", "check_label", "check_row",
+__all__ = ["PERCENT_CHECKS", "STEP_SOURCES", "SENSE", "STATUS_TEXT", "BEHAVIOUR", "check_label", "check_row",
            "key_figures", "verdict"]
 
 #: The verdict's status as printed.
@@ -48,6 +49,7 @@ STEP_SOURCES = {
     "step 4 PID": "step 4; paper \u00a72.2",
     "simulation (paper section 2.3)": "simulation; paper \u00a72.3, Fig. 5",
     "robustness under friction scatter": "simulation under friction scatter",
+    "positioning": "requirements.positioning, every move simulated",
 }
 
 #: Requirement sense of each check (by name, or by the name's part before the first dot).
@@ -59,7 +61,12 @@ SENSE = {
     "simulation_isolated": "=", "min_crossover_isolated": "\u2264", "landing_force": "<",
     "simulation_non_isolated": "=", "min_crossover_non_isolated": "\u2264", "robustness": "\u2264",
     "end_stop_force": "\u2264", "actuator_force": "<",
+    "positioning": "\u2264",
 }
+
+
+#: Checks whose value is a probability [-], shown in % wherever it is printed.
+PERCENT_CHECKS = frozenset({"robustness"})
 
 
 def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
@@ -106,6 +113,9 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
         "end_stop_force": "End-stop contact force over the move family",
         "actuator_force": "Actuator's peak force over the move family",
     }
+    if head == "positioning":
+        return {"settle_time": "Settle time after every move",
+                "static_error": "Static error after every move"}.get(tail, name)
     flex = {"stiffness": "Flexure net drive stiffness within k_max",
             "stress": "Flexure stress at full stroke",
             "buckling": "Flexure buckling load over the stage's weight",
@@ -116,7 +126,7 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
     if head == "pid" and tail == "tuning_mass":
         return "PID tuning mass"
     if head == "pid" and tail == "integrator":
-        return "Loop without integrator: static error up to Fc / kp"
+        return f"Loop without integrator: static error up to {STATIC_ERROR_FORMULA}"
     return labels.get(head, name.replace("_", " ").capitalize())
 
 
@@ -149,6 +159,8 @@ def check_row(check: Any, cases: Mapping[str, Any] | None = None) -> dict:
     shown, factor = display_scale(check.unit, ref)
     if check.unit == "cycles":
         shown = "cycles"
+    if check.name in PERCENT_CHECKS:  # a probability reads in %, as the key figures give it
+        shown, factor = "%", 100.0
 
     def conv(x):
         if x is None or not isinstance(x, (int, float)) or isinstance(x, bool):
@@ -212,15 +224,15 @@ def key_figures(result: Any) -> list[dict]:
         c = st.cycle
         if st.hunts:
             note = (f"{len(st.hunting_moves)} of {len(st.moves)} moves end in "
-                    + (f"a cycle of {qty(c.amplitude, 'm')} peak to peak, period "
-                       f"{qty(c.period, 's')}" if c is not None else "a cycle"))
+                    + (f"a cycle of {qty(c.amplitude, 'm', 3)} peak to peak, period "
+                       f"{qty(c.period, 's', 3)}" if c is not None else "a cycle"))
         elif st.outcome in ("settles", "static_error"):
             note = f"all {len(st.moves)} moves of the family come to rest"
         else:
             bad = next(m for m in st.moves if m.outcome in ("stuck", "rests", "undetermined"))
             note = f"after the {qty(abs(bad.distance), 'm')} move: {bad.reason}"
         need = ("no move hunts" if st.static_error_bound is None
-                else f"every move rests within {qty(st.static_error_bound, 'm')}")
+                else f"every move rests within {qty(st.static_error_bound, 'm', 3)}")
         short = {"stuck": "sticks", "static_error": "static error",
                  "settles": "settles"}.get(st.outcome, BEHAVIOUR[st.outcome][1])
         rows.append(_figure(f"Every move of the family at {qty(fc, 'Hz')}", short, "", need,
@@ -231,11 +243,21 @@ def key_figures(result: Any) -> list[dict]:
                 f"{_pct(rob.interval[1])} %; {rob.hunting} of {rob.valid} valid samples")
         if rob.comparison is not None and rob.comparison["hunting_probability"] is not None:
             other = ("without the isolator" if rob.comparison["plant"] == "non_isolated"
-                     else "with the suggested isolator")
+                     else "with the rule's isolator")
             note += f"; {other}: {_pct(rob.comparison['hunting_probability'])} %"
         rows.append(_figure("Probability of not settling under friction scatter",
                             _pct(rob.hunting_probability), "%", f"\u2264 {_pct(rob.limit)}",
                             note, css))
+    pos = result.positioning
+    if pos is not None:
+        for c in result.checks:
+            if not c.name.startswith("positioning."):
+                continue
+            unit = "s" if c.name.endswith("settle_time") else "m"
+            rows.append(_figure(check_label(c.name), "never" if c.value is None else c.value,
+                                unit if c.value is not None else "", f"\u2264 {qty(c.limit, unit)}",
+                                f"requirements.positioning, band \u00b1{qty(pos.band, 'm')}",
+                                c.status.value.lower(), 3))
     if m is None:
         return rows
     if m.crossover_factor is not None:
@@ -282,8 +304,8 @@ def key_figures(result: Any) -> list[dict]:
     if m.static_error is not None:
         ok = m.static_error <= m.static_error_bound + spec.requirements.hunting.settle_band
         rows.append(_figure("Static error at rest (loop without integrator)", m.static_error,
-                            "m", f"\u2264 {qty(m.static_error_bound, 'm')}",
-                            "(Fc + |offset|) / kp", "pass" if ok else "fail", 3))
+                            "m", f"\u2264 {qty(m.static_error_bound, 'm', 3)}",
+                            STATIC_ERROR_FORMULA, "pass" if ok else "fail", 3))
     return rows
 
 
@@ -302,7 +324,8 @@ def verdict(result: Any) -> dict:
         (as printed), ``css`` (pass, warn, fail), ``behaviour`` (the stamp),
         ``behaviour_css``, ``headline``, ``reasons`` (``severity``, ``css``,
         ``text``), ``figures`` (:func:`key_figures`), ``notes`` (margins not
-        reported, and why), ``recommendation`` (text or None), ``counts`` and
+        reported, and why), ``recommendation`` (text or None), ``next_step``
+        (after a FAIL, the command that searches a design that passes), ``counts`` and
         ``total`` of the checks, ``groups`` (``step``, ``title``, ``rows`` of
         :func:`check_row`) and ``conclusion``.
     """
@@ -321,7 +344,7 @@ def verdict(result: Any) -> dict:
     if v.status == "FAIL" and behaviour_css in ("settles", "static-error"):
         behaviour_css, stamp = NOMINAL
     return {
-        "status": v.status, "overall": STATUS_TEXT[v.status], "css": css,
+        "status": str(v.status), "overall": STATUS_TEXT[v.status], "css": css,
         "behaviour": stamp, "behaviour_css": behaviour_css, "headline": v.headline,
         "reasons": [{"severity": r.severity, "css": r.severity.lower(), "text": r.text}
                     for r in v.reasons],
@@ -329,6 +352,7 @@ def verdict(result: Any) -> dict:
         "notes": list(result.margins.notes) if result.margins is not None else [],
         "recommendation": None if result.recommendation is None
         else result.recommendation.text,
+        "next_step": v.next_step,
         "counts": [{"status": s, "count": n, "css": s.lower()} for s, n in counts.items()],
         "total": len(rows),
         "groups": groups,
@@ -346,5 +370,6 @@ def _step_title(step: str) -> str:
         "simulation (paper section 2.3)": "Nonlinear confirmation (simulated hunting)",
         "step 3 refinement: landing": "Step 3 refinement \u2013 where the cart comes to rest",
         "robustness under friction scatter": "Robustness under friction scatter",
+        "positioning": "Positioning after every move (requirements.positioning)",
     }
     return titles.get(step, step[:1].upper() + step[1:] if step else "Other")

@@ -12,16 +12,19 @@ from __future__ import annotations
 from typing import Any
 
 from ..results.design import DesignResult
-from ..results.stage import length_range
+from ..results.stage import STATIC_ERROR_FORMULA, length_range
 from ..results.studies import DesignMap
+from .assumptions import assumptions, family_words
 from .blocks import figure_entry
 from .checks import verdict
 from .context import build_context
 from .filters import num, qty
+from .glossary import glossary
 from .guide import guide_section
 from .inputs import spec_inputs
 from .meta import spec_listing, title_block, versions
 from .steps import guideline_steps
+from .validation import validation_section
 
 __all__ = ["design_context", "REFERENCES"]
 
@@ -122,7 +125,7 @@ def _error_caption(sim: Any, spec: Any) -> str:
     """What the position-error figure draws, mark by mark: only what is there."""
     h = spec.requirements.hunting
     plants = [sim.isolated, sim.non_isolated]
-    which = ("with the suggested isolator and without it" if sim.suggested_isolator
+    which = ("with the rule's isolator (for comparison) and without it" if sim.suggested_isolator
              else "with and without the isolator")
     marks = ["grey, the counting window", "dashed, the minimum peak height"]
     if any(len(p.metrics.peak_times) for p in plants):
@@ -145,7 +148,7 @@ _MODEL_NAMES = {"lugre": "LuGre", "switch": "switch (Karnopp-type)"}
 def _plant_labels(sim: Any) -> dict[str, str]:
     """The two plants' row labels: which one the spec specifies, which one is compared."""
     if sim.suggested_isolator:
-        return {"isolated": "suggested isolator (recommendation)",
+        return {"isolated": "rule's isolator (comparison)",
                 "non_isolated": "without isolator (as specified)"}
     return {"isolated": "with isolator (as specified)",
             "non_isolated": "without isolator (comparison)"}
@@ -168,7 +171,7 @@ def _plant_rows(sim: Any) -> list[dict]:
             "other_model": other.friction_model if other is not None else "",
             "reason": m.reason if v.outcome != "static_error" else (
                 f"at rest {qty(abs(m.final_error), 'm')} from the target, within the static "
-                f"error (Fc + |offset|) / kp = {qty(v.static_error_bound, 'm')} of a loop "
+                f"error {STATIC_ERROR_FORMULA} = {qty(v.static_error_bound, 'm', 3)} of a loop "
                 "without integrator"),
         })
     return rows
@@ -195,8 +198,7 @@ def _stage_rows(sim: Any) -> list[dict]:
             "limiter": "" if c is None or c.on_limiter is None else
             ("yes" if c.on_limiter else "no"),
             "free_from": st.hunting_free_from,
-            "bracket": (f"fold bisected to {qty(b['resolution'], 'Hz')}"
-                        if b.get("kind") == "fold" else b.get("note", "")),
+            "bracket": st.boundary_text(),
             "text": st.describe(name[0].upper() + name[1:]),
         })
     return rows
@@ -211,17 +213,16 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
     spec = result.spec
     h = spec.requirements.hunting
     iso = sim.results["isolated"]
-    label = "the suggested isolator" if sim.suggested_isolator else "the isolator"
+    label = ("the rule's isolator (step 3's k_max / 2 for the paper's 0.3 mm stroke)"
+             if sim.suggested_isolator else "the isolator")
     land = sim.landing
-    fam = spec.motion.family
     out = {
         "intro": (
             f"Hunting is a property of the stage, not of one move: with {label} and without it, "
             "at the design crossover and with "
             f"{_MODEL_NAMES.get(sim.isolated.friction_model, sim.isolated.friction_model)} "
-            f"friction, the stage is simulated after every move of a family ({fam.count} "
-            "distances, log-spaced from a tenth of the stroke, 0.1 mm without isolator, to five "
-            "times the spec's largest move, and the spec's own motion). A run stops once the "
+            f"friction, the stage is simulated after every move of a family "
+            f"({family_words(result)}). A run stops once the "
             "stage rests within the settle band for good (the friction force the loop will "
             "ask of the resting cart stays below its static friction) or once its state repeats "
             "at the Poincar\u00e9 section x1 - r = 0: a sustained cycle. The cycle is then "
@@ -243,17 +244,22 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "How the stage ends after each move of its family: the cycle's peak to peak for a "
             "move that hunts (filled), 0 for one that comes to rest (open); the star is the "
             "spec's own motion.", fig_no()),
-        "cycle": figure_entry(
+        # the cycles' and the boundary's figures only where a plant hunts or a boundary was
+        # found: no empty phase portrait, no boundary axis for a loop without integrator
+        "cycle": None if not any(st.cycle is not None for st in sim.stage.values()) else
+        figure_entry(
             (lambda: plots.cycle_figure(sim, spec)) if figures else None, "cycle",
             "The hunting cycles: phase portraits (left), the isolated stage's joint deflection "
             "over one period against its stroke (middle), and the settling after the spec's "
             f"own motion in the \u00b1{num(h.settle_band * 1e6)} \u00b5m settle band (right).",
             fig_no()),
-        "boundary": figure_entry(
+        "boundary": None if not any((st.boundary or {}).get("branch")
+                                    for st in sim.stage.values()) else figure_entry(
             (lambda: plots.boundary_figure(sim)) if figures else None, "boundary",
             "The stage-level boundary: the peak to peak of each plant's hunting cycle as the "
             "crossover rises, up to the cycle's fold (dotted), from which no move of the "
             "family hunts; dashed, the design crossover.", fig_no()),
+        "positioning": _positioning(result, figures, fig_no),
         "error": figure_entry(
             (lambda: plots.error_figure(sim, spec)) if figures else None, "error",
             _error_caption(sim, spec), fig_no()),
@@ -265,6 +271,8 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "deflection": land.deflection, "stroke": land.stroke, "force": land.force,
             "static_friction": land.static_friction, "rule_force": land.rule_force,
             "on_limiter": "yes" if land.on_limiter else "no",
+            # the one judged statement of the landing: the check's
+            "text": next(c.message for c in result.checks if c.name == "landing_force"),
         },
         "forces": _forces(sim.forces),
         "models_agree": sim.models_agree,
@@ -310,6 +318,38 @@ def _forces(forces: Any) -> dict | None:
     return {"intro": intro, "rows": rows}
 
 
+def _positioning(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
+    """The positioning requirement over the move family: what it asks, the figure, the checks."""
+    from .. import plots
+
+    pos = result.positioning
+    if pos is None:
+        return None
+    asks = []
+    if pos.settle_time_limit is not None:
+        asks.append(f"within \u00b1{qty(pos.band, 'm')} of its target at most "
+                    f"{qty(pos.settle_time_limit, 's')} after the end of each move")
+    if pos.static_error_limit is not None:
+        asks.append(f"at rest at most {qty(pos.static_error_limit, 'm')} from it")
+    checks = [c for c in result.checks if c.name.startswith("positioning.")]
+    return {
+        "intro": ("What the stage is for (requirements.positioning): " + " and ".join(asks)
+                  + f", after every move of the family ({len(pos.moves)} moves of the stage as "
+                  "specified). The settle time is read from each move's trace sampled every "
+                  f"{qty(pos.resolution, 's')}: the last instant the error lies outside the "
+                  "band, counted from the end of the move."),
+        "checks": [{"status": c.status.value, "css": c.status.value.lower(),
+                    "text": c.message} for c in checks],
+        "figure": figure_entry(
+            (lambda: plots.positioning_figure(pos)) if figures else None, "positioning",
+            "Positioning after every move of the family: left, the settle time (dashed: the "
+            "requirement; a cross at the top: never within the band); right, the error the "
+            "stage rests at (dashed: the allowed static error, dotted: the band). Filled: the "
+            "move meets the requirement; lighter: negative moves; star: the spec's motion.",
+            fig_no()),
+    }
+
+
 def _map_section(design_map: DesignMap | None, figures: bool, fig_no: _Numbering) -> dict | None:
     if design_map is None:
         return None
@@ -319,7 +359,7 @@ def _map_section(design_map: DesignMap | None, figures: bool, fig_no: _Numbering
     x, y = result.x, result.y
     note = ""
     if design_map.suggested:
-        note = (f"The spec has no isolator: the map uses the suggested one "
+        note = (f"The spec has no isolator: the map uses the rule's one "
                 f"({qty(design_map.stroke, 'm')} stroke, {qty(design_map.stiffness, 'N/m')}). ")
     held = ("the drive stiffness held at the design value" if design_map.stiffness is not None
             else "the drive stiffness following the stroke (k_max / 2: the spec gives none)")
@@ -338,69 +378,6 @@ def _map_section(design_map: DesignMap | None, figures: bool, fig_no: _Numbering
                                "Marks: s stuck, ? undetermined, \u00d7 failed.", fig_no()),
         "counts": ", ".join(f"{k} {v}" for k, v in counts.items() if v),
     }
-
-
-def _assumptions(result: Any) -> dict:
-    spec = result.spec
-    sim = spec.simulation
-    h = spec.requirements.hunting
-    return {
-        "model": [
-            "Two rigid masses (stage m1, cart m2) joined by a linear spring-damper (k, c) with "
-            "compliant end stops at \u00b1s; without the isolator one rigid mass m1 + m2. Motion "
-            "along one axis only: tilt, yaw and support compliance enter only as the parasitic "
-            "modes of the linear analysis.",
-            "LuGre friction (Canudas de Wit et al. 1995) with constant parameters along the "
-            "rail; the switch (Karnopp-type) model serves as a cross-check. Real friction varies "
-            "with position, time, temperature and wear (paper \u00a73.2), so the simulated "
-            "number of cycles is an indication, not a prediction.",
-            "The PID is continuous-time unless a sample rate is given; actuator and sensor are "
-            "ideal apart from the effects listed in the spec.",
-            _robustness_assumption(spec),
-            "The linear analysis linearises friction in four limit cases (cart sliding or stuck, "
-            "joint free or on its limiter, paper Figure 2): the margins hold near each case, not "
-            "during transitions between them.",
-        ],
-        "solver": [
-            f"Fast path: a linearly implicit Rosenbrock method of order 4 (RODAS4, Hairer and "
-            f"Wanner) with step-size control at relative tolerance {num(sim.tolerance)}, mode "
-            "switches of limiter and stick-slip located as events; traces sampled at "
-            f"{qty(sim.output_rate, 'Hz')}.",
-            "The fast integrator is tested against scipy's solve_ivp (Radau) at a tolerance "
-            "10\u2074 times tighter on the same equations.",
-        ],
-        "metric": [
-            f"The metric counts peaks above +{qty(h.min_height, 'm')} only: a cycle with a "
-            "smaller amplitude, or one offset below the target, counts as none.",
-            f"A cycle slower than the {qty(h.window_length, 's')} window shows no peak; the "
-            "verdict then says 'undetermined', not 'settled'.",
-            "A stage resting away from its target (stuck) shows no peaks either; the verdict "
-            f"calls it 'stuck' unless it lies within the settle band of {qty(h.settle_band, 'm')}.",
-            "Hunting can come and go with the crossover (the paper saw a hunting-free run at "
-            "9.5 Hz): the lowest hunting-free crossover is the one above which every scanned "
-            "crossover settles, within one scan step.",
-        ],
-    }
-
-
-def _robustness_assumption(spec: Any) -> str:
-    r = spec.requirements.robustness
-    if r.samples == 0:
-        return ("No robustness check (requirements.robustness.samples: 0): friction is "
-                "simulated at its nominal values only.")
-    ripple = ("" if r.ripple is None else
-              f", and a {num(100 * r.ripple.amplitude, 3)} % ripple with a "
-              f"{qty(r.ripple.wavelength, 'm')} wavelength along the rail at a random phase")
-    stiff = ("the flexure's stock tolerance" if r.stiffness is None
-             else f"{num(100 * r.stiffness, 3)} %")
-    return (f"Robustness: {r.samples} samples ({r.distribution}, seed {r.seed}), each drawing "
-            f"Coulomb friction ({num(100 * r.coulomb, 3)} %) and the gap Fs \u2212 Fc "
-            f"({num(100 * r.gap, 3)} %) together, so static friction never falls below "
-            f"Coulomb friction and no sample is lost, the true masses ({num(100 * r.mass, 3)} "
-            f"%, the controller keeping its tuning), the drive stiffness ({stiff}) and the "
-            f"loop delay ({num(100 * r.delay, 3)} %){ripple}. The parasitic modes do not "
-            "enter the nonlinear simulation. The hunting probability carries a Wilson interval "
-            f"at {num(100 * r.confidence, 3)} % confidence.")
 
 
 #: The paper and the standard works it builds on.
@@ -473,6 +450,17 @@ def _appendix(result: Any) -> dict:
     return {**spec_listing(spec), "solver": solver, "versions": versions()}
 
 
+def _texts(node: Any) -> list[str]:
+    """Every sentence of a report context (figures and equations left out), for the glossary."""
+    if isinstance(node, str):
+        return [node]
+    if isinstance(node, dict):
+        return [t for k, v in node.items() if k not in ("svg", "tex") for t in _texts(v)]
+    if isinstance(node, (list, tuple)):
+        return [t for v in node for t in _texts(v)]
+    return []
+
+
 def _design_sections(ctx: dict) -> list[dict]:
     sections = [
         {"id": "verdict", "title": "Verdict", "template": "verdict.html.jinja"},
@@ -490,8 +478,10 @@ def _design_sections(ctx: dict) -> list[dict]:
         sections.append({"id": "map", "title": "Hunting map around the design point",
                          "template": "map.html.jinja"})
     sections += [
+        {"id": "validation", "title": "Validation", "template": "validation.html.jinja"},
         {"id": "assumptions", "title": "Assumptions and limitations",
          "template": "assumptions.html.jinja"},
+        {"id": "glossary", "title": "Glossary", "template": "glossary.html.jinja"},
         {"id": "references", "title": "References", "template": "references.html.jinja"},
         {"id": "appendix", "title": "Appendix: spec, solver and software",
          "template": "appendix.html.jinja"},
@@ -526,8 +516,8 @@ def design_context(result: DesignResult, *, date: Any = None, command: str | Non
     dict
         Keys ``meta`` (title block), ``sections`` (the contents, in order),
         ``verdict``, ``inputs``, ``steps``, ``linear``, ``nonlinear`` (None
-        without simulation), ``map`` (None without map), ``assumptions``,
-        ``references``, ``appendix``. Numbers are SI floats with a ``unit`` key
+        without simulation), ``map`` (None without map), ``validation``, ``assumptions``,
+        ``glossary`` (the terms the report uses), ``references``, ``appendix``. Numbers are SI floats with a ``unit`` key
         beside them (the templates format them with the ``qty`` filter), or text.
     """
     spec = result.spec
@@ -551,8 +541,10 @@ def design_context(result: DesignResult, *, date: Any = None, command: str | Non
                                     "--no-simulation, or design(spec, confirm=False)): the "
                                     "verdict rests on the linear steps alone.")
     ctx["map"] = _map_section(design_map, figures, fig_no)
-    ctx["assumptions"] = _assumptions(result)
+    ctx["validation"] = validation_section(result)
+    ctx["assumptions"] = assumptions(result)
     ctx["references"] = [{"key": k, "text": t} for k, t in REFERENCES]
     ctx["appendix"] = _appendix(result)
+    ctx["glossary"] = glossary(" ".join(_texts(ctx)))
     ctx["sections"] = _design_sections(ctx)
     return ctx

@@ -64,10 +64,7 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
             "loose at static friction, the cart slips past the target because sliding friction "
             "is lower, and sticks again. The larger the gap between static and Coulomb friction, "
             "the larger the overshoot (paper Figure 4A: hunting appears above a gap of about "
-            f"1 N). Here the gap is {qty(gap.gap, 'N')}, "
-            + ("at or above the threshold: hunting is a risk and the next steps decide how to "
-               "avoid it." if gap.hunting_risk else
-               "below the threshold: stick-slip, and so hunting, is unlikely.")),
+            "1 N for the paper's stage). Here: " + gap.checks[0].message + "."),
     })
 
     # step 2
@@ -190,8 +187,10 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
         results.append({"quantity": "flexure force on the resting cart", "value": land.force,
                         "unit": "N"})
     if st.suggested:
-        lead = ("The spec has no isolator; these are the values to start a design from, for the "
-                "paper's 0.3 mm stroke. ")
+        lead = ("The spec has no isolator; these are the rule's values for the paper's 0.3 mm "
+                "stroke, the isolator the simulation tries beside the stage for comparison"
+                + ("" if result.isolator_advice is None else
+                   f" ({result.isolator_advice.reason})") + ". ")
     else:
         lead = ""
     steps.append({

@@ -62,8 +62,9 @@ class PlantVerdict(Result):
         Failure description, empty on success.
     static_error_bound : float or None
         For a loop without integrator: the static error it may leave against
-        friction, (Fc + |offset|) / kp with the larger Coulomb friction of the
-        two directions [m]; None when the loop integrates.
+        friction, (Fs + |offset|) / kp with the larger static friction of the
+        two directions [m] (:attr:`fi_design.model.Model.static_error_bound`);
+        None when the loop integrates.
     outcome : str
         What the stage does, with the loop in mind: the metric's verdict,
         except that a loop without integrator resting within

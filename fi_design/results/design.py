@@ -17,10 +17,12 @@ from ..provenance import Source, current_source
 from . import Check, Result, Status, to_jsonable
 from .confirmation import Confirmation, IsolatorAdvice, Landing, PlantVerdict
 from .mechanism import FeMechanics
+from .positioning import PositioningResult
+from .sensitivity import CrossoverSensitivity
 from .steps import (CaseResponse, CrossoverResult, FlexureResult, FrictionGapResult,
                     LoopResponses, ModeSeparation, PidResult, StiffnessResult)
 from .verdict import (VERDICT_STATUSES, Margins, Reason, Recommendation, RobustnessCheck,
-                      Verdict)
+                      Verdict, VerdictStatus)
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..model import Model
@@ -28,7 +30,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["FrictionGapResult", "ModeSeparation", "CrossoverResult", "StiffnessResult",
            "FlexureResult", "PidResult", "CaseResponse", "LoopResponses", "IsolatorAdvice",
-           "PlantVerdict", "Landing", "Confirmation", "VERDICT_STATUSES",
+           "PlantVerdict", "Landing", "Confirmation", "VERDICT_STATUSES", "VerdictStatus",
            "Reason", "Verdict", "RobustnessCheck", "Margins", "Recommendation",
            "DesignResult"]
 
@@ -91,6 +93,14 @@ class DesignResult(Result):
     flexure_fe : fi_design.results.mechanism.FeMechanics or None
         The guide as a finite-element model, the independent check of the
         closed forms (JSON: ``flexure.fe``); None when it did not run.
+    sensitivity : fi_design.results.sensitivity.CrossoverSensitivity or None
+        The hunting-free crossover of the spec's own plant with sigma0,
+        sigma1 and vs divided and multiplied by 3; None when not run
+        (``design(sensitivity=False)``, a loop without integrator).
+    positioning : fi_design.results.positioning.PositioningResult or None
+        ``requirements.positioning`` judged over the move family of the
+        spec's own plant (its checks are among ``checks``); None when the
+        spec requires none or the stage was not simulated.
     """
 
     spec: Spec = field(repr=False)
@@ -114,6 +124,8 @@ class DesignResult(Result):
     fi_design_source: Source = field(default_factory=current_source)
     model: "Model | None" = field(default=None, repr=False)
     flexure_fe: FeMechanics | None = None
+    positioning: PositioningResult | None = None
+    sensitivity: CrossoverSensitivity | None = None
 
     @property
     def passed(self) -> bool:
@@ -136,7 +148,7 @@ class DesignResult(Result):
 
         Keys: ``name``, ``passed``, ``verdict``, ``recommendation``, ``robustness``,
         ``margins``, ``friction_gap``, ``crossover``, ``stiffness``, ``flexure``,
-        ``pid``, ``isolator_advice``, ``checks``, ``warnings``, ``conclusion``,
+        ``pid``, ``isolator_advice``, ``positioning``, ``sensitivity``, ``checks``, ``warnings``, ``conclusion``,
         ``fi_design_version``, ``fi_design_source`` (``commit``,
         ``modified``, ``code_sha256``: :class:`~fi_design.provenance.Source`),
         ``spec_sha256`` and, when set, ``simulation`` and ``stage_hunting``
@@ -158,6 +170,8 @@ class DesignResult(Result):
                 **({} if self.flexure_fe is None else {"fe": self.flexure_fe.to_dict()})},
             "pid": self.pid.to_dict(),
             "isolator_advice": to_jsonable(self.isolator_advice),
+            "positioning": to_jsonable(self.positioning),
+            "sensitivity": to_jsonable(self.sensitivity),
             "checks": [to_jsonable(c) for c in self.checks],
             "warnings": [{"path": p, "message": m} for p, m in self.warnings],
             "conclusion": self.conclusion,

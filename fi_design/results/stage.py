@@ -19,7 +19,7 @@ import numpy as np
 from ..display import display_scale, number, quantity
 from . import Result, dataclass_dict, to_jsonable
 
-__all__ = ["MOVE_OUTCOMES", "MoveOutcome", "CycleTrace", "Cycle", "StageHunting", "length_text",
+__all__ = ["STATIC_ERROR_FORMULA", "MOVE_OUTCOMES", "MoveOutcome", "CycleTrace", "Cycle", "StageHunting", "length_text",
            "length_range"]
 
 def length_text(x: float) -> str:
@@ -31,6 +31,12 @@ def length_range(lo: float, hi: float) -> str:
     """Two lengths [m] in the unit of the larger: ``"0.396 to 50 mm"``."""
     shown, factor = display_scale("m", max(abs(lo), abs(hi)))
     return f"{number(lo * factor, 3)} to {number(hi * factor, 3)} {shown}"
+
+
+#: The static error bound of a loop without integrator, as every statement names it
+#: (:attr:`fi_design.model.Model.static_error_bound`): the larger static friction of the two
+#: directions and the load offset over kp.
+STATIC_ERROR_FORMULA = "(Fs + |offset|) / kp"
 
 
 #: How a move can end: at rest at the target, in a sustained cycle, at rest
@@ -47,7 +53,8 @@ class MoveOutcome(Result):
     Attributes
     ----------
     distance : float
-        Signed move distance [m]; for the spec's own motion, its net travel.
+        Signed move distance [m]; for the spec's own motion, the distance of
+        its largest move (a back-and-forth motion nets to 0).
     label : str
         ``"family"`` or ``"spec"`` (the spec's own motion, all its moves).
     outcome : str
@@ -243,6 +250,13 @@ class StageHunting(Result):
         return m.outcome == "rests" and (bound is None
                                          or abs(m.final_error) > bound + self.settle_band)
 
+    def _first_bad(self) -> MoveOutcome:
+        """The first move that makes the outcome stuck (or undetermined)."""
+        if self.outcome == "stuck":
+            return next(m for m in self.moves
+                        if m.outcome == "stuck" or self._rests_too_far(m))
+        return next(m for m in self.moves if m.outcome == "undetermined")
+
     @property
     def outcome(self) -> str:
         """The plant in a word: ``hunts`` (some move ends in a cycle), ``stuck`` (some
@@ -277,6 +291,50 @@ class StageHunting(Result):
         amps += [m.amplitude for m in self.moves if m.hunts and m.amplitude is not None]
         return float(max(amps)) if amps else 0.0
 
+    def summary(self) -> str:
+        """What the plant does after its moves, in a short phrase without a subject.
+
+        The same judged outcome :meth:`describe` states in full, for the
+        sentences that refer to it (step 1, the isolator advice, the
+        verdict's headline): ``"hunts at 8 Hz (7 of 25 moves end in a
+        cycle)"``, ``"comes to rest at its target at 8 Hz after every move (25
+        moves)"``.
+        """
+        n = len(self.moves)
+        out = self.outcome
+        at = f"at {number(self.crossover, 4)} Hz"
+        if out == "hunts":
+            return f"hunts {at} ({len(self.hunting_moves)} of {n} moves end in a cycle)"
+        if out in ("stuck", "undetermined"):
+            m = self._first_bad()
+            verb = "sticks away from its target" if out == "stuck" else "cannot be judged"
+            return f"{verb} {at} after the {length_text(abs(m.distance))} move"
+        if out == "static_error":
+            return f"rests within its static error {at} after every move ({n} moves)"
+        return f"comes to rest at its target {at} after every move ({n} moves)"
+
+    def boundary_text(self) -> str:
+        """The hunting-free crossover in words, with how it was found.
+
+        ``"no move of the family hunts from 11.28 Hz up (the fold of its cycle,
+        bisected to 0.011 Hz)"``; the cycle persisting to the top of the
+        search, a bound at its bottom, or not computed (a loop without
+        integrator, which cannot hunt by the paper's mechanism).
+        """
+        b = self.boundary
+        m = self.hunting_free_from
+        if b is None:
+            if self.static_error_bound is not None:
+                return ("not computed: the loop has no integrator, so no crossover bounds "
+                        "hunting (it rests with a static error instead)")
+            return "not computed"
+        if m is None:
+            return b.get("note") or "the cycle persists up to the top of the search"
+        if b.get("kind") == "fold":
+            return (f"no move of the family hunts from {number(m, 4)} Hz up (the fold of its "
+                    f"cycle, bisected to {number(b['resolution'], 2)} Hz)")
+        return f"{b.get('note') or f'no move of the family hunts from {number(m, 4)} Hz up'} (a bound)"
+
     def describe(self, label: str) -> str:
         """The plant's stage-level answer in one sentence, beginning with ``label``.
 
@@ -307,22 +365,22 @@ class StageHunting(Result):
             sm = self.spec_move
             own = ("" if sm is None or sm.hunts else
                    f"; after the spec's own motion it {'settles' if sm.outcome == 'settles' else sm.outcome}")
-            return f"{label} hunts at {fc:g} Hz: {moves} end in {cyc}{own}"
+            return f"{label} hunts at {number(fc, 4)} Hz: {moves} end in {cyc}{own}"
         if self.outcome == "stuck":
-            m = next(m for m in self.moves if m.outcome in ("stuck", "rests"))
-            return (f"{label} sticks at {fc:g} Hz: after the {length_text(abs(m.distance))} move it "
+            m = self._first_bad()
+            return (f"{label} sticks at {number(fc, 4)} Hz: after the {length_text(abs(m.distance))} move it "
                     f"rests {length_text(abs(m.final_error))} from its target ({m.reason})")
         if self.outcome == "undetermined":
             m = next(m for m in self.moves if m.outcome == "undetermined")
-            return (f"{label} cannot be judged at {fc:g} Hz after the {length_text(abs(m.distance))} move: "
+            return (f"{label} cannot be judged at {number(fc, 4)} Hz after the {length_text(abs(m.distance))} move: "
                     f"{m.reason}")
         if self.outcome == "static_error":
             worst = max(abs(m.final_error) for m in self.moves)
-            return (f"{label} comes to rest at {fc:g} Hz after all {n} moves, at most "
-                    f"{length_text(worst)} from the target, within the (Fs + |offset|) / kp = "
+            return (f"{label} comes to rest at {number(fc, 4)} Hz after all {n} moves, at most "
+                    f"{length_text(worst)} from the target, within the {STATIC_ERROR_FORMULA} = "
                     f"{length_text(self.static_error_bound)} that static friction can hold against a "
                     "loop without integrator")
-        return f"{label} comes to rest at its target at {fc:g} Hz after all {n} moves"
+        return f"{label} comes to rest at its target at {number(fc, 4)} Hz after all {n} moves"
 
     def to_dict(self) -> dict:
         """The contract's form: ``hunts``, ``moves_tried``, ``moves_hunting``,

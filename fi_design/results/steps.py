@@ -326,7 +326,9 @@ class PidResult(Result):
         (``source``), as the analysis and the simulation use it.
     static_error : float or None
         Static position error of a loop without integrator against Coulomb
-        friction, Fc / kp [m]; None when the loop integrates.
+        friction, (Fs + |offset|) / kp [m]
+        (:attr:`fi_design.model.Model.static_error_bound`); None when the
+        loop integrates.
     checks : tuple of Check
         The step's checks.
     """

@@ -6,16 +6,35 @@ the confirmation.
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass, field
 from typing import Any
 
 from . import Result, to_jsonable
 
-__all__ = ["VERDICT_STATUSES", "Reason", "Verdict", "RobustnessCheck", "Margins", "Recommendation"]
+__all__ = ["VERDICT_STATUSES", "VerdictStatus", "Reason", "Verdict", "RobustnessCheck",
+           "Margins", "Recommendation"]
 
 
 #: Statuses of a design verdict, from best to worst.
 VERDICT_STATUSES = ("PASS", "PASS_WITH_WARNINGS", "NOT_CONFIRMED", "FAIL")
+
+
+class VerdictStatus(str, enum.Enum):
+    """Status of a design verdict, an enum like a check's
+    :class:`~fi_design.results.Status`; it compares equal to its name
+    (``verdict.status == "FAIL"``) and prints as it (``f"{status}"``)."""
+
+    PASS = "PASS"
+    PASS_WITH_WARNINGS = "PASS_WITH_WARNINGS"
+    NOT_CONFIRMED = "NOT_CONFIRMED"
+    FAIL = "FAIL"
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __format__(self, spec: str) -> str:
+        return format(self.value, spec)
 
 
 @dataclass(frozen=True)
@@ -46,9 +65,9 @@ class Verdict(Result):
 
     Attributes
     ----------
-    status : str
-        ``"PASS"``, ``"PASS_WITH_WARNINGS"``, ``"NOT_CONFIRMED"`` or ``"FAIL"``
-        (:data:`VERDICT_STATUSES`). FAIL when a check fails, when the
+    status : VerdictStatus
+        ``PASS``, ``PASS_WITH_WARNINGS``, ``NOT_CONFIRMED`` or ``FAIL``
+        (:data:`VERDICT_STATUSES`; equal to those strings). FAIL when a check fails, when the
         spec's own plant hunts, sticks away from its target or cannot be
         determined at the design crossover, or when it hunts under friction
         scatter more often than ``requirements.robustness.hunting_probability``;
@@ -69,13 +88,17 @@ class Verdict(Result):
         without simulation.
     headline : str
         One sentence: what the stage does and the status.
+    next_step : str
+        After a FAIL, what to run next (the design search, ``fi-design
+        recommend SPEC --write-spec OUT.yaml``); empty otherwise.
     """
 
-    status: str
+    status: VerdictStatus
     reasons: tuple[Reason, ...]
     plant: str
     behaviour: str | None
     headline: str
+    next_step: str = ""
 
     @property
     def passed(self) -> bool:
@@ -99,10 +122,11 @@ class Verdict(Result):
 
     def to_dict(self) -> dict:
         """JSON: ``status``, ``reasons`` (their texts), ``findings`` (severity, source and
-        text of each), ``plant``, ``behaviour``, ``headline``."""
-        return {"status": self.status, "reasons": [r.text for r in self.reasons],
+        text of each), ``plant``, ``behaviour``, ``headline``, ``next_step``."""
+        return {"status": str(self.status), "reasons": [r.text for r in self.reasons],
                 "findings": [r.to_dict() for r in self.reasons], "plant": self.plant,
-                "behaviour": self.behaviour, "headline": self.headline}
+                "behaviour": self.behaviour, "headline": self.headline,
+                "next_step": self.next_step}
 
 
 @dataclass(frozen=True, eq=False)
@@ -186,7 +210,9 @@ class Margins(Result):
         True when the plant settles over the whole scan: the factor is then a
         lower bound (design crossover / the scan's lowest crossover).
     hunting_free_crossover : float or None
-        The lowest hunting-free crossover used [Hz] (within one scan step).
+        The lowest crossover from which no move of the family hunts [Hz]: the
+        fold of the hunting cycle, bisected to the resolution in the stage's
+        ``boundary`` (:attr:`fi_design.results.stage.StageHunting.boundary`).
     achievable_factor : float or None
         Achievable / desired crossover of step 2 [-]; None when the
         achievable crossover is only a bound (the search cap) or none.
@@ -212,7 +238,8 @@ class Margins(Result):
     static_error : float or None
         Resting error |x1 - r| of a loop without integrator [m].
     static_error_bound : float or None
-        The static error it may leave, (Fc + |offset|) / kp [m].
+        The static error it may leave, (Fs + |offset|) / kp [m]
+        (:attr:`fi_design.model.Model.static_error_bound`).
     notes : tuple of str
         Why a margin is left out or is a bound.
     """

@@ -29,7 +29,8 @@ from .fields import OptQ, Q, StrictModel, Text
 from .sections import (MAX_OUTPUT_SAMPLES, MAX_SCAN_POINTS, MAX_STEPS, REPORT_KINDS, Body, Bounds,
                        Controller, CrossoverScan, DocumentIds, Family, Feedforward, Flexure,
                        Friction, Gains, Hunting, Isolator, Limiter, Material, Measurement, Motion,
-                       Move, ParasiticMode, RecommendBounds, ReportInfo, Requirements, Reserve, Revision,
+                       Move, ParasiticMode, Positioning, RecommendBounds, ReportInfo,
+                       Requirements, Reserve, Revision,
                        Ripple, Robustness, Simulation, Stage, move_duration, scan_points)
 
 __all__ = [
@@ -37,8 +38,8 @@ __all__ = [
     "EFFECT_MODELS", "EffectEntry", "Family", "Feedforward", "Flexure", "Friction", "Gains",
     "Hunting", "Isolator", "JOINT_DAMPING_RATIO", "Limiter", "MAX_OUTPUT_SAMPLES",
     "MAX_SCAN_POINTS", "MAX_STEPS", "Material", "Measurement", "Motion", "Move", "OptQ",
-    "ParasiticMode", "Q", "REPORT_KINDS", "RecommendBounds", "ReportInfo", "Requirements",
-    "Reserve",
+    "ParasiticMode", "Positioning", "Q", "REPORT_KINDS", "RecommendBounds", "ReportInfo",
+    "Requirements", "Reserve",
     "Revision", "Ripple", "Robustness", "Simulation", "Spec", "Stage", "StrictModel", "Text",
     "antiresonance", "bristle_damping", "default_joint_damping", "default_limiter_damping",
     "design_crossover", "drive_stiffness", "gains_crossover", "joint_damping",

@@ -185,10 +185,11 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     Fc / (Fs - Fc) (the warning recommends a value within the bound and says
     what it costs: the presliding mode then rings; the default sqrt(sigma0
     (m1 + m2)), damping ratio 0.5 of the presliding mode, breaks the bound
-    deliberately and is not warned about when left out), a stroke within
-    five presliding ranges, a move :data:`MOVE_STROKE_PLAUSIBLE` times the
-    stroke or more, a motion that outlasts the run, a hunting window that
-    starts before the last move ends, and a loop without the hardware's sampling and delay (a
+    deliberately and is not warned about when left out, nor when given at
+    its value), a stroke within five presliding ranges, a move
+    :data:`MOVE_STROKE_PLAUSIBLE` times the stroke or more, a motion that
+    outlasts the run, a hunting window that starts before the last move ends,
+    and a loop without the hardware's sampling and delay (a
     continuous controller without delay: the margins and the hunting depend
     on both).
     """
@@ -199,7 +200,7 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
         s1 = f.bristle_damping
         default = math.sqrt(f.bristle_stiffness * spec.total_mass)
         bound = f.viscous * f.coulomb / gap
-        if s1 >= bound:
+        if s1 >= bound and not math.isclose(s1, default, rel_tol=5e-3):
             within = 0.9 * bound
             ratio = within / (2.0 * default)  # sigma1 / (2 sqrt(sigma0 m)) of the presliding mode
             advice = (f"a value below the bound, e.g. {number(within, 3)} N s/m, keeps it "

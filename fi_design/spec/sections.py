@@ -530,6 +530,31 @@ class Reserve(StrictModel):
                                                 "longer [-]. Default 50 %.")
 
 
+class Positioning(StrictModel):
+    """What the stage is for: settling after each move of the family, and the error it rests at.
+
+    Judged over every move of ``motion.family`` (and the spec's own motion) of
+    the spec's own plant: a stage that never hunts can still fail it.
+    """
+
+    band: OptQ("m") = Field(None, gt=0, description="Settle band on |x1 - r| [m]: in position "
+                                                     "once the error stays inside it. Default: "
+                                                     "requirements.hunting.settle_band.")
+    settle_time: OptQ("s") = Field(None, gt=0, description="Longest time after the end of each "
+                                                            "move until the error stays within "
+                                                            "the band [s]; null: not required.")
+    static_error: OptQ("m") = Field(None, ge=0, description="Largest error |x1 - r| the stage "
+                                                             "may rest at after each move [m]; "
+                                                             "null: not required.")
+
+    @model_validator(mode="after")
+    def _something(self) -> "Positioning":
+        if self.settle_time is None and self.static_error is None:
+            raise ValueError("give settle_time, static_error or both: a band alone requires "
+                             "nothing")
+        return self
+
+
 class Requirements(StrictModel):
     """Design requirements and metric settings."""
 
@@ -563,6 +588,9 @@ class Requirements(StrictModel):
                                                            "Default 1 (the paper's rule).")
     hunting: Hunting = Field(default_factory=Hunting)
     robustness: Robustness = Field(default_factory=Robustness)
+    positioning: Positioning | None = Field(None, description="Settle time and static error "
+                                                             "after every move of the family "
+                                                             "(optional).")
     recommend: RecommendBounds = Field(default_factory=RecommendBounds,
                                        description="Bounds of the recommendation's search.")
 

@@ -42,6 +42,8 @@ from __future__ import annotations
 from .cycle import converge_cycle, cycle_exists, cycle_fold
 from .judge import stage_hunting, stage_hunts
 from .moves import Watch, family_distances, move_outcome, rest_is_final, watch_settings
+from .positioning import positioning, positioning_checks, settle_time
 
 __all__ = ["Watch", "watch_settings", "family_distances", "rest_is_final", "move_outcome",
-           "converge_cycle", "cycle_exists", "cycle_fold", "stage_hunting", "stage_hunts"]
+           "converge_cycle", "cycle_exists", "cycle_fold", "stage_hunting", "stage_hunts",
+           "positioning", "positioning_checks", "settle_time"]

@@ -28,8 +28,10 @@ def _moves(model, isolated, params, horizon, family):
     """(distance, label, reference, move end) of the spec's motion and the family."""
     spec = model.spec
     ref, end = _spec_reference(spec, horizon)
-    net = ref.final
-    out = [(net, "spec", ref, end)]
+    # the spec's motion stands for its largest move: a back-and-forth motion nets to 0, and
+    # a move of 0 m is not a distance to state or to draw on a log axis
+    largest = max(spec.motion.moves, key=lambda mv: abs(mv.distance)).distance
+    out = [(float(largest), "spec", ref, end)]
     dists = family_distances(model, isolated, params) if family is None else tuple(family)
     for d in dists:
         r, e = _family_reference(spec, d, horizon)
@@ -135,12 +137,10 @@ def stage_hunting(model: Model | _spec.Spec, isolated: bool | None = None, *,
     if boundary and _integrates(p):
         bound = _boundary(model, iso, fc, cycle, family, say)
         free_from = bound.pop("hunting_free_from")
-    fr = model.friction
-    held = max(fr.static(1.0), fr.static(-1.0))  # what static friction can hold against the loop
     return StageHunting(plant=plant, crossover=float(fc), moves=outcomes, cycle=cycle,
                         other_cycles=tuple(others), hunting_free_from=free_from,
                         boundary=bound, first_only=first_only,
-                        static_error_bound=model.law.static_error(held + abs(model.offset)),
+                        static_error_bound=model.static_error_bound,
                         settle_band=model.spec.requirements.hunting.settle_band)
 
 

@@ -16,7 +16,9 @@ one module per topic (the result types they return are in
 - :mod:`.scatter` -- :func:`robustness` under scatter
   (:func:`parse_scatter`, :func:`wilson_interval`);
 - :mod:`.points` -- one point simulated and judged, many run in chunks;
-- :mod:`.cache` -- :class:`PointCache`, the SQLite store of finished points.
+- :mod:`.cache` -- :class:`PointCache`, the SQLite store of finished points;
+- :mod:`.sensitivity` -- :func:`crossover_sensitivity`, the hunting-free
+  crossover over the unidentified LuGre values sigma0, sigma1 and vs.
 
 Execution. Points are independent; they are grouped in chunks (points of a
 chunk interleaved over the grid, so chunks cost about the same) and the chunks
@@ -56,12 +58,14 @@ from .cache import CACHE_ENV, PointCache, default_cache_dir
 from .paper import PAPER_MAPS, paper_study
 from .points import warm_up
 from .scatter import parse_position_friction, parse_scatter, robustness, wilson_interval
+from .sensitivity import crossover_sensitivity
 from .sweeps import design_map, sweep
 
 __all__ = [
     "Axis", "CACHE_ENV", "DesignMap", "HuntingProbability", "MapDefinition", "PAPER_MAPS",
     "POINT_VERDICTS", "PointCache", "PointResult", "PositionFriction", "RobustnessResult",
-    "RunInfo", "Scatter", "StudyMap", "StudyResult", "SweepResult", "default_cache_dir",
+    "RunInfo", "Scatter", "StudyMap", "StudyResult", "SweepResult", "crossover_sensitivity",
+    "default_cache_dir",
     "design_map", "design_value", "make_axis", "paper_study", "parse_axis",
     "parse_position_friction", "parse_scatter", "robustness", "sweep", "warm_up",
     "wilson_interval",

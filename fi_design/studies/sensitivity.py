@@ -1,0 +1,91 @@
+"""How the hunting-free crossover depends on the LuGre values nobody identified.
+
+sigma0, sigma1 and vs shape the stick phase and the breakaway, and so the
+hunting cycle and its fold; a datasheet gives none of them, and an
+identification needs a record that holds the excitation (presliding
+reversals, slow breakaways). :func:`crossover_sensitivity` divides and
+multiplies each by a factor (3 by default), the others held at the values the
+design used, and finds the stage-level hunting-free crossover of the spec's
+own plant for each (:func:`fi_design.stage.stage_hunting`, the fold of the
+cycle by bisection): six stage-level answers, about a second each on the
+paper setup.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..model import Model, as_model
+from ..results.sensitivity import SENSITIVITY_PARAMETERS, CrossoverSensitivity, SensitivityPoint
+from ..specpaths import with_values
+
+__all__ = ["crossover_sensitivity", "DEFAULT_FACTORS"]
+
+#: The factors each parameter is scaled by [-].
+DEFAULT_FACTORS = (1.0 / 3.0, 3.0)
+
+
+def _nominal(model: Model) -> dict[str, float]:
+    f = model.friction
+    return {"friction.bristle_stiffness": f.sigma0, "friction.bristle_damping": f.sigma1,
+            "friction.stribeck_velocity": f.vs}
+
+
+def _fold(spec: Any, isolated: bool, values: dict) -> tuple[float | None, str]:
+    """The hunting-free crossover of a spec with some values replaced (one task)."""
+    from ..stage import stage_hunting
+
+    st = stage_hunting(with_values(spec, values), isolated, converge=False, trace=False)
+    kind = (st.boundary or {}).get("kind", "none")
+    return st.hunting_free_from, kind
+
+
+def crossover_sensitivity(model: Model | Any, nominal: float | None = None, *,
+                          factors: tuple[float, ...] = DEFAULT_FACTORS,
+                          executor: Any = None) -> CrossoverSensitivity | None:
+    """The spec's own plant's hunting-free crossover with sigma0, sigma1 and vs scaled.
+
+    Parameters
+    ----------
+    model : Model or Spec
+        The resolved model (a spec is resolved); its spec is varied.
+    nominal : float, optional
+        The nominal hunting-free crossover [Hz] when already known (the
+        design's); computed when None.
+    factors : tuple of float, optional
+        Factors other than 1 to scale each parameter by [-]; default 1/3 and 3.
+    executor : concurrent.futures-style executor, optional
+        Runs the six answers; None runs them here.
+
+    Returns
+    -------
+    CrossoverSensitivity or None
+        None for a loop without integrator (no hunting by the paper's
+        mechanism, no crossover to find) or a friction model without these
+        parameters (the switch model).
+    """
+    model = as_model(model)
+    if not model.law.integrator or model.friction.model != "lugre":
+        return None
+    iso = model.has_isolator
+    spec = model.spec
+    base = _nominal(model)
+    # the others held at the values the design used (sigma1's default follows sigma0 otherwise)
+    jobs = []
+    for path in SENSITIVITY_PARAMETERS:
+        for f in factors:
+            values = dict(base)
+            values[path] = base[path] * f
+            jobs.append((path, f, values[path], values))
+    if nominal is None:
+        nominal = _fold(spec, iso, base)[0]
+    if executor is None:
+        found = [_fold(spec, iso, values) for *_, values in jobs]
+    else:
+        futures = [executor.submit(_fold, spec, iso, values) for *_, values in jobs]
+        found = [fut.result() for fut in futures]
+    points = tuple(SensitivityPoint(path=path, factor=float(f), value=float(v),
+                                    hunting_free_from=m, kind=kind)
+                   for (path, f, v, _), (m, kind) in zip(jobs, found))
+    return CrossoverSensitivity(plant="isolated" if iso else "non_isolated", nominal=nominal,
+                                factors=tuple(sorted((1.0, *factors))), points=points)
