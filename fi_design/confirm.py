@@ -208,11 +208,12 @@ def _force_checks(model: Model, forces) -> list[Check]:
     if flim is None or not math.isfinite(flim):
         out.append(Check("actuator_force", None, peak, None, "N", text, step))
     else:
-        ok = peak < 0.999 * flim
+        cmd = forces.peak_command
+        ok = cmd < flim
         out.append(Check("actuator_force", ok, peak, flim, "N", text + (
             f", below controller.force_limit = {flim:.3g} N" if ok else
-            f": the actuator saturates at controller.force_limit = {flim:.3g} N"), step,
-            status=None if ok else Status.WARN))
+            f": the actuator saturates at controller.force_limit = {flim:.3g} N (the loop "
+            f"commands up to {cmd:.3g} N)"), step, status=None if ok else Status.WARN))
     return out
 
 

@@ -454,8 +454,8 @@ def test_the_assumptions_describe_the_method_that_ran(documents, example_designs
         assert "k_stop = " in text and "c_stop = " in text
     if r.flexure is not None:
         assert "Gravity is modelled on the leaf-spring guide" in text
-    if r.robustness is not None:
-        assert "Only these scatter" in text
+    if r.robustness is not None:       # what the scatter varies, and what it does not
+        assert "the gap Fs \u2212 Fc" in text and "stay nominal" in text
 
 
 @pytest.mark.parametrize("name", NAMES)

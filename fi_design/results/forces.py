@@ -27,9 +27,12 @@ class MoveForces(Result):
     peak_stop_force : float
         Largest contact force of the end stop [N] (0 without contact).
     peak_actuator_force : float
-        Largest actuator force the controller commands [N].
+        Largest force the actuator applies [N] (after the delay and the
+        saturation of ``controller.force_limit``).
     contact_time : float
         Time the joint spends on its end stop [s].
+    peak_command : float
+        Largest force the controller commands [N] (before the saturation).
     """
 
     distance: float
@@ -38,6 +41,7 @@ class MoveForces(Result):
     peak_stop_force: float
     peak_actuator_force: float
     contact_time: float
+    peak_command: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -86,6 +90,11 @@ class StageForces(Result):
         return max((m.peak_actuator_force for m in self.moves), default=0.0)
 
     @property
+    def peak_command(self) -> float:
+        """Largest force the controller commands over the family [N]."""
+        return max((m.peak_command for m in self.moves), default=0.0)
+
+    @property
     def most_impacts(self) -> int:
         """Most end-stop impacts of one move."""
         return max((m.impacts for m in self.moves), default=0)
@@ -97,6 +106,7 @@ class StageForces(Result):
                 "moves_tried": len(self.moves), "most_impacts": self.most_impacts,
                 "peak_stop_force": self.peak_stop_force,
                 "peak_actuator_force": self.peak_actuator_force,
+                "peak_command": self.peak_command,
                 "stop_stiffness": self.stop_stiffness, "stop_damping": self.stop_damping,
                 "stop_default": self.stop_default, "settle": self.settle, "rate": self.rate,
                 "moves": [m.to_dict() for m in self.moves]}

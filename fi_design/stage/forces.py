@@ -36,11 +36,14 @@ def _one(model: Model, isolated: bool, moves, end: float, settle: float, rate: f
     duration = end + settle
     res = simulate(model, isolated, reference=from_moves(moves, duration), duration=duration,
                    rate=rate)
-    u = np.abs(res.force[np.isfinite(res.force)])
-    peak_u = float(u.max()) if u.size else 0.0
+    def peak(x) -> float:
+        a = np.abs(x[np.isfinite(x)])
+        return float(a.max()) if a.size else 0.0
+
+    peak_u, peak_cmd = peak(res.applied_force), peak(res.force)
     if not isolated:
         return MoveForces(distance=distance, label=label, impacts=0, peak_stop_force=0.0,
-                          peak_actuator_force=peak_u, contact_time=0.0)
+                          peak_actuator_force=peak_u, contact_time=0.0, peak_command=peak_cmd)
     j, lim = model.joint, model.limiter
     d = res.position - res.cart_position
     dv = res.velocity - res.cart_velocity
@@ -53,7 +56,8 @@ def _one(model: Model, isolated: bool, moves, end: float, settle: float, rate: f
     return MoveForces(distance=distance, label=label, impacts=starts,
                       peak_stop_force=float(np.max(np.abs(force[finite]), initial=0.0)),
                       peak_actuator_force=peak_u,
-                      contact_time=float(np.count_nonzero(contact)) / rate)
+                      contact_time=float(np.count_nonzero(contact)) / rate,
+                      peak_command=peak_cmd)
 
 
 def move_forces(model: Model | _spec.Spec, isolated: bool | None = None, *,
