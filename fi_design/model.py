@@ -34,7 +34,7 @@ from .errors import ArgumentError, SimulationError, SpecError
 from .pid import at_crossover, control_law
 from .kernel.layout import PlantParameters
 from .mechanism.geometry import StageBody, stage_body
-from .results.controller import ControlLaw
+from .results.controller import ControlLaw, Filter
 from .results.friction import FrictionLaw
 from .results.mechanism import Mode
 from .results.steps import FlexureResult
@@ -254,7 +254,7 @@ class Model:
            stroke: float | None = None, damping: float | None = None,
            friction_model: str | None = None, effects=None,
            masses: tuple[float, float] | None = None, delay: float | None = None,
-           mode_scale: float | None = None) -> "Model":
+           mode_scale: float | None = None, filters=None) -> "Model":
         """The same model with some values changed, checked like the spec checks them.
 
         Parameters
@@ -288,6 +288,8 @@ class Model:
             The loop's computational delay [s].
         mode_scale : float, optional
             Factor on the guide's computed modes' frequencies [-].
+        filters : sequence of fi_design.results.controller.Filter, optional
+            The drive's filter chain replacing the law's (``controller.filters``).
 
         Returns
         -------
@@ -309,10 +311,13 @@ class Model:
         paths = [path for path, value in (
             ("controller.crossover", crossover), ("isolator.stiffness", stiffness),
             ("isolator.stroke", stroke), ("isolator.damping", damping),
-            ("friction.model", friction_model), ("effects", effects)) if value is not None]
+            ("friction.model", friction_model), ("effects", effects),
+            ("controller.filters", filters)) if value is not None]
         law, friction = model.law, model.friction
         if crossover is not None:
             law = at_crossover(law, _positive(crossover, "controller.crossover", "Hz"))
+        if filters is not None:
+            law = replace(law, filters=_checked_filters(filters, law.sample_period))
         if friction_model is not None:
             if friction_model not in FRICTION_MODELS:
                 raise SpecError(f"must be one of {', '.join(FRICTION_MODELS)}, got "
@@ -557,6 +562,21 @@ def _positive(value, path: str, unit: str) -> float:
     if not x > 0.0:
         raise SpecError(f"must be greater than 0 {unit}, got {value!r}", path=path)
     return x
+
+
+def _checked_filters(filters, period: float) -> tuple:
+    out = tuple(filters)
+    for i, f in enumerate(out):
+        if not isinstance(f, Filter):
+            raise SpecError(f"expected a Filter, got {type(f).__name__}",
+                            path=f"controller.filters[{i}]")
+        if not (f.frequency > 0.0 and math.isfinite(f.frequency)):
+            raise SpecError(f"frequency must be a positive number [Hz], got {f.frequency!r}",
+                            path=f"controller.filters[{i}].frequency")
+        if period > 0.0 and f.frequency >= 0.5 / period:
+            raise SpecError(f"{f.frequency:g} Hz lies at or above the Nyquist frequency "
+                            f"{0.5 / period:g} Hz", path=f"controller.filters[{i}].frequency")
+    return out
 
 
 def _checked_effects(entries, joint: Joint | None) -> tuple:

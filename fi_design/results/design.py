@@ -18,7 +18,7 @@ from . import Check, Result, Status, to_jsonable
 from .confirmation import Confirmation, IsolatorAdvice, Landing, PlantVerdict
 from .mechanism import FeMechanics
 from .steps import (CaseResponse, CrossoverResult, FlexureResult, FrictionGapResult,
-                    LoopResponses, ModeSeparation, PidResult, StiffnessResult)
+                    LoopResponses, ModeSeparation, NotchSuggestion, PidResult, StiffnessResult)
 from .verdict import (VERDICT_STATUSES, Margins, Reason, Recommendation, RobustnessCheck,
                       Verdict)
 
@@ -26,7 +26,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..model import Model
     from ..spec import Spec
 
-__all__ = ["FrictionGapResult", "ModeSeparation", "CrossoverResult", "StiffnessResult",
+__all__ = ["FrictionGapResult", "ModeSeparation", "NotchSuggestion", "CrossoverResult", "StiffnessResult",
            "FlexureResult", "PidResult", "CaseResponse", "LoopResponses", "IsolatorAdvice",
            "PlantVerdict", "Landing", "Confirmation", "VERDICT_STATUSES",
            "Reason", "Verdict", "RobustnessCheck", "Margins", "Recommendation",

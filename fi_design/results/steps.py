@@ -11,11 +11,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import Check, Result, to_jsonable
-from .controller import ControlLaw, PidGains
+from .controller import ControlLaw, DiscreteController, DriveGains, Filter, PidGains
 from .linear import CaseMargins
 from .mechanism import GuideMechanics
 
-__all__ = ["FrictionGapResult", "ModeSeparation", "CrossoverResult", "StiffnessResult", "FlexureResult", "RULE_FORM", "CONTROLLER_FORM", "HAND_OFF_FORM", "PidResult", "CaseResponse", "LoopResponses"]
+__all__ = ["FrictionGapResult", "ModeSeparation", "NotchSuggestion", "CrossoverResult", "StiffnessResult", "FlexureResult", "RULE_FORM", "CONTROLLER_FORM", "HAND_OFF_FORM", "PidResult", "CaseResponse", "LoopResponses"]
 
 
 @dataclass(frozen=True)
@@ -57,7 +57,8 @@ class ModeSeparation(Result):
     frequency : float
         Its frequency [Hz].
     required : float
-        ``parasitic_separation`` x desired crossover [Hz].
+        ``parasitic_separation`` x the loop's crossover [Hz]
+        (:attr:`CrossoverResult.loop_crossover`).
     collocated : bool
         Collocated (antiresonance first) or not.
     passed : bool
@@ -78,6 +79,28 @@ class ModeSeparation(Result):
     source: str = "given"
     direction: str = "given"
     coupling: float = 1.0
+
+
+@dataclass(frozen=True)
+class NotchSuggestion(Result):
+    """What a notch at the mode that limits the crossover would allow.
+
+    Attributes
+    ----------
+    notch : fi_design.results.controller.Filter
+        The notch, added after the spec's own filters (``controller.filters``).
+    achievable : float or None
+        The achievable crossover with it [Hz]; None when none is.
+    limited_by : str
+        What limits that one, in words.
+    limit_kind : str
+        ``margin``, ``mode``, ``scan_limit`` or ``infeasible``.
+    """
+
+    notch: Filter
+    achievable: float | None
+    limited_by: str
+    limit_kind: str
 
 
 @dataclass(frozen=True)
@@ -108,7 +131,22 @@ class CrossoverResult(Result):
         Margins of each limit case with the PID tuned at the desired
         crossover, each judged (its ``status`` and ``criteria``).
     parasitic_modes : tuple of ModeSeparation
-        Each parasitic mode against ``parasitic_separation`` x desired crossover.
+        Each parasitic mode against ``parasitic_separation`` x the loop's
+        crossover (``loop_crossover``).
+    loop_crossover : float or None
+        The loop's actual crossover at the desired one: the highest in-band
+        0 dB crossing of any limit case [Hz]; the parasitic separation is
+        judged on it. None when no case crosses in the band (then the
+        desired crossover stands in).
+    loop_crossover_case : str or None
+        The case that crossing belongs to.
+    limiting_mode : str or None
+        The parasitic mode that limits the achievable crossover (through a
+        margin at its resonance, or the separation); None when none does.
+    limiting_mode_frequency : float or None
+        Its frequency [Hz].
+    notch : NotchSuggestion or None
+        What a notch at that mode would allow (a margin limit only).
     checks : tuple of Check
         The step's checks.
     """
@@ -123,7 +161,17 @@ class CrossoverResult(Result):
     stiffness: float | None
     cases: tuple[CaseMargins, ...]
     parasitic_modes: tuple[ModeSeparation, ...]
+    loop_crossover: float | None = None
+    loop_crossover_case: str | None = None
+    limiting_mode: str | None = None
+    limiting_mode_frequency: float | None = None
+    notch: NotchSuggestion | None = None
     checks: tuple[Check, ...] = field(default=(), repr=False)
+
+    @property
+    def separation_crossover(self) -> float:
+        """The crossover the parasitic separation is judged on [Hz]: the loop's, else the desired."""
+        return self.desired if self.loop_crossover is None else self.loop_crossover
 
 
 @dataclass(frozen=True)
@@ -386,12 +434,19 @@ class LoopResponses(Result):
     Attributes
     ----------
     frequency : ndarray, shape (n,)
-        Log-spaced frequencies [Hz]: from a third of the lowest gain crossover
+        Ascending frequencies [Hz]: from a third of the lowest gain crossover
         of any case (and a thirtieth of the desired crossover) to thirty times
-        the desired crossover or twice the highest parasitic mode.
+        the desired crossover or twice the highest parasitic mode (a sampled
+        controller's Nyquist frequency at most); log-spaced, packed at every
+        resonance and antiresonance, holding every crossing and sensitivity
+        peak (:func:`fi_design.responses.loop_responses`).
     cases : tuple of CaseResponse
         One per limit case, in the paper's order.
+    nyquist : float or None
+        The Nyquist frequency of a sampled controller [Hz], where the grid
+        ends; None in continuous time.
     """
 
     frequency: np.ndarray
     cases: tuple[CaseResponse, ...]
+    nyquist: float | None = None
