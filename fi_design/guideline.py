@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 
+from .controller import discrete_controller, drive_gains
 from .errors import ArgumentError
 from .display import number, quantity
 from .mechanism.checks import flexure_checks
@@ -358,6 +359,7 @@ def _controller_words(c: ControlLaw) -> str:
     parts.append("continuous" if c.sample_period == 0 else
                  f"sampled at {quantity(1.0 / c.sample_period, 'Hz')}")
     parts.append("no delay" if c.delay == 0 else f"delay {quantity(c.delay, 's')}")
+    parts += [f.describe() for f in c.filters]
     return ", ".join(parts)
 
 
@@ -387,9 +389,9 @@ def step4_pid(model: Model | Spec) -> PidResult:
     g = law.rule
     step = "step 4 PID"
     if law.source == "rule":
-        msg = (f"tuned at {_g(g.crossover)} Hz on {_g(g.tuning_mass)} kg; as controller.gains "
-               f"takes them (controller.roll_off filters the D term only): kp = {_g(law.kp)} "
-               f"N/m, ki = {_g(law.ki)} N/(m s), kd = {_g(law.kd)} N s/m "
+        msg = (f"tuned at {_g(g.crossover)} Hz on {_g(g.tuning_mass)} kg; the gains a drive "
+               f"takes (controller.gains, with controller.roll_off on the D term only): kp = "
+               f"{_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s), kd = {_g(law.kd)} N s/m "
                f"({_controller_words(law)})")
         checks = [Check("pid", None, law.kp, None, "N/m", msg, step=step)]
     else:
@@ -413,8 +415,28 @@ def step4_pid(model: Model | Spec) -> PidResult:
             "tuned on the stage mass alone: with the limiter engaged the loop sees m1 + m2 and "
             "crosses over lower (the paper tunes on the maximum moving mass)", step=step,
             status=Status.WARN))
+    discrete = discrete_controller(law)
+    units = drive_gains(law, discrete)
+    if units is not None:
+        d = law.drive
+        checks.append(Check(
+            "pid.drive_units", None, units.kp, None, units.units["kp"],
+            f"in the drive's units ({_g(d.motor_constant)} N/A, {quantity(d.encoder_resolution, 'm')}"
+            f" per count, a current unit of {_g(d.current_scaling)} A): kp = {_g(units.kp)} "
+            f"{units.units['kp']}, ki = {_g(units.ki)} {units.units['ki']}, kd = {_g(units.kd)} "
+            f"{units.units['kd']}", step=step))
+    if discrete is not None:
+        checks.append(Check(
+            "pid.discrete", None, discrete.sample_rate, None, "Hz",
+            f"sampled at {quantity(discrete.sample_rate, 'Hz')}: per sample kp = "
+            f"{_g(discrete.kp)} N/m, integrator gain ki T/2 = {_g(discrete.integrator_gain)} N/m, "
+            f"D recursion pole {_g(discrete.derivative_pole)} and gain "
+            f"{_g(discrete.derivative_gain)} N/m"
+            + (f"; {len(discrete.filters)} filter biquad(s) by the Tustin rule prewarped at "
+               "their frequencies" if discrete.filters else ""), step=step))
     return PidResult(gains=g, tuning_rule=ctl.tuning_mass, derivative_ratio=ctl.derivative_ratio,
                      integrator_ratio=ctl.integrator_ratio, controller=law, static_error=static,
+                     discrete=discrete, drive_gains=units,
                      checks=tuple(checks))
 
 
@@ -697,6 +719,8 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
                f"{xo.achievable:.4g} Hz")
     else:
         ach = f"the achievable crossover is {xo.achievable:.3g} Hz, limited by {xo.limited_by}"
+    if xo.notch is not None:
+        ach += f"; {_notch_words(xo.notch)}"
     at = ("the desired crossover" if pid.controller.source == "rule"
           else "the hardware's crossover")
     if not bad:

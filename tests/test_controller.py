@@ -301,11 +301,11 @@ def test_industrial_example_reports_the_hardware_loop(repo_root):
     d = design(spec, confirm=False).to_dict()
     pid = d["pid"]
     assert pid["source"] == "gains" and pid["integrator"] is False
-    assert pid["controller"]["kp"] == pytest.approx(1.37e6)
-    assert pid["controller"]["derivative_on"] == "measurement"
-    assert pid["controller"]["sample_period"] == pytest.approx(1e-3)
+    assert pid["drive"]["kp"] == pytest.approx(1.37e6)
+    assert pid["drive"]["derivative_on"] == "measurement"
+    assert pid["drive"]["sample_rate"] == pytest.approx(1e3)
     assert pid["static_error"] == pytest.approx(20.0 / 1.37e6)
     law = control_law(spec)
-    assert set(pid["rule_in_hardware_form"]) == {"kp", "ki", "kd", "roll_off"}
+    assert set(pid["rule"]["in_drive_form"]) == {"kp", "ki", "kd", "roll_off"}
     assert d["crossover"]["desired"] == pytest.approx(law.crossover)
     assert "no integrator" in d["conclusion"] and "hardware's crossover" in d["conclusion"]

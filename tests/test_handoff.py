@@ -26,7 +26,7 @@ def _cases(result):
 
 def _printed_gains(output: str) -> dict:
     """kp, ki, kd and roll_off [Hz] as the console's step-4 table prints them."""
-    line = next(ln for ln in output.splitlines() if re.match(r"^\s*rule\s+[\d.]", ln))
+    line = next(ln for ln in output.splitlines() if re.match(r"^\s*drive\s+[\d.]", ln))
     kp, ki, kd, roll = (float(x) for x in line.split()[1:5])
     return {"kp": kp, "ki": ki, "kd": kd, "roll_off": roll}
 
@@ -53,17 +53,33 @@ def test_printed_gains_copied_into_controller_gains_keep_the_loop(paper_spec, tm
         assert b["phase_margin_deg"] == pytest.approx(a["phase_margin_deg"], abs=0.1)
 
 
-def test_json_labels_both_forms(paper_spec):
+def test_json_has_one_gain_set_named_for_the_drive(paper_spec):
+    """No trap: one set of kp, ki, kd (the drive's, pid.drive), frequencies in Hz like the spec,
+    every key's unit written beside it; the rule gives its corners, not a second gain set."""
     d = design(paper_spec, confirm=False).to_dict()["pid"]
-    assert "whole PID" in d["form"] and "not the form of controller.gains" in d["form"]
-    hand = d["hand_off"]
-    assert "controller.gains" in hand["form"] and "D term only" in hand["form"]
-    assert (hand["kp"], hand["ki"], hand["kd"]) == (d["controller"]["kp"], d["controller"]["ki"],
-                                                    d["controller"]["kd"])
-    assert hand["kp"] != d["kp"]  # the rule's whole-PID kp is another number
-    assert hand["roll_off"] == pytest.approx(24.0)  # Hz: wt = 3 wc at 8 Hz
-    assert hand["sample_rate"] is None and hand["delay"] == 0.0
-    assert hand["derivative_on"] == "error"
+    drive, rule = d["drive"], d["rule"]
+    assert "drive takes" in drive["form"] and "D term only" in drive["form"]
+    law = design(paper_spec, confirm=False).pid.controller
+    assert (drive["kp"], drive["ki"], drive["kd"]) == (law.kp, law.ki, law.kd)
+    assert drive["roll_off"] == pytest.approx(24.0)  # Hz: wt = 3 wc at 8 Hz
+    assert drive["sample_rate"] is None and drive["delay"] == 0.0
+    assert drive["derivative_on"] == "error" and drive["filters"] == []
+    assert drive["discrete"] is None and drive["in_drive_units"] is None
+    assert drive["units"]["roll_off"] == "Hz" and drive["units"]["kp"] == "N/m"
+    # the rule: its corners in Hz, no kp, ki, kd of another form to copy by mistake
+    assert not {"kp", "ki", "kd"} & set(rule) and "in_drive_form" not in rule
+    assert rule["roll_off"] == pytest.approx(24.0) and rule["lead_corner"] == pytest.approx(8 / 3)
+    assert rule["integrator_corner"] == pytest.approx(0.8) and rule["units"]["ks"] == "N/m"
+    assert not {"kp", "ki", "kd", "controller", "hand_off", "wt", "wc"} & set(d)
+
+    def keys(node, path=""):
+        for k, v in node.items():
+            yield f"{path}{k}"
+            if isinstance(v, dict):
+                yield from keys(v, f"{path}{k}.")
+
+    # nothing in rad/s: every frequency-like key of pid is in Hz
+    assert not [k for k in keys(d) if k.split(".")[-1] in ("wt", "wd", "wi", "wc", "omega")]
 
 
 def test_write_spec_round_trips_exactly(paper_confirmed_design, paper_spec_path, tmp_path):

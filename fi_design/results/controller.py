@@ -468,5 +468,8 @@ class ControlLaw:
         return self.rule.filtered_d()
 
     def to_dict(self) -> dict:
-        """Plain JSON data (SI; rad/s for ``roll_off``, infinities as null; without ``rule``)."""
-        return dataclass_dict(self)
+        """Plain JSON data: SI, frequencies in Hz like the spec (``roll_off`` [Hz], null for
+        an ideal D; ``sample_period`` [s]), infinities as null; without ``rule``."""
+        out = dataclass_dict(self)
+        out["roll_off"] = None if math.isinf(self.roll_off) else self.roll_off / (2 * math.pi)
+        return out
