@@ -46,8 +46,10 @@ Margins (:class:`CaseMargins`) come from :func:`control.stability_margins`
 with ``returnall=True``; closed-loop stability from the roots of
 ``den + num`` of the loop. To keep the polynomial root finding well
 conditioned, every loop is evaluated with the Laplace variable scaled by the
-tuned crossover ``wc`` (``s = wc s'``); frequencies are scaled back before they
-are reported. :func:`achievable_crossover` retunes the PID over a log scan of
+geometric mean of its poles' magnitudes (``s = w0 s'``; with a millihertz
+integrator and kilohertz filters in one loop a scale by the crossover
+overflows python-control's squared polynomials); frequencies are scaled back
+before they are reported. :func:`achievable_crossover` retunes the PID over a log scan of
 crossovers and refines the highest feasible one by bisection.
 
 ``import control`` takes one to three seconds: callers import this module
@@ -71,7 +73,7 @@ from .model import Model, as_model
 from .results import Status, frozen_array
 from .results.controller import ControlLaw, PidGains
 from .results.linear import (CRITERIA, AchievableCrossover, CaseMargins, GainCrossing,
-                             LoopAnalysis, PhaseCrossing)
+                             LoopAnalysis, PhaseCrossing, loop_crossover)
 from .spec import Spec
 
 __all__ = [
@@ -442,7 +444,21 @@ def _scaled(p: np.ndarray, w0: float) -> np.ndarray:
     return np.asarray(p, float) * w0 ** np.arange(n, -1, -1, dtype=float)
 
 
-def loop_margins(num: Sequence[float], den: Sequence[float], scale: float = 1.0,
+def _balanced_scale(den: np.ndarray) -> float:
+    """The geometric mean of the magnitudes of the nonzero roots of ``den`` [rad/s] (1 without).
+
+    Scaling s by it makes the polynomial's leading and trailing coefficients alike, which
+    keeps the squared polynomials of python-control's margin search finite when the loop
+    holds both a millihertz integrator and kilohertz filters."""
+    d = np.trim_zeros(np.asarray(den, float), "f")
+    d = np.trim_zeros(d, "b")
+    if d.size < 2:
+        return 1.0
+    lead, tail = abs(d[0]), abs(d[-1])
+    return float((tail / lead) ** (1.0 / (d.size - 1)))
+
+
+def loop_margins(num: Sequence[float], den: Sequence[float], scale: float | None = None,
                  name: str = "", description: str = "") -> CaseMargins:
     """Margins and closed-loop stability of a loop L = num/den.
 
@@ -452,8 +468,9 @@ def loop_margins(num: Sequence[float], den: Sequence[float], scale: float = 1.0,
         Loop numerator and denominator, descending powers of s [rad/s].
     scale : float, optional
         Frequency [rad/s] the Laplace variable is scaled by before the
-        polynomial root finding (the crossover is a good choice). Results are
-        reported unscaled.
+        polynomial root finding; default the geometric mean of the
+        denominator's nonzero roots (:func:`_balanced_scale`), which keeps the
+        coefficients balanced. Results are reported unscaled.
     name, description : str, optional
         Labels copied into the result.
 
@@ -462,6 +479,8 @@ def loop_margins(num: Sequence[float], den: Sequence[float], scale: float = 1.0,
     CaseMargins
         The margins; ``passed`` is left True (see :func:`analyse`).
     """
+    if scale is None:
+        scale = _balanced_scale(den)
     ns, ds = _scaled(num, scale), _scaled(den, scale)
     lead = ds[np.nonzero(ds)[0][0]]
     ns, ds = ns / lead, ds / lead
@@ -573,44 +592,16 @@ def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None) -> Lo
                         loop_crossover=top, loop_crossover_case=which)
 
 
-def loop_crossover(cases: Sequence[CaseMargins]) -> tuple[float | None, str | None]:
-    """The loop's actual crossover: the highest in-band 0 dB crossing of any limit case.
-
-    The bandwidth the parasitic modes must stay clear of
-    (``requirements.parasitic_separation``): with the cart stuck and the
-    joint free the loop may cross 0 dB well above the crossover the PID is
-    tuned for (the joint's resonance lifts |L|).
-
-    Parameters
-    ----------
-    cases : sequence of CaseMargins
-        The judged margins of the limit cases (:func:`analyse`).
-
-    Returns
-    -------
-    frequency, case : float or None, str or None
-        The crossing [Hz] and the name of the case it belongs to; None, None
-        when no case crosses 0 dB in the loop's band.
-    """
-    best, which = None, None
-    for c in cases:
-        for g in c.gain_crossings:
-            if g.in_band and (best is None or g.frequency > best):
-                best, which = g.frequency, c.name
-    return best, which
-
-
 def _margins(model: Model, lcs: Sequence[LimitCase], first_fail: bool) -> list[CaseMargins]:
     """Judged margins of each case (stopping at the first failing one when ``first_fail``)."""
     law = model.law
     cn, cd = controller_polynomials(law)
     dn, dd = delay_polynomials(model)
     ln, ld = np.polymul(cn, dn), np.polymul(cd, dd)
-    wc = 2.0 * math.pi * law.crossover
     out = []
     low = law.crossover / BAND_FACTOR
     for lc in lcs:
-        m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den), scale=wc,
+        m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den),
                                 name=lc.name, description=lc.description),
                    model.requirements, low)
         out.append(m)

@@ -10,11 +10,12 @@ checks, the report and the console read them.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Sequence
 
 from . import Result, Status
 from .controller import ControlLaw
 
-__all__ = ["CRITERIA", "GainCrossing", "PhaseCrossing", "CaseMargins", "LoopAnalysis",
+__all__ = ["CRITERIA", "loop_crossover", "GainCrossing", "PhaseCrossing", "CaseMargins", "LoopAnalysis",
            "AchievableCrossover"]
 
 #: The requirements a limit case is judged on, in the order they are listed.
@@ -233,3 +234,30 @@ class AchievableCrossover(Result):
     evaluations: int
     mode: str | None = None
     mode_frequency: float | None = None
+
+
+def loop_crossover(cases: Sequence[CaseMargins]) -> tuple[float | None, str | None]:
+    """The loop's actual crossover: the highest in-band 0 dB crossing of any limit case.
+
+    The bandwidth the parasitic modes must stay clear of
+    (``requirements.parasitic_separation``): with the cart stuck and the
+    joint free the loop may cross 0 dB well above the crossover the PID is
+    tuned for (the joint's resonance lifts |L|).
+
+    Parameters
+    ----------
+    cases : sequence of CaseMargins
+        The judged margins of the limit cases (:func:`fi_design.linear.analyse`).
+
+    Returns
+    -------
+    frequency, case : float or None, str or None
+        The crossing [Hz] and the name of the case it belongs to; None, None
+        when no case crosses 0 dB in the loop's band.
+    """
+    best, which = None, None
+    for c in cases:
+        for g in c.gain_crossings:
+            if g.in_band and (best is None or g.frequency > best):
+                best, which = g.frequency, c.name
+    return best, which
