@@ -126,3 +126,38 @@ def test_no_simulation_fails_the_ci_gate(paper_spec_path, tmp_path):
     assert r.exit_code == 3, r.output
     assert json.loads(out.read_text())["verdict"]["status"] == "NOT_CONFIRMED"
     assert "Verdict: NOT_CONFIRMED" in r.stdout
+
+
+def test_write_spec_round_trips_with_filters_and_a_drive(paper_spec, tmp_path):
+    """A sampled loop with a notch, a low-pass and the drive's units: the written spec keeps
+    the filters and the drive, and its design is the same loop to the last digit."""
+    from fi_design.specedit import edited_spec_text
+
+    spec = variant(paper_spec, **{
+        "controller.sample_rate": "4 kHz", "controller.delay": "250 us",
+        "controller.filters": [{"type": "notch", "frequency": "150 Hz", "width": "75 Hz"},
+                               {"type": "low_pass", "frequency": "600 Hz", "damping": 0.5}],
+        "controller.drive": {"motor_constant": "20 N/A", "encoder_resolution": "1 um"}})
+    path, out = tmp_path / "filtered.yaml", tmp_path / "handed.yaml"
+    path.write_text(edited_spec_text(spec))
+    r = runner.invoke(app, [str(path), "--no-simulation", "--write-spec", str(out)],
+                      env={"COLUMNS": "120"})
+    assert r.exit_code == 0, r.output
+    assert "A/count" in r.stdout and "per sample" in r.stdout  # the drive's own terms
+    handed = load_spec(out)
+    assert handed.controller.gains is not None
+    assert handed.controller.filters == spec.controller.filters
+    assert handed.controller.drive == spec.controller.drive
+    first, again = design(spec, confirm=False), design(handed, confirm=False)
+    assert again.pid.controller.source == "gains"
+    assert again.pid.controller.filters == first.pid.controller.filters
+    assert again.crossover.achievable == pytest.approx(first.crossover.achievable, rel=1e-6)
+    for a, b in zip(_cases(first), _cases(again)):
+        for k in MARGINS:
+            assert b[k] == pytest.approx(a[k], rel=1e-9), k
+    da, db = first.to_dict()["pid"]["drive"], again.to_dict()["pid"]["drive"]
+    for key in ("kp", "ki", "kd", "roll_off"):
+        assert db[key] == pytest.approx(da[key], rel=1e-12)
+    assert db["filters"] == da["filters"]
+    assert db["discrete"]["num"] == pytest.approx(da["discrete"]["num"], rel=1e-9)
+    assert db["in_drive_units"]["kp"] == pytest.approx(da["in_drive_units"]["kp"], rel=1e-12)
