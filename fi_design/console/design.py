@@ -313,7 +313,12 @@ def print_verdict(console: "Console", result) -> None:
         if mar.crossover_factor is not None:
             items.append(f"crossover {'>= ' if mar.crossover_factor_bound else ''}"
                          f"{mar.crossover_factor:.3g}x the hunting-free "
-                         f"{number(mar.hunting_free_crossover, 4)} Hz")
+                         f"{number(mar.hunting_free_crossover, 4)} Hz"
+                         + (f" (the sliding loop crosses 0 dB at "
+                            f"{number(mar.hunting_loop_crossover, 4)} Hz and "
+                            f"{number(mar.hunting_free_loop_crossover, 4)} Hz)"
+                            if mar.hunting_loop_crossover and mar.hunting_free_loop_crossover
+                            else ""))
         if mar.end_stop_clearance is not None:
             items.append(f"end stop {quantity(mar.end_stop_clearance, 'm', 3)} away at rest")
         if mar.stiffness_factor is not None:

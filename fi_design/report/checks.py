@@ -62,6 +62,12 @@ SENSE = {
 }
 
 
+#: The limit cases the hunting margin names (case number and words).
+_CASE_WORDS = {"sliding_limited": "case 3, cart sliding, limiter engaged",
+               "sliding_free": "case 1, cart sliding, joint free",
+               "sliding": "case 1, cart sliding, no isolator"}
+
+
 def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
     """A check's name in words: ``phase_margin.stuck_free`` -> ``Phase margin, case 2 ...``.
 
@@ -244,7 +250,12 @@ def key_figures(result: Any) -> list[dict]:
             "Crossover factor: design / lowest hunting-free",
             ("\u2265 " if m.crossover_factor_bound else "") + num(m.crossover_factor, 3), "1",
             "> 1", f"no move hunts from {qty(m.hunting_free_crossover, 'Hz')} (the fold of "
-                   "the cycle)", css))
+                   "the cycle); the ratio of the set crossovers, the loop's frequency scale"
+            + (f"; the loop the cycle slides in ({_CASE_WORDS.get(m.hunting_case, m.hunting_case)})"
+               f" crosses 0 dB at {qty(m.hunting_loop_crossover, 'Hz')} and at "
+               f"{qty(m.hunting_free_loop_crossover, 'Hz')}: "
+               f"{num(m.hunting_loop_crossover / m.hunting_free_loop_crossover, 3)}"
+               if m.hunting_loop_crossover and m.hunting_free_loop_crossover else ""), css))
     if m.achievable_factor is not None:
         rows.append(_figure("Achievable / desired crossover (linear, step 2)",
                             num(m.achievable_factor, 3), "1", "\u2265 1",
