@@ -143,7 +143,7 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
         (:attr:`fi_design.results.linear.CaseMargins.criteria`).
     """
     from . import linear
-    from .notch import limiting_mode, with_notch
+    from .notch import limiting_mode, notched, with_notch
 
     model = as_model(model)
     req = model.requirements
@@ -155,12 +155,14 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
     suggestion = None
     limited_by = ach.limited_by
     if mode is not None and ach.kind == "margin":
-        limited_by = (f"{ach.limited_by}, at the resonance of the parasitic mode '{mode.name}' "
+        limited_by = (f"{ach.limited_by}, caused by the parasitic mode '{mode.name}' "
                       f"({mode.frequency:.4g} Hz, {mode.source}): without that mode the case "
                       "keeps its margins")
-        notch, alt = with_notch(model, mode)
-        suggestion = NotchSuggestion(notch=notch, achievable=alt.frequency,
-                                     limited_by=alt.limited_by, limit_kind=alt.kind)
+        if not notched(model, mode):  # a notch there already: another would not be the advice
+            notch, alt = with_notch(model, mode)
+            if alt.frequency is not None and alt.frequency > ach.frequency:
+                suggestion = NotchSuggestion(notch=notch, achievable=alt.frequency,
+                                             limited_by=alt.limited_by, limit_kind=alt.kind)
     step = "step 2 crossover"
     checks: list[Check] = []
     reach = ach.frequency is not None and fc <= ach.frequency * (1 + 1e-9)

@@ -111,6 +111,9 @@ CASE_NUMBERS = {**{n: i for i, n in enumerate(ISOLATED_CASES, 1)},
 SCAN_LIMIT = 1000.0
 #: Lowest crossover of the scan [Hz] (lower still when the desired crossover is low).
 SCAN_START = 0.1
+#: A -180 deg crossing where |L| is below 1 / MUTE (120 dB down: a full notch's zero, where the
+#: phase flips) is no crossing to report [-].
+MUTE = 1e6
 #: The achievable-crossover scan stops at this factor times the lowest mode over the parasitic
 #: separation [-]: the separation itself is judged on the loop's actual crossover.
 MODE_SCAN_FACTOR = 2.0
@@ -518,7 +521,7 @@ def loop_margins(num: Sequence[float], den: Sequence[float], scale: float | None
     else:
         gain = math.inf
     phases = tuple(PhaseCrossing(frequency=float(w * hz), gain_margin_db=float(20 * np.log10(g)))
-                   for w, g in sorted(zip(wpc[ok], finite)))
+                   for w, g in sorted(zip(wpc[ok], finite)) if g < MUTE)
     if sm.size and np.min(sm) < 1.0:
         modulus, peak_at = float(np.min(sm)), float(wms[int(np.argmin(sm))] * hz)
     else:

@@ -22,7 +22,7 @@ from .results.controller import Filter
 from .results.linear import AchievableCrossover
 from .results.mechanism import Mode
 
-__all__ = ["NOTCH_WIDTH", "limiting_mode", "notch_at", "with_notch"]
+__all__ = ["NOTCH_WIDTH", "limiting_mode", "notched", "notch_at", "with_notch"]
 
 #: Width of a suggested notch, as a fraction of the mode's frequency [-]: its -3 dB band
 #: (pole damping 0.25), wide enough for the mode's tolerance, narrow enough to cost little
@@ -101,6 +101,12 @@ def notch_at(mode: Mode) -> Filter:
     """
     return Filter("notch", mode.name, mode.frequency, zeta_pole=NOTCH_WIDTH / 2.0,
                   zeta_zero=0.0, order=2)
+
+
+def notched(model: Model, mode: Mode) -> bool:
+    """Whether the drive's chain already has a notch on the mode (within its -3 dB band)."""
+    return any(f.kind == "notch" and abs(f.frequency - mode.frequency) <= 0.5 * f.width
+               for f in model.law.filters)
 
 
 def with_notch(model: Model, mode: Mode) -> tuple[Filter, AchievableCrossover]:

@@ -151,6 +151,12 @@ def test_step_2_names_the_tilt_mode_and_what_a_notch_allows(paper_spec):
     assert "notch" in check.message and "stage tilt" in check.message
 
 
+def test_with_a_notch_there_no_second_one_is_suggested(paper_spec):
+    """The spec's own notch on the tilt: the crossover rises and no notch is advised again."""
+    xo = step2_crossover(variant(paper_spec, **{"controller.filters": [NOTCH]}))
+    assert xo.achievable > 30.0 and xo.notch is None
+
+
 def test_without_the_mode_no_mode_is_named(paper_spec):
     """A delay limits the rigid loop: no mode is behind it, none is named."""
     spec = variant(paper_spec, isolator=None, **{"controller.delay": "2 ms"})

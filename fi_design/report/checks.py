@@ -123,6 +123,10 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
         return "PID tuning mass"
     if head == "pid" and tail == "integrator":
         return "Loop without integrator: static error up to Fc / kp"
+    if head == "pid" and tail == "drive_units":
+        return "PID gains in the drive's units (counts, current)"
+    if head == "pid" and tail == "discrete":
+        return "PID and filters per sample (the drive's recursion)"
     return labels.get(head, name.replace("_", " ").capitalize())
 
 

@@ -100,7 +100,9 @@ class CaseMargins(Result):
     gain_crossings : tuple of GainCrossing
         Every 0 dB crossing with its phase and delay margin, ascending.
     phase_crossings : tuple of PhaseCrossing
-        Every -180 deg crossing with its gain margin, ascending.
+        Every -180 deg crossing with its gain margin, ascending; where |L|
+        is below 1e-6 (a full notch's zero, where the phase flips as the loop
+        vanishes) none is counted.
     modulus_frequency : float or None
         Where |1 + L| is smallest, the peak of the sensitivity [Hz]; None
         when |1 + L| never falls below 1.
