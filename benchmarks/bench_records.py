@@ -89,7 +89,7 @@ def command(name: str, record: Path) -> list[str]:
                      "--force"]
     if name == "simulate":
         return fi + ["simulate", str(SPEC), "--record", str(record), "--csv", "replay.csv",
-                     "--force"]
+                     "--json", "replay.json", "--force"]
     return fi + ["reconcile", str(SPEC), str(record), "--json", "gap.json", "--force"]
 
 
@@ -119,7 +119,7 @@ def section(sizes: list[int], commands: list[str]) -> str:
         "| ---: | ---: | --- | ---: | ---: | ---: | ---: | ---: |"]
     for n, mb, name, wall, mem, code, y_wall, y_mem in rows:
         label = {"identify": "`identify MEASURED.csv --spec SPEC --json`",
-                 "simulate": "`simulate SPEC --record MEASURED.csv --csv`",
+                 "simulate": "`simulate SPEC --record MEASURED.csv --csv --json`",
                  "reconcile": "`reconcile SPEC MEASURED.csv --json`"}[name]
         lines.append(f"| {n:.0e} | {mb:.0f} | {label} | {wall:.1f} | {mem:.0f} | {code} | "
                      f"{mem / y_mem:.2f} | {wall / y_wall:.1f} |")

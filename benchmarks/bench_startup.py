@@ -161,7 +161,8 @@ from fi_design.confirm import confirm
 confirm(spec, None)
 mark("the confirmation (with and without isolator, crossover scans)")
 from fi_design import verdict
-study = verdict.run_robustness(spec, None)
+from fi_design.model import resolve
+study = verdict.run_robustness(resolve(spec), None)
 mark(f"the robustness study ({study.samples} samples, both plants)")
 result = design(spec)
 mark("design(spec) again, all of it in this process")
@@ -172,7 +173,11 @@ print_design(Console(file=io.StringIO(), width=100), result)
 mark("the console summary")
 from fi_design.report import build_context, render_html
 html = render_html(build_context(result))
-mark("the report: context, figures (matplotlib) and HTML")
+mark("the HTML report: context, figures (matplotlib, SVG) and HTML")
+from fi_design.plots import raster_figures
+with raster_figures():
+    html = render_html(build_context(result))
+mark("the PDF's context, figures (matplotlib, PNG) and HTML")
 import weasyprint
 mark("WeasyPrint's import")
 weasyprint.HTML(string=html).write_pdf()

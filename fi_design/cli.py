@@ -17,7 +17,8 @@ library raises; :class:`~fi_design.cliparts.DefaultCommandGroup` translates:
   (``fail``: the design does not pass, FAIL or NOT_CONFIRMED; ``warn``: also
   PASS_WITH_WARNINGS), for scripts and CI;
   the outputs are written first;
-- exit 130: a parameter study interrupted with Ctrl-C.
+- exit 130: interrupted with Ctrl-C (128 + the signal's number for SIGTERM and
+  SIGHUP), at any instant: the message says which outputs were written.
 
 ``fi-design SPEC.yaml`` runs the default command ``design`` through
 :class:`~fi_design.cliparts.DefaultCommandGroup`: when the first word after the group's own options
@@ -640,5 +641,7 @@ def identify_command(
 
 def main() -> None:
     """Console-script entry point (``fi-design``, ``python -m fi_design``)."""
-    app(prog_name="fi-design")
+    from .cliparts import run_app
+
+    run_app(app)
 

@@ -15,11 +15,9 @@ The commands themselves are in :mod:`fi_design.cli`.
 
 from __future__ import annotations
 
-import contextlib
 import difflib
 import os
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Optional
 
@@ -96,8 +94,13 @@ class DefaultCommandGroup(TyperGroup):
     with ``--debug`` or ``FI_DESIGN_DEBUG=1``); SIGTERM and SIGHUP become
     :class:`Terminated` in the main thread, so that temporary files are
     removed and worker processes stopped as after Ctrl-C, and exit with 128
-    plus the signal's number. Every command runs in a :mod:`contextvars`
-    context of its own (the outputs it claims, :mod:`fi_design.output`).
+    plus the signal's number; Ctrl-C exits 130. A signal is never lost: held
+    while a worker pool starts or a temporary file is made, and raised again
+    before any output is written when its first exception was swallowed
+    (:mod:`fi_design.interrupts`); an error raised on the way out of an
+    interruption reports the interruption. Every command runs in a
+    :mod:`contextvars` context of its own (the outputs it claims,
+    :mod:`fi_design.output`).
     """
 
     default_command = DEFAULT_COMMAND
@@ -143,19 +146,41 @@ class DefaultCommandGroup(TyperGroup):
                 break
         return i
 
+    def main(self, *args: Any, **kwargs: Any) -> Any:
+        # signals become exceptions before the arguments are parsed (a fifth of a second of
+        # building the commands); typer turns an interruption there into a silent exit 130
+        from .interrupts import signals_to_exceptions
+
+        try:
+            with signals_to_exceptions(_signal_exception):
+                return super().main(*args, **kwargs)
+        except SystemExit as exc:
+            cause = _interruption(exc)
+            if cause is not None:  # not said yet: parsing, or the command had returned
+                _say_interrupted(cause, "outside the command")
+            raise
+
     def invoke(self, ctx: Any) -> Any:
         import contextvars
 
+        return contextvars.copy_context().run(self._invoke, ctx)
+
+    def _invoke(self, ctx: Any) -> Any:
+        from .interrupts import signals_to_exceptions
+        from .output import begin_run
+
+        begin_run()
         try:
-            with terminate_by_exception():
-                return contextvars.copy_context().run(super().invoke, ctx)
-        except Terminated as exc:
-            typer.echo(f"terminated by signal {exc.signum}; no output was written and no "
-                       "temporary file is left", err=True)
-            raise typer.Exit(128 + exc.signum) from None
+            with signals_to_exceptions(_signal_exception):
+                return super().invoke(ctx)
+        except KeyboardInterrupt as exc:  # Ctrl-C, or Terminated (SIGTERM, SIGHUP)
+            raise _interrupted(exc) from None
         except (typer.Exit, typer.Abort, typer.TyperException, BrokenPipeError):
             raise  # usage errors, explicit exits, `fi-design ... | head`
         except Exception as exc:  # noqa: BLE001 -- the one place that turns errors into codes
+            cause = _interruption(exc)
+            if cause is not None:  # an error on the way out of an interruption is not one
+                raise _interrupted(cause) from None
             debug = _debug_requested(ctx)
             if debug:
                 import traceback
@@ -186,32 +211,70 @@ class Terminated(KeyboardInterrupt):
         self.signum = signum
 
 
-@contextlib.contextmanager
-def terminate_by_exception() -> Iterator[None]:
-    """Turn SIGTERM and SIGHUP into :class:`Terminated` for the duration (main thread only).
-
-    The default action of these signals ends the process at once: a
-    temporary file half written stays, worker processes are orphaned. As an
-    exception, they unwind like Ctrl-C does: every ``finally`` runs.
-    """
+def _signal_exception(signum: int) -> KeyboardInterrupt:
+    """The exception of a signal: KeyboardInterrupt for Ctrl-C, :class:`Terminated` else."""
     import signal
-    import threading
 
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
+    return KeyboardInterrupt() if signum == signal.SIGINT else Terminated(signum)
 
-    def terminate(signum: int, frame: Any) -> None:
-        raise Terminated(signum)
 
-    kinds = [s for s in (getattr(signal, "SIGTERM", None), getattr(signal, "SIGHUP", None))
-             if s is not None]
-    previous = {s: signal.signal(s, terminate) for s in kinds}
+def _interruption(exc: BaseException) -> KeyboardInterrupt | None:
+    """The interruption an error was raised on the way out of, if any.
+
+    An interruption inside the import of a compiled module becomes
+    ``ImportError: initialization failed``; stopping an interrupted worker pool
+    can fail on a pipe its own thread closed meanwhile. Either error carries
+    the KeyboardInterrupt as its cause or context.
+    """
+    seen: set[int] = set()
+    node: BaseException | None = exc
+    while node is not None and id(node) not in seen:
+        if isinstance(node, KeyboardInterrupt):
+            return node
+        seen.add(id(node))
+        # `raise ... from None` ends the chain: the interruption was handled there
+        node = node.__cause__ or (None if node.__suppress_context__ else node.__context__)
+    return None
+
+
+def _interrupted(exc: KeyboardInterrupt) -> typer.Exit:
+    """Say that the run was interrupted and what it wrote; the exit (128 + the signal)."""
+    _say_interrupted(exc)
+    return typer.Exit(128 + exc.signum if isinstance(exc, Terminated) else EXIT_INTERRUPTED)
+
+
+def run_app(application: typer.Typer) -> None:
+    """Run the application as ``fi-design``, signals turned into exceptions from the first
+    instant (typer builds the commands before :meth:`DefaultCommandGroup.main` runs).
+
+    Parameters
+    ----------
+    application : typer.Typer
+        The application (:data:`app` with its commands).
+    """
+    from .interrupts import signals_to_exceptions
+
     try:
-        yield
-    finally:
-        for s, handler in previous.items():
-            signal.signal(s, handler)
+        with signals_to_exceptions(_signal_exception):
+            application(prog_name="fi-design")
+    except KeyboardInterrupt as exc:  # before the command began, or as it ended
+        _say_interrupted(exc, "outside the command")
+        raise SystemExit(128 + exc.signum if isinstance(exc, Terminated) else
+                         EXIT_INTERRUPTED) from None
+
+
+def _say_interrupted(exc: KeyboardInterrupt, where: str = "") -> None:
+    """Print what interrupted the run and which outputs it had written (stderr)."""
+    from .output import written
+
+    files = written()
+    what = (f"terminated by signal {exc.signum}" if isinstance(exc, Terminated) else
+            "interrupted")
+    done = (f"it had written {', '.join(str(f) for f in files)}" if files else
+            "no output was written")
+    if where:
+        what, done = f"{what} {where}", "no output was left half-written"
+    typer.echo(f"{what}; {done} and no temporary file is left", err=True)
 
 
 app = typer.Typer(
@@ -469,14 +532,25 @@ def run_study(label: str, pool: Any, no_cache: bool, work: Any) -> Any:
     try:
         with pool as ex, ProgressBar(err, label) as bar:
             return work(ex, bar, None if no_cache else PointCache())
+    except Exception as exc:  # noqa: BLE001 -- only an error on the way out of an interruption
+        cause = _interruption(exc)
+        if cause is None:
+            raise
+        _study_interrupted(err, cause, no_cache)
     except KeyboardInterrupt as exc:
-        what = "terminated" if isinstance(exc, Terminated) else "interrupted"
-        err.print(f"{what}; nothing was kept (--no-cache) and no output was written"
-                  if no_cache else f"{what}; the finished points are in the result cache: "
-                  "run the same command again to resume. No output was written",
-                  markup=False, highlight=False)
-        raise typer.Exit(128 + exc.signum if isinstance(exc, Terminated) else
-                         EXIT_INTERRUPTED) from None
+        _study_interrupted(err, exc, no_cache)
+
+
+def _study_interrupted(err: "Console", exc: KeyboardInterrupt, no_cache: bool) -> None:
+    """Say that a study was interrupted and where its finished points are; exit 130 (or 128 +
+    the signal)."""
+    what = "terminated" if isinstance(exc, Terminated) else "interrupted"
+    err.print(f"{what}; nothing was kept (--no-cache) and no output was written"
+              if no_cache else f"{what}; the finished points are in the result cache: "
+              "run the same command again to resume. No output was written",
+              markup=False, highlight=False)
+    raise typer.Exit(128 + exc.signum if isinstance(exc, Terminated) else
+                     EXIT_INTERRUPTED) from None
 
 
 def write_study(console: "Console", outs: dict, result: Any, figure: Any) -> None:

@@ -6,8 +6,9 @@ default), with a minimum distance between peaks (0.5 s) and a minimum peak
 height (0.1 mm); one peak per hunting cycle. A peak must also stand out from
 its surroundings by the minimum height (its prominence), so a stage at rest
 or the plateau of a stick phase is never a cycle, and one period with a main
-and a secondary bump counts once; a cycle that stays below the target counts
-its negative peaks.
+and a secondary bump counts once. A plateau at a cycle's top is one peak, in
+its middle, even where round-off steps its samples up and down; a cycle that
+stays below the target counts its negative peaks.
 
 The metric judges one trace: whether the *stage* hunts is answered over a
 family of moves and by the cycle itself (:mod:`fi_design.stage`).
@@ -19,7 +20,9 @@ The count alone is blind in two ways, and the verdict here is not:
   verdict ``undetermined`` ("too slow to judge in this window").
 
 Only a stage whose error stays inside the settle band at the end of the
-window is ``settled``.
+window is ``settled``; a run that ends, or a window that closes, before the
+motion does is never settled: ``undetermined`` ("not finished"), since a
+stage on its ramp follows the reference within the band.
 """
 
 from __future__ import annotations
@@ -55,7 +58,8 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     settle_band : float
         Band for ``settled`` and the settling time [m].
     motion_end : float
-        End of the last move [s]; the settling time counts from here.
+        End of the last move [s]; the settling time counts from here. A
+        trace or window that ends before it is not finished: ``undetermined``.
     success : bool
         Whether the trace is complete; an incomplete one is ``undetermined``.
     failure : str
@@ -82,6 +86,7 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
         for side in (1.0, -1.0):
             found, _ = find_peaks(side * ew, height=min_height, prominence=min_height,
                                   distance=distance)
+            found = _one_per_plateau(side * ew, found, min_height)
             if len(found) > len(idx):
                 idx = found
     peaks_t, peaks_h = tw[idx], ew[idx]
@@ -91,12 +96,20 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     finite = np.isfinite(e)
     final_error = float(e[finite][-1]) if finite.any() else float("nan")
 
+    t_last = float(t[-1]) if len(t) else 0.0
+    moving = motion_end > min(w1, t_last)  # the motion outlasts the window or the run
     tail = inside & (t >= w1 - window_length / 4.0)
-    settled = bool(success and tail.any() and np.all(np.abs(e[tail]) <= settle_band))
+    settled = bool(success and not moving and tail.any()
+                   and np.all(np.abs(e[tail]) <= settle_band))
     settling_time = _settling_time(t, e, settle_band, motion_end) if success else None
 
     if not success:
         verdict, reason = "undetermined", f"the simulation did not complete: {failure}"
+    elif moving:
+        what = "run" if t_last <= w1 else "counting window"
+        verdict = "undetermined"
+        reason = (f"not finished: the motion runs until {motion_end:.4g} s, past the end of the "
+                  f"{what} at {min(w1, t_last):.4g} s; the stage is still moving")
     elif len(ew) < 2:
         verdict, reason = "undetermined", "the trace does not cover the counting window"
     elif cycles > 0:
@@ -119,6 +132,52 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
         amplitude=amplitude, period=period, settled=settled, settling_time=settling_time,
         final_error=final_error, verdict=verdict, reason=reason, window=(w0, w1),
         settle_band=settle_band)
+
+
+def _one_per_plateau(y: np.ndarray, peaks: np.ndarray, min_height: float) -> np.ndarray:
+    """One peak per plateau: peaks no dip of ``min_height`` separates are one.
+
+    scipy's prominence looks past a neighbour of *equal* height (it stops at a
+    strictly higher one), so the samples of a stick plateau that round to the
+    same value, with dips of a unit in the last place between them, would each
+    stand out by the whole cycle. Adjacent peaks are one peak unless the trace
+    falls by ``min_height`` below the lower of the two between them. The peak
+    kept is the middle of its flat top (the samples within a millionth of
+    ``min_height`` of its highest one), as scipy places a peak on an exactly
+    flat top: one time per cycle, wherever the rounding puts the highest sample.
+
+    Parameters
+    ----------
+    y : ndarray, shape (n,)
+        The trace whose peaks were found [m].
+    peaks : ndarray of int
+        Their indices, increasing.
+    min_height : float
+        The prominence a peak needs [m].
+
+    Returns
+    -------
+    ndarray of int
+        The indices kept, increasing.
+    """
+    if len(peaks) == 0:
+        return peaks
+    groups = [[int(peaks[0])]]
+    for a, b in zip(peaks[:-1], peaks[1:]):
+        if min(y[a], y[b]) - float(np.min(y[a:b + 1])) < min_height:
+            groups[-1].append(int(b))
+        else:
+            groups.append([int(b)])
+    keep = []
+    for g in groups:
+        top = g[int(np.argmax(y[g]))]
+        below = y < y[top] - 1e-6 * min_height
+        left = np.nonzero(below[:top])[0]
+        right = np.nonzero(below[top:])[0]
+        lo = int(left[-1]) + 1 if len(left) else 0
+        hi = top + int(right[0]) - 1 if len(right) else len(y) - 1
+        keep.append((lo + hi) // 2)
+    return np.asarray(keep, dtype=int)
 
 
 def _settling_time(t: np.ndarray, e: np.ndarray, band: float, start: float) -> float | None:

@@ -13,9 +13,12 @@ things with it:
    name) to write it: the data goes to a temporary file in the same directory,
    is flushed to disk and moved into place with :func:`os.replace`. A failure
    leaves the old file untouched and no temporary file behind; a reader never
-   sees half a file. SIGINT and SIGTERM are held while the temporary file is
-   made and removed, so an interruption (translated into an exception, as
-   the command line does) always removes it.
+   sees half a file. SIGINT, SIGTERM and SIGHUP are held while the temporary
+   file is made and removed (:func:`fi_design.interrupts.held`), so an
+   interruption (translated into an exception, as the command line does)
+   always removes it; and a run interrupted before the move never makes it,
+   even when the interruption's exception was swallowed on its way
+   (:func:`fi_design.interrupts.raise_received`).
 
 The check also *claims* the path for the run (in the current
 :mod:`contextvars` context; the command line runs every command in a context
@@ -33,14 +36,12 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import os
-import signal
 import tempfile
-import threading
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
+from . import interrupts
 from .errors import OutputError
 
 
@@ -63,6 +64,9 @@ class Claim:
 #: The outputs the current run checked, by resolved path (see the module docstring).
 _CLAIMS: contextvars.ContextVar[dict | None] = contextvars.ContextVar("fi_design_output_claims",
                                                                      default=None)
+#: The files the current run has written, in order.
+_WRITTEN: contextvars.ContextVar[tuple] = contextvars.ContextVar("fi_design_output_written",
+                                                                 default=())
 
 
 def check_output(path: str | os.PathLike, *, force: bool = False,
@@ -260,40 +264,62 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """
     out = Path(path)
     parent = out.parent if str(out.parent) else Path(".")
-    held = _hold_signals()  # until the file is known to the cleanup below
-    tmp: Path | None = None
+    made: list[Path] = []
     try:
-        try:
-            fd, tmp_name = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp", dir=parent)
-        except OSError as exc:
-            raise OutputError(f"{out}: cannot create a file in {parent} ({exc.strerror})") \
-                from None
-        os.close(fd)
-        tmp = Path(tmp_name)
-        held = _release_signals(held)  # a signal held meanwhile raises here, inside the try
+        with interrupts.held():  # a signal meanwhile comes at the end, the file then known
+            try:
+                fd, tmp_name = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp",
+                                                dir=parent)
+            except OSError as exc:
+                raise OutputError(f"{out}: cannot create a file in {parent} ({exc.strerror})") \
+                    from None
+            made.append(Path(tmp_name))
+            os.close(fd)
+        tmp = made[0]
         yield tmp
         _fsync_file(tmp)
         os.chmod(tmp, _mode_for(out))
+        interrupts.raise_received()  # an interrupted run never writes, whatever swallowed it
         _move(tmp, out, parent)
     except OSError as exc:
-        _remove_held(tmp, held)
+        _remove_held(made)
         if isinstance(exc, OutputError):
             raise
         raise OutputError(f"{out}: cannot write ({exc.strerror or exc})") from None
     except BaseException:
-        _remove_held(tmp, held)
+        _remove_held(made)
         raise
+    _WRITTEN.set((*_WRITTEN.get(), out))
     _fsync_dir(parent)
 
 
-def _remove_held(tmp: Path | None, held: Any) -> None:
-    """Remove the temporary file with SIGINT and SIGTERM held, then let them through."""
-    held = held if held is not None else _hold_signals()
-    try:
-        if tmp is not None:
+def _remove_held(made: list[Path]) -> None:
+    """Remove the temporary file (if made) with the signals held, then let them through."""
+    with interrupts.held():
+        for tmp in made:
             _remove(tmp)
-    finally:
-        _release_signals(held)
+
+
+def written() -> tuple[Path, ...]:
+    """The files this run has moved into place (in the current :mod:`contextvars` context,
+    since :func:`begin_run`).
+
+    Returns
+    -------
+    tuple of pathlib.Path
+        In the order they were written.
+    """
+    return _WRITTEN.get()
+
+
+def begin_run() -> None:
+    """Start the list of :func:`written` files afresh in the current context.
+
+    A copied context starts with the values of the one it was copied from:
+    the command line calls this at the start of every command, in the
+    command's own context, so that its files are the command's only.
+    """
+    _WRITTEN.set(())
 
 
 def _move(tmp: Path, out: Path, parent: Path) -> None:
@@ -334,26 +360,6 @@ def _directory_lock(directory: Path) -> Iterator[None]:
         yield
     finally:
         os.close(fd)  # closing releases the lock
-
-
-#: Signals held while a temporary file is made or removed.
-_HELD = frozenset(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
-                  if hasattr(signal, name))
-
-
-def _hold_signals() -> Any:
-    """Hold SIGINT, SIGTERM and SIGHUP in the main thread; returns the mask to restore."""
-    if threading.current_thread() is not threading.main_thread() \
-            or not hasattr(signal, "pthread_sigmask"):
-        return None
-    return signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
-
-
-def _release_signals(previous: Any) -> None:
-    """Restore the mask: a signal that came meanwhile is handled now. Returns None."""
-    if previous is not None:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-    return None
 
 
 def write_atomic(path: str | os.PathLike, data: str | bytes) -> Path:

@@ -11,11 +11,13 @@ CLI makes them here, as context managers that close them again:
   or a dask.distributed client.
 
 Both start their worker processes at once, when entered, before the caller
-starts a progress display's thread (fork and threads do not mix). The
-workers end with their parent: they leave SIGINT to it, die on SIGTERM, and
-Linux sends them SIGTERM when the parent dies, however it dies. When the
-work fails or is interrupted, a pool stops its own workers at once (never
-any other child process of the interpreter) instead of waiting for them.
+starts a progress display's thread (fork and threads do not mix), with the
+signals held (:func:`fi_design.interrupts.held`): a Ctrl-C while a pool
+starts comes when it has started, and then stops it. The workers end with
+their parent: they leave SIGINT to it, die on SIGTERM, and Linux sends them
+SIGTERM when the parent dies, however it dies. When the work fails or is
+interrupted, a pool stops its own workers at once (never any other child
+process of the interpreter) instead of waiting for them.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ import sys
 from collections.abc import Callable, Iterator
 from typing import Any
 
+from . import interrupts
 from .errors import ArgumentError, FiDesignError
 
 __all__ = ["EXECUTORS", "confirmation_pool", "StudyPool"]
@@ -48,6 +51,8 @@ def _worker_start(parent: int, then: Callable[[], None] | None = None) -> None:
     """Initializer of every worker: end with the parent, leave Ctrl-C to it, then ``then()``."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C and ends us
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the parent's handler: just end
+    if hasattr(signal, "SIGHUP"):
+        signal.signal(signal.SIGHUP, signal.SIG_DFL)
     if sys.platform.startswith("linux"):
         import ctypes
 
@@ -82,16 +87,27 @@ def _process_pool(workers: int, ctx: Any, then: Callable[[], None] | None = None
 
 
 def _stop(pool: Any, workers: list) -> None:
-    """Stop a pool at once: cancel what has not started, end its own workers (no others)."""
-    pool.shutdown(wait=False, cancel_futures=True)
-    for worker in workers:
-        if worker.is_alive():
-            worker.terminate()
-    for worker in workers:
-        worker.join(timeout=5)
-        if worker.is_alive():  # busy in a signal handler or starved of CPU: no more waiting
-            worker.kill()
-            worker.join(timeout=5)
+    """Stop a pool at once: cancel what has not started, end its own workers (no others).
+
+    Runs with the signals held (a second Ctrl-C does not leave workers behind) and on the
+    way out of a failure or an interruption, which stays the outcome: the pool's manager
+    thread takes the pool apart at the same time (its pipes closed, its workers reaped),
+    and an error of that race (``OSError: [Errno 9] Bad file descriptor``) is not the
+    run's.
+    """
+    with interrupts.held():
+        with contextlib.suppress(OSError, ValueError, RuntimeError):
+            pool.shutdown(wait=False, cancel_futures=True)
+        for worker in workers:
+            with contextlib.suppress(OSError, ValueError):
+                if worker.is_alive():
+                    worker.terminate()
+        for worker in workers:
+            with contextlib.suppress(OSError, ValueError):
+                worker.join(timeout=5)
+                if worker.is_alive():  # busy in a signal handler or starved of CPU: no waiting
+                    worker.kill()
+                    worker.join(timeout=5)
 
 
 @contextlib.contextmanager
@@ -123,18 +139,23 @@ def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
         return
     from .studies import warm_up
 
-    # scipy.signal (the metric's peak finder; python-control needs it here anyway) is the
-    # larger part of every import the work needs: loaded once before the fork, the workers
-    # inherit it instead of each importing it again on two cores (measured in BENCHMARKS.md)
-    warm_up()
-
-    pool, workers = _process_pool(min(2, os.cpu_count() or 1), ctx)
+    started: list = []
     try:
-        yield pool
+        # held: an interruption inside the import of a compiled module or a fork is no
+        # interruption but an ImportError or a half-started pool; it comes at the end
+        with interrupts.held():
+            # scipy.signal (the metric's peak finder; python-control needs it here anyway) is
+            # the larger part of every import the work needs: loaded once before the fork, the
+            # workers inherit it instead of each importing it again on two cores (measured in
+            # BENCHMARKS.md)
+            warm_up()
+            started.extend(_process_pool(min(2, os.cpu_count() or 1), ctx))
+        yield started[0]
     except BaseException:
-        _stop(pool, workers)
+        if started:
+            _stop(*started)
         raise
-    pool.shutdown(wait=True)
+    started[0].shutdown(wait=True)
 
 
 class StudyPool:
@@ -186,17 +207,21 @@ class StudyPool:
     def _start(self) -> Any:
         from .studies import warm_up
 
-        warm_up()  # compile or load the kernel once here, before any worker starts
-        if self.kind == "dask":
-            return self._dask()
-        if self.jobs == 1:
-            return None
-        # the workers start now, before the progress bar's thread exists (fork and threads
-        # do not mix)
-        pool, workers = _process_pool(self.jobs, _fork_context(), warm_up)
-        self._closers.append(lambda failed: _stop(pool, workers) if failed else
-                             pool.shutdown(wait=True, cancel_futures=True))
-        return pool
+        # held: an interruption inside the import of a compiled module or a fork is no
+        # interruption but an ImportError or a half-started pool; it comes at the end
+        # (__enter__ then closes what was started)
+        with interrupts.held():
+            warm_up()  # compile or load the kernel once here, before any worker starts
+            if self.kind == "dask":
+                return self._dask()
+            if self.jobs == 1:
+                return None
+            # the workers start now, before the progress bar's thread exists (fork and
+            # threads do not mix)
+            pool, workers = _process_pool(self.jobs, _fork_context(), warm_up)
+            self._closers.append(lambda failed: _stop(pool, workers) if failed else
+                                 pool.shutdown(wait=True, cancel_futures=True))
+            return pool
 
     def _dask(self) -> Any:
         import logging

@@ -151,7 +151,9 @@ def loop_responses(model: Model | Spec, crossover: CrossoverResult,
     fc = crossover.desired
     lows = [fc / 30.0] + [c / 3.0 for case in crossover.cases for c in case.crossovers
                           if c and c > 0]
-    highs = [30.0 * fc] + [2.0 * m.frequency for m in model.modes]
+    # the modes the loop shows: the given ones, and the computed ones that show in x by 1 %
+    highs = [30.0 * fc] + [2.0 * m.frequency for m in model.modes
+                           if m.source == "given" or abs(m.participation) >= 0.01]
     highs += [2.0 * f.frequency for f in model.law.filters]
     lo = 10.0 ** math.floor(math.log10(min(lows)))
     hi = 10.0 ** math.ceil(math.log10(max(highs)))

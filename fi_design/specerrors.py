@@ -98,6 +98,36 @@ def _inner_model(ann, typing):
     return None
 
 
+def real_errors(errors: list[dict]) -> list[dict]:
+    """The validation errors without those another one causes.
+
+    A sequence with a minimum length (``motion.moves``) whose items fail is
+    also "too short" to pydantic, which counts the items that passed; the
+    entries as written are enough, so only the items' own errors are real.
+
+    Parameters
+    ----------
+    errors : list of dict
+        ``ValidationError.errors()``.
+
+    Returns
+    -------
+    list of dict
+        The same errors, in order, without the consequential ones.
+    """
+    def caused(err: dict) -> bool:
+        if err["type"] != "too_short":
+            return False
+        given, least = err.get("input"), (err.get("ctx") or {}).get("min_length")
+        loc = tuple(err["loc"])
+        inner = any(tuple(o["loc"])[:len(loc)] == loc and len(o["loc"]) > len(loc)
+                    for o in errors)
+        return inner and least is not None and hasattr(given, "__len__") and len(given) >= least
+
+    kept = [e for e in errors if not caused(e)]
+    return kept or errors
+
+
 def describe(err: dict, raw: dict) -> tuple[str, str]:
     """One pydantic validation error of a spec as ``(dotted path, message)``.
 
@@ -136,9 +166,12 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
                 f"; allowed: {', '.join(model.model_fields)}"
         return path, f"unknown key '{key}'{hint}"
     if kind == "unknown_effect":
-        given = err.get("input", {}).get("type") if isinstance(err.get("input"), dict) else None
         if not isinstance(err.get("input"), dict):
             return path, _not_an_effect_entry(err.get("input"))
+        given = err["input"].get("type")
+        if given is None:  # no `type:` key, or one without a value
+            return path + ".type", (f"required field is missing (the effect's type, one of: "
+                                    f"{', '.join(_effects.EFFECT_NAMES)})")
         close = difflib.get_close_matches(str(given), list(_effects.EFFECT_NAMES), n=1)
         hint = f" (did you mean '{close[0]}'?)" if close else ""
         return path + ".type", (f"unknown effect '{given}'{hint}; known: "

@@ -22,7 +22,7 @@ from typing import Any, Mapping
 
 from .errors import SpecError, SpecFileError
 from .spec import Spec
-from .specerrors import clean_loc, describe, dotted
+from .specerrors import clean_loc, describe, dotted, real_errors
 # the values at dotted paths live in fi_design.specpaths; named here as well
 from .specpaths import path_description, path_unit, value_at, with_values
 
@@ -364,7 +364,7 @@ def _validate(raw: dict, org: SpecOrigin) -> Spec:
     except ValidationError as exc:
         # an unknown key first: a misspelt required key also makes it "missing", and the
         # typo is the cause the user has to see
-        errors = sorted(exc.errors(include_url=False),
+        errors = sorted(real_errors(exc.errors(include_url=False)),
                         key=lambda e: e["type"] != "extra_forbidden")
         msgs = [describe(e, raw) for e in errors]
         first_loc = clean_loc(errors[0]["loc"], raw)

@@ -16,7 +16,7 @@ from typing import Any, Mapping
 
 from .errors import SpecError
 from .spec import Spec
-from .specerrors import describe
+from .specerrors import describe, real_errors
 
 
 # --------------------------------------------------------------------------- dotted-path values
@@ -72,7 +72,7 @@ def with_values(spec: Spec, values: Mapping[str, Any]) -> Spec:
     try:
         new = Spec.model_validate(data)
     except ValidationError as exc:
-        errors = exc.errors(include_url=False)
+        errors = real_errors(exc.errors(include_url=False))
         where, text = describe(errors[0], data)
         given = ", ".join(f"{p} = {_show(v)}" for p, v in values.items())
         raise SpecError(f"{text} (with {given})", path=where or None) from None

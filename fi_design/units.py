@@ -150,6 +150,18 @@ def _refuse_misread(text: str, path: str | None) -> None:
 
 
 def _convert(text: str, unit: str, path: str | None) -> float:
+    try:
+        return _quantity(text, unit, path)
+    except UnitError as exc:
+        fixes = _case_fixes(text, unit)
+        if not fixes:
+            raise
+        meant = " or ".join(repr(f) for f in fixes)
+        raise UnitError(f"{exc.message}; did you mean {meant}? (units are case-sensitive)",
+                        path=path) from None
+
+
+def _quantity(text: str, unit: str, path: str | None) -> float:
     import pint
 
     ureg = registry()
@@ -210,6 +222,74 @@ def from_si(value: float, unit: str, shown: str) -> float:
         return float(ureg.Quantity(value, unit).to(shown).magnitude)
     except (pint.errors.PintError, ValueError, TypeError, AttributeError) as exc:
         raise UnitError(f"cannot express {unit} in {shown!r} ({exc})") from None
+
+
+#: A unit's name in a quantity's text (letters; an exponent's ``e`` is skipped by the caller).
+_WORD = re.compile(r"[A-Za-z_]+")
+
+
+def _case_fixes(text: str, unit: str, most: int = 2) -> list[str]:
+    """The text with its unit names' letter case changed so that it reads as ``unit``.
+
+    ``"15 hz"`` is ``["15 Hz"]``, ``"1 KN"`` is ``["1 kN"]``, ``"10 MM"`` (megamolar)
+    is ``["10 Mm", "10 mm"]`` for a length: every casing of each name that the
+    registry defines, kept when the whole text then converts to ``unit``, fewest
+    changed letters first.
+
+    Parameters
+    ----------
+    text : str
+        The quantity as written.
+    unit : str
+        Target unit, one of :data:`KNOWN_UNITS`.
+    most : int
+        How many to return at most.
+
+    Returns
+    -------
+    list of str
+        Empty when no change of case helps.
+    """
+    import itertools
+
+    ureg = registry()
+    words, options = [], []
+    for m in _WORD.finditer(text):
+        w = m.group(0)
+        before, after = text[:m.start()], text[m.end():]
+        if w in ("e", "E") and re.search(r"[\d.]$", before) and re.match(r"[-+]?\d", after):
+            continue  # the exponent of a number
+        if len(w) <= 5:
+            casings = {"".join(c) for c in itertools.product(*((ch.lower(), ch.upper())
+                                                               for ch in w))}
+        else:
+            casings = {w, w.lower(), w.upper(), w.capitalize()}
+        defined = sorted(c for c in casings if c == w or _defined(ureg, c))
+        words.append(m)
+        options.append(defined)
+    found = []
+    for combo in itertools.islice(itertools.product(*options), 256):
+        parts, last = [], 0
+        for m, c in zip(words, combo):
+            parts += [text[last:m.start()], c]
+            last = m.end()
+        candidate = "".join(parts) + text[last:]
+        if candidate == text:
+            continue
+        try:
+            _quantity(candidate, unit, None)
+        except UnitError:
+            continue
+        found.append(candidate)
+    found.sort(key=lambda c: (sum(a != b for a, b in zip(c, text)), c))
+    return found[:most]
+
+
+def _defined(ureg, name: str) -> bool:
+    try:
+        return name in ureg
+    except Exception:  # noqa: BLE001  (pint raises assorted errors on odd names)
+        return False
 
 
 def _has_angle(q) -> bool:

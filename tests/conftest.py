@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from pathlib import Path
 
@@ -11,6 +12,26 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 #: Scripts of the virtual environment running the tests (fi-design, lint-imports).
 BIN = Path(sys.executable).parent
+
+
+# --------------------------------------------------------------------------- order of the files
+
+#: The files that take longest (minutes of CPU between them), longest first: pytest-xdist
+#: hands files to its processes in collection order (--dist loadfile, --no-loadscope-reorder),
+#: and a long file started last keeps one process busy after the other has finished. Only an
+#: order: a file missing here runs after these, in its usual place.
+LONGEST_FIRST = (
+    "test_reconciliation_emps.py", "test_controller.py", "test_console.py", "test_identify.py",
+    "test_docs.py", "test_reconciliation_independent.py", "test_reconciliation.py",
+    "test_verdict.py", "test_identify_dynamic.py", "test_simulation.py", "test_recommend.py",
+    "test_report.py", "test_cli.py", "test_studies.py",
+)
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """The longest files first (:data:`LONGEST_FIRST`); each file's tests in their order."""
+    rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))
 
 
 @pytest.fixture(scope="session")
@@ -99,12 +120,91 @@ def _private_result_cache(tmp_path_factory):
 # --------------------------------------------------------------------------- reports
 
 
+#: Designs and design searches computed in this process, by kind, spec file and content.
+_SHARED: dict[tuple, object] = {}
+
+
+def _spec_key(spec) -> tuple | None:
+    """(resolved path or None, SHA-256 of the file, the validated values) of a spec read by
+    load_spec; None for anything else."""
+    from fi_design.spec import Spec
+    from fi_design.specfile import origin
+
+    found = origin(spec) if isinstance(spec, Spec) else None
+    if found is None:
+        return None
+    return (str(Path(found.path).resolve()) if found.path is not None else None, found.sha256,
+            spec.model_dump_json())
+
+
+def remember(kind: str, spec, result, *extra) -> None:
+    """Keep a result computed elsewhere for :func:`shared` (unless one is kept already)."""
+    key = _spec_key(spec)
+    if key is not None:
+        _SHARED.setdefault((kind, *key, *extra), result)
+
+
+def shared(kind: str, spec, compute, *extra):
+    """``compute()`` once per process for this kind of result of this spec (file and content)."""
+    key = _spec_key(spec)
+    if key is None:
+        return compute()
+    key = (kind, *key, *extra)
+    if key not in _SHARED:
+        _SHARED[key] = compute()
+    return _SHARED[key]
+
+
+@contextlib.contextmanager
+def sharing_designs():
+    """The guideline's design and the design search computed once per spec and process.
+
+    For tests of what the command line or a documented example does with a design (prints,
+    writes, exits with), not of how it is computed: ``fi_design.guideline.design`` and
+    ``fi_design.recommend.recommend`` return the result an earlier call on the same spec file
+    (same path, same bytes) computed in this process, as the design command would compute it
+    again (a design is a function of its spec; the executor changes where it runs, not what it
+    gives). The first call computes, with the caller's executor and progress; later calls do
+    not report progress. Calls with other arguments (a grid, a spec that is no file) compute.
+    """
+    import importlib
+
+    from fi_design import guideline
+
+    search = importlib.import_module("fi_design.recommend")  # the package, not the function
+    real_design, real_recommend = guideline.design, search.recommend
+
+    def design(spec, *, confirm=True, executor=None, progress=None, **kwargs):
+        return shared("design", spec, lambda: real_design(
+            spec, confirm=confirm, executor=executor, progress=progress, **kwargs), confirm,
+            *sorted(kwargs.items()))
+
+    def recommend(spec, *, executor=None, progress=None, **kwargs):
+        if kwargs:
+            return real_recommend(spec, executor=executor, progress=progress, **kwargs)
+        return shared("recommend", spec, lambda: real_recommend(
+            spec, executor=executor, progress=progress))
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(guideline, "design", design)
+        patch.setattr(search, "recommend", recommend)
+        yield
+
+
+@pytest.fixture
+def shared_designs():
+    """:func:`sharing_designs` for the test."""
+    with sharing_designs():
+        yield
+
+
 @pytest.fixture(scope="session")
 def paper_confirmed_design(paper_spec):
-    """The design of examples/paper_setup.yaml with its simulated confirmation, computed once."""
+    """The design of examples/paper_setup.yaml with its simulated confirmation, computed once
+    (and shared with the tests that use :func:`shared_designs`)."""
     from fi_design.guideline import design
 
-    return design(paper_spec)
+    return shared("design", paper_spec, lambda: design(paper_spec), True)
 
 
 def variant(spec, **paths):

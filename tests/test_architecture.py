@@ -70,6 +70,46 @@ def test_public_functions_stay_callable_after_their_modules_are_imported():
     subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)
 
 
+#: After ``design()`` or its import: every public name calls what its module defines.
+_STABLE = ("import fi_design, importlib\n"
+           "from fi_design.errors import ArgumentError\n"
+           "try:\n"
+           "    fi_design.recommend(42)\n"
+           "except ArgumentError as exc:\n"
+           "    assert 'spec must be' in str(exc), exc\n"
+           "else:\n"
+           "    raise AssertionError('recommend accepted a number for a spec')\n"
+           "for name, module in fi_design._API.items():\n"
+           "    assert getattr(fi_design, name) is getattr(importlib.import_module(module), name),"
+           " name\n")
+
+
+def _stable_after(code: str) -> None:
+    p = subprocess.run([sys.executable, "-c", code + _STABLE], capture_output=True, text=True,
+                       cwd=ROOT, timeout=300)
+    assert p.returncode == 0, p.stderr
+
+
+def test_public_names_are_stable_after_their_modules_are_imported():
+    """`fi_design.recommend` became the module of that name once `design()` had imported it
+    (``from .recommend import recommend``): TypeError, 'module' object is not callable. And
+    `fi_design.report.build_context` needed an explicit import of the subpackage."""
+    _stable_after("import fi_design\n"
+                  "assert fi_design.report.build_context.__name__ == 'build_context'\n"
+                  "spec = fi_design.load_spec('examples/paper_setup.yaml')\n"
+                  "from fi_design.recommend import recommend\n"  # what design() runs on a FAIL
+                  "import fi_design.recommend\n")
+
+
+@pytest.mark.slow
+def test_recommend_is_callable_after_a_failing_design_run():
+    """The issue's case as a user meets it: a design run that fails recommends (about 15 s)."""
+    _stable_after("import fi_design, sys\n"
+                  "spec = fi_design.load_spec('examples/no_isolator.yaml')\n"
+                  "assert fi_design.design(spec).recommendation is not None\n"
+                  "assert 'fi_design.recommend' in sys.modules\n")
+
+
 # --------------------------------------------------------------------------- module sizes
 
 

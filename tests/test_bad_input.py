@@ -87,6 +87,12 @@ CASES = [
     ("unknown-effect", BASE + "effects:\n  - {type: time_dleay, delay: 1 ms}\n",
      ["effects[0].type", "unknown effect 'time_dleay'", "did you mean 'time_delay'"],
      "type: time_dleay"),
+    ("unit-wrong-case", edit("crossover: 8 Hz", "crossover: 15 hz"),
+     ["controller.crossover", "'15 hz'", "did you mean '15 Hz'"], "crossover: 15 hz"),
+    ("effect-without-type", BASE + "effects:\n  - {delay: 1 ms}\n",
+     ["effects[0].type", "required field is missing", "time_delay"], "{delay: 1 ms}"),
+    ("effect-with-empty-type", BASE + "effects:\n  - type:\n    delay: 1 ms\n",
+     ["effects[0].type", "required field is missing"], "  - type:"),
     ("effect-missing-parameter", BASE + "effects:\n  - {type: time_delay}\n",
      ["effects[0].delay", "required field is missing"], "type: time_delay"),
     ("python-tag", edit("stage: {mass: 1.6 kg}",
@@ -222,6 +228,32 @@ def test_bad_spec(tmp_path, monkeypatch, text, expected, needle):
         n = line_of(text, needle)
         assert f"{spec}:{n}:" in result.stderr or f"(line {n})" in result.stderr, result.stderr
     assert not (tmp_path / "PWNED").exists()
+
+
+@pytest.mark.parametrize("old,new,path", [
+    ("distance: 10 mm", "distance: 10 mmm", "motion.moves[0].distance"),
+    ("velocity: 50 mm/s", "velocity: -50 mm/s", "motion.moves[0].velocity"),
+    ("acceleration: 1 m/s^2", "acceleration: 1 m/s^2, jerk: fast", "motion.moves[0].jerk"),
+])
+def test_a_bad_field_in_a_move_is_the_only_problem(tmp_path, monkeypatch, old, new, path):
+    """Pydantic also finds the moves "too short" (counting the moves that passed): not a
+    problem of the spec, which has its one move."""
+    monkeypatch.chdir(tmp_path)
+    spec = tmp_path / "bad.yaml"
+    spec.write_text(edit(old, new))
+    result, out = _run(str(spec), tmp_path)
+    _assert_refused(result, out, tmp_path, [path, f"{spec}:{line_of(edit(old, new), new)}:"])
+    assert "more problem" not in result.stderr and "at least 1 item" not in result.stderr, \
+        result.stderr
+
+
+def test_a_spec_without_moves_is_still_told_so(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    spec = tmp_path / "bad.yaml"
+    spec.write_text(edit("    - {distance: 10 mm, velocity: 50 mm/s, acceleration: 1 m/s^2}\n",
+                         "").replace("moves:", "moves: []"))
+    result, out = _run(str(spec), tmp_path)
+    _assert_refused(result, out, tmp_path, ["motion.moves", "at least 1 item"])
 
 
 def test_missing_file(tmp_path):

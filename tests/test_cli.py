@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 from fi_design import __version__
 from fi_design.cli import app
 
-from conftest import BIN, ROOT
+from conftest import BIN, ROOT, sharing_designs
 
 runner = CliRunner()
 
@@ -30,9 +30,11 @@ TOP_KEYS = ("flexure", "checks", "fi_design_version", "spec_sha256")
 
 @pytest.fixture(scope="module")
 def design_run(tmp_path_factory, paper_spec_path):
-    """One default-command run on the paper spec with --json (shared: the design takes a while)."""
+    """One default-command run on the paper spec with --json (shared: the design takes a while;
+    the design and its search are those of the session when computed already)."""
     out = tmp_path_factory.mktemp("design") / "result.json"
-    result = runner.invoke(app, [str(paper_spec_path), "--json", str(out)])
+    with sharing_designs():
+        result = runner.invoke(app, [str(paper_spec_path), "--json", str(out)])
     return result, out
 
 
@@ -207,10 +209,12 @@ def test_mistyped_command_gets_a_hint():
 
 
 def test_installed_entry_point(tmp_path, paper_spec_path):
+    """The console script in a process of its own, simulation included; the design search
+    (--no-recommend here) runs in this file's CliRunner run and in test_console's."""
     exe = BIN / "fi-design"
     assert exe.exists(), f"{exe}: the package is not installed (pip install -e .)"
     out = tmp_path / "r.json"
-    p = subprocess.run([str(exe), str(paper_spec_path), "--json", str(out)],
+    p = subprocess.run([str(exe), str(paper_spec_path), "--json", str(out), "--no-recommend"],
                        capture_output=True, text=True, timeout=300, cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     assert "Conclusion" in p.stdout

@@ -159,7 +159,7 @@ def test_a_cycle_that_outlives_the_search_gives_no_hunting_free_crossover(paper_
     assert st.boundary["kind"] == "bound" and st.boundary["bracket"][1] == 20.0
 
 
-def test_cli_design_prints_the_confirmation(paper_spec_path, tmp_path):
+def test_cli_design_prints_the_confirmation(paper_spec_path, tmp_path, shared_designs):
     out = tmp_path / "r.json"
     res = runner.invoke(app, [str(paper_spec_path), "--json", str(out)])
     assert res.exit_code == 0, res.output

@@ -8,6 +8,7 @@ width would set it.
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import pytest
 from rich.console import Console
@@ -16,7 +17,7 @@ from typer.testing import CliRunner
 from fi_design import console as con
 from fi_design.cli import app
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, sharing_designs
 
 runner = CliRunner()
 
@@ -43,10 +44,11 @@ def design_outputs():
     """The design summary of every example with a stage of its own, at 80 and 120 columns
     (the recommendation a failing spec adds is read at the narrow width only)."""
     out = {}
-    for name in ("paper_setup", "no_isolator", "industrial_axis"):
-        for width in (80, 120):
-            out[name, width] = _run([str(EXAMPLES / f"{name}.yaml")]
-                                    + (["--no-recommend"] if width > 80 else []), width)
+    with sharing_designs():  # an example's design computed once, printed at both widths
+        for name in ("paper_setup", "no_isolator", "industrial_axis"):
+            for width in (80, 120):
+                out[name, width] = _run([str(EXAMPLES / f"{name}.yaml")]
+                                        + (["--no-recommend"] if width > 80 else []), width)
     return out
 
 
@@ -135,8 +137,11 @@ def test_a_wide_map_prints_whole_axis_values_in_blocks(paper_spec_path):
         assert values == pytest.approx([2 + 18 * i / 19 for i in range(20)], rel=6e-3), headers
 
 
-def test_a_map_too_wide_to_print_names_its_file(paper_spec_path, tmp_path):
-    csv = tmp_path / "line.csv"
+def test_a_map_too_wide_to_print_names_its_file(paper_spec_path, tmp_path, monkeypatch):
+    # a path relative to the working folder: a temporary folder's full path (longer under
+    # pytest-xdist) is cut across lines at 80 columns
+    monkeypatch.chdir(tmp_path)
+    csv = Path("line.csv")
     out = _run(["sweep", str(paper_spec_path), "--x", "controller.crossover=2 Hz:20 Hz:70",
                 "--csv", str(csv), "-j", "1"], 80)
     flat = " ".join(out.split())

@@ -94,8 +94,11 @@ def test_readme_commands_marked(readme):
         assert after.startswith("```"), f"{marker} must be followed by a code block"
 
 
-def test_readme_run_command_succeeds_on_every_run(readme, tmp_path, monkeypatch):
-    """The documented first command failed when run a second time: the report existed."""
+def test_readme_run_command_succeeds_on_every_run(readme, tmp_path, monkeypatch,
+                                                  shared_designs):
+    """The documented first command failed when run a second time: the report existed.
+
+    Both runs write the report; the design is computed once (:func:`shared_designs`)."""
     import shlex
 
     from typer.testing import CliRunner
@@ -137,7 +140,9 @@ def test_the_documentation_stands_alone():
 
 
 @pytest.mark.parametrize("page", ["README.md", "docs/library.md", "docs/measured.md"])
-def test_python_examples_run(page, monkeypatch):
+def test_python_examples_run(page, monkeypatch, shared_designs):
+    """The documentation's Python blocks run (a design of a spec file computed once a process:
+    README.md and docs/library.md show the same one)."""
     text = (ROOT / page).read_text(encoding="utf-8")
     blocks = re.findall(r"```python\n(.*?)```", text, flags=re.DOTALL)
     assert blocks, f"{page} should show the library API in a ```python block"

@@ -71,8 +71,15 @@ def ss_response(sys, s):
 # --------------------------------------------------------------------------- plants
 
 
-def test_paper_cases_equal_hand_derived_transfer_functions(paper_spec):
-    cases = linear.limit_cases(paper_spec)
+@pytest.fixture(scope="module")
+def paper_given(paper_spec):
+    """The paper setup with its measured tilt mode alone: no flexure guide, whose computed modes
+    (the leaves' bending couples into x by 0.3 %) the hand-derived transfer functions leave out."""
+    return variant(paper_spec, **{"isolator.flexure": None})
+
+
+def test_paper_cases_equal_hand_derived_transfer_functions(paper_given):
+    cases = linear.limit_cases(paper_given)
     assert [c.name for c in cases] == list(linear.ISOLATED_CASES)
     assert [c.number for c in cases] == [1, 2, 3, 4]
     for case in cases:
@@ -108,26 +115,26 @@ def test_no_isolator_is_one_rigid_mass(paper_spec):
         np.testing.assert_allclose(ss_response(case.plant, S), hand(S), rtol=1e-9)
 
 
-def test_controller_and_loop(paper_spec):
+def test_controller_and_loop(paper_given):
     from fi_design.pid import control_law, tune_pid
 
-    g = tune_pid(paper_spec)
+    g = tune_pid(paper_given)
     np.testing.assert_allclose(ss_response(linear.controller_tf(g), S), pid(S), rtol=1e-9)
-    law = control_law(paper_spec)
+    law = control_law(paper_given)
     np.testing.assert_allclose(ss_response(linear.controller_tf(law), S), pid(S), rtol=1e-9)
     # the rule in the filtered-D form the hardware gains use is the same C(s)
     from dataclasses import replace
     general = replace(law, source="gains")
     np.testing.assert_allclose(ss_response(linear.controller_tf(general), S), pid(S), rtol=1e-9)
-    lp = linear.loop_transfer_function(paper_spec, "stuck_free")
+    lp = linear.loop_transfer_function(paper_given, "stuck_free")
     np.testing.assert_allclose(ss_response(lp, S), pid(S) * HAND["stuck_free"](S) * mode(S),
                                rtol=1e-9)
-    sens = linear.sensitivity(paper_spec, 2)
+    sens = linear.sensitivity(paper_given, 2)
     np.testing.assert_allclose(ss_response(sens, S), 1 / (1 + ss_response(lp, S)), rtol=1e-9)
-    comp = linear.complementary_sensitivity(paper_spec, 2)
+    comp = linear.complementary_sensitivity(paper_given, 2)
     np.testing.assert_allclose(ss_response(comp, S) + ss_response(sens, S), 1.0, rtol=1e-9)
     with pytest.raises(ValueError, match="unknown limit case"):
-        linear.loop_transfer_function(paper_spec, "floating")
+        linear.loop_transfer_function(paper_given, "floating")
 
 
 def test_delay_is_a_pade_of_delay_plus_half_a_sample(paper_spec):
@@ -174,9 +181,9 @@ PAPER_PHASE_MARGINS = {"sliding_free": (62.451, 7.914), "stuck_free": (47.306, 1
                        "sliding_limited": (58.601, 7.921), "stuck_limited": (90.122, 0.0013475)}
 
 
-def test_paper_phase_margins_agree_with_a_hand_calculation(paper_spec):
+def test_paper_phase_margins_agree_with_a_hand_calculation(paper_given):
     hand = hand_phase_margins()
-    result = linear.analyse(paper_spec)
+    result = linear.analyse(paper_given)
     assert result.passed and result.crossover == 8.0 and result.stiffness == 6667.0
     for case in result.cases:
         pm, fx = hand[case.name]
@@ -190,8 +197,8 @@ def test_paper_phase_margins_agree_with_a_hand_calculation(paper_spec):
     assert len(stuck_free.crossovers) == 3 and stuck_free.crossover == stuck_free.crossovers[2]
 
 
-def test_modulus_gain_and_delay_margin_consistent(paper_spec):
-    result = linear.analyse(paper_spec)
+def test_modulus_gain_and_delay_margin_consistent(paper_given):
+    result = linear.analyse(paper_given)
     w = np.geomspace(1e-3, 1e4, 200001)
     for case in result.cases:
         plant = HAND[case.name]

@@ -103,3 +103,43 @@ def test_a_cycle_below_the_target_counts_its_negative_peaks():
     e = -0.6e-3 + 0.4e-3 * np.sin(2 * np.pi * T / 2.0)  # never above -0.2 mm
     m = hunting_metrics(T, e)
     assert m.hunting_cycles == 5 and m.verdict == "hunting"
+
+
+def test_a_stick_plateau_with_round_off_counts_once():
+    """Karnopp stick-slip: a 0.5 s slip, then 0.75 s stuck at +-0.5 mm, period 2.5 s.
+
+    While stuck, x1 - r rounds to three neighbouring floats (as a switch-model run
+    does near r = 1 m): equal maxima with dips of 1e-16 m between them are one plateau,
+    one peak in its middle, not one peak per rounding step.
+    """
+    period, slip, a = 2.5, 0.5, 0.5e-3
+    ph = np.mod(T, period)
+    half = period / 2.0
+    up = -a * np.cos(np.pi * np.clip(ph / slip, 0.0, 1.0))  # -a to +a, then stuck at +a
+    down = a * np.cos(np.pi * np.clip((ph - half) / slip, 0.0, 1.0))  # +a to -a, then stuck
+    e = np.where(ph < half, up, down)
+    rng = np.random.default_rng(3)
+    stuck = np.abs(np.abs(e) - a) == 0.0
+    e = np.where(stuck, e + rng.integers(-1, 2, T.shape) * 1.1e-16, e)
+    assert len(np.unique(e[stuck])) > 2  # the plateaus hold rounding steps
+    m = hunting_metrics(T, e)
+    assert m.hunting_cycles == 4  # plateaus at 10.5, 13, 15.5 and 18 s
+    assert m.period == pytest.approx(period, abs=2e-3)
+    middles = 10.0 + slip + (half - slip) / 2.0 + period * np.arange(4)
+    assert m.peak_times == pytest.approx(middles, abs=0.05)
+
+
+@pytest.mark.parametrize("motion_end", [250.0, 20.5, 25.0])
+def test_a_motion_that_outlasts_the_run_or_window_is_not_finished(motion_end):
+    """A stage on its ramp follows the reference within the band: no cycles, error zero. The
+    move ends at 250 s (a 5 m move at 20 mm/s) in a 20 s run: never settled."""
+    e = 1e-9 * np.sin(T)
+    done = hunting_metrics(T, e, motion_end=2.0)
+    assert done.verdict == "settled"
+    m = hunting_metrics(T, e, motion_end=motion_end)
+    assert m.verdict == "undetermined" and not m.settled
+    assert m.reason.startswith("not finished") and f"{motion_end:.4g} s" in m.reason
+    assert m.settling_time is None
+    longer = np.arange(40001) / 1000.0  # a 40 s run, the window [10 s, 20 s) inside the move
+    w = hunting_metrics(longer, 1e-9 * np.sin(longer), motion_end=motion_end)
+    assert w.verdict == "undetermined" and "counting window at 20 s" in w.reason

@@ -56,7 +56,8 @@ def test_the_error_path_ends_only_the_pools_own_workers():
         bystander.join()
 
 
-def test_the_design_pool_starts_before_the_spinner(paper_spec_path, tmp_path, monkeypatch):
+def test_the_design_pool_starts_before_the_spinner(paper_spec_path, tmp_path, monkeypatch,
+                                                   shared_designs):
     """Fork and threads do not mix: when the spinner (a thread on a terminal) starts, the
     confirmation's workers must already be running."""
     from typer.testing import CliRunner
@@ -122,3 +123,87 @@ def test_sigterm_ends_a_sweep_and_its_workers(tmp_path):
         time.sleep(0.1)
     assert not [w for w in workers if _alive(w)], "workers outlived their parent"
     assert not out.exists()
+
+
+# --------------------------------------------------------------------------- Ctrl-C at any instant
+
+#: Runs the CLI after its imports, saying when it is ready and when the command has finished
+#: (a signal sent after that finds nothing left to interrupt).
+_DRIVER = """\
+import sys, time
+from fi_design.cli import main
+print("ready", flush=True)
+sys.argv = ["fi-design"] + sys.argv[1:]
+try:
+    main()
+except SystemExit as exc:
+    code = exc.code
+print("finished", repr(time.time()), flush=True)
+sys.exit(code)
+"""
+
+
+def _interrupted_sweep(tmp_path, delay: float) -> dict:
+    """A 6-point sweep on 2 workers, output to a file, sent SIGINT ``delay`` s after the
+    command line is ready: pool start, points, the CSV written, or already finished."""
+    import tempfile
+    from pathlib import Path
+
+    work = Path(tempfile.mkdtemp(prefix=f"at_{delay:.2f}_", dir=tmp_path))
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _DRIVER, "sweep", str(EXAMPLES / "paper_setup.yaml"), "--x",
+         "controller.crossover=3 Hz:15 Hz:3", "--y", "isolator.stroke=0.1 mm:0.9 mm:2",
+         "--jobs", "2", "--no-cache", "--csv", "map.csv"],
+        cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        time.sleep(delay)
+        sent = time.time()
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    finished = [float(line.split()[1]) for line in out.splitlines()
+                if line.startswith("finished ")]
+    return dict(delay=delay, code=proc.returncode, err=err, files=sorted(
+        p.name for p in work.iterdir()), before=bool(finished) and finished[0] < sent)
+
+
+def _check_interrupted(run: dict) -> None:
+    """A Ctrl-C that came while the command ran ends it with 130 and the interruption's
+    message (never an internal error, never exit 0 with the output written); a temporary
+    file is never left."""
+    assert not [f for f in run["files"] if f.endswith(".tmp")], run
+    if run["before"]:  # the command had finished: nothing to interrupt
+        return
+    # -2: the interpreter's own exit by SIGINT after the message (the shell shows 130)
+    assert run["code"] in (130, -signal.SIGINT), run
+    assert "interrupted" in run["err"], run
+    assert "internal error" not in run["err"] and "Traceback" not in run["err"], run
+    assert "map.csv" not in run["files"] or "it had written" in run["err"], run
+
+
+def _sweep_at(tmp_path, delays, at_once: int = 2) -> None:
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(at_once) as ex:
+        runs = list(ex.map(lambda d: _interrupted_sweep(tmp_path, d), delays))
+    bad = []
+    for run in runs:
+        try:
+            _check_interrupted(run)
+        except AssertionError as exc:
+            bad.append(str(exc).splitlines()[0])
+    assert not bad, f"{len(bad)} of {len(runs)} interruptions went wrong:\n" + "\n".join(bad)
+
+
+def test_ctrl_c_at_a_few_instants_of_a_sweep(tmp_path):
+    """Of six SIGINTs sent into a sweep on a loaded machine, one printed `OSError: [Errno 9]
+    Bad file descriptor`, one was lost (the sweep wrote map.csv and exited 0)."""
+    _sweep_at(tmp_path, [0.2, 1.2, 2.5], at_once=3)  # parsing; the pool's start; the points
+
+
+@pytest.mark.slow
+def test_ctrl_c_at_many_instants_of_a_sweep(tmp_path):
+    _sweep_at(tmp_path, [0.05 + 0.1 * k + 0.03 * (k % 3) for k in range(60)])

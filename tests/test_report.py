@@ -581,7 +581,7 @@ def test_cli_map_needs_a_report(monkeypatch, paper_spec_path):
     assert r.exit_code == 2 and "--report" in r.output
 
 
-def test_cli_writes_the_html_report_with_force(tmp_path, paper_spec_path):
+def test_cli_writes_the_html_report_with_force(tmp_path, paper_spec_path, shared_designs):
     out = tmp_path / "report.html"
     out.write_text("old")
     r = runner.invoke(app, [str(paper_spec_path), "--report", str(out), "--force"])
@@ -658,15 +658,23 @@ def test_public_api_exports_render_report():
 # --------------------------------------------------------------------------- packaging
 
 
+@pytest.mark.slow
 def test_templates_ship_in_the_wheel_and_load_from_an_installed_copy(tmp_path):
     """Build the wheel, install it into a target directory, find the templates from there."""
     import importlib.util
 
     wheels = tmp_path / "wheels"
+    # Built from a copy of the source tree: pip builds in the tree, and the build hook
+    # replaces the kernel's extension there, which other tests running at the same time
+    # (pytest -n) load.
+    source = tmp_path / "source"
+    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(
+        ".git", ".venv", "__pycache__", ".pytest_cache", ".hypothesis", ".import_linter_cache",
+        "artifacts", "build", "dist", "*.egg-info", "_aot.*"))
     # The build backend from this environment when it has one (no network needed), else pip
     # fetches it into an isolated build environment as `pip install` does.
     isolation = ["--no-build-isolation"] if importlib.util.find_spec("hatchling") else []
-    build = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps",
+    build = subprocess.run([sys.executable, "-m", "pip", "wheel", str(source), "--no-deps",
                             *isolation, "-q", "-w", str(wheels)],
                            capture_output=True, text=True, timeout=600)
     assert build.returncode == 0, build.stderr[-3000:]

@@ -358,6 +358,40 @@ def test_result_arrays_are_read_only(paper_fast):
     assert d["metrics"]["verdict"] == "settled" and "position" not in d
 
 
+def test_to_dict_without_traces_never_converts_them(paper_fast):
+    """`simulate --record --json` of a 2e6-row record peaked at 1.09 GB: to_dict turned every
+    trace into a list of Python floats, then dropped it. Left out, it costs nothing."""
+    import dataclasses
+    import tracemalloc
+
+    n = 200_000
+    big = {name: np.zeros(n) for name in ("time", "reference", "position", "cart_position",
+                                          "velocity", "cart_velocity", "force",
+                                          "applied_force", "bristle")}
+    r = dataclasses.replace(paper_fast[True], **big)
+    tracemalloc.start()
+    try:
+        d = r.to_dict()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert "position" not in d and d["metrics"]["verdict"] == "settled"
+    assert peak < 1e6  # [bytes]; the 9 traces as lists of floats are about 60 MB
+    assert len(r.to_dict(traces=True)["position"]) == n
+
+
+def test_a_move_that_outlasts_the_run_is_not_finished(paper_spec):
+    """`distance: 5` (5 m at 50 mm/s: 100 s) in a 20 s run read "settled, final error 0 mm"
+    while the stage was on its ramp."""
+    spec = variant(paper_spec, **{"motion.moves": [{"distance": 5, "velocity": "50 mm/s",
+                                                    "acceleration": "1 m/s^2"}]})
+    r = simulate(spec)
+    assert r.success and abs(r.reference[-1] - 1.0) < 0.01  # at 20 s: 1 m of 5 m, on the ramp
+    m = r.metrics
+    assert m.verdict == "undetermined" and not m.settled
+    assert "not finished" in m.reason and "100 s" in m.reason
+
+
 def _effects(*entries):
     from fi_design.spec import EFFECT_MODELS
 

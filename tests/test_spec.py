@@ -108,10 +108,30 @@ def test_warnings_fire_on_the_users_own_values(paper_spec):
                                     {"distance": "10 mm", "velocity": "1 mm/s",
                                      "acceleration": "1 m/s^2"}]})
     found = dict(sp.warnings_for(calm))
-    assert list(found) == ["isolator.stroke", "requirements.hunting.window_start"]
+    # a 10 mm move on a 3 um stroke is also 3333 strokes long
+    assert list(found) == ["isolator.stroke", "motion.moves[0].distance",
+                           "requirements.hunting.window_start"]
     assert "the default window start" in found["requirements.hunting.window_start"]
     given = variant(calm, **{"requirements.hunting": {"window_start": "10 s"}})
     assert "default" not in dict(sp.warnings_for(given))["requirements.hunting.window_start"]
+
+
+def test_a_move_thousands_of_strokes_long_and_a_run_it_outlasts_are_warned(paper_spec):
+    """A bare `distance: 5` is 5 m: 16667 times the 0.3 mm stroke, a 100 s move in a 20 s run."""
+    spec = variant(paper_spec, **{"motion.moves": [
+        {"distance": "10 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2"},
+        {"distance": 5, "velocity": "50 mm/s", "acceleration": "1 m/s^2", "start": "1 s"}]})
+    found = dict(sp.warnings_for(spec))
+    assert "16,667 times the isolator stroke" in found["motion.moves[1].distance"]
+    assert "bare number is in metres" in found["motion.moves[1].distance"]
+    assert "motion.moves[0].distance" not in found  # 33 strokes: plausible
+    assert "after the run ends at 20 s" in found["motion.duration"]
+    assert "after the hunting window [10 s, 20 s) ends" in \
+        found["requirements.hunting.window_start"]
+    long_stroke = variant(paper_spec, **{"motion.moves": [
+        {"distance": "0.5 m", "velocity": "0.5 m/s", "acceleration": "5 m/s^2"}]})
+    assert not {"motion.moves[0].distance", "motion.duration"} & set(
+        dict(sp.warnings_for(long_stroke)))  # 1667 strokes, 1.1 s: a long-stroke stage
 
 
 def test_the_bristle_damping_warning_recommends_a_value_within_its_bound(paper_spec):

@@ -29,20 +29,20 @@ def paper_isolated(paper_spec):
     return stage_hunting(paper_spec, True)
 
 
-def _canudas_spec():
+def _canudas_spec(model: str = "lugre", hunting: dict | None = None, duration: str = "20 s"):
     from fi_design.specfile import load_spec
 
     return load_spec({
         "name": "Canudas de Wit et al. 1995, unit mass under PID",
         "stage": {"mass": "0.5 kg"}, "cart": {"mass": "0.5 kg"},
-        "friction": {"static": "1.5 N", "coulomb": "1 N", "stribeck_velocity": "1 mm/s",
+        "friction": {"model": model, "static": "1.5 N", "coulomb": "1 N", "stribeck_velocity": "1 mm/s",
                      "viscous": "0.4 N*s/m", "bristle_stiffness": "1e5 N/m",
                      "bristle_damping": f"{math.sqrt(1e5)} N*s/m"},
         "controller": {"gains": {"kp": "3 N/m", "ki": "4 N/(m*s)", "kd": "6 N*s/m"},
                        "derivative_on": "measurement"},
         "motion": {"moves": [{"distance": "1 m", "velocity": "1 m/s",
-                              "acceleration": "10 m/s^2"}], "duration": "20 s"},
-        "requirements": {"hunting": {"horizon": "1000 s"}}})
+                              "acceleration": "10 m/s^2"}], "duration": duration},
+        "requirements": {"hunting": {"horizon": "1000 s", **(hunting or {})}}})
 
 
 def _upward_crossings(t, e):
@@ -153,6 +153,27 @@ def test_canudas_de_wit_1995_pid_example_hunts_with_its_published_cycle():
     assert c.period == pytest.approx(24.4, abs=0.05)
     assert c.amplitude == pytest.approx(0.1278, abs=0.0005)
     assert c.stable
+
+
+def test_canudas_de_wit_1995_switch_model_counts_one_peak_per_stick_plateau():
+    """The same case with Karnopp (switch) friction over [100 s, 200 s): four cycles.
+
+    The stage sticks for about 9 s at each extreme, where x1 - r rounds to
+    neighbouring floats near r = 1 m; the metric counted those rounding steps as
+    peaks (32 peaks, period 2.6 s). Its period must agree with the cycle converged on
+    the section (an independent route: shooting on section crossings, no peaks) and
+    lie near the LuGre run's published 24.4 s.
+    """
+    from fi_design.simulation import simulate
+
+    window = {"window_start": "100 s", "window_length": "100 s"}
+    m = simulate(_canudas_spec("switch", window, "200 s"), False).metrics
+    cycle = stage_hunting(_canudas_spec("switch"), False, family=[1.0], boundary=False).cycle
+    assert cycle.period == pytest.approx(23.73, abs=0.05)
+    assert m.verdict == "hunting" and m.hunting_cycles == 4
+    assert m.period == pytest.approx(cycle.period, rel=2e-3)
+    assert m.period == pytest.approx(24.4, rel=0.05)
+    assert np.ptp(m.peak_heights) < 1e-4  # one level per side: the plateau, not its steps
 
 
 def test_a_multiplier_the_two_perturbations_disagree_on_is_not_reported(paper_spec):
@@ -288,3 +309,27 @@ def test_the_watch_lands_on_the_section_and_leaves_the_trajectory_alone(paper_sp
     assert np.allclose(watched.crossing_times, tc[:len(watched.crossing_times)], atol=1e-5)
     # the section only splits steps: the trajectory is the same within the tolerance
     assert np.nanmax(np.abs(watched.states[:, 0] - plain.states[:, 0])) < 1e-6
+
+
+def test_a_move_entering_a_known_cycle_stops_there_with_the_same_answer(paper_spec,
+                                                                       monkeypatch):
+    """The match rule (a move stops once its section state is within MATCH of a cycle an
+    earlier move repeated) changes when a move stops, not how the stage ends: against the
+    family run with the rule off, every move has the same outcome and every hunting move's
+    cycle the same amplitude and period within the repeat tolerance's reach."""
+    from fi_design.stage import moves
+
+    spec = paper_spec
+    fast, runs = stage_hunts(spec, True, crossover=5.0)
+    monkeypatch.setattr(moves, "MATCH", 0.0)  # the kernel's rule off: every move to its repeat
+    slow, _ = stage_hunts(spec, True, crossover=5.0)
+    assert [m.outcome for m in fast] == [m.outcome for m in slow]
+    matched = [(f, s) for f, s in zip(fast, slow) if "enters the cycle" in f.reason]
+    assert len(matched) >= 5, [m.reason for m in fast]
+    for f, s in zip(fast, slow):
+        if f.hunts:
+            assert f.amplitude == pytest.approx(s.amplitude, rel=2e-3)
+            assert f.period == pytest.approx(s.period, rel=2e-3)
+    # and it stopped earlier: the point of the rule
+    assert sum(f.time for f, _ in matched) < 0.8 * sum(s.time for _, s in matched)
+    assert all(r.cycle_states is not None for r in runs if r.outcome.hunts)

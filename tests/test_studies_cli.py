@@ -66,6 +66,7 @@ def test_sweep_one_dimensional_with_invalid_points(paper_spec_path, tmp_path):
     (["--x", "isolator.stroke=1 mm:2 mm"], "START:STOP:N"),
     (["--x", "isolator.stroke=1 N:2 N:3"], "not a length"),
     (["--x", "isolator.stroke=1 mm:2 mm:0"], "at least 1"),
+    (["--x", "isolator.stroke=0.2:1 mm:3"], "'0.2' is a bare number"),
     (["--x", "isolator.stroke=1 mm:2 mm:2", "--log", "z"], "expected x or y"),
     (["--x", "isolator.stroke=1 mm:2 mm:2", "--executor", "spark"], "local, dask"),
     (["--x", "isolator.stroke=1 mm:2 mm:2", "--scheduler", "tcp://x:1"], "--executor dask"),
@@ -128,7 +129,8 @@ def test_robustness_reproducible_with_seed(paper_spec_path, tmp_path):
     a, b = outs
     assert a["draws"] == b["draws"] and a["points"] == b["points"]
     assert a["isolated"]["probability"] == b["isolated"]["probability"]
-    assert a["scatter"][1] == {"path": "friction.coulomb", "spread": 0.1, "relative": False}
+    assert a["scatter"][1] == {"path": "friction.coulomb", "spread": 0.1, "relative": False,
+                               "meaning": ""}
 
 
 @pytest.mark.parametrize("args,words", [

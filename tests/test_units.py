@@ -58,6 +58,26 @@ def test_bad_values_name_the_path(value, unit, words):
         assert w in str(err.value), str(err.value)
 
 
+@pytest.mark.parametrize("value,unit,meant", [
+    ("15 hz", "Hz", ["'15 Hz'"]), ("2 khz", "Hz", ["'2 kHz'"]), ("1 KN", "N", ["'1 kN'"]),
+    ("2 Kg", "kg", ["'2 kg'"]), ("1e5 n/m", "N/m", ["'1e5 N/m'"]),
+    # read as megamolar: pint knows MM, only not as a length
+    ("10 MM", "m", ["'10 Mm'", "'10 mm'"]),
+])
+def test_a_unit_in_the_wrong_case_is_named(value, unit, meant):
+    with pytest.raises(UnitError) as err:
+        to_si(value, unit, path="friction.static")
+    assert "did you mean " + " or ".join(meant) + "?" in str(err.value), str(err.value)
+    assert to_si(meant[-1].strip("'"), unit) > 0  # the suggestion reads
+
+
+@pytest.mark.parametrize("value,unit", [("3 bananas", "m"), ("10 mmm", "m"), ("3 mm", "N")])
+def test_no_case_suggestion_where_case_does_not_help(value, unit):
+    with pytest.raises(UnitError) as err:
+        to_si(value, unit)
+    assert "did you mean" not in str(err.value)
+
+
 def test_unknown_target_unit_is_a_programming_error():
     with pytest.raises(ArgumentError, match="unknown target unit"):
         to_si(1.0, "furlong")

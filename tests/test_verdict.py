@@ -45,8 +45,10 @@ def cases(paper_spec, no_isolator_spec, paper_confirmed_design):
     return {
         # the paper stage at 11.5 Hz on a 3 N/mm flexure: every move settles, no scatter sample
         # fails
+        # (requirements.hunting_margin: 1: the fold lies just below the crossover)
         "settling_isolated": design(variant(paper_spec, **{
-            "controller.crossover": "11.5 Hz", "isolator.stiffness": "3 N/mm", **_samples(80)})),
+            "controller.crossover": "11.5 Hz", "isolator.stiffness": "3 N/mm",
+            "requirements.hunting_margin": 1.0, **_samples(80)})),
         "no_isolator": design(variant(no_isolator_spec, **_samples(20))),
         # a drive limited to 3 N cannot break a 4 N static friction loose: stuck for good
         "stuck": design(variant(no_isolator_spec, **{"controller.force_limit": "3 N",
@@ -57,7 +59,8 @@ def cases(paper_spec, no_isolator_spec, paper_confirmed_design):
         # 11 Hz on a 5 N/mm flexure: every move settles, but about a tenth of the scatter
         # samples hunt
         "robustness_failure": design(variant(paper_spec, **{
-            "controller.crossover": "11 Hz", "isolator.stiffness": "5 N/mm", **_samples(40)})),
+            "controller.crossover": "11 Hz", "isolator.stiffness": "5 N/mm",
+            "requirements.hunting_margin": 1.0, **_samples(40)})),
         # the paper setup as shipped: its own 10 mm move settles, 7 other moves hunt
         "hunts_after_other_moves": paper_confirmed_design,
     }
@@ -141,14 +144,15 @@ def test_the_sign_off_recommends_a_design_it_passes(no_isolator_spec):
     r = fi_design.design(spec)
     rec = r.recommendation
     assert r.verdict.status == "FAIL" and rec.feasible and rec.search is not None
-    assert rec.text.startswith("Build a") and set(rec.isolator) == {"stroke", "stiffness",
-                                                                    "damping"}
+    assert rec.text.startswith("Build ") and set(rec.isolator) == {"stroke", "stiffness",
+                                                                   "damping"}
     data = json.loads(json.dumps(r.to_dict(), allow_nan=False))["recommendation"]
     assert data["feasible"] is True and data["isolator"]["stroke"] == rec.isolator["stroke"]
-    again = design(with_values(spec, {"isolator": {k: v for k, v in rec.isolator.items()
-                                                   if v is not None},
-                                      "controller.crossover": rec.crossover}))
-    assert again.verdict.status != "FAIL"
+    assert data["flexure"]["thickness"] > 0                   # a guide from stock
+    from fi_design.recommend import recommended_values
+
+    again = design(with_values(spec, recommended_values(rec.search)))
+    assert again.verdict.status != "FAIL", [x.text for x in again.verdict.reasons]
 
 
 def test_pd_loop_at_rest_within_its_static_error_is_not_stuck(cases):
@@ -208,7 +212,9 @@ def test_robustness_failure_and_its_figures(cases):
     assert rob.samples == 40 and rob.limit == 0.05
     assert rob.hunting_probability == rob.hunting / rob.valid > rob.limit
     assert rob.interval == pytest.approx(wilson_interval(rob.hunting, rob.valid, 0.95))
-    assert rob.scatter == {"friction.static": 0.2, "friction.coulomb": 0.2}
+    assert rob.scatter["friction.coulomb"] == 0.2 and rob.scatter["the gap Fs - Fc"] == 0.2
+    assert set(rob.scatter) >= {"effects[type=mass_error].stage_mass", "isolator.stiffness"}
+    assert rob.valid == rob.samples                          # no draw is lost
     # the samples are the study's, judged at the stage level: a sample fails when its stage
     # does not settle after every move, whatever the reason
     study = rob.study
@@ -251,9 +257,12 @@ def test_paper_setup_fails_on_the_moves_its_own_move_hides(cases):
 def test_warnings_only_pass_with_warnings(cases):
     r = cases["settling_isolated"]
     warns = [x for x in r.verdict.reasons if x.severity == "WARN"]
-    assert r.passed and [x.source for x in warns] == ["input", "input"]
-    assert "friction.bristle_damping" in warns[0].text   # the given sigma1 breaks its bound
-    assert "controller.sample_rate" in warns[1].text     # no sampling and delay: say so
+    # one of 80 scatter samples hunts: 1.25 %, within the limit, but the Wilson interval
+    # reaches above 5 % (the samples do not demonstrate it)
+    assert r.passed and [x.source for x in warns] == ["robustness", "input", "input"]
+    assert r.robustness.hunting_probability <= 0.05 < r.robustness.interval[1]
+    assert "friction.bristle_damping" in warns[1].text   # the given sigma1 breaks its bound
+    assert "controller.sample_rate" in warns[2].text     # no sampling and delay: say so
     assert r.verdict.at_or_below("PASS_WITH_WARNINGS") and not r.verdict.at_or_below("FAIL")
 
 
@@ -342,7 +351,8 @@ def test_json_fields(cases):
         assert set(rob) >= {"samples", "hunting_probability", "interval", "scatter"}
         lo, hi = rob["interval"]
         assert lo <= rob["hunting_probability"] <= hi
-        assert rob["scatter"] == {"friction.static": 0.2, "friction.coulomb": 0.2}
+        assert rob["scatter"]["friction.coulomb"] == 0.2
+        assert rob["scatter"]["the gap Fs - Fc"] == 0.2
     d = cases["no_isolator"].to_dict()
     assert d["verdict"]["plant"] == "non_isolated" and d["verdict"]["behaviour"] == "hunts"
     assert d["simulation"]["non_isolated"]["outcome"] == "hunting"
@@ -379,7 +389,8 @@ def quick_specs(tmp_path_factory):
     ("no_isolator", ["--fail-on", "fail"], 3),
     ("no_isolator", ["--fail-on", "warn"], 3),
 ])
-def test_fail_on_exit_codes(quick_specs, tmp_path, name, option, code):
+def test_fail_on_exit_codes(quick_specs, tmp_path, name, option, code, shared_designs):
+    """Each spec's design computed once (:func:`shared_designs`), its exit code per option."""
     out = tmp_path / "r.json"
     r = runner.invoke(app, [str(quick_specs[name]), "--json", str(out), *option])
     assert r.exit_code == code, r.output

@@ -24,8 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .layout import (N_STATS, N_WATCH, ST_CROSSINGS, ST_EVENTS, ST_PERIOD, ST_REJECTED, ST_STEPS,
-                     ST_STOP, ST_T, STATUS_TEXT, STOP_TEXT, W_QUIET, W_START, Integration)
+from .layout import (N_STATS, N_WATCH, ST_CROSSINGS, ST_EVENTS, ST_OUT, ST_PERIOD, ST_REJECTED,
+                     ST_STEPS, ST_STOP, ST_T, STATUS_TEXT, STOP_TEXT, W_QUIET, W_START,
+                     Integration)
 
 __all__ = ["run"]
 
@@ -54,10 +55,11 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     in_f = np.zeros(0) if input_force is None else np.array(input_force, dtype=np.float64)
     n = y.shape[0]
     m = t_out.shape[0]
-    out_y = np.full((m, n), np.nan)
-    out_r = np.full(m, np.nan)
-    out_fa = np.full(m, np.nan)
-    out_cmd = np.full(m, np.nan)
+    # the kernel writes every output row up to where it stopped; the rest is NaN (below)
+    out_y = np.empty((m, n))
+    out_r = np.empty(m)
+    out_fa = np.empty(m)
+    out_cmd = np.empty(m)
     stats = np.zeros(N_STATS)
     if watch is None:
         w = np.zeros(N_WATCH)
@@ -75,6 +77,9 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
         bool(land), float(t_end), t_out, float(rtol), np.array(atol, dtype=np.float64),
         float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r, out_fa, out_cmd,
         stats, w, cross_t, cross_y, cross_e, y_end)
+    written = int(stats[ST_OUT])
+    for arr in (out_y, out_r, out_fa, out_cmd):
+        arr[written:] = np.nan
     c = int(stats[ST_CROSSINGS])
     return Integration(code=int(status), status=STATUS_TEXT[int(status)], states=out_y,
                        reference=out_r, applied_force=out_fa, command=out_cmd,

@@ -67,9 +67,9 @@ from .layout import (DIVERGED, EV_LEVEL, EV_LIMIT, EV_NONE, EV_SECTION, EV_SIGN,
                      P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT,
                      ST_CROSSINGS, ST_EVENTS, ST_H, ST_LIMIT_EVENTS, ST_OUT, ST_PERIOD,
                      ST_REJECTED, ST_STEPS, ST_STOP, ST_T, ST_ZERO_EVENTS, STEP_UNDERFLOW,
-                     STOP_CROSSINGS, STOP_END, STOP_QUIET, STOP_REPEAT, TOO_MANY_STEPS, W_ARM,
-                     W_BAND, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_REPEAT, W_REST_ANYWHERE,
-                     W_START)
+                     STOP_CROSSINGS, STOP_END, STOP_MATCH, STOP_QUIET, STOP_REPEAT,
+                     TOO_MANY_STEPS, W_ARM, W_BAND, W_LEVEL, W_MATCH, W_MAX_CROSSINGS, W_QUIET,
+                     W_REPEAT, W_REST_ANYWHERE, W_START, N_WATCH)
 
 HIST = 8192  # delay history ring size
 HT, HU, HDU, HUR, HDUR = range(5)  # rows of the history: time, value and rate in, out
@@ -227,9 +227,9 @@ def struct_factor(J, sigma, M, piv, w):
     "leaves": each depends only on the mechanical core and itself (u also on
     I), and the core sees them through its own rows of J. Eliminating them
     leaves a Schur complement on the core (4 x 4 isolated, 2 x 2 rigid),
-    factored with partial pivoting. ``w`` (shape (4, max(nc, 3)))
-    keeps the elimination coefficients for :func:`struct_solve`. Returns
-    False if singular.
+    factored with partial pivoting, U's diagonal stored as its reciprocal.
+    ``w`` (shape (4, max(nc, 3))) keeps the elimination coefficients for
+    :func:`struct_solve`. Returns False if singular.
     """
     n = J.shape[0]
     nc = n - 3
@@ -253,7 +253,13 @@ def struct_factor(J, sigma, M, piv, w):
             if i == c:
                 v += sigma
             M[i, c] = v
-    return lu_factor(M, piv)
+    if not lu_factor(M, piv):
+        return False
+    # the diagonal of U as its reciprocal: the six solves of a step multiply instead of
+    # dividing (a division's latency, four in a row per solve, was much of their time)
+    for i in range(nc):
+        M[i, i] = 1.0 / M[i, i]
+    return True
 
 
 @kernel_function((A2, A2, I1, A2, A1, A1))
@@ -285,7 +291,7 @@ def struct_solve(J, M, piv, w, b, tmp):
         s = tmp[i]
         for j in range(i + 1, nc):
             s -= M[i, j] * tmp[j]
-        tmp[i] = s / M[i, i]
+        tmp[i] = s * M[i, i]  # the reciprocal of U's diagonal (struct_factor)
     yI = gI
     yu = gu
     yz = gz
@@ -625,13 +631,15 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
         feedforward and input force, before delay and saturation).
     stats : ndarray, shape (N_STATS,)
         Output: counters (``ST_*``).
-    watch : ndarray, shape (N_WATCH,)
+    watch : ndarray, shape (N_WATCH + k n,)
         What to watch for once the motion is over (``W_*`` in
         :mod:`fi_design.kernel.layout`): from ``watch[W_START]`` on, the upward
         crossings of x1 - r = 0 (r = ``watch[W_LEVEL]``, the held reference)
         are located like mode events (the step is redone to end on them) and
         recorded, and the run stops early when the stage has come to rest (the
-        quiet rule) or its motion repeats at the section (the repeat rule).
+        quiet rule), its motion repeats at the section (the repeat rule) or its
+        state at the section matches a known one (the match rule: the known
+        states follow the ``N_WATCH`` values).
         ``watch[W_START] = inf`` turns it off.
     cross_t : ndarray, shape (K,)
         Output: times of the crossings [s] (the first ``stats[ST_CROSSINGS]``).
@@ -729,6 +737,8 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     repeat = watch[W_REPEAT]
     rest_anywhere = watch[W_REST_ANYWHERE] != 0.0
     arm = watch[W_ARM]
+    match = watch[W_MATCH]
+    n_known = (watch.shape[0] - N_WATCH) // n
     max_cross = min(int(watch[W_MAX_CROSSINGS]), cross_t.shape[0])
     n_cross = 0
     armed = False
@@ -902,6 +912,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 h *= 0.5
                 n_rej += 1
                 continue
+            hinv = 1.0 / h  # the stages multiply by it (a division per component was slow)
             # stage 1
             for j in range(n):
                 k1[j] = f0[j] + h * D1 * ft[j]
@@ -919,7 +930,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                                           hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
-                k2[j] = fs[j] + C21 / h * k1[j] + h * D2 * ft[j]
+                k2[j] = fs[j] + C21 * hinv * k1[j] + h * D2 * ft[j]
             struct_solve(J, M, piv, w, k2, tmp)
             # stage 3
             for j in range(n):
@@ -931,7 +942,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                                           hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
-                k3[j] = fs[j] + (C31 * k1[j] + C32 * k2[j]) / h + h * D3 * ft[j]
+                k3[j] = fs[j] + (C31 * k1[j] + C32 * k2[j]) * hinv + h * D3 * ft[j]
             struct_solve(J, M, piv, w, k3, tmp)
             # stage 4
             for j in range(n):
@@ -943,7 +954,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                                           hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
-                k4[j] = fs[j] + (C41 * k1[j] + C42 * k2[j] + C43 * k3[j]) / h + h * D4 * ft[j]
+                k4[j] = fs[j] + (C41 * k1[j] + C42 * k2[j] + C43 * k3[j]) * hinv + h * D4 * ft[j]
             struct_solve(J, M, piv, w, k4, tmp)
             # stage 5
             for j in range(n):
@@ -955,7 +966,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                                           hist, head, count)
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
-                k5[j] = fs[j] + (C51 * k1[j] + C52 * k2[j] + C53 * k3[j] + C54 * k4[j]) / h
+                k5[j] = fs[j] + (C51 * k1[j] + C52 * k2[j] + C53 * k3[j] + C54 * k4[j]) * hinv
             struct_solve(J, M, piv, w, k5, tmp)
             # stage 6 (embedded solution + correction)
             for j in range(n):
@@ -963,7 +974,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
                 k6[j] = fs[j] + (C61 * k1[j] + C62 * k2[j] + C63 * k3[j] + C64 * k4[j]
-                                 + C65 * k5[j]) / h
+                                 + C65 * k5[j]) * hinv
             struct_solve(J, M, piv, w, k6, tmp)
             err = 0.0
             for j in range(n):
@@ -1114,7 +1125,24 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 e_lo = math.inf
                 e_hi = -math.inf
                 pending = EV_NONE
-                if n_cross >= max_cross:
+                if match > 0.0 and n_known > 0:
+                    c = n_cross - 1
+                    for kk in range(n_known):
+                        worst = 0.0
+                        for j in range(n):
+                            dj = cross_y[c, j] - watch[N_WATCH + kk * n + j]
+                            if j == 0 or (iso and j == 2):
+                                dj -= level
+                            dj = abs(dj) * rtol / atol[j]
+                            if dj > worst:
+                                worst = dj
+                        if worst <= match:
+                            stop = STOP_MATCH
+                            period = kk
+                            break
+                if stop != STOP_END:
+                    pass
+                elif n_cross >= max_cross:
                     stop = STOP_CROSSINGS
                 elif repeat > 0.0:
                     c = n_cross - 1

@@ -209,7 +209,8 @@ class Integration:
         [m] (since the watch's start for the first).
     period_crossings : int
         With ``stop == "repeat"``: crossings per period of the repeating
-        motion (0 otherwise).
+        motion; with ``stop == "match"``: the index of the known section
+        state matched (0 otherwise).
     """
 
     code: int
@@ -322,13 +323,19 @@ N_STATS = 11
 # W_REPEAT: stop once the state at a section crossing repeats the one 1 to
 # MAX_PERIOD crossings before within this fraction of the physical scales atol / rtol (0:
 # never); W_MAX_CROSSINGS: stop after this many crossings (at most the rows of the crossing
-# outputs); W_ARM: x1 - r must fall below -W_ARM between two counted crossings.
+# outputs); W_ARM: x1 - r must fall below -W_ARM between two counted crossings;
+# W_MATCH: stop once the state at a section crossing comes within this fraction of the
+# physical scales of a known section state (0: never). The known states follow the N_WATCH
+# values, n each (n the number of states), positions relative to their section's level:
+# the match rule compares the crossing state less W_LEVEL in x1 (and x2), so it holds for
+# a plant whose forces do not depend on where the stage is.
 (W_START, W_LEVEL, W_BAND, W_QUIET, W_REPEAT, W_MAX_CROSSINGS, W_REST_ANYWHERE,
- W_ARM) = range(8)
-N_WATCH = 8
+ W_ARM, W_MATCH) = range(9)
+N_WATCH = 9
 #: Longest period, in section crossings, the repeat rule compares.
 MAX_PERIOD = 4
-# Why a run stopped (stats[ST_STOP]).
-STOP_END, STOP_QUIET, STOP_REPEAT, STOP_CROSSINGS = range(4)
+# Why a run stopped (stats[ST_STOP]); with STOP_MATCH, stats[ST_PERIOD] is the index of the
+# known state matched.
+STOP_END, STOP_QUIET, STOP_REPEAT, STOP_CROSSINGS, STOP_MATCH = range(5)
 STOP_TEXT = {STOP_END: "end", STOP_QUIET: "quiet", STOP_REPEAT: "repeat",
-             STOP_CROSSINGS: "crossings"}
+             STOP_CROSSINGS: "crossings", STOP_MATCH: "match"}

@@ -1,10 +1,9 @@
 """What makes one design better than another, what binds the best one, and the trade-off.
 
-The objective (DESIGN.md's revision of the recommendation): the stiffest
-joint that keeps the hunting margin. "Lower is better" holds for hunting
-only; the guide's support stiffness, its modes, gravity and handling all want
-the joint stiff. Among designs the margin admits, the stiffer one wins, then
-the one with more margin (:func:`order`).
+The objective: the stiffest joint that keeps the hunting margin. "Lower is
+better" holds for hunting only; the guide's support stiffness, its modes,
+gravity and handling all want the joint stiff. Among designs the margin
+admits, the stiffer one wins, then the one with more margin (:func:`order`).
 """
 
 from __future__ import annotations

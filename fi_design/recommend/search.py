@@ -316,15 +316,16 @@ class _Search:
         return True, (fx, corners, r)
 
 
-def recommend(spec: _spec.Spec, *, executor: Any = None,
+def recommend(spec: _spec.Spec | str | Any, *, executor: Any = None,
               progress: Callable[[str], None] | None = None) -> RecommendResult:
     """Search a buildable isolator (and the rule's crossover) that the sign-off passes.
 
     Parameters
     ----------
-    spec : Spec
-        The design spec; without an isolator the search is for one to add,
-        without a flexure section for a steel leaf-spring guide.
+    spec : Spec, path or mapping
+        The design spec (a YAML path or mapping is loaded); without an isolator
+        the search is for one to add, without a flexure section for a steel
+        leaf-spring guide.
     executor : concurrent.futures-style executor, optional
         Runs the stage-level evaluations and the robustness samples; None
         runs them here. The library creates no pool.
@@ -338,11 +339,21 @@ def recommend(spec: _spec.Spec, *, executor: Any = None,
         reserves and passes the sign-off, its guide, what binds it, the least
         change of the spec that passes, and the trade-off; or the nearest
         design and what it violates.
+
+    Raises
+    ------
+    ArgumentError
+        ``spec`` is not a spec, a path or a mapping.
+    SpecError
+        A path or mapping that does not validate.
     """
     from ..guideline import step2_crossover
     from .least import least_change
 
+    from ..specfile import as_spec
+
     start = _time.perf_counter()
+    spec = as_spec(spec)
     say = progress or (lambda text: None)
     srch = _Search(spec, executor, say)
     srch.run()

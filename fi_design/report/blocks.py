@@ -52,7 +52,8 @@ class FigureBlock:
     Attributes
     ----------
     svg : str or None
-        The ``<svg>`` element (:func:`fi_design.plots.figure_svg`); None leaves
+        The figure's element (:func:`fi_design.plots.figure_markup`: inline
+        ``<svg>``, or an ``<img>`` in a PDF); None leaves
         only the caption (the golden tests build contexts without figures).
     caption : str
         Caption below the figure.
@@ -86,9 +87,9 @@ def figure_block(fig: Any, caption: str, name: str = "figure", width: str = "ful
     -------
     FigureBlock
     """
-    from ..plots import figure_svg
+    from ..plots import figure_markup
 
-    return FigureBlock(svg=figure_svg(fig, name), caption=caption, name=name, width=width)
+    return FigureBlock(svg=figure_markup(fig, name), caption=caption, name=name, width=width)
 
 
 @dataclass(frozen=True)
@@ -146,7 +147,7 @@ def figure_entry(make: Callable[[], Any] | None, name: str, caption: str, number
 
     svg = None
     if make is not None:
-        from ..plots import figure_svg
+        from ..plots import figure_markup
 
-        svg = Markup(figure_svg(make(), name))
+        svg = Markup(figure_markup(make(), name))
     return {"name": name, "number": number, "caption": caption, "svg": svg, "width": width}

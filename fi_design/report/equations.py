@@ -14,7 +14,7 @@ import re
 
 from ..cachedir import cache_dir
 
-__all__ = ["equation", "equation_svg", "math_text", "EQUATION_RC", "EQUATION_SIZE"]
+__all__ = ["equation", "equation_svg", "equation_img", "math_text", "EQUATION_RC", "EQUATION_SIZE"]
 
 #: matplotlib settings of the equations: STIX, a Times-like face that matches the body text.
 EQUATION_RC = {"mathtext.fontset": "stix"}
@@ -44,7 +44,10 @@ def equation(tex: str, name: str, render: bool = True) -> dict:
     if render:
         from markupsafe import Markup
 
-        svg = Markup(equation_svg(tex, name))
+        from ..plots import raster_dpi
+
+        dpi = raster_dpi()
+        svg = Markup(equation_svg(tex, name) if dpi is None else equation_img(tex, dpi))
     return {"tex": tex, "text": math_text(tex), "svg": svg}
 
 
@@ -72,26 +75,53 @@ def equation_svg(tex: str, name: str) -> str:
     str
         The ``<svg>`` element, sized in pt.
     """
+    return _cached(tex, "svg", lambda: _draw(tex))
+
+
+def equation_img(tex: str, dpi: float) -> str:
+    """A formula as an ``<img>`` element: the outline of :func:`equation_svg` filled at ``dpi``.
+
+    For PDF reports (:func:`fi_design.plots.raster_figures`), where WeasyPrint
+    would otherwise parse and fill the outline's path in Python. Kept in the
+    user cache like the SVG.
+
+    Parameters
+    ----------
+    tex : str
+        The formula (mathtext TeX, without ``$``).
+    dpi : float
+        Resolution [dots per inch].
+
+    Returns
+    -------
+    str
+        The ``<img>`` element (a PNG data URL), as wide in pt as the SVG.
+    """
+    return _cached(tex, f"{dpi:g}.img", lambda: _draw_img(tex, dpi))
+
+
+def _cached(tex: str, kind: str, draw) -> str:
+    """The drawing of ``tex`` of this ``kind`` from the user cache, else ``draw()`` (stored)."""
     import hashlib
 
     import matplotlib
 
     key = hashlib.sha256(repr((tex, EQUATION_SIZE, EQUATION_RC, matplotlib.__version__,
                                _FORMAT)).encode()).hexdigest()
-    path = cache_dir("equations") / f"{key}.svg"
+    path = cache_dir("equations") / f"{key}.{kind}"
     try:
         return path.read_text(encoding="utf-8")
     except OSError:
         pass
-    svg = _draw(tex)
+    text = draw()
     try:  # a cache that cannot be written only costs the next run the time
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(svg, encoding="utf-8")
+        tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, path)
     except OSError:
         pass
-    return svg
+    return text
 
 
 #: Version of the drawing below (part of the cache key: change it when the output changes).
@@ -100,17 +130,45 @@ _FORMAT = 2
 _MARGIN = 1.0
 
 
-def _draw(tex: str) -> str:
-    """The SVG element of a formula (no cache)."""
+def _outline(tex: str):
+    """The glyph outline of a formula (a matplotlib Path, in pt) and its extents."""
     import matplotlib
     from matplotlib.font_manager import FontProperties
-    from matplotlib.path import Path as MplPath
     from matplotlib.textpath import TextPath
 
     source = "$" + tex.replace("\\frac", "\\dfrac") + "$"
     with matplotlib.rc_context(EQUATION_RC):
         outline = TextPath((0.0, 0.0), source, prop=FontProperties(size=EQUATION_SIZE))
-    box = outline.get_extents()
+    return outline, outline.get_extents()
+
+
+#: Colour of a rasterised formula: the report's ink (report.css ``--ink``).
+_INK = "#1d2329"
+
+
+def _draw_img(tex: str, dpi: float) -> str:
+    """The ``<img>`` element of a formula at ``dpi`` (no cache)."""
+    from matplotlib.figure import Figure
+    from matplotlib.patches import PathPatch
+
+    from ..plots import png_img, rgb_png
+
+    outline, box = _outline(tex)
+    width, height = box.width + 2 * _MARGIN, box.height + 2 * _MARGIN
+    fig = Figure(figsize=(width / 72.0, height / 72.0), dpi=dpi, facecolor="white")
+    ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
+    ax.set_axis_off()
+    ax.set_xlim(box.x0 - _MARGIN, box.x1 + _MARGIN)
+    ax.set_ylim(box.y0 - _MARGIN, box.y1 + _MARGIN)
+    ax.add_patch(PathPatch(outline, facecolor=_INK, edgecolor="none", linewidth=0.0))
+    return png_img(rgb_png(fig, dpi), width_pt=width, alt=math_text(tex))
+
+
+def _draw(tex: str) -> str:
+    """The SVG element of a formula (no cache)."""
+    from matplotlib.path import Path as MplPath
+
+    outline, box = _outline(tex)
     x0, y1 = box.x0 - _MARGIN, box.y1 + _MARGIN
     width, height = box.width + 2 * _MARGIN, box.height + 2 * _MARGIN
     letters = {MplPath.MOVETO: "M", MplPath.LINETO: "L", MplPath.CURVE3: "Q",

@@ -154,15 +154,18 @@ def write_document(html: str, path: str | os.PathLike) -> Path:
     logging.getLogger("fontTools").setLevel(logging.ERROR)
     from weasyprint import HTML
 
-    document = HTML(string=html, base_url=None, url_fetcher=_no_fetch).render()
+    document = HTML(string=html, base_url=None, url_fetcher=_self_contained()).render()
     with atomic_path(out) as tmp:
         document.write_pdf(str(tmp))
     return out
 
 
-def _no_fetch(url: str, *args: Any, **kwargs: Any) -> dict:
-    """URL fetcher that refuses everything: the report is self-contained by design."""
-    raise ValueError(f"the report makes no external requests (refused {url!r})")
+def _self_contained() -> Any:
+    """WeasyPrint's URL fetcher limited to ``data:`` URLs (the PDF's figures): the report is
+    self-contained by design and makes no external request (any other URL is refused)."""
+    from weasyprint.urls import URLFetcher
+
+    return URLFetcher(allowed_protocols={"data"}, fail_on_errors=True)
 
 
 def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
@@ -210,10 +213,22 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     if progress is not None:
         progress("drawing the report's figures ...")
     options = {} if design_map is None else {"design_map": design_map}
-    html = render_html(build_context(result, date=date, command=command, **options))
+    with _figures_for(fmt):
+        html = render_html(build_context(result, date=date, command=command, **options))
     if progress is not None:
         progress("writing the PDF ..." if fmt == "pdf" else "writing the HTML ...")
     return write_document(html, out)
+
+
+def _figures_for(fmt: str) -> Any:
+    """Figures and equations as inline SVG for HTML, as PNG images for a PDF
+    (:func:`fi_design.plots.raster_figures`: WeasyPrint draws them in a fraction of the
+    time)."""
+    import contextlib
+
+    from ..plots import raster_figures
+
+    return raster_figures() if fmt == "pdf" else contextlib.nullcontext()
 
 
 def render_document(path: str | os.PathLike, *, title: str, spec: Any, sections: Any,

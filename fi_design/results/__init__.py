@@ -19,6 +19,7 @@ from __future__ import annotations
 import dataclasses
 import enum
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -133,11 +134,29 @@ def to_jsonable(obj: Any) -> Any:
     return obj
 
 
-def dataclass_dict(obj: Any) -> dict:
+def dataclass_dict(obj: Any, exclude: Callable[[Any], bool] | None = None) -> dict:
     """Field-by-field :func:`to_jsonable` of a dataclass.
 
     :meth:`Result.to_dict` is this; a result's own ``to_dict`` builds on it
     (calling :func:`to_jsonable` on itself would recurse). Fields declared
     with ``repr=False`` are left out.
+
+    Parameters
+    ----------
+    obj : dataclass instance
+        The result.
+    exclude : callable, optional
+        ``exclude(value)`` true leaves a field out *before* it is converted
+        (a trace of millions of samples becomes millions of Python floats
+        when converted: leave it out, do not convert it and drop it).
+
+    Returns
+    -------
+    dict
     """
-    return {f.name: to_jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj) if f.repr}
+    out = {}
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if f.repr and not (exclude is not None and exclude(value)):
+            out[f.name] = to_jsonable(value)
+    return out

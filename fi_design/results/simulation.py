@@ -208,5 +208,5 @@ class SimulationResult(Result):
         -------
         dict
         """
-        return {k: v for k, v in dataclass_dict(self).items()
-                if traces or not isinstance(getattr(self, k), np.ndarray)}
+        return dataclass_dict(self, None if traces else
+                              (lambda value: isinstance(value, np.ndarray)))

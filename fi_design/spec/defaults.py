@@ -12,7 +12,7 @@ import math
 import sys
 from typing import TYPE_CHECKING
 
-from ..display import number
+from ..display import number, quantity
 from .sections import Limiter, ParasiticMode
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -170,6 +170,11 @@ def antiresonance(mode: ParasiticMode) -> float:
 
 # --------------------------------------------------------------------------- warnings
 
+#: A move this many times the isolator's stroke is implausible (a unit slip, most likely: a
+#: long-stroke stage moves up to about a metre on a stroke of half a millimetre, 2000 times).
+MOVE_STROKE_PLAUSIBLE = 2000.0
+
+
 
 def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     """Suspicious but legal input, as ``(path, message)`` pairs.
@@ -181,8 +186,9 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     what it costs: the presliding mode then rings; the default sqrt(sigma0
     (m1 + m2)), damping ratio 0.5 of the presliding mode, breaks the bound
     deliberately and is not warned about when left out), a stroke within
-    five presliding ranges, a hunting window that starts before the last
-    move ends, and a loop without the hardware's sampling and delay (a
+    five presliding ranges, a move :data:`MOVE_STROKE_PLAUSIBLE` times the
+    stroke or more, a motion that outlasts the run, a hunting window that
+    starts before the last move ends, and a loop without the hardware's sampling and delay (a
     continuous controller without delay: the margins and the hunting depend
     on both).
     """
@@ -211,15 +217,31 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
             out.append(("isolator.stroke",
                         f"stroke {spec.isolator.stroke * 1e3:.3g} mm is within 5x the presliding "
                         f"range Fs/sigma0 = {presl * 1e6:.3g} um: the joint can hardly isolate"))
+    if spec.isolator is not None:
+        for i, mv in enumerate(spec.motion.moves):
+            ratio = abs(mv.distance) / spec.isolator.stroke
+            if ratio >= MOVE_STROKE_PLAUSIBLE:
+                out.append((f"motion.moves[{i}].distance",
+                            f"a move of {quantity(mv.distance, 'm', 3)} is {ratio:,.0f} times the "
+                            f"isolator stroke of {quantity(spec.isolator.stroke, 'm', 3)}: check "
+                            "its unit (a bare number is in metres); the family of moves the "
+                            "stage is judged on grows with it"))
     t_end = spec.motion.end_time
     h = spec.requirements.hunting
+    if t_end > spec.motion.duration:
+        out.append(("motion.duration",
+                    f"the last move ends at {t_end:.4g} s, after the run ends at "
+                    f"{spec.motion.duration:g} s: the stage is still moving when the simulation "
+                    "stops, and the spec's move is not finished (undetermined, never settled)"))
     if t_end > h.window_start:
         whose = ("" if "window_start" in h.model_fields_set
                  else " (the default window start: set requirements.hunting.window_start and "
                       "motion.duration for this motion)")
+        w1 = h.window_start + h.window_length
+        where = ("inside the hunting window that starts at" if t_end < w1 else
+                 f"after the hunting window [{h.window_start:g} s, {w1:g} s) ends; it starts at")
         out.append(("requirements.hunting.window_start",
-                    f"the last move ends at {t_end:.3g} s, inside the hunting window that starts "
-                    f"at {h.window_start:g} s{whose}"))
+                    f"the last move ends at {t_end:.4g} s, {where} {h.window_start:g} s{whose}"))
     ctl = spec.controller
     delayed = any(e.type == "time_delay" for e in spec.effects)
     if ctl.sample_rate is None and ctl.delay == 0 and not delayed:

@@ -66,9 +66,13 @@ def stage_hunts(model: Model | _spec.Spec, isolated: bool, *, crossover: float |
     p = model.plant(isolated)
     w = watch_settings(model, p)
     runs: list[_Run] = []
+    cycles: list[_Run] = []  # one run per cycle found: later moves stop on entering one
     for dist, label, ref, end in _moves(model, isolated, p, w.horizon, family):
-        r = move_outcome(p, ref, end, w, distance=dist, label=label)
+        r = move_outcome(p, ref, end, w, distance=dist, label=label, known=cycles)
         runs.append(r)
+        if r.cycle_states is not None and not any(c.cycle_states is r.cycle_states
+                                                  for c in cycles):
+            cycles.append(r)
         if first_only and r.outcome.hunts:
             break
     return tuple(r.outcome for r in runs), runs

@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import logging
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,8 +19,9 @@ import numpy as np
 from .. import spec as _spec
 from ..kernel import run
 from ..kernel.build import compiled
-from ..kernel.layout import (N_WATCH, W_ARM, W_BAND, W_LEVEL, W_MAX_CROSSINGS, W_QUIET,
-                             W_REPEAT, W_REST_ANYWHERE, W_START, PlantParameters, state_index)
+from ..kernel.layout import (N_WATCH, W_ARM, W_BAND, W_LEVEL, W_MATCH, W_MAX_CROSSINGS,
+                             W_QUIET, W_REPEAT, W_REST_ANYWHERE, W_START, PlantParameters,
+                             state_index)
 from ..model import Model, as_model
 from ..results.stage import MoveOutcome, length_text
 from ..simulation import tolerances
@@ -33,6 +35,11 @@ CROSSINGS = 400
 #: Repeat tolerance of the family runs: the section state repeats within this
 #: fraction of the physical scales (1 mm, 1 cm/s, Fs / sigma0, Fs) [-].
 REPEAT = 1e-3
+#: Match tolerance of the family runs: a move whose section state comes within this
+#: fraction of the physical scales of a cycle an earlier move of the same plant repeated
+#: has entered that cycle (an attracting cycle draws it in, by the cycle's multiplier,
+#: about 0.5, at every crossing; the repeat rule needs about five crossings more) [-].
+MATCH = 1e-2
 #: Relative tolerance of the orbit computations (shooting, multipliers) [-].
 ORBIT_RTOL = 1e-9
 #: Finite-difference perturbation of the return map, in physical scales [-].
@@ -124,6 +131,14 @@ def _integrates(p: PlantParameters) -> bool:
 def _restartable(p: PlantParameters) -> bool:
     """Whether the state vector holds the whole state (a continuous controller without delay)."""
     return p.sample_period == 0.0 and p.delay == 0.0
+
+
+def _translation_invariant(p: PlantParameters) -> bool:
+    """Whether the plant's forces do not depend on where the stage is (a cycle about one
+    target is the same cycle about another, shifted): no position-dependent friction, force
+    ripple, cable spring or quantization."""
+    return (p.pdf_amplitude == 0.0 and p.ripple_amplitude == 0.0 and p.cable_stiffness == 0.0
+            and p.quantization == 0.0)
 
 
 def _symmetric(p: PlantParameters) -> bool:
@@ -288,17 +303,39 @@ def _rest_ends_run(params: PlantParameters, y: np.ndarray, level: float, band: f
 
 @dataclass(frozen=True, eq=False)
 class _Run:
-    """What one watched run of a move left: its outcome and the cycle's section state."""
+    """What one watched run of a move left: its outcome and the cycle's section state.
+
+    ``cycle_states`` (hunting runs): the section states of one period of the cycle, shape
+    (crossings, n), positions relative to ``level`` (what the match rule compares).
+    """
 
     outcome: MoveOutcome
     section_state: np.ndarray | None
     crossings: int
     level: float
+    cycle_states: np.ndarray | None = None
+
+
+def _relative(params: PlantParameters, states: np.ndarray, level: float) -> np.ndarray:
+    """Section states with the positions (x1, and x2 of the isolated plant) less ``level``."""
+    out = np.array(states, dtype=float, ndmin=2)
+    idx = state_index(bool(params.isolated))
+    out[:, idx["x1"]] -= level
+    if params.isolated:
+        out[:, idx["x2"]] -= level
+    return out
 
 
 def _watch_array(w: Watch, start: float, level: float, *, repeat: float = REPEAT,
-                 quiet: bool = True, max_crossings: int = CROSSINGS) -> np.ndarray:
-    arr = np.zeros(N_WATCH)
+                 quiet: bool = True, max_crossings: int = CROSSINGS,
+                 known: np.ndarray | None = None, match: float | None = None) -> np.ndarray:
+    """The kernel's watch array; ``known`` (k, n) section states (positions relative to
+    their level) for the match rule, within ``match`` (default :data:`MATCH`)."""
+    k = 0 if known is None else len(known)
+    arr = np.zeros(N_WATCH + (0 if k == 0 else known.size))
+    if k:
+        arr[W_MATCH] = MATCH if match is None else match
+        arr[N_WATCH:] = np.ravel(known)
     arr[W_START] = start
     arr[W_LEVEL] = level
     arr[W_BAND] = w.band
@@ -329,7 +366,8 @@ def _integrate(params, y0, ref, t_end, watch, tol, max_steps, crossings=CROSSING
 
 
 def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: Watch, *,
-                 distance: float, label: str = "family", repeat: float = REPEAT) -> _Run:
+                 distance: float, label: str = "family", repeat: float = REPEAT,
+                 known: Sequence[_Run] = ()) -> _Run:
     """Simulate one move from rest and judge how the stage ends.
 
     Parameters
@@ -348,6 +386,13 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
         ``"family"`` or ``"spec"``.
     repeat : float
         Repeat tolerance of the section state [-].
+    known : sequence of _Run
+        Hunting runs of earlier moves of the same plant: once the section
+        state comes within :data:`MATCH` of one of their cycles, the move has
+        entered that cycle and the run stops there; its outcome takes that
+        cycle's amplitude and period (for a plant whose state vector is whole
+        and whose forces do not depend on where the stage is; otherwise the
+        run goes on until its own motion repeats).
 
     Returns
     -------
@@ -359,12 +404,17 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
     y0 = np.zeros(params.n_states)
     t_end = move_end + w.horizon
     restart = _restartable(params)
+    known = [r for r in known if r.cycle_states is not None] \
+        if restart and _translation_invariant(params) else []
+    table = np.concatenate([r.cycle_states for r in known]) if known else None
+    owner = [r for r in known for _ in range(len(r.cycle_states))]
     start, offset, elapsed = move_end, 0.0, 0.0
     cur_ref, cur_y0, cur_end = ref, y0, t_end
     rested_at = None  # when the stage last came to rest inside the band, not for good [s]
     while True:
         out = _integrate(params, cur_y0, cur_ref, cur_end,
-                         _watch_array(w, start, level, repeat=repeat), w.tolerance, w.max_steps)
+                         _watch_array(w, start, level, repeat=repeat, known=table), w.tolerance,
+                         w.max_steps)
         elapsed = offset + out.t_reached - move_end
         y = out.final_state
         if out.code != 0:
@@ -397,6 +447,16 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
                                   "integrator to pull it in)")
         return _Run(MoveOutcome(distance, label, word, e, None, None, elapsed, why), None, 0,
                     level)
+    if out.stop == "match":
+        seen = owner[out.period_crossings]
+        m = seen.outcome
+        why = (f"a sustained cycle: {m.amplitude * 1e3:.3g} mm peak to peak"
+               + (f", period {m.period:.3g} s" if m.period else "")
+               + f" (enters the cycle of the {length_text(abs(m.distance))} move)")
+        return _Run(MoveOutcome(distance, label, "hunts", float(out.crossing_states[-1][0]
+                                                                  - level),
+                                m.amplitude, m.period, elapsed, why),
+                    seen.section_state, seen.crossings, seen.level, seen.cycle_states)
     if out.stop in ("repeat", "crossings") or (out.stop == "end" and n >= 4):
         q = out.period_crossings if out.stop == "repeat" else _guess_period(out.crossing_states)
         q = max(1, min(q, n - 1)) if n > 1 else 1
@@ -410,7 +470,9 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
         return _Run(MoveOutcome(distance, label, "hunts", float(out.crossing_states[-1][0]
                                                                   - level),
                                 amp, period, elapsed, why),
-                    np.array(out.crossing_states[-1]), q, level)
+                    np.array(out.crossing_states[-1]), q, level,
+                    _relative(params, out.crossing_states[-q:], level)
+                    if out.stop == "repeat" else None)
     if (rested_at is not None and out.stop == "end" and n == 0 and abs(e) <= w.band
             and t_end - rested_at <= w.quiet):
         # at rest inside the band, and still inside it at the horizon, too soon after for

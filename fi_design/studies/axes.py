@@ -8,6 +8,7 @@ own value at a path, the design point a study is drawn around.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 
 import numpy as np
@@ -77,7 +78,9 @@ def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> 
     text : str
         ``"controller.crossover=2 Hz:30 Hz:15"``, ``"isolator.stroke=0.05 mm:1 mm:12"``
         or ``"stage.mass=1,2,4"``. START and STOP are SI numbers or strings
-        with units; N is the number of values, end points included.
+        with units, both alike (a bare number beside one with units is
+        refused; a bare 0 mixes); N is the number of values, end points
+        included.
     log : bool, optional
         Space the N values logarithmically (START and STOP above zero).
     spec : Spec, optional
@@ -90,7 +93,8 @@ def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> 
     Raises
     ------
     SpecError
-        Unknown path, malformed range, wrong unit, N below 1.
+        Unknown path, malformed range, wrong unit, a bare number beside one
+        with units, N below 1.
     """
     from ..units import to_si
 
@@ -114,12 +118,15 @@ def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> 
             raise SpecError(f"range {rng!r}: {what}: {exc.message}", path=path) from None
 
     if ":" not in rng and "," in rng:
-        values = [number(w, f"value {i + 1}") for i, w in enumerate(rng.split(","))]
+        words = rng.split(",")
+        _one_unit(words, rng, unit, path)
+        values = [number(w, f"value {i + 1}") for i, w in enumerate(words)]
         return make_axis(path, values, log=log, spec=spec)
     parts = rng.split(":")
     if len(parts) != 3:
         raise SpecError(f"range {rng!r}: expected START:STOP:N (three parts separated by ':'), "
                         f"e.g. '0.05 mm:1 mm:12'", path=path)
+    _one_unit(parts[:2], rng, unit, path)
     start, stop = number(parts[0], "START"), number(parts[1], "STOP")
     try:
         n = int(parts[2].strip())
@@ -144,6 +151,35 @@ def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> 
     else:
         values = np.linspace(start, stop, n)
     return Axis(path=path, values=values, unit=unit, log=log)
+
+
+#: The number that starts a value with units (``"1 mm"``, ``"-2.5e-3 N/m"``).
+_LEADING_NUMBER = re.compile(r"^\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*")
+
+
+def _one_unit(words: Sequence[str], rng: str, unit: str, path: str) -> None:
+    """Refuse a range that mixes bare numbers (SI) with values given in units.
+
+    ``0.2:1 mm:3`` would run from 0.2 m down to 1 mm: the bare number is most
+    likely meant in the other's unit, so neither reading is taken for granted.
+    A bare zero is zero in every unit and mixes freely.
+
+    Raises
+    ------
+    SpecError
+        A nonzero bare number beside a value with units.
+    """
+    words = [w.strip() for w in words]
+    bare = [w for w in words if w and is_number(w) and float(w) != 0.0]
+    united = [w for w in words if w and not is_number(w)]
+    if not (bare and united):
+        return
+    lead = _LEADING_NUMBER.match(united[0])
+    meant = united[0][lead.end():].strip() if lead else ""
+    hint = f" (e.g. '{bare[0]} {meant}' if that is what {bare[0]!r} means)" if meant else ""
+    raise SpecError(f"range {rng!r}: {bare[0]!r} is a bare number, read as {bare[0]} {unit} (SI), "
+                    f"while {united[0]!r} has a unit; give every value its unit{hint}, or none "
+                    "(all SI)", path=path)
 
 
 def is_number(word: str) -> bool:

@@ -1,0 +1,181 @@
+"""Interrupts: never lost, never turned into another error, never cutting a held step in two.
+
+Each case reproduces in one process a window an adversarial run found by sending SIGINT to
+`fi-design sweep` at random instants (the same, at many instants, is in tests/test_pools.py).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import threading
+import time
+
+import pytest
+from typer.testing import CliRunner
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="POSIX signals")
+
+runner = CliRunner()
+
+
+def _sigint_here() -> None:
+    """Ctrl-C to this process; its handler runs at the next bytecode of the main thread."""
+    os.kill(os.getpid(), signal.SIGINT)
+    for _ in range(1000):  # a C-level handler only trips a flag: give it a bytecode to run at
+        pass
+
+
+class _Finalizer:
+    """An object whose finalizer runs when Ctrl-C's handler does: Python prints the
+    KeyboardInterrupt raised inside it ("Exception ignored in ...") and carries on."""
+
+    def __del__(self) -> None:
+        _sigint_here()
+
+
+# the finalizer's KeyboardInterrupt is printed and dropped: the very thing under test
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_an_interrupt_swallowed_by_a_finalizer_still_stops_the_run(paper_spec_path, tmp_path,
+                                                                  monkeypatch):
+    """The run went on to its end, wrote its output and exited 0."""
+    import fi_design.simulation as simulation
+
+    real = simulation.simulate
+
+    def simulate(*args, **kwargs):
+        _Finalizer()  # collected at once: Ctrl-C lands inside its finalizer
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(simulation, "simulate", simulate)
+    out = tmp_path / "out.json"
+    result = runner.invoke(app(), ["simulate", str(paper_spec_path), "--json", str(out)])
+    assert result.exit_code == 130, result.output
+    assert "interrupted; no output was written" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_error_raised_by_an_interruption_is_the_interruption(paper_spec_path, tmp_path,
+                                                               monkeypatch):
+    """Ctrl-C inside the import of a compiled module is `ImportError: initialization failed`
+    (pybind11 modules), and stopping an interrupted pool met `OSError: [Errno 9] Bad file
+    descriptor`: both were reported as internal errors (exit 1) instead of the interruption."""
+    import errno
+
+    import fi_design.simulation as simulation
+
+    for error in (ImportError("initialization failed"),
+                  OSError(errno.EBADF, "Bad file descriptor")):
+        def simulate(*args, error=error, **kwargs):
+            try:
+                raise KeyboardInterrupt
+            except KeyboardInterrupt:
+                raise error  # noqa: B904 -- raised while handling it, as the libraries do
+
+        monkeypatch.setattr(simulation, "simulate", simulate)
+        out = tmp_path / "out.json"
+        result = runner.invoke(app(), ["simulate", str(paper_spec_path), "--json", str(out)])
+        assert result.exit_code == 130, result.output
+        assert "interrupted; no output was written" in result.stderr
+        assert "internal error" not in result.stderr and not out.exists()
+
+
+def test_an_interrupt_outside_a_study_says_so(paper_spec_path, tmp_path, monkeypatch):
+    """typer turned a KeyboardInterrupt into a silent exit 130; the CLI says what was written."""
+    import fi_design.simulation as simulation
+
+    def simulate(*args, **kwargs):
+        _sigint_here()
+        raise AssertionError("Ctrl-C did not stop the run")
+
+    monkeypatch.setattr(simulation, "simulate", simulate)
+    result = runner.invoke(app(), ["simulate", str(paper_spec_path)])
+    assert result.exit_code == 130, result.output
+    assert "interrupted; no output was written and no temporary file is left" in result.stderr
+
+
+@pytest.mark.parametrize("command_line", [True, False])
+def test_an_interrupt_delivered_to_another_thread_leaves_no_temporary_file(tmp_path,
+                                                                           monkeypatch,
+                                                                           command_line):
+    """The main thread held the signals by its mask while it made the temporary file; the
+    kernel then delivered Ctrl-C to another thread (a pool's manager thread, a progress
+    bar), whose handler raised in the main thread anyway, before the file was known to the
+    cleanup: `.out.json.XXXX.tmp` stayed behind."""
+    import tempfile
+
+    from fi_design import output
+
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait, daemon=True)
+    other.start()
+    real = tempfile.mkstemp
+
+    def mkstemp(*args, **kwargs):
+        made = real(*args, **kwargs)
+        signal.pthread_kill(other.ident, signal.SIGINT)
+        time.sleep(0.05)  # the other thread runs the C handler; the main thread then checks
+        for _ in range(1000):
+            pass
+        return made
+
+    monkeypatch.setattr(output.tempfile, "mkstemp", mkstemp)
+    out = tmp_path / "out.json"
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            if command_line:
+                from fi_design.cliparts import _signal_exception
+                from fi_design.interrupts import signals_to_exceptions
+
+                with signals_to_exceptions(_signal_exception):
+                    output.write_atomic(out, "{}")
+            else:
+                output.write_atomic(out, "{}")
+    finally:
+        stop.set()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_held_block_gets_its_signal_at_the_end():
+    from fi_design.cliparts import Terminated, _signal_exception
+    from fi_design.interrupts import held, received, signals_to_exceptions
+
+    steps = []
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(Terminated) as err:
+        with signals_to_exceptions(_signal_exception):
+            with held():
+                os.kill(os.getpid(), signal.SIGTERM)
+                for _ in range(1000):
+                    pass
+                steps.append("the block ran on")
+                assert received() == (signal.SIGTERM,)
+    assert steps == ["the block ran on"] and err.value.signum == signal.SIGTERM
+    assert signal.getsignal(signal.SIGTERM) is before  # restored
+    assert received() == ()
+
+
+def app():
+    from fi_design.cli import app as the_app
+
+    return the_app
+
+
+def test_an_interrupt_between_two_outputs_names_the_one_written(paper_spec_path, tmp_path,
+                                                                 monkeypatch):
+    from fi_design import output
+
+    real = output.write_atomic
+
+    def write_atomic(path, data):
+        _sigint_here()
+        return real(path, data)
+
+    monkeypatch.setattr(output, "write_atomic", write_atomic)
+    csv, js = tmp_path / "trace.csv", tmp_path / "out.json"
+    result = runner.invoke(app(), ["simulate", str(paper_spec_path), "--csv", str(csv),
+                                   "--json", str(js)])
+    assert result.exit_code == 130, result.output
+    assert f"interrupted; it had written {csv} and no temporary file is left" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["trace.csv"]
