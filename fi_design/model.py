@@ -427,10 +427,6 @@ class Model:
         """
         if isolated and self.joint is None:
             raise SimulationError("the spec has no isolator: cannot simulate the isolated plant")
-        if self.law.filters:
-            raise SimulationError(
-                "controller.filters: the simulation kernel does not carry the drive's filters "
-                "yet; the linear steps and the hand-off do (run with --no-simulation)")
         law, f = self.law, self.friction
         if isolated:
             j, lim = self.joint, self.limiter
@@ -449,6 +445,8 @@ class Model:
             isolated=1.0 if isolated else 0.0, switch_model=1.0 if f.model == "switch" else 0.0)
         if law.sample_period > 0.0:
             params = replace(params, sample_period=law.sample_period, **law.discrete_form())
+        if law.filters:
+            params = replace(params, **filter_fields(law.filters, law.sample_period))
         return apply_effects(params, self.effects)
 
 
@@ -566,6 +564,39 @@ def _positive(value, path: str, unit: str) -> float:
     if not x > 0.0:
         raise SpecError(f"must be greater than 0 {unit}, got {value!r}", path=path)
     return x
+
+
+def filter_fields(filters, period: float) -> dict[str, float]:
+    """The kernel's fields of the drive's filter chain (:class:`~fi_design.kernel.layout.PlantParameters`).
+
+    Each filter a section: its polynomials in s, ``(b0 s^2 + b1 s + b2) / (s^2 + a1 s + a2)``
+    or ``(b0 s + b1) / (s + a1)``, and, for a sampled controller (``period`` [s] > 0), the
+    biquad the drive computes (:func:`fi_design.controller.tustin_biquad`).
+    """
+    from .controller import filter_polynomials, tustin_biquad
+    from .kernel.layout import MAX_FILTER_SECTIONS
+
+    if len(filters) > MAX_FILTER_SECTIONS:
+        raise SpecError(f"at most {MAX_FILTER_SECTIONS} filters, got {len(filters)}",
+                        path="controller.filters")
+    out: dict[str, float] = {"filter_states": float(sum(f.order for f in filters))}
+    for i, f in enumerate(filters):
+        num, den = filter_polynomials(f)
+        num = [0.0] * (len(den) - len(num)) + [float(x) for x in num]
+        if f.order == 2:
+            b0, b1, b2 = num
+            a1, a2 = float(den[1]), float(den[2])
+        else:
+            (b0, b1), b2, a1, a2 = num, 0.0, float(den[1]), 0.0
+        out.update({f"f{i}_order": float(f.order), f"f{i}_b0": b0, f"f{i}_b1": b1,
+                    f"f{i}_b2": b2, f"f{i}_a1": a1, f"f{i}_a2": a2})
+        if period > 0.0:
+            b, a = tustin_biquad(f, period)
+            b = list(b) + [0.0] * (3 - len(b))
+            a = list(a) + [0.0] * (3 - len(a))
+            out.update({f"f{i}_z0": float(b[0]), f"f{i}_z1": float(b[1]), f"f{i}_z2": float(b[2]),
+                        f"f{i}_p1": float(a[1]), f"f{i}_p2": float(a[2])})
+    return out
 
 
 def _checked_filters(filters, period: float) -> tuple:

@@ -309,10 +309,12 @@ class Controller(StrictModel):
     delay: Q("s") = Field(0.0, ge=0, description="Computational delay [s]. Default 0.")
     pade_order: int = Field(3, ge=1, le=10, description="Order of the Pade approximation of the "
                                                         "delay in the linear analysis. Default 3.")
-    filters: tuple[FilterEntry, ...] = Field((), description="The drive's filter chain: notch "
-                                                             "and low_pass filters in series "
-                                                             "with the PID, on its output, in "
-                                                             "this order. Default none.")
+    filters: tuple[FilterEntry, ...] = Field((), max_length=4,
+                                             description="The drive's filter chain: notch "
+                                                         "and low_pass filters in series "
+                                                         "with the PID, on its output, in "
+                                                         "this order (at most 4). Default "
+                                                         "none.")
     drive: Drive | None = Field(None, description="The drive's units (motor constant, encoder "
                                                   "resolution, current scaling): the gains in "
                                                   "counts and amperes too. Default none.")
