@@ -761,9 +761,9 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
     g = pid.gains
     law = pid.controller
     if law.source == "rule":
-        parts.append(f"The PID tuned on {_g(g.tuning_mass)} kg, in the form controller.gains "
-                     f"takes, has kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s) and kd = "
-                     f"{_g(law.kd)} N s/m ({_controller_words(law)}).")
+        parts.append(f"The PID tuned on {_g(g.tuning_mass)} kg gives the drive (in the form "
+                     f"controller.gains takes) kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
+                     f"N/(m s) and kd = {_g(law.kd)} N s/m ({_controller_words(law)}).")
     else:
         parts.append(f"The hardware's controller (kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
                      f"N/(m s), kd = {_g(law.kd)} N s/m; {_controller_words(law)}) crosses over "
