@@ -37,18 +37,18 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
-import numpy as np
 
+from .controller import discrete_controller, drive_gains
 from .errors import ArgumentError
 from .display import number, quantity
 from .mechanism.checks import flexure_checks
 from .model import Model, as_model
-from .results import Check, Status, frozen_array
+from .results import Check, Status
 from .results.controller import ControlLaw
 from .results.stage import STATIC_ERROR_FORMULA
-from .results.design import (CaseResponse, Confirmation, CrossoverResult, DesignResult,
-                             FlexureResult, FrictionGapResult, IsolatorAdvice, LoopResponses,
-                             ModeSeparation, PidResult, StiffnessResult)
+from .results.design import (Confirmation, CrossoverResult, DesignResult,
+                             FlexureResult, FrictionGapResult, IsolatorAdvice, ModeSeparation,
+                             NotchSuggestion, PidResult, StiffnessResult)
 from .spec import Spec, proposed_stiffness, stiffness_limit, warnings_for
 from .verdict import friction_gap_judged
 
@@ -145,6 +145,7 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
         (:attr:`fi_design.results.linear.CaseMargins.criteria`).
     """
     from . import linear
+    from .notch import limiting_mode, notched, with_notch
 
     model = as_model(model)
     req = model.requirements
@@ -152,21 +153,35 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
     cases = linear.limit_cases(model)
     at = linear.analyse(model, cases=cases)
     ach = linear.achievable_crossover(model)
+    mode = limiting_mode(model, ach)
+    suggestion = None
+    limited_by = ach.limited_by
+    if mode is not None and ach.kind == "margin":
+        limited_by = (f"{ach.limited_by}, caused by the parasitic mode '{mode.name}' "
+                      f"({mode.frequency:.4g} Hz, {mode.source}): without that mode the case "
+                      "keeps its margins")
+        if not notched(model, mode):  # a notch there already: another would not be the advice
+            notch, alt = with_notch(model, mode)
+            if alt.frequency is not None and alt.frequency > ach.frequency:
+                suggestion = NotchSuggestion(notch=notch, achievable=alt.frequency,
+                                             limited_by=alt.limited_by, limit_kind=alt.kind)
     step = "step 2 crossover"
     checks: list[Check] = []
     reach = ach.frequency is not None and fc <= ach.frequency * (1 + 1e-9)
     if ach.frequency is None:
-        msg = f"no crossover is achievable: {ach.limited_by}"
+        msg = f"no crossover is achievable: {limited_by}"
     elif ach.kind == "scan_limit":
         msg = (f"the desired crossover {fc:.4g} Hz: the linear model limits the crossover "
                f"nowhere below {ach.frequency:.4g} Hz, the search cap (a bound, not a result; "
                "the hardware's sampling, delay and parasitic modes set the real limit)")
     elif reach:
         msg = (f"the desired crossover {fc:.4g} Hz is at or below the achievable "
-               f"{ach.frequency:.4g} Hz (limited by {ach.limited_by})")
+               f"{ach.frequency:.4g} Hz (limited by {limited_by})")
     else:
         msg = (f"the desired crossover {fc:.4g} Hz is above the achievable {ach.frequency:.4g} Hz "
-               f"(limited by {ach.limited_by})")
+               f"(limited by {limited_by})")
+    if suggestion is not None:
+        msg += f"; {_notch_words(suggestion)}"
     checks.append(Check("crossover_achievable", reach, fc, ach.frequency, "Hz", msg, step=step))
 
     for c in at.cases:
@@ -202,8 +217,15 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
 
     modes = []
     sep = req.parasitic_separation
+    loop_fc = fc if at.loop_crossover is None else at.loop_crossover
+    if at.loop_crossover is None:
+        which = "the desired crossover (no case crosses 0 dB in the loop's band)"
+    else:
+        which = (f"the loop's crossover, {loop_fc:.4g} Hz (case "
+                 f"{linear.CASE_NUMBERS[at.loop_crossover_case]}, "
+                 f"{linear.CASE_DESCRIPTIONS[at.loop_crossover_case]}, crosses 0 dB highest)")
     for m in model.modes:
-        need = sep * fc
+        need = sep * loop_fc
         ok = m.frequency >= need
         modes.append(ModeSeparation(m.name, m.frequency, need, m.collocated, ok,
                                     source=m.source, direction=m.direction,
@@ -213,13 +235,24 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
                 f"parasitic_separation.{m.name}", ok, m.frequency, need, "Hz",
                 f"parasitic mode '{m.name}' (given) at {m.frequency:.4g} Hz "
                 + ("lies above" if ok else "lies below")
-                + f" {sep:g} x the desired crossover ({need:.4g} Hz)", step=step))
+                + f" {sep:g} x {which}: {need:.4g} Hz", step=step))
 
     return CrossoverResult(
-        desired=fc, achievable=ach.frequency, limited_by=ach.limited_by, limit_kind=ach.kind,
+        desired=fc, achievable=ach.frequency, limited_by=limited_by, limit_kind=ach.kind,
         limiting_case=ach.case, feasible_ranges=ach.feasible_ranges, delay=at.delay,
         stiffness=at.stiffness, cases=at.cases, parasitic_modes=tuple(modes),
+        loop_crossover=at.loop_crossover, loop_crossover_case=at.loop_crossover_case,
+        limiting_mode=None if mode is None else mode.name,
+        limiting_mode_frequency=None if mode is None else mode.frequency, notch=suggestion,
         checks=tuple(checks))
+
+
+def _notch_words(n: NotchSuggestion) -> str:
+    """What a notch at the limiting mode would allow, in words."""
+    head = f"a {n.notch.describe()} in controller.filters would "
+    if n.achievable is None:
+        return head + f"not help: {n.limited_by}"
+    return head + f"allow {n.achievable:.4g} Hz (then limited by {n.limited_by})"
 
 
 def _criterion_check(case, criterion: str, name: str, value, limit, unit: str, message: str,
@@ -228,52 +261,6 @@ def _criterion_check(case, criterion: str, name: str, value, limit, unit: str, m
     status = case.criteria[criterion]
     passed = None if status == Status.INFO else status == Status.PASS
     return Check(name, passed, value, limit, unit, message, step=step, status=status)
-
-
-# --------------------------------------------------------------------------- loop responses
-
-
-def loop_responses(model: Model | Spec, crossover: CrossoverResult,
-                   points: int = 500) -> LoopResponses:
-    """The loop of every limit case over a frequency grid that holds every crossover and mode.
-
-    The loop is the one whose margins step 2 reports: the model's controller
-    at the desired crossover, its joint stiffness.
-
-    Parameters
-    ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
-    crossover : CrossoverResult
-        Step 2 (desired crossover, the gain crossovers of each case, the
-        joint stiffness the cases use).
-    points : int, optional
-        Number of frequencies.
-
-    Returns
-    -------
-    LoopResponses
-    """
-    from . import linear
-
-    model = as_model(model)
-    fc = crossover.desired
-    lows = [fc / 30.0] + [c / 3.0 for case in crossover.cases for c in case.crossovers
-                          if c and c > 0]
-    # the modes the loop shows: the given ones, and the computed ones that show in x by 1 %
-    highs = [30.0 * fc] + [2.0 * m.frequency for m in model.modes
-                           if m.source == "given" or abs(m.participation) >= 0.01]
-    lo = 10.0 ** math.floor(math.log10(min(lows)))
-    hi = 10.0 ** math.ceil(math.log10(max(highs)))
-    f = np.geomspace(lo, hi, points)
-    s = 2j * math.pi * f
-    cases = []
-    for lc in linear.limit_cases(model):
-        num, den = linear.loop_polynomials(model, lc)
-        cases.append(CaseResponse(name=lc.name, number=lc.number, description=lc.description,
-                                  loop=frozen_array(np.polyval(num, s) / np.polyval(den, s),
-                                                    dtype=complex)))
-    return LoopResponses(frequency=frozen_array(f), cases=tuple(cases))
 
 
 # --------------------------------------------------------------------------- step 3
@@ -377,6 +364,7 @@ def _controller_words(c: ControlLaw) -> str:
     parts.append("continuous" if c.sample_period == 0 else
                  f"sampled at {quantity(1.0 / c.sample_period, 'Hz')}")
     parts.append("no delay" if c.delay == 0 else f"delay {quantity(c.delay, 's')}")
+    parts += [f.describe() for f in c.filters]
     return ", ".join(parts)
 
 
@@ -407,9 +395,9 @@ def step4_pid(model: Model | Spec) -> PidResult:
     g = law.rule
     step = "step 4 PID"
     if law.source == "rule":
-        msg = (f"tuned at {_g(g.crossover)} Hz on {_g(g.tuning_mass)} kg; as controller.gains "
-               f"takes them (controller.roll_off filters the D term only): kp = {_g(law.kp)} "
-               f"N/m, ki = {_g(law.ki)} N/(m s), kd = {_g(law.kd)} N s/m "
+        msg = (f"tuned at {_g(g.crossover)} Hz on {_g(g.tuning_mass)} kg; the gains a drive "
+               f"takes (controller.gains, with controller.roll_off on the D term only): kp = "
+               f"{_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s), kd = {_g(law.kd)} N s/m "
                f"({_controller_words(law)})")
         checks = [Check("pid", None, law.kp, None, "N/m", msg, step=step)]
     else:
@@ -436,8 +424,28 @@ def step4_pid(model: Model | Spec) -> PidResult:
             "tuned on the stage mass alone: with the limiter engaged the loop sees m1 + m2 and "
             "crosses over lower (the paper tunes on the maximum moving mass)", step=step,
             status=Status.WARN))
+    discrete = discrete_controller(law)
+    units = drive_gains(law, discrete)
+    if units is not None:
+        d = law.drive
+        checks.append(Check(
+            "pid.drive_units", None, units.kp, None, units.units["kp"],
+            f"in the drive's units ({_g(d.motor_constant)} N/A, {quantity(d.encoder_resolution, 'm')}"
+            f" per count, a current unit of {_g(d.current_scaling)} A): kp = {_g(units.kp)} "
+            f"{units.units['kp']}, ki = {_g(units.ki)} {units.units['ki']}, kd = {_g(units.kd)} "
+            f"{units.units['kd']}", step=step))
+    if discrete is not None:
+        checks.append(Check(
+            "pid.discrete", None, discrete.sample_rate, None, "Hz",
+            f"sampled at {quantity(discrete.sample_rate, 'Hz')}: per sample kp = "
+            f"{_g(discrete.kp)} N/m, integrator gain ki T/2 = {_g(discrete.integrator_gain)} N/m, "
+            f"D recursion pole {_g(discrete.derivative_pole)} and gain "
+            f"{_g(discrete.derivative_gain)} N/m"
+            + (f"; {len(discrete.filters)} filter biquad(s) by the Tustin rule prewarped at "
+               "their frequencies" if discrete.filters else ""), step=step))
     return PidResult(gains=g, tuning_rule=ctl.tuning_mass, derivative_ratio=ctl.derivative_ratio,
                      integrator_ratio=ctl.integrator_ratio, controller=law, static_error=static,
+                     discrete=discrete, drive_gains=units,
                      checks=tuple(checks))
 
 
@@ -595,6 +603,7 @@ def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool
     from . import __version__
     from . import verdict as _verdict
     from .confirm import confirm as run_confirmation
+    from .responses import loop_responses
     from .stage import positioning, positioning_checks
 
     if not isinstance(spec, Model):
@@ -730,6 +739,8 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
     else:
         ach = (f"the achievable crossover is {number(xo.achievable, 4)} Hz, limited by "
                f"{xo.limited_by}")
+    if xo.notch is not None:
+        ach += f"; {_notch_words(xo.notch)}"
     at = ("the desired crossover" if pid.controller.source == "rule"
           else "the hardware's crossover")
     if not bad:
@@ -768,9 +779,9 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
     g = pid.gains
     law = pid.controller
     if law.source == "rule":
-        parts.append(f"The PID tuned on {_g(g.tuning_mass)} kg, in the form controller.gains "
-                     f"takes, has kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s) and kd = "
-                     f"{_g(law.kd)} N s/m ({_controller_words(law)}).")
+        parts.append(f"The PID tuned on {_g(g.tuning_mass)} kg gives the drive (in the form "
+                     f"controller.gains takes) kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
+                     f"N/(m s) and kd = {_g(law.kd)} N s/m ({_controller_words(law)}).")
     else:
         r = law.rule_in_this_form()
         parts.append(f"The hardware's controller (kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "

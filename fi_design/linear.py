@@ -30,8 +30,11 @@ gives multiplies it by :func:`mode_factor`; a mode computed from the flexure
 guide adds its modal term :func:`mode_term` (modal superposition).
 
 The controller is the loop's :class:`fi_design.pid.ControlLaw` (the rule's
-PID or the hardware's gains), the same description the simulation uses. The
-margins do not depend on where the D term acts (error or measurement: the
+PID or the hardware's gains) in series with the drive's filter chain
+(``controller.filters``, :func:`fi_design.controller.controller_polynomials`),
+the same description the simulation uses. A sampled controller is analysed
+in continuous time with its filters as given (the drive's prewarped Tustin
+biquads match them at their own frequencies). The margins do not depend on where the D term acts (error or measurement: the
 loop broken at the plant input is the same); the closed loop from the
 reference does (:func:`complementary_sensitivity`). The computational delay
 ``controller.delay``, plus half a sample period for the zero-order hold when
@@ -43,8 +46,10 @@ Margins (:class:`CaseMargins`) come from :func:`control.stability_margins`
 with ``returnall=True``; closed-loop stability from the roots of
 ``den + num`` of the loop. To keep the polynomial root finding well
 conditioned, every loop is evaluated with the Laplace variable scaled by the
-tuned crossover ``wc`` (``s = wc s'``); frequencies are scaled back before they
-are reported. :func:`achievable_crossover` retunes the PID over a log scan of
+geometric mean of its poles' magnitudes (``s = w0 s'``; with a millihertz
+integrator and kilohertz filters in one loop a scale by the crossover
+overflows python-control's squared polynomials); frequencies are scaled back
+before they are reported. :func:`achievable_crossover` retunes the PID over a log scan of
 crossovers and refines the highest feasible one by bisection.
 
 ``import control`` takes one to three seconds: callers import this module
@@ -61,12 +66,14 @@ from typing import Any, Sequence
 import control
 import numpy as np
 
+from .controller.polynomials import controller_polynomials, pid_polynomials, reference_polynomials
 from .errors import SpecError
 from .mechanism.modes import mode_factor, mode_term
 from .model import Model, as_model
 from .results import Status, frozen_array
 from .results.controller import ControlLaw, PidGains
-from .results.linear import CRITERIA, AchievableCrossover, CaseMargins, LoopAnalysis
+from .results.linear import (CRITERIA, AchievableCrossover, CaseMargins, GainCrossing,
+                             LoopAnalysis, PhaseCrossing, loop_crossover)
 from .spec import Spec
 
 __all__ = [
@@ -74,8 +81,10 @@ __all__ = [
     "SCAN_START", "BAND_FACTOR",
     "LimitCase", "CaseMargins", "LoopAnalysis", "AchievableCrossover",
     "limit_cases", "mode_factor", "mode_term", "delay_time", "delay_polynomials", "controller_polynomials",
+    "pid_polynomials", "reference_polynomials",
     "controller_tf", "delay_tf", "loop_polynomials", "loop_transfer_function", "sensitivity",
-    "complementary_sensitivity", "loop_margins", "analyse", "achievable_crossover",
+    "complementary_sensitivity", "loop_margins", "analyse", "loop_crossover",
+    "achievable_crossover",
 ]
 
 log = logging.getLogger(__name__)
@@ -102,6 +111,12 @@ CASE_NUMBERS = {**{n: i for i, n in enumerate(ISOLATED_CASES, 1)},
 SCAN_LIMIT = 1000.0
 #: Lowest crossover of the scan [Hz] (lower still when the desired crossover is low).
 SCAN_START = 0.1
+#: A -180 deg crossing where |L| is below 1 / MUTE (120 dB down: a full notch's zero, where the
+#: phase flips) is no crossing to report [-].
+MUTE = 1e6
+#: The achievable-crossover scan stops at this factor times the lowest mode over the parasitic
+#: separation [-]: the separation itself is judged on the loop's actual crossover.
+MODE_SCAN_FACTOR = 2.0
 #: Scan points per decade before bisection.
 SCAN_POINTS_PER_DECADE = 10
 #: A gain crossover more than this factor below the controller's crossover lies outside the
@@ -175,7 +190,7 @@ def _two_mass(m1: float, m2: float, k: float, c: float, cart_stiffness: float,
     return sys, num, den
 
 
-def limit_cases(model: Model | Spec) -> tuple[LimitCase, ...]:
+def limit_cases(model: Model | Spec, modes=None) -> tuple[LimitCase, ...]:
     """The linear limit cases of a model.
 
     Parameters
@@ -184,6 +199,9 @@ def limit_cases(model: Model | Spec) -> tuple[LimitCase, ...]:
         The resolved model (a spec is resolved): masses, friction, the joint's
         stiffness and damping (:meth:`~fi_design.model.Model.at` varies them),
         the parasitic modes.
+    modes : sequence of fi_design.results.mechanism.Mode, optional
+        The parasitic modes to add; default ``model.modes`` (fewer: what a
+        mode does to the loop).
 
     Returns
     -------
@@ -206,9 +224,9 @@ def limit_cases(model: Model | Spec) -> tuple[LimitCase, ...]:
             "sliding_limited": _rigid(M, s2, 0.0),
             "stuck_limited": _rigid(M, s1 + s2, s0),
         }
-    factors = [mode_factor(m) for m in model.modes if m.source == "given"]
-    terms = [mode_term(m, m1) for m in model.modes
-             if m.source != "given" and m.participation != 0.0]
+    modes = model.modes if modes is None else tuple(modes)
+    factors = [mode_factor(m) for m in modes if m.source == "given"]
+    terms = [mode_term(m, m1) for m in modes if m.source != "given" and m.participation != 0.0]
     out = []
     for i, (name, (sys, num, den)) in enumerate(raw.items(), start=1):
         num, den = np.asarray(num, float), np.asarray(den, float)
@@ -280,56 +298,6 @@ def delay_polynomials(model: Model | Spec) -> tuple[np.ndarray, np.ndarray]:
         return np.array([1.0]), np.array([1.0])
     num, den = control.pade(t, model.spec.controller.pade_order)
     return np.asarray(num, float), np.asarray(den, float)
-
-
-def controller_polynomials(controller: ControlLaw | PidGains) -> tuple[np.ndarray, np.ndarray]:
-    """The loop's controller C(s) as numerator and denominator.
-
-    Parameters
-    ----------
-    controller : ControlLaw or PidGains
-        The loop's controller (``model.law``), or the
-        rule's gains.
-
-    Returns
-    -------
-    num, den : numpy.ndarray
-        Descending powers of s [rad/s], C in N/m. The rule:
-        ``ks wt (s + wi)(s + wd) / (wd s (s + wt))``; in general
-        ``kp + ki/s + kd s wf / (s + wf)``. Without an integrator the factor
-        s cancels (no pole at the origin).
-    """
-    if isinstance(controller, PidGains) or controller.is_rule:
-        g = controller if isinstance(controller, PidGains) else controller.rule
-        if g.wi == 0.0:
-            return (g.ks * g.wt / g.wd) * np.array([1.0, g.wd]), np.array([1.0, g.wt])
-        num = (g.ks * g.wt / g.wd) * np.polymul([1.0, g.wi], [1.0, g.wd])
-        return num, np.array([1.0, g.wt, 0.0])
-    c = controller
-    return _parallel(c.kp, c.ki, c.kd, c.roll_off)
-
-
-def _parallel(kp: float, ki: float, kd: float, wf: float) -> tuple[np.ndarray, np.ndarray]:
-    """kp + ki/s + kd s wf / (s + wf) (wf = inf: an ideal D) as polynomials in s."""
-    if math.isinf(wf):
-        num, den = np.array([kd, kp, ki]), np.array([1.0, 0.0])
-    else:
-        num, den = np.array([kp + kd * wf, kp * wf + ki, ki * wf]), np.array([1.0, wf, 0.0])
-    if ki == 0.0:  # no integrator: cancel the common s
-        num, den = num[:-1], den[:-1]
-    nz = np.nonzero(num)[0]
-    return (num[nz[0]:] if nz.size else np.array([0.0])), den
-
-
-def reference_polynomials(controller: ControlLaw) -> tuple[np.ndarray, np.ndarray]:
-    """The part of C(s) that acts on the error (the reference path) [N/m].
-
-    All of C with the D term on the error; kp + ki/s with the D term on the
-    measurement (velocity feedback does not see the reference).
-    """
-    if controller.derivative_on == "error":
-        return controller_polynomials(controller)
-    return _parallel(controller.kp, controller.ki, 0.0, math.inf)
 
 
 def controller_tf(controller: ControlLaw | PidGains):
@@ -479,7 +447,21 @@ def _scaled(p: np.ndarray, w0: float) -> np.ndarray:
     return np.asarray(p, float) * w0 ** np.arange(n, -1, -1, dtype=float)
 
 
-def loop_margins(num: Sequence[float], den: Sequence[float], scale: float = 1.0,
+def _balanced_scale(den: np.ndarray) -> float:
+    """The geometric mean of the magnitudes of the nonzero roots of ``den`` [rad/s] (1 without).
+
+    Scaling s by it makes the polynomial's leading and trailing coefficients alike, which
+    keeps the squared polynomials of python-control's margin search finite when the loop
+    holds both a millihertz integrator and kilohertz filters."""
+    d = np.trim_zeros(np.asarray(den, float), "f")
+    d = np.trim_zeros(d, "b")
+    if d.size < 2:
+        return 1.0
+    lead, tail = abs(d[0]), abs(d[-1])
+    return float((tail / lead) ** (1.0 / (d.size - 1)))
+
+
+def loop_margins(num: Sequence[float], den: Sequence[float], scale: float | None = None,
                  name: str = "", description: str = "") -> CaseMargins:
     """Margins and closed-loop stability of a loop L = num/den.
 
@@ -489,8 +471,9 @@ def loop_margins(num: Sequence[float], den: Sequence[float], scale: float = 1.0,
         Loop numerator and denominator, descending powers of s [rad/s].
     scale : float, optional
         Frequency [rad/s] the Laplace variable is scaled by before the
-        polynomial root finding (the crossover is a good choice). Results are
-        reported unscaled.
+        polynomial root finding; default the geometric mean of the
+        denominator's nonzero roots (:func:`_balanced_scale`), which keeps the
+        coefficients balanced. Results are reported unscaled.
     name, description : str, optional
         Labels copied into the result.
 
@@ -499,38 +482,54 @@ def loop_margins(num: Sequence[float], den: Sequence[float], scale: float = 1.0,
     CaseMargins
         The margins; ``passed`` is left True (see :func:`analyse`).
     """
+    if scale is None:
+        scale = _balanced_scale(den)
     ns, ds = _scaled(num, scale), _scaled(den, scale)
     lead = ds[np.nonzero(ds)[0][0]]
     ns, ds = ns / lead, ds / lead
     sys = control.tf(ns, ds)
-    gm, pm, sm, _wpc, wgc, _wms = control.stability_margins(sys, returnall=True)
-    gm, pm, sm, wgc = (np.atleast_1d(np.asarray(a, float)) for a in (gm, pm, sm, wgc))
+    gm, pm, sm, wpc, wgc, wms = control.stability_margins(sys, returnall=True)
+    gm, pm, sm, wpc, wgc, wms = (np.atleast_1d(np.asarray(a, float))
+                                 for a in (gm, pm, sm, wpc, wgc, wms))
 
     char = np.polyadd(ds, ns)
     char = char[np.nonzero(char)[0][0]:]
     poles = np.roots(char)
     stable = bool(poles.size == 0 or np.all(poles.real < 0.0))
 
+    hz = scale / (2.0 * math.pi)
     if wgc.size:
         dist = np.abs(pm)
         i = int(np.argmin(dist))
-        crossover = float(wgc[i] * scale / (2.0 * math.pi))
+        crossover = float(wgc[i] * hz)
         phase = float(dist[i]) if stable else -float(dist[i])
-        lag = np.radians(np.mod(pm, 360.0))
-        delay = float(np.min(lag / (wgc * scale))) if stable else 0.0
-        crossings = tuple(float(w * scale / (2.0 * math.pi)) for w in wgc)
+        lag = np.radians(np.mod(pm, 360.0)) / (wgc * scale)
+        delay = float(np.min(lag)) if stable else 0.0
+        crossings = tuple(float(w * hz) for w in wgc)
+        gains = tuple(GainCrossing(frequency=float(w * hz),
+                                   phase_margin_deg=float(d) if stable else -float(d),
+                                   delay_margin=float(t) if stable else 0.0)
+                      for w, d, t in zip(wgc, dist, lag))
     else:
         crossover, phase, delay, crossings = None, math.inf, math.inf if stable else 0.0, ()
-    finite = gm[np.isfinite(gm) & (gm > 0)]
+        gains = ()
+    ok = np.isfinite(gm) & (gm > 0)
+    finite = gm[ok]
     if finite.size:
         db = 20.0 * np.log10(finite)
         gain = float(db[int(np.argmin(np.abs(db)))])
     else:
         gain = math.inf
-    modulus = float(min(np.min(sm), 1.0)) if sm.size else 1.0
+    phases = tuple(PhaseCrossing(frequency=float(w * hz), gain_margin_db=float(20 * np.log10(g)))
+                   for w, g in sorted(zip(wpc[ok], finite)) if g < MUTE)
+    if sm.size and np.min(sm) < 1.0:
+        modulus, peak_at = float(np.min(sm)), float(wms[int(np.argmin(sm))] * hz)
+    else:
+        modulus, peak_at = 1.0, None
     return CaseMargins(name=name, description=description, crossover=crossover,
                        phase_margin_deg=phase, gain_margin_db=gain, modulus_margin=modulus,
-                       delay_margin=delay, stable=stable, crossovers=crossings)
+                       delay_margin=delay, stable=stable, crossovers=crossings,
+                       gain_crossings=gains, phase_crossings=phases, modulus_frequency=peak_at)
 
 
 def _judge(m: CaseMargins, requirements, band_low: float) -> CaseMargins:
@@ -551,6 +550,7 @@ def _judge(m: CaseMargins, requirements, band_low: float) -> CaseMargins:
     if req.modulus_margin is not None and m.modulus_margin < req.modulus_margin:
         failed.append("modulus margin")
     in_band = any(f >= band_low for f in m.crossovers)
+    gains = tuple(replace(g, in_band=g.frequency >= band_low) for g in m.gain_crossings)
     criteria = {}
     for name in CRITERIA:
         if name == "modulus margin" and req.modulus_margin is None:
@@ -563,7 +563,7 @@ def _judge(m: CaseMargins, requirements, band_low: float) -> CaseMargins:
             criteria[name] = Status.PASS
     status = (Status.FAIL if failed else Status.INFO if not in_band else Status.PASS)
     return replace(m, passed=not failed, failed=tuple(failed), in_band=in_band, status=status,
-                   criteria=criteria)
+                   criteria=criteria, gain_crossings=gains)
 
 
 def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None) -> LoopAnalysis:
@@ -589,8 +589,10 @@ def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None) -> Lo
     law = model.law
     out = _margins(model, lcs, first_fail=False)
     k = model.joint.stiffness if model.joint is not None else None
+    top, which = loop_crossover(out)
     return LoopAnalysis(crossover=law.crossover, stiffness=k, delay=delay_time(model),
-                        controller=law, cases=tuple(out), passed=all(c.passed for c in out))
+                        controller=law, cases=tuple(out), passed=all(c.passed for c in out),
+                        loop_crossover=top, loop_crossover_case=which)
 
 
 def _margins(model: Model, lcs: Sequence[LimitCase], first_fail: bool) -> list[CaseMargins]:
@@ -599,11 +601,10 @@ def _margins(model: Model, lcs: Sequence[LimitCase], first_fail: bool) -> list[C
     cn, cd = controller_polynomials(law)
     dn, dd = delay_polynomials(model)
     ln, ld = np.polymul(cn, dn), np.polymul(cd, dd)
-    wc = 2.0 * math.pi * law.crossover
     out = []
     low = law.crossover / BAND_FACTOR
     for lc in lcs:
-        m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den), scale=wc,
+        m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den),
                                 name=lc.name, description=lc.description),
                    model.requirements, low)
         out.append(m)
@@ -628,7 +629,8 @@ def achievable_crossover(model: Model | Spec, start: float | None = None,
     crossover is feasible when every case is stable and meets ``requirements.phase_margin``,
     ``requirements.gain_margin`` and ``requirements.modulus_margin`` (if set),
     and every parasitic mode lies at or above ``requirements.parasitic_separation``
-    times the crossover. A log scan (:data:`SCAN_POINTS_PER_DECADE`) finds the
+    times the loop's actual crossover (:func:`loop_crossover`: the highest
+    in-band 0 dB crossing of any case, not the set value). A log scan (:data:`SCAN_POINTS_PER_DECADE`) finds the
     highest feasible grid point; bisection refines the boundary above it.
 
     Parameters
@@ -661,46 +663,60 @@ def achievable_crossover(model: Model | Spec, start: float | None = None,
     rate = model.spec.controller.sample_rate  # the setting as given (its Nyquist frequency)
     if rate is not None:
         scan_limit = min(scan_limit, 0.5 * rate)
-    mode_limit, low_mode = math.inf, None
-    for m in modes:
-        if m.frequency / sep < mode_limit:
-            mode_limit, low_mode = m.frequency / sep, m
-    f_hi = min(scan_limit, mode_limit)
+    low_mode = min(modes, key=lambda m: m.frequency) if modes else None
+    mode_limit = math.inf if low_mode is None else low_mode.frequency / sep
+    # the separation is judged on the loop's actual crossover at each point; the set
+    # crossover stops the scan where no loop could keep it (its crossings sit near the set one)
+    f_hi = min(scan_limit, MODE_SCAN_FACTOR * mode_limit)
     if f_hi <= f_lo:
         f_lo = f_hi / 10.0
     n = max(2, int(math.ceil(SCAN_POINTS_PER_DECADE * math.log10(f_hi / f_lo))) + 1)
     grid = np.geomspace(f_lo, f_hi, n)
     count = 0
 
-    def failures(fc: float, first_only: bool) -> list[CaseMargins]:
+    def failures(fc: float, first_only: bool) -> list:
+        """The failing cases at fc, or the separation [(loop crossover Hz, case)]; [] when fine."""
         nonlocal count
         count += 1
         at = model.at(crossover=fc)
         res = _margins(at, lcs, first_fail=first_only)
-        return [c for c in res if not c.passed]
+        bad = [c for c in res if not c.passed]
+        if bad or low_mode is None:
+            return bad
+        top, which = loop_crossover(res)
+        return [(top, which)] if top is not None and low_mode.frequency < sep * top else []
 
     ok = np.array([not failures(float(f), True) for f in grid])
     ranges = _ranges(grid, ok)
 
+    def mode_words(top: float | None, which: str | None) -> str:
+        where = ("" if top is None else f" (case {CASE_NUMBERS[which]}, "
+                 f"{CASE_DESCRIPTIONS[which]}, crosses 0 dB at {top:.4g} Hz)")
+        return (f"parasitic mode '{low_mode.name}' at {low_mode.frequency:.4g} Hz, which must lie "
+                f"above {sep:g} x the loop's crossover{where}")
+
     if ok[-1]:
-        if f_hi == mode_limit:
+        if f_hi < scan_limit:
             return AchievableCrossover(
-                frequency=float(f_hi),
-                limited_by=(f"parasitic mode '{low_mode.name}' at {low_mode.frequency:.4g} Hz, "
-                            f"which must lie above {sep:g} x the crossover"),
-                kind="mode", case=None, criterion="parasitic separation", scan_start=f_lo,
-                scan_stop=f_hi, feasible_ranges=ranges, evaluations=count)
+                frequency=float(f_hi), limited_by=mode_words(None, None), kind="mode",
+                case=None, criterion="parasitic separation", scan_start=f_lo, scan_stop=f_hi,
+                feasible_ranges=ranges, evaluations=count, mode=low_mode.name,
+                mode_frequency=low_mode.frequency)
         return AchievableCrossover(
             frequency=float(f_hi), limited_by=f"nothing up to the scan limit {f_hi:.4g} Hz",
             kind="scan_limit", case=None, criterion=None, scan_start=f_lo, scan_stop=f_hi,
             feasible_ranges=ranges, evaluations=count)
     if not ok.any():
         bad = failures(float(grid[0]), False)[0]
+        if isinstance(bad, tuple):
+            what, case, crit = mode_words(*bad), bad[1], "parasitic separation"
+        else:
+            what, case, crit = _describe(bad, req), bad.name, bad.failed[0]
         return AchievableCrossover(
             frequency=None,
             limited_by=(f"no crossover from {f_lo:.3g} Hz to {f_hi:.4g} Hz meets the "
-                        f"requirements; at {f_lo:.3g} Hz it is {_describe(bad, req)}"),
-            kind="infeasible", case=bad.name, criterion=bad.failed[0], scan_start=f_lo,
+                        f"requirements; at {f_lo:.3g} Hz it is {what}"),
+            kind="infeasible", case=case, criterion=crit, scan_start=f_lo,
             scan_stop=f_hi, feasible_ranges=(), evaluations=count)
 
     i = int(np.nonzero(ok)[0][-1])
@@ -714,6 +730,12 @@ def achievable_crossover(model: Model | Spec, start: float | None = None,
     bad = failures(b, False)[0]
     ranges = ranges[:-1] + ((ranges[-1][0], a),)
     log.debug("achievable crossover %.4g Hz after %d evaluations", a, count)
+    if isinstance(bad, tuple):
+        return AchievableCrossover(
+            frequency=a, limited_by=mode_words(*bad), kind="mode", case=bad[1],
+            criterion="parasitic separation", scan_start=f_lo, scan_stop=f_hi,
+            feasible_ranges=ranges, evaluations=count, mode=low_mode.name,
+            mode_frequency=low_mode.frequency)
     return AchievableCrossover(
         frequency=a, limited_by=_describe(bad, req, above=a), kind="margin",
         case=bad.name, criterion=bad.failed[0], scan_start=f_lo, scan_stop=f_hi,

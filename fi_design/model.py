@@ -34,7 +34,7 @@ from .errors import ArgumentError, SimulationError, SpecError
 from .pid import at_crossover, control_law
 from .kernel.layout import PlantParameters
 from .mechanism.geometry import StageBody, stage_body
-from .results.controller import ControlLaw
+from .results.controller import ControlLaw, Filter
 from .results.friction import FrictionLaw
 from .results.mechanism import Mode
 from .results.steps import FlexureResult
@@ -267,7 +267,7 @@ class Model:
            stroke: float | None = None, damping: float | None = None,
            friction_model: str | None = None, effects=None,
            masses: tuple[float, float] | None = None, delay: float | None = None,
-           mode_scale: float | None = None) -> "Model":
+           mode_scale: float | None = None, filters=None) -> "Model":
         """The same model with some values changed, checked like the spec checks them.
 
         Parameters
@@ -301,6 +301,8 @@ class Model:
             The loop's computational delay [s].
         mode_scale : float, optional
             Factor on the guide's computed modes' frequencies [-].
+        filters : sequence of fi_design.results.controller.Filter, optional
+            The drive's filter chain replacing the law's (``controller.filters``).
 
         Returns
         -------
@@ -322,10 +324,13 @@ class Model:
         paths = [path for path, value in (
             ("controller.crossover", crossover), ("isolator.stiffness", stiffness),
             ("isolator.stroke", stroke), ("isolator.damping", damping),
-            ("friction.model", friction_model), ("effects", effects)) if value is not None]
+            ("friction.model", friction_model), ("effects", effects),
+            ("controller.filters", filters)) if value is not None]
         law, friction = model.law, model.friction
         if crossover is not None:
             law = at_crossover(law, _positive(crossover, "controller.crossover", "Hz"))
+        if filters is not None:
+            law = replace(law, filters=_checked_filters(filters, law.sample_period))
         if friction_model is not None:
             if friction_model not in FRICTION_MODELS:
                 raise SpecError(f"must be one of {', '.join(FRICTION_MODELS)}, got "
@@ -453,6 +458,8 @@ class Model:
             isolated=1.0 if isolated else 0.0, switch_model=1.0 if f.model == "switch" else 0.0)
         if law.sample_period > 0.0:
             params = replace(params, sample_period=law.sample_period, **law.discrete_form())
+        if law.filters:
+            params = replace(params, **filter_fields(law.filters, law.sample_period))
         return apply_effects(params, self.effects)
 
 
@@ -570,6 +577,54 @@ def _positive(value, path: str, unit: str) -> float:
     if not x > 0.0:
         raise SpecError(f"must be greater than 0 {unit}, got {value!r}", path=path)
     return x
+
+
+def filter_fields(filters, period: float) -> dict[str, float]:
+    """The kernel's fields of the drive's filter chain (:class:`~fi_design.kernel.layout.PlantParameters`).
+
+    Each filter a section: its polynomials in s, ``(b0 s^2 + b1 s + b2) / (s^2 + a1 s + a2)``
+    or ``(b0 s + b1) / (s + a1)``, and, for a sampled controller (``period`` [s] > 0), the
+    biquad the drive computes (:func:`fi_design.controller.tustin_biquad`).
+    """
+    from .controller import filter_polynomials, tustin_biquad
+    from .kernel.layout import MAX_FILTER_SECTIONS
+
+    if len(filters) > MAX_FILTER_SECTIONS:
+        raise SpecError(f"at most {MAX_FILTER_SECTIONS} filters, got {len(filters)}",
+                        path="controller.filters")
+    out: dict[str, float] = {"filter_states": float(sum(f.order for f in filters))}
+    for i, f in enumerate(filters):
+        num, den = filter_polynomials(f)
+        num = [0.0] * (len(den) - len(num)) + [float(x) for x in num]
+        if f.order == 2:
+            b0, b1, b2 = num
+            a1, a2 = float(den[1]), float(den[2])
+        else:
+            (b0, b1), b2, a1, a2 = num, 0.0, float(den[1]), 0.0
+        out.update({f"f{i}_order": float(f.order), f"f{i}_b0": b0, f"f{i}_b1": b1,
+                    f"f{i}_b2": b2, f"f{i}_a1": a1, f"f{i}_a2": a2})
+        if period > 0.0:
+            b, a = tustin_biquad(f, period)
+            b = list(b) + [0.0] * (3 - len(b))
+            a = list(a) + [0.0] * (3 - len(a))
+            out.update({f"f{i}_z0": float(b[0]), f"f{i}_z1": float(b[1]), f"f{i}_z2": float(b[2]),
+                        f"f{i}_p1": float(a[1]), f"f{i}_p2": float(a[2])})
+    return out
+
+
+def _checked_filters(filters, period: float) -> tuple:
+    out = tuple(filters)
+    for i, f in enumerate(out):
+        if not isinstance(f, Filter):
+            raise SpecError(f"expected a Filter, got {type(f).__name__}",
+                            path=f"controller.filters[{i}]")
+        if not (f.frequency > 0.0 and math.isfinite(f.frequency)):
+            raise SpecError(f"frequency must be a positive number [Hz], got {f.frequency!r}",
+                            path=f"controller.filters[{i}].frequency")
+        if period > 0.0 and f.frequency >= 0.5 / period:
+            raise SpecError(f"{f.frequency:g} Hz lies at or above the Nyquist frequency "
+                            f"{0.5 / period:g} Hz", path=f"controller.filters[{i}].frequency")
+    return out
 
 
 def _checked_effects(entries, joint: Joint | None) -> tuple:

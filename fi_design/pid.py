@@ -32,9 +32,9 @@ import math
 from dataclasses import replace
 
 from .errors import SpecError
-from .results.controller import ControlLaw, PidGains
+from .results.controller import ControlLaw, DriveUnits, Filter, PidGains
 
-__all__ = ["tune_pid", "pid_gains", "control_law", "at_crossover"]
+__all__ = ["tune_pid", "pid_gains", "control_law", "at_crossover", "spec_filter"]
 
 
 def pid_gains(mass: float, crossover: float, derivative_ratio: float = 3.0,
@@ -142,7 +142,11 @@ def control_law(spec, crossover: float | None = None) -> ControlLaw:
         ff_mass=ff.mass if ff else 0.0, ff_viscous=ff.viscous if ff else 0.0,
         ff_coulomb=ff.coulomb if ff else 0.0, tuning_mass=m,
         derivative_ratio=ctl.derivative_ratio, integrator_ratio=ctl.integrator_ratio,
-        roll_off_given=ctl.roll_off is not None)
+        roll_off_given=ctl.roll_off is not None,
+        filters=tuple(spec_filter(f) for f in ctl.filters),
+        drive=None if ctl.drive is None else DriveUnits(
+            ctl.drive.motor_constant, ctl.drive.encoder_resolution,
+            1.0 if ctl.drive.current_scaling is None else ctl.drive.current_scaling))
     if ctl.gains is None:
         rule = pid_gains(m, own, ctl.derivative_ratio, ctl.integrator_ratio)
         f = rule.filtered_d()
@@ -158,6 +162,30 @@ def control_law(spec, crossover: float | None = None) -> ControlLaw:
     return law if crossover is None else at_crossover(law, crossover)
 
 
+def spec_filter(entry) -> Filter:
+    """One entry of ``controller.filters`` as the law's :class:`~fi_design.results.controller.Filter`.
+
+    Parameters
+    ----------
+    entry : fi_design.spec.Notch or fi_design.spec.LowPass
+        The spec's filter.
+
+    Returns
+    -------
+    Filter
+        A notch with its zeros' and poles' damping; a low-pass of order 1
+        (``zeta_pole`` 1, unused) or 2 (its damping, Butterworth by default).
+    """
+    if entry.type == "notch":
+        return Filter("notch", entry.name, entry.frequency, zeta_pole=entry.zeta_pole,
+                      zeta_zero=entry.zeta_zero, order=2)
+    from .spec import BUTTERWORTH
+
+    zeta = 1.0 if entry.order == 1 else (BUTTERWORTH if entry.damping is None
+                                         else entry.damping)
+    return Filter("low_pass", entry.name, entry.frequency, zeta_pole=zeta, order=entry.order)
+
+
 def at_crossover(law: ControlLaw, crossover: float) -> ControlLaw:
     """The same loop shifted to another crossover [Hz].
 
@@ -165,7 +193,8 @@ def at_crossover(law: ControlLaw, crossover: float) -> ControlLaw:
     where it is, the default moves with the rule's wt); explicit gains
     scale in frequency by ``lam = crossover / law.crossover`` (kp lam^2,
     ki lam^3, kd lam, roll-off lam), which keeps the loop's shape and is
-    exactly what retuning the rule does.
+    exactly what retuning the rule does. The filters stay where they are
+    (a notch sits at a mode, a low-pass where the hardware needs it).
 
     Parameters
     ----------

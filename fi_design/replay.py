@@ -290,6 +290,9 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
     changes = dict(x1_initial=x1)
     if params.sample_period > 0.0:
         changes.update(_discrete_state(params, law, e, xm, rd - v1, v1, command, feedforward))
+        d_in = -xm if law.derivative_on == "measurement" else e
+        target = (params.dp * e + changes["dx1"] + params.dc * e + changes["dx2"]
+                  + params.db * d_in)  # the PID's first output
     else:
         kf = law.kernel_form()
         v_wo_i = kf["kp"] * e + kf["kd"] * (rd - v1) - kf["kdm"] * v1
@@ -298,6 +301,9 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
             y0[idx["I"]] = target - v_wo_i
         if not math.isinf(kf["wt"]):  # the filter state is the output itself
             y0[idx["u"]] = target
+    nf = int(params.filter_states)
+    if nf:  # the drive's filter chain at rest on the PID's first output (unit DC gain)
+        y0[len(y0) - nf:] = params.filter_rest(target)
     if command is not None:
         changes["u_initial"] = command
     return y0, replace(params, **changes)

@@ -50,13 +50,15 @@ def tolerances(params: PlantParameters, rtol: float) -> np.ndarray:
     """Absolute tolerance per state [state units]: ``rtol`` times a physical scale.
 
     Scales: 1 mm for positions, 1 cm/s for velocities, the presliding range
-    Fs / sigma0 for the bristle state, Fs for the controller forces.
+    Fs / sigma0 for the bristle state, Fs for the controller forces and the
+    filter chain's states (forces too).
     """
     zs = params.Fs / params.sigma0
     if params.isolated:
         scale = [1e-3, 1e-2, 1e-3, 1e-2, zs, params.Fs, params.Fs]
     else:
         scale = [1e-3, 1e-2, zs, params.Fs, params.Fs]
+    scale += [params.Fs] * int(params.filter_states)
     return rtol * np.array(scale)
 
 

@@ -17,7 +17,8 @@ from .spec import Spec
 
 
 def clean_loc(loc: tuple, raw: dict) -> tuple:
-    """Drop union tags that pydantic inserts (``effects.0.time_delay.delay``).
+    """Drop union tags that pydantic inserts (``effects.0.time_delay.delay``,
+    ``controller.filters.0.notch.width``).
 
     The tag is the entry's own ``type`` right after its index, even where a
     parameter has the effect's name (``effects.0.stribeck_velocity.stribeck_velocity``).
@@ -27,7 +28,7 @@ def clean_loc(loc: tuple, raw: dict) -> tuple:
     tagged = False
     for part in loc:
         if isinstance(node, dict) and isinstance(part, str) and not tagged and len(out) >= 2 \
-                and isinstance(out[-1], int) and out[-2] == "effects" \
+                and isinstance(out[-1], int) and out[-2] in ("effects", "filters") \
                 and node.get("type") == part:
             tagged = True
             continue
@@ -62,7 +63,7 @@ def _model_at(loc: tuple, raw: Any = None):
     """
     import typing
 
-    from .spec import EFFECT_MODELS
+    from .spec import EFFECT_MODELS, FILTER_TYPES
 
     model: Any = Spec
     node: Any = raw
@@ -71,9 +72,10 @@ def _model_at(loc: tuple, raw: Any = None):
             node[part] if isinstance(node, list) and isinstance(part, int) \
             and part < len(node) else None
         if isinstance(part, int):
-            if n >= 1 and loc[n - 1] == "effects":
+            if n >= 1 and loc[n - 1] in ("effects", "filters"):
                 kind = node.get("type") if isinstance(node, dict) else None
-                model = EFFECT_MODELS.get(kind) if isinstance(kind, str) else None
+                models = EFFECT_MODELS if loc[n - 1] == "effects" else FILTER_TYPES
+                model = models.get(kind) if isinstance(kind, str) else None
                 if model is None:
                     return None
             continue

@@ -44,6 +44,8 @@ KNOWN_UNITS = {
     "rad": "angle",
     "deg": "angle",
     "dB": "gain in decibels",
+    "A": "electric current",
+    "N/A": "motor force constant (force per current)",
 }
 
 _DB = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*dB\s*$")

@@ -246,6 +246,33 @@ def _scatter_words(r: RobustnessCheck) -> str:
 # --------------------------------------------------------------------------- margins
 
 
+def _hunting_loop(model: Model, crossover: CrossoverResult, stage, free_from: float) -> dict:
+    """The loop the hunting cycle slides in, and its actual crossover at the design and at the
+    hunting-free crossover (the hunting margin's two loops).
+
+    The cycle slides with the joint on its limiter (case 3, the rigid m1 + m2 sliding), or
+    with the joint free (case 1); without isolator, the one rigid case that slides. Its 0 dB
+    crossing at the two crossovers [Hz].
+    """
+    from . import linear
+
+    if not model.has_isolator:
+        case = "sliding"
+    else:
+        cyc = stage.cycle
+        case = "sliding_limited" if cyc is None or cyc.on_limiter is not False else "sliding_free"
+
+    def top(cases) -> float | None:
+        c = next((c for c in cases if c.name == case), None)
+        inside = [g.frequency for g in (c.gain_crossings if c else ()) if g.in_band]
+        return max(inside) if inside else None
+
+    at_design = top(crossover.cases)
+    at_free = top(linear.analyse(model.at(crossover=free_from)).cases)
+    return {"hunting_case": case, "hunting_loop_crossover": at_design,
+            "hunting_free_loop_crossover": at_free}
+
+
 def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult,
             flexure: FlexureResult | None, pid: PidResult,
             simulation: Confirmation | None) -> Margins:
@@ -307,6 +334,7 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
         else:
             out["hunting_free_crossover"] = m
             out["crossover_factor"] = fc / m
+            out.update(_hunting_loop(model, crossover, st, m))
             if b.get("kind") == "bound":
                 out["crossover_factor_bound"] = True
                 notes.append(f"no move of the family hunts from {m:g} Hz, the bottom of the "

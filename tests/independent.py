@@ -51,7 +51,16 @@ Controllers (e = r - x_m, x_m = x1 or round(x1 / q) q with ``quantization``):
 * continuous, or sampled at ``sample_rate`` with zero-order hold: trapezoidal integrator, ideal
   D as the backward difference ``(x[k] - x[k-1]) / T``, filtered D as the Tustin transform of
   ``kd s / (1 + s / wf)``; the rule as the Tustin transform of C(s);
-* feedforward ``mass r'' + viscous r' + coulomb sign(r')`` added to the feedback.
+* feedforward ``mass r'' + viscous r' + coulomb sign(r')`` added to the feedback;
+* a drive's filter chain on the feedback (before the feedforward), in order, each with unit
+  DC gain and w = 2 pi frequency: a notch ``(s^2 + 2 zz w s + w^2) / (s^2 + 2 zp w s +
+  w^2)`` given by its -3 dB ``width`` [Hz] (zp = width / (2 frequency)) and ``depth`` [dB]
+  (zz = zp 10^(-depth/20), full without) or ``damping=(zz, zp)``; a low-pass ``w / (s + w)``
+  (``order=1``) or ``w^2 / (s^2 + 2 damping w s + w^2)`` (``order=2``, damping 1/sqrt(2) by
+  default). Continuous: each section in controllable canonical form, its states in the ODE;
+  sampled: scipy's ``bilinear`` at the sample rate prewarped to the filter's frequency (the
+  drive's Tustin rule), run as a difference equation. Both start at steady state on their
+  first input.
 
 Integration
 -----------
@@ -134,7 +143,9 @@ K_STOP = 1e6
 _FRICTION_KEYS = {"Fs", "Fc", "vs", "sigma0", "sigma1", "sigma2", "Fc_neg", "sigma2_neg",
                   "offset"}
 _ISOLATOR_KEYS = {"k", "c", "s", "k_stop", "c_stop"}
-_COMMON_CONTROLLER_KEYS = {"sample_rate", "delay", "force_limit", "feedforward"}
+_COMMON_CONTROLLER_KEYS = {"sample_rate", "delay", "force_limit", "feedforward", "filters"}
+_NOTCH_KEYS = {"type", "frequency", "width", "depth", "damping", "name"}
+_LOW_PASS_KEYS = {"type", "frequency", "order", "damping", "name"}
 _GAIN_KEYS = {"kp", "ki", "kd", "roll_off", "derivative_on"}
 _RULE_KEYS = {"fc", "r", "ri", "mass"}
 _MOVE_KEYS = {"distance", "velocity", "acceleration", "start"}
@@ -574,7 +585,9 @@ class _Simulation:
             self.ff = (float(self.ff.get("mass", 0.0)), float(self.ff.get("viscous", 0.0)),
                        float(self.ff.get("coulomb", 0.0)))
 
-        # ---- state layout: x1, v1, [x2, v2], z, controller states
+        self._setup_filters(ctl.get("filters") or ())
+
+        # ---- state layout: x1, v1, [x2, v2], z, controller states, filter states
         self.iz = 4 if self.isolated else 2
         self.ic = self.iz + 1
         self.y0 = self._initial_state(x1_0, v1_0, float(ini.get("integral", 0.0)))
@@ -626,6 +639,96 @@ class _Simulation:
               and self.wf is None):
             raise ValueError("an ideal continuous derivative of a quantized position is "
                              "undefined: give roll_off or sample_rate")
+
+    def _setup_filters(self, filters):
+        """The filter chain as sections (b, a) in s: numerator and monic denominator."""
+        self.sections = []
+        for i, f in enumerate(filters):
+            f = dict(f)
+            kind = f.get("type")
+            if kind == "notch":
+                _check_keys(f, _NOTCH_KEYS, f"controller.filters[{i}]")
+                f0 = float(f["frequency"])
+                if "damping" in f:
+                    zz, zp = (float(x) for x in f["damping"])
+                else:
+                    zp = float(f["width"]) / (2 * f0)
+                    zz = 0.0 if f.get("depth") is None else zp * 10 ** (-float(f["depth"]) / 20)
+                w = 2 * math.pi * f0
+                self.sections.append(([1.0, 2 * zz * w, w * w], [1.0, 2 * zp * w, w * w], w))
+            elif kind == "low_pass":
+                _check_keys(f, _LOW_PASS_KEYS, f"controller.filters[{i}]")
+                w = 2 * math.pi * float(f["frequency"])
+                if int(f.get("order", 2)) == 1:
+                    self.sections.append(([0.0, w], [1.0, w], w))
+                else:
+                    zeta = float(f.get("damping") or 1 / math.sqrt(2))
+                    self.sections.append(([0.0, 0.0, w * w], [1.0, 2 * zeta * w, w * w], w))
+            else:
+                raise ValueError(f"controller.filters[{i}]: type 'notch' or 'low_pass'")
+        if self.sections and self.kind is None:
+            raise ValueError("controller.filters need a controller")
+        self.n_filt = sum(len(a) - 1 for _, a, _ in self.sections)
+        if self.sections:
+            w_max = max(w for _, _, w in self.sections)
+            self.hold_cap = min(self.hold_cap, 0.1 / w_max)
+
+    def filter_chain(self, u, xs):
+        """Continuous filters on the feedback u [N] with their states xs (controllable canonical
+        form, per section: x1' = x2, x2' = -a2 x1 - a1 x2 + in, out = (b2 - b0 a2) x1 +
+        (b1 - b0 a1) x2 + b0 in; first order: x' = -a1 x + in, out = (b1 - b0 a1) x + b0 in).
+
+        Returns
+        -------
+        (float, list of float)
+            The chain's output [N]; the state derivatives.
+        """
+        out, i, d = u, 0, []
+        for b, a, _ in self.sections:
+            if len(a) == 3:
+                x1, x2 = xs[i], xs[i + 1]
+                d += [x2, -a[2] * x1 - a[1] * x2 + out]
+                out = (b[2] - b[0] * a[2]) * x1 + (b[1] - b[0] * a[1]) * x2 + b[0] * out
+                i += 2
+            else:
+                x = xs[i]
+                d.append(-a[1] * x + out)
+                out = (b[1] - b[0] * a[1]) * x + b[0] * out
+                i += 1
+        return out, d
+
+    def filter_steady(self, u):
+        """Filter states at rest on a constant input u [N] (unit DC gain: output u)."""
+        xs = []
+        for _, a, _ in self.sections:
+            xs += [u / a[2], 0.0] if len(a) == 3 else [u / a[1]]
+        return xs
+
+    def discrete_filters(self, u):
+        """The sampled chain on u_k [N]: each section by scipy's bilinear map prewarped at its
+        frequency, as a difference equation; steady state on the first input."""
+        from scipy.signal import bilinear
+
+        if not hasattr(self, "fmem"):
+            T = 1.0 / self.fs
+            self.fcoef = []
+            for b, a, w in self.sections:
+                # s = 2 fs' (z - 1)/(z + 1) with 2 fs' = w / tan(w T / 2): exact at w
+                bz, az = bilinear(b, a, fs=w / (2 * math.tan(w * T / 2)))
+                self.fcoef.append((np.asarray(bz, float), np.asarray(az, float)))
+            self.fmem = None
+        if self.fmem is None:
+            self.fmem = [([u] * len(bz), [u] * (len(az) - 1)) for bz, az in self.fcoef]
+        out = u
+        for (bz, az), (xin, yout) in zip(self.fcoef, self.fmem):
+            xin.insert(0, out)
+            xin.pop()
+            y = (sum(c * x for c, x in zip(bz, xin))
+                 - sum(c * v for c, v in zip(az[1:], yout))) / az[0]
+            yout.insert(0, y)
+            yout.pop()
+            out = y
+        return out
 
     def measure(self, x1):
         """Position the controller sees [m]."""
@@ -748,9 +851,23 @@ class _Simulation:
                     ctrl.append(xd - xdd / self.wf)
             if self.fs is None:
                 y += ctrl
+                if self.sections:  # at rest on the first feedback (without feedforward)
+                    yy = y + [0.0] * self.n_filt
+                    fb = self._feedback_only(yy, x1)
+                    y += self.filter_steady(fb)
             else:
                 self._discrete_memory(e, ed, x1, v1)
         return np.array(y, dtype=float)
+
+    def _feedback_only(self, Y, x1):
+        """The unfiltered feedback [N] at t = 0 of a state Y (filter states ignored)."""
+        sections, self.sections = self.sections, []
+        try:
+            u = self.control(0.0, Y, self.measure(x1))[0]
+            r, rd, rdd = self.ref(0.0)
+            return u - self.feedforward(rd, rdd)
+        finally:
+            self.sections = sections
 
     def _atol(self, atol):
         n = len(self.y0)
@@ -763,6 +880,8 @@ class _Simulation:
                 scale += [1e-3, 1e-3 / self.wt]
             else:
                 scale += [1e-3] + ([1e-3] if self.wf is not None else [])
+            for _, a, w in self.sections:  # 1 N through the section: x1 ~ 1/w^2, x2 ~ 1/w
+                scale += [1.0 / (w * w), 1.0 / w] if len(a) == 3 else [1.0 / w]
         return self.rtol * np.array(scale)
 
     # ..................................................................... continuous law
@@ -779,7 +898,7 @@ class _Simulation:
         r, rd, rdd = self.ref(t, at)
         v1 = Y[1]
         e = r - xm
-        c = Y[self.ic:]
+        c = Y[self.ic:self.ic + self.n_ctrl]
         if self.kind == "rule":
             q, p = c
             u = self.K * (e + self.A * q + self.B * p)
@@ -798,6 +917,9 @@ class _Simulation:
             if self.wf is not None:
                 xd = e if self.on_error else -xm
                 dc.append(self.wf * (xd - c[1]))
+        if self.sections:
+            u, df = self.filter_chain(u, Y[self.ic + self.n_ctrl:])
+            dc = list(dc) + df
         return u + self.feedforward(rd, rdd), dc
 
     # ..................................................................... discrete law
@@ -840,6 +962,8 @@ class _Simulation:
             m["x"], m["D"] = xd, D
             u = self.kp * e + self.ki * m["I"] + D
         m["e"] = e
+        if self.sections:
+            u = self.discrete_filters(u)
         u += self.feedforward(rd, rdd)
         self.commands.append(u)
         return u
@@ -1185,7 +1309,10 @@ def generate(m1, m2=0.0, *, friction=None, isolator=None, controller=None, moves
         (None: ideal D; with a continuous controller and quantization a roll-off is needed),
         ``derivative_on`` ("error" or "measurement"); plus ``sample_rate`` [Hz] (None:
         continuous), ``delay`` [s], ``force_limit`` [N], ``feedforward=dict(mass [kg], viscous
-        [N s/m], coulomb [N])``. None only with ``drive_force``.
+        [N s/m], coulomb [N])``, ``filters`` (a list of ``dict(type="notch", frequency [Hz],
+        width [Hz], depth [dB])`` or ``damping=(zz, zp)``, and ``dict(type="low_pass",
+        frequency [Hz], order=1 or 2, damping)``, the spec's keys in Hz). None only with
+        ``drive_force``.
     moves : list of dict or None
         Trapezoidal moves run one after another from the initial position: ``distance`` [m],
         ``velocity`` [m/s], ``acceleration`` [m/s^2], ``start`` [s] (optional, not earlier than

@@ -21,7 +21,7 @@ runner = CliRunner()
 #: The JSON contract of `fi-design SPEC --json` (docs/interfaces.md and the guideline).
 CONTRACT = {
     "friction_gap": ("gap", "threshold", "hunting_risk"),
-    "pid": ("kp", "ki", "kd", "wt", "tuning_mass"),
+    "pid": ("drive", "rule", "source"),
     "crossover": ("desired", "achievable", "limited_by", "cases"),
     "stiffness": ("maximum", "chosen"),
 }
@@ -59,6 +59,9 @@ def test_json_contract(design_run, paper_spec_path):
     for key in TOP_KEYS:
         assert key in data, key
     assert isinstance(data["crossover"]["cases"], list)
+    drive = data["pid"]["drive"]  # the one gain set a drive takes, frequencies in Hz
+    assert {"kp", "ki", "kd", "roll_off", "filters", "units"} <= set(drive)
+    assert drive["units"]["roll_off"] == "Hz" and data["pid"]["rule"]["tuning_mass"] == 2.0
     assert data["fi_design_version"] == __version__
     import hashlib
 

@@ -306,9 +306,9 @@ def test_industrial_example_reports_the_hardware_loop(repo_root):
     d = design(spec, confirm=False).to_dict()
     pid = d["pid"]
     assert pid["source"] == "gains" and pid["integrator"] is False
-    assert pid["controller"]["kp"] == pytest.approx(1.37e6)
-    assert pid["controller"]["derivative_on"] == "measurement"
-    assert pid["controller"]["sample_period"] == pytest.approx(1e-3)
+    assert pid["drive"]["kp"] == pytest.approx(1.37e6)
+    assert pid["drive"]["derivative_on"] == "measurement"
+    assert pid["drive"]["sample_rate"] == pytest.approx(1e3)
     # where static friction holds the resting cart against the loop: (Fs + |offset|) / kp,
     # with the larger static friction of the two directions
     from fi_design.model import resolve
@@ -317,6 +317,6 @@ def test_industrial_example_reports_the_hardware_loop(repo_root):
     fs = max(m.friction.static(1.0), m.friction.static(-1.0))
     assert pid["static_error"] == pytest.approx((fs + abs(m.offset)) / 1.37e6)
     law = control_law(spec)
-    assert set(pid["rule_in_hardware_form"]) == {"kp", "ki", "kd", "roll_off"}
+    assert set(pid["rule"]["in_drive_form"]) == {"kp", "ki", "kd", "roll_off"}
     assert d["crossover"]["desired"] == pytest.approx(law.crossover)
     assert "no integrator" in d["conclusion"] and "hardware's crossover" in d["conclusion"]

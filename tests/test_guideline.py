@@ -35,9 +35,9 @@ def test_json_contract_for_the_paper_setup(paper_design, paper_spec):
     gap = d["friction_gap"]
     assert gap["gap"] == pytest.approx(3.0) and gap["threshold"] == 1.0
     assert gap["hunting_risk"] is True
-    for key in ("kp", "ki", "kd", "wt", "tuning_mass"):
-        assert isinstance(d["pid"][key], float) and d["pid"][key] > 0, key
-    assert d["pid"]["tuning_mass"] == 2.0
+    for key in ("kp", "ki", "kd", "roll_off"):
+        assert isinstance(d["pid"]["drive"][key], float) and d["pid"]["drive"][key] > 0, key
+    assert d["pid"]["rule"]["tuning_mass"] == 2.0
     xo = d["crossover"]
     assert xo["desired"] == 8.0 and isinstance(xo["achievable"], float)
     assert isinstance(xo["limited_by"], str) and xo["limited_by"]

@@ -26,7 +26,7 @@ def _cases(result):
 
 def _printed_gains(output: str) -> dict:
     """kp, ki, kd and roll_off [Hz] as the console's step-4 table prints them."""
-    line = next(ln for ln in output.splitlines() if re.match(r"^\s*rule\s+[\d.]", ln))
+    line = next(ln for ln in output.splitlines() if re.match(r"^\s*drive\s+[\d.]", ln))
     kp, ki, kd, roll = (float(x) for x in line.split()[1:5])
     return {"kp": kp, "ki": ki, "kd": kd, "roll_off": roll}
 
@@ -53,17 +53,33 @@ def test_printed_gains_copied_into_controller_gains_keep_the_loop(paper_spec, tm
         assert b["phase_margin_deg"] == pytest.approx(a["phase_margin_deg"], abs=0.1)
 
 
-def test_json_labels_both_forms(paper_spec):
+def test_json_has_one_gain_set_named_for_the_drive(paper_spec):
+    """No trap: one set of kp, ki, kd (the drive's, pid.drive), frequencies in Hz like the spec,
+    every key's unit written beside it; the rule gives its corners, not a second gain set."""
     d = design(paper_spec, confirm=False).to_dict()["pid"]
-    assert "whole PID" in d["form"] and "not the form of controller.gains" in d["form"]
-    hand = d["hand_off"]
-    assert "controller.gains" in hand["form"] and "D term only" in hand["form"]
-    assert (hand["kp"], hand["ki"], hand["kd"]) == (d["controller"]["kp"], d["controller"]["ki"],
-                                                    d["controller"]["kd"])
-    assert hand["kp"] != d["kp"]  # the rule's whole-PID kp is another number
-    assert hand["roll_off"] == pytest.approx(24.0)  # Hz: wt = 3 wc at 8 Hz
-    assert hand["sample_rate"] is None and hand["delay"] == 0.0
-    assert hand["derivative_on"] == "error"
+    drive, rule = d["drive"], d["rule"]
+    assert "drive takes" in drive["form"] and "D term only" in drive["form"]
+    law = design(paper_spec, confirm=False).pid.controller
+    assert (drive["kp"], drive["ki"], drive["kd"]) == (law.kp, law.ki, law.kd)
+    assert drive["roll_off"] == pytest.approx(24.0)  # Hz: wt = 3 wc at 8 Hz
+    assert drive["sample_rate"] is None and drive["delay"] == 0.0
+    assert drive["derivative_on"] == "error" and drive["filters"] == []
+    assert drive["discrete"] is None and drive["in_drive_units"] is None
+    assert drive["units"]["roll_off"] == "Hz" and drive["units"]["kp"] == "N/m"
+    # the rule: its corners in Hz, no kp, ki, kd of another form to copy by mistake
+    assert not {"kp", "ki", "kd"} & set(rule) and "in_drive_form" not in rule
+    assert rule["roll_off"] == pytest.approx(24.0) and rule["lead_corner"] == pytest.approx(8 / 3)
+    assert rule["integrator_corner"] == pytest.approx(0.8) and rule["units"]["ks"] == "N/m"
+    assert not {"kp", "ki", "kd", "controller", "hand_off", "wt", "wc"} & set(d)
+
+    def keys(node, path=""):
+        for k, v in node.items():
+            yield f"{path}{k}"
+            if isinstance(v, dict):
+                yield from keys(v, f"{path}{k}.")
+
+    # nothing in rad/s: every frequency-like key of pid is in Hz
+    assert not [k for k in keys(d) if k.split(".")[-1] in ("wt", "wd", "wi", "wc", "omega")]
 
 
 def test_write_spec_round_trips_exactly(paper_confirmed_design, paper_spec_path, tmp_path):
@@ -110,3 +126,38 @@ def test_no_simulation_fails_the_ci_gate(paper_spec_path, tmp_path):
     assert r.exit_code == 3, r.output
     assert json.loads(out.read_text())["verdict"]["status"] == "NOT_CONFIRMED"
     assert "Verdict: NOT_CONFIRMED" in r.stdout
+
+
+def test_write_spec_round_trips_with_filters_and_a_drive(paper_spec, tmp_path):
+    """A sampled loop with a notch, a low-pass and the drive's units: the written spec keeps
+    the filters and the drive, and its design is the same loop to the last digit."""
+    from fi_design.specedit import edited_spec_text
+
+    spec = variant(paper_spec, **{
+        "controller.sample_rate": "4 kHz", "controller.delay": "250 us",
+        "controller.filters": [{"type": "notch", "frequency": "150 Hz", "width": "75 Hz"},
+                               {"type": "low_pass", "frequency": "600 Hz", "damping": 0.5}],
+        "controller.drive": {"motor_constant": "20 N/A", "encoder_resolution": "1 um"}})
+    path, out = tmp_path / "filtered.yaml", tmp_path / "handed.yaml"
+    path.write_text(edited_spec_text(spec))
+    r = runner.invoke(app, [str(path), "--no-simulation", "--write-spec", str(out)],
+                      env={"COLUMNS": "120"})
+    assert r.exit_code == 0, r.output
+    assert "A/count" in r.stdout and "per sample" in r.stdout  # the drive's own terms
+    handed = load_spec(out)
+    assert handed.controller.gains is not None
+    assert handed.controller.filters == spec.controller.filters
+    assert handed.controller.drive == spec.controller.drive
+    first, again = design(spec, confirm=False), design(handed, confirm=False)
+    assert again.pid.controller.source == "gains"
+    assert again.pid.controller.filters == first.pid.controller.filters
+    assert again.crossover.achievable == pytest.approx(first.crossover.achievable, rel=1e-6)
+    for a, b in zip(_cases(first), _cases(again)):
+        for k in MARGINS:
+            assert b[k] == pytest.approx(a[k], rel=1e-9), k
+    da, db = first.to_dict()["pid"]["drive"], again.to_dict()["pid"]["drive"]
+    for key in ("kp", "ki", "kd", "roll_off"):
+        assert db[key] == pytest.approx(da[key], rel=1e-12)
+    assert db["filters"] == da["filters"]
+    assert db["discrete"]["num"] == pytest.approx(da["discrete"]["num"], rel=1e-9)
+    assert db["in_drive_units"]["kp"] == pytest.approx(da["in_drive_units"]["kp"], rel=1e-12)

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.linalg import expm
-from scipy.signal import cont2discrete, lfilter
+from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
 from independent import Truth, generate
 
@@ -268,6 +268,69 @@ def test_derivative_on_error_and_on_measurement_give_their_own_responses():
         assert np.max(np.abs(rec.truth.x1 - expected)) < 1e-10
         out[on] = expected
     assert np.max(np.abs(out["error"] - out["measurement"])) > 1e-5   # they do differ
+
+
+def test_a_filter_chain_on_the_feedback_is_in_series_with_the_pid():
+    """A notch and a second-order low-pass on the PD's output: x1 of a free mass follows
+    the exact response of C F / (m s^2 + C F) to the trapezoidal move, F written out here."""
+    m, kp, kd = 2.0, 2000.0, 40.0
+    mv = dict(distance=5e-3, velocity=50e-3, acceleration=1.0)   # corners 0, .05, .1, .15 s
+    corners = [(0.0, 1.0), (0.05, -1.0), (0.1, -1.0), (0.15, 1.0)]
+    wn, wl = 2 * math.pi * 40.0, 2 * math.pi * 120.0
+    zp, zz, zl = 10.0 / 40.0, 10.0 / 40.0 * 10 ** (-20 / 20), 0.5   # 20 Hz wide, 20 dB deep
+    fn = np.polymul([1.0, 2 * zz * wn, wn ** 2], [wl ** 2])
+    fd = np.polymul([1.0, 2 * zp * wn, wn ** 2], [1.0, 2 * zl * wl, wl ** 2])
+    cf = np.polymul([kd, kp], fn)
+    den = np.polyadd(np.polymul([m, 0.0, 0.0], fd), cf)
+    t = np.linspace(0, 0.4, 161)
+    rec = generate(m1=m, controller=dict(
+        kp=kp, kd=kd, filters=[dict(type="notch", frequency=40.0, width=20.0, depth=20.0),
+                               dict(type="low_pass", frequency=120.0, damping=0.5)]),
+        moves=[mv], t_end=0.4, rate=400.0)
+    expected = trapezoid_response(cf, den, corners, t)
+    assert np.max(np.abs(rec.truth.x1 - expected)) < 1e-9
+    plain = trapezoid_response([kd, kp], [m, kd, kp], corners, t)
+    assert np.max(np.abs(expected - plain)) > 1e-5   # the filters do change the loop
+
+
+def test_sampled_filters_are_the_prewarped_tustin_biquads():
+    """At 2 kHz each filter is the bilinear map prewarped at its frequency, on the PID's output
+    before the feedforward; written here with cont2discrete and the prewarped period."""
+    fs, T = 2000.0, 5e-4
+    kp, ki, kd, wf = 3000.0, 2e4, 60.0, 900.0
+    f1, width, f2 = 150.0, 60.0, 300.0
+    rec = generate(m1=2.0, friction=dict(sigma2=5.0), controller=dict(
+        kp=kp, ki=ki, kd=kd, roll_off=wf, sample_rate=fs,
+        feedforward=dict(mass=1.0),
+        filters=[dict(type="notch", frequency=f1, width=width),
+                 dict(type="low_pass", frequency=f2, order=1)]),
+        moves=[dict(distance=2e-3, velocity=40e-3, acceleration=2.0)], t_end=0.2, rate=fs)
+    e = rec.reference - rec.truth.x1
+    pn = np.polyadd(np.polymul([kp, ki], [1 / wf, 1.0]), [kd, 0.0, 0.0])   # s (1 + s/wf) C
+    pid_b, pid_a, _ = cont2discrete((pn, np.polymul([1.0, 0.0], [1 / wf, 1.0])), T,
+                                    method="bilinear")
+    assert e[0] == 0.0           # from rest: the PID's recursion starts from zero
+    u = lfilter(np.ravel(pid_b), pid_a, e)
+    for num, den, f in (([1.0, 0.0, (2 * math.pi * f1) ** 2],
+                         [1.0, 2 * (width / (2 * f1)) * 2 * math.pi * f1,
+                          (2 * math.pi * f1) ** 2], f1),
+                        ([2 * math.pi * f2], [1.0, 2 * math.pi * f2], f2)):
+        w = 2 * math.pi * f
+        warped = 2 * math.tan(w * T / 2) / w        # the period that maps w onto itself
+        b, a, _ = cont2discrete((num, den), warped, method="bilinear")
+        b = np.ravel(b)
+        u = lfilter(b, a, u, zi=lfilter_zi(b, a) * u[0])[0]   # at rest on the first input
+    ff = 1.0 * np.array([_accel(t) for t in rec.time])
+    assert np.allclose(rec.truth.command - ff, u, rtol=1e-9, atol=1e-9)
+
+
+def _accel(t, a=2.0, v=40e-3, d=2e-3):
+    """r'' of the trapezoidal move of test_sampled_filters_are_the_prewarped_tustin_biquads."""
+    t1 = v / a
+    t2 = d / v
+    if t < 0 or t >= t2 + t1:
+        return 0.0
+    return a if t < t1 else (0.0 if t < t2 else -a)
 
 
 def test_mass_feedforward_cancels_the_tracking_error():

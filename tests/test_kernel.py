@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fi_design.kernel import integrator
-from fi_design.kernel.equations import jacobian
+from fi_design.kernel.equations import jacobian, rhs
 from fi_design.kernel.layout import MODE_SIGN
 from fi_design.trajectory import from_moves
 from fi_design.model import resolve
@@ -39,6 +39,56 @@ def test_structured_solve_equals_dense_solve(paper_spec, isolated):
         b = rng.normal(size=n)
         x = b.copy()
         integrator.struct_solve(J, M, piv, w, x, np.empty(n))
+        exact = np.linalg.solve(sigma * np.eye(n) - J, b)
+        assert np.allclose(x, exact, rtol=1e-9, atol=1e-12 * np.max(np.abs(exact)))
+
+
+FILTERS = [{"type": "notch", "frequency": "150 Hz", "width": "75 Hz", "depth": "20 dB"},
+           {"type": "low_pass", "frequency": "600 Hz", "damping": 0.5},
+           {"type": "low_pass", "frequency": "900 Hz", "order": 1}]
+
+
+@pytest.mark.parametrize("isolated", [True, False])
+@pytest.mark.parametrize("gains", [None, {"kp": 2000.0, "ki": 8000.0, "kd": 80.0}])
+def test_the_jacobian_of_the_filter_chain_is_the_rhs_s_derivative(paper_spec, isolated, gains):
+    """With the drive's filters (their states after u), the analytic Jacobian equals central
+    differences of the right-hand side, the rule's filtered output and an ideal D's
+    algebraic one alike; the dense solve of such a plant equals numpy's."""
+    from conftest import variant
+
+    more = {} if gains is None else {"controller.crossover": None, "controller.gains": gains}
+    params = resolve(variant(paper_spec, **{"controller.filters": FILTERS}, **more)).plant(
+        isolated)
+    p = params.to_array()
+    n = params.n_states
+    assert n == (7 if isolated else 5) + 5
+    rng = np.random.default_rng(2)
+    modes = np.zeros(4, dtype=np.int64)
+    modes[MODE_SIGN] = 1
+    scale = np.array(([1e-3, 1e-2, 1e-3, 1e-2] if isolated else [1e-3, 1e-2])
+                     + [1e-6, 1.0, 1.0] + [1.0] * 5)
+    for _ in range(5):
+        y = rng.normal(size=n) * scale
+        J = np.empty((n, n))
+        jacobian(0.0, y, p, modes, 1e-3, 1e-2, 0.3, True, J)
+        fd = np.empty((n, n))
+        for j in range(n):
+            h = 1e-6 * scale[j]
+            fp, fm = np.empty(n), np.empty(n)
+            yp, ym = y.copy(), y.copy()
+            yp[j] += h
+            ym[j] -= h
+            rhs(0.0, yp, p, modes, 1e-3, 1e-2, 0.3, True, fp)
+            rhs(0.0, ym, p, modes, 1e-3, 1e-2, 0.3, True, fm)
+            fd[:, j] = (fp - fm) / (2 * h)
+        np.testing.assert_allclose(J, fd, rtol=1e-6, atol=1e-6 * np.max(np.abs(fd)))
+        sigma = 10 ** rng.uniform(1, 6)
+        M = np.empty((n, n))
+        piv = np.empty(n, dtype=np.int64)
+        assert integrator.factor_e(J, sigma, M, piv, np.empty((4, n)), True)
+        b = rng.normal(size=n)
+        x = b.copy()
+        integrator.solve_e(J, M, piv, np.empty((4, n)), x, np.empty(n), True)
         exact = np.linalg.solve(sigma * np.eye(n) - J, b)
         assert np.allclose(x, exact, rtol=1e-9, atol=1e-12 * np.max(np.abs(exact)))
 

@@ -103,6 +103,9 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     pid = data.get("pid") or {}
     if pid:
         console.print(_gains_table(pid))
+        sampled = discrete_table(pid)
+        if sampled is not None:
+            console.print(sampled)
 
     xo = data.get("crossover") or {}
     if xo:
@@ -114,9 +117,22 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
         elif xo.get("limited_by"):
             line += f", limited by {xo['limited_by']}"
         console.print(Text(line))
+        notch = xo.get("notch")
+        if notch:
+            console.print(Text(f"A {_filter_words(notch['notch'])} in controller.filters would "
+                               + (f"allow {number(notch['achievable'])} Hz, then limited by "
+                                  f"{notch['limited_by']}" if notch["achievable"] is not None
+                                  else f"not help: {notch['limited_by']}")))
         cases = xo.get("cases") or []
+        numbers = {c.name: c.number for c in result.loop.cases}
         if cases:
-            console.print(cases_table(cases, {c.name: c.number for c in result.loop.cases}))
+            console.print(cases_table(cases, numbers))
+            console.print(crossings_table(cases, numbers))
+        if xo.get("loop_crossover") is not None:
+            console.print(Text(
+                f"Loop crossover {number(xo['loop_crossover'])} Hz: the highest 0 dB crossing "
+                f"in the band, case {numbers.get(xo['loop_crossover_case'], '?')}; the parasitic "
+                f"separation is judged on it (requirements.parasitic_separation)"))
 
     stiff = data.get("stiffness") or {}
     if stiff.get("maximum") is not None:
@@ -173,36 +189,101 @@ def _print_terms(console: "Console", result, data: dict) -> None:
 
 
 def _gains_table(pid: dict) -> Any:
-    """Step 4's gains in the form the spec's ``controller.gains`` takes (``pid.hand_off``).
+    """Step 4's gains, the one set a drive takes (``pid.drive``), named so.
 
-    With the hardware's own gains, the rule's at the same crossover in the same
-    form beside them. The roll-off is ``controller.roll_off``: a low-pass on the
-    D term only; the sampling and delay are the ones the analysis used.
+    ``kp + ki/s + kd s / (1 + s/(2 pi roll_off))`` with the roll-off on the D
+    term only (``controller.gains`` and ``controller.roll_off``), the filters
+    on the output; with the hardware's own gains, the rule's at the same
+    crossover in the same form beside them (``pid.rule.in_drive_form``); with
+    ``controller.drive`` the same gains in counts and the drive's current unit.
     """
     from rich.text import Text
 
-    hand = pid["hand_off"]
-    rows = [("hardware" if pid.get("source") == "gains" else "rule", hand)]
+    drive = pid["drive"]
+    rows = [("drive (hardware)" if pid.get("source") == "gains" else "drive", drive)]
     if pid.get("source") == "gains":
-        rows.append(("rule", {**hand, **pid["rule_in_hardware_form"],
-                              "roll_off": pid["rule_in_hardware_form"]["roll_off"]
-                              / (2 * math.pi)}))
-    t = table("PID gains (step 4) as controller.gains takes them: kp + ki/s + kd s / (1 + "
-               "s/(2 pi roll_off)), the roll-off on the D term only")
+        rows.append(("rule, for comparison", pid["rule"]["in_drive_form"]))
+    t = table("PID gains (step 4) a drive takes: kp + ki/s + kd s / (1 + s/(2 pi roll_off)), the "
+              "roll-off on the D term only (controller.gains, controller.roll_off)")
     t.add_column("")
     for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "roll_off [Hz]"):
         t.add_column(Text(col), justify="right", no_wrap=True)
     for label, g in rows:
         t.add_row(label, number(g["kp"]), number(g["ki"]), number(g["kd"]),
                   "none" if g["roll_off"] is None else number(g["roll_off"]))
-    sampled = ("continuous" if hand["sample_rate"] is None
-               else f"sampled at {quantity(hand['sample_rate'], 'Hz')}")
-    delay = "no delay" if not hand["delay"] else f"delay {quantity(hand['delay'], 's')}"
-    t.caption = Text(f"D on the {hand['derivative_on']}, {sampled}, {delay}, tuned on "
-                     f"{quantity(pid['tuning_mass'], 'kg')} (controller.derivative_on, "
-                     "sample_rate and delay); --write-spec writes them into a spec",
-                     style="dim")
+    units = drive.get("in_drive_units")
+    if units:
+        u = units["units"]
+        t.add_row(f"drive, in {units['current_unit']} and counts", f"{number(units['kp'])} {u['kp']}",
+                  f"{number(units['ki'])} {u['ki']}", f"{number(units['kd'])} {u['kd']}", "")
+    sampled = ("continuous" if drive["sample_rate"] is None
+               else f"sampled at {quantity(drive['sample_rate'], 'Hz')}")
+    delay = "no delay" if not drive["delay"] else f"delay {quantity(drive['delay'], 's')}"
+    filters = "; ".join(_filter_words(f) for f in drive.get("filters") or ())
+    rule = pid["rule"]
+    t.caption = Text(f"D on the {drive['derivative_on']}, {sampled}, {delay}"
+                     + (f"; filters on the output: {filters}" if filters else "; no filters")
+                     + f"; the rule tunes on {quantity(rule['tuning_mass'], 'kg')} (controller."
+                     "derivative_on, sample_rate, delay, filters); --write-spec writes them "
+                     "into a spec", style="dim")
     t.caption_justify = "left"
+    return t
+
+
+def _filter_words(f: dict) -> str:
+    """One filter of ``pid.drive.filters`` in words."""
+    if f["type"] == "notch":
+        depth = "full" if f["depth"] is None else f"{number(f['depth'], 3)} dB"
+        return (f"notch '{f['name']}' {number(f['frequency'])} Hz, {number(f['width'], 3)} Hz "
+                f"wide, depth {depth}")
+    if f["order"] == 1:
+        return f"low-pass '{f['name']}' {number(f['frequency'])} Hz, first order"
+    return (f"low-pass '{f['name']}' {number(f['frequency'])} Hz, second order, damping "
+            f"{number(f['damping'], 3)}")
+
+
+def discrete_table(pid: dict) -> Any:
+    """The sampled controller a drive computes each period (``pid.drive.discrete``), or None."""
+    from rich.text import Text
+
+    d = pid["drive"].get("discrete")
+    if not d:
+        return None
+    t = table(f"The controller per sample at {quantity(d['sample_rate'], 'Hz')} (PID recursion, "
+              "filter biquads)")
+    t.add_column("")
+    t.add_column("coefficients", ratio=1)
+    t.add_row("PID", Text(f"kp {number(d['kp'])} N/m; integrator ki T/2 "
+                          f"{number(d['integrator_gain'])} N/m; D pole "
+                          f"{number(d['derivative_pole'])}, gain "
+                          f"{number(d['derivative_gain'])} N/m"))
+    for f in d["filters"]:
+        t.add_row(f["name"], Text("b = " + ", ".join(number(x, 6) for x in f["b"]) + "; a = "
+                                  + ", ".join(number(x, 6) for x in f["a"])))
+    t.caption = Text("I_k = I_(k-1) + (ki T/2)(e_k + e_(k-1)); D_k = pole D_(k-1) + gain "
+                     "(d_k - d_(k-1)); u_k = kp e_k + I_k + D_k, then each biquad y_k = b0 x_k "
+                     "+ b1 x_(k-1) + b2 x_(k-2) - a1 y_(k-1) - a2 y_(k-2) (Tustin prewarped at "
+                     "the filter's frequency)", style="dim")
+    t.caption_justify = "left"
+    return t
+
+
+def crossings_table(cases: list, numbers: dict) -> Any:
+    """Every 0 dB and -180 deg crossing of each limit case with the margin read there."""
+    from rich.text import Text
+
+    t = table("Every crossing of each limit case")
+    t.add_column("#", justify="right", no_wrap=True)
+    t.add_column("0 dB crossings: frequency (phase margin, delay margin)", ratio=1)
+    t.add_column("-180° crossings: frequency (gain margin)", ratio=1)
+    for i, case in enumerate(cases, 1):
+        gains = ", ".join(
+            f"{number(g['frequency'])} Hz ({number(g['phase_margin_deg'], 3)}°, "
+            f"{number(g['delay_margin'], 3)} s" + ("" if g["in_band"] else ", below the band")
+            + ")" for g in case.get("gain_crossings") or ()) or "none"
+        phases = ", ".join(f"{number(p['frequency'])} Hz ({number(p['gain_margin_db'], 3)} dB)"
+                           for p in case.get("phase_crossings") or ()) or "none"
+        t.add_row(str(numbers.get(case.get("name"), i)), Text(gains), Text(phases))
     return t
 
 
@@ -253,7 +334,12 @@ def print_verdict(console: "Console", result) -> None:
         if mar.crossover_factor is not None:
             items.append(f"crossover {'>= ' if mar.crossover_factor_bound else ''}"
                          f"{mar.crossover_factor:.3g}x the hunting-free "
-                         f"{number(mar.hunting_free_crossover, 4)} Hz")
+                         f"{number(mar.hunting_free_crossover, 4)} Hz"
+                         + (f" (the sliding loop crosses 0 dB at "
+                            f"{number(mar.hunting_loop_crossover, 4)} Hz and "
+                            f"{number(mar.hunting_free_loop_crossover, 4)} Hz)"
+                            if mar.hunting_loop_crossover and mar.hunting_free_loop_crossover
+                            else ""))
         if mar.end_stop_clearance is not None:
             items.append(f"end stop {quantity(mar.end_stop_clearance, 'm', 3)} away at rest")
         if mar.stiffness_factor is not None:
@@ -302,7 +388,7 @@ CASE_CAPTION = ("fc: gain crossover; PM, GM, MM, DM: phase, gain, modulus and de
 
 
 _CASE_SKIP = {"name", "description", "passed", "failed", "crossovers", "stable", "in_band",
-              "status"}
+              "status", "modulus_frequency"}
 
 
 def cases_table(cases: list, numbers: dict) -> Any:

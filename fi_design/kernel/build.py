@@ -50,7 +50,7 @@ FUNCTIONS = {
     "integrate": "integrator", "rhs": "equations", "jacobian": "equations",
     "natural_modes": "equations", "drive_force": "equations", "controller_output": "equations", "actuator": "equations",
     "static_friction": "equations", "stribeck": "equations", "feedforward": "equations",
-    "breakaway": "equations", "switch_mode": "equations",
+    "breakaway": "equations", "switch_mode": "equations", "sample_filters": "equations",
 }
 
 
@@ -149,7 +149,8 @@ def _returns() -> dict:
     return {"integrate": t.int64, "rhs": t.void, "jacobian": t.void, "natural_modes": t.void,
             "drive_force": f8, "controller_output": f8, "actuator": t.UniTuple(f8, 2),
             "static_friction": f8, "stribeck": t.UniTuple(f8, 3),
-            "feedforward": t.UniTuple(f8, 2), "breakaway": f8, "switch_mode": t.void}
+            "feedforward": t.UniTuple(f8, 2), "breakaway": f8, "switch_mode": t.void,
+            "sample_filters": f8}
 
 
 def built(output_dir: str | os.PathLike | None = None) -> list[Path]:

@@ -24,7 +24,8 @@ from .layout import (
     N_CORE_ISO, N_CORE_RIGID, TWO_PI, P_C, P_CABLE_F0, P_CABLE_K, P_CSTOP, P_FC, P_FC_NEG,
     P_FF_C, P_FF_F, P_FF_M, P_FLIMIT, P_FS, P_ISO, P_K, P_KD, P_KDM, P_KI, P_KP, P_KSTOP, P_M1,
     P_M2, P_OFFSET, P_PDF_A, P_PDF_L, P_PDF_PHI, P_QUANT, P_RIP_A, P_RIP_P, P_RIP_PHI, P_S,
-    P_SIGMA0, P_SIGMA1, P_SIGMA2, P_SIGMA2_NEG, P_SWITCH, P_TS, P_VS, P_WT, P_X10)
+    P_SIGMA0, P_SIGMA1, P_SIGMA2, P_SIGMA2_NEG, P_SWITCH, P_TS, P_VS, P_WT, P_X10,
+    FILT_STRIDE, MAX_FILTER_SECTIONS, P_FILT, P_NF)
 
 
 # --------------------------------------------------------------------------- pieces
@@ -143,6 +144,208 @@ def feedforward(rd, rdd, r3, p):
     return F, p[P_FF_M] * r3 + p[P_FF_C] * rdd
 
 
+# --------------------------------------------------------------------------- the filter chain
+
+
+@kernel_function((A1, i8))
+def section_order(p, s):
+    """Order of section ``s`` of the drive's filter chain (0: none)."""
+    if s >= MAX_FILTER_SECTIONS:
+        return 0
+    return int(p[P_FILT + s * FILT_STRIDE])
+
+
+@kernel_function((A1, i8, i8))
+def section_weight(p, s, j):
+    """How the output of section ``s`` depends on its own state ``j`` (0 or 1) [-] (continuous).
+
+    ``(b2 - b0 a2) / a2`` on P1 and ``(b1 - b0 a1) wn / a2`` on P2 of a
+    second-order section; ``(b1 - b0 a1) / a1`` on P of a first-order one.
+    """
+    b = P_FILT + s * FILT_STRIDE
+    b0 = p[b + 1]
+    b1 = p[b + 2]
+    a1 = p[b + 4]
+    if int(p[b]) == 1:
+        return (b1 - b0 * a1) / a1
+    b2 = p[b + 3]
+    a2 = p[b + 5]
+    if j == 0:
+        return (b2 - b0 * a2) / a2
+    return (b1 - b0 * a1) * math.sqrt(a2) / a2
+
+
+@kernel_function((A1, i8, i8))
+def feedthrough(p, s0, s1):
+    """Product of the sections' direct terms b0 from section ``s0`` to ``s1 - 1`` [-]."""
+    g = 1.0
+    for s in range(s0, s1):
+        if section_order(p, s) == 0:
+            break
+        g *= p[P_FILT + s * FILT_STRIDE + 1]
+    return g
+
+
+@kernel_function((f8, A1, A1, i8))
+def filter_chain(c, y, p, i0):
+    """The continuous filter chain's output on the controller output ``c`` [N].
+
+    States from ``y[i0]`` on (layout in :mod:`fi_design.kernel.layout`).
+    Returns ``(w, dw/dc)``; ``(c, 1)`` without filters.
+    """
+    x = c
+    g = 1.0
+    k = i0
+    for s in range(MAX_FILTER_SECTIONS):
+        order = section_order(p, s)
+        if order == 0:
+            break
+        b0 = p[P_FILT + s * FILT_STRIDE + 1]
+        if order == 2:
+            x = b0 * x + section_weight(p, s, 0) * y[k] + section_weight(p, s, 1) * y[k + 1]
+            k += 2
+        else:
+            x = b0 * x + section_weight(p, s, 0) * y[k]
+            k += 1
+        g *= b0
+    return x, g
+
+
+@kernel_function((f8, A1, A1, i8, A1))
+def filter_rates(c, y, p, i0, f):
+    """Rates of the continuous filter states into ``f[i0:]`` for the controller output ``c``."""
+    x = c
+    k = i0
+    for s in range(MAX_FILTER_SECTIONS):
+        order = section_order(p, s)
+        if order == 0:
+            break
+        b = P_FILT + s * FILT_STRIDE
+        b0 = p[b + 1]
+        a1 = p[b + 4]
+        if order == 2:
+            wn = math.sqrt(p[b + 5])
+            f[k] = wn * y[k + 1]
+            f[k + 1] = wn * (x - y[k]) - a1 * y[k + 1]
+            x = b0 * x + section_weight(p, s, 0) * y[k] + section_weight(p, s, 1) * y[k + 1]
+            k += 2
+        else:
+            f[k] = a1 * (x - y[k])
+            x = b0 * x + section_weight(p, s, 0) * y[k]
+            k += 1
+
+
+@kernel_function((f8, A1, A1, i8))
+def filter_output_rate(dc, f, p, i0):
+    """Rate of the chain's output [N/s] from the input's rate ``dc`` and the states' rates ``f``."""
+    out = dc * feedthrough(p, 0, MAX_FILTER_SECTIONS)
+    k = i0
+    for s in range(MAX_FILTER_SECTIONS):
+        order = section_order(p, s)
+        if order == 0:
+            break
+        down = 1.0
+        for t in range(s + 1, MAX_FILTER_SECTIONS):
+            if section_order(p, t) == 0:
+                break
+            down *= p[P_FILT + t * FILT_STRIDE + 1]
+        for j in range(order):
+            out += down * section_weight(p, s, j) * f[k + j]
+        k += order
+    return out
+
+
+@kernel_function((f8, A1, A1, i8))
+def sample_filters(x, y, p, i0):
+    """One sample of the chain's biquads on ``x`` [N], memories ``y[i0:]`` updated; the output."""
+    k = i0
+    for s in range(MAX_FILTER_SECTIONS):
+        order = section_order(p, s)
+        if order == 0:
+            break
+        b = P_FILT + s * FILT_STRIDE
+        z0 = p[b + 6]
+        z1 = p[b + 7]
+        p1 = p[b + 9]
+        out = z0 * x + y[k]
+        if order == 2:
+            y[k] = z1 * x - p1 * out + y[k + 1]
+            y[k + 1] = p[b + 8] * x - p[b + 10] * out
+            k += 2
+        else:
+            y[k] = z1 * x - p1 * out
+            k += 1
+        x = out
+    return x
+
+
+@kernel_function((A1, i8, f8, A1))
+def filter_time_rate(p, i0, dc, ft):
+    """The filter rows of the explicit time derivative of the right-hand side into ``ft``,
+    for an explicit rate ``dc`` of the controller output [N/s] (a reference moving under it).
+    Returns the chain output's share, ``dc`` times the product of the direct terms."""
+    k = i0
+    for s in range(MAX_FILTER_SECTIONS):
+        order = section_order(p, s)
+        if order == 0:
+            break
+        b = P_FILT + s * FILT_STRIDE
+        g = feedthrough(p, 0, s)
+        if order == 2:
+            ft[k + 1] = math.sqrt(p[b + 5]) * g * dc
+        else:
+            ft[k] = p[b + 4] * g * dc
+        k += order
+    return dc * feedthrough(p, 0, MAX_FILTER_SECTIONS)
+
+
+@kernel_function((A1, A1, i8, A2, f8, f8, i8, f8, f8, i8, i8, f8))
+def filter_jacobian(y, p, i0, J, scale, dc_dx, ix, dc_dv, dc_dI, ii, iu, du):
+    """The filter states' rows of the Jacobian, and the force row's share of the chain.
+
+    The input of section s is ``g_s c + sum_j h_sj y_j`` over the states of the
+    sections before it, ``g_s`` the product of their direct terms; ``c``
+    depends on x1 (``dc_dx``), v1 (``dc_dv``), I (``dc_dI``) and u (``du``).
+    Row ``ix`` (the stage's acceleration) gets ``scale`` times the chain
+    output's dependence (``scale``: dFa / m, the force's weight there).
+    """
+    k = i0
+    for s in range(MAX_FILTER_SECTIONS + 1):
+        order = section_order(p, s)
+        last = order == 0
+        g = feedthrough(p, 0, s)
+        # the row that sees this section's input, and its weight
+        if last:
+            row, wgt = ix, scale
+        else:
+            b = P_FILT + s * FILT_STRIDE
+            a1 = p[b + 4]
+            if order == 2:
+                wn = math.sqrt(p[b + 5])
+                J[k, k + 1] = wn
+                J[k + 1, k] = -wn
+                J[k + 1, k + 1] = -a1
+                row, wgt = k + 1, wn
+            else:
+                J[k, k] = -a1
+                row, wgt = k, a1
+        if wgt != 0.0:
+            J[row, 0] += wgt * g * dc_dx
+            J[row, 1] += wgt * g * dc_dv
+            J[row, ii] += wgt * g * dc_dI
+            J[row, iu] += wgt * g * du
+            kt = i0
+            for t in range(s):
+                ot = section_order(p, t)
+                down = feedthrough(p, t + 1, s)
+                for j in range(ot):
+                    J[row, kt + j] += wgt * down * section_weight(p, t, j)
+                kt += ot
+        if last:
+            break
+        k += order
+
+
 @kernel_function((A1, A1, I1, f8, f8, i8))
 def control_law(y, p, modes, r, rd, ii):
     """The continuous controller's unfiltered output v and its partials.
@@ -167,11 +370,16 @@ def control_law(y, p, modes, r, rd, ii):
 
 @kernel_function((A1, A1, I1, f8, f8, i8, i8))
 def controller_output(y, p, modes, r, rd, ii, iu):
-    """Output u of the continuous controller [N]: the filter state, or v without a filter."""
+    """The continuous controller's command [N]: u (or v without output filter) through the
+    drive's filter chain, whose states follow u."""
     if math.isinf(p[P_WT]):
-        v, _, _, _ = control_law(y, p, modes, r, rd, ii)
-        return v
-    return y[iu]
+        c, _, _, _ = control_law(y, p, modes, r, rd, ii)
+    else:
+        c = y[iu]
+    if p[P_NF] == 0.0:
+        return c
+    w, _ = filter_chain(c, y, p, iu + 1)
+    return w
 
 
 @kernel_function((A1, A1, I1, f8, f8, f8, b1))
@@ -245,8 +453,14 @@ def rhs(t, y, p, modes, r, rd, fa, fa_state, f):
     e = 0.0
     if not discrete:
         v, _, _, e = control_law(y, p, modes, r, rd, ii)
+    nf = p[P_NF] > 0.0
+    c = 0.0
+    if not discrete:
+        c = v if math.isinf(wt) else y[iu]
     if fa_state:
-        u = v if math.isinf(wt) else y[iu]
+        u = c
+        if nf:
+            u, _ = filter_chain(c, y, p, iu + 1)
         Fa, _ = actuator(u + fa, p)
     else:
         Fa, _ = actuator(fa, p)
@@ -291,9 +505,13 @@ def rhs(t, y, p, modes, r, rd, fa, fa_state, f):
     if discrete:
         f[ii] = 0.0
         f[iu] = 0.0
+        for k in range(iu + 1, y.shape[0]):  # the biquads' memories: held between samples
+            f[k] = 0.0
     else:
         f[ii] = p[P_KI] * e
         f[iu] = 0.0 if math.isinf(wt) else wt * (v - y[iu])
+        if nf:
+            filter_rates(c, y, p, iu + 1, f)
 
 
 @kernel_function((f8, A1, A1, I1, f8, f8, f8, b1, A2))
@@ -319,9 +537,16 @@ def jacobian(t, y, p, modes, r, rd, fa, fa_state, J):
     dv_dv = 0.0
     if not discrete:
         v, dv_dx, dv_dv, _ = control_law(y, p, modes, r, rd, ii)
+    nf = p[P_NF] > 0.0
     dFa = 0.0
     if fa_state:
-        _, dFa = actuator((v if algebraic else y[iu]) + fa, p)
+        c = v if algebraic else y[iu]
+        if nf:
+            c, _ = filter_chain(c, y, p, iu + 1)
+        _, dFa = actuator(c + fa, p)
+    dFc = dFa  # the force's weight on the controller output: through the chain when it has one
+    if nf:
+        dFa = 0.0
     _, dFe = external_force(x1, p)
     stick = p[P_SWITCH] != 0.0 and modes[MODE_STICK] == 1
     sgn = float(modes[MODE_SIGN])
@@ -395,6 +620,15 @@ def jacobian(t, y, p, modes, r, rd, fa, fa_state, J):
             J[iu, 1] = wt * dv_dv
             J[iu, ii] = wt
             J[iu, iu] = -wt
+        if nf:
+            if iso:
+                scale = dFc / p[P_M1]
+            else:
+                scale = 0.0 if stick else dFc / (p[P_M1] + p[P_M2])
+            if algebraic:
+                filter_jacobian(y, p, iu + 1, J, scale, dv_dx, 1, dv_dv, 1.0, ii, iu, 0.0)
+            else:
+                filter_jacobian(y, p, iu + 1, J, scale, 0.0, 1, 0.0, 0.0, ii, iu, 1.0)
 
 
 @kernel_function((A1, A1, I1))

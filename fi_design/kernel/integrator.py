@@ -57,12 +57,13 @@ import math
 import numpy as np
 
 from .equations import (actuator, breakaway, control_law, controller_output, drive_force,
-                        feedforward, jacobian, limit_mode, measured_position, natural_modes, rhs,
-                        switch_mode)
+                        feedforward, filter_output_rate, filter_time_rate, jacobian, limit_mode,
+                        measured_position, natural_modes, rhs, sample_filters, switch_mode)
 from .jit import A1, A2, I1, b1, f8, i8, kernel_function
 from .layout import (DIVERGED, EV_LEVEL, EV_LIMIT, EV_NONE, EV_SECTION, EV_SIGN, EV_UNSTICK,
                      HISTORY_OVERFLOW, MAX_PERIOD, MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK,
                      N_CORE_ISO, N_CORE_RIGID, N_STATS, NOT_FINITE, OK, P_DA, P_DB, P_DC, P_DELAY,
+                     P_NF,
                      P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F, P_FF_M, P_ISO, P_KD, P_KDM,
                      P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT,
                      ST_CROSSINGS, ST_EVENTS, ST_H, ST_LIMIT_EVENTS, ST_OUT, ST_PERIOD,
@@ -304,6 +305,50 @@ def struct_solve(J, M, piv, w, b, tmp):
     b[ii] = yI
     b[iu] = yu
     b[iz] = yz
+
+
+@kernel_function((A2, f8, A2, I1, A2, b1))
+def factor_e(J, sigma, M, piv, w, full):
+    """Factor E = sigma I - J: by its structure (:func:`struct_factor`), or, with ``full``
+    (a plant with the filter chain's states after the leaves), as a dense LU with U's
+    diagonal as its reciprocal. Returns False if singular."""
+    if not full:
+        return struct_factor(J, sigma, M, piv, w)
+    n = J.shape[0]
+    for i in range(n):
+        for j in range(n):
+            M[i, j] = -J[i, j]
+        M[i, i] += sigma
+    if not lu_factor(M, piv):
+        return False
+    for i in range(n):
+        M[i, i] = 1.0 / M[i, i]
+    return True
+
+
+@kernel_function((A2, A2, I1, A2, A1, A1, b1))
+def solve_e(J, M, piv, w, b, tmp, full):
+    """Solve (sigma I - J) x = b in place with the factors of :func:`factor_e`."""
+    if not full:
+        struct_solve(J, M, piv, w, b, tmp)
+        return
+    n = b.shape[0]
+    for k in range(n):
+        m = piv[k]
+        if m != k:
+            t = b[k]
+            b[k] = b[m]
+            b[m] = t
+    for i in range(n):
+        s = b[i]
+        for j in range(i):
+            s -= M[i, j] * b[j]
+        b[i] = s
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, n):
+            s -= M[i, j] * b[j]
+        b[i] = s * M[i, i]
 
 
 @kernel_function((A1, A1, A1, A1, f8, A1))
@@ -549,8 +594,9 @@ def write_output(i, tq, yq, p, modes, breaks, coeffs, in_t, in_f, hints, fa_hold
     the controller's output.
     """
     n = yq.shape[0]
-    iu = n - 1
-    ii = n - 2
+    nc = N_CORE_ISO if p[P_ISO] != 0.0 else N_CORE_RIGID
+    ii = nc + 1
+    iu = nc + 2
     for j in range(n):
         out_y[i, j] = yq[j]
     rr, rdr, _, _, kout = reference_at(tq, breaks, coeffs, hints[H_OUT])
@@ -698,8 +744,11 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     cd2 = np.empty(n)
     cd3 = np.empty(n)
     J = np.empty((n, n))
-    M = np.empty((n - 3, n - 3))
-    piv = np.empty(n - 3, dtype=np.int64)
+    # the filter chain's states follow the leaves: a plant with them takes the dense LU
+    full = p[P_NF] > 0.0
+    nm = n if full else n - 3
+    M = np.empty((nm, nm))
+    piv = np.empty(nm, dtype=np.int64)
     w = np.empty((4, n - 3 if n - 3 > 3 else 3))
     tmp = np.empty(n)
     modes = np.zeros(4, dtype=np.int64)
@@ -778,6 +827,8 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             e_k = r_s - xm
             d_k = -xm if p[P_DMEAS] != 0.0 else e_k
             u_k = p[P_DP] * e_k + dx1 + p[P_DC] * e_k + dx2 + p[P_DB] * d_k
+            if full:  # the drive's biquads on the PID's output, before the feedforward
+                u_k = sample_filters(u_k, y, p, iu + 1)
             if has_ff:
                 ff_k, _ = feedforward(rd_s, rdd_s, r3_s, p)
                 u_k += ff_k
@@ -859,11 +910,14 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             dv_dt = p[P_KP] * rd0 + p[P_KD] * rdd0  # explicit time derivative of v
             if not algebraic:
                 ft[iu] = p[P_WT] * dv_dt
+            dw_dt = dv_dt  # the explicit rate of the command: through the chain when it has one
+            if full:
+                dw_dt = filter_time_rate(p, iu + 1, dv_dt if algebraic else 0.0, ft)
             if fa_state:
                 if algebraic or has_ff or n_in > 0:
                     uc = controller_output(y, p, modes, r0, rd0, ii, iu)
                     _, dsat = actuator(uc + fa0, p)
-                    ft[1] = dsat * (dfa0 + (dv_dt if algebraic else 0.0)) / m_acc
+                    ft[1] = dsat * (dfa0 + (dw_dt if algebraic else 0.0)) / m_acc
             else:
                 _, dsat = actuator(fa0, p)
                 ft[1] = dsat * dfa0 / m_acc
@@ -871,6 +925,8 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             # record the controller output for the delayed force
             uc = controller_output(y, p, modes, r0, rd0, ii, iu)
             duc = law_rate(y, p, modes, r0, rd0, rdd0, f0, ii) if algebraic else f0[iu]
+            if full:
+                duc = filter_output_rate(duc, f0, p, iu + 1)
             newest = (head - 1) % HIST
             if count > 0 and t == hist[HT, newest]:
                 hist[HUR, newest] = uc
@@ -908,7 +964,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             if n_steps + n_rej >= max_steps:
                 status = TOO_MANY_STEPS
                 break
-            if not struct_factor(J, 1.0 / (h * GAMMA), M, piv, w):
+            if not factor_e(J, 1.0 / (h * GAMMA), M, piv, w, full):
                 h *= 0.5
                 n_rej += 1
                 continue
@@ -916,7 +972,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             # stage 1
             for j in range(n):
                 k1[j] = f0[j] + h * D1 * ft[j]
-            struct_solve(J, M, piv, w, k1, tmp)
+            solve_e(J, M, piv, w, k1, tmp, full)
             # stage 2
             for j in range(n):
                 ytmp[j] = y[j] + A21 * k1[j]
@@ -931,7 +987,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
                 k2[j] = fs[j] + C21 * hinv * k1[j] + h * D2 * ft[j]
-            struct_solve(J, M, piv, w, k2, tmp)
+            solve_e(J, M, piv, w, k2, tmp, full)
             # stage 3
             for j in range(n):
                 ytmp[j] = y[j] + A31 * k1[j] + A32 * k2[j]
@@ -943,7 +999,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
                 k3[j] = fs[j] + (C31 * k1[j] + C32 * k2[j]) * hinv + h * D3 * ft[j]
-            struct_solve(J, M, piv, w, k3, tmp)
+            solve_e(J, M, piv, w, k3, tmp, full)
             # stage 4
             for j in range(n):
                 ytmp[j] = y[j] + A41 * k1[j] + A42 * k2[j] + A43 * k3[j]
@@ -955,7 +1011,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
                 k4[j] = fs[j] + (C41 * k1[j] + C42 * k2[j] + C43 * k3[j]) * hinv + h * D4 * ft[j]
-            struct_solve(J, M, piv, w, k4, tmp)
+            solve_e(J, M, piv, w, k4, tmp, full)
             # stage 5
             for j in range(n):
                 ytmp[j] = y[j] + A51 * k1[j] + A52 * k2[j] + A53 * k3[j] + A54 * k4[j]
@@ -967,7 +1023,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             rhs(ts, ytmp, p, modes, rs, rds, fas, fa_state, fs)
             for j in range(n):
                 k5[j] = fs[j] + (C51 * k1[j] + C52 * k2[j] + C53 * k3[j] + C54 * k4[j]) * hinv
-            struct_solve(J, M, piv, w, k5, tmp)
+            solve_e(J, M, piv, w, k5, tmp, full)
             # stage 6 (embedded solution + correction)
             for j in range(n):
                 ytmp[j] += k5[j]
@@ -975,7 +1031,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             for j in range(n):
                 k6[j] = fs[j] + (C61 * k1[j] + C62 * k2[j] + C63 * k3[j] + C64 * k4[j]
                                  + C65 * k5[j]) * hinv
-            struct_solve(J, M, piv, w, k6, tmp)
+            solve_e(J, M, piv, w, k6, tmp, full)
             err = 0.0
             for j in range(n):
                 ynew[j] = ytmp[j] + k6[j]
@@ -1046,6 +1102,8 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                             jump_pending = True
                             jump_u = u_before
                             jump_du = f0[iu]
+                            if full:
+                                jump_du = filter_output_rate(jump_du, f0, p, iu + 1)
                     n_events += 1
                     n_zero += 1
                     zero_run += 1
@@ -1092,7 +1150,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                         out_cmd[i_out] = ybuf[iu]
                         out_fa[i_out], _ = actuator(fa_hold, p)
                     else:
-                        uc = ybuf[iu] if not algebraic else controller_output(
+                        uc = ybuf[iu] if not (algebraic or full) else controller_output(
                             ybuf, p, modes, rr, rdr, ii, iu)
                         out_cmd[i_out] = uc
                         out_fa[i_out], _ = actuator(uc, p)
@@ -1186,6 +1244,8 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                     u_before = controller_output(y, p, modes, r_e, rd_e, ii, iu)
                     du_before = law_rate(y, p, modes, r_e, rd_e, rdd_e, fs, ii) if algebraic \
                         else fs[iu]
+                    if full:
+                        du_before = filter_output_rate(du_before, fs, p, iu + 1)
                 apply_event(pending, y, p, modes, iv2, iu, r_e, rd_e, fa0, fa_state, yev)
                 if cont_delay and pending == EV_LEVEL:
                     if controller_output(y, p, modes, r_e, rd_e, ii, iu) != u_before:

@@ -45,6 +45,11 @@ dmeas          -         1: the discrete D term acts on the measurement
 dx1, dx2       N         discrete controller states at t = 0
 u_initial      N         command applied before the controller's first output
 x1_initial     m         stage position at t = 0 (the cable force's zero)
+filter_states  -         number of states of the drive's filter chain (0: none)
+fK_order       -         section K of the chain (0..3, packed): 0 unused, 1 or 2
+fK_b0 .. fK_a2 -, 1/s, 1/s^2  (b0 s^2 + b1 s + b2) / (s^2 + a1 s + a2), or
+                         (b0 s + b1) / (s + a1) (order 1), continuous
+fK_z0 .. fK_p2 -         the same sampled: (z0 + z1/z + z2/z^2) / (1 + p1/z + p2/z^2)
 ============== ========= =====================================================
 
 States (one table, :data:`ISOLATED_STATES` and :data:`RIGID_STATES`). Isolated
@@ -52,7 +57,27 @@ plant (7): x1, v1, x2, v2, z, I, u. Rigid plant (5): x, v, z, I, u. Positions
 in m, velocities in m/s, the bristle deflection z in m, the integrator force
 I = ki * integral(e) and the controller output u in N. The last three are the
 "leaves" the kernel's structured linear solve eliminates; the layout is checked
-at import.
+at import. The drive's filter chain (``controller.filters``) adds its states
+after u (``filter_states`` of them, :func:`state_index` names them f0, f1,
+...), in N; a plant with them is solved with a dense LU instead.
+
+The filter chain acts on the controller's output u (or v without output
+filter), the command that reaches the stage is its output w, section after
+section, each with unit DC gain. Continuous, a second-order section
+``(b0 s^2 + b1 s + b2) / (s^2 + a1 s + a2)`` with ``wn = sqrt(a2)`` has the
+states P1 (its input low-passed to unit DC gain) and P2 = P1' / wn::
+
+    P1' = wn P2,   P2' = wn (x - P1) - a1 P2
+    out = b0 x + ((b2 - b0 a2) P1 + (b1 - b0 a1) wn P2) / a2
+
+and a first-order one ``(b0 s + b1) / (s + a1)`` the state P with
+``P' = a1 (x - P)``, ``out = b0 x + (b1 - b0 a1) P / a1``: every state is a
+force, at rest equal to the command. Sampled, each section is a biquad (the
+drive's Tustin rule prewarped at the filter's frequency, computed by
+:mod:`fi_design.controller`) in transposed direct form II, its two memories
+(one for a first-order section) held in the filter states between samples::
+
+    out = z0 x + s1,   s1 <- z1 x - p1 out + s2,   s2 <- z2 x - p2 out
 
 The continuous controller, one law for every controller the spec describes
 (:mod:`fi_design.pid` maps the tuning rule and explicit hardware gains onto
@@ -151,6 +176,52 @@ class PlantParameters:
     dx2: float = 0.0
     u_initial: float = 0.0
     x1_initial: float = 0.0
+    # the drive's filter chain (see the module docstring): states after u, sections packed
+    filter_states: float = 0.0
+    f0_order: float = 0.0
+    f0_b0: float = 0.0
+    f0_b1: float = 0.0
+    f0_b2: float = 0.0
+    f0_a1: float = 0.0
+    f0_a2: float = 0.0
+    f0_z0: float = 0.0
+    f0_z1: float = 0.0
+    f0_z2: float = 0.0
+    f0_p1: float = 0.0
+    f0_p2: float = 0.0
+    f1_order: float = 0.0
+    f1_b0: float = 0.0
+    f1_b1: float = 0.0
+    f1_b2: float = 0.0
+    f1_a1: float = 0.0
+    f1_a2: float = 0.0
+    f1_z0: float = 0.0
+    f1_z1: float = 0.0
+    f1_z2: float = 0.0
+    f1_p1: float = 0.0
+    f1_p2: float = 0.0
+    f2_order: float = 0.0
+    f2_b0: float = 0.0
+    f2_b1: float = 0.0
+    f2_b2: float = 0.0
+    f2_a1: float = 0.0
+    f2_a2: float = 0.0
+    f2_z0: float = 0.0
+    f2_z1: float = 0.0
+    f2_z2: float = 0.0
+    f2_p1: float = 0.0
+    f2_p2: float = 0.0
+    f3_order: float = 0.0
+    f3_b0: float = 0.0
+    f3_b1: float = 0.0
+    f3_b2: float = 0.0
+    f3_a1: float = 0.0
+    f3_a2: float = 0.0
+    f3_z0: float = 0.0
+    f3_z1: float = 0.0
+    f3_z2: float = 0.0
+    f3_p1: float = 0.0
+    f3_p2: float = 0.0
 
     def to_array(self) -> np.ndarray:
         """The kernel's float64 parameter array (negative-direction friction resolved)."""
@@ -167,8 +238,31 @@ class PlantParameters:
 
     @property
     def n_states(self) -> int:
-        """Number of states: 7 isolated, 5 rigid."""
-        return len(ISOLATED_STATES if self.isolated else RIGID_STATES)
+        """Number of states: 7 isolated, 5 rigid, plus the filter chain's."""
+        return len(ISOLATED_STATES if self.isolated else RIGID_STATES) + int(self.filter_states)
+
+    def filter_rest(self, command: float) -> np.ndarray:
+        """The filter chain's states at rest on a constant controller output [N].
+
+        Continuous (``sample_period`` 0): each section's low-passed input
+        ``P1`` (and ``P2 = 0`` of a second-order one) equals the command, all
+        sections having unit DC gain. Sampled: the biquads' transposed direct
+        form II memory that outputs the command for it.
+        """
+        out = []
+        for i in range(MAX_FILTER_SECTIONS):
+            c = [getattr(self, f"f{i}_{n}") for n in FILTER_FIELDS]
+            order = int(c[0])
+            if order == 0:
+                break
+            if self.sample_period == 0.0:
+                out += [command, 0.0] if order == 2 else [command]
+            elif order == 2:
+                _, _, _, _, _, _, z0, z1, z2, p1, p2 = c
+                out += [(z1 + z2 - p1 - p2) * command, (z2 - p2) * command]
+            else:
+                out += [(c[7] - c[9]) * command]
+        return np.array(out, dtype=float)
 
 
 @dataclass(frozen=True, eq=False)
@@ -250,6 +344,17 @@ _P = PARAMETER_INDEX
 if len(set(_P)) != N_PARAMS or any(f.type not in ("float", float) for f in fields(PlantParameters)):
     raise RuntimeError("PlantParameters must be a flat table of distinct float fields")
 
+#: Sections of the drive's filter chain the kernel carries, and each one's fields.
+MAX_FILTER_SECTIONS = 4
+FILTER_FIELDS = ("order", "b0", "b1", "b2", "a1", "a2", "z0", "z1", "z2", "p1", "p2")
+FILT_STRIDE = len(FILTER_FIELDS)
+#: Index of the filter chain's count and of its first section's first field.
+P_NF = _P["filter_states"]
+P_FILT = _P["f0_order"]
+if [_P[f"f{i}_{n}"] for i in range(MAX_FILTER_SECTIONS) for n in FILTER_FIELDS] != list(
+        range(P_FILT, P_FILT + MAX_FILTER_SECTIONS * FILT_STRIDE)):
+    raise RuntimeError("the filter sections' fields must follow one another")
+
 #: State names of the two plants; the index of a name is its place in the state vector.
 ISOLATED_STATES = ("x1", "v1", "x2", "v2", "z", "I", "u")
 RIGID_STATES = ("x1", "v1", "z", "I", "u")
@@ -274,12 +379,14 @@ EV_NONE, EV_SIGN, EV_LIMIT, EV_LEVEL, EV_UNSTICK, EV_SECTION = 0, 1, 2, 3, 4, 5
 TWO_PI = 2.0 * math.pi
 
 
-def state_index(isolated: bool) -> dict[str, int]:
+def state_index(isolated: bool, filter_states: int = 0) -> dict[str, int]:
     """Names of the state components and their index for one plant.
 
     The rigid plant's cart is the stage: ``x2`` and ``v2`` name ``x1`` and ``v1``.
+    The filter chain's states follow as ``f0``, ``f1``, ...
     """
     names = ISOLATED_STATES if isolated else RIGID_STATES
+    names = names + tuple(f"f{i}" for i in range(int(filter_states)))
     out = {n: i for i, n in enumerate(names)}
     if not isolated:
         out.update(x2=out["x1"], v2=out["v1"])

@@ -70,7 +70,7 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
     k = compiled()  # the compiled equations and mode switch
     actuator, controller_output, drive_force = k.actuator, k.controller_output, k.drive_force
     feedforward, jacobian, natural_modes, rhs = k.feedforward, k.jacobian, k.natural_modes, k.rhs
-    breakaway = k.breakaway
+    breakaway, sample_filters = k.breakaway, k.sample_filters
     p = params.to_array()
     n = len(y0)
     iso = bool(params.isolated)
@@ -210,6 +210,8 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
             e_k = float(ref(t)) - xm
             d_k = -xm if params.dmeas else e_k
             u_k = params.dp * e_k + dx[0] + params.dc * e_k + dx[1] + params.db * d_k
+            if params.filter_states:  # the drive's biquads, their memories in y after u
+                u_k = sample_filters(u_k, y, p, iu + 1)
             u_k += feedforward(float(ref(t, 1)), float(ref(t, 2)), 0.0, p)[0]
             dx = [dx[0] + 2.0 * params.dc * e_k,
                   params.da * (dx[1] + params.db * d_k) - params.db * d_k]

@@ -149,6 +149,7 @@ def bode_figure(result: Any) -> Any:
     inside = (f >= lo) & (f <= hi)
     band_mag = np.concatenate([20 * np.log10(np.abs(L[inside])) for _, L in responses])
     mag.set_ylim(max(np.nanmin(band_mag), -120.0) - 5, min(np.nanmax(band_mag), 160.0) + 5)
+    _mark_nyquist(result, (mag, pha))
     mag.annotate(f"fc = {fc:g} Hz", (fc, 0.02), xycoords=mag.get_xaxis_transform(),
                  xytext=(3, 0), textcoords="offset points", ha="left", va="bottom",
                  fontsize=7.5, color="0.3")
@@ -158,11 +159,26 @@ def bode_figure(result: Any) -> Any:
     return fig
 
 
+def _mark_nyquist(result: Any, axes) -> None:
+    """A sampled loop's Nyquist frequency, where its curves end (dotted, labelled on the first axes)."""
+    fn = getattr(result.loop, "nyquist", None)
+    if fn is None:
+        return
+    for ax in axes:
+        ax.axvline(fn, color="0.45", lw=0.8, ls=":")
+    axes[0].annotate("Nyquist", (fn, 0.98), xycoords=axes[0].get_xaxis_transform(),
+                     xytext=(-3, 0), textcoords="offset points", ha="right", va="top",
+                     fontsize=7, color="0.4")
+
+
 @styled
 def nyquist_figure(result: Any) -> Any:
     """Nyquist plot of the limit cases (positive frequencies), zoomed on the critical point -1.
 
-    Colours and line styles as in :func:`bode_figure`; the circle
+    The curves are drawn on the loop's own grid, refined where they move fast
+    (:func:`fi_design.responses.frequency_grid`), so they are smooth; a
+    sampled loop's end at its Nyquist frequency. Colours and line styles as
+    in :func:`bode_figure`; the circle
     ``|1 + L| = m`` marks the modulus margin ``m`` (the spec's requirement, else
     0.5, i.e. 6 dB of sensitivity peak).
 
@@ -202,6 +218,9 @@ def nyquist_figure(result: Any) -> Any:
 def sensitivity_figure(result: Any) -> Any:
     """Sensitivity |S| = |1 / (1 + L)| of the limit cases, peaks marked.
 
+    The grid holds each case's sensitivity peak (its modulus margin's
+    frequency), so the dot is the table's peak, 1 / modulus margin.
+
     Parameters
     ----------
     result : fi_design.guideline.DesignResult
@@ -229,6 +248,7 @@ def sensitivity_figure(result: Any) -> Any:
             va="bottom", ha="left", fontsize=7, color="0.35")
     ax.axhline(0.0, color="0.3", lw=0.8)
     ax.axvline(result.crossover.desired, color="0.3", lw=0.9, ls="--")
+    _mark_nyquist(result, (ax,))
     ax.set_ylim(-60, 15)
     log_x(ax, numticks=6)
     ax.set_xlim(*design_band(result))

@@ -68,6 +68,11 @@ SENSE = {
 #: Checks whose value is a probability [-], shown in % wherever it is printed.
 PERCENT_CHECKS = frozenset({"robustness"})
 
+#: The limit cases the hunting margin names (case number and words).
+_CASE_WORDS = {"sliding_limited": "case 3, cart sliding, limiter engaged",
+               "sliding_free": "case 1, cart sliding, joint free",
+               "sliding": "case 1, cart sliding, no isolator"}
+
 
 def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
     """A check's name in words: ``phase_margin.stuck_free`` -> ``Phase margin, case 2 ...``.
@@ -127,6 +132,10 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
         return "PID tuning mass"
     if head == "pid" and tail == "integrator":
         return f"Loop without integrator: static error up to {STATIC_ERROR_FORMULA}"
+    if head == "pid" and tail == "drive_units":
+        return "PID gains in the drive's units (counts, current)"
+    if head == "pid" and tail == "discrete":
+        return "PID and filters per sample (the drive's recursion)"
     return labels.get(head, name.replace("_", " ").capitalize())
 
 
@@ -266,7 +275,12 @@ def key_figures(result: Any) -> list[dict]:
             "Crossover factor: design / lowest hunting-free",
             ("\u2265 " if m.crossover_factor_bound else "") + num(m.crossover_factor, 3), "1",
             "> 1", f"no move hunts from {qty(m.hunting_free_crossover, 'Hz')} (the fold of "
-                   "the cycle)", css))
+                   "the cycle); the ratio of the set crossovers, the loop's frequency scale"
+            + (f"; the loop the cycle slides in ({_CASE_WORDS.get(m.hunting_case, m.hunting_case)})"
+               f" crosses 0 dB at {qty(m.hunting_loop_crossover, 'Hz')} and at "
+               f"{qty(m.hunting_free_loop_crossover, 'Hz')}: "
+               f"{num(m.hunting_loop_crossover / m.hunting_free_loop_crossover, 3)}"
+               if m.hunting_loop_crossover and m.hunting_free_loop_crossover else ""), css))
     if m.achievable_factor is not None:
         rows.append(_figure("Achievable / desired crossover (linear, step 2)",
                             num(m.achievable_factor, 3), "1", "\u2265 1",

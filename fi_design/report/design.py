@@ -50,6 +50,24 @@ def _cases_table(result: Any) -> list[dict]:
     return rows
 
 
+def _crossings(result: Any) -> list[dict]:
+    """Every 0 dB and -180 deg crossing of each case with its margin, one row a case."""
+    numbers = {c.name: c.number for c in result.loop.cases}
+    rows = []
+    for c in result.crossover.cases:
+        gains = "; ".join(
+            f"{qty(g.frequency, 'Hz')}: {qty(g.phase_margin_deg, 'deg', 3)}, "
+            f"{qty(g.delay_margin, 's', 3)}" + ("" if g.in_band else " (below the band)")
+            for g in c.gain_crossings) or "none"
+        phases = "; ".join(f"{qty(p.frequency, 'Hz')}: {qty(p.gain_margin_db, 'dB', 3)}"
+                           for p in c.phase_crossings) or "none"
+        rows.append({"number": numbers.get(c.name, ""), "description": c.description,
+                     "gain_crossings": gains, "phase_crossings": phases,
+                     "peak": "none" if c.modulus_frequency is None
+                     else qty(c.modulus_frequency, "Hz")})
+    return rows
+
+
 class _Numbering:
     """Figure numbers in order of appearance."""
 
@@ -76,8 +94,11 @@ def _linear(result: Any, figures: bool, fig_no: _Numbering) -> dict:
                if xo.delay > 0 else "")
             + ". Margins come from python-control's stability_margins; closed-loop stability "
             "from the roots of the characteristic polynomial. A case can cross 0 dB more than "
-            "once; the table gives the crossing with the smallest phase margin and the "
-            "number of crossings."),
+            "once; the first table gives the crossing with the smallest phase margin and the "
+            "number of crossings, the second every crossing with the margin read there."
+            + (f" The drive's filters on the PID's output: "
+               + "; ".join(f.describe() for f in result.pid.controller.filters) + "."
+               if result.pid.controller.filters else "")),
         "bode": figure_entry(
             (lambda: plots.bode_figure(result)) if figures else None, "bode",
             _bode_caption(result), fig_no()),
@@ -91,6 +112,17 @@ def _linear(result: Any, figures: bool, fig_no: _Numbering) -> dict:
             "case's peak (1 / modulus margin), dotted: the modulus margin's limit, dashed: the "
             "desired crossover.", fig_no(), "half"),
         "cases": _cases_table(result),
+        "crossings": _crossings(result),
+        "loop_crossover": (
+            f"The parasitic separation is judged on the loop's crossover, the highest 0 dB "
+            f"crossing in the band: {qty(xo.loop_crossover, 'Hz')} (case "
+            f"{next((c.number for c in result.loop.cases if c.name == xo.loop_crossover_case), '?')}"
+            f", {next((c.description for c in xo.cases if c.name == xo.loop_crossover_case), '')})"
+            f", so every parasitic mode must lie above "
+            f"{qty(req.parasitic_separation * xo.loop_crossover, 'Hz')}."
+            if xo.loop_crossover is not None else
+            "No case crosses 0 dB in the loop's band: the parasitic separation is judged on the "
+            "desired crossover."),
         "requirements": {"phase_margin": req.phase_margin, "gain_margin": req.gain_margin,
                          "modulus_margin": req.modulus_margin},
         "note": ("A negative gain margin marks a lower gain margin: the integrator on a free mass "

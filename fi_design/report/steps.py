@@ -12,6 +12,11 @@ from .filters import num, qty, tex_num, tex_qty
 __all__ = ["guideline_steps"]
 
 
+def _case_number(xo: Any, name: str) -> int:
+    """The paper's number of a limit case of step 2 (1 to 4)."""
+    return next((i for i, c in enumerate(xo.cases, 1) if c.name == name), 0)
+
+
 def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
     """The four guideline steps: equations in symbols and with numbers, results, explanation.
 
@@ -69,7 +74,8 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
 
     # step 2
     sep = req.parasitic_separation
-    need = sep * xo.desired
+    loop_fc = xo.separation_crossover
+    need = sep * loop_fc
     eqs = [eq(f"\\omega_c = 2\\pi f_c = 2\\pi \\times {tex_qty(xo.desired, 'Hz')} = "
                      f"{tex_qty(2 * math.pi * xo.desired, 'rad/s')}")]
     if xo.achievable is not None:
@@ -78,8 +84,8 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
         eqs.append(eq(
             f"f_c = {tex_qty(xo.desired, 'Hz')}\\ {rel}\\ "
             f"f_{{c,\\mathrm{{ach}}}} = {tex_qty(xo.achievable, 'Hz')}"))
-    eqs.append(eq(f"f_\\mathrm{{par}} \\geq n_\\mathrm{{sep}}\\, f_c = {tex_num(sep)} "
-                         f"\\times {tex_qty(xo.desired, 'Hz')} = {tex_qty(need, 'Hz')}"))
+    eqs.append(eq(f"f_\\mathrm{{par}} \\geq n_\\mathrm{{sep}}\\, f_\\mathrm{{loop}} = "
+                  f"{tex_num(sep)} \\times {tex_qty(loop_fc, 'Hz')} = {tex_qty(need, 'Hz')}"))
     pms = [c.phase_margin_deg for c in xo.cases]
     gms = [abs(c.gain_margin_db) for c in xo.cases]
     results = [
@@ -90,8 +96,22 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
          "unit": "deg"},
         {"quantity": "smallest gain margin at fc (all cases)", "value": min(gms), "unit": "dB"},
         {"quantity": "loop delay in the analysis", "value": xo.delay, "unit": "s"},
+        {"quantity": "loop crossover f_loop (the highest 0 dB crossing in the band"
+                     + (f", case {_case_number(xo, xo.loop_crossover_case)})"
+                        if xo.loop_crossover_case else ": none, the desired crossover)"),
+         "value": loop_fc, "unit": "Hz"},
         {"quantity": "lowest allowed parasitic frequency", "value": need, "unit": "Hz"},
     ]
+    if xo.limiting_mode is not None:
+        results.append({"quantity": "parasitic mode that limits the crossover",
+                        "value": f"{xo.limiting_mode} ({qty(xo.limiting_mode_frequency, 'Hz')})",
+                        "unit": ""})
+    if xo.notch is not None:
+        n = xo.notch
+        results.append({"quantity": f"achievable with a {n.notch.describe()}",
+                        "value": n.achievable if n.achievable is not None else "none",
+                        "unit": "Hz" if n.achievable is not None else ""})
+        results.append({"quantity": "then limited by", "value": n.limited_by, "unit": ""})
     for m in xo.parasitic_modes:
         results.append({"quantity": f"parasitic mode \u2018{m.name}\u2019"
                                     f" ({'collocated' if m.collocated else 'non-collocated'})",
@@ -105,7 +125,11 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
             f"({qty(req.phase_margin, 'deg')} phase, {qty(req.gain_margin, 'dB')} gain), in every "
             "linear limit case the stage switches between near standstill (paper Figure 2). The "
             "achievable crossover is the highest at which all cases keep these margins and every "
-            f"parasitic flexure mode stays {num(sep)} times above the crossover. A limited "
+            f"parasitic flexure mode stays {num(sep)} times above the loop's crossover (the "
+            "highest frequency at which any case crosses 0 dB in the loop's band: with the "
+            "cart stuck the joint's resonance can lift it well above the set crossover). A "
+            "lightly damped mode that limits the margins is named, with the crossover a notch "
+            "at it would allow (controller.filters gain-stabilises it). A limited "
             "achievable crossover makes an isolator useful; a high one may avoid hunting by "
             "control alone. The margins of each case are in the linear analysis below."),
     })
@@ -235,18 +259,43 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
     sampled = ("continuous" if hand["sample_rate"] is None
                else f"sampled at {qty(hand['sample_rate'], 'Hz')}")
     delay = "no delay" if not hand["delay"] else f"delay {qty(hand['delay'], 's')}"
+    results = [
+        {"quantity": "tuning mass m", "value": g.tuning_mass, "unit": "kg"},
+        {"quantity": "drive gain kp (controller.gains.kp)", "value": hand["kp"], "unit": "N/m"},
+        {"quantity": "drive gain ki (controller.gains.ki)", "value": hand["ki"],
+         "unit": "N/(m s)"},
+        {"quantity": "drive gain kd (controller.gains.kd)", "value": hand["kd"],
+         "unit": "N s/m"},
+        {"quantity": "controller.roll_off (D term only)",
+         "value": "none (an ideal D)" if hand["roll_off"] is None else hand["roll_off"],
+         "unit": "Hz"},
+    ]
+    for i, f in enumerate(law.filters):
+        results.append({"quantity": f"controller.filters[{i}]", "value": f.describe(),
+                        "unit": ""})
+    units = result.pid.drive_gains
+    if units is not None:
+        for key in ("kp", "ki", "kd"):
+            results.append({"quantity": f"{key} in the drive's units", "value": getattr(units, key),
+                            "unit": units.units[key]})
+    dz = result.pid.discrete
+    if dz is not None:
+        results += [
+            {"quantity": "per sample: integrator gain ki T/2", "value": dz.integrator_gain,
+             "unit": "N/m"},
+            {"quantity": "per sample: D recursion pole", "value": dz.derivative_pole,
+             "unit": "1"},
+            {"quantity": "per sample: D recursion gain", "value": dz.derivative_gain,
+             "unit": "N/m"},
+        ]
+        for f in dz.filters:
+            results.append({"quantity": f"biquad '{f.name}' b; a (Tustin, prewarped)",
+                            "value": ", ".join(num(x, 6) for x in f.b) + "; "
+                            + ", ".join(num(x, 6) for x in f.a), "unit": ""})
     steps.append({
         "number": 4, "title": "PID gains", "source": "paper \u00a72.2 and \u00a74 step 4",
         "equations": eqs,
-        "results": [
-            {"quantity": "tuning mass m", "value": g.tuning_mass, "unit": "kg"},
-            {"quantity": "controller.gains.kp", "value": hand["kp"], "unit": "N/m"},
-            {"quantity": "controller.gains.ki", "value": hand["ki"], "unit": "N/(m s)"},
-            {"quantity": "controller.gains.kd", "value": hand["kd"], "unit": "N s/m"},
-            {"quantity": "controller.roll_off (D term only)",
-             "value": "none (an ideal D)" if hand["roll_off"] is None else hand["roll_off"],
-             "unit": "Hz"},
-        ],
+        "results": results,
         "explanation": (
             "The gains follow from the moving mass and the crossover: the lead-lag part has its "
             "phase maximum at \u03c9c, and k_s puts |C(j\u03c9c)| = m \u03c9c\u00b2, so a free "

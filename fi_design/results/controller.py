@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 
 from . import dataclass_dict
 
-__all__ = ["PidGains", "ControlLaw"]
+__all__ = ["PidGains", "Filter", "DriveUnits", "ControlLaw", "SampledFilter",
+           "DiscreteController", "DriveGains"]
 
 
 @dataclass(frozen=True)
@@ -81,6 +82,218 @@ class PidGains:
 
 
 @dataclass(frozen=True)
+class Filter:
+    """One filter of the drive's chain, in series with the PID on its output.
+
+    A notch ``(s^2 + 2 zeta_zero w s + w^2) / (s^2 + 2 zeta_pole w s + w^2)``;
+    a low-pass ``w / (s + w)`` (order 1) or ``w^2 / (s^2 + 2 zeta_pole w s +
+    w^2)`` (order 2); ``w = 2 pi frequency``. Unit DC gain.
+
+    Attributes
+    ----------
+    kind : str
+        ``"notch"`` or ``"low_pass"``.
+    name : str
+        Its label.
+    frequency : float
+        Centre (notch) or corner (low-pass) frequency [Hz].
+    zeta_pole : float
+        Damping ratio of the poles [-] (a first-order low-pass: 1, unused).
+    zeta_zero : float
+        Damping ratio of a notch's zeros [-] (0: a full notch; 0 for a low-pass, unused).
+    order : int
+        1 or 2 (a notch: 2).
+    """
+
+    kind: str
+    name: str
+    frequency: float
+    zeta_pole: float
+    zeta_zero: float = 0.0
+    order: int = 2
+
+    @property
+    def width(self) -> float | None:
+        """A notch's -3 dB bandwidth as a full notch, 2 zeta_pole frequency [Hz]; None for a low-pass."""
+        return 2.0 * self.zeta_pole * self.frequency if self.kind == "notch" else None
+
+    @property
+    def depth(self) -> float | None:
+        """A notch's attenuation at its centre, 20 log10(zeta_pole / zeta_zero) [dB] (inf: full)."""
+        if self.kind != "notch":
+            return None
+        return math.inf if self.zeta_zero == 0.0 else 20.0 * math.log10(self.zeta_pole
+                                                                        / self.zeta_zero)
+
+    def describe(self) -> str:
+        """The filter in words: ``notch 'tilt' at 150 Hz, 75 Hz wide (full depth)``."""
+        if self.kind == "notch":
+            d = self.depth
+            depth = "full depth" if math.isinf(d) else f"{d:.3g} dB deep"
+            return (f"notch '{self.name}' at {self.frequency:.4g} Hz, {self.width:.3g} Hz wide "
+                    f"({depth})")
+        if self.order == 1:
+            return f"first-order low-pass '{self.name}' at {self.frequency:.4g} Hz"
+        return (f"second-order low-pass '{self.name}' at {self.frequency:.4g} Hz, damping "
+                f"{self.zeta_pole:.3g}")
+
+    def to_dict(self) -> dict:
+        """JSON: ``type``, ``name``, ``frequency`` [Hz], ``order``, and a notch's ``width`` [Hz],
+        ``depth`` [dB] (null: full) and ``damping`` [zeta of the zeros, zeta of the poles] or a
+        second-order low-pass's ``damping`` [-]: the spec's keys."""
+        out: dict = {"type": self.kind, "name": self.name, "frequency": self.frequency,
+                     "order": self.order}
+        if self.kind == "notch":
+            d = self.depth
+            out.update(width=self.width, depth=None if math.isinf(d) else d,
+                       damping=[self.zeta_zero, self.zeta_pole])
+        elif self.order == 2:
+            out["damping"] = self.zeta_pole
+        return out
+
+
+@dataclass(frozen=True)
+class DriveUnits:
+    """The drive's units (``controller.drive``).
+
+    Attributes
+    ----------
+    motor_constant : float
+        Force constant [N/A].
+    encoder_resolution : float
+        Length of one encoder count [m].
+    current_scaling : float
+        Amperes per unit of the drive's current command [A].
+    """
+
+    motor_constant: float
+    encoder_resolution: float
+    current_scaling: float = 1.0
+
+    @property
+    def force_per_unit(self) -> float:
+        """Force of one unit of current command [N]: motor_constant x current_scaling."""
+        return self.motor_constant * self.current_scaling
+
+    def to_dict(self) -> dict:
+        """JSON: the three values [N/A, m, A]."""
+        return dataclass_dict(self)
+
+
+@dataclass(frozen=True)
+class SampledFilter:
+    """One filter of the chain as the drive computes it each period (a biquad).
+
+    ``y_k = b0 x_k + b1 x_{k-1} + b2 x_{k-2} - a1 y_{k-1} - a2 y_{k-2}``
+    (:func:`scipy.signal.lfilter`'s convention; a first-order low-pass has
+    two coefficients each).
+
+    Attributes
+    ----------
+    name : str
+        The filter's label.
+    b : tuple of float
+        Numerator, descending powers of z [-].
+    a : tuple of float
+        Denominator, descending powers of z, ``a[0] = 1`` [-].
+    """
+
+    name: str
+    b: tuple[float, ...]
+    a: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class DiscreteController:
+    """The controller as a drive computes it, once per sample period.
+
+    Per sample, with ``e_k = r_k - x_k`` and ``d_k`` the D term's input
+    (``e_k``, or ``-x_k`` with the D term on the measurement)::
+
+        I_k = I_{k-1} + integrator_gain (e_k + e_{k-1})       (trapezoidal)
+        D_k = derivative_pole D_{k-1} + derivative_gain (d_k - d_{k-1})
+        v_k = kp e_k + I_k + D_k
+        u_k = the filters' biquads in turn on v_k
+
+    The integrator and a filtered D term by the Tustin rule (``ki T / 2``;
+    ``(2 - wf T)/(2 + wf T)`` and ``2 kd wf / (2 + wf T)``), an ideal D by the
+    backward difference (pole 0, gain ``kd / T``); each filter by the Tustin
+    rule prewarped at its own frequency.
+
+    Attributes
+    ----------
+    sample_rate : float
+        Sample rate [Hz].
+    kp : float
+        Proportional gain [N/m].
+    integrator_gain : float
+        ki T / 2 [N/m].
+    derivative_pole : float
+        Pole of the D term's recursion [-].
+    derivative_gain : float
+        Gain of the D term's recursion [N/m].
+    derivative_on : str
+        ``"error"`` or ``"measurement"``.
+    filters : tuple of SampledFilter
+        The filter chain, in order.
+    num, den : tuple of float
+        The whole controller C(z) = F(z) C_pid(z) from the error to the force
+        command [N/m], descending powers of z (equally long, ``den[0] = 1``):
+        with the D term on the measurement, the loop's (from -x), which is
+        what the margins see.
+    """
+
+    sample_rate: float
+    kp: float
+    integrator_gain: float
+    derivative_pole: float
+    derivative_gain: float
+    derivative_on: str
+    filters: tuple[SampledFilter, ...]
+    num: tuple[float, ...]
+    den: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class DriveGains:
+    """The loop's gains in the drive's units: encoder counts in, current command out.
+
+    A force F [N] is ``motor_constant x current_scaling`` times the drive's
+    current command; a position x [m] is ``encoder_resolution`` times the
+    count. Each gain [N/m, N/(m s), N s/m] times ``encoder_resolution /
+    (motor_constant current_scaling)``.
+
+    Attributes
+    ----------
+    current_unit : str
+        The drive's unit of current command: ``A``, or the scaled unit
+        (``unit of 0.01 A``).
+    kp : float
+        Proportional gain [current unit / count].
+    ki : float
+        Integral gain [current unit / (count s)].
+    kd : float
+        Derivative gain [current unit s / count].
+    force_limit : float or None
+        The actuator's saturation [current unit]; None: none.
+    integrator_gain, derivative_gain : float or None
+        A sampled law's recursion gains (:class:`DiscreteController`)
+        [current unit / count]; None in continuous time.
+    units : dict of str to str
+        The unit of each value above, as text.
+    """
+
+    current_unit: str
+    kp: float
+    ki: float
+    kd: float
+    force_limit: float | None
+    integrator_gain: float | None
+    derivative_gain: float | None
+    units: dict[str, str]
+
+
+@dataclass(frozen=True)
 class ControlLaw:
     """The controller of the loop: one description for the linear analysis, the kernel and the report.
 
@@ -96,7 +309,10 @@ class ControlLaw:
     with a zero-order hold when ``sample_period`` > 0 (integrator by the
     trapezoidal rule, the D term by the Tustin rule, or the backward
     difference for an ideal D); the command reaches the stage ``delay``
-    later, saturated at ``force_limit``.
+    later, saturated at ``force_limit``. ``filters`` (the drive's chain of
+    notch and low-pass filters) act on the PID's output, before the
+    feedforward is added; they keep their frequencies when the loop shifts
+    to another crossover.
 
     Attributes
     ----------
@@ -135,6 +351,10 @@ class ControlLaw:
         rule's law keeps a given roll-off where it is when the crossover
         shifts, and moves the default (its wt) with the crossover (not in the
         JSON).
+    filters : tuple of Filter
+        The drive's filter chain on the PID's output, in order (empty: none).
+    drive : DriveUnits or None
+        The drive's units (``controller.drive``), for the hand-off; None: SI only.
     """
 
     source: str
@@ -155,6 +375,8 @@ class ControlLaw:
     integrator_ratio: float
     rule: PidGains = field(repr=False)
     roll_off_given: bool = field(default=False, repr=False)
+    filters: tuple[Filter, ...] = ()
+    drive: DriveUnits | None = None
 
     @property
     def integrator(self) -> bool:
@@ -246,5 +468,8 @@ class ControlLaw:
         return self.rule.filtered_d()
 
     def to_dict(self) -> dict:
-        """Plain JSON data (SI; rad/s for ``roll_off``, infinities as null; without ``rule``)."""
-        return dataclass_dict(self)
+        """Plain JSON data: SI, frequencies in Hz like the spec (``roll_off`` [Hz], null for
+        an ideal D; ``sample_period`` [s]), infinities as null; without ``rule``."""
+        out = dataclass_dict(self)
+        out["roll_off"] = None if math.isinf(self.roll_off) else self.roll_off / (2 * math.pi)
+        return out

@@ -20,7 +20,7 @@ from .mechanism import FeMechanics
 from .positioning import PositioningResult
 from .sensitivity import CrossoverSensitivity
 from .steps import (CaseResponse, CrossoverResult, FlexureResult, FrictionGapResult,
-                    LoopResponses, ModeSeparation, PidResult, StiffnessResult)
+                    LoopResponses, ModeSeparation, NotchSuggestion, PidResult, StiffnessResult)
 from .verdict import (VERDICT_STATUSES, Margins, Reason, Recommendation, RobustnessCheck,
                       Verdict, VerdictStatus)
 
@@ -28,7 +28,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..model import Model
     from ..spec import Spec
 
-__all__ = ["FrictionGapResult", "ModeSeparation", "CrossoverResult", "StiffnessResult",
+__all__ = ["FrictionGapResult", "ModeSeparation", "NotchSuggestion", "CrossoverResult", "StiffnessResult",
            "FlexureResult", "PidResult", "CaseResponse", "LoopResponses", "IsolatorAdvice",
            "PlantVerdict", "Landing", "Confirmation", "VERDICT_STATUSES", "VerdictStatus",
            "Reason", "Verdict", "RobustnessCheck", "Margins", "Recommendation",

@@ -10,14 +10,58 @@ checks, the report and the console read them.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Sequence
 
 from . import Result, Status
 from .controller import ControlLaw
 
-__all__ = ["CRITERIA", "CaseMargins", "LoopAnalysis", "AchievableCrossover"]
+__all__ = ["CRITERIA", "loop_crossover", "GainCrossing", "PhaseCrossing", "CaseMargins", "LoopAnalysis",
+           "AchievableCrossover"]
 
 #: The requirements a limit case is judged on, in the order they are listed.
 CRITERIA = ("stability", "phase margin", "gain margin", "modulus margin")
+
+
+@dataclass(frozen=True)
+class GainCrossing(Result):
+    """One 0 dB crossing of a loop (a gain crossover) and the margins read there.
+
+    Attributes
+    ----------
+    frequency : float
+        Where |L| = 1 [Hz].
+    phase_margin_deg : float
+        Phase distance of L from -180 deg there, ``|wrap(angle L + 180)|``
+        [deg]; negative when the closed loop is unstable.
+    delay_margin : float
+        Extra loop delay that brings this crossing to -180 deg [s]; 0 when
+        the closed loop is unstable.
+    in_band : bool
+        At or above :data:`fi_design.linear.BAND_FACTOR` below the
+        controller's crossover (True before the case is judged).
+    """
+
+    frequency: float
+    phase_margin_deg: float
+    delay_margin: float
+    in_band: bool = True
+
+
+@dataclass(frozen=True)
+class PhaseCrossing(Result):
+    """One -180 deg crossing of a loop (a phase crossover) and the gain margin read there.
+
+    Attributes
+    ----------
+    frequency : float
+        Where the phase of L is -180 deg [Hz].
+    gain_margin_db : float
+        ``-20 log10 |L|`` there [dB]: positive, the gain may rise by this
+        much; negative, the loop goes unstable when the gain falls by this much.
+    """
+
+    frequency: float
+    gain_margin_db: float
 
 
 @dataclass(frozen=True)
@@ -53,6 +97,15 @@ class CaseMargins(Result):
         All closed-loop poles (roots of den + num of L) in the open left half-plane.
     crossovers : tuple of float
         All gain crossovers [Hz], ascending.
+    gain_crossings : tuple of GainCrossing
+        Every 0 dB crossing with its phase and delay margin, ascending.
+    phase_crossings : tuple of PhaseCrossing
+        Every -180 deg crossing with its gain margin, ascending; where |L|
+        is below 1e-6 (a full notch's zero, where the phase flips as the loop
+        vanishes) none is counted.
+    modulus_frequency : float or None
+        Where |1 + L| is smallest, the peak of the sensitivity [Hz]; None
+        when |1 + L| never falls below 1.
     passed : bool
         Stable, and phase, gain and (if required) modulus margins meet the
         spec's requirements.
@@ -88,6 +141,9 @@ class CaseMargins(Result):
     delay_margin: float
     stable: bool
     crossovers: tuple[float, ...] = ()
+    gain_crossings: tuple[GainCrossing, ...] = ()
+    phase_crossings: tuple[PhaseCrossing, ...] = ()
+    modulus_frequency: float | None = None
     passed: bool = True
     failed: tuple[str, ...] = ()
     in_band: bool = True
@@ -113,6 +169,12 @@ class LoopAnalysis(Result):
         One per limit case, in the paper's order.
     passed : bool
         All cases meet the margin requirements.
+    loop_crossover : float or None
+        The loop's actual crossover: the highest in-band 0 dB crossing of
+        any case [Hz] (:func:`fi_design.linear.loop_crossover`); None when no
+        case crosses in the band.
+    loop_crossover_case : str or None
+        The case it belongs to.
     """
 
     crossover: float
@@ -121,6 +183,8 @@ class LoopAnalysis(Result):
     controller: ControlLaw
     cases: tuple[CaseMargins, ...]
     passed: bool
+    loop_crossover: float | None = None
+    loop_crossover_case: str | None = None
 
 
 @dataclass(frozen=True)
@@ -140,7 +204,8 @@ class AchievableCrossover(Result):
         separation), ``scan_limit`` (nothing found up to the top of the scan)
         or ``infeasible`` (no scanned crossover works).
     case : str or None
-        Name of the limiting case (``kind == "margin"``).
+        Name of the limiting case (``kind == "margin"``; with ``mode``, the
+        case whose 0 dB crossing the separation is judged on).
     criterion : str or None
         The failing requirement: ``stability``, ``phase margin``,
         ``gain margin``, ``modulus margin`` or ``parasitic separation``.
@@ -152,6 +217,12 @@ class AchievableCrossover(Result):
         crossover can fail where a higher one passes.
     evaluations : int
         Crossovers evaluated.
+    mode : str or None
+        The parasitic mode that limits it: the one the separation is judged
+        on (``kind == "mode"``); for a margin, filled in by step 2 when a
+        mode causes it (:func:`fi_design.notch.limiting_mode`).
+    mode_frequency : float or None
+        That mode's frequency [Hz].
     """
 
     frequency: float | None
@@ -163,3 +234,32 @@ class AchievableCrossover(Result):
     scan_stop: float
     feasible_ranges: tuple[tuple[float, float], ...]
     evaluations: int
+    mode: str | None = None
+    mode_frequency: float | None = None
+
+
+def loop_crossover(cases: Sequence[CaseMargins]) -> tuple[float | None, str | None]:
+    """The loop's actual crossover: the highest in-band 0 dB crossing of any limit case.
+
+    The bandwidth the parasitic modes must stay clear of
+    (``requirements.parasitic_separation``): with the cart stuck and the
+    joint free the loop may cross 0 dB well above the crossover the PID is
+    tuned for (the joint's resonance lifts |L|).
+
+    Parameters
+    ----------
+    cases : sequence of CaseMargins
+        The judged margins of the limit cases (:func:`fi_design.linear.analyse`).
+
+    Returns
+    -------
+    frequency, case : float or None, str or None
+        The crossing [Hz] and the name of the case it belongs to; None, None
+        when no case crosses 0 dB in the loop's band.
+    """
+    best, which = None, None
+    for c in cases:
+        for g in c.gain_crossings:
+            if g.in_band and (best is None or g.frequency > best):
+                best, which = g.frequency, c.name
+    return best, which

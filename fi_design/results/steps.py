@@ -6,16 +6,17 @@ responses of the four limit cases) and :func:`fi_design.flexure.size_flexure`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import Check, Result, to_jsonable
-from .controller import ControlLaw, PidGains
+from .controller import ControlLaw, DiscreteController, DriveGains, Filter, PidGains
 from .linear import CaseMargins
 from .mechanism import GuideMechanics
 
-__all__ = ["FrictionGapResult", "ModeSeparation", "CrossoverResult", "StiffnessResult", "FlexureResult", "RULE_FORM", "CONTROLLER_FORM", "HAND_OFF_FORM", "PidResult", "CaseResponse", "LoopResponses"]
+__all__ = ["FrictionGapResult", "ModeSeparation", "NotchSuggestion", "CrossoverResult", "StiffnessResult", "FlexureResult", "DRIVE_FORM", "RULE_FORM", "DRIVE_UNITS", "RULE_UNITS", "DISCRETE_UNITS", "DISCRETE_METHOD", "PidResult", "CaseResponse", "LoopResponses"]
 
 
 @dataclass(frozen=True)
@@ -57,7 +58,8 @@ class ModeSeparation(Result):
     frequency : float
         Its frequency [Hz].
     required : float
-        ``parasitic_separation`` x desired crossover [Hz].
+        ``parasitic_separation`` x the loop's crossover [Hz]
+        (:attr:`CrossoverResult.loop_crossover`).
     collocated : bool
         Collocated (antiresonance first) or not.
     passed : bool
@@ -78,6 +80,28 @@ class ModeSeparation(Result):
     source: str = "given"
     direction: str = "given"
     coupling: float = 1.0
+
+
+@dataclass(frozen=True)
+class NotchSuggestion(Result):
+    """What a notch at the mode that limits the crossover would allow.
+
+    Attributes
+    ----------
+    notch : fi_design.results.controller.Filter
+        The notch, added after the spec's own filters (``controller.filters``).
+    achievable : float or None
+        The achievable crossover with it [Hz]; None when none is.
+    limited_by : str
+        What limits that one, in words.
+    limit_kind : str
+        ``margin``, ``mode``, ``scan_limit`` or ``infeasible``.
+    """
+
+    notch: Filter
+    achievable: float | None
+    limited_by: str
+    limit_kind: str
 
 
 @dataclass(frozen=True)
@@ -108,7 +132,22 @@ class CrossoverResult(Result):
         Margins of each limit case with the PID tuned at the desired
         crossover, each judged (its ``status`` and ``criteria``).
     parasitic_modes : tuple of ModeSeparation
-        Each parasitic mode against ``parasitic_separation`` x desired crossover.
+        Each parasitic mode against ``parasitic_separation`` x the loop's
+        crossover (``loop_crossover``).
+    loop_crossover : float or None
+        The loop's actual crossover at the desired one: the highest in-band
+        0 dB crossing of any limit case [Hz]; the parasitic separation is
+        judged on it. None when no case crosses in the band (then the
+        desired crossover stands in).
+    loop_crossover_case : str or None
+        The case that crossing belongs to.
+    limiting_mode : str or None
+        The parasitic mode that limits the achievable crossover (through a
+        margin at its resonance, or the separation); None when none does.
+    limiting_mode_frequency : float or None
+        Its frequency [Hz].
+    notch : NotchSuggestion or None
+        What a notch at that mode would allow (a margin limit only).
     checks : tuple of Check
         The step's checks.
     """
@@ -123,7 +162,17 @@ class CrossoverResult(Result):
     stiffness: float | None
     cases: tuple[CaseMargins, ...]
     parasitic_modes: tuple[ModeSeparation, ...]
+    loop_crossover: float | None = None
+    loop_crossover_case: str | None = None
+    limiting_mode: str | None = None
+    limiting_mode_frequency: float | None = None
+    notch: NotchSuggestion | None = None
     checks: tuple[Check, ...] = field(default=(), repr=False)
+
+    @property
+    def separation_crossover(self) -> float:
+        """The crossover the parasitic separation is judged on [Hz]: the loop's, else the desired."""
+        return self.desired if self.loop_crossover is None else self.loop_crossover
 
 
 @dataclass(frozen=True)
@@ -289,21 +338,40 @@ class FlexureResult(Result):
         return out
 
 
-#: What the top-level gains of ``pid`` in the JSON are (the rule's, roll-off on the whole PID).
-RULE_FORM = ("the rule's gains: C(s) = ks (1 + wi/s) (1 + s/wd) / (1 + s/wt) = (kp + ki/s + kd s) "
-             "/ (1 + s/wt), the roll-off wt [rad/s] on the whole PID; not the form of "
-             "controller.gains (see hand_off)")
+#: What ``pid.drive`` is: the one gain set to give a drive.
+DRIVE_FORM = ("the gains a drive takes: u = F(s) [kp e + ki integral(e) + kd s / (1 + s / (2 pi "
+              "roll_off)) d], e = r - x, d = e or -x (derivative_on), the low-pass on the D term "
+              "only, F the filters in series on the output; the spec's controller.gains, "
+              "roll_off, derivative_on and filters; frequencies in Hz")
 
+#: What ``pid.rule`` is: the tuning rule's parameters, not gains to copy.
+RULE_FORM = ("the tuning rule (series form): C(s) = ks (1 + wi/s) (1 + s/wd) / (1 + s/wt), its "
+             "corners given in Hz (integrator_corner = wi / 2 pi, lead_corner = wd / 2 pi, "
+             "roll_off = wt / 2 pi, on the whole PID); with the rule, the same loop as drive")
 
-#: What ``pid.controller`` is.
-CONTROLLER_FORM = ("the loop as analysed and simulated: kp + ki/s + kd s / (1 + s/roll_off), the "
-                   "roll-off [rad/s] on the D term only (inf: an ideal D)")
+#: Units of the keys of ``pid.drive``.
+DRIVE_UNITS = {"kp": "N/m", "ki": "N/(m s)", "kd": "N s/m", "roll_off": "Hz",
+               "sample_rate": "Hz", "delay": "s", "force_limit": "N",
+               "filters.frequency": "Hz", "filters.width": "Hz", "filters.depth": "dB",
+               "filters.damping": "-", "feedforward.mass": "kg",
+               "feedforward.viscous": "N s/m", "feedforward.coulomb": "N"}
 
+#: Units of the keys of ``pid.rule``.
+RULE_UNITS = {"crossover": "Hz", "tuning_mass": "kg", "ks": "N/m", "integrator_corner": "Hz",
+              "lead_corner": "Hz", "roll_off": "Hz"}
 
-#: What ``pid.hand_off`` is.
-HAND_OFF_FORM = ("the loop in the form the spec takes: controller.gains {kp, ki, kd} with "
-                 "controller.roll_off [Hz] on the D term only, controller.derivative_on, "
-                 "controller.sample_rate [Hz] and controller.delay [s]")
+#: Units of the keys of ``pid.drive.discrete``.
+DISCRETE_UNITS = {"sample_rate": "Hz", "kp": "N/m", "integrator_gain": "N/m",
+                  "derivative_pole": "-", "derivative_gain": "N/m", "filters.b": "-",
+                  "filters.a": "-", "num": "N/m", "den": "-"}
+
+#: How a sampled controller is discretised, in words (JSON ``pid.drive.discrete.method``).
+DISCRETE_METHOD = ("per sample: I_k = I_(k-1) + integrator_gain (e_k + e_(k-1)) (trapezoidal), "
+                   "D_k = derivative_pole D_(k-1) + derivative_gain (d_k - d_(k-1)) (Tustin; an "
+                   "ideal D by the backward difference), u_k = kp e_k + I_k + D_k through each "
+                   "filter's biquad y_k = b0 x_k + b1 x_(k-1) + b2 x_(k-2) - a1 y_(k-1) - a2 "
+                   "y_(k-2) (Tustin prewarped at the filter's frequency); num/den: the whole "
+                   "C(z), descending powers of z")
 
 
 @dataclass(frozen=True)
@@ -313,8 +381,8 @@ class PidResult(Result):
     Attributes
     ----------
     gains : fi_design.results.controller.PidGains
-        The rule's gains at the loop's crossover (JSON: flattened into the
-        ``pid`` object); with explicit hardware gains, the recommendation.
+        The rule's gains at the loop's crossover; with explicit hardware
+        gains, the recommendation.
     tuning_rule : str
         ``total`` (m1 + m2, the paper's choice) or ``stage`` (m1).
     derivative_ratio : float
@@ -323,12 +391,17 @@ class PidResult(Result):
         wi = wc / ratio [-].
     controller : fi_design.results.controller.ControlLaw
         The loop's controller: the rule's, or the hardware's own gains
-        (``source``), as the analysis and the simulation use it.
+        (``source``), with its filters, as the analysis and the simulation
+        use it.
     static_error : float or None
         Static position error of a loop without integrator against Coulomb
         friction, (Fs + |offset|) / kp [m]
         (:attr:`fi_design.model.Model.static_error_bound`); None when the
         loop integrates.
+    discrete : fi_design.results.controller.DiscreteController or None
+        The controller as a sampled drive computes it; None in continuous time.
+    drive_gains : fi_design.results.controller.DriveGains or None
+        The gains in the drive's units (``controller.drive``); None without.
     checks : tuple of Check
         The step's checks.
     """
@@ -339,23 +412,62 @@ class PidResult(Result):
     integrator_ratio: float
     controller: ControlLaw
     static_error: float | None
+    discrete: DiscreteController | None = None
+    drive_gains: DriveGains | None = None
     checks: tuple[Check, ...] = field(default=(), repr=False)
 
-    def to_dict(self) -> dict:
-        """JSON: the rule's gains (flat, labelled by ``form``), the rule and its ratios, the
-        loop's controller and ``hand_off``, the loop in the form the spec's
-        ``controller.gains`` takes (with ``roll_off`` in Hz on the D term, the sampling and
-        the delay the analysis used)."""
-        out = {"form": RULE_FORM, **self.gains.to_dict(), "tuning_rule": self.tuning_rule,
-               "derivative_ratio": self.derivative_ratio,
-               "integrator_ratio": to_jsonable(self.integrator_ratio),
-               "source": self.controller.source, "integrator": self.controller.integrator,
-               "static_error": self.static_error,
-               "controller": {"form": CONTROLLER_FORM, **self.controller.to_dict()},
-               "hand_off": {"form": HAND_OFF_FORM, **self.controller.hand_off()}}
-        if self.controller.source == "gains":
-            out["rule_in_hardware_form"] = to_jsonable(self.controller.rule_in_this_form())
+    def drive(self) -> dict:
+        """The one gain set a drive takes (JSON ``pid.drive``), frequencies in Hz.
+
+        ``kp`` [N/m], ``ki`` [N/(m s)], ``kd`` [N s/m], ``roll_off`` [Hz] (null:
+        an ideal D), ``derivative_on``, ``sample_rate`` [Hz] (null:
+        continuous), ``delay`` [s], ``force_limit`` [N] (null: none),
+        ``filters`` (the spec's keys), ``feedforward``, ``units``, and
+        ``in_drive_units`` (with ``controller.drive``) and ``discrete`` (a
+        sampled loop) or null.
+        """
+        law = self.controller
+        out = {"form": DRIVE_FORM, **law.hand_off(),
+               "force_limit": to_jsonable(law.force_limit),
+               "filters": [f.to_dict() for f in law.filters],
+               "feedforward": {"mass": law.ff_mass, "viscous": law.ff_viscous,
+                               "coulomb": law.ff_coulomb},
+               "units": dict(DRIVE_UNITS),
+               "in_drive_units": to_jsonable(self.drive_gains),
+               "discrete": None}
+        if self.discrete is not None:
+            out["discrete"] = {"method": DISCRETE_METHOD, **to_jsonable(self.discrete),
+                               "units": dict(DISCRETE_UNITS)}
         return out
+
+    def rule(self) -> dict:
+        """The tuning rule's parameters (JSON ``pid.rule``), corners in Hz.
+
+        ``crossover`` [Hz], ``tuning_mass`` [kg], ``ks`` [N/m],
+        ``integrator_corner``, ``lead_corner``, ``roll_off`` [Hz], ``units``;
+        with the hardware's gains ``in_drive_form``: the rule's gains at the
+        same crossover in the drive's form (``kp``, ``ki``, ``kd``,
+        ``roll_off`` [Hz] on the D term), the recommendation.
+        """
+        g = self.gains
+        two_pi = 2.0 * math.pi
+        out = {"form": RULE_FORM, "crossover": g.crossover, "tuning_mass": g.tuning_mass,
+               "ks": g.ks, "integrator_corner": g.wi / two_pi, "lead_corner": g.wd / two_pi,
+               "roll_off": g.wt / two_pi, "units": dict(RULE_UNITS)}
+        if self.controller.source == "gains":
+            r = self.controller.rule_in_this_form()
+            out["in_drive_form"] = {"kp": r["kp"], "ki": r["ki"], "kd": r["kd"],
+                                    "roll_off": r["roll_off"] / two_pi}
+        return out
+
+    def to_dict(self) -> dict:
+        """JSON: ``drive`` (the one gain set a drive takes, :meth:`drive`), ``rule`` (the
+        tuning rule's parameters, :meth:`rule`), the source, the ratios and the static error."""
+        return {"source": self.controller.source, "integrator": self.controller.integrator,
+                "static_error": self.static_error, "tuning_rule": self.tuning_rule,
+                "derivative_ratio": self.derivative_ratio,
+                "integrator_ratio": to_jsonable(self.integrator_ratio),
+                "drive": self.drive(), "rule": self.rule()}
 
 
 @dataclass(frozen=True, eq=False)
@@ -388,12 +500,19 @@ class LoopResponses(Result):
     Attributes
     ----------
     frequency : ndarray, shape (n,)
-        Log-spaced frequencies [Hz]: from a third of the lowest gain crossover
+        Ascending frequencies [Hz]: from a third of the lowest gain crossover
         of any case (and a thirtieth of the desired crossover) to thirty times
-        the desired crossover or twice the highest parasitic mode.
+        the desired crossover or twice the highest parasitic mode (a sampled
+        controller's Nyquist frequency at most); log-spaced, packed at every
+        resonance and antiresonance, holding every crossing and sensitivity
+        peak (:func:`fi_design.responses.loop_responses`).
     cases : tuple of CaseResponse
         One per limit case, in the paper's order.
+    nyquist : float or None
+        The Nyquist frequency of a sampled controller [Hz], where the grid
+        ends; None in continuous time.
     """
 
     frequency: np.ndarray
     cases: tuple[CaseResponse, ...]
+    nyquist: float | None = None

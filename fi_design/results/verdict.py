@@ -213,6 +213,19 @@ class Margins(Result):
         The lowest crossover from which no move of the family hunts [Hz]: the
         fold of the hunting cycle, bisected to the resolution in the stage's
         ``boundary`` (:attr:`fi_design.results.stage.StageHunting.boundary`).
+    hunting_case : str or None
+        The limit case the hunting cycle slides in (``sliding_limited`` when
+        the joint rides its limiter, ``sliding_free``, or ``sliding`` without
+        isolator): the loop whose actual crossovers the margin is read on.
+    hunting_loop_crossover : float or None
+        That case's 0 dB crossing at the design [Hz].
+    hunting_free_loop_crossover : float or None
+        That case's 0 dB crossing with the loop at the hunting-free
+        crossover [Hz]. ``crossover_factor`` is the ratio of the set
+        crossovers, the loop's frequency scale (every corner of the
+        controller moves by it), which ``requirements.hunting_margin`` bounds;
+        the ratio of these two crossings is the same to within the plant's
+        own dynamics (under 1 % on the paper setup).
     achievable_factor : float or None
         Achievable / desired crossover of step 2 [-]; None when the
         achievable crossover is only a bound (the search cap) or none.
@@ -247,6 +260,9 @@ class Margins(Result):
     crossover_factor: float | None = None
     crossover_factor_bound: bool = False
     hunting_free_crossover: float | None = None
+    hunting_case: str | None = None
+    hunting_loop_crossover: float | None = None
+    hunting_free_loop_crossover: float | None = None
     achievable_factor: float | None = None
     achievable_crossover_bound: float | None = None
     end_stop_clearance: float | None = None

@@ -14,7 +14,8 @@ prints them all.
 
 The package, one job a module: :mod:`.fields` (quantities with units, plain
 text, the strict base model), :mod:`.sections` (every section of the file),
-:mod:`.document` (the :class:`Spec` itself, its effects list and the checks
+:mod:`.filters` (the controller's filter chain and
+the drive's units), :mod:`.document` (the :class:`Spec` itself, its effects list and the checks
 across sections) and :mod:`.defaults` (derived defaults and warnings).
 """
 
@@ -26,6 +27,7 @@ from .defaults import (CROSSOVER_AGREEMENT, JOINT_DAMPING_RATIO, antiresonance, 
                        proposed_stiffness, stiffness_limit, tuning_mass, warnings_for)
 from .document import EFFECT_MODELS, EffectEntry, Spec
 from .fields import OptQ, Q, StrictModel, Text
+from .filters import BUTTERWORTH, FILTER_TYPES, Drive, FilterEntry, LowPass, Notch
 from .sections import (MAX_OUTPUT_SAMPLES, MAX_SCAN_POINTS, MAX_STEPS, REPORT_KINDS, Body, Bounds,
                        Controller, CrossoverScan, DocumentIds, Family, Feedforward, Flexure,
                        Friction, Gains, Hunting, Isolator, Limiter, Material, Measurement, Motion,
@@ -34,6 +36,7 @@ from .sections import (MAX_OUTPUT_SAMPLES, MAX_SCAN_POINTS, MAX_STEPS, REPORT_KI
                        Ripple, Robustness, Simulation, Stage, move_duration, scan_points)
 
 __all__ = [
+    "BUTTERWORTH", "Drive", "FILTER_TYPES", "FilterEntry", "LowPass", "Notch",
     "Body", "Bounds", "CROSSOVER_AGREEMENT", "Controller", "CrossoverScan", "DocumentIds",
     "EFFECT_MODELS", "EffectEntry", "Family", "Feedforward", "Flexure", "Friction", "Gains",
     "Hunting", "Isolator", "JOINT_DAMPING_RATIO", "Limiter", "MAX_OUTPUT_SAMPLES",

@@ -11,6 +11,7 @@ from pydantic import Field, model_validator
 
 from ..trajectory import profile_duration
 from .fields import OptQ, Q, StrictModel, Text
+from .filters import Drive, FilterEntry
 
 
 # --------------------------------------------------------------------------- sections
@@ -308,12 +309,27 @@ class Controller(StrictModel):
     delay: Q("s") = Field(0.0, ge=0, description="Computational delay [s]. Default 0.")
     pade_order: int = Field(3, ge=1, le=10, description="Order of the Pade approximation of the "
                                                         "delay in the linear analysis. Default 3.")
+    filters: tuple[FilterEntry, ...] = Field((), max_length=4,
+                                             description="The drive's filter chain: notch "
+                                                         "and low_pass filters in series "
+                                                         "with the PID, on its output, in "
+                                                         "this order (at most 4). Default "
+                                                         "none.")
+    drive: Drive | None = Field(None, description="The drive's units (motor constant, encoder "
+                                                  "resolution, current scaling): the gains in "
+                                                  "counts and amperes too. Default none.")
 
     @model_validator(mode="after")
     def _crossover_or_gains(self) -> "Controller":
         if self.crossover is None and self.gains is None:
             raise ValueError("give the desired crossover (the PID rule tunes for it) or the "
                              "hardware's gains")
+        if self.sample_rate is not None:
+            for i, f in enumerate(self.filters):
+                if f.frequency >= 0.5 * self.sample_rate:
+                    raise ValueError(f"filters[{i}] ({f.name}) at {f.frequency:g} Hz lies at or "
+                                     f"above the Nyquist frequency {0.5 * self.sample_rate:g} Hz "
+                                     "of sample_rate")
         return self
 
 
