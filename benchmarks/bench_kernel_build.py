@@ -52,8 +52,8 @@ RUN = r"""
 import time
 t0 = time.perf_counter()
 import json, sys
-from fi_design.specfile import load_spec
-from fi_design.simulation import simulate
+from fi_design.spec.file import load_spec
+from fi_design.simulation.run import simulate
 from fi_design.kernel.build import compiled
 spec = load_spec(sys.argv[1])
 t1 = time.perf_counter()
@@ -105,8 +105,8 @@ def one_round(repeat: int) -> dict:
 def speed(rounds: int, repeat: int) -> None:
     """Both builds' kernel time per plant in this process, alternating (needs the extension)."""
     from fi_design.kernel.build import BACKEND_ENV, compiled
-    from fi_design.simulation import simulate
-    from fi_design.specfile import load_spec
+    from fi_design.simulation.run import simulate
+    from fi_design.spec.file import load_spec
 
     spec = load_spec(SPEC)
     times: dict = {}

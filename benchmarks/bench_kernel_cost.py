@@ -40,8 +40,8 @@ try:  # compiles, or loads the cache
     import fi_design.kernel.integrator  # noqa: F401
 except ModuleNotFoundError:  # a baseline from before the kernel package
     import fi_design.kernel  # noqa: F401
-from fi_design.simulation import simulate
-from fi_design.specfile import load_spec
+from fi_design.simulation.run import simulate
+from fi_design.spec.file import load_spec
 spec = load_spec(sys.argv[1])
 simulate(spec, isolated=True)
 simulate(spec, isolated=False)

@@ -43,9 +43,9 @@ def trace(effect: str, isolated: bool):
     import yaml
 
     from fi_design.measured import measurement_from_arrays
-    from fi_design.simulation import simulate
+    from fi_design.simulation.run import simulate
     from fi_design.spec import EFFECT_MODELS
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     raw = yaml.safe_load((ROOT / "examples" / "measured_stage.yaml").read_text())
     raw["motion"] = {"moves": [
@@ -78,7 +78,7 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--no-isolator", action="store_true")
     args = ap.parse_args(argv)
     from fi_design.reconciliation import reconcile
-    from fi_design.simulation import simulate
+    from fi_design.simulation.run import simulate
 
     isolated = not args.no_isolator
     spec, data = trace(args.effect, isolated)

@@ -45,8 +45,8 @@ def make_record(n: int, path: Path) -> None:
     import yaml
 
     from fi_design.measured import measurement_from_arrays, to_csv_text
-    from fi_design.simulation import simulate
-    from fi_design.specfile import load_spec
+    from fi_design.simulation.run import simulate
+    from fi_design.spec.file import load_spec
 
     duration = (n - 1) / RATE
     raw = yaml.safe_load(SPEC.read_text())

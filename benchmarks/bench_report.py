@@ -91,7 +91,7 @@ def main(argv: list[str] | None = None) -> int:
         load1 = os.getloadavg()[0]
 
         from fi_design import design, report
-        from fi_design.specfile import load_spec
+        from fi_design.spec.file import load_spec
 
         result = design(load_spec(SPEC))
         ctx_t = phase(lambda: report.build_context(result, date="2026-01-01"), args.repeat)

@@ -53,7 +53,7 @@ def kernel_only(spec, isolated: bool):
     from fi_design.kernel import run
     from fi_design.trajectory import from_moves
     from fi_design.model import resolve
-    from fi_design.simulation import tolerances
+    from fi_design.simulation.run import tolerances
 
     key = (id(spec), isolated)
     if key not in _PREPARED:
@@ -76,7 +76,7 @@ def plain_solve_ivp(spec, isolated: bool, t_end: float, method: str):
     from fi_design.kernel import equations as plant
     from fi_design.trajectory import from_moves
     from fi_design.model import resolve
-    from fi_design.simulation import tolerances
+    from fi_design.simulation.run import tolerances
 
     par = resolve(spec).plant(isolated)
     p = par.to_array()
@@ -185,7 +185,7 @@ def python_control_run(spec, isolated: bool, t_end: float):
     from fi_design.kernel import equations as plant
     from fi_design.trajectory import from_moves
     from fi_design.model import resolve
-    from fi_design.simulation import tolerances
+    from fi_design.simulation.run import tolerances
 
     par = resolve(spec).plant(isolated)
     p = par.to_array()
@@ -221,8 +221,8 @@ def main() -> None:
     ap.add_argument("--skip-cold", action="store_true")
     args = ap.parse_args()
 
-    from fi_design.simulation import simulate
-    from fi_design.specfile import load_spec
+    from fi_design.simulation.run import simulate
+    from fi_design.spec.file import load_spec
 
     spec = load_spec(SPEC)
     simulate(spec, isolated=True)  # compile or load the kernel

@@ -97,8 +97,8 @@ def commands(rounds: int, work: Path) -> list[tuple[str, float, str, float, floa
 def in_process(rounds: int) -> tuple[float, float]:
     """(stage-level answer of both paper plants [s], the spec's move of both plants [s])."""
     from fi_design.kernel.build import compiled
-    from fi_design.simulation import simulate
-    from fi_design.specfile import load_spec
+    from fi_design.simulation.run import simulate
+    from fi_design.spec.file import load_spec
     from fi_design.stage import stage_hunting
 
     compiled()

@@ -112,8 +112,8 @@ def cad_loop(calls: int) -> list[tuple[str, float]]:
     """Seconds per call of design() in one process, and of the yardstick."""
     import control
 
-    from fi_design.guideline import design
-    from fi_design.specfile import load_spec
+    from fi_design.guideline.evaluate import evaluate as design
+    from fi_design.spec.file import load_spec
 
     spec = load_spec(SPEC)
     out = []
@@ -142,9 +142,9 @@ T = [time.perf_counter()]
 out = []
 def mark(label):
     T.append(time.perf_counter()); out.append((label, T[-1] - T[-2]))
-import typer, rich, fi_design.cli
+import typer, rich, fi_design.cli.app
 mark("Python, typer, rich and the CLI module")
-from fi_design.specfile import load_spec
+from fi_design.spec.file import load_spec
 spec = load_spec(sys.argv[1])
 mark("pydantic, pint and the spec")
 import scipy.signal
@@ -154,13 +154,13 @@ mark("the rest of python-control (matplotlib.pyplot among it)")
 from fi_design.kernel.build import compiled
 compiled()
 mark("the simulation kernel (the extension built at install)")
-from fi_design.guideline import design
+from fi_design.guideline.evaluate import evaluate as design
 design(spec, confirm=False)
 mark("the four linear steps (about 140 margin evaluations)")
-from fi_design.confirm import confirm
+from fi_design.stage.confirm import confirm
 confirm(spec, None)
 mark("the confirmation (with and without isolator, crossover scans)")
-from fi_design import verdict
+from fi_design.guideline import verdict
 from fi_design.model import resolve
 study = verdict.run_robustness(resolve(spec), None)
 mark(f"the robustness study ({study.samples} samples, both plants)")

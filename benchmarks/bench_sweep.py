@@ -70,7 +70,7 @@ def main() -> None:
     args = ap.parse_args()
 
     t0 = time.perf_counter()
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
     from fi_design.studies import PointCache, parse_axis, sweep, warm_up
 
     spec = load_spec(SPEC)

@@ -86,7 +86,7 @@ def table(results: dict) -> str:
 def run_examples(names: list[str] | None = None) -> dict:
     """The sign-off of every example spec (or of the named ones), by name."""
     from fi_design import design
-    from fi_design.pools import confirmation_pool
+    from fi_design.cli.pools import confirmation_pool
 
     paths = sorted(EXAMPLES.glob("*.yaml"))
     if names:

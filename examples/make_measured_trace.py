@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from fi_design import load_spec
-from fi_design.simulation import simulate
+from fi_design.simulation.run import simulate
 from fi_design.measured import measurement_from_arrays, to_csv_text
 from fi_design.spec import EFFECT_MODELS
 

@@ -46,15 +46,15 @@ except PackageNotFoundError:  # running from a source tree without install
     __version__ = "0.0.0+unknown"
 
 _API = {
-    "load_spec": "fi_design.specfile",
-    "with_values": "fi_design.specpaths",
+    "load_spec": "fi_design.spec.file",
+    "with_values": "fi_design.spec.paths",
     "Spec": "fi_design.spec",
     "design": "fi_design.signoff",
     "recommend": "fi_design.recommend",
     "resolve": "fi_design.model",
     "Model": "fi_design.model",
     "DesignResult": "fi_design.results.design",
-    "simulate": "fi_design.simulation",
+    "simulate": "fi_design.simulation.run",
     "SimulationResult": "fi_design.results.simulation",
     "sweep": "fi_design.studies",
     "robustness": "fi_design.studies",

@@ -1,5 +1,5 @@
 """``python -m fi_design``: the command-line interface."""
 
-from fi_design.cli import main
+from fi_design.cli.app import main
 
 main()

@@ -6,7 +6,7 @@ samples, a method name) are checked here, at the function's entry, so that a
 script passing ``crossover="5 Hz"`` or ``form="bogus"`` gets an
 :class:`~fi_design.errors.ArgumentError` naming the argument and what it got,
 never a ``ValueError`` from deep inside numpy. Text with units is read by
-:func:`fi_design.units.to_si`; these functions take numbers (SI) only.
+:func:`fi_design.spec.units.to_si`; these functions take numbers (SI) only.
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def number(value: Any, name: str, unit: str, *, positive: bool = False,
         of bounds; the message names the argument and the value.
     """
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        hint = " (read text with units by fi_design.units.to_si)" if isinstance(value, str) else ""
+        hint = " (read text with units by fi_design.spec.units.to_si)" if isinstance(value, str) else ""
         raise ArgumentError(f"{name} must be a number in {unit}, got {_shown(value)}{hint}")
     try:
         x = float(value)

@@ -93,7 +93,7 @@ def cli_reference(app: Any = None) -> str:
     Parameters
     ----------
     app : typer.Typer, optional
-        The app; default :data:`fi_design.cli.app`.
+        The app; default :data:`fi_design.cli.app.app`.
 
     Returns
     -------
@@ -104,7 +104,7 @@ def cli_reference(app: Any = None) -> str:
     from typer.main import get_command
 
     if app is None:
-        from .cli import app
+        from .cli.app import app
     group = get_command(app)
     root = click.Context(group, info_name="fi-design")
     out = [_HEAD, f"Usage: {_usage(group, root)}", "", _help_text(group), ""]

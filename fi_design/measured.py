@@ -17,7 +17,7 @@ disturbance_N  N      no       known force injected at the actuator by the exper
 ``force_N`` is the total force command the actuator received, an injected
 disturbance included; the controller's own output is ``force_N -
 disturbance_N``. A record may start in motion: replays start from the state
-in the first samples (:mod:`fi_design.simulation`).
+in the first samples (:mod:`fi_design.simulation.run`).
 
 Lines starting with ``#`` before the header are comments (e.g. how the trace
 was recorded); blank lines are skipped; other columns are ignored. Every value must be a plain number

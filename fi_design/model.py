@@ -31,7 +31,7 @@ from functools import cached_property
 from . import effects as _effects
 from . import spec as _spec
 from .errors import ArgumentError, SimulationError, SpecError
-from .pid import at_crossover, control_law
+from .controller.pid import at_crossover, control_law
 from .kernel.layout import PlantParameters
 from .mechanism.geometry import StageBody, stage_body
 from .results.controller import ControlLaw, Filter
@@ -274,7 +274,7 @@ class Model:
         ----------
         crossover : float, optional
             Shift the loop to this crossover [Hz]: the rule retunes, explicit
-            gains scale in frequency (:func:`fi_design.pid.at_crossover`).
+            gains scale in frequency (:func:`fi_design.controller.pid.at_crossover`).
         stiffness : float, optional
             Drive stiffness k [N/m]. A damping the spec does not give keeps
             the joint mode's damping ratio.
@@ -485,7 +485,7 @@ def resolve(spec: _spec.Spec) -> Model:
 
     Examples
     --------
-    >>> from fi_design.specfile import load_spec
+    >>> from fi_design.spec.file import load_spec
     >>> model = resolve(load_spec("examples/paper_setup.yaml"))
     >>> model.crossover, model.joint.stiffness, round(model.joint.damping, 2)
     (8.0, 6667.0, 4.62)

@@ -2,7 +2,7 @@
 
 :func:`design` is the library's and the design command's entry point: the
 four guideline steps, the simulated confirmation and the verdict
-(:func:`fi_design.guideline.design`), and, when the verdict fails, the design
+(:func:`fi_design.guideline.evaluate.evaluate`), and, when the verdict fails, the design
 search of :func:`fi_design.recommend.recommend` as the result's
 ``recommendation``: what to build, found by the same computation that signs
 a design off.
@@ -15,7 +15,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from . import guideline
+from .guideline import evaluate as guideline
 from .results.design import DesignResult
 from .spec import Spec
 
@@ -33,7 +33,7 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     spec : Spec, path or mapping
         A validated spec, or a YAML path or mapping.
     confirm : bool, optional
-        Simulate (see :func:`fi_design.guideline.design`). Default True; a
+        Simulate (see :func:`fi_design.guideline.evaluate.evaluate`). Default True; a
         design that was not simulated is never recommended on.
     executor : concurrent.futures-style executor, optional
         Runs the simulations (the confirmation, the robustness samples and
@@ -47,11 +47,11 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         a minute) and return it as ``recommendation``. Default True.
     fe_check : bool, optional
         Also check the flexure guide with a finite-element model (see
-        :func:`fi_design.guideline.design`). Default False.
+        :func:`fi_design.guideline.evaluate.evaluate`). Default False.
     sensitivity : bool, optional
         Also find how the hunting-free crossover moves with the unidentified
         LuGre values sigma0, sigma1 and vs (see
-        :func:`fi_design.guideline.design`; a few seconds). Default False;
+        :func:`fi_design.guideline.evaluate.evaluate`; a few seconds). Default False;
         the design command runs it for a report.
 
     Returns
@@ -63,12 +63,12 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     fi_design.errors.SpecError
         When ``spec`` is a path or mapping that does not validate.
     """
-    result = guideline.design(spec, confirm=confirm, executor=executor, progress=progress,
-                              fe_check=fe_check, sensitivity=sensitivity)
+    result = guideline.evaluate(spec, confirm=confirm, executor=executor, progress=progress,
+                                fe_check=fe_check, sensitivity=sensitivity)
     if not (recommend and result.simulation is not None and result.verdict.status == "FAIL"):
         return result
     from .recommend import recommend as search
-    from .verdict import recommendation
+    from .guideline.verdict import recommendation
 
     if progress is not None:
         progress("searching for a design that passes ...")

@@ -49,7 +49,7 @@ def paper_spec_path() -> Path:
 @pytest.fixture(scope="session")
 def paper_spec(paper_spec_path):
     """The validated :class:`~fi_design.spec.Spec` of examples/paper_setup.yaml."""
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     return load_spec(paper_spec_path)
 
@@ -128,7 +128,7 @@ def _spec_key(spec) -> tuple | None:
     """(resolved path or None, SHA-256 of the file, the validated values) of a spec read by
     load_spec; None for anything else."""
     from fi_design.spec import Spec
-    from fi_design.specfile import origin
+    from fi_design.spec.file import origin
 
     found = origin(spec) if isinstance(spec, Spec) else None
     if found is None:
@@ -160,7 +160,7 @@ def sharing_designs():
     """The guideline's design and the design search computed once per spec and process.
 
     For tests of what the command line or a documented example does with a design (prints,
-    writes, exits with), not of how it is computed: ``fi_design.guideline.design`` and
+    writes, exits with), not of how it is computed: ``fi_design.guideline.evaluate.evaluate`` and
     ``fi_design.recommend.recommend`` return the result an earlier call on the same spec file
     (same path, same bytes) computed in this process, as the design command would compute it
     again (a design is a function of its spec; the executor changes where it runs, not what it
@@ -169,10 +169,10 @@ def sharing_designs():
     """
     import importlib
 
-    from fi_design import guideline
+    from fi_design.guideline import evaluate as guideline
 
     search = importlib.import_module("fi_design.recommend")  # the package, not the function
-    real_design, real_recommend = guideline.design, search.recommend
+    real_design, real_recommend = guideline.evaluate, search.recommend
 
     def design(spec, *, confirm=True, executor=None, progress=None, **kwargs):
         return shared("design", spec, lambda: real_design(
@@ -186,7 +186,7 @@ def sharing_designs():
             spec, executor=executor, progress=progress))
 
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(guideline, "design", design)
+        patch.setattr(guideline, "evaluate", design)
         patch.setattr(search, "recommend", recommend)
         yield
 
@@ -202,7 +202,7 @@ def shared_designs():
 def paper_confirmed_design(paper_spec):
     """The design of examples/paper_setup.yaml with its simulated confirmation, computed once
     (and shared with the tests that use :func:`shared_designs`)."""
-    from fi_design.guideline import design
+    from fi_design.guideline.evaluate import evaluate as design
 
     return shared("design", paper_spec, lambda: design(paper_spec), True)
 
@@ -213,11 +213,11 @@ def variant(spec, **paths):
     ``variant(spec, **{"friction.static": "3 N", "isolator": None})``: a value
     replaces (or adds) the key, None removes it; values are written as in the
     YAML file (SI numbers or strings with units). Unlike
-    :func:`fi_design.specfile.with_values` it may add or drop whole sections.
+    :func:`fi_design.spec.file.with_values` it may add or drop whole sections.
     """
     import copy
 
-    from fi_design.specfile import load_spec, origin
+    from fi_design.spec.file import load_spec, origin
 
     raw = copy.deepcopy(origin(spec).raw)
     for path, value in paths.items():

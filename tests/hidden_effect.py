@@ -14,9 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from fi_design.measured import Measurement, measurement_from_arrays
-from fi_design.simulation import simulate
+from fi_design.simulation.run import simulate
 from fi_design.spec import EFFECT_MODELS
-from fi_design.specfile import load_spec
+from fi_design.spec.file import load_spec
 
 from conftest import EXAMPLES
 

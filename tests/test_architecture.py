@@ -42,7 +42,7 @@ def test_import_fi_design_is_light():
                                   ["design", "--help"], ["init", "--help"]])
 def test_cli_help_is_light(argv):
     code = ("sys.argv = ['fi-design'] + " + repr(argv) + "\n"
-            "from fi_design.cli import main\n"
+            "from fi_design.cli.app import main\n"
             "import contextlib, io\n"
             "with contextlib.redirect_stdout(io.StringIO()):\n"
             "    try:\n"
@@ -54,14 +54,14 @@ def test_cli_help_is_light(argv):
 
 
 def test_cli_module_imports_no_library_at_top_level():
-    loaded = _loaded_after("import fi_design.cli")
+    loaded = _loaded_after("import fi_design.cli.app")
     assert not loaded & (set(HEAVY) | {"pydantic", "numpy", "pint", "rich"}), sorted(loaded)
 
 
 def test_public_functions_stay_callable_after_their_modules_are_imported():
     """``fi_design.simulate`` etc. are functions, whatever was imported before."""
-    code = ("import fi_design.simulation, fi_design.studies, fi_design.reconciliation, "
-            "fi_design.guideline, fi_design.report, fi_design.measured\n"
+    code = ("import fi_design.simulation.run, fi_design.studies, fi_design.reconciliation, "
+            "fi_design.guideline.steps, fi_design.report, fi_design.measured\n"
             "import fi_design\n"
             "names = ['simulate', 'sweep', 'robustness', 'reconcile', 'design', 'load_spec',\n"
             "         'load_measurement', 'render_report']\n"

@@ -11,7 +11,7 @@ from __future__ import annotations
 import pytest
 from typer.testing import CliRunner
 
-from fi_design.cli import app
+from fi_design.cli.app import app
 
 from conftest import EXAMPLES
 
@@ -380,16 +380,16 @@ def test_the_record_is_an_input_not_an_output(tmp_path):
 def test_a_file_that_appears_during_the_run_is_kept(tmp_path, paper_spec_path, monkeypatch):
     """A file created after the start-up check (another program, another run) is not replaced
     without --force; the run says so and exits 2."""
-    import fi_design.guideline as guideline
+    import fi_design.guideline.evaluate as guideline
 
     out = tmp_path / "out.json"
-    real = guideline.design
+    real = guideline.evaluate
 
     def design_while_someone_writes(*args, **kwargs):
         out.write_text("written by someone else")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(guideline, "design", design_while_someone_writes)
+    monkeypatch.setattr(guideline, "evaluate", design_while_someone_writes)
     result = runner.invoke(app, [str(paper_spec_path), "--no-simulation", "--json", str(out)])
     assert result.exit_code == 2, result.output
     assert "appeared while this run worked" in result.stderr

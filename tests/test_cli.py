@@ -12,7 +12,7 @@ import pytest
 from typer.testing import CliRunner
 
 from fi_design import __version__
-from fi_design.cli import app
+from fi_design.cli.app import app
 
 from conftest import BIN, ROOT, sharing_designs
 
@@ -126,12 +126,12 @@ def test_wrong_extension_and_missing_directory(tmp_path, paper_spec_path):
 
 
 def test_internal_error_exit_1_without_traceback(paper_spec_path, monkeypatch):
-    import fi_design.guideline
+    import fi_design.guideline.evaluate
 
     def boom(spec, **kwargs):
         raise RuntimeError("kaboom")
 
-    monkeypatch.setattr(fi_design.guideline, "design", boom)
+    monkeypatch.setattr(fi_design.guideline.evaluate, "evaluate", boom)
     monkeypatch.delenv("FI_DESIGN_DEBUG", raising=False)
     r = runner.invoke(app, [str(paper_spec_path)])
     assert r.exit_code == 1
@@ -268,7 +268,7 @@ class _FakeResult:
 
 def _fake_design(monkeypatch, calls):
     """Replace the (slow) design and simulations by stubs: these tests are about plumbing."""
-    import fi_design.cli
+    import fi_design.cli.app
     import fi_design.signoff
 
     def fake(spec, **kwargs):

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from fi_design.cli import app
-from fi_design.confirm import confirm
-from fi_design.guideline import design
-from fi_design.specfile import load_spec
+from fi_design.cli.app import app
+from fi_design.stage.confirm import confirm
+from fi_design.guideline.evaluate import evaluate as design
+from fi_design.spec.file import load_spec
 
 runner = CliRunner()
 
@@ -45,7 +45,7 @@ def test_paper_headline_isolator_needs_far_less_bandwidth(paper_confirmation):
 
 def test_more_bandwidth_means_fewer_cycles_without_isolator(paper_spec):
     """Paper Figure 4 B: the hunting cycles fall away with crossover; none above ~20 Hz."""
-    from fi_design.simulation import simulate
+    from fi_design.simulation.run import simulate
 
     cycles = [simulate(paper_spec, isolated=False, crossover=fc).metrics.hunting_cycles
               for fc in (8.0, 12.0, 16.0, 19.0, 22.0, 26.0)]
@@ -61,8 +61,8 @@ def test_landing_refinement(paper_confirmation, paper_spec):
     assert land.force <= land.rule_force < land.static_friction
     # lower crossover: the cart lands on the limiter and the stage is stuck (hunting returns later)
     spec = paper_spec
-    from fi_design.simulation import simulate
-    from fi_design.confirm import landing
+    from fi_design.simulation.run import simulate
+    from fi_design.stage.confirm import landing
 
     low = simulate(spec, isolated=True, crossover=5.0)
     land5 = landing(spec, low)

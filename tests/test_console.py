@@ -15,7 +15,7 @@ from rich.console import Console
 from typer.testing import CliRunner
 
 from fi_design import console as con
-from fi_design.cli import app
+from fi_design.cli.app import app
 
 from conftest import EXAMPLES, sharing_designs
 

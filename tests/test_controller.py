@@ -18,12 +18,12 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from fi_design import linear
+from fi_design.loop import linear
 from fi_design.errors import SpecError
-from fi_design.guideline import design
-from fi_design.pid import control_law
-from fi_design.simulation import simulate
-from fi_design.specfile import load_spec
+from fi_design.guideline.evaluate import evaluate as design
+from fi_design.controller.pid import control_law
+from fi_design.simulation.run import simulate
+from fi_design.spec.file import load_spec
 from fi_design.trajectory import from_moves
 
 M = 4.0  # kg, the whole moving mass of the test axes (stage 3 kg, cart 1 kg)

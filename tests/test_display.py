@@ -60,8 +60,8 @@ def test_an_effect_value_and_its_error_share_a_unit():
 def test_prose_and_tables_print_a_number_alike(paper_spec, capsys):
     """ki read 3.307e+04 in the conclusion and 33073 in the table; one form now."""
     from fi_design.console import make_console, print_design
-    from fi_design.guideline import design
-    from fi_design.specfile import with_values
+    from fi_design.guideline.evaluate import evaluate as design
+    from fi_design.spec.file import with_values
 
     spec = with_values(paper_spec, {"controller.crossover": "10 Hz"})
     result = design(spec, confirm=False)
@@ -95,7 +95,7 @@ def test_sentences_of_the_metric_and_the_stage_give_lengths_in_micrometres_and_m
     """The hunting metric's reasons and the stage's sentences write µm, never "um"."""
     import numpy as np
 
-    from fi_design.metrics import hunting_metrics
+    from fi_design.simulation.metrics import hunting_metrics
     from fi_design.results.stage import length_range, length_text
 
     t = np.linspace(0.0, 20.0, 2001)

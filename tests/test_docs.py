@@ -17,7 +17,7 @@ from typer.main import get_command
 
 import fi_design
 from fi_design import docs
-from fi_design.cli import DEFAULT_COMMAND, app
+from fi_design.cli.app import DEFAULT_COMMAND, app
 
 from conftest import ROOT
 

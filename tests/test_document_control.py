@@ -19,10 +19,10 @@ import yaml
 
 from fi_design import provenance, report
 from fi_design.errors import SpecError
-from fi_design.guideline import design
+from fi_design.guideline.evaluate import evaluate as design
 from fi_design.report.meta import title_block
 from fi_design.spec import REPORT_KINDS
-from fi_design.specfile import load_spec
+from fi_design.spec.file import load_spec
 
 from conftest import EXAMPLES, ROOT
 

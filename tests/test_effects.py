@@ -18,10 +18,10 @@ import yaml
 from fi_design import effects as fx
 from fi_design.kernel.layout import PlantParameters
 from fi_design.model import resolve
-from fi_design.simulation import simulate
+from fi_design.simulation.run import simulate
 from fi_design.spec import EFFECT_MODELS
-from fi_design.specfile import load_spec, origin
-from fi_design.units import KNOWN_UNITS
+from fi_design.spec.file import load_spec, origin
+from fi_design.spec.units import KNOWN_UNITS
 
 #: A clearly non-neutral value per effect (SI), chosen to matter on the paper setup.
 ACTIVE = {

@@ -34,7 +34,7 @@ def test_messages_name_the_place():
 
 
 def test_misuse_raises_library_errors():
-    from fi_design.pid import pid_gains
+    from fi_design.controller.pid import pid_gains
     from fi_design.plots import figure_bytes
 
     with pytest.raises(SpecError, match="positive"):

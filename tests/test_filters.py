@@ -13,12 +13,13 @@ import control
 import numpy as np
 import pytest
 
-from fi_design import linear
+from fi_design.loop import linear
 from fi_design.controller import (controller_polynomials, discrete_controller,
                                   filter_polynomials, pid_polynomials, tustin_biquad)
 from fi_design.controller.discrete import pid_z
 from fi_design.errors import SpecError
-from fi_design.guideline import design, step2_crossover
+from fi_design.guideline.evaluate import evaluate as design
+from fi_design.guideline.steps import step2_crossover
 from fi_design.model import resolve
 
 from conftest import variant
@@ -351,7 +352,7 @@ def test_the_kernel_carries_the_filters_as_the_independent_simulator_does(paper_
     and more, the two agree to 2 nm in position and 0.1 mN in force."""
     from independent import generate
 
-    from fi_design.simulation import simulate
+    from fi_design.simulation.run import simulate
 
     spec = variant(paper_spec, **{"controller.filters": KERNEL_FILTERS}, **more)
     run = simulate(spec, isolated=True, duration=3.0)

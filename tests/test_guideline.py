@@ -11,9 +11,10 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 import fi_design
-from fi_design import guideline as gl
+from fi_design.guideline import steps as gl
+from fi_design.guideline.evaluate import evaluate
 from fi_design.results import Check, Status
-from fi_design.specfile import origin
+from fi_design.spec.file import origin
 from conftest import variant
 
 
@@ -22,7 +23,7 @@ from conftest import variant
 @pytest.fixture(scope="module")
 def paper_design(paper_spec):
     """The linear steps only: the simulated confirmation is tested in test_confirm.py."""
-    return gl.design(paper_spec, confirm=False)
+    return evaluate(paper_spec, confirm=False)
 
 
 # --------------------------------------------------------------------------- JSON contract
@@ -113,7 +114,7 @@ def test_step1_small_gap(paper_spec):
     assert s1.gap == pytest.approx(0.3) and not s1.hunting_risk
     assert s1.checks[0].status == Status.PASS
     # below the paper's threshold: a screening rule, and only the simulation decides
-    assert "so hunting is less likely." in gl.design(spec, confirm=False).conclusion
+    assert "so hunting is less likely." in evaluate(spec, confirm=False).conclusion
 
 
 def _pd(spec):
@@ -146,7 +147,7 @@ def test_step3_proposes_half_of_k_max_when_stiffness_is_missing(paper_spec):
 
 def test_step3_fails_above_k_max(paper_spec):
     spec = variant(paper_spec, **{"isolator.stiffness": "20 N/mm"})
-    r = gl.design(spec, confirm=False)
+    r = evaluate(spec, confirm=False)
     check = next(c for c in r.checks if c.name == "drive_stiffness")
     assert check.status == Status.FAIL and "exceeds" in check.message
     # the conclusion names the step that fails, never the check's internal name
@@ -182,7 +183,7 @@ def test_k_max_scales_as_static_friction_over_stroke(paper_spec, fs, stroke, fac
 def test_infeasible_flexure_is_a_failed_check(paper_spec):
     spec = variant(paper_spec, **{"isolator.flexure.thickness": ["0.8 mm", "1 mm"],
                                   "isolator.flexure.length": ["10 mm", "15 mm"]})
-    r = gl.design(spec, confirm=False)
+    r = evaluate(spec, confirm=False)
     assert r.flexure is not None and not r.flexure.feasible
     check = next(c for c in r.checks if c.name == "flexure")
     assert check.status == Status.FAIL and r.flexure.reason in check.message
@@ -190,14 +191,14 @@ def test_infeasible_flexure_is_a_failed_check(paper_spec):
 
 
 def test_no_flexure_section_gives_null(paper_spec):
-    r = gl.design(variant(paper_spec, **{"isolator.flexure": None}), confirm=False)
+    r = evaluate(variant(paper_spec, **{"isolator.flexure": None}), confirm=False)
     assert r.flexure is None and r.to_dict()["flexure"] is None
     assert not any(c.name.startswith("flexure") for c in r.checks)
 
 
 def test_desired_crossover_above_achievable_fails(paper_spec):
     spec = variant(paper_spec, **{"controller.crossover": "60 Hz"})
-    r = gl.design(spec, confirm=False)
+    r = evaluate(spec, confirm=False)
     names = {c.name for c in r.failed_checks}
     assert "crossover_achievable" in names and "parasitic_separation.stage tilt" in names
     assert r.crossover.achievable < 60.0
@@ -208,7 +209,7 @@ def test_desired_crossover_above_achievable_fails(paper_spec):
 
 def test_without_isolator_advises_on_the_need(paper_spec):
     spec = variant(paper_spec, isolator=None, **{"controller.delay": "2 ms"})
-    r = gl.design(spec, confirm=False)
+    r = evaluate(spec, confirm=False)
     assert len(r.crossover.cases) == 2 and r.flexure is None
     adv = r.isolator_advice
     assert adv.needed is True and adv.stroke == 0.3e-3
@@ -219,9 +220,9 @@ def test_without_isolator_advises_on_the_need(paper_spec):
     d = r.to_dict()
     assert d["isolator_advice"]["needed"] is True and len(d["crossover"]["cases"]) == 2
 
-    ideal = gl.design(variant(paper_spec, isolator=None), confirm=False)
+    ideal = evaluate(variant(paper_spec, isolator=None), confirm=False)
     assert ideal.isolator_advice.needed is None       # no crossover limit in the linear model
-    small = gl.design(variant(paper_spec, isolator=None, **{"friction.static": "1.5 N"}), confirm=False)
+    small = evaluate(variant(paper_spec, isolator=None, **{"friction.static": "1.5 N"}), confirm=False)
     assert small.isolator_advice.needed is False
 
 
@@ -248,10 +249,10 @@ def test_spec_hash_without_origin(paper_spec):
     spec = paper_spec.model_copy()
     spec._origin = None                    # as if built in code, not read by load_spec
     assert origin(spec) is None and origin(paper_spec) is not None
-    r = gl.design(spec, confirm=False)
+    r = evaluate(spec, confirm=False)
     assert r.spec_sha256 == hashlib.sha256(spec.model_dump_json().encode()).hexdigest()
-    assert gl.design(origin(paper_spec).raw, confirm=False).crossover.achievable == \
-        pytest.approx(gl.design(paper_spec, confirm=False).crossover.achievable)
+    assert evaluate(origin(paper_spec).raw, confirm=False).crossover.achievable == \
+        pytest.approx(evaluate(paper_spec, confirm=False).crossover.achievable)
 
 
 def test_results_are_frozen(paper_design):

@@ -9,9 +9,9 @@ import re
 import pytest
 from typer.testing import CliRunner
 
-from fi_design.cli import app
-from fi_design.guideline import design
-from fi_design.specfile import load_spec
+from fi_design.cli.app import app
+from fi_design.guideline.evaluate import evaluate as design
+from fi_design.spec.file import load_spec
 
 from conftest import variant
 
@@ -34,7 +34,7 @@ def _printed_gains(output: str) -> dict:
 def test_printed_gains_copied_into_controller_gains_keep_the_loop(paper_spec, tmp_path):
     """The report put the roll-off on the whole PID: copied into controller.gains, those numbers
     moved a 10 Hz crossover to 11.13 Hz and took 1.2 dB of gain margin."""
-    from fi_design.specedit import edited_spec_text
+    from fi_design.spec.edit import edited_spec_text
 
     spec = variant(paper_spec, **{"controller.crossover": "10 Hz"})
     path = tmp_path / "rule10.yaml"
@@ -131,7 +131,7 @@ def test_no_simulation_fails_the_ci_gate(paper_spec_path, tmp_path):
 def test_write_spec_round_trips_with_filters_and_a_drive(paper_spec, tmp_path):
     """A sampled loop with a notch, a low-pass and the drive's units: the written spec keeps
     the filters and the drive, and its design is the same loop to the last digit."""
-    from fi_design.specedit import edited_spec_text
+    from fi_design.spec.edit import edited_spec_text
 
     spec = variant(paper_spec, **{
         "controller.sample_rate": "4 kHz", "controller.delay": "250 us",

@@ -22,12 +22,12 @@ import pytest
 from typer.testing import CliRunner
 
 from fi_design import load_spec, simulate
-from fi_design.cli import app
+from fi_design.cli.app import app
 from fi_design.errors import DataError
 from fi_design.identification import (DYNAMIC, NAMES, identified_spec, identified_spec_text,
                                       identify, predict_force, segment)
 from fi_design.measured import measurement_from_arrays
-from fi_design.specfile import parse_yaml
+from fi_design.spec.file import parse_yaml
 
 from conftest import EXAMPLES
 

@@ -29,7 +29,7 @@ from scipy.integrate import cumulative_trapezoid
 from fi_design import load_spec
 from fi_design.identification import DYNAMIC, identified_spec_text, identify
 from fi_design.measured import measurement_from_arrays
-from fi_design.specfile import parse_yaml
+from fi_design.spec.file import parse_yaml
 
 import independent
 

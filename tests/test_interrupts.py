@@ -40,7 +40,7 @@ class _Finalizer:
 def test_an_interrupt_swallowed_by_a_finalizer_still_stops_the_run(paper_spec_path, tmp_path,
                                                                   monkeypatch):
     """The run went on to its end, wrote its output and exited 0."""
-    import fi_design.simulation as simulation
+    import fi_design.simulation.run as simulation
 
     real = simulation.simulate
 
@@ -63,7 +63,7 @@ def test_an_error_raised_by_an_interruption_is_the_interruption(paper_spec_path,
     descriptor`: both were reported as internal errors (exit 1) instead of the interruption."""
     import errno
 
-    import fi_design.simulation as simulation
+    import fi_design.simulation.run as simulation
 
     for error in (ImportError("initialization failed"),
                   OSError(errno.EBADF, "Bad file descriptor")):
@@ -83,7 +83,7 @@ def test_an_error_raised_by_an_interruption_is_the_interruption(paper_spec_path,
 
 def test_an_interrupt_outside_a_study_says_so(paper_spec_path, tmp_path, monkeypatch):
     """typer turned a KeyboardInterrupt into a silent exit 130; the CLI says what was written."""
-    import fi_design.simulation as simulation
+    import fi_design.simulation.run as simulation
 
     def simulate(*args, **kwargs):
         _sigint_here()
@@ -125,7 +125,7 @@ def test_an_interrupt_delivered_to_another_thread_leaves_no_temporary_file(tmp_p
     try:
         with pytest.raises(KeyboardInterrupt):
             if command_line:
-                from fi_design.cliparts import _signal_exception
+                from fi_design.cli.parts import _signal_exception
                 from fi_design.interrupts import signals_to_exceptions
 
                 with signals_to_exceptions(_signal_exception):
@@ -138,7 +138,7 @@ def test_an_interrupt_delivered_to_another_thread_leaves_no_temporary_file(tmp_p
 
 
 def test_a_held_block_gets_its_signal_at_the_end():
-    from fi_design.cliparts import Terminated, _signal_exception
+    from fi_design.cli.parts import Terminated, _signal_exception
     from fi_design.interrupts import held, received, signals_to_exceptions
 
     steps = []
@@ -157,7 +157,7 @@ def test_a_held_block_gets_its_signal_at_the_end():
 
 
 def app():
-    from fi_design.cli import app as the_app
+    from fi_design.cli.app import app as the_app
 
     return the_app
 

@@ -131,7 +131,7 @@ def test_dense_output_is_as_accurate_as_the_steps(paper_spec):
     """The 1 kHz outputs lie between steps (a few thousand steps for 20 001 samples);
     the continuous extension keeps them at the tolerance's accuracy, and tighter
     tolerance makes them better."""
-    from fi_design.simulation import simulate
+    from fi_design.simulation.run import simulate
 
     exact = simulate(paper_spec, isolated=True, method="reference", rtol=1e-10)
     errs = []
@@ -172,8 +172,8 @@ def test_the_installed_kernel_is_the_ahead_of_time_build_of_these_sources():
     assert _aot.source_digest() == build.source_digest()
     # the simulation path runs without loading numba at all
     out = subprocess.run([sys.executable, "-c",
-                          "import sys; from fi_design.specfile import load_spec; "
-                          "from fi_design.simulation import simulate; "
+                          "import sys; from fi_design.spec.file import load_spec; "
+                          "from fi_design.simulation.run import simulate; "
                           "r = simulate(load_spec(sys.argv[1]), isolated=False); "
                           "print(r.metrics.hunting_cycles, 'numba' in sys.modules)",
                           str(os.path.join(os.path.dirname(__file__), "..", "examples",
@@ -185,10 +185,10 @@ def test_the_installed_kernel_is_the_ahead_of_time_build_of_these_sources():
 def test_the_jit_build_of_the_same_source_agrees(paper_spec, tmp_path):
     """FI_DESIGN_KERNEL=jit compiles the source with numba: the same trajectories as the
     build in use (to rounding; the hunting plant amplifies it by its stick-slip events)."""
-    from fi_design.simulation import simulate
+    from fi_design.simulation.run import simulate
 
-    code = ("import sys, numpy as np; from fi_design.specfile import load_spec; "
-            "from fi_design.simulation import simulate; from fi_design.kernel import build; "
+    code = ("import sys, numpy as np; from fi_design.spec.file import load_spec; "
+            "from fi_design.simulation.run import simulate; from fi_design.kernel import build; "
             "s = load_spec(sys.argv[1]); "
             "np.save(sys.argv[2], np.array([simulate(s, isolated=i).position for i in (True, "
             "False)])); print(build.backend())")

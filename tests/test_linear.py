@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from fi_design import linear
+from fi_design.loop import linear
 from fi_design.model import resolve
 
 from conftest import variant
@@ -116,7 +116,7 @@ def test_no_isolator_is_one_rigid_mass(paper_spec):
 
 
 def test_controller_and_loop(paper_given):
-    from fi_design.pid import control_law, tune_pid
+    from fi_design.controller.pid import control_law, tune_pid
 
     g = tune_pid(paper_given)
     np.testing.assert_allclose(ss_response(linear.controller_tf(g), S), pid(S), rtol=1e-9)

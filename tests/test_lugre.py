@@ -20,7 +20,7 @@ from hypothesis import given, settings, strategies as st
 
 from fi_design.kernel import equations
 from fi_design.model import resolve
-from fi_design.simulation import simulate
+from fi_design.simulation.run import simulate
 
 FRICTION = dict(static=st.floats(0.5, 20.0), ratio=st.floats(0.05, 1.0),
                 vs=st.floats(1e-4, 2e-2), sigma0=st.floats(1e4, 1e8),

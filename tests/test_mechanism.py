@@ -338,7 +338,7 @@ def test_closed_forms_hold_against_the_fe_model(fe_results, name):
 
 
 def _paper_variant(paper_spec, **values):
-    from fi_design.specfile import with_values
+    from fi_design.spec.file import with_values
 
     return with_values(paper_spec, values)
 
@@ -372,7 +372,7 @@ def test_the_loop_sees_the_guide_s_modes_through_the_sensor_offset(paper_spec):
     """Without measured modes, the sized guide's own modes enter the limit cases: with the
     sensor above and the actuator below the centre of mass, its pitch mode is
     non-collocated and shows in every case's response at its frequency."""
-    from fi_design import linear
+    from fi_design.loop import linear
     from fi_design.model import resolve
 
     spec = _paper_variant(paper_spec, **{"isolator.parasitic_modes": [],

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fi_design.metrics import hunting_metrics
+from fi_design.simulation.metrics import hunting_metrics
 
 T = np.arange(20001) / 1000.0
 

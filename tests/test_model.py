@@ -126,7 +126,7 @@ def test_at_stroke_moves_a_proposed_stiffness_with_it(paper_spec):
 
 
 def test_at_adds_the_isolator_a_spec_would_get(paper_spec):
-    from fi_design.confirm import with_isolator
+    from fi_design.stage.confirm import with_isolator
 
     bare = variant(paper_spec, isolator=None)
     added = resolve(bare).at(stroke=0.3e-3, stiffness=5000.0)
@@ -218,11 +218,13 @@ def _count(monkeypatch, module, name) -> list:
 
 def test_design_resolves_the_spec_once(paper_spec, monkeypatch):
     """The control law, the gains' crossover and the drive stiffness are worked out once."""
-    import fi_design.guideline  # noqa: F401  (the modules whose references are counted)
-    import fi_design.linear  # noqa: F401
-    import fi_design.verdict  # noqa: F401
-    from fi_design import pid, spec as spec_module
-    from fi_design.guideline import design
+    import fi_design.guideline.evaluate  # noqa: F401  (the modules whose references are counted)
+    import fi_design.guideline.steps  # noqa: F401
+    import fi_design.loop.linear  # noqa: F401
+    import fi_design.guideline.verdict  # noqa: F401
+    from fi_design.controller import pid
+    from fi_design import spec as spec_module
+    from fi_design.guideline.evaluate import evaluate as design
 
     gains = variant(paper_spec, **{"controller.crossover": None,
                                    "controller.gains": {"kp": 5000.0, "ki": 20000.0, "kd": 90.0}})
@@ -253,7 +255,8 @@ def test_the_gains_crossover_is_the_root_of_the_loop_gain(paper_spec):
 
 
 def test_the_value_types_live_in_the_results_layer_and_are_typed():
-    from fi_design import linear, pid
+    from fi_design.loop import linear
+    from fi_design.controller import pid
     from fi_design.results import controller, design
     from fi_design.results import linear as linear_results
 
@@ -280,7 +283,7 @@ def test_no_spec_is_copied_without_validation():
 
 
 def test_with_sections_validates_what_it_replaces(paper_spec):
-    from fi_design.confirm import with_isolator
+    from fi_design.stage.confirm import with_isolator
     from fi_design.results.reconciliation import ReconcileResult
     from fi_design.spec import EFFECT_MODELS
 
@@ -307,8 +310,8 @@ def test_with_sections_validates_what_it_replaces(paper_spec):
 
 def test_a_limit_case_is_judged_where_its_margins_are_computed(paper_spec):
     """The status and the criteria of each case; step 2's checks are those judgements."""
-    from fi_design import linear
-    from fi_design.guideline import step2_crossover
+    from fi_design.loop import linear
+    from fi_design.guideline.steps import step2_crossover
     from fi_design.results import Status
 
     cases = linear.analyse(paper_spec).cases
@@ -332,7 +335,7 @@ def test_report_and_console_show_the_status_the_analysis_gave(paper_spec):
     from rich.console import Console
 
     from fi_design import console as console_module
-    from fi_design.guideline import design
+    from fi_design.guideline.evaluate import evaluate as design
     from fi_design.report.design import _cases_table
     from fi_design.results import Status
 
@@ -375,7 +378,7 @@ def _old_curve(p, form, stribeck, v):
 def identified():
     import fi_design
     from fi_design.measured import load_measurement
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     root = PACKAGE.parent / "examples"
     record = load_measurement(root / "measured_trace.csv")
@@ -416,7 +419,7 @@ def test_the_identification_report_draws_the_results_curve(identified, monkeypat
 
 def test_a_varied_model_says_what_it_changed_and_design_takes_it(paper_spec):
     from fi_design.errors import ArgumentError
-    from fi_design.guideline import design
+    from fi_design.guideline.evaluate import evaluate as design
 
     m = resolve(paper_spec)
     assert m.changed == ()

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from fi_design.pid import PidGains, pid_gains, tune_pid
+from fi_design.controller.pid import PidGains, pid_gains, tune_pid
 
 
 def free_mass_crossover_ratio(r: float, ri: float) -> float:
@@ -69,7 +69,7 @@ def test_parallel_form_equals_series_form():
 
 def test_free_mass_crosses_over_just_above_wc_with_the_rule_phase(paper_spec):
     """The rule on a free mass: exact crossover and phase margin, via python-control."""
-    from fi_design.linear import controller_polynomials, loop_margins
+    from fi_design.loop.linear import controller_polynomials, loop_margins
 
     g = tune_pid(paper_spec)
     x = free_mass_crossover_ratio(3.0, 10.0)
@@ -115,7 +115,7 @@ def test_to_dict_is_plain_si():
 
 
 def test_pid_module_stays_light():
-    code = ("import sys, fi_design.pid; "
+    code = ("import sys, fi_design.controller.pid; "
             "print(' '.join(m for m in ('control', 'scipy', 'pint', 'numba') if m in sys.modules))")
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert p.returncode == 0, p.stderr

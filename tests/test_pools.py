@@ -33,7 +33,7 @@ def _running(pid: int) -> bool:
 
 def test_the_error_path_ends_only_the_pools_own_workers():
     """A failure inside the design's pool stopped every child process of the interpreter."""
-    from fi_design.pools import confirmation_pool
+    from fi_design.cli.pools import confirmation_pool
 
     ctx = multiprocessing.get_context("fork")
     bystander = ctx.Process(target=_sleep, args=(30,))
@@ -63,7 +63,7 @@ def test_the_design_pool_starts_before_the_spinner(paper_spec_path, tmp_path, mo
     from typer.testing import CliRunner
 
     import fi_design.console as console
-    from fi_design.cli import app
+    from fi_design.cli.app import app
 
     seen = []
     real = console.Status.__enter__
@@ -131,7 +131,7 @@ def test_sigterm_ends_a_sweep_and_its_workers(tmp_path):
 #: (a signal sent after that finds nothing left to interrupt).
 _DRIVER = """\
 import sys, time
-from fi_design.cli import main
+from fi_design.cli.app import main
 print("ready", flush=True)
 sys.argv = ["fi-design"] + sys.argv[1:]
 try:

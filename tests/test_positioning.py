@@ -26,7 +26,7 @@ def test_settle_time_is_the_last_exit_from_the_band():
 
 def test_spec_and_band_are_checked():
     from fi_design.errors import SpecError
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     spec = load_spec(EXAMPLES / "industrial_axis.yaml")
     with pytest.raises(SpecError, match="settle_time, static_error or both"):
@@ -40,7 +40,7 @@ def industrial_positioned():
     """The industrial PD axis asked for a 15 um static error and a 0.5 s settle time in a
     20 um band (robustness off: the requirement is what is read)."""
     from fi_design.signoff import design
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     spec = variant(load_spec(EXAMPLES / "industrial_axis.yaml"), **{
         "requirements.positioning": {"static_error": "15 um", "settle_time": "0.5 s",
@@ -90,7 +90,7 @@ def test_the_spec_moves_settle_time_is_the_metrics(paper_spec):
     """With the band the metric's settle band, the spec's own move settles when the paper's
     metric, on its own simulation of that move, says it does."""
     from fi_design.model import resolve
-    from fi_design.simulation import simulate
+    from fi_design.simulation.run import simulate
     from fi_design.stage import positioning, stage_hunting
 
     spec = variant(paper_spec, **{"requirements.positioning": {"settle_time": "10 s"}})

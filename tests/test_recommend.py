@@ -35,7 +35,7 @@ def paper_file(paper_spec_path, tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def paper_recommendation(paper_file):
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     return recommend(load_spec(paper_file))
 
@@ -121,9 +121,9 @@ def test_the_written_spec_passes_the_design_command(paper_recommendation, tmp_pa
     """--write-spec: the input's text with the guide drawn in its own units (mm stays mm, four
     digits), the comments of the keys replaced, a revision added; the design command on it
     runs the computation that signed the design off, and passes."""
-    from fi_design.guideline import design
+    from fi_design.guideline.evaluate import evaluate as design
     from fi_design.recommend import recommended_spec_text
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     text = recommended_spec_text(paper_recommendation)
     assert "# m1: actuated, carries the encoder" in text      # the input's comments stay
@@ -143,8 +143,8 @@ def test_the_written_spec_passes_the_design_command(paper_recommendation, tmp_pa
 
 
 def test_the_least_change_passes(paper_recommendation, paper_spec):
-    from fi_design.guideline import design
-    from fi_design.specfile import with_values
+    from fi_design.guideline.evaluate import evaluate as design
+    from fi_design.spec.file import with_values
 
     lc = paper_recommendation.least_change
     assert lc is not None and lc.feasible and 1 <= len(lc.changes) <= 2
@@ -159,7 +159,7 @@ def test_an_empty_space_says_so_with_the_nearest_design(repo_root, tmp_path):
     import yaml
     from typer.testing import CliRunner
 
-    from fi_design.cli import app
+    from fi_design.cli.app import app
 
     raw = yaml.safe_load((repo_root / "examples" / "paper_setup.yaml").read_text())
     raw["requirements"]["robustness"] = {"samples": 20}
@@ -178,7 +178,7 @@ def test_an_empty_space_says_so_with_the_nearest_design(repo_root, tmp_path):
 
 @pytest.mark.slow
 def test_no_isolator_gets_a_buildable_one_at_the_crossover_the_model_does_not_limit(repo_root):
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     spec = variant(load_spec(repo_root / "examples" / "no_isolator.yaml"), **FEW)
     r = recommend(spec)
@@ -194,7 +194,7 @@ def test_recommend_command_writes_a_spec_that_passes(repo_root, tmp_path):
     import yaml
     from typer.testing import CliRunner
 
-    from fi_design.cli import app
+    from fi_design.cli.app import app
 
     runner = CliRunner()
     raw = yaml.safe_load((repo_root / "examples" / "paper_setup.yaml").read_text())

@@ -233,7 +233,7 @@ def test_non_uniform_sampling():
 
 def test_two_effects_with_max_effects():
     from fi_design.spec import EFFECT_MODELS
-    from fi_design.simulation import simulate
+    from fi_design.simulation.run import simulate
     from fi_design.measured import measurement_from_arrays
 
     case = Case("two", True, None, {}, duration=3.0, moves=LONG)
@@ -275,7 +275,7 @@ def test_a_nominal_model_that_fails_is_reported_not_raised(tmp_path):
     data = measure(case)
     raw = spec_mapping(case)
     raw["effects"] = [{"type": "time_delay", "delay": "30 ms"}]  # the loop diverges at 1.2 s
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     spec = load_spec(raw)
     result = reconcile(spec, data, candidates=["viscous_friction"])

@@ -9,9 +9,9 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from fi_design.cli import app
+from fi_design.cli.app import app
 from fi_design.measured import to_csv_text
-from fi_design.specfile import load_spec
+from fi_design.spec.file import load_spec
 
 from hidden_effect import Case, base_spec, measure, spec_mapping
 

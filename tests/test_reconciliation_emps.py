@@ -23,7 +23,7 @@ import pytest
 
 from fi_design.measured import measurement_from_arrays
 from fi_design.reconciliation import reconcile
-from fi_design.specfile import load_spec, with_values
+from fi_design.spec.file import load_spec, with_values
 
 from conftest import EXAMPLES
 

@@ -32,7 +32,7 @@ import pytest
 import yaml
 
 from fi_design.reconciliation import reconcile
-from fi_design.specfile import load_spec
+from fi_design.spec.file import load_spec
 
 from independent import generate
 
@@ -288,7 +288,7 @@ def test_cli_open_loop_names_a_hidden_effect(tmp_path):
 
     from typer.testing import CliRunner
 
-    from fi_design.cli import app
+    from fi_design.cli.app import app
 
     isolated, effects, moves, fc, resolution = CASES["position_dependent_friction-iso"]
     rec = _record(isolated, effects, moves, fc, resolution, 4.0)
@@ -326,7 +326,7 @@ def test_open_loop_effect_named_with_its_parameters(outcome, case_id):
 def test_cli_drive_is_checked(tmp_path):
     from typer.testing import CliRunner
 
-    from fi_design.cli import app
+    from fi_design.cli.app import app
 
     spec = tmp_path / "stage.yaml"
     spec.write_text(yaml.safe_dump(_spec_mapping(True, ONE, 8.0, 1.0)))

@@ -93,7 +93,7 @@ def test_a_failed_run_scores_far_above_the_nominal_misfit(paper_spec):
     from fi_design.measured import measurement_from_arrays
     from fi_design.reconciliation.comparison import FAIL_FACTOR, Comparison, ModelRun
     from fi_design.reconciliation.noise import noise_levels
-    from fi_design.simulation import simulate
+    from fi_design.simulation.run import simulate
 
     res = simulate(paper_spec, True)
     rng = np.random.default_rng(7)
@@ -120,8 +120,8 @@ def test_a_failed_run_scores_far_above_the_nominal_misfit(paper_spec):
 def _fast_record(spec, rate: float):
     """The spec's own motion at ``rate``, with sensor noise: a record logged fast."""
     from fi_design.measured import measurement_from_arrays
-    from fi_design.simulation import simulate
-    from fi_design.specfile import with_values
+    from fi_design.simulation.run import simulate
+    from fi_design.spec.file import with_values
 
     res = simulate(with_values(spec, {"simulation.output_rate": rate}))
     rng = np.random.default_rng(5)
@@ -137,7 +137,7 @@ def test_a_record_logged_faster_than_the_model_needs_is_thinned():
     the conclusion says so. Every run of the model had a sample per record sample, and every
     evaluation of a fit kept its run: 17 GB for two million samples."""
     from fi_design.reconciliation import reconcile
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     from conftest import EXAMPLES
 

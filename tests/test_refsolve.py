@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from fi_design.simulation import simulate
+from fi_design.simulation.run import simulate
 
 from conftest import variant
 

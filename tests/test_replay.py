@@ -15,9 +15,9 @@ import pytest
 
 from fi_design.errors import DataError, SimulationError
 from fi_design.measured import measurement_from_arrays
-from fi_design.replay import record_state
-from fi_design.simulation import simulate
-from fi_design.specfile import load_spec, with_values
+from fi_design.simulation.replay import record_state
+from fi_design.simulation.run import simulate
+from fi_design.spec.file import load_spec, with_values
 from conftest import EXAMPLES
 
 
@@ -172,7 +172,7 @@ def _emps_yaml(tmp_path, identification):
 def test_cli_simulate_record(tmp_path, emps_path, emps_identification):
     from typer.testing import CliRunner
 
-    from fi_design.cli import app
+    from fi_design.cli.app import app
     from fi_design.measured import load_measurement
 
     spec = _emps_yaml(tmp_path, emps_identification)
@@ -204,7 +204,7 @@ def test_cli_simulate_record(tmp_path, emps_path, emps_identification):
 def test_cli_simulate_bad_replay_options(paper_spec_path, args, words):
     from typer.testing import CliRunner
 
-    from fi_design.cli import app
+    from fi_design.cli.app import app
 
     res = CliRunner().invoke(app, ["simulate", str(paper_spec_path), *args])
     assert res.exit_code == 2 and words in res.output
@@ -213,7 +213,7 @@ def test_cli_simulate_bad_replay_options(paper_spec_path, args, words):
 def test_cli_simulate_record_with_nan_disturbance_names_the_row(tmp_path, paper_spec_path):
     from typer.testing import CliRunner
 
-    from fi_design.cli import app
+    from fi_design.cli.app import app
 
     rows = ["time_s,reference_m,position_m,force_N,disturbance_N"]
     rows += [f"{i * 1e-3},0,0,0,{'nan' if i == 30 else 0}" for i in range(100)]

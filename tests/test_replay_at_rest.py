@@ -1,4 +1,4 @@
-"""Replaying a record from rest (fi_design.replay): noise must not start the model sliding.
+"""Replaying a record from rest (fi_design.simulation.replay): noise must not start the model sliding.
 
 A record taken from rest holds sensor noise in its first samples. A velocity
 estimate within its own noise is zero, the bristles then carry the static load
@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from fi_design.measured import measurement_from_arrays
-from fi_design.replay import record_state, reference_state
-from fi_design.simulation import simulate
+from fi_design.simulation.replay import record_state, reference_state
+from fi_design.simulation.run import simulate
 
 from hidden_effect import NOISE, Case, base_spec
 

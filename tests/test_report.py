@@ -24,7 +24,7 @@ from typer.testing import CliRunner
 
 from fi_design import report
 from fi_design.errors import OutputError, ReportError
-from fi_design.cli import app
+from fi_design.cli.app import app
 
 from conftest import EXAMPLES, ROOT
 
@@ -383,7 +383,7 @@ def hostile_design():
     raw["name"] = "<script>alert('x')</script> & \"Co\""
     raw["report"] = {"document_id": "<b>FI-9</b>", "revision": "B&C", "status": "for review",
                      "author": "<img src=x onerror=alert(1)>"}
-    from fi_design.guideline import design
+    from fi_design.guideline.evaluate import evaluate as design
 
     return design(raw, confirm=False)
 
@@ -532,12 +532,12 @@ def test_html_renders_in_chromium_without_console_errors(design_html, tmp_path):
 
 
 def _refuse_work(monkeypatch):
-    import fi_design.specfile
+    import fi_design.spec.file
 
     def boom(*a, **k):
         raise AssertionError("the spec was read: the output path was not checked first")
 
-    monkeypatch.setattr(fi_design.specfile, "load_spec", boom)
+    monkeypatch.setattr(fi_design.spec.file, "load_spec", boom)
 
 
 def test_cli_refuses_a_wrong_extension_before_any_work(tmp_path, monkeypatch, paper_spec_path):
@@ -693,7 +693,7 @@ def test_templates_ship_in_the_wheel_and_load_from_an_installed_copy(tmp_path):
              "from importlib.resources import files\n"
              "from fi_design.provenance import current_source\n"
              "from fi_design.report.meta import title_block\n"
-             "from fi_design.specfile import load_spec\n"
+             "from fi_design.spec.file import load_spec\n"
              "print(fi_design.__file__)\n"
              "print(r.template_dir())\n"
              "spec = load_spec(str(files('fi_design').joinpath('example_spec.yaml')))\n"

@@ -19,8 +19,8 @@ from scipy.integrate import solve_ivp
 from fi_design.kernel import equations as plant
 from fi_design.errors import SimulationError
 from fi_design.kernel.layout import MODE_SIGN, PlantParameters
-from fi_design.simulation import simulate
-from fi_design.specfile import load_spec
+from fi_design.simulation.run import simulate
+from fi_design.spec.file import load_spec
 from conftest import variant
 
 

@@ -1,4 +1,4 @@
-"""The spec (fi_design.spec) and its file (fi_design.specfile): SI values, derived defaults,
+"""The spec (fi_design.spec) and its file (fi_design.spec.file): SI values, derived defaults,
 validation that names the field and line, immutability, provenance."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from pydantic import ValidationError
 
 from fi_design import spec as sp
 from fi_design.errors import SpecError
-from fi_design.specfile import load_spec, origin
+from fi_design.spec.file import load_spec, origin
 
 from conftest import EXAMPLES, variant
 

@@ -9,8 +9,8 @@ import yaml
 
 from fi_design import effects
 from fi_design.reconciliation import fixed_spec_text
-from fi_design.specedit import REMOVE, edited_spec_text, spec_quantity
-from fi_design.specfile import load_spec
+from fi_design.spec.edit import REMOVE, edited_spec_text, spec_quantity
+from fi_design.spec.file import load_spec
 
 from conftest import EXAMPLES
 

@@ -30,7 +30,7 @@ def paper_isolated(paper_spec):
 
 
 def _canudas_spec(model: str = "lugre", hunting: dict | None = None, duration: str = "20 s"):
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     return load_spec({
         "name": "Canudas de Wit et al. 1995, unit mass under PID",
@@ -164,7 +164,7 @@ def test_canudas_de_wit_1995_switch_model_counts_one_peak_per_stick_plateau():
     the section (an independent route: shooting on section crossings, no peaks) and
     lie near the LuGre run's published 24.4 s.
     """
-    from fi_design.simulation import simulate
+    from fi_design.simulation.run import simulate
 
     window = {"window_start": "100 s", "window_length": "100 s"}
     m = simulate(_canudas_spec("switch", window, "200 s"), False).metrics
@@ -181,7 +181,7 @@ def test_a_multiplier_the_two_perturbations_disagree_on_is_not_reported(paper_sp
     stick event: the multiplier reads 1.14 at one perturbation and 0.51 at ten times it.
     Four moves end in the cycle, so it attracts; the multiplier is not reported. At Fc
     3.02 N the two agree (0.48) and the cycle is stable by its multiplier."""
-    from fi_design.specfile import with_values
+    from fi_design.spec.file import with_values
 
     st = stage_hunting(with_values(paper_spec, {"friction.coulomb": 3.0}), False,
                        boundary=False)
@@ -217,7 +217,7 @@ def test_a_stage_creeping_at_its_static_friction_inside_the_band_settles(paper_s
     the cart at its static friction, so the rest is not final by the static balance; the
     cart creeps and never leaves the band. Such a move settles (it was 'undetermined'), and a
     horizon four times longer finds the same."""
-    from fi_design.specfile import with_values
+    from fi_design.spec.file import with_values
 
     point = with_values(paper_spec, {
         "controller.crossover": 11.0, "friction.static": 4.138233676825914,
@@ -287,7 +287,7 @@ def test_the_watch_lands_on_the_section_and_leaves_the_trajectory_alone(paper_sp
     from fi_design.kernel import run
     from fi_design.kernel.layout import N_WATCH, W_ARM, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_START
     from fi_design.model import resolve
-    from fi_design.simulation import tolerances
+    from fi_design.simulation.run import tolerances
     from fi_design.stage.moves import _family_reference
 
     p = resolve(paper_spec).plant(False)

@@ -47,7 +47,7 @@ needs_poppler = pytest.mark.skipif(shutil.which("pdftotext") is None,
 
 def _design(name: str, sensitivity: bool):
     from fi_design.signoff import design
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     return design(load_spec(EXAMPLES / f"{name}.yaml"), recommend=False,
                   sensitivity=sensitivity)
@@ -397,7 +397,7 @@ def test_step_1_screens_and_the_stage_level_answer_decides(documents, name):
 def test_step_1_below_its_threshold_beside_a_hunting_stage_is_no_pass():
     """Canudas de Wit et al. (1995): Fs - Fc = 0.5 N, below the 1 N threshold, and a 127.8 mm
     cycle. Step 1 must not read as a pass the simulation refutes."""
-    from fi_design.guideline import friction_gap_judged, step1_friction_gap
+    from fi_design.guideline.steps import friction_gap_judged, step1_friction_gap
     from fi_design.stage import stage_hunting
 
     from test_stage import _canudas_spec
@@ -429,7 +429,7 @@ def test_terms_printed_are_defined(documents, name):
 
 def test_a_failing_headline_names_steps_not_check_ids(paper_spec):
     """A design failing its margins (no simulation needed): the headline names the step."""
-    from fi_design.guideline import design
+    from fi_design.guideline.evaluate import evaluate as design
 
     from conftest import variant
 
@@ -560,7 +560,7 @@ def test_a_failing_design_with_its_recommendation_reads_as_one():
     the conclusion never advises the rule's isolator the report shows hunting, and the
     recommendation is the search's design (a minute on two cores)."""
     from fi_design.signoff import design
-    from fi_design.specfile import load_spec
+    from fi_design.spec.file import load_spec
 
     r = design(load_spec(EXAMPLES / "no_isolator.yaml"))
     rec = r.recommendation
@@ -569,7 +569,7 @@ def test_a_failing_design_with_its_recommendation_reads_as_one():
     doc = console_text(r)
     assert rec.text in doc.replace("\n", " ") or rec.text[:40] in doc
     if rec.feasible:
-        from fi_design.specpaths import with_values
+        from fi_design.spec.paths import with_values
 
         values = {"isolator": {k: v for k, v in rec.isolator.items() if v is not None}}
         if rec.crossover is not None:

@@ -24,7 +24,7 @@ from fi_design.errors import ArgumentError, SpecError
 from fi_design.execution import chunks
 from fi_design.results.studies import spec_digest
 from fi_design.studies import cache as cachemod, points
-from fi_design.specfile import with_values
+from fi_design.spec.file import with_values
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ import json
 import pytest
 from typer.testing import CliRunner
 
-from fi_design.cli import app
+from fi_design.cli.app import app
 
 runner = CliRunner()
 

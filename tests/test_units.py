@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from fi_design.errors import ArgumentError, UnitError
-from fi_design.units import registry, to_si
+from fi_design.spec.units import registry, to_si
 
 
 @pytest.mark.parametrize("value,unit,expected", [

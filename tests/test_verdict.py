@@ -19,10 +19,10 @@ import yaml
 from typer.testing import CliRunner
 
 from fi_design import report
-from fi_design.cli import app
+from fi_design.cli.app import app
 from fi_design.mechanism.sizing import net_stiffness
-from fi_design.guideline import design
-from fi_design.specfile import load_spec
+from fi_design.guideline.evaluate import evaluate as design
+from fi_design.spec.file import load_spec
 from fi_design.studies import wilson_interval
 
 from conftest import EXAMPLES, variant
@@ -138,7 +138,7 @@ def test_the_sign_off_recommends_a_design_it_passes(no_isolator_spec):
     """fi_design.design (the design command): a failing stage gets the design search's answer,
     and the design command on that design passes."""
     import fi_design
-    from fi_design.specfile import with_values
+    from fi_design.spec.file import with_values
 
     spec = variant(no_isolator_spec, **_samples(20))
     r = fi_design.design(spec)
@@ -195,7 +195,7 @@ def test_stuck_stage_fails(cases):
 def test_a_slow_integrator_settles_after_every_move_but_not_in_the_window(no_isolator_spec):
     """An integrator 300 times slower than the crossover rests off target for long: the
     spec's move is 'stuck' in the metric's window, a warning, while every move settles."""
-    from fi_design.confirm import confirm
+    from fi_design.stage.confirm import confirm
 
     spec = variant(no_isolator_spec, **{"controller.integrator_ratio": 300})
     c = confirm(spec, (0.3e-3, 6667.0))

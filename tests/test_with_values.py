@@ -1,4 +1,4 @@
-"""Dotted-path access to a spec: with_values, path_unit, value_at (fi_design.specfile)."""
+"""Dotted-path access to a spec: with_values, path_unit, value_at (fi_design.spec.file)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from fi_design.errors import SpecError
-from fi_design.specfile import path_unit, value_at, with_values
+from fi_design.spec.file import path_unit, value_at, with_values
 
 
 def test_replaces_and_revalidates(paper_spec):

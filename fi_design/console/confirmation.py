@@ -178,7 +178,7 @@ def simulation_table(sim: dict, window: tuple[float, float] | None = None,
 
 
 def print_simulation(console: "Console", result) -> None:
-    """Print the metrics and solver statistics of a :class:`~fi_design.simulation.SimulationResult`.
+    """Print the metrics and solver statistics of a :class:`~fi_design.simulation.run.SimulationResult`.
 
     A replay of a measured record shows its agreement with the record
     instead of the hunting metric (which judges a settling stage, not a
@@ -188,7 +188,7 @@ def print_simulation(console: "Console", result) -> None:
     ----------
     console : rich.console.Console
         Where to print.
-    result : fi_design.simulation.SimulationResult
+    result : fi_design.simulation.run.SimulationResult
         The simulation.
     """
     from rich import box

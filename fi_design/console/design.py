@@ -70,13 +70,13 @@ def checks_table(checks, title: str = "Checks", cases: Any = None):
 
 
 def print_design(console: "Console", result, spec_path: Path | None = None) -> None:
-    """Print the readable summary of a :class:`~fi_design.guideline.DesignResult`.
+    """Print the readable summary of a :class:`~fi_design.guideline.steps.DesignResult`.
 
     Parameters
     ----------
     console : rich.console.Console
         Where to print.
-    result : fi_design.guideline.DesignResult
+    result : fi_design.guideline.steps.DesignResult
         The design result.
     spec_path : pathlib.Path, optional
         The spec file, named in the heading.

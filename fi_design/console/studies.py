@@ -296,7 +296,7 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
 
 
 def _path_unit(path: str, spec) -> str:
-    from ..specfile import path_unit
+    from ..spec.file import path_unit
 
     try:
         return path_unit(path, spec)

@@ -2,6 +2,10 @@
 
 A small package with one job a module:
 
+- :mod:`.pid`: the tuning rule, the PID's gains from the crossover and the
+  moving mass (step 4), and its forms;
+- :mod:`.handoff`: the hand-off, the spec's controller written with the gains
+  a drive takes;
 - :mod:`.filters`: the drive's notch and low-pass filters as polynomials in s
   and, sampled, as biquads by the Tustin rule prewarped at their frequency;
 - :mod:`.polynomials`: the loop's controller C(s), the PID in series with the

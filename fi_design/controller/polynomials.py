@@ -1,6 +1,6 @@
 """The loop's controller C(s) as polynomials: the PID in series with the drive's filters.
 
-The linear analysis (:mod:`fi_design.linear`) builds every loop from these.
+The linear analysis (:mod:`fi_design.loop.linear`) builds every loop from these.
 C(s) = F(s) C_pid(s), with F the filter chain (:mod:`.filters`, unit DC gain)
 on the PID's output; the rule's PID in its series form, any other law in
 parallel form with a filtered (or ideal) D term.

@@ -19,7 +19,7 @@ import numpy as np
 from ..arguments import choice, integer, number
 from ..errors import ArgumentError, DataError
 from ..measured import Measurement, measurement_from_arrays
-from ..specfile import as_spec
+from ..spec.file import as_spec
 from .dynamic import dynamic_parameters
 from .events import excitation
 from .preprocess import JITTER, check_record, joint_model, prepare, processing

@@ -3,7 +3,7 @@
 :func:`spec_values` lists the values by dotted path, :func:`identified_spec`
 validates them as a spec, :func:`identified_spec_text` writes the input
 spec's own YAML text with the values replaced in place and commented
-(:func:`fi_design.specedit.edited_spec_text`: comments and layout kept).
+(:func:`fi_design.spec.edit.edited_spec_text`: comments and layout kept).
 """
 
 from __future__ import annotations
@@ -108,7 +108,7 @@ def identified_spec(spec, params, masses, form, direction: str = "both"):
         in the per-direction form: then use the symmetric form).
     """
     from ..errors import SpecError
-    from ..specfile import with_values
+    from ..spec.file import with_values
 
     values = _values(spec, params, masses, form, direction)
     bad = [k for k in ("stage.mass", "cart.mass", "friction.coulomb",
@@ -137,11 +137,11 @@ def identified_spec_text(result: IdentificationResult) -> str:
     """YAML text of the input spec with the identified values filled in (``--write-spec``).
 
     The spec file's own text is kept, comments and layout included
-    (:func:`fi_design.specedit.edited_spec_text`): each value of
+    (:func:`fi_design.spec.edit.edited_spec_text`): each value of
     :func:`spec_values` replaces the one written in the file, with a comment
     giving the estimate, its standard error and the value it replaced; a
     missing key is added to its section. A header comment names the record
-    and the form. The text is checked with :func:`fi_design.specfile.load_spec`
+    and the form. The text is checked with :func:`fi_design.spec.file.load_spec`
     before it is returned.
 
     Parameters
@@ -160,8 +160,8 @@ def identified_spec_text(result: IdentificationResult) -> str:
         No spec, or an identified value the spec cannot hold.
     """
     from ..errors import SpecError
-    from ..specedit import edited_spec_text, spec_quantity
-    from ..specfile import origin
+    from ..spec.edit import edited_spec_text, spec_quantity
+    from ..spec.file import origin
 
     spec = result.spec
     if spec is None:

@@ -42,7 +42,7 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     ``W_*`` in :mod:`fi_design.kernel.layout`, None for none; ``crossings``:
     room for this many section crossings). This thin wrapper is the
     integrator's only Python-level entry point, in whichever build
-    :func:`fi_design.kernel.build.compiled` chose; :mod:`fi_design.simulation`
+    :func:`fi_design.kernel.build.compiled` chose; :mod:`fi_design.simulation.run`
     wraps it in a result.
     """
     from .build import compiled  # not at import: `python -m fi_design.kernel.build` runs it

@@ -80,7 +80,7 @@ drive's Tustin rule prewarped at the filter's frequency, computed by
     out = z0 x + s1,   s1 <- z1 x - p1 out + s2,   s2 <- z2 x - p2 out
 
 The continuous controller, one law for every controller the spec describes
-(:mod:`fi_design.pid` maps the tuning rule and explicit hardware gains onto
+(:mod:`fi_design.controller.pid` maps the tuning rule and explicit hardware gains onto
 it)::
 
     v = kp e + I + kd e' - kdm x'       e = r - x, x the measured position

@@ -65,7 +65,7 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
 
     Parameters
     ----------
-    confirmation : fi_design.confirm.Confirmation
+    confirmation : fi_design.stage.confirm.Confirmation
         The simulated confirmation (its ``results`` hold the traces).
     spec : fi_design.spec.Spec
         The design spec (hunting-metric settings).
@@ -137,7 +137,7 @@ def deflection_figure(confirmation: Any, spec: Any) -> Any:
 
     Parameters
     ----------
-    confirmation : fi_design.confirm.Confirmation
+    confirmation : fi_design.stage.confirm.Confirmation
         The simulated confirmation.
     spec : fi_design.spec.Spec
         The design spec (the stroke; a spec without isolator uses the

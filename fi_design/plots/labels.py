@@ -52,7 +52,7 @@ def quantity_name(path: str) -> str:
     if path in QUANTITY_NAMES:
         return QUANTITY_NAMES[path]
     from ..errors import SpecError
-    from ..specfile import path_description
+    from ..spec.file import path_description
 
     try:
         text = path_description(path)

@@ -29,7 +29,7 @@ def case_label(case: Any) -> str:
 
     Parameters
     ----------
-    case : fi_design.guideline.CaseResponse
+    case : fi_design.guideline.steps.CaseResponse
         The case (``number`` and ``description``).
 
     Returns
@@ -95,12 +95,12 @@ def bode_figure(result: Any) -> Any:
     """Open-loop Bode plot of the four limit cases (paper Figure 2) in one figure.
 
     Magnitude and phase of L = C D P for every case (the design's
-    :class:`~fi_design.guideline.LoopResponses`), the desired crossover
+    :class:`~fi_design.guideline.steps.LoopResponses`), the desired crossover
     (dashed), 0 dB and -180 deg, and each case's gain crossovers (dots).
 
     Parameters
     ----------
-    result : fi_design.guideline.DesignResult
+    result : fi_design.guideline.steps.DesignResult
         The design.
 
     Returns
@@ -176,7 +176,7 @@ def nyquist_figure(result: Any) -> Any:
     """Nyquist plot of the limit cases (positive frequencies), zoomed on the critical point -1.
 
     The curves are drawn on the loop's own grid, refined where they move fast
-    (:func:`fi_design.responses.frequency_grid`), so they are smooth; a
+    (:func:`fi_design.loop.responses.frequency_grid`), so they are smooth; a
     sampled loop's end at its Nyquist frequency. Colours and line styles as
     in :func:`bode_figure`; the circle
     ``|1 + L| = m`` marks the modulus margin ``m`` (the spec's requirement, else
@@ -184,7 +184,7 @@ def nyquist_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.guideline.DesignResult
+    result : fi_design.guideline.steps.DesignResult
         The design.
 
     Returns
@@ -223,7 +223,7 @@ def sensitivity_figure(result: Any) -> Any:
 
     Parameters
     ----------
-    result : fi_design.guideline.DesignResult
+    result : fi_design.guideline.steps.DesignResult
         The design.
 
     Returns

@@ -24,7 +24,7 @@ import math
 from typing import Any
 
 from .. import spec as _spec
-from ..specfile import with_values
+from ..spec.file import with_values
 
 __all__ = ["SEARCH_POINTS", "reserve_spec", "crossover_cap", "guide_for", "loop_meets",
            "stage_answer", "margin_screen", "reserve_corners", "hunting_margin"]
@@ -63,7 +63,7 @@ def crossover_cap(base: _spec.Spec, rule: bool) -> tuple[float, str]:
     -------
     (float, str)
     """
-    from .. import linear
+    from ..loop import linear
     from ..model import resolve
 
     fc = _spec.design_crossover(base)
@@ -123,7 +123,7 @@ def loop_meets(spec: _spec.Spec) -> tuple[bool, str]:
     structure's measured ones) are in the loop; every mode lies at the
     separation times the crossover.
     """
-    from .. import linear
+    from ..loop import linear
     from ..model import resolve
 
     model = resolve(reserve_spec(spec))
@@ -225,7 +225,7 @@ def reserve_corners(spec: _spec.Spec) -> tuple[dict, ...]:
     tuple of dict
         ``name``, ``passed`` (bool), ``why`` (str, empty when passed).
     """
-    from .. import linear
+    from ..loop import linear
     from ..model import resolve
 
     model = resolve(spec)

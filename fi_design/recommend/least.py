@@ -24,7 +24,7 @@ from typing import Any
 from .. import spec as _spec
 from ..display import quantity
 from ..results.recommend import LeastChange
-from ..specfile import with_values
+from ..spec.file import with_values
 from . import constraints as _c
 
 __all__ = ["least_change", "BISECTION_STEPS", "STROKE_FACTORS"]
@@ -62,7 +62,7 @@ def _stiffest(spec: _spec.Spec, stroke: float, margin: float) -> tuple[float | N
 
 
 def _passes(spec: _spec.Spec, executor: Any) -> tuple[bool, str]:
-    from ..guideline import design
+    from ..guideline.evaluate import evaluate as design
 
     r = design(spec, executor=executor)
     if r.verdict.status == "FAIL":

@@ -273,7 +273,7 @@ class _Search:
     def sign_off(self, p: _Point) -> tuple[bool, Any]:
         """The guide at full resolution, the loop with its reserve, the reserve corners, the
         design command's verdict. Returns (passed, (guide, corners, design result))."""
-        from ..guideline import design
+        from ..guideline.evaluate import evaluate as design
 
         fx = _c.guide_for(self.base, p.stiffness, p.stroke, self.fc, points=FULL_POINTS)
         if fx.feasible and abs(fx.drive_stiffness / p.stiffness - 1.0) < 0.02:
@@ -347,10 +347,10 @@ def recommend(spec: _spec.Spec | str | Any, *, executor: Any = None,
     SpecError
         A path or mapping that does not validate.
     """
-    from ..guideline import step2_crossover
+    from ..guideline.steps import step2_crossover
     from .least import least_change
 
-    from ..specfile import as_spec
+    from ..spec.file import as_spec
 
     start = _time.perf_counter()
     spec = as_spec(spec)

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from .. import spec as _spec
-from ..specfile import with_values
+from ..spec.file import with_values
 
 __all__ = ["ASSUMED_FLEXURE", "STROKE_FLOOR", "STROKE_SPAN", "Candidate", "base_spec",
            "stroke_envelope", "damping_ratio"]
@@ -55,7 +55,7 @@ def base_spec(spec: _spec.Spec) -> tuple[_spec.Spec, tuple[str, ...]]:
     assumed = []
     base = spec
     if base.isolator is None:
-        from ..guideline import suggested_isolator
+        from ..guideline.steps import suggested_isolator
 
         s, k = suggested_isolator(spec)
         base = with_values(base, {"isolator": {"stroke": s, "stiffness": k}})

@@ -30,9 +30,9 @@ def written(spec: Any, path: str, value: float, *, down: bool = False) -> Any:
     """The value at a path in the unit the spec wrote there (else its field's), DIGITS digits;
     ``down`` rounds towards zero (a leaf's width: the stiffness stays at or below the
     design's)."""
-    from ..specfile import path_unit
-    from ..specedit import written_unit
-    from ..units import from_si
+    from ..spec.file import path_unit
+    from ..spec.edit import written_unit
+    from ..spec.units import from_si
 
     unit = written_unit(spec, path)
     si = path_unit(path)
@@ -64,7 +64,7 @@ def recommended_values(result: RecommendResult) -> dict[str, Any]:
         for a spec tuned by the rule; for a spec without isolator or flexure
         the sections as a whole.
     """
-    from ..specedit import REMOVE
+    from ..spec.edit import REMOVE
 
     d, spec = result.design, result.spec
     values: dict[str, Any] = {}
@@ -132,7 +132,7 @@ def recommended_spec_text(result: RecommendResult, *, date: datetime.date | None
     """YAML text of the input spec with the recommended design written in.
 
     The input's text is edited (comments and layout kept,
-    :func:`fi_design.specedit.edited_spec_text`), the comments of the keys
+    :func:`fi_design.spec.edit.edited_spec_text`), the comments of the keys
     changed replaced, and a revision added to ``report.revisions``; the design
     command on it runs the same computation that signed the design off.
 
@@ -153,7 +153,7 @@ def recommended_spec_text(result: RecommendResult, *, date: datetime.date | None
     ArgumentError
         The search found no design that passes.
     """
-    from ..specedit import REMOVE, edited_spec_text
+    from ..spec.edit import REMOVE, edited_spec_text
 
     if not result.feasible:
         raise ArgumentError("no design of the searched space passes: there is no "

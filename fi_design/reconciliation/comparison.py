@@ -1,7 +1,7 @@
 """The comparison of one model run with the record: replay, segments, weighted residual.
 
 :class:`Comparison` holds the record, the noise levels and the way the trace
-is split, runs the model on the record (:func:`fi_design.simulation.simulate`
+is split, runs the model on the record (:func:`fi_design.simulation.run.simulate`
 with ``record=``: the replay starts from the state in the data) and turns a
 run into the weighted residual vector every fit and score works on.
 
@@ -25,8 +25,8 @@ import numpy as np
 from ..errors import DataError
 from ..measured import Measurement
 from ..model import as_model
-from ..replay import command_state
-from ..simulation import simulate
+from ..simulation.replay import command_state
+from ..simulation.run import simulate
 from ..trajectory import from_samples
 from ..results.reconciliation import Lattice, ModelTrace, NoiseLevels, Segment
 
@@ -355,7 +355,7 @@ def model_tolerance(spec, noise: NoiseLevels) -> float:
     """Relative tolerance of the reconciliation's simulations.
 
     The integrator's absolute position tolerance is ``rtol`` times 1 mm
-    (:func:`fi_design.simulation.tolerances`). Integration errors of the size of
+    (:func:`fi_design.simulation.run.tolerances`). Integration errors of the size of
     a fraction of the sensor noise, summed over thousands of samples, would
     otherwise let a fit "explain" numerical jitter: the tolerance is set so
     that the position tolerance is a hundredth of the smallest position or

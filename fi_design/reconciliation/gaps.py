@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from ..metrics import hunting_metrics
+from ..simulation.metrics import hunting_metrics
 from .comparison import Comparison, ModelRun
 from ..results.reconciliation import GapMetric
 

@@ -61,7 +61,7 @@ def spec_with_entries(spec, entries):
 def fixed_spec_text(result) -> str:
     """YAML text of the spec with the chosen effects added to its ``effects`` list.
 
-    The input spec's own text is edited (:func:`fi_design.specedit.edited_spec_text`:
+    The input spec's own text is edited (:func:`fi_design.spec.edit.edited_spec_text`:
     comments and layout kept): an entry of the same type is replaced, the
     others are kept; a header comment names the record and the conclusion.
     With the answer ``none`` the spec is written unchanged under that header.
@@ -76,8 +76,8 @@ def fixed_spec_text(result) -> str:
     str
         YAML that ``load_spec`` reads back (checked).
     """
-    from ..specedit import edited_spec_text
-    from ..specfile import origin
+    from ..spec.edit import edited_spec_text
+    from ..spec.file import origin
 
     spec = result.spec
     entries = [entry_input(e["type"], {k: v for k, v in e.items() if k != "type"})

@@ -23,8 +23,8 @@ from ..arguments import integer, number
 from ..errors import ArgumentError, DataError, SimulationError
 from ..measured import Measurement
 from ..model import resolve
-from ..replay import DRIVES
-from ..specfile import as_spec
+from ..simulation.replay import DRIVES
+from ..spec.file import as_spec
 from .comparison import MAX_POINTS, Comparison, ModelRun
 from .diagnosis import diagnose
 from .fitting import (Baseline, FitOutcome, JointObjective, fit, fit_baseline, joint_fit,

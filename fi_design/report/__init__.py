@@ -7,7 +7,7 @@ How a report is made
 1. :func:`build_context` turns a result into plain data: strings, SI floats
    with their unit, lists and dicts. It is a :func:`functools.singledispatch`
    function with one builder per result type: :mod:`.design` (a
-   :class:`~fi_design.guideline.DesignResult`, optionally with a
+   :class:`~fi_design.guideline.steps.DesignResult`, optionally with a
    :class:`~fi_design.studies.DesignMap` computed by the caller), :mod:`.study`
    (sweeps, the paper's study, robustness), :mod:`.recommend` (a design
    search), :mod:`.gap` (a reconciliation: :func:`gap_context`) and

@@ -29,7 +29,7 @@ def build_context(result: Any, *, date: Any = None, command: str | None = None,
     """Everything the report of a result shows, as plain data (for :func:`render_html`).
 
     Builders are registered per result type: a
-    :class:`~fi_design.guideline.DesignResult` (which also takes
+    :class:`~fi_design.guideline.steps.DesignResult` (which also takes
     ``design_map``), :class:`~fi_design.studies.SweepResult`,
     :class:`~fi_design.studies.StudyResult`,
     :class:`~fi_design.studies.RobustnessResult`,

@@ -1,4 +1,4 @@
-"""The design report: the context of a :class:`~fi_design.guideline.DesignResult`.
+"""The design report: the context of a :class:`~fi_design.guideline.steps.DesignResult`.
 
 Sections in order: verdict, inputs, the four guideline steps, the linear
 analysis, the nonlinear confirmation, a hunting map around the design point
@@ -530,7 +530,7 @@ def design_context(result: DesignResult, *, date: Any = None, command: str | Non
 
     Parameters
     ----------
-    result : fi_design.guideline.DesignResult
+    result : fi_design.guideline.steps.DesignResult
         The design (with its simulated confirmation, if any).
     date : str or datetime.date, optional
         The report date; default :func:`~fi_design.report.meta.report_date` (today).

@@ -71,7 +71,7 @@ def spec_inputs(spec: Any, model: Any) -> list[dict]:
     """
     from pydantic import BaseModel
 
-    from ..specfile import path_unit
+    from ..spec.file import path_unit
 
     src = spec_file(spec)
     raw = src["raw"] if src["raw"] is not None else {}

@@ -83,7 +83,7 @@ def spec_file(spec: Any) -> dict:
         code), and ``text``, the file's text as read (None unless read from a
         file).
     """
-    from ..specfile import origin
+    from ..spec.file import origin
 
     org = origin(spec)
     if org is None:

@@ -22,7 +22,7 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
 
     Parameters
     ----------
-    result : fi_design.guideline.DesignResult
+    result : fi_design.guideline.steps.DesignResult
         The design (and its simulated landing, when confirmed).
     figures : bool, optional
         Draw the equations (default); False leaves their ``svg`` None.

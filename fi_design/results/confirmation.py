@@ -1,7 +1,7 @@
 """Results of the nonlinear confirmation: each plant's verdict, where the cart rests.
 
-Produced by :func:`fi_design.confirm.confirm` (the simulated confirmation) and
-:func:`fi_design.guideline.design` (the isolator advice of a spec without one).
+Produced by :func:`fi_design.stage.confirm.confirm` (the simulated confirmation) and
+:func:`fi_design.guideline.evaluate.evaluate` (the isolator advice of a spec without one).
 """
 
 from __future__ import annotations

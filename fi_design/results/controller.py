@@ -1,11 +1,11 @@
 """The loop's controller as values: the rule's PID gains and the control law.
 
-Produced by :func:`fi_design.pid.pid_gains` (the tuning rule, guideline step 4)
+Produced by :func:`fi_design.controller.pid.pid_gains` (the tuning rule, guideline step 4)
 and by :func:`fi_design.model.resolve` (the loop's controller of a spec,
-through :func:`fi_design.pid.control_law`). The linear analysis, the kernel's
+through :func:`fi_design.controller.pid.control_law`). The linear analysis, the kernel's
 parameters, the replay and the report all read these values; the arithmetic
 here only restates a law in another form (parallel, filtered, kernel,
-discrete), it never retunes one (that is :func:`fi_design.pid.at_crossover`).
+discrete), it never retunes one (that is :func:`fi_design.controller.pid.at_crossover`).
 """
 
 from __future__ import annotations

@@ -1,9 +1,9 @@
 """The result of the design workflow: the four guideline steps, the loop, the confirmation.
 
-Produced by :func:`fi_design.guideline.design`. Its parts live by stage of
+Produced by :func:`fi_design.guideline.evaluate.evaluate`. Its parts live by stage of
 the work, and are named here too: :mod:`.steps` (steps 1 to 4, the loop
 responses; :func:`fi_design.flexure.size_flexure`), :mod:`.confirmation`
-(the simulated confirmation, :func:`fi_design.confirm.confirm`; the isolator
+(the simulated confirmation, :func:`fi_design.stage.confirm.confirm`; the isolator
 advice) and :mod:`.verdict` (the sign-off: verdict, robustness, margins,
 recommendation).
 """
@@ -70,7 +70,7 @@ class DesignResult(Result):
         Version of fi_design that computed it.
     spec_sha256 : str
         SHA-256 of the spec file (of the spec's JSON when not read from a file).
-    simulation : fi_design.confirm.Confirmation or None
+    simulation : fi_design.stage.confirm.Confirmation or None
         The nonlinear confirmation; None when it was not run (``confirm=False``),
         and then left out of the JSON.
     fi_design_source : fi_design.provenance.Source
@@ -78,7 +78,7 @@ class DesignResult(Result):
         of the package's source files; default the running package's.
     verdict : Verdict or None
         The sign-off verdict on the hardware as specified (None only while
-        :func:`fi_design.guideline.design` assembles the result).
+        :func:`fi_design.guideline.evaluate.evaluate` assembles the result).
     robustness : RobustnessCheck or None
         Hunting under friction scatter; None when not run
         (``confirm=False`` or ``requirements.robustness.samples: 0``).

@@ -1,7 +1,7 @@
 """Results of the linear analysis: the margins of the limit cases and the achievable crossover.
 
-Produced by :mod:`fi_design.linear` (:func:`~fi_design.linear.loop_margins`,
-:func:`~fi_design.linear.analyse`, :func:`~fi_design.linear.achievable_crossover`).
+Produced by :mod:`fi_design.loop.linear` (:func:`~fi_design.loop.linear.loop_margins`,
+:func:`~fi_design.loop.linear.analyse`, :func:`~fi_design.loop.linear.achievable_crossover`).
 A limit case is judged where its margins are computed: :class:`CaseMargins`
 carries the status of each requirement and of the case, and the guideline's
 checks, the report and the console read them.
@@ -37,7 +37,7 @@ class GainCrossing(Result):
         Extra loop delay that brings this crossing to -180 deg [s]; 0 when
         the closed loop is unstable.
     in_band : bool
-        At or above :data:`fi_design.linear.BAND_FACTOR` below the
+        At or above :data:`fi_design.loop.linear.BAND_FACTOR` below the
         controller's crossover (True before the case is judged).
     """
 
@@ -71,7 +71,7 @@ class CaseMargins(Result):
     Attributes
     ----------
     name : str
-        Case name (see :data:`fi_design.linear.ISOLATED_CASES`).
+        Case name (see :data:`fi_design.loop.linear.ISOLATED_CASES`).
     description : str
         The case in words.
     crossover : float or None
@@ -114,7 +114,7 @@ class CaseMargins(Result):
         ``gain margin``, ``modulus margin``.
     in_band : bool
         Whether a gain crossover lies within the loop's band, at or above
-        :data:`fi_design.linear.BAND_FACTOR` below the controller's
+        :data:`fi_design.loop.linear.BAND_FACTOR` below the controller's
         crossover. A case that crosses 0 dB only far below (the integrator
         against the stiff bristles of a stuck cart crosses at millihertz) or
         never has no phase or delay margin worth reporting; its gain margin
@@ -123,7 +123,7 @@ class CaseMargins(Result):
         The case's judgement: FAIL when a requirement is not met, INFO when
         it passes without a crossing in the loop's band (its phase and delay
         margins are no margins to pass), PASS otherwise; None before the
-        case is judged (:func:`fi_design.linear.loop_margins` alone).
+        case is judged (:func:`fi_design.loop.linear.loop_margins` alone).
     criteria : dict of str to Status
         The judgement of each requirement judged (:data:`CRITERIA`; the
         modulus margin only when required): FAIL when it is not met or the
@@ -171,7 +171,7 @@ class LoopAnalysis(Result):
         All cases meet the margin requirements.
     loop_crossover : float or None
         The loop's actual crossover: the highest in-band 0 dB crossing of
-        any case [Hz] (:func:`fi_design.linear.loop_crossover`); None when no
+        any case [Hz] (:func:`fi_design.loop.linear.loop_crossover`); None when no
         case crosses in the band.
     loop_crossover_case : str or None
         The case it belongs to.
@@ -220,7 +220,7 @@ class AchievableCrossover(Result):
     mode : str or None
         The parasitic mode that limits it: the one the separation is judged
         on (``kind == "mode"``); for a margin, filled in by step 2 when a
-        mode causes it (:func:`fi_design.notch.limiting_mode`).
+        mode causes it (:func:`fi_design.loop.notch.limiting_mode`).
     mode_frequency : float or None
         That mode's frequency [Hz].
     """
@@ -249,7 +249,7 @@ def loop_crossover(cases: Sequence[CaseMargins]) -> tuple[float | None, str | No
     Parameters
     ----------
     cases : sequence of CaseMargins
-        The judged margins of the limit cases (:func:`fi_design.linear.analyse`).
+        The judged margins of the limit cases (:func:`fi_design.loop.linear.analyse`).
 
     Returns
     -------

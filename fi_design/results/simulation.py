@@ -1,7 +1,7 @@
 """Results of one simulation: the hunting metric of a trace, and the simulation itself.
 
-Produced by :func:`fi_design.metrics.hunting_metrics` and
-:func:`fi_design.simulation.simulate`.
+Produced by :func:`fi_design.simulation.metrics.hunting_metrics` and
+:func:`fi_design.simulation.run.simulate`.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from . import Result, dataclass_dict
 if TYPE_CHECKING:  # pragma: no cover
     from ..spec import Spec
 
-# The kernel's PlantParameters (fi_design.kernel.layout) and a replay's ReplayFit (fi_design.replay) are
+# The kernel's PlantParameters (fi_design.kernel.layout) and a replay's ReplayFit (fi_design.simulation.replay) are
 # typed Any here: the results layer imports no physics, not even for a type.
 
 __all__ = ["HuntingMetrics", "SimulationResult"]
@@ -138,7 +138,7 @@ class SimulationResult(Result):
         Open-loop replay: the number of the re-anchored window of each
         sample (the state is reset to the measurement at each window's
         start); None otherwise.
-    replay : fi_design.replay.ReplayFit or None
+    replay : fi_design.simulation.replay.ReplayFit or None
         How a record's replay agrees with the measurement; None otherwise.
     """
 

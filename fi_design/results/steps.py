@@ -1,6 +1,6 @@
 """Results of the four guideline steps: friction gap, crossover, stiffness, flexure, gains.
 
-Produced by :func:`fi_design.guideline.design` (steps 1 to 4 and the loop
+Produced by :func:`fi_design.guideline.evaluate.evaluate` (steps 1 to 4 and the loop
 responses of the four limit cases) and :func:`fi_design.flexure.size_flexure`.
 """
 
@@ -505,7 +505,7 @@ class LoopResponses(Result):
         the desired crossover or twice the highest parasitic mode (a sampled
         controller's Nyquist frequency at most); log-spaced, packed at every
         resonance and antiresonance, holding every crossing and sensitivity
-        peak (:func:`fi_design.responses.loop_responses`).
+        peak (:func:`fi_design.loop.responses.loop_responses`).
     cases : tuple of CaseResponse
         One per limit case, in the paper's order.
     nyquist : float or None

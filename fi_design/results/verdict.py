@@ -1,6 +1,6 @@
 """Results of the sign-off: the verdict, its reasons, robustness, margins, advice.
 
-Produced by :func:`fi_design.verdict.judge` from the guideline's steps and
+Produced by :func:`fi_design.guideline.verdict.judge` from the guideline's steps and
 the confirmation.
 """
 

@@ -16,7 +16,11 @@ The package, one job a module: :mod:`.fields` (quantities with units, plain
 text, the strict base model), :mod:`.sections` (every section of the file),
 :mod:`.filters` (the controller's filter chain and
 the drive's units), :mod:`.document` (the :class:`Spec` itself, its effects list and the checks
-across sections) and :mod:`.defaults` (derived defaults and warnings).
+across sections) and :mod:`.defaults` (derived defaults and warnings). Around the spec itself:
+:mod:`.units` (pint at the YAML boundary), :mod:`.file` (reading a spec file,
+its origin and hash), :mod:`.errors` (pydantic's errors worded with the path,
+line and column), :mod:`.paths` (the values at dotted paths) and :mod:`.edit`
+(a spec file written back with changed values, comments kept).
 """
 
 from __future__ import annotations

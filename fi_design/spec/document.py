@@ -75,7 +75,7 @@ class Spec(StrictModel):
     report: ReportInfo = Field(default_factory=ReportInfo)
     simulation: Simulation = Field(default_factory=Simulation)
 
-    #: Where the spec was read from (set by fi_design.specfile.load_spec).
+    #: Where the spec was read from (set by fi_design.spec.file.load_spec).
     _origin: Any = PrivateAttr(default=None)
 
     @model_validator(mode="after")
@@ -138,7 +138,7 @@ class Spec(StrictModel):
         given as mappings are validated as in the YAML file, and the checks
         across sections run); the sections not named are shared. For single
         values at dotted paths, with units, use
-        :func:`fi_design.specfile.with_values`.
+        :func:`fi_design.spec.file.with_values`.
 
         Parameters
         ----------
@@ -160,7 +160,7 @@ class Spec(StrictModel):
 
         Examples
         --------
-        >>> from fi_design.specfile import load_spec
+        >>> from fi_design.spec.file import load_spec
         >>> spec = load_spec("examples/paper_setup.yaml")
         >>> spec.with_sections(isolator=None).has_isolator
         False

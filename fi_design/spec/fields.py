@@ -1,7 +1,7 @@
 """The spec's field types: quantities with units, plain text, the strict base model.
 
 Every physical field accepts an SI number or a string with units
-(:func:`fi_design.units.to_si`, at this boundary only) and holds an SI float.
+(:func:`fi_design.spec.units.to_si`, at this boundary only) and holds an SI float.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from typing import Annotated, Any, Union
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, WithJsonSchema
 
-from ..units import to_si
+from .units import to_si
 
 
 # --------------------------------------------------------------------------- quantities

@@ -18,7 +18,7 @@ import numpy as np
 from ..kernel.layout import W_ARM, PlantParameters, state_index
 from ..model import Model
 from ..results.stage import Cycle, CycleTrace
-from ..simulation import tolerances
+from ..simulation.run import tolerances
 from .moves import (FOLD_RELATIVE, FOLD_RESOLUTION, FOLD_STEP, MULTIPLIER_AGREEMENT, ORBIT_RTOL,
                     PERTURBATION, REPEAT, Watch, _guess_period, _hold, _integrate, _rest_ends_run, _restartable,
                     _watch_array, watch_settings)

@@ -31,7 +31,7 @@ RATE = 5000.0
 
 def _one(model: Model, isolated: bool, moves, end: float, settle: float, rate: float,
          distance: float, label: str) -> MoveForces:
-    from ..simulation import simulate
+    from ..simulation.run import simulate
 
     duration = end + settle
     res = simulate(model, isolated, reference=from_moves(moves, duration), duration=duration,

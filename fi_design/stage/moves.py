@@ -24,7 +24,7 @@ from ..kernel.layout import (N_WATCH, W_ARM, W_BAND, W_LEVEL, W_MATCH, W_MAX_CRO
                              state_index)
 from ..model import Model, as_model
 from ..results.stage import MoveOutcome, length_text
-from ..simulation import tolerances
+from ..simulation.run import tolerances
 from ..trajectory import Trajectory, from_moves, profile_duration
 
 log = logging.getLogger(__name__)

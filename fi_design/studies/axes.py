@@ -16,7 +16,7 @@ import numpy as np
 from .. import spec as _spec
 from ..errors import SpecError
 from ..results.studies import Axis
-from ..specfile import path_unit, value_at
+from ..spec.file import path_unit, value_at
 
 __all__ = ["make_axis", "parse_axis", "design_value", "is_number"]
 
@@ -96,7 +96,7 @@ def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> 
         Unknown path, malformed range, wrong unit, a bare number beside one
         with units, N below 1.
     """
-    from ..units import to_si
+    from ..spec.units import to_si
 
     if "=" not in text:
         raise SpecError(f"axis {text!r}: expected PATH=START:STOP:N, e.g. "

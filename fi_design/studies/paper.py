@@ -135,7 +135,7 @@ def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
     from .. import __version__
 
     from ..arguments import integer
-    from ..specfile import as_spec
+    from ..spec.file import as_spec
 
     spec = as_spec(spec)
     if isinstance(resolution, int) and resolution < 2:

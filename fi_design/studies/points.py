@@ -1,7 +1,7 @@
 """Points of a parameter study: simulate one, run many in chunks, record the outcomes.
 
 Every point is the base spec with some values replaced
-(:func:`fi_design.specfile.with_values`), simulated with the fast kernel and
+(:func:`fi_design.spec.file.with_values`), simulated with the fast kernel and
 judged (:func:`evaluate_point`) by one of two measures: ``"stage"`` (the
 default: whether any move of the family ends in a sustained cycle, and that
 cycle's amplitude, :mod:`fi_design.stage`) or ``"move"`` (the paper's hunting
@@ -29,7 +29,7 @@ from ..errors import ArgumentError, FiDesignError, SpecError
 from ..execution import Executor, chunks, run_chunks
 from ..results import frozen_array
 from ..results.studies import PointResult, RunInfo, spec_digest
-from ..specfile import with_values
+from ..spec.file import with_values
 from .cache import METHOD, PointCache, open_cache, point_key
 
 __all__ = ["MEASURES", "MAX_CHUNK", "MAX_POINTS", "TARGET_CHUNKS", "Task", "ProgressCallback",
@@ -61,7 +61,7 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
     spec : Spec
         The base spec.
     values : mapping of str to value
-        Dotted path to value, applied with :func:`~fi_design.specfile.with_values`.
+        Dotted path to value, applied with :func:`~fi_design.spec.file.with_values`.
     isolated : bool
         Simulate the isolated plant (True) or the stage without isolator.
     measure : {"move", "stage", "stage_first"}
@@ -82,7 +82,7 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
         ``period``, ``settling_time``, ``final_error``, ``message`` and
         ``cacheable`` (False for outcomes that depend on the machine).
     """
-    from ..simulation import simulate
+    from ..simulation.run import simulate
 
     if measure not in _MEASURES:
         raise ArgumentError(f"measure must be one of {MEASURES}, got {measure!r}")
@@ -198,7 +198,7 @@ def warm_up() -> None:
     """
     import scipy.signal  # noqa: F401  (the metric's peak finder, imported on first use)
 
-    from .. import simulation  # noqa: F401
+    from ..simulation import run as simulation  # noqa: F401
     from ..kernel.build import compiled
 
     compiled()  # the extension built at install, or numba's JIT (compiles or loads its cache)

@@ -26,7 +26,7 @@ from ..execution import Executor
 from ..results import frozen_array
 from ..results.studies import (POINT_VERDICTS, HuntingProbability, PointResult, PositionFriction,
                                RobustnessResult, Scatter)
-from ..specfile import path_unit, with_values
+from ..spec.file import path_unit, with_values
 from .axes import design_value, is_number
 from .cache import PointCache
 from .points import MAX_POINTS, STAGE_FIRST, ProgressCallback, evaluate, point_result
@@ -59,7 +59,7 @@ def parse_scatter(text: str, spec: _spec.Spec | None = None) -> Scatter:
     SpecError
         Unknown path, non-numeric value, malformed or negative spread.
     """
-    from ..units import to_si
+    from ..spec.units import to_si
 
     if "=" not in text:
         raise SpecError(f"scatter {text!r}: expected PATH=SPREAD, e.g. 'friction.static=10%'")
@@ -108,7 +108,7 @@ def parse_position_friction(text: str) -> PositionFriction:
     SpecError
         Malformed text or values out of range.
     """
-    from ..units import to_si
+    from ..spec.units import to_si
 
     path = "effects[type=position_dependent_friction]"
     parts = text.split(":")
@@ -230,7 +230,7 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
         A scatter that is not a :class:`Scatter`.
     """
     from .. import __version__
-    from ..specfile import as_spec
+    from ..spec.file import as_spec
 
     start = _time.perf_counter()
     spec = as_spec(spec)
@@ -317,7 +317,7 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
                   chunksize=chunksize, measure=STAGE_FIRST if measure == "stage" else measure)
     points = tuple(point_result((n % samples,), sample_values[n % samples], iso, out)
                    for n, ((_, iso), out) in enumerate(zip(all_tasks, ev.outcomes)))
-    from ..pid import control_law
+    from ..controller.pid import control_law
 
     integrates = control_law(spec).integrator
     probs = {}

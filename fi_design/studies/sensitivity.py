@@ -17,7 +17,7 @@ from typing import Any
 
 from ..model import Model, as_model
 from ..results.sensitivity import SENSITIVITY_PARAMETERS, CrossoverSensitivity, SensitivityPoint
-from ..specpaths import with_values
+from ..spec.paths import with_values
 
 __all__ = ["crossover_sensitivity", "DEFAULT_FACTORS"]
 

@@ -91,7 +91,7 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
         pair.
     """
     from .. import __version__
-    from ..specfile import as_spec
+    from ..spec.file import as_spec
 
     spec = as_spec(spec)
     ax = _as_axis(x, spec, "x")
@@ -141,7 +141,7 @@ def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
 
     Parameters
     ----------
-    result : fi_design.guideline.DesignResult
+    result : fi_design.guideline.steps.DesignResult
         The design; a spec without isolator is mapped with the isolator the
         guideline suggests (``result.isolator_advice``).
     resolution : (int, int), optional
@@ -154,7 +154,7 @@ def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
     -------
     DesignMap
     """
-    from ..confirm import with_isolator
+    from ..stage.confirm import with_isolator
     from ..model import resolve
 
     spec = result.spec

@@ -31,8 +31,8 @@ import sys
 from collections.abc import Callable, Iterator
 from typing import Any
 
-from . import interrupts
-from .errors import ArgumentError, FiDesignError
+from .. import interrupts
+from ..errors import ArgumentError, FiDesignError
 
 __all__ = ["EXECUTORS", "confirmation_pool", "StudyPool"]
 
@@ -137,7 +137,7 @@ def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
     if ctx is None:
         yield None
         return
-    from .studies import warm_up
+    from ..studies import warm_up
 
     started: list = []
     try:
@@ -205,7 +205,7 @@ class StudyPool:
             raise
 
     def _start(self) -> Any:
-        from .studies import warm_up
+        from ..studies import warm_up
 
         # held: an interruption inside the import of a compiled module or a fork is no
         # interruption but an ImportError or a half-started pool; it comes at the end
@@ -226,7 +226,7 @@ class StudyPool:
     def _dask(self) -> Any:
         import logging
 
-        from .studies import warm_up
+        from ..studies import warm_up
 
         try:
             from distributed import Client, LocalCluster

@@ -3,8 +3,8 @@
 :func:`describe` turns one validation error of a spec into ``(path, message)``:
 the dotted field path (``friction.static``, ``effects[0].delay``), what was
 read and why it is refused, with a suggestion for a misspelt key. Reading
-a file (:mod:`fi_design.specfile`) and changing values at dotted paths
-(:mod:`fi_design.specpaths`) both report through it.
+a file (:mod:`fi_design.spec.file`) and changing values at dotted paths
+(:mod:`fi_design.spec.paths`) both report through it.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import difflib
 import re
 from typing import Any
 
-from .spec import Spec
+from . import Spec
 
 
 def clean_loc(loc: tuple, raw: dict) -> tuple:
@@ -63,7 +63,7 @@ def _model_at(loc: tuple, raw: Any = None):
     """
     import typing
 
-    from .spec import EFFECT_MODELS, FILTER_TYPES
+    from . import EFFECT_MODELS, FILTER_TYPES
 
     model: Any = Spec
     node: Any = raw
@@ -144,7 +144,7 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
         The dotted path (empty for the top level) and the message: what was
         read, why it is refused, with a suggestion for a misspelt key.
     """
-    from . import effects as _effects
+    from .. import effects as _effects
 
     loc = clean_loc(err["loc"], raw)
     path = dotted(loc)
@@ -212,7 +212,7 @@ def _shown(value: Any) -> str:
 
 def _not_an_effect_entry(given: Any) -> str:
     """The message for an ``effects`` entry that is not a mapping (``- time_delay``)."""
-    from . import effects as _effects
+    from .. import effects as _effects
 
     name = given if isinstance(given, str) and given in _effects.CATALOGUE else "time_delay"
     required = [p.name for p in _effects.get(name).parameters if p.required]

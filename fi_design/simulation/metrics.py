@@ -29,9 +29,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .display import quantity
-from .results import frozen_array
-from .results.simulation import VERDICTS, HuntingMetrics
+from ..display import quantity
+from ..results import frozen_array
+from ..results.simulation import VERDICTS, HuntingMetrics
 
 __all__ = ["VERDICTS", "HuntingMetrics", "hunting_metrics"]
 

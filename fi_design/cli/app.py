@@ -3,9 +3,9 @@
 Each command parses its arguments, checks its output paths, calls one public
 function, prints a summary (:mod:`fi_design.console`) and writes its outputs
 atomically. Executors and progress displays are made on this side
-(:mod:`fi_design.pools`, :mod:`fi_design.console`) and passed into the
-library; the steps the commands share are in :mod:`fi_design.cliparts`. The
-library raises; :class:`~fi_design.cliparts.DefaultCommandGroup` translates:
+(:mod:`fi_design.cli.pools`, :mod:`fi_design.console`) and passed into the
+library; the steps the commands share are in :mod:`fi_design.cli.parts`. The
+library raises; :class:`~fi_design.cli.parts.DefaultCommandGroup` translates:
 
 - exit 0: done (whatever the design verdict);
 - exit 2: bad input -- any :class:`~fi_design.errors.FiDesignError` (the
@@ -21,7 +21,7 @@ library raises; :class:`~fi_design.cliparts.DefaultCommandGroup` translates:
   SIGHUP), at any instant: the message says which outputs were written.
 
 ``fi-design SPEC.yaml`` runs the default command ``design`` through
-:class:`~fi_design.cliparts.DefaultCommandGroup`: when the first word after the group's own options
+:class:`~fi_design.cli.parts.DefaultCommandGroup`: when the first word after the group's own options
 is not a command name, ``design`` is put in front of it. Every other command is
 one function decorated with ``@app.command()``; error handling lives in the
 group, so a new command needs nothing else.
@@ -39,12 +39,10 @@ from typing import Annotated, Optional
 
 import typer
 
-from .cliparts import (DEFAULT_COMMAND, EXIT_VERDICT, Drive, ExecutorKind, Force, Jobs,
-                       JsonOut, Measure, NoCache, NoIsolator, Scheduler, SpecArg, app, at_most,
-                       check_drive, check_measure, check_outputs, check_spec_path,
-                       json_text, load,
-                       output_option, run_study, study_pool, write_outputs, write_report,
-                       write_study)
+from .parts import (DEFAULT_COMMAND, EXIT_VERDICT, Drive, ExecutorKind, Force, Jobs, JsonOut,
+                    Measure, NoCache, NoIsolator, Scheduler, SpecArg, app, at_most, check_drive,
+                    check_measure, check_outputs, check_spec_path, json_text, load, output_option,
+                    run_study, study_pool, write_outputs, write_report, write_study)
 
 __all__ = ["app", "main", "DEFAULT_COMMAND"]
 
@@ -112,9 +110,9 @@ def design_command(
                          spec=(write_spec, (".yaml", ".yml")))
     spec_obj = load(spec)
 
-    from .console import Status, make_console, print_design
+    from ..console import Status, make_console, print_design
     from .pools import confirmation_pool
-    from .signoff import design
+    from ..signoff import design
 
     console, err = make_console(), make_console(stderr=True)
     # the pool's workers fork before the spinner's thread starts (fork and threads do not mix)
@@ -125,7 +123,7 @@ def design_command(
                         sensitivity=outs["report"] is not None)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
     if outs["spec"] is not None:
-        from .handoff import gains_spec_text
+        from ..controller.handoff import gains_spec_text
 
         payloads["spec"] = gains_spec_text(result)
     print_design(console, result, spec_path=spec)
@@ -133,7 +131,7 @@ def design_command(
     design_map = None
     if outs["report"] is not None and (with_map or (not no_simulation
                                                     and result.spec.report.map)):
-        from .studies import design_map as make_map
+        from ..studies import design_map as make_map
 
         with Status(err, "computing the hunting map ...") as status:
             design_map = make_map(result, progress=lambda done, total: status(
@@ -183,9 +181,9 @@ def simulate_command(
     outs = check_outputs(inputs, force, csv=(csv_out, (".csv",)), json=(json_out, (".json",)))
     spec_obj = load(spec)
 
-    from .console import Status, make_console, print_simulation
-    from .measured import load_measurement
-    from .simulation import simulate
+    from ..console import Status, make_console, print_simulation
+    from ..measured import load_measurement
+    from ..simulation.run import simulate
 
     measured = None if record is None else load_measurement(record)
     with Status(make_console(stderr=True),
@@ -197,7 +195,7 @@ def simulate_command(
     print_simulation(console, result)
     payloads = {}
     if outs["csv"] is not None:
-        from .measured import write_columns_csv
+        from ..measured import write_columns_csv
 
         payloads["csv"] = lambda fh: write_columns_csv(fh, result.traces())
     if outs["json"] is not None:
@@ -213,13 +211,13 @@ def schema_command(
 ) -> None:
     """Print the JSON Schema of the spec file."""
     if markdown:
-        from .docs import reference_markdown
+        from ..docs import reference_markdown
 
         typer.echo(reference_markdown(), nl=False)
         return
     import json
 
-    from .spec import Spec
+    from ..spec import Spec
 
     typer.echo(json.dumps(Spec.model_json_schema(), indent=2))
 
@@ -234,7 +232,7 @@ def init_command(
     """Write a fully commented example spec (default bearing.yaml)."""
     from importlib.resources import files
 
-    from .output import check_output, write_atomic
+    from ..output import check_output, write_atomic
 
     out = check_output(path, force=force, extensions=(".yaml", ".yml"))
     text = files("fi_design").joinpath("example_spec.yaml").read_text(encoding="utf-8")
@@ -295,9 +293,9 @@ def sweep_command(
     pool = study_pool(executor, jobs, scheduler)
     spec_obj = load(spec)
 
-    from .console import make_console, print_sweep
-    from .plots import sweep_figure
-    from .studies import parse_axis, sweep
+    from ..console import make_console, print_sweep
+    from ..plots import sweep_figure
+    from ..studies import parse_axis, sweep
 
     ax = parse_axis(x, log="x" in logs, spec=spec_obj)
     ay = parse_axis(y, log="y" in logs, spec=spec_obj) if y is not None else None
@@ -355,7 +353,7 @@ def study_command(
                                  + f"; available: {', '.join(STUDIES)}", param_hint="STUDY")
     letters = [k for k in maps.upper() if not k.isspace()]
     names = ["figure4.svg", "figure4.png", "study.json"] + [f"map_{k}.csv" for k in letters]
-    from .output import check_output_dir
+    from ..output import check_output_dir
 
     targets = check_output_dir(out, names, force=force, protect=(spec,))
     report_path = check_outputs((spec,), force, report=(report_out, (".html", ".pdf")))["report"]
@@ -368,9 +366,9 @@ def study_command(
     pool = study_pool(executor, jobs, scheduler)
     spec_obj = load(spec)
 
-    from .console import make_console, print_study
-    from .plots import figure_bytes, study_figure
-    from .studies import paper_study
+    from ..console import make_console, print_study
+    from ..plots import figure_bytes, study_figure
+    from ..studies import paper_study
 
     result = run_study("paper study", pool, no_cache, lambda ex, bar, cache: paper_study(
         spec_obj, resolution, maps="".join(letters), executor=ex, progress=bar, cache=cache,
@@ -381,7 +379,7 @@ def study_command(
                 "study.json": json_text(result)}
     payloads.update({f"map_{m.definition.key}.csv": m.result.to_csv() for m in result.maps})
     out.mkdir(exist_ok=True)
-    from .output import write_atomic
+    from ..output import write_atomic
 
     for name, data in payloads.items():
         write_atomic(targets[name], data)
@@ -453,9 +451,9 @@ def robustness_command(
     pool = study_pool(executor, jobs, scheduler)
     spec_obj = load(spec)
 
-    from .console import make_console, print_robustness
-    from .plots import robustness_figure
-    from .studies import parse_position_friction, parse_scatter, robustness
+    from ..console import make_console, print_robustness
+    from ..plots import robustness_figure
+    from ..studies import parse_position_friction, parse_scatter, robustness
 
     items = [parse_scatter(s, spec_obj) for s in scatter or []]
     pf = parse_position_friction(position_friction) if position_friction else None
@@ -501,8 +499,8 @@ def recommend_command(
     pool = study_pool(executor, jobs, scheduler)
     spec_obj = load(spec)
 
-    from .console import Status, make_console, print_recommendation
-    from .recommend import recommend, recommended_spec_text
+    from ..console import Status, make_console, print_recommendation
+    from ..recommend import recommend, recommended_spec_text
 
     console, err = make_console(), make_console(stderr=True)
     # the pool's workers fork before the spinner's thread starts (fork and threads do not mix)
@@ -558,9 +556,9 @@ def reconcile_command(
                     json=(json_out, (".json",)), fixed=(write_spec, (".yaml", ".yml")))
     spec_obj = load(spec)
 
-    from .console import FractionBar, make_console, print_reconcile
-    from .measured import load_measurement
-    from .reconciliation import fixed_spec_text, reconcile
+    from ..console import FractionBar, make_console, print_reconcile
+    from ..measured import load_measurement
+    from ..reconciliation import fixed_spec_text, reconcile
 
     data = load_measurement(measured)
     with FractionBar(make_console(stderr=True), "reconciling") as bar:
@@ -571,7 +569,7 @@ def reconcile_command(
     if outs["json"] is not None:
         write_outputs(console, outs, {"json": json_text(result)})
     if outs["fixed"] is not None:
-        from .output import write_atomic
+        from ..output import write_atomic
 
         write_atomic(outs["fixed"], fixed_spec_text(result))
         console.print(f"wrote {outs['fixed']}"
@@ -624,9 +622,9 @@ def identify_command(
                     report=(report_out, (".html", ".pdf")))
     spec_obj = load(spec) if spec is not None else None
 
-    from .console import FractionBar, make_console, print_identification
-    from .identification import identified_spec_text, identify
-    from .measured import load_measurement
+    from ..console import FractionBar, make_console, print_identification
+    from ..identification import identified_spec_text, identify
+    from ..measured import load_measurement
 
     data = load_measurement(measured)
     with FractionBar(make_console(stderr=True), "identifying") as bar:
@@ -642,7 +640,7 @@ def identify_command(
 
 def main() -> None:
     """Console-script entry point (``fi-design``, ``python -m fi_design``)."""
-    from .cliparts import run_app
+    from .parts import run_app
 
     run_app(app)
 

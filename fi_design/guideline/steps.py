@@ -14,15 +14,10 @@ checks (:class:`~fi_design.results.Check`):
    :func:`step3_flexure` sizes a leaf-spring guide when the spec asks for one.
 4. :func:`step4_pid` -- the PID gains from the tuning mass and the crossover.
 
-:func:`design` runs the four steps and returns a :class:`DesignResult`, whose
-``to_dict()`` is the JSON contract of ``fi-design SPEC.yaml --json``. Without
-an isolator in the spec, :func:`isolator_advice` says whether one looks needed
-and which stroke and stiffness to start from.
-
-:func:`design` also runs the nonlinear confirmation
-(:func:`fi_design.confirm.confirm`) on the executor the caller passes, so that
-its simulations overlap the linear analysis; it appears in JSON under
-``simulation`` when it ran.
+Without an isolator in the spec, :func:`isolator_advice` says whether one
+looks needed and which stroke and stiffness to start from.
+:func:`fi_design.guideline.evaluate.evaluate` runs the four steps, the
+confirmation and the verdict.
 
 The linear analysis (python-control) is imported inside the step functions,
 so importing this module stays fast.
@@ -30,36 +25,27 @@ so importing this module stays fast.
 
 from __future__ import annotations
 
-import hashlib
 import logging
 import math
-from dataclasses import replace
-from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 
-from .controller import discrete_controller, drive_gains
-from .errors import ArgumentError
-from .display import number, quantity
-from .mechanism.checks import flexure_checks
-from .model import Model, as_model
-from .results import Check, Status
-from .results.controller import ControlLaw
-from .results.stage import STATIC_ERROR_FORMULA
-from .results.design import (Confirmation, CrossoverResult, DesignResult,
-                             FlexureResult, FrictionGapResult, IsolatorAdvice, ModeSeparation,
-                             NotchSuggestion, PidResult, StiffnessResult)
-from .spec import Spec, proposed_stiffness, stiffness_limit, warnings_for
+from ..controller import discrete_controller, drive_gains
+from ..display import number, quantity
+from ..model import Model, as_model
+from ..results import Check, Status
+from ..results.controller import ControlLaw
+from ..results.stage import STATIC_ERROR_FORMULA
+from ..results.design import (Confirmation, CrossoverResult, DesignResult, FlexureResult,
+                              FrictionGapResult, IsolatorAdvice, ModeSeparation, NotchSuggestion,
+                              PidResult, StiffnessResult)
+from ..spec import Spec, proposed_stiffness, stiffness_limit
 from .verdict import friction_gap_judged
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .execution import Executor
 
 __all__ = [
     "SUGGESTED_STROKE", "FrictionGapResult", "ModeSeparation", "CrossoverResult",
     "StiffnessResult", "PidResult", "IsolatorAdvice", "DesignResult", "step1_friction_gap",
     "step2_crossover", "step3_stiffness", "step3_flexure", "step4_pid", "isolator_advice",
-    "friction_gap_judged", "design",
+    "friction_gap_judged", "controller_words", "notch_words",
 ]
 
 log = logging.getLogger(__name__)
@@ -144,8 +130,8 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
         judgement of each case's requirements as the linear analysis made it
         (:attr:`fi_design.results.linear.CaseMargins.criteria`).
     """
-    from . import linear
-    from .notch import limiting_mode, notched, with_notch
+    from ..loop import linear
+    from ..loop.notch import limiting_mode, notched, with_notch
 
     model = as_model(model)
     req = model.requirements
@@ -181,7 +167,7 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
         msg = (f"the desired crossover {fc:.4g} Hz is above the achievable {ach.frequency:.4g} Hz "
                f"(limited by {limited_by})")
     if suggestion is not None:
-        msg += f"; {_notch_words(suggestion)}"
+        msg += f"; {notch_words(suggestion)}"
     checks.append(Check("crossover_achievable", reach, fc, ach.frequency, "Hz", msg, step=step))
 
     for c in at.cases:
@@ -247,7 +233,7 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
         checks=tuple(checks))
 
 
-def _notch_words(n: NotchSuggestion) -> str:
+def notch_words(n: NotchSuggestion) -> str:
     """What a notch at the limiting mode would allow, in words."""
     head = f"a {n.notch.describe()} in controller.filters would "
     if n.achievable is None:
@@ -356,7 +342,7 @@ def step3_flexure(model: Model | Spec,
 # --------------------------------------------------------------------------- step 4
 
 
-def _controller_words(c: ControlLaw) -> str:
+def controller_words(c: ControlLaw) -> str:
     """The structure of a controller in words (D input, roll-off, sampling)."""
     parts = [f"D on the {c.derivative_on}",
              "ideal D" if math.isinf(c.roll_off) else
@@ -398,12 +384,12 @@ def step4_pid(model: Model | Spec) -> PidResult:
         msg = (f"tuned at {_g(g.crossover)} Hz on {_g(g.tuning_mass)} kg; the gains a drive "
                f"takes (controller.gains, with controller.roll_off on the D term only): kp = "
                f"{_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s), kd = {_g(law.kd)} N s/m "
-               f"({_controller_words(law)})")
+               f"({controller_words(law)})")
         checks = [Check("pid", None, law.kp, None, "N/m", msg, step=step)]
     else:
         r = law.rule_in_this_form()
         msg = (f"the hardware's gains kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s), "
-               f"kd = {_g(law.kd)} N s/m ({_controller_words(law)}) cross over at "
+               f"kd = {_g(law.kd)} N s/m ({controller_words(law)}) cross over at "
                f"{law.crossover:.4g} Hz on {law.tuning_mass:.4g} kg; the rule there would give "
                f"kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), kd = {_g(r['kd'])} N s/m "
                f"with a D roll-off of {r['roll_off'] / (2 * math.pi):.4g} Hz")
@@ -480,7 +466,7 @@ def isolator_advice(model: Model | Spec, gap: FrictionGapResult, crossover: Cros
     crossover : CrossoverResult
         Step 2.
     simulation : Confirmation, optional
-        The simulated confirmation (:func:`fi_design.confirm.confirm`).
+        The simulated confirmation (:func:`fi_design.stage.confirm.confirm`).
 
     Returns
     -------
@@ -519,286 +505,3 @@ def isolator_advice(model: Model | Spec, gap: FrictionGapResult, crossover: Cros
         f"the friction gap {gap.gap:.3g} N is a hunting risk and the crossover is limited to "
         f"{_g(crossover.achievable)} Hz ({crossover.limited_by}): an isolator looks needed "
         f"(the simulation decides); {start}"), s, k, kmax)
-
-
-# --------------------------------------------------------------------------- the design
-
-
-def _sha256(spec: Spec) -> str:
-    from .specfile import origin
-
-    org = origin(spec)
-    if org is not None:
-        return org.sha256
-    return hashlib.sha256(spec.model_dump_json().encode()).hexdigest()
-
-
-def design(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool = True,
-           executor: Executor | None = None,
-           progress: Callable[[str], None] | None = None,
-           fe_check: bool = False, sensitivity: bool = False) -> DesignResult:
-    """Run the four guideline steps on a spec and confirm them by simulation.
-
-    The spec is resolved once (:func:`fi_design.model.resolve`) and every
-    step, the confirmation and the verdict read the resolved model.
-
-    Parameters
-    ----------
-    spec : Spec, Model, path or mapping
-        A validated spec, its resolved model, or a YAML path or mapping for
-        :func:`fi_design.specfile.load_spec`. The robustness study of the
-        sign-off varies the spec, so a model varied with
-        :meth:`~fi_design.model.Model.at` is designed with ``confirm=False``
-        (or ``requirements.robustness.samples: 0``).
-    confirm : bool, optional
-        Simulate the stage with and without the isolator, scan the crossover
-        for the lowest hunting-free one, check the landing deflection and
-        cross-check with the other friction model
-        (:func:`fi_design.confirm.confirm`, about a second once the kernel is
-        compiled). Default True; CAD loops that only need the linear steps pass
-        False.
-    executor : concurrent.futures-style executor, optional
-        Runs the confirmation as one task and the robustness samples in
-        chunks (``submit`` returning a future with ``result``, ``cancel`` and
-        ``add_done_callback``), while this process does the linear analysis:
-        with a process pool of two workers they overlap (and a first run
-        compiles the simulation kernel there). None runs them here, after the
-        linear steps. The library creates no pool.
-    progress : callable, optional
-        ``progress(text)`` with a short message as the work proceeds (the
-        confirmation's own messages too when it runs here).
-    fe_check : bool, optional
-        Also build the flexure guide as a finite-element model
-        (:func:`fi_design.mechanism.fe.fe_mechanics`, pyfe3d; a fraction of a
-        second), the independent check of its closed forms, as
-        ``flexure_fe``. Default False; skipped without a guide or without
-        pyfe3d.
-    sensitivity : bool, optional
-        Also find the hunting-free crossover of the spec's own plant with the
-        unidentified LuGre values sigma0, sigma1 and vs divided and multiplied
-        by 3 (:func:`fi_design.studies.crossover_sensitivity`: six stage-level
-        answers, about a second each on the paper setup, on ``executor``), as
-        ``sensitivity``; the report's validation section shows it. Default
-        False; skipped for a loop without integrator.
-
-    Returns
-    -------
-    DesignResult
-        Steps 1 to 4, the confirmation, all checks, warnings, a conclusion
-        and the sign-off: ``verdict`` on the hardware as specified,
-        ``robustness`` under the friction scatter of
-        ``requirements.robustness`` (simulated on ``executor`` beside the
-        confirmation; about 200 simulations of a few ms by default),
-        ``margins``; no ``recommendation`` (:func:`fi_design.signoff.design`
-        adds the design search's when the verdict fails).
-
-    Raises
-    ------
-    fi_design.errors.SpecError
-        When ``spec`` is a path or mapping that does not validate.
-    fi_design.errors.ArgumentError
-        A model varied with :meth:`~fi_design.model.Model.at` with the
-        robustness study to run.
-    """
-    from . import __version__
-    from . import verdict as _verdict
-    from .confirm import confirm as run_confirmation
-    from .responses import loop_responses
-    from .stage import positioning, positioning_checks
-
-    if not isinstance(spec, Model):
-        from .specfile import as_spec
-
-        spec = as_spec(spec)
-    model = as_model(spec)
-    spec = model.spec
-    suggestion = suggested_isolator(model) if not model.has_isolator else None
-    robust = confirm and model.requirements.robustness.samples > 0
-    if robust and model.changed:
-        raise ArgumentError(
-            f"this model differs from its spec at {', '.join(model.changed)} (Model.at), but "
-            "the robustness study of the sign-off varies the spec: design it with "
-            "confirm=False, or write the values into the spec "
-            "(fi_design.specfile.with_values) and design that")
-    pending = []
-    if confirm and executor is not None:
-        pending.append(executor.submit(run_confirmation, model, suggestion))
-    try:
-        gap = step1_friction_gap(model)
-        xo = step2_crossover(model)
-        st = step3_stiffness(model)
-        fx = step3_flexure(model, st)
-        pid = step4_pid(model)
-    except BaseException:
-        for fut in pending:
-            fut.cancel()
-        raise
-    advice = isolator_advice(model, gap, xo) if not model.has_isolator else None
-    fe = _fe_check(fx) if fe_check else None
-    checks = (gap.checks + xo.checks + st.checks
-              + flexure_checks(fx, xo.desired, model.requirements.parasitic_separation)
-              + pid.checks)
-    result = DesignResult(
-        spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,
-        loop=loop_responses(model, xo), isolator_advice=advice, checks=checks,
-        warnings=tuple(warnings_for(spec)),
-        conclusion=_conclusion(model, gap, xo, st, fx, pid, advice, checks),
-        fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None,
-        model=model, flexure_fe=fe)
-    sim = study = None
-    if confirm:
-        if progress is not None:
-            progress("simulating with and without the isolator ...")
-        if robust:
-            # the samples go to the executor in chunks, beside the confirmation
-            if progress is not None:
-                progress("simulating the friction scatter of requirements.robustness ...")
-            study = _verdict.run_robustness(
-                model, suggestion, None if progress is None else
-                (lambda done, total: progress(f"friction scatter: {done}/{total} samples")),
-                executor=executor)
-        sim = pending[0].result() if pending else \
-            run_confirmation(model, suggestion, progress=progress)
-        own = "isolated" if model.has_isolator else "non_isolated"
-        # the stage-level answer decides: step 1 and the advice now read it
-        n_gap = len(gap.checks)
-        gap = _verdict.friction_gap_judged(gap, sim.stage[own], model.law.integrator)
-        checks = gap.checks + checks[n_gap:]
-        if not model.has_isolator:
-            advice = isolator_advice(model, gap, xo, sim)
-        text = _conclusion(model, gap, xo, st, fx, pid, advice, checks, simulated=True)
-        pos = positioning(model, sim.stage[own])
-        result = replace(result, friction_gap=gap, isolator_advice=advice,
-                         simulation=sim, positioning=pos,
-                         checks=checks + sim.checks + (() if pos is None
-                                                       else positioning_checks(pos)),
-                         conclusion=text + _verdict.simulation_sentence(sim))
-    rob = None if study is None else _verdict.robustness_check(model, study)
-    if rob is not None:  # a check like the others: the tally counts it
-        result = replace(result, checks=result.checks + (_verdict.robustness_as_check(rob),))
-    if sensitivity and sim is not None:
-        from .studies import crossover_sensitivity
-
-        if progress is not None:
-            progress("the hunting-free crossover over sigma0, sigma1 and vs ...")
-        own = "isolated" if model.has_isolator else "non_isolated"
-        result = replace(result, sensitivity=crossover_sensitivity(
-            model, sim.stage[own].hunting_free_from, executor=executor))
-    margins = _verdict.margins(model, xo, st, fx, pid, sim)
-    result = replace(
-        result, robustness=rob, margins=margins,
-        verdict=_verdict.judge(model, result.checks, result.warnings, sim, rob, margins))
-    log.info("design of %r: %s, %d checks, %d failed", spec.name, result.verdict.status,
-             len(result.checks), len(result.failed_checks))
-    return result
-
-
-def _fe_check(fx: FlexureResult | None):
-    """The guide as a finite-element model, or None without a guide or without pyfe3d."""
-    if fx is None or fx.mechanics is None:
-        return None
-    try:
-        from .mechanism.fe import fe_mechanics
-
-        return fe_mechanics(fx.guide)
-    except ImportError:
-        log.info("pyfe3d is not installed: the flexure's FE check did not run")
-        return None
-
-
-def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: StiffnessResult,
-                fx: FlexureResult | None, pid: PidResult, advice: IsolatorAdvice | None,
-                checks: tuple[Check, ...], simulated: bool = False) -> str:
-    from .linear import CASE_NUMBERS
-
-    parts = []
-    where = "at or above" if gap.hunting_risk else "below"
-    first = (f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, {where} the "
-             f"{gap.threshold:.3g} N threshold of step 1 (the paper's rule for its own stage)")
-    if gap.hunting_risk and not pid.controller.integrator:
-        first += (", but the loop has no integrator to push the cart through stiction, so it "
-                  "cannot hunt by the paper's mechanism")
-    elif gap.hunting_risk:
-        first += ", so stick-slip can make the integrating controller hunt"
-    else:
-        first += ", so hunting is less likely"
-    parts.append(first + ("; the simulation of every move decides (below)." if simulated
-                          else "."))
-    n = len(xo.cases)
-    bad = [c for c in xo.cases if not c.passed]
-    pms = [c.phase_margin_deg for c in xo.cases if c.in_band] or [math.inf]
-    gms = [abs(c.gain_margin_db) for c in xo.cases]
-    margins = (f"phase margins of at least {min(pms):.3g} deg and gain margins of at least "
-               f"{min(gms):.3g} dB" if all(math.isfinite(x) for x in gms)
-               else f"phase margins of at least {min(pms):.3g} deg")
-    if xo.achievable is None:
-        ach = f"no crossover meets the requirements ({xo.limited_by})"
-    elif xo.limit_kind == "scan_limit":
-        ach = (f"the linear model limits the crossover nowhere up to the scan limit of "
-               f"{xo.achievable:.4g} Hz")
-    else:
-        ach = (f"the achievable crossover is {number(xo.achievable, 4)} Hz, limited by "
-               f"{xo.limited_by}")
-    if xo.notch is not None:
-        ach += f"; {_notch_words(xo.notch)}"
-    at = ("the desired crossover" if pid.controller.source == "rule"
-          else "the hardware's crossover")
-    if not bad:
-        every = "both" if n == 2 else f"all {n}"
-        parts.append(f"At {at} of {number(xo.desired, 4)} Hz {every} linear limit "
-                     f"cases are stable with {margins}; {ach}.")
-    else:
-        which = ", ".join(f"case {CASE_NUMBERS[c.name]} ({c.description}: "
-                          f"{', '.join(c.failed)})" for c in bad)
-        parts.append(f"At {at} of {number(xo.desired, 4)} Hz the margins fail in "
-                     f"{which}; {ach}.")
-    if model.has_isolator:
-        ok = st.chosen <= st.maximum * (1 + 1e-12)
-        parts.append(f"The drive stiffness of {_g(st.chosen)} N/m is "
-                     + ("within" if ok else "above")
-                     + f" the maximum of {_g(st.maximum)} N/m, so the flexure pushes the cart "
-                     f"with {st.force_at_stroke:.3g} N at full stroke against {st.static:.3g} N "
-                     "of static friction.")
-        if fx is not None:
-            if fx.feasible:
-                low = fx.lowest_mode
-                parts.append(
-                    f"A {fx.leaves}-leaf spring guide (L x b x t = "
-                    f"{quantity(fx.length, 'm', 3, shown=('mm', 1e3))} x "
-                    f"{quantity(fx.width, 'm', 3, shown=('mm', 1e3))} x "
-                    f"{quantity(fx.thickness, 'm', 3, shown=('mm', 1e3))}, "
-                    f"{fx.guide.orientation}) "
-                    + ("as drawn" if fx.drawn else "sized from stock")
-                    + f" has a net drive stiffness of {_g(fx.drive_stiffness)} N/m with "
-                    f"gravity, a stress margin of {fx.stress_margin:.3g} and its lowest "
-                    f"parasitic mode ({low.name}) at {_g(low.frequency)} Hz.")
-            else:
-                parts.append(f"No leaf-spring guide within the given bounds fits ({fx.reason}).")
-    elif advice is not None:
-        parts.append(advice.reason[0].upper() + advice.reason[1:] + ".")
-    g = pid.gains
-    law = pid.controller
-    if law.source == "rule":
-        parts.append(f"The PID tuned on {_g(g.tuning_mass)} kg gives the drive (in the form "
-                     f"controller.gains takes) kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
-                     f"N/(m s) and kd = {_g(law.kd)} N s/m ({_controller_words(law)}).")
-    else:
-        r = law.rule_in_this_form()
-        parts.append(f"The hardware's controller (kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
-                     f"N/(m s), kd = {_g(law.kd)} N s/m; {_controller_words(law)}) crosses over "
-                     f"at {number(law.crossover, 4)} Hz on {_g(law.tuning_mass)} kg; the rule "
-                     f"would tune kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), kd = "
-                     f"{_g(r['kd'])} N s/m with a D roll-off of "
-                     f"{_g(r['roll_off'] / (2 * math.pi))} Hz there.")
-    if pid.static_error is not None:
-        parts.append(f"The loop has no integrator, so it cannot hunt by the paper's mechanism; "
-                     f"it leaves a static error of up to {STATIC_ERROR_FORMULA} = "
-                     f"{quantity(pid.static_error, 'm', 3)} instead.")
-    failed = [c for c in checks if c.status == Status.FAIL]
-    if failed:
-        steps = ", ".join(dict.fromkeys(c.step for c in failed))
-        parts.append(f"{len(failed)} check(s) of the four steps fail ({steps}; see the checks): "
-                     "revise the design.")
-    else:
-        parts.append("No check of the four steps fails.")
-    return " ".join(parts)

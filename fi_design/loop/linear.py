@@ -29,7 +29,7 @@ Parasitic modes (``model.modes``) enter every isolated case: a mode the spec
 gives multiplies it by :func:`mode_factor`; a mode computed from the flexure
 guide adds its modal term :func:`mode_term` (modal superposition).
 
-The controller is the loop's :class:`fi_design.pid.ControlLaw` (the rule's
+The controller is the loop's :class:`fi_design.controller.pid.ControlLaw` (the rule's
 PID or the hardware's gains) in series with the drive's filter chain
 (``controller.filters``, :func:`fi_design.controller.controller_polynomials`),
 the same description the simulation uses. A sampled controller is analysed
@@ -66,15 +66,15 @@ from typing import Any, Sequence
 import control
 import numpy as np
 
-from .controller.polynomials import controller_polynomials, pid_polynomials, reference_polynomials
-from .errors import SpecError
-from .mechanism.modes import mode_factor, mode_term
-from .model import Model, as_model
-from .results import Status, frozen_array
-from .results.controller import ControlLaw, PidGains
-from .results.linear import (CRITERIA, AchievableCrossover, CaseMargins, GainCrossing,
-                             LoopAnalysis, PhaseCrossing, loop_crossover)
-from .spec import Spec
+from ..controller.polynomials import controller_polynomials, pid_polynomials, reference_polynomials
+from ..errors import SpecError
+from ..mechanism.modes import mode_factor, mode_term
+from ..model import Model, as_model
+from ..results import Status, frozen_array
+from ..results.controller import ControlLaw, PidGains
+from ..results.linear import (CRITERIA, AchievableCrossover, CaseMargins, GainCrossing,
+                              LoopAnalysis, PhaseCrossing, loop_crossover)
+from ..spec import Spec
 
 __all__ = [
     "ISOLATED_CASES", "RIGID_CASES", "CASE_DESCRIPTIONS", "CASE_NUMBERS", "SCAN_LIMIT",

@@ -28,10 +28,10 @@ from typing import Sequence
 import numpy as np
 
 from . import linear
-from .model import Model, as_model
-from .results import frozen_array
-from .results.steps import CaseResponse, CrossoverResult, LoopResponses
-from .spec import Spec
+from ..model import Model, as_model
+from ..results import frozen_array
+from ..results.steps import CaseResponse, CrossoverResult, LoopResponses
+from ..spec import Spec
 
 __all__ = ["loop_responses", "frequency_grid"]
 

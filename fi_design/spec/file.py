@@ -3,12 +3,12 @@
 :func:`load_spec` is the one entry point. It accepts a path or an already
 parsed mapping. YAML is read with ruamel.yaml in round-trip mode
 (:func:`yaml_loader`), which builds plain data only and keeps each key's line
-and the comments (a spec written back, :mod:`fi_design.specedit`, keeps them);
+and the comments (a spec written back, :mod:`fi_design.spec.edit`, keeps them);
 tags beyond YAML's core schema, duplicate keys and alias bombs are refused.
 Validation errors become a :class:`~fi_design.errors.SpecError` naming the
 dotted field path and the YAML line, with a suggestion for misspelt keys
-(:mod:`fi_design.specerrors` words them). Values at dotted paths
-(:func:`with_values`, :func:`value_at`, ...) live in :mod:`fi_design.specpaths`
+(:mod:`fi_design.spec.errors` words them). Values at dotted paths
+(:func:`with_values`, :func:`value_at`, ...) live in :mod:`fi_design.spec.paths`
 and are named here too.
 """
 
@@ -20,11 +20,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
-from .errors import SpecError, SpecFileError
-from .spec import Spec
-from .specerrors import clean_loc, describe, dotted, real_errors
-# the values at dotted paths live in fi_design.specpaths; named here as well
-from .specpaths import path_description, path_unit, value_at, with_values
+from ..errors import SpecError, SpecFileError
+from . import Spec
+from .errors import clean_loc, describe, dotted, real_errors
+# the values at dotted paths live in fi_design.spec.paths; named here as well
+from .paths import path_description, path_unit, value_at, with_values
 
 __all__ = ["SpecOrigin", "load_spec", "as_spec", "origin", "parse_yaml", "yaml_loader",
            "read_bytes", "document_line", "with_values", "value_at", "path_unit",
@@ -161,7 +161,7 @@ def as_spec(spec: Any, name: str = "spec") -> Spec:
     SpecFileError, SpecError
         As :func:`load_spec`.
     """
-    from .errors import ArgumentError
+    from ..errors import ArgumentError
 
     if isinstance(spec, Spec):
         return spec

@@ -21,17 +21,16 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import spec as _spec
-from .arguments import number
-from .errors import ArgumentError, SimulationError
+from .. import spec as _spec
+from ..arguments import number
+from ..errors import ArgumentError, SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
-from .model import Model, as_model
-from .kernel.layout import PlantParameters, state_index
-from .replay import (DRIVES, command_state, initial_state, record_state, reference_state,
-                     replay_fit)
-from .results import frozen_array
-from .results.simulation import SimulationResult
-from .trajectory import Trajectory, from_moves, from_samples
+from ..model import Model, as_model
+from ..kernel.layout import PlantParameters, state_index
+from .replay import DRIVES, command_state, initial_state, record_state, reference_state, replay_fit
+from ..results import frozen_array
+from ..results.simulation import SimulationResult
+from ..trajectory import Trajectory, from_moves, from_samples
 
 METHODS = ("fast", "reference")
 
@@ -183,8 +182,8 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
 def _checked_arguments(spec, crossover, duration, rtol, record):
     """The spec or model (a spec loaded when given as a path or mapping) and the numeric
     arguments, checked."""
-    from .measured import Measurement
-    from .specfile import as_spec
+    from ..measured import Measurement
+    from ..spec.file import as_spec
 
     if not isinstance(spec, Model):
         spec = as_spec(spec)
@@ -219,8 +218,8 @@ def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=No
     x_bound = 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(y0[0]))
     start = _time.perf_counter()
     if method == "fast":
-        from .kernel import run
-        from .kernel.build import compiled
+        from ..kernel import run
+        from ..kernel.build import compiled
 
         compiled()  # loads the built kernel (or compiles it) before the clock starts
         start = _time.perf_counter()
@@ -228,7 +227,7 @@ def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=No
                   tolerances(params, tol), 0.05, settings.max_steps, x_bound,
                   input_time, input_force)
     else:
-        from .kernel.reference import solve_reference
+        from ..kernel.reference import solve_reference
 
         out = solve_reference(params, y0, ref, t_end, t_out, tol, tolerances(params, tol),
                               x_bound, input_time=input_time, input_force=input_force)
@@ -310,7 +309,7 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
 
 def _anchor(law, params, record, index, ref, command):
     """Initial state and parameters for a replay starting at sample ``index``."""
-    from .kernel.build import compiled
+    from ..kernel.build import compiled
 
     st = record_state(record, index)
     r, rd, rdd = reference_state(record, index)
@@ -327,7 +326,7 @@ def _merge(pieces, t_out):
     ``pieces`` holds ``(first sample, samples kept, Integration)`` per window;
     samples after a failed window stay NaN (window -1).
     """
-    from .kernel.layout import Integration
+    from ..kernel.layout import Integration
 
     n = len(t_out)
     states = np.full((n, pieces[0][2].states.shape[1]), np.nan)

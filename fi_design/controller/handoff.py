@@ -4,7 +4,7 @@ The rule tunes ``C(s) = (kp + ki/s + kd s) / (1 + s/wt)``, the roll-off on the
 whole PID; ``controller.gains`` with ``controller.roll_off`` means
 ``kp + ki/s + kd s / (1 + s / (2 pi roll_off))``, the roll-off on the D term
 only. The two are the same controller with other numbers
-(:class:`fi_design.pid.ControlLaw`); copying the first into the second moves
+(:class:`fi_design.controller.pid.ControlLaw`); copying the first into the second moves
 the crossover and takes gain margin. :func:`gains_spec_text` writes the
 second: the input spec with ``controller.gains`` and ``controller.roll_off``
 set (``derivative_on``, ``sample_rate``, ``delay`` and ``crossover`` are the
@@ -16,8 +16,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from .display import number, quantity
-from .specedit import REMOVE, edited_spec_text, spec_quantity
+from ..display import number, quantity
+from ..spec.edit import REMOVE, edited_spec_text, spec_quantity
 
 __all__ = ["gains_values", "gains_spec_text"]
 
@@ -47,7 +47,7 @@ def gains_spec_text(result: Any) -> str:
     """YAML text of the design's spec with its loop written as ``controller.gains``.
 
     The input's text is edited (comments and layout kept,
-    :func:`fi_design.specedit.edited_spec_text`). For a spec that tunes by
+    :func:`fi_design.spec.edit.edited_spec_text`). For a spec that tunes by
     the rule, these are the rule's gains at the design crossover in the form
     ``controller.gains`` takes; for a spec with the hardware's gains, its own
     gains again (with the roll-off explicit).

@@ -14,9 +14,9 @@ import functools
 import re
 from typing import Any, Mapping
 
-from .errors import SpecError
-from .spec import Spec
-from .specerrors import describe, real_errors
+from ..errors import SpecError
+from . import Spec
+from .errors import describe, real_errors
 
 
 # --------------------------------------------------------------------------- dotted-path values
@@ -58,7 +58,7 @@ def with_values(spec: Spec, values: Mapping[str, Any]) -> Spec:
 
     Examples
     --------
-    >>> from fi_design.specfile import load_spec, with_values
+    >>> from fi_design.spec.file import load_spec, with_values
     >>> spec = load_spec("examples/paper_setup.yaml")
     >>> with_values(spec, {"isolator.stroke": "0.5 mm"}).isolator.stroke
     0.0005
@@ -147,7 +147,7 @@ def _leaf(path: str, spec: Spec | None = None) -> tuple[Any, Any]:
         instance = getattr(instance, name, None) if instance is not None else None
         for sel in selectors:
             if isinstance(sel, tuple):  # [type=NAME]
-                from .spec import EFFECT_MODELS
+                from . import EFFECT_MODELS
 
                 if name != "effects" or sel[1] not in EFFECT_MODELS:
                     raise SpecError(f"no list entry of type '{sel[1]}' here", path=done)

@@ -4,7 +4,7 @@ A lightly damped mode that does not sit where the sensor and the actuator
 are (non-collocated) turns the loop's phase through -180 deg at its
 resonance: a loop that keeps its margins there is phase-stabilised, and its
 gain margin at the mode sets the achievable crossover
-(:func:`fi_design.linear.achievable_crossover`). A motion engineer
+(:func:`fi_design.loop.linear.achievable_crossover`). A motion engineer
 gain-stabilises such a mode with a notch. :func:`limiting_mode` finds the
 mode behind a margin limit by taking it out: the mode is the one without
 which the failing case passes at the crossover that fails.
@@ -17,10 +17,10 @@ from __future__ import annotations
 import math
 
 from . import linear
-from .model import Model
-from .results.controller import Filter
-from .results.linear import AchievableCrossover
-from .results.mechanism import Mode
+from ..model import Model
+from ..results.controller import Filter
+from ..results.linear import AchievableCrossover
+from ..results.mechanism import Mode
 
 __all__ = ["NOTCH_WIDTH", "limiting_mode", "notched", "notch_at", "with_notch"]
 

@@ -2,11 +2,11 @@
 
 Every ``--write-spec`` of the command line goes through :func:`edited_spec_text`:
 the spec file is read again with ruamel.yaml's round-trip loader
-(:func:`fi_design.specfile.yaml_loader`), the values are set at their dotted
+(:func:`fi_design.spec.file.yaml_loader`), the values are set at their dotted
 paths (``controller.gains``, ``friction.coulomb``, ``effects``), each with an
 optional end-of-line comment, and the document is written out with the input's
 comments, key order, flow or block style and indentation. The text is then
-read back and validated like any spec (:func:`fi_design.specfile.load_spec`),
+read back and validated like any spec (:func:`fi_design.spec.file.load_spec`),
 so a spec the tool writes always loads in the tool.
 
 :func:`spec_quantity` writes a value as a string with the unit of its field
@@ -20,9 +20,9 @@ import io
 import re
 from typing import Any, Mapping, Sequence
 
-from .errors import ArgumentError, SpecError
-from .spec import Spec
-from .specfile import load_spec, origin, parse_yaml, path_unit, yaml_loader
+from ..errors import ArgumentError, SpecError
+from . import Spec
+from .file import load_spec, origin, parse_yaml, path_unit, yaml_loader
 
 __all__ = ["edited_spec_text", "spec_quantity", "written_unit", "REMOVE"]
 
@@ -134,7 +134,7 @@ def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
     Returns
     -------
     str
-        YAML text that :func:`fi_design.specfile.load_spec` reads (checked).
+        YAML text that :func:`fi_design.spec.file.load_spec` reads (checked).
 
     Raises
     ------
@@ -144,7 +144,7 @@ def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
 
     Examples
     --------
-    >>> from fi_design.specfile import load_spec
+    >>> from fi_design.spec.file import load_spec
     >>> spec = load_spec("examples/paper_setup.yaml")
     >>> text = edited_spec_text(spec, {"isolator.stroke": "0.5 mm"},
     ...                         comments={"isolator.stroke": "a longer stroke"})
@@ -161,7 +161,7 @@ def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
     else:
         lines.append("(written anew from the spec's data: it was not read from a file, so "
                      "there are no comments to keep)")
-        from .specfile import _plain
+        from .file import _plain
 
         raw = org.raw if org is not None else spec.model_dump(mode="json", exclude_none=True)
         document = _commented(_plain(raw))

@@ -10,7 +10,7 @@ the plant driven by the measured force, no controller model), where a
 rigid-body mode would otherwise drift without bound.
 
 The functions here only read the record and the kernel parameters; the
-integration itself stays in :mod:`fi_design.simulation`.
+integration itself stays in :mod:`fi_design.simulation.run`.
 """
 
 from __future__ import annotations
@@ -21,11 +21,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .errors import DataError
-from .kernel.build import compiled
-from .kernel.layout import P_SIGMA2_NEG, PlantParameters, state_index
-from .measured import Measurement
-from .pid import ControlLaw
+from ..errors import DataError
+from ..kernel.build import compiled
+from ..kernel.layout import P_SIGMA2_NEG, PlantParameters, state_index
+from ..measured import Measurement
+from ..controller.pid import ControlLaw
 
 #: Span of samples the local velocity estimate fits [s].
 VELOCITY_SPAN = 0.01

@@ -1,6 +1,6 @@
 """The sign-off verdict on the hardware as specified: robustness, margins, recommendation.
 
-:func:`fi_design.guideline.design` runs the four steps and the nonlinear
+:func:`fi_design.guideline.evaluate.evaluate` runs the four steps and the nonlinear
 confirmation; this module turns them into what a review board signs:
 
 - :func:`run_robustness` -- the probability of hunting under the friction
@@ -38,12 +38,13 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
 
-from .model import Model
-from .display import number, percent, quantities, quantity
-from .results import Check, Status
-from .results.design import (Confirmation, CrossoverResult, FlexureResult, Margins, PidResult,
-                             Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict,
-                             VerdictStatus)
+from ..model import Model
+from ..display import number, percent, quantities, quantity
+from ..results import Check, Status
+from ..results.design import (Confirmation, CrossoverResult, FlexureResult, FrictionGapResult,
+                              Margins, PidResult,
+                              Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict,
+                              VerdictStatus)
 
 __all__ = ["recommend_command", "friction_gap_judged", "simulated_isolator_advice",
            "simulation_sentence",
@@ -100,9 +101,9 @@ def run_robustness(model: Model, suggestion: tuple[float, float] | None = None,
     fi_design.studies.RobustnessResult or None
         None when ``samples`` is 0 or nothing scatters.
     """
-    from .confirm import with_isolator
-    from .specfile import with_values
-    from .studies import PositionFriction, Scatter, robustness
+    from ..stage.confirm import with_isolator
+    from ..spec.file import with_values
+    from ..studies import PositionFriction, Scatter, robustness
 
     spec = model.spec
     cfg = model.requirements.robustness
@@ -254,7 +255,7 @@ def _hunting_loop(model: Model, crossover: CrossoverResult, stage, free_from: fl
     with the joint free (case 1); without isolator, the one rigid case that slides. Its 0 dB
     crossing at the two crossovers [Hz].
     """
-    from . import linear
+    from ..loop import linear
 
     if not model.has_isolator:
         case = "sliding"
@@ -489,7 +490,7 @@ def simulated_isolator_advice(spec: Any, gap: Any, simulation: Confirmation, rul
     -------
     fi_design.results.design.IsolatorAdvice
     """
-    from .results.design import IsolatorAdvice
+    from ..results.design import IsolatorAdvice
 
     own, iso = simulation.stage["non_isolated"], simulation.stage["isolated"]
     if own.acceptable:
@@ -675,7 +676,7 @@ def _warnings_words(warned: Sequence[Reason], steps: dict) -> str:
 def recommend_command(spec: Any) -> str:
     """The design search as a command on this spec: ``fi-design recommend PATH --write-spec
     OUT.yaml`` (``SPEC.yaml`` for a spec not read from a file)."""
-    from .specfile import origin
+    from ..spec.file import origin
 
     import os
 

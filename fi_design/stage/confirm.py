@@ -20,7 +20,7 @@ stage with friction, with and without the isolator, at the design crossover
   Karnopp-type switch model), flagged when the verdicts disagree.
 
 A spec without an isolator is confirmed against the isolator step 3 suggests
-(:func:`fi_design.guideline.isolator_advice`), so the comparison is always
+(:func:`fi_design.guideline.steps.isolator_advice`), so the comparison is always
 "with" against "without". Only the spec's own plant is judged (its checks
 PASS or FAIL): the isolated one when the spec has an isolator, else the stage
 without. The other plant is information, and for a spec without isolator a
@@ -39,17 +39,17 @@ from __future__ import annotations
 
 import math
 
-from . import spec as _spec
-from .display import number, quantities, quantity
-from .errors import ArgumentError
-from .model import Model, as_model
-from .results import Check, Status
-from .results.design import Confirmation, Landing, PlantVerdict
-from .results.simulation import SimulationResult
-from .results.stage import STATIC_ERROR_FORMULA
-from .simulation import simulate
-from .stage.forces import move_forces
-from .stage import stage_hunting
+from .. import spec as _spec
+from ..display import number, quantities, quantity
+from ..errors import ArgumentError
+from ..model import Model, as_model
+from ..results import Check, Status
+from ..results.design import Confirmation, Landing, PlantVerdict
+from ..results.simulation import SimulationResult
+from ..results.stage import STATIC_ERROR_FORMULA
+from ..simulation.run import simulate
+from .forces import move_forces
+from . import stage_hunting
 
 PLANTS = ("isolated", "non_isolated")
 

@@ -23,7 +23,7 @@ import math
 import re
 from functools import lru_cache
 
-from .errors import ArgumentError, UnitError
+from ..errors import ArgumentError, UnitError
 
 #: Target units understood by :func:`to_si`, with the dimension users see in messages.
 KNOWN_UNITS = {

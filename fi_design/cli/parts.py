@@ -10,7 +10,7 @@
   after it, and for the studies :func:`study_pool` and :func:`run_study`
   (executor, progress bar, Ctrl-C).
 
-The commands themselves are in :mod:`fi_design.cli`.
+The commands themselves are in :mod:`fi_design.cli.app`.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Optional
 import typer
 from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
-from .errors import FiDesignError
+from ..errors import FiDesignError
 
 if TYPE_CHECKING:  # pragma: no cover
     from rich.console import Console
@@ -149,7 +149,7 @@ class DefaultCommandGroup(TyperGroup):
     def main(self, *args: Any, **kwargs: Any) -> Any:
         # signals become exceptions before the arguments are parsed (a fifth of a second of
         # building the commands); typer turns an interruption there into a silent exit 130
-        from .interrupts import signals_to_exceptions
+        from ..interrupts import signals_to_exceptions
 
         try:
             with signals_to_exceptions(_signal_exception):
@@ -166,8 +166,8 @@ class DefaultCommandGroup(TyperGroup):
         return contextvars.copy_context().run(self._invoke, ctx)
 
     def _invoke(self, ctx: Any) -> Any:
-        from .interrupts import signals_to_exceptions
-        from .output import begin_run
+        from ..interrupts import signals_to_exceptions
+        from ..output import begin_run
 
         begin_run()
         try:
@@ -252,7 +252,7 @@ def run_app(application: typer.Typer) -> None:
     application : typer.Typer
         The application (:data:`app` with its commands).
     """
-    from .interrupts import signals_to_exceptions
+    from ..interrupts import signals_to_exceptions
 
     try:
         with signals_to_exceptions(_signal_exception):
@@ -265,7 +265,7 @@ def run_app(application: typer.Typer) -> None:
 
 def _say_interrupted(exc: KeyboardInterrupt, where: str = "") -> None:
     """Print what interrupted the run and which outputs it had written (stderr)."""
-    from .output import written
+    from ..output import written
 
     files = written()
     what = (f"terminated by signal {exc.signum}" if isinstance(exc, Terminated) else
@@ -295,7 +295,7 @@ app = typer.Typer(
 
 def _show_version(value: bool) -> None:
     if value:
-        from . import __version__
+        from .. import __version__
 
         typer.echo(f"fi-design {__version__}")
         raise typer.Exit(EXIT_OK)
@@ -400,7 +400,7 @@ def check_spec_path(spec: Path) -> None:
     close = difflib.get_close_matches(str(spec), [c for c in app_commands()
                                                   if c != DEFAULT_COMMAND], n=1)
     if close:
-        from .errors import SpecFileError
+        from ..errors import SpecFileError
 
         raise SpecFileError(f"{spec}: no such spec file, and not a command; "
                             f"did you mean 'fi-design {close[0]}'?")
@@ -423,7 +423,7 @@ def check_outputs(inputs: tuple[Path, ...], force: bool, **paths: Any) -> dict:
     dict
         Name to checked path (None where not asked).
     """
-    from .output import check_outputs as check
+    from ..output import check_outputs as check
 
     return check(inputs, force=force, **paths)
 
@@ -440,7 +440,7 @@ def load(spec: Path) -> Any:
     -------
     fi_design.spec.Spec
     """
-    from .specfile import load_spec
+    from ..spec.file import load_spec
 
     check_spec_path(spec)
     return load_spec(spec)
@@ -466,7 +466,7 @@ def write_outputs(console: "Console", outs: dict, payloads: dict) -> None:
     payloads : dict
         Content by the same names.
     """
-    from .output import atomic_path, write_atomic
+    from ..output import atomic_path, write_atomic
 
     for name, data in payloads.items():
         if callable(data):
@@ -493,8 +493,8 @@ def write_report(console: "Console", path: Optional[Path], result: Any, **option
     """
     if path is None:
         return
-    from .console import Status, make_console
-    from .report import render_report
+    from ..console import Status, make_console
+    from ..report import render_report
 
     with Status(make_console(stderr=True), "writing the report ...") as status:
         render_report(result, path, command=command_line(), progress=status, **options)
@@ -509,7 +509,7 @@ def command_line() -> str:
 
 
 def study_pool(kind: str, jobs: int, scheduler: Optional[str]) -> Any:
-    """The executor of a study command (:class:`fi_design.pools.StudyPool`), options checked."""
+    """The executor of a study command (:class:`fi_design.cli.pools.StudyPool`), options checked."""
     from .pools import EXECUTORS, StudyPool
 
     if kind not in EXECUTORS:
@@ -525,8 +525,8 @@ def run_study(label: str, pool: Any, no_cache: bool, work: Any) -> Any:
 
     An interruption writes no output; the finished points stay in the cache.
     """
-    from .console import ProgressBar, make_console
-    from .studies import PointCache
+    from ..console import ProgressBar, make_console
+    from ..studies import PointCache
 
     err = make_console(stderr=True)
     try:
@@ -561,7 +561,7 @@ def write_study(console: "Console", outs: dict, result: Any, figure: Any) -> Non
     if outs["json"] is not None:
         payloads["json"] = json_text(result)
     if outs["figure"] is not None:
-        from .plots import figure_bytes
+        from ..plots import figure_bytes
 
         payloads["figure"] = figure_bytes(figure(result), outs["figure"].suffix)
     write_outputs(console, outs, payloads)

@@ -31,8 +31,8 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from .errors import SpecError
-from .results.controller import ControlLaw, DriveUnits, Filter, PidGains
+from ..errors import SpecError
+from ..results.controller import ControlLaw, DriveUnits, Filter, PidGains
 
 __all__ = ["tune_pid", "pid_gains", "control_law", "at_crossover", "spec_filter"]
 
@@ -98,7 +98,7 @@ def tune_pid(spec, crossover: float | None = None, mass: float | None = None) ->
         fraction of a percent above ``wc``: the integrator raises
         ``|L(j wc)|`` to ``sqrt(1 + 1/ri^2)`` (see the module docstring).
     """
-    from .spec import design_crossover, tuning_mass
+    from ..spec import design_crossover, tuning_mass
 
     ctl = spec.controller
     fc = design_crossover(spec) if crossover is None else crossover
@@ -129,7 +129,7 @@ def control_law(spec, crossover: float | None = None) -> ControlLaw:
     -------
     ControlLaw
     """
-    from .spec import design_crossover, tuning_mass
+    from ..spec import design_crossover, tuning_mass
 
     ctl = spec.controller
     own = design_crossover(spec)
@@ -179,7 +179,7 @@ def spec_filter(entry) -> Filter:
     if entry.type == "notch":
         return Filter("notch", entry.name, entry.frequency, zeta_pole=entry.zeta_pole,
                       zeta_zero=entry.zeta_zero, order=2)
-    from .spec import BUTTERWORTH
+    from ..spec import BUTTERWORTH
 
     zeta = 1.0 if entry.order == 1 else (BUTTERWORTH if entry.damping is None
                                          else entry.damping)
