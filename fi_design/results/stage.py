@@ -19,8 +19,8 @@ import numpy as np
 from ..display import display_scale, number, quantity
 from . import Result, dataclass_dict, to_jsonable
 
-__all__ = ["STATIC_ERROR_FORMULA", "MOVE_OUTCOMES", "BOUNDARY_KINDS", "MoveOutcome", "CycleTrace", "Cycle", "Boundary",
-           "StageHunting", "length_text", "length_range"]
+__all__ = ["STATIC_ERROR_FORMULA", "MOVE_OUTCOMES", "BOUNDARY_KINDS", "MoveOutcome", "CycleTrace",
+           "Cycle", "Boundary", "StageHunting", "length_text", "length_range"]
 
 def length_text(x: float) -> str:
     """A length [m] for a sentence, 3 digits (:func:`fi_design.display.quantity`)."""

@@ -202,7 +202,8 @@ def _finish_cycle(params, level, s, crossings, crossover, period, mult, mult_che
     stable = mult is None or mult < 1.0
     tr = None
     if trace:
-        tr = CycleTrace(time=frozen_array(t_out[ok]), error=frozen_array(err), velocity=frozen_array(Y[ok, idx["v1"]]),
+        tr = CycleTrace(time=frozen_array(t_out[ok]), error=frozen_array(err),
+                        velocity=frozen_array(Y[ok, idx["v1"]]),
                         deflection=None if defl is None else frozen_array(defl),
                         cart_velocity=frozen_array(Y[ok, idx["v2"]]) if params.isolated else None)
     return Cycle(crossover=float(crossover), amplitude=amp, period=float(period), stable=stable,
