@@ -143,3 +143,89 @@ def test_no_module_is_over_800_lines_but_the_integrator():
     sizes = {str(p.relative_to(ROOT)): _lines(p) for p in (ROOT / "fi_design").rglob("*.py")}
     long = {p: n for p, n in sizes.items() if n > MAX_LINES and p not in LONG_MODULES}
     assert not long, long
+
+
+# --------------------------------------------------------------------------- private names
+
+#: Packages whose modules use each other through public names only (a private name is a
+#: module's own business: what a sibling needs is named without the underscore).
+SEALED_PACKAGES = ("stage",)
+
+
+def _private_imports(source: str, module: str, package: str, *,
+                     is_package: bool = False) -> list[str]:
+    """``name (line)`` of each private name ``module`` takes from another module of
+    ``package`` (both dotted, e.g. ``fi_design.stage.judge``, ``fi_design.stage``): a
+    ``from ... import _name``, or ``sibling._name`` on a sibling module it imported.
+    ``is_package``: ``module`` is a package's ``__init__`` (``.`` is the package itself)."""
+    import ast
+
+    tree = ast.parse(source)
+    parts = module.split(".") + ([""] if is_package else [])
+    found, siblings = [], set()
+
+    def resolve(node: ast.ImportFrom) -> str:
+        if node.level == 0:
+            return node.module or ""
+        base = parts[:len(parts) - node.level]
+        return ".".join(base + ([node.module] if node.module else []))
+
+    def inside(name: str) -> bool:
+        return (name == package or name.startswith(package + ".")) and name != module
+
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            source_module = resolve(node)
+            for alias in node.names:
+                full = f"{source_module}.{alias.name}"
+                if inside(source_module) or inside(full):
+                    if alias.name.startswith("_") and not alias.name.startswith("__"):
+                        found.append(f"{alias.name} from {source_module} (line {node.lineno})")
+                    elif inside(full):  # `from . import sibling`
+                        siblings.add(alias.asname or alias.name)
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                if inside(alias.name) and alias.asname:
+                    siblings.add(alias.asname)
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
+                and node.value.id in siblings and node.attr.startswith("_")
+                and not node.attr.startswith("__")):
+            found.append(f"{node.value.id}.{node.attr} (line {node.lineno})")
+    return found
+
+
+def test_the_private_name_check_finds_each_form():
+    """The check below sees the three ways a module reaches a sibling's private name, and
+    leaves public names, other packages and private aliases alone."""
+    bad = ("from .moves import _Run, watch\n"
+           "from fi_design.stage.cycle import _ro\n"
+           "from . import runs as r\n"
+           "x = r._integrate\n")
+    fine = ("from .runs import kernel_run\n"
+            "from .. import spec as _spec\n"
+            "from ..results import _private_elsewhere\n"
+            "from __future__ import annotations\n"
+            "from .settings import __all__\n")
+    got = _private_imports(bad, "fi_design.stage.judge", "fi_design.stage")
+    assert [g.split(" ")[0] for g in got] == ["_Run", "_ro", "r._integrate"], got
+    assert _private_imports(fine, "fi_design.stage.judge", "fi_design.stage") == []
+    init = _private_imports("from .judge import _boundary\nfrom .. import _x\n",
+                            "fi_design.stage", "fi_design.stage", is_package=True)
+    assert [g.split(" ")[0] for g in init] == ["_boundary"], init
+
+
+@pytest.mark.parametrize("package", SEALED_PACKAGES)
+def test_no_module_imports_a_private_name_of_its_package(package):
+    """stage/ imported six private helpers across its modules (cycle.py from moves.py, judge.py
+    from both); each module now offers what the others use under a public name."""
+    folder = ROOT / "fi_design" / package
+    bad = {}
+    for path in sorted(folder.rglob("*.py")):
+        rel = path.relative_to(ROOT).with_suffix("")
+        module = ".".join(rel.parts[:-1] if rel.name == "__init__" else rel.parts)
+        found = _private_imports(path.read_text(encoding="utf-8"), module,
+                                 f"fi_design.{package}", is_package=rel.name == "__init__")
+        if found:
+            bad[str(path.relative_to(ROOT))] = found
+    assert not bad, bad

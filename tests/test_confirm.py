@@ -36,10 +36,10 @@ def test_paper_headline_isolator_needs_far_less_bandwidth(paper_confirmation):
     assert m["non_isolated"] >= 2.0 * m["isolated"]
     for plant in ("isolated", "non_isolated"):
         b = c.stage[plant].boundary
-        assert b["kind"] == "fold" and b["bracket"][1] == m[plant]
+        assert b.kind == "fold" and b.bracket[1] == m[plant]
         # the branch of the cycle ends below the fold, its amplitude shrinking on the way
-        f = [p[0] for p in b["branch"]]
-        a = [p[1] for p in b["branch"]]
+        f = [p[0] for p in b.branch]
+        a = [p[1] for p in b.branch]
         assert max(f) < m[plant] and a[0] > a[-1] > 0
 
 
@@ -158,7 +158,7 @@ def test_a_cycle_that_outlives_the_search_gives_no_hunting_free_crossover(paper_
     spec = variant(paper_spec, **{"simulation.crossover_scan.stop": "20 Hz"})
     st = stage_hunting(spec, False)  # its fold lies at 24.5 Hz
     assert st.hunts and st.hunting_free_from is None
-    assert st.boundary["kind"] == "bound" and st.boundary["bracket"][1] == 20.0
+    assert st.boundary.kind == "bound" and st.boundary.bracket[1] == 20.0
 
 
 def test_cli_design_prints_the_confirmation(paper_spec_path, tmp_path, shared_designs):

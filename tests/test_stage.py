@@ -30,7 +30,7 @@ def paper_isolated(paper_spec):
 
 
 def _canudas_spec(model: str = "lugre", hunting: dict | None = None, duration: str = "20 s"):
-    from fi_design.spec.file import load_spec
+    from fi_design.specfile import load_spec
 
     return load_spec({
         "name": "Canudas de Wit et al. 1995, unit mass under PID",
@@ -120,8 +120,8 @@ def test_paper_cycle_agrees_with_a_long_independent_simulation(paper_isolated):
 def test_paper_fold_lies_above_every_hunting_crossover_of_a_dense_scan(paper_spec,
                                                                      paper_isolated):
     fold = paper_isolated.hunting_free_from
-    assert paper_isolated.boundary["kind"] == "fold"
-    lo, hi = paper_isolated.boundary["bracket"]
+    assert paper_isolated.boundary.kind == "fold"
+    lo, hi = paper_isolated.boundary.bracket
     assert hi - lo <= max(0.01, 1e-3 * hi) * 1.0001 and fold == hi  # the search's resolution
     assert 11.0 < fold < 11.5  # from about 11 Hz no move of 0.1 to 50 mm hunts
     dense = np.geomspace(1e-5, 0.1, 120)
@@ -181,7 +181,7 @@ def test_a_multiplier_the_two_perturbations_disagree_on_is_not_reported(paper_sp
     stick event: the multiplier reads 1.14 at one perturbation and 0.51 at ten times it.
     Four moves end in the cycle, so it attracts; the multiplier is not reported. At Fc
     3.02 N the two agree (0.48) and the cycle is stable by its multiplier."""
-    from fi_design.spec.file import with_values
+    from fi_design.specfile import with_values
 
     st = stage_hunting(with_values(paper_spec, {"friction.coulomb": 3.0}), False,
                        boundary=False)
@@ -217,7 +217,7 @@ def test_a_stage_creeping_at_its_static_friction_inside_the_band_settles(paper_s
     the cart at its static friction, so the rest is not final by the static balance; the
     cart creeps and never leaves the band. Such a move settles (it was 'undetermined'), and a
     horizon four times longer finds the same."""
-    from fi_design.spec.file import with_values
+    from fi_design.specfile import with_values
 
     point = with_values(paper_spec, {
         "controller.crossover": 11.0, "friction.static": 4.138233676825914,
@@ -288,10 +288,10 @@ def test_the_watch_lands_on_the_section_and_leaves_the_trajectory_alone(paper_sp
     from fi_design.kernel.layout import N_WATCH, W_ARM, W_LEVEL, W_MAX_CROSSINGS, W_QUIET, W_START
     from fi_design.model import resolve
     from fi_design.simulation.run import tolerances
-    from fi_design.stage.moves import _family_reference
+    from fi_design.stage.family import family_reference
 
     p = resolve(paper_spec).plant(False)
-    ref, end = _family_reference(paper_spec, 0.01, 12.0)
+    ref, end = family_reference(paper_spec, 0.01, 12.0)
     t_out = np.arange(0.0, end + 12.0, 1e-4)
     args = (p.to_array(), np.zeros(p.n_states), ref.breaks, ref.coeffs, True, end + 12.0, t_out,
             1e-8, tolerances(p, 1e-8), 0.05, 2_000_000, 10.0)
@@ -317,11 +317,11 @@ def test_a_move_entering_a_known_cycle_stops_there_with_the_same_answer(paper_sp
     earlier move repeated) changes when a move stops, not how the stage ends: against the
     family run with the rule off, every move has the same outcome and every hunting move's
     cycle the same amplitude and period within the repeat tolerance's reach."""
-    from fi_design.stage import moves
+    from fi_design.stage import runs as stage_runs
 
     spec = paper_spec
     fast, runs = stage_hunts(spec, True, crossover=5.0)
-    monkeypatch.setattr(moves, "MATCH", 0.0)  # the kernel's rule off: every move to its repeat
+    monkeypatch.setattr(stage_runs, "MATCH", 0.0)  # the kernel's rule off: every move to its repeat
     slow, _ = stage_hunts(spec, True, crossover=5.0)
     assert [m.outcome for m in fast] == [m.outcome for m in slow]
     matched = [(f, s) for f, s in zip(fast, slow) if "enters the cycle" in f.reason]

@@ -561,11 +561,11 @@ def test_stage_cell_is_the_largest_cycle_over_the_family(paper_spec, monkeypatch
     its own repeat, their cycles differ in the fourth digit, where the run left them; the
     match rule, off here, would give every move entering a known cycle that cycle's
     values)."""
-    from fi_design.stage import moves as stage_moves
+    from fi_design.stage import runs as stage_runs
     from fi_design.stage import stage_hunts
     from fi_design.studies.points import evaluate_point
 
-    monkeypatch.setattr(stage_moves, "MATCH", 0.0)
+    monkeypatch.setattr(stage_runs, "MATCH", 0.0)
     moves, _ = stage_hunts(paper_spec, False)
     amps = [m.amplitude for m in moves if m.hunts]
     first = next(m.amplitude for m in moves if m.hunts)

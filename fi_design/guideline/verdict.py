@@ -324,7 +324,6 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
     else:
         st = simulation.stage[own]
         m = st.hunting_free_from
-        b = st.boundary or {}
         if not pid.controller.integrator:
             notes.append("the loop has no integrator: it cannot hunt by the paper's mechanism, "
                          "so there is no hunting-free crossover to keep a distance from")
@@ -336,7 +335,7 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
             out["hunting_free_crossover"] = m
             out["crossover_factor"] = fc / m
             out.update(_hunting_loop(model, crossover, st, m))
-            if b.get("kind") == "bound":
+            if st.boundary is not None and st.boundary.kind == "bound":
                 out["crossover_factor_bound"] = True
                 notes.append(f"no move of the family hunts from {m:g} Hz, the bottom of the "
                              "search: the crossover factor is a lower bound")

@@ -181,14 +181,14 @@ def boundary_figure(confirmation: Any) -> Any:
     for n, key in enumerate(("isolated", "non_isolated")):
         st = confirmation.stage[key]
         col = PLANT_COLOURS[key]
-        b = st.boundary or {}
-        pts = [p for p in b.get("branch") or [] if p[1] is not None]
+        b = st.boundary
+        pts = [p for p in (b.branch if b is not None else ()) if p[1] is not None]
         if pts:
             f, a = np.array([p[0] for p in pts]), np.array([p[1] for p in pts]) * 1e3
             ax.plot(f, a, "o-", color=col, ms=3, lw=1.1, label=f"{names[key]}: cycle")
             top_mm = max(top_mm, float(np.max(a)))
         m = st.hunting_free_from
-        if m is not None and b.get("kind") == "fold":
+        if m is not None and b is not None and b.kind == "fold":
             ax.axvline(m, color=col, lw=0.9, ls=":")
             # in the headroom above the curves, on the side of the line with more room
             left = m < 0.6 * x_top

@@ -171,7 +171,7 @@ def stage_answer(spec: _spec.Spec, crossover: float | None = None,
     return {"hunts": st.hunts, "acceptable": st.acceptable, "outcome": st.outcome,
             "free_from": st.hunting_free_from, "amplitude": None if c is None else c.amplitude,
             "period": None if c is None else c.period,
-            "tests": int((st.boundary or {}).get("tests", 0))}
+            "tests": 0 if st.boundary is None else st.boundary.tests}
 
 
 def margin_screen(spec: _spec.Spec, margin: float, crossover: float | None = None) -> dict:

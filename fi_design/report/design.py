@@ -216,7 +216,6 @@ def _stage_rows(sim: Any) -> list[dict]:
     for key, name in names.items():
         st = sim.stage[key]
         c = st.cycle
-        b = st.boundary or {}
         dist = sorted(abs(d) for d in st.entered_by)
         rows.append({
             "plant": name, "outcome": st.outcome.replace("_", " "),
@@ -285,7 +284,7 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "over one period against its stroke (middle), and the settling after the spec's "
             f"own motion in the \u00b1{num(h.settle_band * 1e6)} \u00b5m settle band (right).",
             fig_no()),
-        "boundary": None if not any((st.boundary or {}).get("branch")
+        "boundary": None if not any(st.boundary is not None and st.boundary.branch
                                     for st in sim.stage.values()) else figure_entry(
             (lambda: plots.boundary_figure(sim)) if figures else None, "boundary",
             "The stage-level boundary: the peak to peak of each plant's hunting cycle as the "

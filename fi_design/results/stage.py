@@ -19,8 +19,8 @@ import numpy as np
 from ..display import display_scale, number, quantity
 from . import Result, dataclass_dict, to_jsonable
 
-__all__ = ["STATIC_ERROR_FORMULA", "MOVE_OUTCOMES", "MoveOutcome", "CycleTrace", "Cycle", "StageHunting", "length_text",
-           "length_range"]
+__all__ = ["STATIC_ERROR_FORMULA", "MOVE_OUTCOMES", "BOUNDARY_KINDS", "MoveOutcome", "CycleTrace",
+           "Cycle", "Boundary", "StageHunting", "length_text", "length_range"]
 
 def length_text(x: float) -> str:
     """A length [m] for a sentence, 3 digits (:func:`fi_design.display.quantity`)."""
@@ -184,6 +184,60 @@ class Cycle(Result):
         return dataclass_dict(self)
 
 
+#: How a boundary was found: ``"fold"`` (the crossover where the cycle ceases to exist,
+#: bisected) or ``"bound"`` (the cycle persists up to the top of the search, or no move
+#: hunts from its bottom up).
+BOUNDARY_KINDS = ("fold", "bound")
+
+
+@dataclass(frozen=True, eq=False)
+class Boundary(Result):
+    """The hunting-free crossover and how it was found (the fold search).
+
+    Produced by :func:`fi_design.stage.cycle_fold` (one cycle followed up to
+    its fold) and by the stage's whole search, which also looks for a cycle
+    below the crossover when no move hunts there and runs the move family
+    just above each fold found.
+
+    Attributes
+    ----------
+    hunting_free_from : float or None
+        The crossover from which no move of the family hunts [Hz]: the upper
+        end of the bracket of a fold, the bottom of the search when no move
+        hunts from there up; None when the cycle persists up to the top of
+        the search.
+    bracket : tuple of float
+        The last bracket [lo, hi] of the search [Hz]: the cycle exists at lo
+        and not at hi (a fold), or the range searched (a bound).
+    kind : str
+        One of :data:`BOUNDARY_KINDS`.
+    resolution : float
+        Width of the fold's bracket [Hz]; 0 for a bound.
+    tests : int
+        Existence tests and family runs the search took.
+    branch : tuple of tuple
+        The cycle followed up the crossover: (crossover [Hz], peak-to-peak
+        amplitude [m], period [s]) per point, by crossover.
+    note : str
+        How the answer was reached, in one phrase.
+    """
+
+    hunting_free_from: float | None
+    bracket: tuple[float, float]
+    kind: str
+    resolution: float
+    tests: int
+    branch: tuple[tuple[float, float | None, float | None], ...]
+    note: str
+
+    def to_dict(self) -> dict:
+        """``bracket``, ``kind``, ``resolution``, ``tests``, ``branch`` and ``note`` (Hz, m,
+        s); the crossover itself is stated by :attr:`StageHunting.hunting_free_from`."""
+        out = dataclass_dict(self)
+        del out["hunting_free_from"]
+        return out
+
+
 @dataclass(frozen=True, eq=False)
 class StageHunting(Result):
     """Whether a plant hunts for any move of its family, the cycle, and the boundary.
@@ -205,10 +259,9 @@ class StageHunting(Result):
         Stage-level hunting-free crossover [Hz]: the fold of the cycle, above
         which it no longer exists (and no move of the family hunts). None
         when not computed, or when the cycle persists up to the search's top.
-    boundary : dict or None
-        How ``hunting_free_from`` was found: ``{"bracket": [lo, hi] Hz,
-        "resolution": Hz, "kind": "fold" | "bound" | "none", "note": str,
-        "tests": int}``.
+    boundary : Boundary or None
+        How ``hunting_free_from`` was found (its bracket, resolution, kind,
+        tests, the cycle's branch); None when not computed.
     first_only : bool
         Whether the family was cut short at the first hunting move (studies).
     static_error_bound : float or None
@@ -225,7 +278,7 @@ class StageHunting(Result):
     cycle: Cycle | None
     other_cycles: tuple[Cycle, ...] = ()
     hunting_free_from: float | None = None
-    boundary: dict | None = None
+    boundary: Boundary | None = None
     first_only: bool = False
     static_error_bound: float | None = None
     settle_band: float = 1e-5
@@ -329,11 +382,11 @@ class StageHunting(Result):
                         "hunting (it rests with a static error instead)")
             return "not computed"
         if m is None:
-            return b.get("note") or "the cycle persists up to the top of the search"
-        if b.get("kind") == "fold":
+            return b.note or "the cycle persists up to the top of the search"
+        if b.kind == "fold":
             return (f"no move of the family hunts from {number(m, 4)} Hz up (the fold of its "
-                    f"cycle, bisected to {number(b['resolution'], 2)} Hz)")
-        return f"{b.get('note') or f'no move of the family hunts from {number(m, 4)} Hz up'} (a bound)"
+                    f"cycle, bisected to {number(b.resolution, 2)} Hz)")
+        return f"{b.note or f'no move of the family hunts from {number(m, 4)} Hz up'} (a bound)"
 
     def describe(self, label: str) -> str:
         """The plant's stage-level answer in one sentence, beginning with ``label``.
@@ -393,5 +446,6 @@ class StageHunting(Result):
             "cycle": None if self.cycle is None else self.cycle.to_dict(),
             "other_cycles": [c.to_dict() for c in self.other_cycles],
             "hunting_free_from": to_jsonable(self.hunting_free_from),
-            "boundary": to_jsonable(self.boundary), "first_only": self.first_only,
+            "boundary": None if self.boundary is None else self.boundary.to_dict(),
+            "first_only": self.first_only,
             "moves": [m.to_dict() for m in self.moves]}

@@ -4,8 +4,20 @@ A PID loop around a mass with stick-slip friction is bistable: beside the
 rest set (the cart stuck, the stage at its target, the friction force below
 the static friction) lives a stable limit cycle, and which of the two a run
 ends in depends on where the cart first sticks after the move. One simulated
-move therefore says little about the stage. This package answers per plant
-(:mod:`.moves`, :mod:`.cycle`, :mod:`.judge`):
+move therefore says little about the stage. This package answers per plant,
+one job per module, each importing only those listed after it:
+
+- :mod:`.judge`: the answer of one plant (:func:`stage_hunting`);
+- :mod:`.boundary`: the one fold search, the hunting-free crossover;
+- :mod:`.moves`: every move of the family run (:func:`stage_hunts`);
+  :mod:`.orbit`: the cycle as a periodic orbit; :mod:`.positioning` and
+  :mod:`.forces`: the positioning requirement and the forces over the family;
+- :mod:`.runs`: one move run to its answer (:func:`move_outcome`);
+- :mod:`.family`: the move distances and references; :mod:`.rest`: when
+  rest is final;
+- :mod:`.settings`: the tolerances, the :class:`Watch`, the plant's traits.
+
+The three steps:
 
 1. *Which moves end in a cycle* (:func:`move_outcome`): a family of moves
    (``motion.family``, and always the spec's own motion), each simulated from
@@ -22,11 +34,12 @@ move therefore says little about the stage. This package answers per plant
    with the Jacobian by finite differences (its eigenvalues are the Floquet
    multipliers, checked at two perturbation sizes); amplitude and period
    from one period of the converged orbit.
-3. *The hunting-free crossover* (:func:`cycle_fold`): the crossover above
-   which the cycle no longer exists, by bisection on its existence, each
-   test started from the orbit at the nearest crossover where it still
-   exists (continuation); the family is then run just above to make sure no
-   other cycle is entered there.
+3. *The hunting-free crossover* (:func:`hunting_free_boundary`): the
+   crossover above which the cycle no longer exists (:func:`cycle_fold`), by
+   bisection on its existence, each test started from the orbit at the
+   nearest crossover where it still exists (continuation); the family is
+   then run just above to make sure no other cycle is entered there. The
+   answer is a :class:`~fi_design.results.stage.Boundary`.
 
 The kernel's watch (:func:`fi_design.kernel.integrator.integrate`) locates the section
 crossings like mode events (the step is redone to end on them, never
@@ -39,11 +52,16 @@ cycle is the one a long simulation settles on.
 
 from __future__ import annotations
 
-from .cycle import converge_cycle, cycle_exists, cycle_fold
-from .judge import stage_hunting, stage_hunts
-from .moves import Watch, family_distances, move_outcome, rest_is_final, watch_settings
+from .boundary import cycle_fold, hunting_free_boundary
+from .family import family_distances
+from .judge import stage_hunting
+from .moves import stage_hunts
+from .orbit import converge_cycle, cycle_exists
 from .positioning import positioning, positioning_checks, settle_time
+from .rest import rest_is_final
+from .runs import move_outcome
+from .settings import Watch, watch_settings
 
 __all__ = ["Watch", "watch_settings", "family_distances", "rest_is_final", "move_outcome",
-           "converge_cycle", "cycle_exists", "cycle_fold", "stage_hunting", "stage_hunts",
-           "positioning", "positioning_checks", "settle_time"]
+           "converge_cycle", "cycle_exists", "cycle_fold", "hunting_free_boundary",
+           "stage_hunting", "stage_hunts", "positioning", "positioning_checks", "settle_time"]

@@ -155,7 +155,7 @@ def confirm(spec: _spec.Spec | Model, suggestion: tuple[float, float] | None = N
     stage = {"isolated": stage_hunting(model_iso, True, progress=progress),
              "non_isolated": stage_hunting(model, False, progress=progress)}
     cfg = model.spec.simulation.crossover_scan
-    widths = [st.boundary["resolution"] for st in stage.values() if st.boundary]
+    widths = [st.boundary.resolution for st in stage.values() if st.boundary is not None]
     mins = {"isolated": stage["isolated"].hunting_free_from,
             "non_isolated": stage["non_isolated"].hunting_free_from,
             "resolution": max(widths) if widths else None,

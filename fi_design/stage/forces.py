@@ -20,6 +20,7 @@ from .. import spec as _spec
 from ..model import Model, as_model
 from ..results.forces import MoveForces, StageForces
 from ..trajectory import from_moves, profile_duration
+from .family import family_distances
 
 __all__ = ["SETTLE", "RATE", "move_forces"]
 
@@ -82,8 +83,6 @@ def move_forces(model: Model | _spec.Spec, isolated: bool | None = None, *,
     -------
     StageForces
     """
-    from .moves import family_distances
-
     model = as_model(model)
     iso = model.has_isolator if isolated is None else bool(isolated)
     spec = model.spec

@@ -16,7 +16,9 @@ import numpy as np
 from ..model import Model, as_model
 from ..results.positioning import MovePosition, PositioningResult
 from ..results.stage import StageHunting
-from .moves import _family_reference, _integrate, _spec_reference, _watch_array, watch_settings
+from .family import family_reference, spec_reference
+from .runs import kernel_run, watch_array
+from .settings import watch_settings
 
 __all__ = ["positioning", "settle_time"]
 
@@ -89,14 +91,14 @@ def positioning(model: Model, stage: StageHunting) -> PositioningResult | None:
             error = abs(m.final_error)
         if m.outcome in ("settles", "rests") and error <= band:
             if m.label == "spec":
-                ref, end = _spec_reference(spec, w.horizon)
+                ref, end = spec_reference(spec, w.horizon)
             else:
-                ref, end = _family_reference(spec, m.distance, w.horizon)
+                ref, end = family_reference(spec, m.distance, w.horizon)
             t_end = end + m.time
             t_out = np.arange(0.0, t_end + 0.5 * dt, dt)
             # a watch that starts after the run's end: no rule stops it
-            out = _integrate(p, np.zeros(p.n_states), ref, t_end,
-                             _watch_array(w, t_end + 1.0, ref.final, quiet=False),
+            out = kernel_run(p, np.zeros(p.n_states), ref, t_end,
+                             watch_array(w, t_end + 1.0, ref.final, quiet=False),
                              w.tolerance, w.max_steps, t_out=t_out)
             if out.code == 0:
                 err = out.states[:, 0] - out.reference

@@ -36,7 +36,7 @@ def _fold(spec: Any, isolated: bool, values: dict) -> tuple[float | None, str]:
     from ..stage import stage_hunting
 
     st = stage_hunting(with_values(spec, values), isolated, converge=False, trace=False)
-    kind = (st.boundary or {}).get("kind", "none")
+    kind = "none" if st.boundary is None else st.boundary.kind
     return st.hunting_free_from, kind
 
 

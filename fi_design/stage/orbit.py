@@ -1,32 +1,30 @@
-"""The cycle itself and its fold: Newton on the return map, bisection on existence.
+"""The hunting cycle as a periodic orbit: the return map, shooting, the Floquet multiplier.
 
-Steps 2 and 3 of the stage-level answer (:mod:`fi_design.stage`):
-:func:`converge_cycle` converges the orbit a hunting move repeated and its
-Floquet multiplier; :func:`cycle_exists` and :func:`cycle_fold` find the
-crossover above which the cycle no longer exists.
+Step 2 of the stage-level answer (:mod:`fi_design.stage`):
+:func:`converge_cycle` converges the orbit a hunting move repeated by
+Newton's method on the return map of the Poincare section (x1 - r = 0,
+upwards), with its Floquet multiplier from the map's Jacobian;
+:func:`cycle_exists` tells whether a cycle lives at a plant, started from a
+nearby orbit (what the fold search in :mod:`.boundary` asks at each step).
 """
 
 from __future__ import annotations
 
-import logging
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..kernel.layout import W_ARM, PlantParameters, state_index
-from ..model import Model
+from ..results import frozen_array
 from ..results.stage import Cycle, CycleTrace
 from ..simulation.run import tolerances
-from .moves import (FOLD_RELATIVE, FOLD_RESOLUTION, FOLD_STEP, MULTIPLIER_AGREEMENT, ORBIT_RTOL,
-                    PERTURBATION, REPEAT, Watch, _guess_period, _hold, _integrate, _rest_ends_run, _restartable,
-                    _watch_array, watch_settings)
+from .family import hold
+from .rest import rest_ends_run
+from .runs import guess_period, kernel_run, watch_array
+from .settings import MULTIPLIER_AGREEMENT, ORBIT_RTOL, PERTURBATION, REPEAT, Watch, restartable
 
-log = logging.getLogger(__name__)
-
-
-# --------------------------------------------------------------------------- the cycle
+__all__ = ["converge_cycle", "FoundCycle", "cycle_exists"]
 
 
 def _return_map(params, level, state, crossings, tol, max_steps, horizon, t_out=None):
@@ -34,9 +32,9 @@ def _return_map(params, level, state, crossings, tol, max_steps, horizon, t_out=
     w = Watch(band=0.0, quiet=math.inf, horizon=horizon, rest_anywhere=False, tolerance=tol,
               max_steps=max_steps)
     arm = max(1e-9, 1e-6 * max(abs(level), 1e-3))
-    arr = _watch_array(w, 0.0, level, repeat=0.0, quiet=False, max_crossings=crossings)
+    arr = watch_array(w, 0.0, level, repeat=0.0, quiet=False, max_crossings=crossings)
     arr[W_ARM] = arm
-    out = _integrate(params, state, _hold(level, horizon), horizon, arr, tol, max_steps,
+    out = kernel_run(params, state, hold(level, horizon), horizon, arr, tol, max_steps,
                      crossings=crossings, t_out=t_out, h_max=math.inf)
     if out.code != 0 or len(out.crossing_times) < crossings:
         return None
@@ -83,7 +81,7 @@ def converge_cycle(params: PlantParameters, level: float, state: np.ndarray, cro
     horizon = 20.0 * period if period else 600.0
     s = np.array(state, dtype=float)
     s[0] = level
-    if not _restartable(params):
+    if not restartable(params):
         return _simulated_cycle(params, level, s, crossings, crossover, horizon, max_steps,
                                 trace)
     free = _free_coordinates(params)
@@ -204,30 +202,37 @@ def _finish_cycle(params, level, s, crossings, crossover, period, mult, mult_che
     stable = mult is None or mult < 1.0
     tr = None
     if trace:
-        tr = CycleTrace(time=_ro(t_out[ok]), error=_ro(err), velocity=_ro(Y[ok, idx["v1"]]),
-                        deflection=None if defl is None else _ro(defl),
-                        cart_velocity=_ro(Y[ok, idx["v2"]]) if params.isolated else None)
+        tr = CycleTrace(time=frozen_array(t_out[ok]), error=frozen_array(err),
+                        velocity=frozen_array(Y[ok, idx["v1"]]),
+                        deflection=None if defl is None else frozen_array(defl),
+                        cart_velocity=frozen_array(Y[ok, idx["v2"]]) if params.isolated else None)
     return Cycle(crossover=float(crossover), amplitude=amp, period=float(period), stable=stable,
                  multiplier=mult, multiplier_check=mult_check, method=method,
                  residual=float(residual), crossings=int(crossings), on_limiter=on_lim,
                  deflection_range=None if defl is None or not len(defl)
                  else (float(np.min(defl)), float(np.max(defl))),
-                 section_state=_ro(s), trace=tr)
+                 section_state=frozen_array(s), trace=tr)
 
 
-def _ro(a) -> np.ndarray:
-    from ..results import frozen_array
-
-    return frozen_array(a)
-
-
-# --------------------------------------------------------------------------- the fold
+# --------------------------------------------------------------------------- existence
 
 
 @dataclass(frozen=True, eq=False)
-class _Found:
-    """A cycle a run from a nearby orbit settled on: its section state, crossings per period,
-    peak-to-peak amplitude [m] (at the step ends) and period [s]."""
+class FoundCycle:
+    """A cycle a run from a nearby orbit settled on.
+
+    Attributes
+    ----------
+    state : ndarray, shape (n,) or None
+        Its last section state (SI); None when the run could not be continued
+        exactly to the cycle (a sampled or delayed controller, not at rest yet).
+    crossings : int
+        Section crossings per period.
+    amplitude : float or None
+        Peak-to-peak x1 - r over one period [m] (at the step ends).
+    period : float or None
+        Period [s].
+    """
 
     state: np.ndarray | None
     crossings: int
@@ -236,113 +241,58 @@ class _Found:
 
 
 def cycle_exists(params: PlantParameters, level: float, guess: np.ndarray, w: Watch,
-                 period: float | None = None) -> _Found | None:
+                 period: float | None = None) -> FoundCycle | None:
     """Whether a cycle lives at ``params``, started from a nearby orbit's section state.
 
     The run starts on the section from ``guess`` and stops once its section
     state repeats (the cycle exists), or once it comes to rest for good (no
     cycle reached from there).
 
+    Parameters
+    ----------
+    params : PlantParameters
+        The plant.
+    level : float
+        The held reference r [m].
+    guess : ndarray, shape (n,)
+        The nearby orbit's section state (SI).
+    w : Watch
+        How the run is judged.
+    period : float, optional
+        The nearby orbit's period [s] (lengthens the horizon to 40 periods).
+
     Returns
     -------
-    _Found or None
+    FoundCycle or None
         The cycle's section state, crossings per period, amplitude and period;
         None when the run comes to rest.
     """
     s = np.array(guess, dtype=float)
     s[0] = level
     horizon = max(w.horizon, 40.0 * period) if period else w.horizon
-    ref = _hold(level, horizon)
+    ref = hold(level, horizon)
     start, offset = 0.0, 0.0
     y0 = s
     for _ in range(1000):
-        out = _integrate(params, y0, ref, horizon - offset,
-                         _watch_array(w, start, level, repeat=REPEAT), w.tolerance, w.max_steps)
+        out = kernel_run(params, y0, ref, horizon - offset,
+                         watch_array(w, start, level, repeat=REPEAT), w.tolerance, w.max_steps)
         if out.code != 0:
             return None
         if out.stop == "quiet":
-            if _rest_ends_run(params, out.final_state, level, w.band):
+            if rest_ends_run(params, out.final_state, level, w.band):
                 return None
-            if not _restartable(params):
-                return _Found(None, 0, None, None)  # cannot continue exactly: not at rest yet
+            if not restartable(params):
+                return FoundCycle(None, 0, None, None)  # cannot continue exactly: not at rest yet
             offset += out.t_reached
             y0 = out.final_state.copy()
-            ref = _hold(level, horizon - offset)
+            ref = hold(level, horizon - offset)
             continue
         n = len(out.crossing_times)
         if out.stop in ("repeat", "crossings") or n >= 4:
-            q = max(1, min(out.period_crossings or _guess_period(out.crossing_states), n - 1))
+            q = max(1, min(out.period_crossings or guess_period(out.crossing_states), n - 1))
             ext = out.crossing_extremes[-q:]
-            return _Found(np.array(out.crossing_states[-1]), q,
+            return FoundCycle(np.array(out.crossing_states[-1]), q,
                           float(np.max(ext[:, 1]) - np.min(ext[:, 0])),
                           float(out.crossing_times[-1] - out.crossing_times[-1 - q]))
         return None
     return None
-
-
-def cycle_fold(model: Model, isolated: bool, cycle: Cycle, *, top: float | None = None,
-               progress: Callable[[str], None] | None = None) -> dict:
-    """The crossover above which a cycle no longer exists (its fold), by bisection.
-
-    Parameters
-    ----------
-    model : Model
-        The resolved model.
-    isolated : bool
-        Which plant.
-    cycle : Cycle
-        The cycle at ``cycle.crossover``.
-    top : float, optional
-        Highest crossover searched [Hz]; default ``simulation.crossover_scan.stop``.
-    progress : callable, optional
-        ``progress(text)``.
-
-    Returns
-    -------
-    dict
-        ``{"fold": Hz or None, "bracket": [lo, hi], "kind": "fold" | "bound",
-        "tests": int, "state": section state at lo, "crossings": int}``.
-    """
-    top = model.spec.simulation.crossover_scan.stop if top is None else top
-    lo, state, q = cycle.crossover, np.array(cycle.section_state), cycle.crossings
-    period = cycle.period
-    branch = [[float(lo), float(cycle.amplitude), float(cycle.period)]]
-    tests = 0
-
-    def exists(fc: float) -> bool:
-        nonlocal tests, lo, state, q, period
-        tests += 1
-        at = model.at(crossover=fc)
-        p = at.plant(isolated)
-        found = cycle_exists(p, float(state[0]), state, watch_settings(at, p), period)
-        if found is None:
-            return False
-        lo = fc
-        if found.state is not None:
-            state, q, period = found.state, found.crossings, found.period or period
-            branch.append([float(fc), found.amplitude, found.period])
-        return True
-
-    while True:
-        hi = None
-        f = lo
-        while f < top:
-            f = min(top, f * FOLD_STEP)
-            if progress is not None:
-                progress(f"following the cycle to {f:.3g} Hz")
-            if not exists(f):
-                hi = f
-                break
-        if hi is None:
-            return {"fold": None, "bracket": [lo, top], "kind": "bound", "tests": tests,
-                    "state": state, "crossings": q, "branch": sorted(branch)}
-        while hi - lo > max(FOLD_RESOLUTION, FOLD_RELATIVE * hi):
-            mid = 0.5 * (lo + hi)
-            if not exists(mid):
-                hi = mid
-        # a test started far from the cycle may have missed it (a step or the first
-        # midpoint): the upper end is tried again from the nearest cycle, and the search
-        # goes on from there when the cycle is found after all
-        if not exists(hi):
-            return {"fold": hi, "bracket": [lo, hi], "kind": "fold", "tests": tests,
-                    "state": state, "crossings": q, "branch": sorted(branch)}

@@ -1,0 +1,312 @@
+"""One move of the family, from rest to its answer: the kernel's watched runs.
+
+:func:`move_outcome` runs one move until the stage rests for good
+(:func:`fi_design.stage.rest.rest_is_final`) or its state at the Poincare
+section (x1 - r = 0 crossed upwards) repeats, and says how the move ended
+(:class:`MoveRun`). :func:`kernel_run` and :func:`watch_array` are the one
+way the stage's modules call the kernel with its watch switched on.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kernel import run
+from ..kernel.layout import (N_WATCH, W_ARM, W_BAND, W_LEVEL, W_MATCH, W_MAX_CROSSINGS,
+                             W_QUIET, W_REPEAT, W_REST_ANYWHERE, W_START, Integration,
+                             PlantParameters, state_index)
+from ..results.stage import MoveOutcome, length_text
+from ..trajectory import Trajectory
+from .family import hold
+from .rest import rest_ends_run
+from .settings import (CROSSINGS, H_MAX, MATCH, REPEAT, Watch, integrates, kernel_arrays,
+                       restartable, translation_invariant)
+
+__all__ = ["MoveRun", "watch_array", "kernel_run", "move_outcome", "guess_period"]
+
+
+@dataclass(frozen=True, eq=False)
+class MoveRun:
+    """What one watched run of a move left: its outcome and the cycle's section state.
+
+    Attributes
+    ----------
+    outcome : MoveOutcome
+        How the move ended.
+    section_state : ndarray, shape (n,) or None
+        For a cycle, the last state at the section (SI); None otherwise.
+    crossings : int
+        Section crossings per period of the cycle (0 without one).
+    level : float
+        The held reference r of the move [m].
+    cycle_states : ndarray, shape (crossings, n) or None
+        Hunting runs that repeated: the section states of one period of the
+        cycle, positions relative to ``level`` (what the match rule compares).
+    """
+
+    outcome: MoveOutcome
+    section_state: np.ndarray | None
+    crossings: int
+    level: float
+    cycle_states: np.ndarray | None = None
+
+
+def _relative(params: PlantParameters, states: np.ndarray, level: float) -> np.ndarray:
+    """Section states with the positions (x1, and x2 of the isolated plant) less ``level``."""
+    out = np.array(states, dtype=float, ndmin=2)
+    idx = state_index(bool(params.isolated))
+    out[:, idx["x1"]] -= level
+    if params.isolated:
+        out[:, idx["x2"]] -= level
+    return out
+
+
+def watch_array(w: Watch, start: float, level: float, *, repeat: float = REPEAT,
+                quiet: bool = True, max_crossings: int = CROSSINGS,
+                known: np.ndarray | None = None, match: float | None = None) -> np.ndarray:
+    """The kernel's watch array: when and how a run is stopped.
+
+    Parameters
+    ----------
+    w : Watch
+        Settle band, quiet time and whether a rest off the target ends a run.
+    start : float
+        When the watch starts [s] (the end of the motion).
+    level : float
+        The held reference r [m]: the section is x1 - r = 0, upwards.
+    repeat : float
+        Repeat tolerance of the section state, in physical scales [-].
+    quiet : bool
+        Whether a quiet stop (at rest for the quiet time) ends the run.
+    max_crossings : int
+        Section crossings after which the run stops.
+    known : ndarray, shape (k, n), optional
+        Section states of known cycles (positions relative to their level) for
+        the match rule.
+    match : float, optional
+        Match tolerance [-] (default :data:`~fi_design.stage.settings.MATCH`).
+
+    Returns
+    -------
+    ndarray
+        The array :func:`fi_design.kernel.run` takes as ``watch``.
+    """
+    k = 0 if known is None else len(known)
+    arr = np.zeros(N_WATCH + (0 if k == 0 else known.size))
+    if k:
+        arr[W_MATCH] = MATCH if match is None else match
+        arr[N_WATCH:] = np.ravel(known)
+    arr[W_START] = start
+    arr[W_LEVEL] = level
+    arr[W_BAND] = w.band
+    arr[W_QUIET] = w.quiet if quiet else math.inf
+    arr[W_REPEAT] = repeat
+    arr[W_MAX_CROSSINGS] = max_crossings
+    arr[W_REST_ANYWHERE] = 1.0 if w.rest_anywhere else 0.0
+    arr[W_ARM] = w.band
+    return arr
+
+
+def _x_bound(ref: Trajectory, y0: np.ndarray) -> float:
+    return 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(y0[0]))
+
+
+def kernel_run(params: PlantParameters, y0: np.ndarray, ref: Trajectory, t_end: float,
+               watch: np.ndarray, tol: float, max_steps: int, crossings: int = CROSSINGS,
+               t_out: np.ndarray | None = None, h_max: float = H_MAX) -> Integration:
+    """One watched run of the compiled kernel from ``y0`` along ``ref``.
+
+    Parameters
+    ----------
+    params : PlantParameters
+        The plant.
+    y0 : ndarray, shape (n,)
+        Initial state (SI).
+    ref : Trajectory
+        The reference [m].
+    t_end : float
+        Last time [s].
+    watch : ndarray
+        From :func:`watch_array`.
+    tol : float
+        Relative tolerance [-].
+    max_steps : int
+        Step budget.
+    crossings : int
+        Room for section crossings.
+    t_out : ndarray, optional
+        Output times [s]; none by default.
+    h_max : float
+        Largest step [s].
+
+    Returns
+    -------
+    fi_design.kernel.layout.Integration
+        What :func:`fi_design.kernel.run` returns (stop reason, final state,
+        section crossings, sampled states).
+    """
+    p, atol = kernel_arrays(params, tol)
+    return run(p, y0, ref.breaks, ref.coeffs, ref.land, t_end,
+               np.zeros(0) if t_out is None else t_out, tol, atol, h_max,
+               max_steps, _x_bound(ref, y0), watch=watch, crossings=crossings)
+
+
+def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: Watch, *,
+                 distance: float, label: str = "family", repeat: float = REPEAT,
+                 known: Sequence[MoveRun] = ()) -> MoveRun:
+    """Simulate one move from rest and judge how the stage ends.
+
+    Parameters
+    ----------
+    params : PlantParameters
+        The plant.
+    ref : Trajectory
+        The move, held at its end position until ``move_end + w.horizon``.
+    move_end : float
+        When the motion is over [s]; the watch starts there.
+    w : Watch
+        Settle band, quiet time, horizon.
+    distance : float
+        The move's signed distance [m] (for the outcome).
+    label : str
+        ``"family"`` or ``"spec"``.
+    repeat : float
+        Repeat tolerance of the section state [-].
+    known : sequence of MoveRun
+        Hunting runs of earlier moves of the same plant: once the section
+        state comes within :data:`MATCH` of one of their cycles, the move has
+        entered that cycle and the run stops there; its outcome takes that
+        cycle's amplitude and period (for a plant whose state vector is whole
+        and whose forces do not depend on where the stage is; otherwise the
+        run goes on until its own motion repeats).
+
+    Returns
+    -------
+    MoveRun
+        The :class:`~fi_design.results.stage.MoveOutcome` and, for a cycle,
+        the last section state and the crossings per period.
+    """
+    level = ref.final
+    y0 = np.zeros(params.n_states)
+    t_end = move_end + w.horizon
+    restart = restartable(params)
+    known = [r for r in known if r.cycle_states is not None] \
+        if restart and translation_invariant(params) else []
+    table = np.concatenate([r.cycle_states for r in known]) if known else None
+    owner = [r for r in known for _ in range(len(r.cycle_states))]
+    start, offset, elapsed = move_end, 0.0, 0.0
+    cur_ref, cur_y0, cur_end = ref, y0, t_end
+    rested_at = None  # when the stage last came to rest inside the band, not for good [s]
+    while True:
+        out = kernel_run(params, cur_y0, cur_ref, cur_end,
+                         watch_array(w, start, level, repeat=repeat, known=table), w.tolerance,
+                         w.max_steps)
+        elapsed = offset + out.t_reached - move_end
+        y = out.final_state
+        if out.code != 0:
+            return MoveRun(MoveOutcome(distance, label, "undetermined", float(y[0] - level), None,
+                                    None, elapsed, f"the simulation failed: {out.status}",
+                                    failed=True), None, 0, level)
+        if out.stop == "quiet" and not rest_ends_run(params, y, level, w.band):
+            # the integrator will break the cart loose again: keep going
+            rested_at = offset + out.t_reached if abs(y[0] - level) <= w.band else None
+            if offset + out.t_reached >= t_end * (1 - 1e-12):
+                break
+            if restart:
+                offset += out.t_reached
+                cur_y0, cur_ref = y.copy(), hold(level, t_end - offset)
+                cur_end, start = t_end - offset, 0.0
+            else:
+                start = out.t_reached + 1e-9
+            continue
+        break
+    e = float(y[0] - level)
+    n = len(out.crossing_times)
+    if out.stop == "quiet":
+        if abs(e) <= w.band:
+            word, why = "settles", f"at rest {length_text(abs(e))} from the target for good"
+        elif integrates(params):
+            word, why = "stuck", (f"at rest {length_text(abs(e))} from the target with the drive "
+                                  f"at its {params.force_limit:.3g} N force limit")
+        else:
+            word, why = "rests", (f"at rest {length_text(abs(e))} from the target (no "
+                                  "integrator to pull it in)")
+        return MoveRun(MoveOutcome(distance, label, word, e, None, None, elapsed, why), None, 0,
+                    level)
+    if out.stop == "match":
+        seen = owner[out.period_crossings]
+        m = seen.outcome
+        why = (f"a sustained cycle: {m.amplitude * 1e3:.3g} mm peak to peak"
+               + (f", period {m.period:.3g} s" if m.period else "")
+               + f" (enters the cycle of the {length_text(abs(m.distance))} move)")
+        return MoveRun(MoveOutcome(distance, label, "hunts", float(out.crossing_states[-1][0]
+                                                                  - level),
+                                m.amplitude, m.period, elapsed, why),
+                    seen.section_state, seen.crossings, seen.level, seen.cycle_states)
+    if out.stop in ("repeat", "crossings") or (out.stop == "end" and n >= 4):
+        q = out.period_crossings if out.stop == "repeat" else guess_period(out.crossing_states)
+        q = max(1, min(q, n - 1)) if n > 1 else 1
+        period = float(out.crossing_times[-1] - out.crossing_times[-1 - q]) if n > q else None
+        ext = out.crossing_extremes[-q:]
+        amp = float(np.max(ext[:, 1]) - np.min(ext[:, 0])) if len(ext) else None
+        how = {"repeat": "repeats at the section", "crossings": "keeps crossing the target",
+               "end": "keeps crossing the target"}[out.stop]
+        why = (f"a sustained cycle: {amp * 1e3:.3g} mm peak to peak"
+               + (f", period {period:.3g} s" if period else "") + f" ({how})")
+        return MoveRun(MoveOutcome(distance, label, "hunts", float(out.crossing_states[-1][0]
+                                                                  - level),
+                                amp, period, elapsed, why),
+                    np.array(out.crossing_states[-1]), q, level,
+                    _relative(params, out.crossing_states[-q:], level)
+                    if out.stop == "repeat" else None)
+    if (rested_at is not None and out.stop == "end" and n == 0 and abs(e) <= w.band
+            and t_end - rested_at <= w.quiet):
+        # at rest inside the band, and still inside it at the horizon, too soon after for
+        # another quiet time and without a crossing: the cart creeps with its force at the
+        # static friction (not at rest for good by the static balance, but nothing breaks
+        # it loose within the horizon)
+        why = (f"within the band for the rest of the {w.horizon:.3g} s horizon, "
+               f"{length_text(abs(e))} from the target; the cart creeps at its static friction")
+        return MoveRun(MoveOutcome(distance, label, "settles", e, None, None, elapsed, why), None,
+                    0, level)
+    if abs(e) > w.band:
+        word = "stuck" if integrates(params) else "rests"
+        why = (f"{length_text(abs(e))} from the target after {elapsed:.3g} s, neither at rest "
+               "there for good nor cycling")
+        return MoveRun(MoveOutcome(distance, label, word, e, None, None, elapsed, why), None, 0,
+                    level)
+    return MoveRun(MoveOutcome(distance, label, "undetermined", e, None, None, elapsed,
+                            f"neither at rest for good nor in a cycle after {elapsed:.3g} s "
+                            "(raise requirements.hunting.horizon)"), None, 0, level)
+
+
+def guess_period(states: np.ndarray, max_period: int = 4) -> int:
+    """Crossings per period of a cycle that has not repeated within tolerance yet.
+
+    Parameters
+    ----------
+    states : ndarray, shape (m, n)
+        The section states of the run, in order (SI).
+    max_period : int
+        Most crossings per period considered.
+
+    Returns
+    -------
+    int
+        The period, in crossings, whose states come back closest (relative to
+        their spread).
+    """
+    n = len(states)
+    if n < 3:
+        return 1
+    best, score = 1, math.inf
+    scale = np.maximum(np.ptp(states, axis=0), 1e-300)
+    for q in range(1, min(max_period, n - 1) + 1):
+        s = float(np.max(np.abs(states[-1] - states[-1 - q]) / scale))
+        if s < score - 1e-12:
+            best, score = q, s
+    return best
