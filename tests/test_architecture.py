@@ -149,7 +149,8 @@ def test_no_module_is_over_800_lines_but_the_integrator():
 
 #: Packages whose modules use each other through public names only (a private name is a
 #: module's own business: what a sibling needs is named without the underscore).
-SEALED_PACKAGES = ("stage",)
+SEALED_PACKAGES = ("stage", "guideline", "loop", "controller", "simulation", "spec", "cli", "mechanism",
+                   "recommend", "studies", "results", "plots", "console", "report")
 
 
 def _private_imports(source: str, module: str, package: str, *,
@@ -217,8 +218,8 @@ def test_the_private_name_check_finds_each_form():
 
 @pytest.mark.parametrize("package", SEALED_PACKAGES)
 def test_no_module_imports_a_private_name_of_its_package(package):
-    """stage/ imported six private helpers across its modules (cycle.py from moves.py, judge.py
-    from both); each module now offers what the others use under a public name."""
+    """A package's modules use each other through public names only (stage/ once imported six
+    private helpers across its modules); each offers what the others use under a public name."""
     folder = ROOT / "fi_design" / package
     bad = {}
     for path in sorted(folder.rglob("*.py")):
@@ -229,3 +230,15 @@ def test_no_module_imports_a_private_name_of_its_package(package):
         if found:
             bad[str(path.relative_to(ROOT))] = found
     assert not bad, bad
+
+
+def test_tests_mirror_the_packages():
+    """Each folder of tests/ is named after a package of fi_design, and the tests of the
+    top level (the architecture, the model, the docs, the examples) stay at the top."""
+    folders = {p.name for p in (ROOT / "tests").iterdir()
+               if p.is_dir() and any(p.glob("test_*.py"))}
+    packages = {p.parent.name for p in (ROOT / "fi_design").glob("*/__init__.py")}
+    assert folders, "no test folders"
+    assert folders <= packages, sorted(folders - packages)
+    top = sorted(p.name for p in (ROOT / "tests").glob("test_*.py"))
+    assert len(top) <= 8, top

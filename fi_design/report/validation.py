@@ -55,35 +55,35 @@ VALIDATIONS = (
         "equations",
         "The fast RODAS4 kernel follows it on the paper setup, with and without the isolator: "
         "position within 5 \u00b5m, force within 0.05 N, the same hunting count and verdict.",
-        "tests/test_simulation.py::test_fast_path_agrees_with_reference", ("5e-6", "0.05")),
+        "tests/simulation/test_simulation.py::test_fast_path_agrees_with_reference", ("5e-6", "0.05")),
     Validation(
         "independent solver", "an independent transcription of the equations integrated by "
         "solve_ivp (tests/independent.py), itself tested against analytic answers only",
         "A 20 mm move of the paper setup run for 30 s ends on the cycle the tool converges by "
         "Newton's method: period within 0.02 %, peak to peak within 0.1 %, and the "
         "convergence of the periods gives its Floquet multiplier within 0.05.",
-        "tests/test_stage.py::test_paper_cycle_agrees_with_a_long_independent_simulation",
+        "tests/stage/test_stage.py::test_paper_cycle_agrees_with_a_long_independent_simulation",
         ("rel=2e-4", "rel=1e-3", "abs=0.05")),
     Validation(
         "independent solver", "the same independent simulator on both sides of the fold",
         "Just below the fold (11.2 Hz) the 0.408 mm move hunts there too; above it (11.5 Hz) "
         "it settles: the fold the tool bisects is where the independent simulation changes "
         "its answer.",
-        "tests/test_stage.py::test_moves_hunting_just_below_the_fold_hunt_in_the_independent_"
+        "tests/stage/test_stage.py::test_moves_hunting_just_below_the_fold_hunt_in_the_independent_"
         "simulator", ("11.2", "11.5")),
     Validation(
         "published case", "Canudas de Wit et al. (1995), a unit mass under PID "
         "(u = 3 e + 4 \u222be \u2212 6 v) with LuGre friction (Fs 1.5 N, Fc 1 N)",
         "The tool finds the published hunting cycle: period 24.4 s (within 0.05 s) and "
         "127.8 mm peak to peak (within 0.5 mm), stable.",
-        "tests/test_stage.py::test_canudas_de_wit_1995_pid_example_hunts_with_its_published_"
+        "tests/stage/test_stage.py::test_canudas_de_wit_1995_pid_example_hunts_with_its_published_"
         "cycle", ("24.4", "0.1278")),
     Validation(
         "independent solver", "a separate computation of the paper setup's cycle without "
         "isolator (shooting and pseudo-arclength continuation in scipy)",
         "The cycle at 8 Hz (period 2.063 s, 1.357 mm, multiplier 0.542) and its fold at "
         "24.53 Hz (within 0.05 Hz) agree.",
-        "tests/test_stage.py::test_without_isolator_the_cycle_lives_to_its_fold_near_24_5_hz",
+        "tests/stage/test_stage.py::test_without_isolator_the_cycle_lives_to_its_fold_near_24_5_hz",
         ("2.063", "1.357e-3", "24.53")),
     Validation(
         "real record", "the EMPS record, a real ball-screw axis under its own PD loop (not "
@@ -91,24 +91,24 @@ VALIDATIONS = (
         "With the documented controller and the mass and friction the tool identifies from "
         "the record, the closed-loop replay reproduces the measured position within 20 \u00b5m "
         "rms and the tracking error within 10 %.",
-        "tests/test_replay.py::test_emps_closed_loop_replay_reproduces_the_measurement",
+        "tests/simulation/test_replay.py::test_emps_closed_loop_replay_reproduces_the_measurement",
         ("20e-6", "rel=0.10")),
     Validation(
         "real record", "the EMPS record split in halves",
         "Friction and mass identified on one half predict the other half's force within "
         "3.5 % relative error.",
-        "tests/test_identify.py::test_emps_cross_validation_between_halves", ("0.035",)),
+        "tests/identification/test_identify.py::test_emps_cross_validation_between_halves", ("0.035",)),
     Validation(
         "finite-element model", "a beam finite-element model of the leaf-spring guide "
         "(pyfe3d, geometric stiffness, modal and buckling analysis) over six geometries",
         "The closed forms the design uses give the six stiffnesses and the stage's six modes "
         "within 5 % and the buckling factor within 10 %.",
-        "tests/test_mechanism.py::test_closed_forms_hold_against_the_fe_model",
+        "tests/mechanism/test_mechanism.py::test_closed_forms_hold_against_the_fe_model",
         ("rel=0.05", "rel=0.10")),
     Validation(
         "hand derivation", "transfer functions of the four limit cases derived by hand",
         "The loop models of step 2 equal them at every test frequency, near the modes too.",
-        "tests/test_linear.py::test_paper_cases_equal_hand_derived_transfer_functions"),
+        "tests/loop/test_linear.py::test_paper_cases_equal_hand_derived_transfer_functions"),
 )
 
 

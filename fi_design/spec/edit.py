@@ -161,10 +161,10 @@ def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
     else:
         lines.append("(written anew from the spec's data: it was not read from a file, so "
                      "there are no comments to keep)")
-        from .file import _plain
+        from .file import plain
 
         raw = org.raw if org is not None else spec.model_dump(mode="json", exclude_none=True)
-        document = _commented(_plain(raw))
+        document = _commented(plain(raw))
         yaml.indent(mapping=2, sequence=4, offset=2)
     for path, value in (values or {}).items():
         parent, key = _parent(document, path)

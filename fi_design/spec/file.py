@@ -126,7 +126,7 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
         message names the field path and line.
     """
     if isinstance(source, Mapping):
-        raw = _plain(source)
+        raw = plain(source)
         digest = hashlib.sha256(json.dumps(raw, sort_keys=True, default=str).encode()).hexdigest()
         return _validate(raw, SpecOrigin(None, digest, raw))
     path = Path(source)
@@ -267,7 +267,7 @@ def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, Any]:
         kind = "a list" if isinstance(document, list) else f"a {type(document).__name__}"
         raise SpecError(f"the top level must be a mapping of sections (name, stage, cart, ...), "
                         f"got {kind}", line=1, source=source)
-    return _plain(document), document
+    return plain(document), document
 
 
 def _count_nodes(node, source: str) -> None:
@@ -335,12 +335,12 @@ def _check_nodes(node, loc: tuple, source: str, seen: set | None = None) -> None
             _check_nodes(item, loc + (i,), source, seen)
 
 
-def _plain(obj: Any) -> Any:
+def plain(obj: Any) -> Any:
     """Plain Python data: dict, list, str, int, float, bool, None (ruamel's scalar types too)."""
     if isinstance(obj, Mapping):
-        return {str(k): _plain(v) for k, v in obj.items()}
+        return {str(k): plain(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
+        return [plain(v) for v in obj]
     if isinstance(obj, bool) or obj is None:
         return obj
     if isinstance(obj, str):

@@ -1,6 +1,6 @@
 """The isolator as a mechanism: the closed forms against analytic limits and published figures.
 
-The finite-element check of the same closed forms is in tests/test_mechanism_fe.py.
+The finite-element check of the same closed forms is in tests/mechanism/test_mechanism_fe.py.
 """
 
 from __future__ import annotations

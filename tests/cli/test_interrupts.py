@@ -1,7 +1,7 @@
 """Interrupts: never lost, never turned into another error, never cutting a held step in two.
 
 Each case reproduces in one process a window an adversarial run found by sending SIGINT to
-`fi-design sweep` at random instants (the same, at many instants, is in tests/test_pools.py).
+`fi-design sweep` at random instants (the same, at many instants, is in tests/cli/test_pools.py).
 """
 
 from __future__ import annotations

@@ -271,7 +271,7 @@ def test_report_of_a_structural_gap_says_so_first(diverging, tmp_path):
 @pytest.mark.slow
 def test_open_loop_noise_only_record_answers_none(outcome):
     """Slow (about 90 s): the default run keeps the closed-loop noise-only controls
-    (tests/test_reconciliation.py) and the real record's open-loop reconciliation."""
+    (tests/reconciliation/test_reconciliation.py) and the real record's open-loop reconciliation."""
     _, result = outcome("noise-only-iso", "force")
     assert result.drive == "force"
     assert result.effect == "none", _ranking(result)
@@ -283,7 +283,7 @@ def test_cli_open_loop_names_a_hidden_effect(tmp_path):
     """``fi-design reconcile --drive force`` on a record with friction varying along the rail.
 
     Slow (about two minutes): the default run reconciles the real record in open loop
-    (tests/test_reconciliation_emps.py)."""
+    (tests/reconciliation/test_reconciliation_emps.py)."""
     import json
 
     from typer.testing import CliRunner

@@ -8,7 +8,7 @@ noise (``excess`` = chi2 / n - 1) shrinks by at least half. Controls (noise
 only, a hunting trace with noise) must answer ``none``.
 
 These records come from the product's own kernel; the independent simulator's
-records (tests/test_reconciliation_independent.py) are the real test, so the
+records (tests/reconciliation/test_reconciliation_independent.py) are the real test, so the
 default run keeps two effects and the controls here, and ``-m slow`` adds every
 other effect on both plants, more magnitudes, moves, crossovers and seeds. ``joint_damping`` has no
 non-isolated case: without an isolator there is no joint (the candidate is

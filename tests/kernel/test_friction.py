@@ -7,7 +7,7 @@
   dz/dt = v - sigma0 |v| z / g(v) (with g(v) <= Fs) points inward, and a stage started from
   rest never leaves it.
 
-(k_max = Fs / stroke scaling is a hypothesis test of the guideline: tests/test_guideline.py.)
+(k_max = Fs / stroke scaling is a hypothesis test of the guideline: tests/guideline/test_guideline.py.)
 """
 
 from __future__ import annotations
