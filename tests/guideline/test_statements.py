@@ -400,9 +400,9 @@ def test_step_1_below_its_threshold_beside_a_hunting_stage_is_no_pass():
     from fi_design.guideline.steps import friction_gap_judged, step1_friction_gap
     from fi_design.stage import stage_hunting
 
-    from test_stage import _canudas_spec
+    from published import canudas_spec
 
-    spec = _canudas_spec()
+    spec = canudas_spec()
     before = step1_friction_gap(spec)
     assert before.checks[0].status.value == "PASS"      # the rule alone
     st = stage_hunting(spec, False, family=[1.0], boundary=False)

@@ -18,6 +18,8 @@ from fi_design.kernel.layout import MODE_SIGN
 from fi_design.trajectory import from_moves
 from fi_design.model import resolve
 
+from conftest import ROOT
+
 
 @pytest.mark.parametrize("isolated", [True, False])
 def test_structured_solve_equals_dense_solve(paper_spec, isolated):
@@ -176,8 +178,7 @@ def test_the_installed_kernel_is_the_ahead_of_time_build_of_these_sources():
                           "from fi_design.simulation.run import simulate; "
                           "r = simulate(load_spec(sys.argv[1]), isolated=False); "
                           "print(r.metrics.hunting_cycles, 'numba' in sys.modules)",
-                          str(os.path.join(os.path.dirname(__file__), "..", "examples",
-                                           "paper_setup.yaml"))],
+                          str(ROOT / "examples" / "paper_setup.yaml")],
                          check=True, capture_output=True, text=True)
     assert out.stdout.split() == ["5", "False"]
 
@@ -193,8 +194,8 @@ def test_the_jit_build_of_the_same_source_agrees(paper_spec, tmp_path):
             "np.save(sys.argv[2], np.array([simulate(s, isolated=i).position for i in (True, "
             "False)])); print(build.backend())")
     env = dict(os.environ, FI_DESIGN_KERNEL="jit")
-    out = subprocess.run([sys.executable, "-c", code, str(os.path.join(
-        os.path.dirname(__file__), "..", "examples", "paper_setup.yaml")),
+    out = subprocess.run([sys.executable, "-c", code, str(
+        ROOT / "examples" / "paper_setup.yaml"),
         str(tmp_path / "jit.npy")], env=env, check=True, capture_output=True, text=True)
     assert out.stdout.strip() == "jit"
     jit = np.load(tmp_path / "jit.npy")

@@ -9,13 +9,13 @@ dense move scan for the boundary.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
 from fi_design.stage import (converge_cycle, family_distances, rest_is_final, stage_hunting,
                              stage_hunts)
+
+from published import canudas_spec
 
 #: The paper setup (isolated, 8 Hz): its independent-simulator parameters.
 PAPER = dict(m1=1.6, m2=0.4, friction=dict(Fs=4.0, Fc=1.0, vs=3e-3, sigma0=1e6, sigma1=1414.0,
@@ -27,22 +27,6 @@ PAPER = dict(m1=1.6, m2=0.4, friction=dict(Fs=4.0, Fc=1.0, vs=3e-3, sigma0=1e6, 
 def paper_isolated(paper_spec):
     """The stage-level answer of the paper setup's isolated plant at 8 Hz."""
     return stage_hunting(paper_spec, True)
-
-
-def _canudas_spec(model: str = "lugre", hunting: dict | None = None, duration: str = "20 s"):
-    from fi_design.specfile import load_spec
-
-    return load_spec({
-        "name": "Canudas de Wit et al. 1995, unit mass under PID",
-        "stage": {"mass": "0.5 kg"}, "cart": {"mass": "0.5 kg"},
-        "friction": {"model": model, "static": "1.5 N", "coulomb": "1 N", "stribeck_velocity": "1 mm/s",
-                     "viscous": "0.4 N*s/m", "bristle_stiffness": "1e5 N/m",
-                     "bristle_damping": f"{math.sqrt(1e5)} N*s/m"},
-        "controller": {"gains": {"kp": "3 N/m", "ki": "4 N/(m*s)", "kd": "6 N*s/m"},
-                       "derivative_on": "measurement"},
-        "motion": {"moves": [{"distance": "1 m", "velocity": "1 m/s",
-                              "acceleration": "10 m/s^2"}], "duration": duration},
-        "requirements": {"hunting": {"horizon": "1000 s", **(hunting or {})}}})
 
 
 def _upward_crossings(t, e):
@@ -146,7 +130,7 @@ def test_without_isolator_the_cycle_lives_to_its_fold_near_24_5_hz(paper_spec):
 
 def test_canudas_de_wit_1995_pid_example_hunts_with_its_published_cycle():
     """Canudas de Wit et al. (1995), u = 3 e + 4 int e - 6 v on a unit mass: 24.4 s, 127.8 mm."""
-    spec = _canudas_spec()
+    spec = canudas_spec()
     st = stage_hunting(spec, False, family=[1.0], boundary=False)
     assert all(m.hunts for m in st.moves)
     c = st.cycle
@@ -167,8 +151,8 @@ def test_canudas_de_wit_1995_switch_model_counts_one_peak_per_stick_plateau():
     from fi_design.simulation.run import simulate
 
     window = {"window_start": "100 s", "window_length": "100 s"}
-    m = simulate(_canudas_spec("switch", window, "200 s"), False).metrics
-    cycle = stage_hunting(_canudas_spec("switch"), False, family=[1.0], boundary=False).cycle
+    m = simulate(canudas_spec("switch", window, "200 s"), False).metrics
+    cycle = stage_hunting(canudas_spec("switch"), False, family=[1.0], boundary=False).cycle
     assert cycle.period == pytest.approx(23.73, abs=0.05)
     assert m.verdict == "hunting" and m.hunting_cycles == 4
     assert m.period == pytest.approx(cycle.period, rel=2e-3)
@@ -181,7 +165,7 @@ def test_a_multiplier_the_two_perturbations_disagree_on_is_not_reported(paper_sp
     stick event: the multiplier reads 1.14 at one perturbation and 0.51 at ten times it.
     Four moves end in the cycle, so it attracts; the multiplier is not reported. At Fc
     3.02 N the two agree (0.48) and the cycle is stable by its multiplier."""
-    from fi_design.specfile import with_values
+    from fi_design.spec.file import with_values
 
     st = stage_hunting(with_values(paper_spec, {"friction.coulomb": 3.0}), False,
                        boundary=False)
@@ -217,7 +201,7 @@ def test_a_stage_creeping_at_its_static_friction_inside_the_band_settles(paper_s
     the cart at its static friction, so the rest is not final by the static balance; the
     cart creeps and never leaves the band. Such a move settles (it was 'undetermined'), and a
     horizon four times longer finds the same."""
-    from fi_design.specfile import with_values
+    from fi_design.spec.file import with_values
 
     point = with_values(paper_spec, {
         "controller.crossover": 11.0, "friction.static": 4.138233676825914,
