@@ -29,7 +29,7 @@ from ..display import quantity
 from ..errors import ArgumentError, FiDesignError, SpecError
 from ..execution import Executor, chunks, run_chunks
 from ..results import frozen_array
-from ..results.studies import PointResult, RunInfo, spec_digest
+from ..results.studies import PointResult, RunInfo
 from ..spec.file import with_values
 from .cache import METHOD, PointCache, open_cache, point_key
 
@@ -295,7 +295,7 @@ def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | No
     outcomes: list[dict | None] = [None] * n
     keys: list[str] = []
     if store is not None:
-        shash = spec_digest(spec)
+        shash = spec.content_sha256()
         keys = [point_key(shash, values, iso, measure) for values, iso in tasks]
         hits = store.get_many(keys)
         for i, k in enumerate(keys):
