@@ -216,7 +216,7 @@ def _attach(text: str, shown: str, sep: str) -> str:
 
 
 def quantity(value: Any, unit: str = "", digits: int = 4, *, sep: str = " ",
-             shown: tuple[str, float] | None = None) -> str:
+             shown: tuple[str, float] | None = None, joiner: str = " \u2013 ") -> str:
     """A value with its unit, converted from SI for reading: ``quantity(3e-4, "m")`` -> ``0.3 mm``.
 
     Parameters
@@ -233,6 +233,9 @@ def quantity(value: Any, unit: str = "", digits: int = 4, *, sep: str = " ",
     shown : (str, float), optional
         The unit and factor to use (from :func:`scale`, for values read
         together); default picked by the value.
+    joiner : str, optional
+        Between the values of a sequence: an en dash (default), ``" to "`` for a
+        range in a sentence, ``" x "`` for dimensions.
 
     Returns
     -------
@@ -243,13 +246,17 @@ def quantity(value: Any, unit: str = "", digits: int = 4, *, sep: str = " ",
     --------
     >>> quantity(3e-4, "m"), quantity(22e-6, "m"), quantity(2e11, "Pa"), quantity(47.31, "deg")
     ('0.3 mm', '22 µm', '200 GPa', '47.31°')
+    >>> quantity((396e-6, 0.05), "m", 3, joiner=" to ")
+    '0.396 to 50 mm'
+    >>> quantity((0.04, 0.01, 5e-4), "m", 3, joiner=" x ")
+    '40 x 10 x 0.5 mm'
     """
     if isinstance(value, (list, tuple)):
         if not value:
             return "\u2013"
         unit_shown, factor = shown or scale(unit, value)
         parts = [number(v * factor if _is_number(v) else v, digits) for v in value]
-        return _attach(" \u2013 ".join(parts), unit_shown, sep)
+        return _attach(joiner.join(parts), unit_shown, sep)
     if value is None or isinstance(value, (str, bool)):
         return number(value, digits)
     if unit == "m" and shown is None and 0 < abs(value) < _SUB_NANO:

@@ -18,6 +18,11 @@ therefore records three things:
   source tree and the wheel built from it give the same digest. The digest is
   the SHA-256 of the lines ``PATH<NUL>SHA256-OF-THE-FILE<LF>`` in path order.
 
+:func:`header` is the provenance every JSON result opens with
+(``fi_design_version``, ``fi_design_source`` and, for a result of one spec,
+``spec_sha256``), :func:`json_sha256` the one digest of JSON data (the spec
+hashes itself with it: :meth:`fi_design.spec.Spec.sha256`).
+
 Nothing here imports the rest of the package: every layer may record its source.
 """
 
@@ -25,13 +30,15 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import json
 import os
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-__all__ = ["Source", "current_source", "code_digest", "code_files", "git_commit",
-           "CODE_SUFFIXES"]
+__all__ = ["Source", "current_source", "code_digest", "code_files", "git_commit", "header",
+           "json_sha256", "CODE_SUFFIXES"]
 
 #: Files of the package that make up its code (the compiled kernel is built from them).
 CODE_SUFFIXES = (".py", ".yaml", ".jinja", ".css")
@@ -97,6 +104,51 @@ class Source:
         if self.commit is None:
             return f"code {self.code_sha256[:12]}"
         return f"commit {self.commit[:12]}" + ("+modified" if self.modified else "")
+
+
+def json_sha256(data: Any) -> str:
+    """SHA-256 of JSON data in canonical form (keys sorted, ``str`` for what JSON lacks).
+
+    Parameters
+    ----------
+    data : dict, list or scalar
+        Plain data.
+
+    Returns
+    -------
+    str
+        Hex digest; equal for equal data whatever its key order.
+    """
+    return hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def header(version: str | None = None, source: Source | None = None,
+           spec: Any = None) -> dict:
+    """The provenance a JSON result writes: which code made it, from which spec.
+
+    Parameters
+    ----------
+    version : str, optional
+        The fi_design version that made the result; default this one.
+    source : Source, optional
+        The code that made it; default :func:`current_source`.
+    spec : fi_design.spec.Spec or str, optional
+        The spec of a result of one spec, or its digest taken when the result was
+        made; its :meth:`~fi_design.spec.Spec.sha256` is written as ``spec_sha256``.
+
+    Returns
+    -------
+    dict
+        ``fi_design_version``, ``fi_design_source`` (:meth:`Source.to_dict`) and,
+        with a spec, ``spec_sha256``.
+    """
+    if version is None:
+        from . import __version__ as version
+    out = {"fi_design_version": version,
+           "fi_design_source": (source if source is not None else current_source()).to_dict()}
+    if spec is not None:
+        out["spec_sha256"] = spec if isinstance(spec, str) else spec.sha256()
+    return out
 
 
 def _templates(package: Path) -> Path | None:

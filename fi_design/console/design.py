@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..display import number, percent, quantity
+from ..display import number, percent, quantity, with_error
 from ..results.stage import STATIC_ERROR_FORMULA
 from .common import heading, status_text, table
 from .confirmation import moves_strips, simulation_table
@@ -137,7 +137,7 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     stiff = data.get("stiffness") or {}
     if stiff.get("maximum") is not None:
         if stiff.get("suggested"):
-            text = (f"Drive stiffness by the rule for a {number(1e3 * stiff['stroke'], 3)} mm "
+            text = (f"Drive stiffness by the rule for a {quantity(stiff['stroke'], 'm', 3)} "
                     f"stroke (no isolator in the spec): k_max = {number(stiff['maximum'])} N/m, "
                     f"k = k_max / 2 = {number(stiff.get('chosen'))} N/m")
         else:
@@ -346,8 +346,8 @@ def print_verdict(console: "Console", result) -> None:
             items.append(f"k_max / k = {mar.stiffness_factor:.3g}")
         if mar.stiffness_range is not None:
             lo, hi = mar.stiffness_range
-            items.append(f"k {lo:.4g}-{hi:.4g} N/m for t = {1e3 * mar.thickness:.3g} \u00b1 "
-                         f"{1e3 * mar.thickness_tolerance:.2g} mm")
+            items.append(f"k {lo:.4g}-{hi:.4g} N/m for t = "
+                         f"{with_error(mar.thickness, mar.thickness_tolerance, 'm', 3, 2)}")
         if mar.static_error is not None:
             items.append(f"static error {quantity(mar.static_error, 'm', 3)} of "
                          f"{quantity(mar.static_error_bound, 'm', 3)} {STATIC_ERROR_FORMULA}")

@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional
 
-from ..display import axis_unit, number
+from ..display import axis_unit, number, quantity
 from .common import heading, table
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -270,7 +270,7 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
     if result.position_friction is not None:
         pf = result.position_friction
         console.print(Text(f"position-dependent friction: amplitude {100 * pf.amplitude:.3g} %, "
-                           f"wavelength {pf.wavelength * 1e3:.4g} mm, random phase"))
+                           f"wavelength {quantity(pf.wavelength, 'm', 4)}, random phase"))
     conf = result.not_isolated.confidence
     t = table(f"Probability of hunting, {result.samples} samples, seed {result.seed}")
     plants = [(label, p) for label, p in (("with isolator", result.isolated),

@@ -12,7 +12,6 @@ contract of ``fi-design SPEC.yaml --json``. The sign-off
 
 from __future__ import annotations
 
-import hashlib
 import logging
 import math
 from dataclasses import replace
@@ -45,14 +44,6 @@ def _g(x: float | None, digits: int = 4) -> str:
     return number(x, digits)
 
 
-
-def _sha256(spec: Spec) -> str:
-    from ..spec.file import origin
-
-    org = origin(spec)
-    if org is not None:
-        return org.sha256
-    return hashlib.sha256(spec.model_dump_json().encode()).hexdigest()
 
 
 def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bool = True,
@@ -165,7 +156,7 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
         loop=loop_responses(model, xo), isolator_advice=advice, checks=checks,
         warnings=tuple(warnings_for(spec)),
         conclusion=_conclusion(model, gap, xo, st, fx, pid, advice, checks),
-        fi_design_version=__version__, spec_sha256=_sha256(spec), simulation=None,
+        fi_design_version=__version__, spec_sha256=spec.sha256(), simulation=None,
         model=model, flexure_fe=fe)
     sim = study = None
     if confirm:

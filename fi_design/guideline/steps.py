@@ -281,7 +281,7 @@ def step3_stiffness(model: Model | Spec) -> StiffnessResult:
         s = SUGGESTED_STROKE
         kmax = stiffness_limit(spec, s)
         k = proposed_stiffness(spec, s)
-        msg = (f"no isolator in the spec; for a {s * 1e3:.3g} mm stroke (the paper's) the rule "
+        msg = (f"no isolator in the spec; for a {quantity(s, 'm', 3)} stroke (the paper's) the rule "
                f"gives k_max = {_g(kmax)} N/m and k = k_max / 2 = {_g(k)} N/m: the isolator "
                "simulated beside the stage for comparison")
         check = Check("drive_stiffness", None, k, kmax, "N/m", msg, step=step)
@@ -483,7 +483,7 @@ def isolator_advice(model: Model | Spec, gap: FrictionGapResult, crossover: Cros
     model = as_model(model)
     s, k = suggested_isolator(model)
     kmax = stiffness_limit(model.spec, s)
-    rule = (f"the rule's first isolator (a {s * 1e3:.3g} mm stroke, the paper's, and k = {_g(k)} "
+    rule = (f"the rule's first isolator (a {quantity(s, 'm', 3)} stroke, the paper's, and k = {_g(k)} "
             f"N/m = Fs / (2 x stroke); k_max = {_g(kmax)} N/m)")
     if simulation is not None:
         from .verdict import simulated_isolator_advice

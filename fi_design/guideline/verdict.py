@@ -239,7 +239,7 @@ def _scatter_words(r: RobustnessCheck) -> str:
         parts = [f"+-{100 * v:.3g} % on {names.get(k, k)}" for k, v in r.scatter.items()]
     if r.ripple is not None:
         parts.append(f"a {100 * r.ripple['amplitude']:.3g} % ripple every "
-                     f"{r.ripple['wavelength'] * 1e3:.3g} mm along the rail")
+                     f"{quantity(r.ripple['wavelength'], 'm', 3)} along the rail")
     kind = "standard deviation" if r.distribution == "normal" else "uniform half-width"
     return f"{', '.join(parts)} ({r.distribution}, {kind}; {r.samples} samples)"
 
@@ -638,7 +638,7 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
         st = simulation.stage[own]
         c = st.cycle
         what += (f" ({len(st.hunting_moves)} of {len(st.moves)} moves"
-                 + (f", a {c.amplitude * 1e3:.3g} mm cycle of {c.period:.3g} s)" if c else ")"))
+                 + (f", a {quantity(c.amplitude, 'm', 3)} cycle of {c.period:.3g} s)" if c else ")"))
     steps = {c.name: c.step for c in checks}
     on = []
     for r in reasons:

@@ -173,6 +173,11 @@ class _Context:
         return g
 
 
+
+def _speed_range(speed: np.ndarray) -> str:
+    """The range of sliding speeds [m/s] of a selection, for a sentence (``0.2 to 1.5 mm/s``)."""
+    return quantity((float(speed.min()), float(speed.max())), "m/s", 3, joiner=" to ")
+
 def _kappa(level: _Fixed) -> _Fixed:
     """1 / Fs with its variance and covariance."""
     k = 1.0 / level.value
@@ -284,7 +289,7 @@ def _breakaway(ctx: _Context, event, vs: _Fixed | None):
         return _empty(base, f"its loading branch holds {len(idx)} samples "
                             f"({MIN_BRANCH_SAMPLES} needed): the force rose to the breakaway "
                             "within the filter's reach "
-                            f"({tr.reach / proc.sample_rate * 1e3:.3g} ms)"), None, None
+                            f"({quantity(tr.reach / proc.sample_rate, 's', 3, shown=('ms', 1e3))})"), None, None
     branch = Branch(idx, s)
     fit, keys = ctx.fit([branch], None, vs)
     kappa, sigma0, sigma1 = (float(x) for x in fit.x[:3])
@@ -337,7 +342,7 @@ def _static(ctx: _Context, events, form: str, vs: _Fixed | None, exc: Excitation
     if not use:
         if not events:
             why = (f"the record holds no breakaway after a stop (a rest of at least "
-                   f"{exc.dwell * 1e3:.3g} ms after sliding, followed by motion); it moves slower "
+                   f"{quantity(exc.dwell, 's', 3, shown=('ms', 1e3))} after sliding, followed by motion); it moves slower "
                    f"than the velocity threshold for {exc.low_speed_time:.3g} s in all without "
                    "stopping, passing through")
         else:
@@ -383,7 +388,7 @@ def _static(ctx: _Context, events, form: str, vs: _Fixed | None, exc: Excitation
                "is left out of the model) and the propagated error of the sliding friction, "
                f"{math.sqrt(var_prop):.2g} N, added; more breakaways would tighten it")
             + f". The force at the onsets, {peak:.4g} N, is not the estimate: the bearing "
-              f"already creeps there ({creep * 1e3:.3g} mm/s), where LuGre's friction is "
+              f"already creeps there ({quantity(creep, 'm/s', 3)}), where LuGre's friction is "
               "g(v) < Fs, and the filter smears the drop after it")
     if form == "per_direction":
         note += ("; per-direction form: the static friction of the positive direction, Fs + "
@@ -591,12 +596,12 @@ def _stribeck(ctx: _Context, level: _Fixed | None, relax):
         return sweep, Parameter(
             None, None, UNITS[name], False,
             f"not identifiable: {len(idx)} samples slide steadily below the velocity threshold "
-            f"at {speed.min() * 1e3:.3g} to {speed.max() * 1e3:.3g} mm/s, but "
+            f"at {_speed_range(speed)}, but "
             + "; ".join(problems) + f" (a fit gave {vs:.3g} m/s); {_EXPERIMENT[name]} would "
             "identify it"), None
     note = (f"steady-state Stribeck curve Fc + (Fs - Fc) exp(-(v/vs)^2) + viscous fitted to "
-            f"{len(idx)} samples sliding steadily at {speed.min() * 1e3:.3g} to "
-            f"{speed.max() * 1e3:.3g} mm/s ({below} below {STEADY_BELOW:g} vs, {above} above "
+            f"{len(idx)} samples sliding steadily at "
+            f"{_speed_range(speed)} ({below} below {STEADY_BELOW:g} vs, {above} above "
             f"{STEADY_ABOVE:g} vs; steady: the speed changing by less than {STEADY_RATE:.0%} "
             f"over the relaxation distance {quantity(relax, 'm', 3)}, {relax_from}), Fc fixed at the "
             "identified Coulomb friction and "

@@ -348,13 +348,13 @@ def _why(grid: GridMechanics, guide: LeafGuide, stroke: float, kmax: float, f_re
     sa = guide.allowed_stress
     if not ok_stress.any():
         least = float(grid.stress.min())
-        return (f"stress: every leaf within the bounds reaches at least {least / 1e6:.4g} MPa at "
-                f"{_mm(stroke)} stroke, above the allowed {sa / 1e6:.4g} MPa")
+        return (f"stress: every leaf within the bounds reaches at least {quantity(least, 'Pa', 4, shown=('MPa', 1e-6))} at "
+                f"{_mm(stroke)} stroke, above the allowed {quantity(sa, 'Pa', 4, shown=('MPa', 1e-6))}")
     sel = ok_stress
     if not (sel & ok_stiff).any():
         least = float(np.min(np.where(sel, grid.net, np.inf)))
         return (f"stiffness with stress: leaves thin and long enough for {_mm(stroke)} stroke "
-                f"within {sa / 1e6:.4g} MPa are at least {least:.4g} N/m stiff (net of "
+                f"within {quantity(sa, 'Pa', 4, shown=('MPa', 1e-6))} are at least {least:.4g} N/m stiff (net of "
                 f"gravity), above k_max = {kmax:.6g} N/m")
     sel = sel & ok_stiff
     if not (sel & ok_buckle).any():

@@ -11,6 +11,12 @@ from typing import Any
 import numpy as np
 
 from .figure import decimate, report_figure, styled
+from ..display import quantity
+
+
+def _micro(x: float) -> str:
+    """A band [m] as the zoomed axis reads it, in µm."""
+    return quantity(x, "m", 6, shown=("\u00b5m", 1e6))
 
 
 #: Colour of each simulated plant.
@@ -99,7 +105,7 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
         ax.set_ylabel("x1 - r [mm]")
         ax.text(m.window[0], 0.03, " counting window", transform=ax.get_xaxis_transform(),
                 va="bottom", ha="left", fontsize=7, color="0.35")
-        ax.text(0.03, h.min_height * 1e3, f"min. peak height {h.min_height * 1e3:g} mm",
+        ax.text(0.03, h.min_height * 1e3, f"min. peak height {quantity(h.min_height, 'm', 6, shown=('mm', 1e3))}",
                 transform=ax.get_yaxis_transform(), va="bottom", ha="left", fontsize=7,
                 color="0.35", bbox={"facecolor": "white", "alpha": 0.8, "lw": 0, "pad": 0.5})
         # the settling, in micrometres, after the motion
@@ -119,7 +125,7 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
         axz.text(0.98, 0.04, note, transform=axz.transAxes, ha="right", va="bottom",
                  fontsize=7, color="0.25",
                  bbox={"facecolor": "white", "alpha": 0.85, "lw": 0, "pad": 0.6})
-        axz.set_title(f"after the motion: \u00b1{band:g} \u00b5m settle band", loc="left",
+        axz.set_title(f"after the motion: \u00b1{_micro(h.settle_band)} settle band", loc="left",
                       fontsize=7.5)
         axz.set_ylabel("x1 - r [\u00b5m]")
     for ax in axes[-1]:
@@ -160,7 +166,7 @@ def deflection_figure(confirmation: Any, spec: Any) -> Any:
     if confirmation.landing is not None:
         land = confirmation.landing
         ax.plot([res.time[-1]], [land.deflection * 1e6], "o", color="black", ms=4,
-                label=f"at rest: {land.deflection * 1e6:.0f} µm")
+                label=f"at rest: {quantity(land.deflection, 'm', 3, shown=('µm', 1e6))}")
     ax.set_ylim(-1.35 * stroke * 1e6, 1.35 * stroke * 1e6)
     ax.set_xlim(0, float(res.time[-1]))
     ax.set_xlabel("time [s]")

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..display import number
+from ..display import number, quantity
 from .figure import report_figure, styled
 
 __all__ = ["guide_figure"]
@@ -24,6 +24,11 @@ _LEAF, _STAGE, _CART, _GRAVITY = "#2b6cb0", "#d9e2ec", "#9aa5b1", "#c53030"
 
 def _mm(x: float) -> float:
     return x * 1e3
+
+
+def _mm_text(x: float) -> str:
+    """A dimension [m] as the drawing's axes read it, in mm."""
+    return quantity(x, "m", 3, shown=("mm", 1e3))
 
 
 def _dim(ax, p0, p1, text: str, offset, *, vertical: bool = False) -> None:
@@ -108,11 +113,11 @@ def guide_figure(mech: Any, body_size: tuple[float, float, float] | None = None)
         side.plot([0.0], [zc - 0.15 * span], marker="X", ms=7, color=_GRAVITY)
         side.text(0.03 * span, zc - 0.15 * span, weight + ", into the page (along \u2212y)",
                   color=_GRAVITY, fontsize=7.5, va="center")
-    _dim(side, (0.5 * d, 0.0), (0.5 * d, sgn * L), f"L = {number(L, 3)} mm",
+    _dim(side, (0.5 * d, 0.0), (0.5 * d, sgn * L), f"L = {_mm_text(g.length)}",
          (0.5 * sx - 0.5 * d + 0.16 * span, 0.0), vertical=True)
-    _dim(side, (-0.5 * d, 0.0), (0.5 * d, 0.0), f"{number(d, 3)} mm",
+    _dim(side, (-0.5 * d, 0.0), (0.5 * d, 0.0), f"{_mm_text(g.spacing)}",
          (0.0, sgn * 0.45 * L))
-    side.text(0.0, sgn * 0.2 * L, f"t = {number(t, 3)} mm", ha="center", fontsize=7.0,
+    side.text(0.0, sgn * 0.2 * L, f"t = {_mm_text(g.thickness)}", ha="center", fontsize=7.0,
               va="center", bbox=dict(fc="white", ec="none", pad=0.3))
     side.set_aspect("equal")
     side.set_xlim(-0.5 * max(sx, d) - 0.25 * span, 0.5 * max(sx, d) + 0.3 * span)
@@ -130,7 +135,7 @@ def guide_figure(mech: Any, body_size: tuple[float, float, float] | None = None)
         top.add_patch(Rectangle((_mm(x) - 0.5 * tw, _mm(y) - 0.5 * b), tw, b, fc=_LEAF,
                                 ec=_LEAF))
     _dim(top, (0.5 * d, -0.5 * b + _mm(g.leaf_positions()[-1][1])),
-         (0.5 * d, 0.5 * b + _mm(g.leaf_positions()[-1][1])), f"b = {number(b, 3)} mm",
+         (0.5 * d, 0.5 * b + _mm(g.leaf_positions()[-1][1])), f"b = {_mm_text(g.width)}",
          (0.5 * sx - 0.5 * d + 0.12 * span, 0.0), vertical=True)
     top.plot([0.0], [0.0], marker="o", ms=4, mfc="white", mec="k")
     top.set_aspect("equal")

@@ -12,6 +12,7 @@ import numpy as np
 
 from .confirmation import PLANT_COLOURS, SETTLE_ZOOM, motion_end, plant_names
 from .figure import decimate, log_x, report_figure, styled
+from ..display import quantity
 
 
 #: Markers of the move outcomes: (marker, filled).
@@ -110,7 +111,7 @@ def cycle_figure(confirmation: Any, spec: Any) -> Any:
         tr = c.trace
         ax_p.plot(np.asarray(tr.error) * 1e3, np.asarray(tr.velocity) * 1e3,
                   color=PLANT_COLOURS[key], lw=1.1,
-                  label=f"{names[key]}: cycle of {c.amplitude * 1e3:.3g} mm, {c.period:.3g} s")
+                  label=f"{names[key]}: cycle of {quantity(c.amplitude, 'm', 3)}, {quantity(c.period, 's', 3)}")
     ax_p.axvline(0.0, color="0.6", lw=0.6)
     ax_p.set_xlabel("x1 - r [mm]")
     ax_p.set_ylabel("v1 [mm/s]")
@@ -147,7 +148,7 @@ def cycle_figure(confirmation: Any, spec: Any) -> Any:
     ax_s.set_xlim(t0, float(res.time[-1]))
     ax_s.set_xlabel("time [s]")
     ax_s.set_ylabel("x1 - r [µm]")
-    ax_s.set_title(f"spec's motion, ±{band:g} µm band", loc="left", fontsize=7.5)
+    ax_s.set_title(f"spec's motion, ±{quantity(h.settle_band, 'm', 6, shown=('µm', 1e6))} band", loc="left", fontsize=7.5)
     return fig
 
 

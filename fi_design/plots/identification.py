@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from ..display import quantity
 from .figure import report_figure, styled
 
 
@@ -68,7 +69,7 @@ def force_velocity_figure(result: Any) -> Any:
     ax.axvline(0.0, color="0.5", lw=0.6)
     ax.set_xlabel("velocity of the bearing side [mm/s]")
     ax.set_ylabel("force - mass x acceleration [N]")
-    ax.text(0.0, 1.0, f" |v| < {th:.3g} mm/s: left out", transform=ax.get_xaxis_transform(),
+    ax.text(0.0, 1.0, f" |v| < {quantity(result.processing.velocity_threshold, 'm/s', 3)}: left out", transform=ax.get_xaxis_transform(),
             ha="center", va="top", fontsize=7, color="0.35")
     ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3, borderaxespad=0.1,
               markerscale=4)

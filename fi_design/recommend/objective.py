@@ -30,6 +30,11 @@ _DISTANCE = {"feasible": 0, "robustness": 1, "reserve": 1, "checks": 2, "margin"
              "not_evaluated": 7, "failed": 8, None: 7}
 
 
+def _dimensions(c: Any) -> str:
+    """A leaf's length x width x thickness [m] in one unit: ``40 x 10 x 0.5 mm``."""
+    return quantity((c.length, c.width, c.thickness), "m", 3, joiner=" x ")
+
+
 def order(p: Any) -> tuple:
     """The objective as a sort key, larger is better: stiffness, then hunting margin."""
     m = p.margin if p.margin is not None else 0.0
@@ -120,7 +125,7 @@ def advice(search: Any, chosen: Any, feasible: bool, binding: tuple[str, ...],
     """One sentence a person acts on."""
     c = chosen.candidate
     if feasible:
-        text = (f"Build {c.length * 1e3:.3g} x {c.width * 1e3:.3g} x {c.thickness * 1e3:.3g} mm "
+        text = (f"Build {_dimensions(c)} "
                 f"leaves for a {quantity(chosen.stroke, 'm')} stroke (k = {chosen.stiffness:.4g}"
                 f" N/m with gravity)"
                 + (f" and tune the loop to {search.fc:.4g} Hz" if search.rule else "")

@@ -23,6 +23,7 @@ from typing import Any
 
 from .. import spec as _spec
 from ..spec.file import with_values
+from ..display import quantity
 
 __all__ = ["ASSUMED_FLEXURE", "STROKE_FLOOR", "STROKE_SPAN", "Candidate", "base_spec",
            "stroke_envelope", "damping_ratio"]
@@ -107,7 +108,7 @@ def stroke_envelope(base: _spec.Spec) -> tuple[float, float, str, str]:
     m = flex.material
     hi = float(stroke_limit(m.allowed_stress, m.youngs_modulus, t0, L1))
     return (STROKE_FLOOR, max(hi, STROKE_FLOOR),
-            f"the shortest stroke worth a limiter ({STROKE_FLOOR * 1e3:g} mm)",
+            f"the shortest stroke worth a limiter ({quantity(STROKE_FLOOR, 'm', 6)})",
             "the stress of the longest, thinnest leaf the flexure's bounds allow")
 
 

@@ -22,6 +22,7 @@ import numpy as np
 
 from .comparison import Comparison, ModelRun
 from ..results.reconciliation import Lattice, Signature
+from ..display import quantity
 
 
 class Line(NamedTuple):
@@ -168,7 +169,7 @@ def scan(cmp: Comparison, nominal: ModelRun, lattice: Lattice, params) -> Eviden
             add("spatial_period", ["position_dependent_friction", "force_ripple"], strength,
                 top.wavelength, "m",
                 f"the residual repeats along the travel with a period of "
-                f"{top.wavelength * 1e3:.4g} mm (amplitude {top.amplitude:.3g} {unit}, "
+                f"{quantity(top.wavelength, 'm', 4)} (amplitude {top.amplitude:.3g} {unit}, "
                 f"{top.ratio:.0f} x the median spectral power)")
     trend = fit_line(res[coh], x[coh] - x[0])
     add("position_trend", ["cable_force"], trend.r2, trend.slope, f"{unit}/m",
@@ -180,7 +181,7 @@ def scan(cmp: Comparison, nominal: ModelRun, lattice: Lattice, params) -> Eviden
     if use_force and move.sum() > 50:
         lag = force_lag(meas.force, nominal.force, cmp.t, max_lag=0.02)
         add("force_lag", ["time_delay"], lag.correlation if lag.lag > 0 else 0.0, lag.lag, "s",
-            f"the measured force lags the modelled one by {lag.lag * 1e3:.3g} ms "
+            f"the measured force lags the modelled one by {quantity(lag.lag, 's', 3, shown=('ms', 1e3))} "
             f"(correlation {lag.correlation:.2f})")
         if lag.lag > 0:
             guesses.setdefault("time_delay", []).append({"delay": lag.lag})

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..display import quantity
 from ..results.design import DesignResult
 from ..results.stage import STATIC_ERROR_FORMULA, length_range
 from ..results.studies import DesignMap
@@ -282,7 +283,8 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             (lambda: plots.cycle_figure(sim, spec)) if figures else None, "cycle",
             "The hunting cycles: phase portraits (left), the isolated stage's joint deflection "
             "over one period against its stroke (middle), and the settling after the spec's "
-            f"own motion in the \u00b1{num(h.settle_band * 1e6)} \u00b5m settle band (right).",
+            f"own motion in the \u00b1{quantity(h.settle_band, 'm', shown=('µm', 1e6))} settle band "
+            "(right).",
             fig_no()),
         "boundary": None if not any(st.boundary is not None and st.boundary.branch
                                     for st in sim.stage.values()) else figure_entry(

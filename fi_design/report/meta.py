@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import datetime as _dt
-import hashlib
 import os
 from typing import Any
 
@@ -88,10 +87,10 @@ def spec_file(spec: Any) -> dict:
     org = origin(spec)
     if org is None:
         return {"path": "(spec given in code)",
-                "sha256": hashlib.sha256(spec.model_dump_json().encode()).hexdigest(),
+                "sha256": spec.sha256(),
                 "raw": None, "text": None}
     path = str(org.path) if org.path is not None else "(spec given as a mapping)"
-    return {"path": path, "sha256": org.sha256, "raw": org.raw, "text": org.text}
+    return {"path": path, "sha256": spec.sha256(), "raw": org.raw, "text": org.text}
 
 
 def _yaml_text(raw: Any) -> str:

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from ..provenance import Source, current_source
+from ..provenance import Source, current_source, header
 from . import Check, Result, Status, to_jsonable
 from .confirmation import Confirmation, IsolatorAdvice, Landing, PlantVerdict
 from .mechanism import FeMechanics
@@ -175,9 +175,7 @@ class DesignResult(Result):
             "checks": [to_jsonable(c) for c in self.checks],
             "warnings": [{"path": p, "message": m} for p, m in self.warnings],
             "conclusion": self.conclusion,
-            "fi_design_version": self.fi_design_version,
-            "fi_design_source": self.fi_design_source.to_dict(),
-            "spec_sha256": self.spec_sha256,
+            **header(self.fi_design_version, self.fi_design_source, self.spec_sha256),
         }
         if self.simulation is not None:
             out["simulation"] = to_jsonable(self.simulation)

@@ -540,8 +540,7 @@ class IdentificationResult:
 
     def to_dict(self) -> dict:
         """Plain JSON data: ``parameters``, ``fit`` (docs/interfaces.md) and the context."""
-        from .. import __version__
-        from ..provenance import current_source
+        from ..provenance import header
 
         return {
             "parameters": {k: p.to_dict() for k, p in self.parameters.items()},
@@ -555,8 +554,7 @@ class IdentificationResult:
             "dynamic": self.dynamic.to_dict(),
             "notes": list(self.notes),
             "measurement": self.measurement.to_dict(),
-            "fi_design_version": __version__,
-            "fi_design_source": current_source().to_dict(),
+            **header(),
         }
 
 

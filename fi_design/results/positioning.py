@@ -4,7 +4,7 @@ Produced by :func:`fi_design.stage.positioning`. ``requirements.positioning``
 asks what the stage is for: after every move of its family, to be within a
 band of its target within a settle time and to rest within a static error. A
 stage that never hunts can still fail it (a loop without integrator resting
-15 um off its target, a slow settling).
+15 µm off its target, a slow settling).
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ..provenance import Source, current_source
+from ..provenance import Source, current_source, header
 from . import Result, to_jsonable
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -236,4 +236,4 @@ class RecommendResult(Result):
             "map": {"strokes": list(self.strokes), "stiffnesses": list(self.stiffnesses),
                     "candidates": [c.to_dict() for c in self.candidates]},
             "evaluations": self.evaluations, "wall_time": self.wall_time,
-            "fi_design_source": self.fi_design_source.to_dict()}
+            **header(source=self.fi_design_source)}

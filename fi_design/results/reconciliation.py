@@ -568,8 +568,7 @@ class ReconcileResult(Result):
 
     def to_dict(self) -> dict:
         """Plain JSON data: the contract keys first, then the details (SI)."""
-        from .. import __version__
-        from ..provenance import current_source
+        from ..provenance import header
 
         return {
             "effect": self.effect,
@@ -601,7 +600,6 @@ class ReconcileResult(Result):
             "conclusion": self.conclusion,
             "n_simulations": self.n_simulations,
             "wall_time": self.wall_time,
-            "fi_design_version": __version__,
-            "fi_design_source": current_source().to_dict(),
+            **header(),
             "measurement": self.measurement.to_dict(),
         }

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..display import display_scale, number, quantity
+from ..display import number, quantity
 from . import Result, dataclass_dict, to_jsonable
 
 __all__ = ["STATIC_ERROR_FORMULA", "MOVE_OUTCOMES", "BOUNDARY_KINDS", "MoveOutcome", "CycleTrace",
@@ -29,8 +29,7 @@ def length_text(x: float) -> str:
 
 def length_range(lo: float, hi: float) -> str:
     """Two lengths [m] in the unit of the larger: ``"0.396 to 50 mm"``."""
-    shown, factor = display_scale("m", max(abs(lo), abs(hi)))
-    return f"{number(lo * factor, 3)} to {number(hi * factor, 3)} {shown}"
+    return quantity((lo, hi), "m", 3, joiner=" to ")
 
 
 #: The static error bound of a loop without integrator, as every statement names it

@@ -9,9 +9,7 @@ results' own (``table()``, ``to_csv()``, ``to_dict()``).
 from __future__ import annotations
 
 import csv
-import hashlib
 import io
-import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -20,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import ArgumentError, SpecError
-from ..provenance import Source, current_source
+from ..provenance import Source, current_source, header
 from . import Result, frozen_array, to_jsonable
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -28,7 +26,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["POINT_VERDICTS", "Axis", "PointResult", "RunInfo", "SweepResult", "DesignMap",
            "MapDefinition", "StudyMap", "StudyResult", "Scatter", "PositionFriction",
-           "HuntingProbability", "RobustnessResult", "spec_digest", "columns", "csv_text"]
+           "HuntingProbability", "RobustnessResult", "columns", "csv_text"]
 
 #: Verdicts of the hunting metric plus the two outcomes of a point that has no metric.
 POINT_VERDICTS = ("settled", "hunting", "stuck", "undetermined", "invalid", "failed")
@@ -285,10 +283,8 @@ class SweepResult(Result):
     def to_dict(self) -> dict:
         """Plain JSON data: axes, metric arrays, points, design point, run info."""
         return {
-            "fi_design_version": self.fi_design_version,
-            "fi_design_source": self.fi_design_source.to_dict(),
+            **header(self.fi_design_version, self.fi_design_source, self.spec),
             "spec_name": self.spec.name,
-            "spec_sha256": spec_digest(self.spec),
             "isolated": self.isolated,
             "x": self.x.to_dict(),
             "y": self.y.to_dict() if self.y is not None else None,
@@ -424,10 +420,7 @@ class StudyResult(Result):
 
     def to_dict(self) -> dict:
         """Plain JSON data."""
-        from .. import __version__
-
-        return {"fi_design_version": __version__,
-                "fi_design_source": self.fi_design_source.to_dict(),
+        return {**header(source=self.fi_design_source),
                 "spec_name": self.spec.name, "resolution": self.resolution,
                 "maps": [m.to_dict() for m in self.maps], "run": self.run.to_dict()}
 
@@ -627,10 +620,8 @@ class RobustnessResult(Result):
     def to_dict(self) -> dict:
         """Plain JSON data."""
         return {
-            "fi_design_version": self.fi_design_version,
-            "fi_design_source": self.fi_design_source.to_dict(),
+            **header(self.fi_design_version, self.fi_design_source, self.spec),
             "spec_name": self.spec.name,
-            "spec_sha256": spec_digest(self.spec),
             "samples": self.samples,
             "seed": self.seed,
             "distribution": self.distribution,
@@ -644,24 +635,6 @@ class RobustnessResult(Result):
             "points": [p.to_dict() for p in self.points],
             "run": self.run.to_dict(),
         }
-
-
-def spec_digest(spec: Spec) -> str:
-    """SHA-256 of a spec's validated content (every value, defaults included).
-
-    Parameters
-    ----------
-    spec : Spec
-        The spec.
-
-    Returns
-    -------
-    str
-        Hex digest; equal for specs that simulate identically however they
-        were written (units, key order, comments).
-    """
-    data = spec.model_dump(mode="json")
-    return hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
 
 
 def columns(paths: Sequence[str], points: Sequence[PointResult], prefix: str = "") \

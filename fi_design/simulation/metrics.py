@@ -114,7 +114,7 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
         verdict, reason = "undetermined", "the trace does not cover the counting window"
     elif cycles > 0:
         verdict = "hunting"
-        reason = (f"{cycles} peak(s) of at least {min_height * 1e3:g} mm in "
+        reason = (f"{cycles} peak(s) of at least {quantity(min_height, 'm', 6)} in "
                   f"[{w0:g} s, {w1:g} s)" + (f", period {period:.3g} s" if period else ""))
     elif settled:
         verdict = "settled"

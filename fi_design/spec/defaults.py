@@ -216,8 +216,8 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
         presl = f.static / f.bristle_stiffness
         if spec.isolator.stroke < 5 * presl:
             out.append(("isolator.stroke",
-                        f"stroke {spec.isolator.stroke * 1e3:.3g} mm is within 5x the presliding "
-                        f"range Fs/sigma0 = {presl * 1e6:.3g} um: the joint can hardly isolate"))
+                        f"stroke {quantity(spec.isolator.stroke, 'm', 3)} is within 5x the presliding "
+                        f"range Fs/sigma0 = {quantity(presl, 'm', 3)}: the joint can hardly isolate"))
     if spec.isolator is not None:
         for i, mv in enumerate(spec.motion.moves):
             ratio = abs(mv.distance) / spec.isolator.stroke

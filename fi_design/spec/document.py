@@ -9,6 +9,7 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import Discriminator, Field, PrivateAttr, Tag, create_model, model_validator
 
 from .. import effects as _effects
+from ..provenance import json_sha256
 from .defaults import CROSSOVER_AGREEMENT, gains_crossover, tuning_mass
 from .fields import OptQ, Q, StrictModel, Text
 from .sections import (MAX_OUTPUT_SAMPLES, Body, Controller, Stage, Friction, Isolator, Measurement,
@@ -77,6 +78,30 @@ class Spec(StrictModel):
 
     #: Where the spec was read from (set by fi_design.spec.file.load_spec).
     _origin: Any = PrivateAttr(default=None)
+
+    def sha256(self) -> str:
+        """The spec's SHA-256, as every result's provenance writes it (``spec_sha256``).
+
+        Returns
+        -------
+        str
+            Hex digest of the file's bytes when the spec was read from a file
+            (what ``sha256sum`` prints), of the mapping it was given as, else
+            of its validated values (:meth:`content_sha256`).
+        """
+        return self._origin.sha256 if self._origin is not None else self.content_sha256()
+
+    def content_sha256(self) -> str:
+        """SHA-256 of the spec's validated values (every value, defaults included).
+
+        Returns
+        -------
+        str
+            Hex digest (:func:`fi_design.provenance.json_sha256`); equal for specs
+            that simulate identically however they were written (units, key order,
+            comments): the key of cached study points.
+        """
+        return json_sha256(self.model_dump(mode="json"))
 
     @model_validator(mode="after")
     def _consistent(self) -> "Spec":

@@ -20,9 +20,10 @@ import io
 import re
 from typing import Any, Mapping, Sequence
 
-from ..errors import ArgumentError, SpecError
+from ..errors import SpecError
 from . import Spec
 from .file import load_spec, origin, parse_yaml, path_unit, yaml_loader
+from .paths import parse_path
 
 __all__ = ["edited_spec_text", "spec_quantity", "written_unit", "REMOVE"]
 
@@ -34,8 +35,6 @@ class _Remove:
 
 #: A value of :func:`edited_spec_text` that removes the key.
 REMOVE = _Remove()
-
-_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$")
 
 
 def spec_quantity(path: str, value: float, digits: int | None = None) -> Any:
@@ -78,7 +77,7 @@ def written_unit(spec: Spec, path: str) -> str | None:
     spec : Spec
         A spec read from a file or mapping.
     path : str
-        Dotted path without list indices (``"isolator.flexure.length"``).
+        Dotted path (``"isolator.flexure.length"``, ``"motion.moves[0].distance"``).
 
     Returns
     -------
@@ -88,10 +87,15 @@ def written_unit(spec: Spec, path: str) -> str | None:
     """
     org = origin(spec)
     node: Any = None if org is None else org.raw
-    for part in path.split("."):
-        if not isinstance(node, Mapping) or part not in node:
+    for name, selectors in parse_path(path):
+        if not isinstance(node, Mapping) or name not in node:
             return None
-        node = node[part]
+        node = node[name]
+        for sel in selectors:
+            try:
+                node = _entry(node, sel, path)
+            except SpecError:
+                return None
     if isinstance(node, (list, tuple)) and node:
         node = node[0]
     if not isinstance(node, str):
@@ -224,20 +228,15 @@ def _parent(document: Any, path: str) -> tuple[Any, Any]:
     """The container and key of a dotted path, adding missing sections on the way."""
     from ruamel.yaml.comments import CommentedMap
 
+    tokens = parse_path(path)  # the one grammar of spec paths (fi_design.spec.paths)
     steps: list = []
-    for part in path.split("."):
-        m = _PART.match(part.strip())
-        if not m:
-            raise ArgumentError(f"not a spec path: {path!r}")
-        steps.append(m.group(1))
-        steps += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
+    for name, selectors in tokens:
+        steps += [name, *selectors]
     node = document
     for i, step in enumerate(steps[:-1]):
-        done = ".".join(str(s) for s in steps[:i + 1])
-        if isinstance(step, int):
-            if not isinstance(node, list) or step >= len(node):
-                raise SpecError(f"the spec has no entry {step} here", path=done)
-            node = node[step]
+        done = _steps_text(steps[:i + 1])
+        if isinstance(step, (int, tuple)):
+            node = _entry(node, step, done)
             continue
         if not isinstance(node, dict):
             raise SpecError("holds a value, not a section", path=done)
@@ -249,7 +248,37 @@ def _parent(document: Any, path: str) -> tuple[Any, Any]:
         node = node[step]
     if not isinstance(node, (dict, list)):
         raise SpecError("holds a value, not a section", path=path)
-    return node, steps[-1]
+    last = steps[-1]
+    if isinstance(last, tuple):  # [type=NAME] as the last step: the entry's index
+        if not isinstance(node, list):
+            raise SpecError("is not a list; remove the [...]", path=path)
+        _entry(node, last, path)
+        last = next(i for i, e in enumerate(node) if isinstance(e, dict)
+                    and e.get("type") == last[1])
+    return node, last
+
+
+def _steps_text(steps: list) -> str:
+    """Steps of :func:`_parent` (keys, indices, type selectors) as a dotted path."""
+    out = ""
+    for s in steps:
+        out += (f"[{s}]" if isinstance(s, int) else f"[type={s[1]}]" if isinstance(s, tuple)
+                else ("." if out else "") + s)
+    return out
+
+
+def _entry(node: Any, selector: int | tuple, done: str) -> Any:
+    """The list entry a selector of a spec path names (``[0]`` or ``[type=NAME]``)."""
+    if not isinstance(node, list):
+        raise SpecError("is not a list; remove the [...]", path=done)
+    if isinstance(selector, tuple):
+        hits = [e for e in node if isinstance(e, dict) and e.get("type") == selector[1]]
+        if not hits:
+            raise SpecError(f"the spec has no entry of type '{selector[1]}'", path=done)
+        return hits[0]
+    if selector >= len(node):
+        raise SpecError(f"the spec has no entry {selector} here", path=done)
+    return node[selector]
 
 
 def _commented(value: Any, flow: bool = False) -> Any:

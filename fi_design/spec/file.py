@@ -15,12 +15,12 @@ and are named here too.
 from __future__ import annotations
 
 import hashlib
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
 from ..errors import SpecError, SpecFileError
+from ..provenance import json_sha256
 from . import Spec
 from .errors import clean_loc, describe, dotted, real_errors
 # the values at dotted paths live in fi_design.spec.paths; named here as well
@@ -127,8 +127,7 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
     """
     if isinstance(source, Mapping):
         raw = plain(source)
-        digest = hashlib.sha256(json.dumps(raw, sort_keys=True, default=str).encode()).hexdigest()
-        return _validate(raw, SpecOrigin(None, digest, raw))
+        return _validate(raw, SpecOrigin(None, json_sha256(raw), raw))
     path = Path(source)
     data = read_bytes(path)
     raw, document = parse_yaml(data, str(path))

@@ -18,6 +18,8 @@ from ..errors import SpecError
 from . import Spec
 from .errors import describe, real_errors
 
+__all__ = ["with_values", "value_at", "path_unit", "path_description", "parse_path", "path_text"]
+
 
 # --------------------------------------------------------------------------- dotted-path values
 # (parameter studies: fi_design.studies varies spec values by their dotted path)
@@ -136,12 +138,12 @@ def _leaf(path: str, spec: Spec | None = None) -> tuple[Any, Any]:
     """The field info (None inside a list entry) and annotation of the value at ``path``."""
     model: Any = Spec
     instance: Any = spec
-    tokens = _tokens(path)
+    tokens = parse_path(path)
     for n, (name, selectors) in enumerate(tokens):
-        done = _dotted_tokens(tokens[:n + 1])
+        done = path_text(tokens[:n + 1])
         fields = model.model_fields
         if name not in fields:
-            raise SpecError(_unknown(name, fields, _dotted_tokens(tokens[:n])), path=done)
+            raise SpecError(_unknown(name, fields, path_text(tokens[:n])), path=done)
         info = fields[name]
         ann = info.annotation
         instance = getattr(instance, name, None) if instance is not None else None
@@ -177,7 +179,7 @@ def _leaf(path: str, spec: Spec | None = None) -> tuple[Any, Any]:
         if sub is None:
             raise SpecError(f"'{name}' holds a value, not a section", path=done)
         model = sub
-    raise SpecError("empty path", path=path)  # pragma: no cover - _tokens refuses it
+    raise SpecError("empty path", path=path)  # pragma: no cover - parse_path refuses it
 
 
 class _Open:
@@ -223,15 +225,15 @@ def _plain_value(value: Any) -> Any:
 
 
 def _assign(root: _Open, path: str, value: Any) -> None:
-    tokens = _tokens(path)
+    tokens = parse_path(path)
     node: Any = root
     for n, (name, selectors) in enumerate(tokens):
-        done = _dotted_tokens(tokens[:n + 1])
+        done = path_text(tokens[:n + 1])
         if not isinstance(node, _Open):
-            raise SpecError(f"'{_dotted_tokens(tokens[:n])}' holds a value, not a section",
+            raise SpecError(f"'{path_text(tokens[:n])}' holds a value, not a section",
                             path=done)
         if name not in node.fields:
-            raise SpecError(_unknown(name, node.model.model_fields, _dotted_tokens(tokens[:n])),
+            raise SpecError(_unknown(name, node.model.model_fields, path_text(tokens[:n])),
                             path=done)
         container, key = node.fields, name
         unit = _field_units(node.model)[name]
@@ -276,7 +278,37 @@ def _assign(root: _Open, path: str, value: Any) -> None:
         node = current
 
 
-def _tokens(path: str) -> list[tuple[str, list]]:
+def parse_path(path: str) -> list[tuple[str, list]]:
+    """The one grammar of dotted spec paths: keys, each with list selectors.
+
+    ``motion.moves[0].distance``, ``effects[type=time_delay].delay``: keys
+    separated by dots, each optionally followed by ``[INDEX]`` (a list entry by
+    position) or ``[type=NAME]`` (the first entry of that type). Every reader
+    and writer of spec paths parses them here (:func:`with_values`,
+    :func:`value_at`, :func:`fi_design.spec.edit.edited_spec_text`).
+
+    Parameters
+    ----------
+    path : str
+        The dotted path.
+
+    Returns
+    -------
+    list of (str, list)
+        Each key with its selectors: an int index or ``("type", NAME)``.
+
+    Raises
+    ------
+    SpecError
+        An empty path, a malformed key or selector; the message names the path.
+
+    Examples
+    --------
+    >>> parse_path("motion.moves[0].distance")
+    [('motion', []), ('moves', [0]), ('distance', [])]
+    >>> parse_path("effects[type=time_delay].delay")
+    [('effects', [('type', 'time_delay')]), ('delay', [])]
+    """
     text = path.strip()
     if not text:
         raise SpecError("empty spec path; give a dotted path such as 'friction.static'")
@@ -300,7 +332,8 @@ def _tokens(path: str) -> list[tuple[str, list]]:
     return out
 
 
-def _dotted_tokens(tokens: list) -> str:
+def path_text(tokens: list) -> str:
+    """A parsed path (:func:`parse_path`) written back: ``motion.moves[0].distance``."""
     out = ""
     for name, selectors in tokens:
         out += ("." if out else "") + name
@@ -419,17 +452,17 @@ def value_at(spec: Spec, path: str) -> Any:
         An unknown path, or a path into a section the spec does not have.
     """
     node: Any = spec
-    tokens = _tokens(path)
+    tokens = parse_path(path)
     for n, (name, selectors) in enumerate(tokens):
-        done = _dotted_tokens(tokens[:n + 1])
+        done = path_text(tokens[:n + 1])
         if node is None:
-            raise SpecError("is not set in this spec", path=_dotted_tokens(tokens[:n]))
+            raise SpecError("is not set in this spec", path=path_text(tokens[:n]))
         fields = getattr(type(node), "model_fields", None)
         if fields is None:
-            raise SpecError(f"'{_dotted_tokens(tokens[:n])}' holds a value, not a section",
+            raise SpecError(f"'{path_text(tokens[:n])}' holds a value, not a section",
                             path=done)
         if name not in fields:
-            raise SpecError(_unknown(name, fields, _dotted_tokens(tokens[:n])), path=done)
+            raise SpecError(_unknown(name, fields, path_text(tokens[:n])), path=done)
         node = getattr(node, name)
         for sel in selectors:
             if not isinstance(node, tuple):

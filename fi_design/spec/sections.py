@@ -430,7 +430,7 @@ class Hunting(StrictModel):
     min_height: Q("m") = Field(1e-4, gt=0, description="Minimum peak height of x1 - r [m]. "
                                                        "Default 0.1 mm.")
     settle_band: Q("m") = Field(1e-5, gt=0, description="Error band for 'settled' and the "
-                                                        "settling time [m]. Default 10 um.")
+                                                        "settling time [m]. Default 10 µm.")
     horizon: Q("s") = Field(300.0, gt=0, le=1e5,
                             description="Stage-level hunting: the longest time after a move to "
                                         "wait for the stage to come to rest or repeat a cycle "

@@ -240,7 +240,7 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
     if out.stop == "match":
         seen = owner[out.period_crossings]
         m = seen.outcome
-        why = (f"a sustained cycle: {m.amplitude * 1e3:.3g} mm peak to peak"
+        why = (f"a sustained cycle: {length_text(m.amplitude)} peak to peak"
                + (f", period {m.period:.3g} s" if m.period else "")
                + f" (enters the cycle of the {length_text(abs(m.distance))} move)")
         return MoveRun(MoveOutcome(distance, label, "hunts", float(out.crossing_states[-1][0]
@@ -255,7 +255,7 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
         amp = float(np.max(ext[:, 1]) - np.min(ext[:, 0])) if len(ext) else None
         how = {"repeat": "repeats at the section", "crossings": "keeps crossing the target",
                "end": "keeps crossing the target"}[out.stop]
-        why = (f"a sustained cycle: {amp * 1e3:.3g} mm peak to peak"
+        why = (f"a sustained cycle: {length_text(amp)} peak to peak"
                + (f", period {period:.3g} s" if period else "") + f" ({how})")
         return MoveRun(MoveOutcome(distance, label, "hunts", float(out.crossing_states[-1][0]
                                                                   - level),

@@ -191,7 +191,7 @@ def point_key(spec_hash: str, values: Sequence[tuple[str, Any]], isolated: bool,
     Parameters
     ----------
     spec_hash : str
-        :func:`spec_digest` of the base spec.
+        :meth:`~fi_design.spec.Spec.content_sha256` of the base spec.
     values : sequence of (path, value)
         The point's values.
     isolated : bool

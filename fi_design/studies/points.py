@@ -25,10 +25,11 @@ from typing import Any
 import numpy as np
 
 from .. import spec as _spec
+from ..display import quantity
 from ..errors import ArgumentError, FiDesignError, SpecError
 from ..execution import Executor, chunks, run_chunks
 from ..results import frozen_array
-from ..results.studies import PointResult, RunInfo, spec_digest
+from ..results.studies import PointResult, RunInfo
 from ..spec.file import with_values
 from .cache import METHOD, PointCache, open_cache, point_key
 
@@ -124,7 +125,7 @@ def _stage_point(point: _spec.Spec, isolated: bool, first_only: bool = False) ->
     final = _num(moves[0].final_error)
     broken = next((m for m in moves if m.failed), None)
     if broken is not None:
-        return _outcome("failed", "failed", message=f"the {broken.distance * 1e3:.4g} mm move: "
+        return _outcome("failed", "failed", message=f"the {_distance(broken.distance)} move: "
                                                     f"{broken.reason}")
     hunting = [m for m in moves if m.hunts]
     if hunting:
@@ -132,17 +133,22 @@ def _stage_point(point: _spec.Spec, isolated: bool, first_only: bool = False) ->
         hunt = max(hunting, key=lambda m: m.amplitude or 0.0)
         return _outcome("ok", "hunting", amplitude=_num(hunt.amplitude),
                         period=_num(hunt.period), final_error=final,
-                        message=(f"the {hunt.distance * 1e3:.4g} mm move hunts (the moves stop "
+                        message=(f"the {_distance(hunt.distance)} move hunts (the moves stop "
                                  f"at the first that does): {hunt.reason}" if first_only else
                                  f"{len(hunting)} of {len(moves)} moves hunt; the largest cycle, "
-                                 f"after the {hunt.distance * 1e3:.4g} mm move: {hunt.reason}"))
+                                 f"after the {_distance(hunt.distance)} move: {hunt.reason}"))
     for word, verdict in (("stuck", "stuck"), ("undetermined", "undetermined")):
         bad = next((m for m in moves if m.outcome == word), None)
         if bad is not None:
             return _outcome("ok", verdict, amplitude=0.0, final_error=final,
-                            message=f"the {bad.distance * 1e3:.4g} mm move: {bad.reason}")
+                            message=f"the {_distance(bad.distance)} move: {bad.reason}")
     return _outcome("ok", "settled", amplitude=0.0, final_error=final,
                     message=f"all {len(moves)} moves come to rest")
+
+
+def _distance(x: float) -> str:
+    """A move's distance [m] for a message, 4 digits (``0.5 mm``)."""
+    return quantity(x, "m", 4)
 
 
 def _num(x: Any) -> float | None:
@@ -289,7 +295,7 @@ def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | No
     outcomes: list[dict | None] = [None] * n
     keys: list[str] = []
     if store is not None:
-        shash = spec_digest(spec)
+        shash = spec.content_sha256()
         keys = [point_key(shash, values, iso, measure) for values, iso in tasks]
         hits = store.get_many(keys)
         for i, k in enumerate(keys):

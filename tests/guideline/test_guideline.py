@@ -250,7 +250,9 @@ def test_spec_hash_without_origin(paper_spec):
     spec._origin = None                    # as if built in code, not read by load_spec
     assert origin(spec) is None and origin(paper_spec) is not None
     r = evaluate(spec, confirm=False)
-    assert r.spec_sha256 == hashlib.sha256(spec.model_dump_json().encode()).hexdigest()
+    # built in code: the digest of its validated values, keys sorted
+    canonical = json.dumps(spec.model_dump(mode="json"), sort_keys=True, default=str)
+    assert r.spec_sha256 == hashlib.sha256(canonical.encode()).hexdigest() == spec.sha256()
     assert evaluate(origin(paper_spec).raw, confirm=False).crossover.achievable == \
         pytest.approx(evaluate(paper_spec, confirm=False).crossover.achievable)
 

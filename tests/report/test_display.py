@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import ast
 import doctest
 import re
+from pathlib import Path
 
 import pytest
 
@@ -107,3 +109,58 @@ def test_sentences_of_the_metric_and_the_stage_give_lengths_in_micrometres_and_m
     assert length_text(1.8026e-3) == "1.8 mm" and length_text(2.2e-5) == "22 µm"
     assert length_range(4e-4, 5e-2) == "0.4 to 50 mm"
     assert length_range(1e-5, 5e-5) == "10 to 50 µm"
+
+
+# --------------------------------------------------------------------------- the one home
+# Units are converted for readers in fi_design.display only: an f-string that scales a value
+# by a power of ten, or prints a formatted value followed by a scaled unit, converts by hand.
+
+_SCALES = {1e3, 1e6, 1e9, 1e-3, 1e-6, 1e-9}
+_SCALED_UNIT = re.compile(
+    r"^\s?(mm|\u00b5m|um|nm|ms|\u00b5s|mm/s|MPa|GPa|kPa|N/mm)(?![A-Za-z])")
+
+
+def _scaled(node) -> bool:
+    return any(isinstance(n, ast.BinOp) and isinstance(n.op, (ast.Mult, ast.Div))
+               and any(isinstance(s, ast.Constant) and isinstance(s.value, (int, float))
+                       and not isinstance(s.value, bool) and float(s.value) in _SCALES
+                       for s in (n.left, n.right))
+               for n in ast.walk(node))
+
+
+def hand_conversions(source: str) -> list[str]:
+    """Formatted values of f-strings that convert a unit by hand: ``{x * 1e3:.3g} mm``,
+    ``{number(x * 1e3)} mm``, ``{band:g} µm`` (a value scaled before)."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if not isinstance(node, ast.JoinedStr):
+            continue
+        for i, part in enumerate(node.values):
+            if not isinstance(part, ast.FormattedValue):
+                continue
+            after = node.values[i + 1] if i + 1 < len(node.values) else None
+            unit_after = isinstance(after, ast.Constant) and _SCALED_UNIT.match(str(after.value))
+            if _scaled(part.value) or unit_after:
+                found.append(f"{part.lineno}: {ast.unparse(part.value)}")
+    return found
+
+
+def test_the_scan_finds_each_hand_conversion():
+    planted = ('s = 3e-4\nprint(f"a {s * 1e3:.3g} mm stroke")\n'
+               'print(f"{number(1e6 * s, 3)} um")\nband = s * 1e6\nprint(f"+-{band:g} \u00b5m")\n'
+               'print(f"{s / 1e6:.4g} MPa")\n')
+    assert [f.split(":")[0] for f in hand_conversions(planted)] == ["2", "3", "5", "6"]
+    fine = ('print(f"a {quantity(s, \'m\', 3)} stroke, {100 * f:.3g} %, {k:.4g} N/m, '
+            '{t:.3g} s")\n')
+    assert hand_conversions(fine) == []
+
+
+def test_units_are_converted_in_display_only():
+    import fi_design
+
+    package = Path(fi_design.__file__).parent
+    offenders = [f"{p.relative_to(package)}:{hit}" for p in sorted(package.rglob("*.py"))
+                 if p.name != "display.py"
+                 for hit in hand_conversions(p.read_text(encoding="utf-8"))]
+    assert not offenders, ("convert units with fi_design.display (quantity, quantities, "
+                           "with_error): " + "; ".join(offenders))

@@ -22,7 +22,6 @@ import pytest
 from fi_design import studies as sw
 from fi_design.errors import ArgumentError, SpecError
 from fi_design.execution import chunks
-from fi_design.results.studies import spec_digest
 from fi_design.studies import cache as cachemod, points
 from fi_design.spec.file import with_values
 
@@ -420,7 +419,7 @@ def test_cache_skips_finished_points(paper_spec, kernel, tmp_path):
 
 
 def test_cache_key_covers_version_and_code(paper_spec, monkeypatch):
-    h = spec_digest(paper_spec)
+    h = paper_spec.content_sha256()
     key = cachemod.point_key(h, (("controller.crossover", 8.0),), True)
     assert key == cachemod.point_key(h, (("controller.crossover", 8.0),), True)
     assert key != cachemod.point_key(h, (("controller.crossover", 8.000000001),), True)
