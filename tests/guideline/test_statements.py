@@ -533,7 +533,7 @@ def test_the_docs_quote_a_fresh_run(example_designs, repo_root):
     st = r.simulation.stage["isolated"]
     m = re.search(r"hunts for (\d+) of its (\d+) moves", commands)
     assert m and (int(m.group(1)), int(m.group(2))) == (len(st.hunting_moves), len(st.moves))
-    m = re.search(rf"rests ({NUM}) um from its end stop", commands)
+    m = re.search(rf"rests ({NUM}) µm from its end stop", commands)
     assert m and len(distinct([si(m.group(1), "µm"), r.margins.end_stop_clearance])) == 1
     m = re.search(rf"leaves are ({NUM}) mm, ({NUM}) to ({NUM}) N/m", commands)
     assert m
