@@ -26,8 +26,8 @@ from typing import Any
 from .. import spec as _spec
 from ..spec.file import with_values
 
-__all__ = ["SEARCH_POINTS", "reserve_spec", "crossover_cap", "guide_for", "loop_meets",
-           "stage_answer", "margin_screen", "reserve_corners", "hunting_margin"]
+__all__ = ["SEARCH_POINTS", "reserve_spec", "crossover_cap", "with_notch_spec", "notch_entries",
+           "guide_for", "loop_meets", "stage_answer", "margin_screen", "reserve_corners", "hunting_margin"]
 
 #: Lengths of the guide's sizing grid during the search (the chosen design is sized again at
 #: full resolution).
@@ -42,14 +42,17 @@ def reserve_spec(spec: _spec.Spec) -> _spec.Spec:
                               "requirements.gain_margin": req.gain_margin + r.gain_margin})
 
 
-def crossover_cap(base: _spec.Spec, rule: bool) -> tuple[float, str]:
-    """The crossover the recommendation tunes to [Hz], and why.
+def crossover_cap(base: _spec.Spec, rule: bool) -> tuple[float, str, Any]:
+    """The crossover the recommendation tunes to [Hz], why, and the notch it adds.
 
     The loop's limit is the hardware's: the spec's drive (sampling, delay),
     its stage and its measured modes, without the flexure guide the search
     replaces (each candidate's own guide must then keep its modes at the
     separation times this crossover). Where that loop sets no limit below the
-    search cap, the desired crossover is kept.
+    search cap, the desired crossover is kept. With
+    ``requirements.recommend.filters``, a parasitic mode that limits that loop
+    gets a notch in the drive's chain (:func:`fi_design.loop.notch.with_notch`)
+    where the notch lifts the achievable crossover.
 
     Parameters
     ----------
@@ -61,23 +64,33 @@ def crossover_cap(base: _spec.Spec, rule: bool) -> tuple[float, str]:
 
     Returns
     -------
-    (float, str)
+    (float, str, Filter or None)
+        The crossover [Hz], why, and the notch added to the chain (None: none).
     """
     from ..loop import linear
+    from ..loop.notch import limiting_mode, notched, with_notch
     from ..model import resolve
 
     fc = _spec.design_crossover(base)
     if not rule:
-        return fc, "the hardware's gains: the crossover stays theirs"
+        return fc, "the hardware's gains: the crossover stays theirs", None
     bounds = base.requirements.recommend.crossover
     reserve = base.requirements.reserve.crossover
     loop = base
     if base.isolator is not None and base.isolator.flexure is not None:
         loop = with_values(base, {"isolator.flexure": None})
-    ach = linear.achievable_crossover(resolve(reserve_spec(loop)))
+    model = resolve(reserve_spec(loop))
+    ach = linear.achievable_crossover(model)
+    notch = None
+    mode = limiting_mode(model, ach) if (bounds_allow_filters(base) and ach.frequency is not None
+                                        and ach.kind != "scan_limit") else None
+    if mode is not None and not notched(model, mode):
+        filt, alt = with_notch(model, mode)
+        if alt.frequency is not None and alt.frequency > ach.frequency:
+            notch, ach = filt, alt
     if ach.frequency is None:
         return fc, (f"no crossover meets the margins with their reserve ({ach.limited_by}): "
-                    "the desired one is kept")
+                    "the desired one is kept"), None
     if ach.kind == "scan_limit":
         cap, why = fc, (f"kept at the desired {fc:.4g} Hz: the linear model sets no limit "
                         "below its search cap (give the hardware's sampling, delay and "
@@ -86,12 +99,31 @@ def crossover_cap(base: _spec.Spec, rule: bool) -> tuple[float, str]:
         cap = reserve * ach.frequency
         why = (f"{reserve:g} x the achievable {ach.frequency:.4g} Hz with the margins' reserve, "
                f"which is limited by {ach.limited_by}")
+        if notch is not None:
+            why += f" (with the {notch.describe()} the search adds, requirements.recommend.filters)"
     if bounds is not None:
         if cap > bounds[1]:
             cap, why = bounds[1], "the upper bound of requirements.recommend.crossover"
         elif cap < bounds[0]:
             why += f"; below requirements.recommend.crossover ({bounds[0]:.4g} Hz)"
-    return float(cap), why
+    return float(cap), why, notch
+
+
+def bounds_allow_filters(spec: _spec.Spec) -> bool:
+    """Whether the spec lets the search add a notch (``requirements.recommend.filters``)."""
+    return bool(spec.requirements.recommend.filters)
+
+
+def with_notch_spec(spec: _spec.Spec, notch: Any) -> _spec.Spec:
+    """The spec with a notch appended to ``controller.filters``."""
+    return with_values(spec, {"controller.filters": notch_entries(spec, notch)})
+
+
+def notch_entries(spec: _spec.Spec, notch: Any) -> list[dict]:
+    """``controller.filters`` as the spec file takes it, with a notch appended."""
+    own = [f.model_dump(mode="json", exclude_none=True) for f in spec.controller.filters]
+    return own + [{"type": "notch", "name": notch.name, "frequency": f"{notch.frequency:.6g} Hz",
+                   "width": f"{notch.width:.6g} Hz"}]
 
 
 def guide_for(base: _spec.Spec, stiffness: float, stroke: float, crossover: float, *,

@@ -108,7 +108,9 @@ class _Search:
         self.say = say
         self.base, self.assumed = base_spec(spec)
         self.rule = spec.controller.gains is None
-        self.fc, self.fc_why = _c.crossover_cap(spec, self.rule)
+        self.fc, self.fc_why, self.notch = _c.crossover_cap(spec, self.rule)
+        if self.notch is not None:  # every candidate carries the notch the search adds
+            self.base = _c.with_notch_spec(self.base, self.notch)
         self.margin = self.base.requirements.hunting_margin
         self.zeta = damping_ratio(self.base)
         m1, m2 = self.base.stage.mass, self.base.cart.mass
@@ -403,4 +405,4 @@ def recommend(spec: _spec.Spec | str | Any, *, executor: Any = None,
         stiffnesses=tuple(sorted({p.target for p in srch.points})),
         candidates=tuple(p.result() for p in srch.points), spec_design=spec_design,
         crossover_limit=srch.fc_why, assumptions=srch.assumed, rule=srch.rule,
-        evaluations=srch.evaluations, wall_time=_time.perf_counter() - start)
+        evaluations=srch.evaluations, wall_time=_time.perf_counter() - start, notch=srch.notch)

@@ -61,8 +61,9 @@ def recommended_values(result: RecommendResult) -> dict[str, Any]:
         the guide: ``isolator.stiffness`` removed), ``isolator.damping`` when
         the spec gives a damping (its ratio kept), the measured modes that
         belong to the spec's own guide removed, and ``controller.crossover``
-        for a spec tuned by the rule; for a spec without isolator or flexure
-        the sections as a whole.
+        for a spec tuned by the rule, ``controller.filters`` with the notch the
+        search added; for a spec without isolator or flexure the sections as a
+        whole.
     """
     from ..spec.edit import REMOVE
 
@@ -100,6 +101,10 @@ def recommended_values(result: RecommendResult) -> dict[str, Any]:
                 [m.model_dump(mode="json", exclude_none=True) for m in kept] if kept else REMOVE)
     if result.rule:
         values["controller.crossover"] = written(spec, "controller.crossover", d.crossover)
+    if result.notch is not None:
+        from .constraints import notch_entries
+
+        values["controller.filters"] = notch_entries(spec, result.notch)
     return values
 
 

@@ -174,6 +174,9 @@ class RecommendResult(Result):
         Stage-level evaluations (one move family each) the search made.
     wall_time : float
         Time the search took [s].
+    notch : fi_design.results.controller.Filter or None
+        The notch the search added to the drive's chain
+        (``requirements.recommend.filters``); None: the chain as the spec has it.
     fi_design_source : fi_design.provenance.Source
         The code that produced it.
     """
@@ -201,6 +204,7 @@ class RecommendResult(Result):
     rule: bool
     evaluations: int
     wall_time: float
+    notch: Any = None
     fi_design_source: Source = field(default_factory=current_source)
 
     @property
@@ -217,8 +221,8 @@ class RecommendResult(Result):
     def to_dict(self) -> dict:
         """The contract: ``feasible``, ``isolator``, ``crossover``, ``flexure``, ``binding``,
         ``least_change``, ``stage_hunting``, ``robustness``, ``reserves``, ``forces``,
-        ``margins``, ``pareto``; the nearest design's ``violates``, the ``advice`` and every
-        judged ``candidate``."""
+        ``margins``, ``pareto``, the ``notch`` the search added (null: none); the nearest
+        design's ``violates``, the ``advice`` and every judged ``candidate``."""
         return {
             "feasible": self.feasible, "isolator": to_jsonable(self.isolator),
             "crossover": self.crossover,
@@ -233,6 +237,7 @@ class RecommendResult(Result):
             "design": self.design.to_dict(), "spec_design": to_jsonable(self.spec_design),
             "crossover_limit": self.crossover_limit, "assumptions": list(self.assumptions),
             "rule": self.rule,
+            "notch": None if self.notch is None else self.notch.to_dict(),
             "map": {"strokes": list(self.strokes), "stiffnesses": list(self.stiffnesses),
                     "candidates": [c.to_dict() for c in self.candidates]},
             "evaluations": self.evaluations, "wall_time": self.wall_time,

@@ -508,6 +508,10 @@ class RecommendBounds(StrictModel):
     crossover: Union[tuple[Q("Hz"), Q("Hz")], None] = Field(
         None, description="[min, max] controller crossover [Hz] (a spec tuned by the rule); "
                           "default up to the achievable crossover.")
+    filters: bool = Field(
+        False, description="Whether the search may add a notch to controller.filters at the "
+                           "parasitic mode that limits the spec's loop, where the notch lifts "
+                           "the achievable crossover (a spec tuned by the rule).")
 
     @model_validator(mode="after")
     def _ordered(self) -> "RecommendBounds":
