@@ -22,7 +22,7 @@ from .context import build_context
 from .filters import num, qty
 from .glossary import glossary
 from .guide import guide_section
-from .inputs import spec_inputs
+from .inputs import spec_inputs, split_inputs
 from .meta import spec_listing, title_block, versions
 from .steps import guideline_steps
 from .validation import validation_section
@@ -516,6 +516,7 @@ def _design_sections(ctx: dict) -> list[dict]:
          "template": "assumptions.html.jinja"},
         {"id": "glossary", "title": "Glossary", "template": "glossary.html.jinja"},
         {"id": "references", "title": "References", "template": "references.html.jinja"},
+        {"id": "settings", "title": "Analysis settings", "template": "settings.html.jinja"},
         {"id": "appendix", "title": "Appendix: spec, solver and software",
          "template": "appendix.html.jinja"},
     ]
@@ -560,9 +561,9 @@ def design_context(result: DesignResult, *, date: Any = None, command: str | Non
                             sha256=result.spec_sha256, version=result.fi_design_version,
                             source=result.fi_design_source),
         "verdict": verdict(result),
-        "inputs": spec_inputs(spec, result.model),
         "steps": guideline_steps(result, figures),
     }
+    ctx["inputs"], ctx["settings"] = split_inputs(spec_inputs(spec, result.model))
     ctx["guide"] = guide_section(result, figures, fig_no()) if result.flexure is not None \
         else None
     ctx |= {

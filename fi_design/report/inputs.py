@@ -7,7 +7,7 @@ from typing import Any, Callable
 
 from .meta import spec_file
 
-__all__ = ["spec_inputs"]
+__all__ = ["spec_inputs", "split_inputs", "SETTINGS"]
 
 
 #: Derived defaults: path -> (rule in words, its value in the resolved model).
@@ -22,6 +22,22 @@ _DERIVED: dict[str, tuple[str, Callable[[Any], float]]] = {
 
 
 _MISSING = object()
+
+#: Spec paths that set how the tool analyses, not the hardware or what it must meet: the
+#: hunting metric and solver, the scatter, the search, the move family and the document.
+SETTINGS = ("requirements.hunting.", "requirements.robustness.", "requirements.recommend.",
+            "motion.family.", "controller.pade_order", "simulation.", "report.")
+
+INPUTS_INTRO = ("Every value of the spec that describes the hardware, its motion and what it must "
+                "meet, as the design used it, in engineering units, with its source: given in "
+                "the spec file, a default of the spec schema, or a derived default computed "
+                "from other values by the stated rule. How the tool analysed it (the hunting "
+                "metric and solver, the scatter, the search, the document) is under Analysis "
+                "settings.")
+SETTINGS_INTRO = ("The spec's values that set how the design was analysed rather than what the "
+                  "hardware is: the hunting metric, the solver and the crossover scan, the "
+                  "robustness scatter, the recommendation's search, the move family and the "
+                  "document's control, with their sources as under Inputs.")
 
 
 def _raw_at(raw: Any, key: Any) -> Any:
@@ -166,3 +182,30 @@ def _is_section(info: Any) -> bool:
         if isinstance(arg, type) and issubclass(arg, BaseModel):
             return True
     return False
+
+
+def split_inputs(groups: list[dict]) -> tuple[dict, dict]:
+    """The inputs of :func:`spec_inputs` in two parts: the design and the analysis settings.
+
+    Parameters
+    ----------
+    groups : list of dict
+        :func:`spec_inputs`.
+
+    Returns
+    -------
+    (dict, dict)
+        ``{"intro", "groups"}`` of the hardware, motion and requirements, and of
+        the settings (paths under :data:`SETTINGS`); a group without rows is left out.
+    """
+    design, settings = [], []
+    for g in groups:
+        own = [r for r in g["rows"] if not r["path"].startswith(SETTINGS)]
+        other = [r for r in g["rows"] if r["path"].startswith(SETTINGS)]
+        if own:
+            design.append({"title": g["title"], "rows": own})
+        if other:
+            settings.append({"title": g["title"], "rows": other})
+    return ({"intro": INPUTS_INTRO, "groups": design},
+            {"intro": SETTINGS_INTRO, "groups": settings})
+

@@ -36,7 +36,7 @@ NBSP = "\u00a0"
 
 #: Sections of the design report, in the order the issue asks for.
 DESIGN_SECTIONS = ["verdict", "inputs", "steps", "guide", "linear", "nonlinear",
-                   "validation", "assumptions", "glossary", "references", "appendix"]
+                   "validation", "assumptions", "glossary", "references", "settings", "appendix"]
 
 runner = CliRunner()
 
@@ -273,7 +273,10 @@ def test_context_numbers(paper_confirmed_design):
     assert iso["outcome"] == "hunts" and iso["moves"] == "7 of 25"
     assert iso["entered"] == "0.396 to 50 mm" and iso["limiter"] == "yes"
     assert iso["free_from"] == pytest.approx(11.28, abs=0.02)
-    inputs = {r["path"]: r for g in ctx["inputs"] for r in g["rows"]}
+    inputs = {r["path"]: r for g in ctx["inputs"]["groups"] for r in g["rows"]}
+    settings = {r["path"]: r for g in ctx["settings"]["groups"] for r in g["rows"]}
+    assert "simulation.tolerance" in settings and "simulation.tolerance" not in inputs
+    assert "requirements.hunting.horizon" in settings and "requirements.phase_margin" in inputs
     assert inputs["friction.static"]["source"] == "given"
     assert inputs["friction.static"]["written"] == "4 N"
     assert inputs["isolator.limiter.stiffness"]["source"] == "default"
