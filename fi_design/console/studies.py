@@ -197,6 +197,8 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
         console.print(Text(_axis_values_text(result.y)))
     _print_grid(console, result, files)
     _print_counts(console, result.counts())
+    for note in result.notes:
+        console.print(Text(f"note: {note}", style="yellow"))
     xu, xf = axis_unit(result.x.unit)
     above = result.boundary("above")
     if result.y is None:

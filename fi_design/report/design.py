@@ -516,7 +516,7 @@ def _design_sections(ctx: dict) -> list[dict]:
          "template": "assumptions.html.jinja"},
         {"id": "glossary", "title": "Glossary", "template": "glossary.html.jinja"},
         {"id": "references", "title": "References", "template": "references.html.jinja"},
-        {"id": "settings", "title": "Analysis settings", "template": "settings.html.jinja"},
+        {"id": "settings", "title": "Analysis settings", "template": "inputs.html.jinja"},
         {"id": "appendix", "title": "Appendix: spec, solver and software",
          "template": "appendix.html.jinja"},
     ]

@@ -54,6 +54,7 @@ def sweep_section(result: SweepResult, sid: str, title: str, lead: str = "",
                              for v, a in zip(result.design_point,
                                              [result.x] + ([result.y] if result.y else [])))
                  + ".")
+    paras += [f"Note: {n}." for n in result.notes]
     rows = tuple((k, num(v)) for k, v in counts.items())
     table = Table(("Verdict", "Points"), rows, caption="Points per verdict")
     figs: tuple[FigureBlock, ...] = ()

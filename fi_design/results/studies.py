@@ -187,6 +187,9 @@ class SweepResult(Result):
         and ``amplitude`` the peak to peak of the cycle it enters (0 where
         every move comes to rest), ``hunting_cycles`` NaN; ``"move"``: the
         paper's metric on the spec's own move.
+    notes : tuple of str
+        What the axes leave as the spec gives it and what that moves (a given
+        joint damping held while the stiffness varies: its damping ratio).
     """
 
     spec: Spec
@@ -203,6 +206,7 @@ class SweepResult(Result):
     fi_design_version: str = ""
     fi_design_source: Source = field(default_factory=current_source)
     measure: str = "move"
+    notes: tuple[str, ...] = ()
 
     @property
     def paths(self) -> tuple[str, ...]:
@@ -295,6 +299,7 @@ class SweepResult(Result):
             "verdict": self.verdict.tolist(),
             "counts": self.counts(),
             "points": [p.to_dict() for p in self.points],
+            "notes": list(self.notes),
             "run": self.run.to_dict(),
         }
 

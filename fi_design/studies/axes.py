@@ -18,7 +18,7 @@ from ..errors import SpecError
 from ..results.studies import Axis
 from ..spec.file import path_unit, value_at
 
-__all__ = ["make_axis", "parse_axis", "design_value", "is_number"]
+__all__ = ["make_axis", "parse_axis", "design_value", "is_number", "held_damping_note"]
 
 
 def make_axis(path: str, values: Sequence[float], log: bool = False,
@@ -230,3 +230,50 @@ def design_value(spec: _spec.Spec, path: str) -> float | None:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return None
     return float(value)
+
+
+#: Spec values that move the joint's stiffness or its masses, and so the damping ratio of a
+#: damping the spec gives.
+_JOINT_PATHS = ("isolator.stiffness", "isolator.stroke", "stage.mass", "cart.mass")
+
+
+def held_damping_note(spec: _spec.Spec, axes: Sequence[Axis]) -> str | None:
+    """A sentence when the axes vary the joint while the spec gives its damping, else None.
+
+    A given ``isolator.damping`` c [N s/m] is a damper's: it stays as the
+    stiffness (or the stroke, through the proposed stiffness, or a mass)
+    varies, so the joint's damping ratio c / (2 sqrt(k m1 m2 / (m1 + m2))) [-]
+    moves with it; a damping left to its default keeps the ratio instead.
+
+    Parameters
+    ----------
+    spec : Spec
+        The study's spec.
+    axes : sequence of Axis
+        The swept axes.
+
+    Returns
+    -------
+    str or None
+    """
+    import math
+
+    from ..display import number
+    from ..spec.paths import with_values
+
+    iso = spec.isolator
+    moving = [a for a in axes if a is not None and a.path in _JOINT_PATHS]
+    if iso is None or iso.damping is None or not moving:
+        return None
+    ratios = []
+    for a in moving:
+        for v in (float(np.min(a.values)), float(np.max(a.values))):
+            s = with_values(spec, {a.path: v})
+            k = _spec.drive_stiffness(s)
+            m1, m2 = s.stage.mass, s.cart.mass
+            ratios.append(iso.damping / (2.0 * math.sqrt(k * m1 * m2 / (m1 + m2))))
+    return (f"isolator.damping is given ({number(iso.damping)} N s/m) and held as "
+            f"{', '.join(a.path for a in moving)} varies: the joint's damping ratio runs "
+            f"from {number(min(ratios), 3)} to {number(max(ratios), 3)} over the axes (leave "
+            "the key out to keep the ratio of the default instead)")
+

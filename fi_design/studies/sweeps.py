@@ -18,7 +18,7 @@ from ..errors import ArgumentError, SpecError
 from ..execution import Executor
 from ..results.design import DesignResult
 from ..results.studies import Axis, DesignMap, SweepResult
-from .axes import design_value, make_axis
+from .axes import design_value, held_damping_note, make_axis
 from .cache import PointCache
 from .points import MAX_POINTS, ProgressCallback, evaluate, grid, point_result, verdict_grid
 
@@ -126,7 +126,8 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
         hunting_cycles=grid(points, shape, "hunting_cycles"),
         amplitude=grid(points, shape, "amplitude"), period=grid(points, shape, "period"),
         verdict=verdict_grid(points, shape), design_point=design, run=ev.run,
-        fi_design_version=__version__, measure=measure)
+        fi_design_version=__version__, measure=measure,
+        notes=tuple(n for n in (held_damping_note(spec, (ax, ay)),) if n))
 
 
 def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
