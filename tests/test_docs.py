@@ -139,7 +139,8 @@ def test_the_documentation_stands_alone():
         assert r.exit_code == 0 and "DESIGN.md" not in r.output, (name, r.output)
 
 
-@pytest.mark.parametrize("page", ["README.md", "docs/library.md", "docs/measured.md"])
+@pytest.mark.parametrize("page", ["README.md", "docs/library.md", "docs/measured.md",
+                                  "docs/paper_reproduction.md"])
 def test_python_examples_run(page, monkeypatch, shared_designs):
     """Every ```python block runs; one followed by "prints" and a ```text block prints that
     text (the sweep example promised a boundary in Hz and printed nan)."""
