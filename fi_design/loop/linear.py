@@ -74,7 +74,7 @@ from ..results import Status, frozen_array
 from ..results.controller import ControlLaw, PidGains
 from ..results.linear import (CRITERIA, AchievableCrossover, CaseMargins, GainCrossing,
                               LoopAnalysis, PhaseCrossing, loop_crossover)
-from ..spec import Spec
+from ..spec import Requirements, Spec
 
 __all__ = [
     "ISOLATED_CASES", "RIGID_CASES", "CASE_DESCRIPTIONS", "CASE_NUMBERS", "SCAN_LIMIT",
@@ -566,7 +566,8 @@ def _judge(m: CaseMargins, requirements, band_low: float) -> CaseMargins:
                    criteria=criteria, gain_crossings=gains)
 
 
-def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None) -> LoopAnalysis:
+def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None,
+            requirements: Requirements | None = None) -> LoopAnalysis:
     """Margins of all limit cases with the model's controller.
 
     Parameters
@@ -578,6 +579,10 @@ def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None) -> Lo
     cases : sequence of LimitCase, optional
         Precomputed :func:`limit_cases` of the model (saves rebuilding them
         in a loop).
+    requirements : fi_design.spec.Requirements, optional
+        The requirements the margins are judged against; default the
+        model's (the recommendation judges its candidates with the margins
+        raised by their reserve).
 
     Returns
     -------
@@ -587,7 +592,7 @@ def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None) -> Lo
     model = as_model(model)
     lcs = limit_cases(model) if cases is None else tuple(cases)
     law = model.law
-    out = _margins(model, lcs, first_fail=False)
+    out = _margins(model, lcs, first_fail=False, requirements=requirements)
     k = model.joint.stiffness if model.joint is not None else None
     top, which = loop_crossover(out)
     return LoopAnalysis(crossover=law.crossover, stiffness=k, delay=delay_time(model),
@@ -595,8 +600,11 @@ def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None) -> Lo
                         loop_crossover=top, loop_crossover_case=which)
 
 
-def _margins(model: Model, lcs: Sequence[LimitCase], first_fail: bool) -> list[CaseMargins]:
-    """Judged margins of each case (stopping at the first failing one when ``first_fail``)."""
+def _margins(model: Model, lcs: Sequence[LimitCase], first_fail: bool,
+             requirements: Requirements | None = None) -> list[CaseMargins]:
+    """Judged margins of each case (stopping at the first failing one when ``first_fail``),
+    against ``requirements`` (default the model's)."""
+    req = model.requirements if requirements is None else requirements
     law = model.law
     cn, cd = controller_polynomials(law)
     dn, dd = delay_polynomials(model)
@@ -606,7 +614,7 @@ def _margins(model: Model, lcs: Sequence[LimitCase], first_fail: bool) -> list[C
     for lc in lcs:
         m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den),
                                 name=lc.name, description=lc.description),
-                   model.requirements, low)
+                   req, low)
         out.append(m)
         if first_fail and not m.passed:
             break
