@@ -55,8 +55,8 @@ from .results.friction import FrictionLaw
 from .results.mechanism import Mode
 from .results.steps import FlexureResult
 
-__all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "apply_effects",
-           "given_mode"]
+__all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "require_model",
+           "apply_effects", "given_mode"]
 
 #: Friction models of the spec (``friction.model``).
 FRICTION_MODELS = ("lugre", "switch")
@@ -619,6 +619,24 @@ def given_mode(mode: _spec.ParasiticMode) -> Mode:
 def as_model(spec_or_model) -> Model:
     """A model as given, or the spec resolved (:func:`resolve`)."""
     return spec_or_model if isinstance(spec_or_model, Model) else resolve(spec_or_model)
+
+
+def require_model(value: Any) -> Model:
+    """``value``, checked to be a :class:`Model`.
+
+    The analyses take a model only; the entry points (:func:`fi_design.design`,
+    :func:`fi_design.simulate`, the stage-level answers, the studies, the
+    recommendation) resolve a spec once at their edge (:func:`as_model`).
+
+    Raises
+    ------
+    ArgumentError
+        ``value`` is not a model (a spec, say): resolve it first.
+    """
+    if not isinstance(value, Model):
+        raise ArgumentError(f"expected a Model, got {type(value).__name__}: resolve a spec "
+                            "once with fi_design.resolve(spec) and pass the model")
+    return value
 
 
 def apply_effects(params: PlantParameters, entries) -> PlantParameters:

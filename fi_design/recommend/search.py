@@ -330,7 +330,7 @@ class _Search:
         return True, (fx, corners, r)
 
 
-def recommend(spec: _spec.Spec | str | Any, *, executor: Any = None,
+def recommend(spec: _spec.Spec | Model | str | Any, *, executor: Any = None,
               progress: Callable[[str], None] | None = None) -> RecommendResult:
     """Search a buildable isolator (and the rule's crossover) that the sign-off passes.
 
