@@ -16,7 +16,8 @@ The public API (imported lazily, so ``import fi_design`` stays fast):
   the sign-off verdict, with a recommendation that passes when it fails;
 - :func:`recommend` -- search the isolator and crossover for a design that passes;
 - :func:`resolve` -- the spec resolved once into a :class:`Model` (every
-  default filled in; ``model.at(...)`` varies it);
+  default filled in; ``model.varied({path: value})`` varies it, ``model.at(...)``
+  is the fast form for its physical values);
 - :func:`simulate` -- one nonlinear simulation;
 - :func:`sweep`, :func:`robustness` -- parameter studies;
 - :func:`load_measurement`, :func:`reconcile` -- compare with measured data;

@@ -9,14 +9,28 @@ every number the linear analysis, the simulation, the confirmation, the
 verdict and the studies need, in SI. Like pvlib's ``ModelChain``, the choices
 are made once and every step runs on the resolved model.
 
-A study or a search varies the model with :meth:`Model.at`, which returns a
-new, checked model (another crossover, stiffness, stroke, joint damping,
-friction model or effects list), never by rebuilding it from the spec.
+A study, a robustness draw or a search candidate varies the model by a method
+of the model that returns a new, checked one, never by rebuilding it from the
+spec by hand:
+
+- :meth:`Model.varied` is the one general way: any spec values at their
+  dotted paths (``{"isolator.stroke": 1e-4, "controller.crossover": 12.0}``),
+  the spec validated again (:func:`fi_design.spec.paths.with_values`) and
+  resolved once; the new model's spec holds the values, so everything that
+  reads the spec (the robustness study of the sign-off) sees them.
+- :meth:`Model.at` is its fast form for the physical values an analysis
+  sweeps (crossover, stiffness, stroke, joint damping, friction model,
+  effects, masses, delay, filters, the computed modes' scale): the spec is
+  neither validated nor resolved again and the guide, once worked out, is
+  kept; the model's spec stays as it was and :attr:`Model.changed` lists what
+  differs from it.
+
 :meth:`Model.plant` gives the kernel's parameters of one plant.
 
 The public entry points (:func:`fi_design.design`, :func:`fi_design.simulate`,
-the studies) take a spec and resolve it at the top; they take a model as well
-(:func:`as_model`).
+the studies, the recommendation) take a spec and resolve it once at their edge
+(:func:`as_model`); they take a model as well. The analyses below them take a
+model only.
 
 Units: masses kg, stiffnesses N/m, dampings N s/m, forces N, velocities m/s,
 lengths m, the crossover Hz.
@@ -25,8 +39,10 @@ lengths m, the crossover Hz.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from functools import cached_property
+from typing import Any
 
 from . import effects as _effects
 from . import spec as _spec
@@ -39,8 +55,8 @@ from .results.friction import FrictionLaw
 from .results.mechanism import Mode
 from .results.steps import FlexureResult
 
-__all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "apply_effects",
-           "given_mode"]
+__all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "require_model",
+           "apply_effects", "given_mode"]
 
 #: Friction models of the spec (``friction.model``).
 FRICTION_MODELS = ("lugre", "switch")
@@ -105,9 +121,11 @@ class Limiter:
 class Model:
     """A spec resolved into the numbers every analysis reads (SI).
 
-    Build it with :func:`resolve`; vary it with :meth:`at`. The physical
-    values live here, and only here: read them from the model, not from
-    ``spec``, which may differ after :meth:`at`.
+    Build it with :func:`resolve`; vary it with :meth:`varied` (any spec
+    value by its dotted path, resolved again) or its fast form :meth:`at`
+    (the physical values, the spec kept). The physical values live here, and
+    only here: read them from the model, not from ``spec``, which may differ
+    after :meth:`at`.
 
     Attributes
     ----------
@@ -141,7 +159,8 @@ class Model:
         in order by :meth:`plant`.
     changed : tuple of str
         The spec paths whose values :meth:`at` changed, in order (empty: the
-        spec as resolved). A study that varies the spec does not see them.
+        spec as resolved, also after :meth:`varied`). A study that varies the
+        spec does not see them.
     mode_scale : float
         Factor on the frequencies of the guide's computed modes [-] (1: as
         computed; a reserve check lowers them).
@@ -263,12 +282,68 @@ class Model:
 
     # ---- variants
 
+    def varied(self, values: Mapping[str, Any]) -> "Model":
+        """The model of this model's spec with values at dotted spec paths, resolved once.
+
+        The one general way to vary a design: a study axis, a robustness
+        draw, a search candidate. The spec is validated again with the values
+        (:func:`fi_design.spec.paths.with_values`) and resolved
+        (:func:`resolve`) once, so the new model's spec holds them: whatever
+        reads the spec (the sign-off's robustness study, the report) sees the
+        same design as the analyses. For the physical values it names,
+        :meth:`at` is the fast form (no validation of the whole spec, the
+        guide kept).
+
+        Parameters
+        ----------
+        values : mapping of str to value
+            Dotted spec path (``"isolator.stroke"``,
+            ``"effects[type=time_delay].delay"``) to the new value: an SI
+            number, a string with units (``"0.3 mm"``) or None to clear an
+            optional value, as the YAML file takes it.
+
+        Returns
+        -------
+        Model
+            A new model with :attr:`changed` empty; this one is unchanged.
+
+        Raises
+        ------
+        SpecError
+            An unknown path or a value the spec refuses; the message names
+            the path.
+        ArgumentError
+            This model was varied with :meth:`at` (its values are not in its
+            spec, so they would be lost): vary the resolved model instead.
+
+        Examples
+        --------
+        >>> from fi_design.spec.file import load_spec
+        >>> model = resolve(load_spec("examples/paper_setup.yaml"))
+        >>> m = model.varied({"isolator.stroke": "0.5 mm", "controller.crossover": 10.0})
+        >>> m.joint.stroke, m.crossover, m.spec.isolator.stroke, m.changed
+        (0.0005, 10.0, 0.0005, ())
+        """
+        if self.changed or self.mode_scale != 1.0:
+            what = ", ".join(self.changed + (("mode_scale",) if self.mode_scale != 1.0 else ()))
+            raise ArgumentError(f"this model differs from its spec at {what} (Model.at): "
+                                "vary the model resolved from the spec, with every value "
+                                "in Model.varied")
+        from .spec.paths import with_values
+
+        return resolve(with_values(self.spec, values))
+
     def at(self, *, crossover: float | None = None, stiffness: float | None = None,
            stroke: float | None = None, damping: float | None = None,
            friction_model: str | None = None, effects=None,
            masses: tuple[float, float] | None = None, delay: float | None = None,
            mode_scale: float | None = None, filters=None) -> "Model":
-        """The same model with some values changed, checked like the spec checks them.
+        """The same model with some physical values changed, checked like the spec checks them.
+
+        The fast form of :meth:`varied` for the values an analysis sweeps: the
+        spec is neither validated nor resolved again, the guide once worked
+        out is kept while the joint stays; the model's spec stays as it was
+        and :attr:`changed` names the paths that now differ from it.
 
         Parameters
         ----------
@@ -325,7 +400,9 @@ class Model:
             ("controller.crossover", crossover), ("isolator.stiffness", stiffness),
             ("isolator.stroke", stroke), ("isolator.damping", damping),
             ("friction.model", friction_model), ("effects", effects),
-            ("controller.filters", filters)) if value is not None]
+            ("controller.filters", filters), ("controller.delay", delay),
+            ("stage.mass", None if masses is None else masses[0]),
+            ("cart.mass", None if masses is None else masses[1])) if value is not None]
         law, friction = model.law, model.friction
         if crossover is not None:
             law = at_crossover(law, _positive(crossover, "controller.crossover", "Hz"))
@@ -542,6 +619,24 @@ def given_mode(mode: _spec.ParasiticMode) -> Mode:
 def as_model(spec_or_model) -> Model:
     """A model as given, or the spec resolved (:func:`resolve`)."""
     return spec_or_model if isinstance(spec_or_model, Model) else resolve(spec_or_model)
+
+
+def require_model(value: Any) -> Model:
+    """``value``, checked to be a :class:`Model`.
+
+    The analyses take a model only; the entry points (:func:`fi_design.design`,
+    :func:`fi_design.simulate`, the stage-level answers, the studies, the
+    recommendation) resolve a spec once at their edge (:func:`as_model`).
+
+    Raises
+    ------
+    ArgumentError
+        ``value`` is not a model (a spec, say): resolve it first.
+    """
+    if not isinstance(value, Model):
+        raise ArgumentError(f"expected a Model, got {type(value).__name__}: resolve a spec "
+                            "once with fi_design.resolve(spec) and pass the model")
+    return value
 
 
 def apply_effects(params: PlantParameters, entries) -> PlantParameters:

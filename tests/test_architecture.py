@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import ast
 import json
+import re
 import subprocess
 import sys
 
@@ -242,3 +244,65 @@ def test_tests_mirror_the_packages():
     assert folders <= packages, sorted(folders - packages)
     top = sorted(p.name for p in (ROOT / "tests").glob("test_*.py"))
     assert len(top) <= 8, top
+
+
+# --------------------------------------------------------------------------- the model as currency
+
+#: The functions that take a spec or its model: the entry points, which resolve a spec once at
+#: their edge (fi_design.model.as_model). Every analysis below them takes a Model only.
+SPEC_OR_MODEL_ENTRY_POINTS = {
+    ("guideline/evaluate.py", "evaluate"),     # fi_design.design's steps, confirmation, verdict
+    ("simulation/run.py", "simulate"),         # fi_design.simulate
+    ("stage/judge.py", "stage_hunting"),       # the stage-level answer
+    ("stage/moves.py", "stage_hunts"),         # every move of the family
+    ("recommend/search.py", "recommend"),      # fi_design.recommend
+}
+
+
+def _names(node: ast.AST) -> set[str]:
+    """The names a type annotation mentions (``_spec.Spec`` as ``Spec``)."""
+    out = set()
+    for sub in ast.walk(node):
+        if isinstance(sub, ast.Name):
+            out.add(sub.id)
+        elif isinstance(sub, ast.Attribute):
+            out.add(sub.attr)
+        elif isinstance(sub, ast.Constant) and isinstance(sub.value, str):
+            out |= set(re.findall(r"[A-Za-z_]\w*", sub.value))
+    return out
+
+
+def spec_or_model_signatures(package) -> set[tuple[str, str]]:
+    """(module path, function) of every function with a parameter annotated with both a Model
+    and a Spec (``Model | Spec``, ``Spec | Model | str``, ...), by an AST scan."""
+    found = set()
+    for path in sorted(package.rglob("*.py")):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            a = node.args
+            for arg in a.posonlyargs + a.args + a.kwonlyargs:
+                if arg.annotation is not None and {"Model", "Spec"} <= _names(arg.annotation):
+                    found.add((path.relative_to(package).as_posix(), node.name))
+    return found
+
+
+def test_only_the_entry_points_take_a_spec_or_a_model():
+    """The analyses take a Model; a spec is resolved once at the entry points (issue 32)."""
+    found = spec_or_model_signatures(ROOT / "fi_design")
+    assert found == SPEC_OR_MODEL_ENTRY_POINTS, (
+        f"take Model | Spec but are no entry point: {sorted(found - SPEC_OR_MODEL_ENTRY_POINTS)}; "
+        f"entry points that no longer do: {sorted(SPEC_OR_MODEL_ENTRY_POINTS - found)}")
+
+
+def test_an_analysis_refuses_a_spec_with_a_clear_message(paper_spec):
+    from fi_design.errors import ArgumentError
+    from fi_design.guideline.steps import step2_crossover
+    from fi_design.loop import linear
+    from fi_design.model import resolve
+
+    assert step2_crossover(resolve(paper_spec)).desired == 8.0
+    for call in (lambda: step2_crossover(paper_spec), lambda: linear.analyse(paper_spec)):
+        with pytest.raises(ArgumentError, match="expected a Model, got Spec.*resolve"):
+            call()

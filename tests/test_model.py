@@ -155,6 +155,42 @@ def test_at_refuses_what_the_spec_refuses(paper_spec, change, path):
     assert m.crossover == 8.0 and m.joint.stiffness == 6667.0  # unchanged
 
 
+def test_varied_is_the_spec_with_the_values_resolved(paper_spec):
+    """Model.varied: the spec edited at dotted paths, validated and resolved once; its spec
+    holds the values (nothing differs from it) and the fast form at() gives the same plant."""
+    from fi_design.spec.file import with_values
+
+    m = resolve(paper_spec)
+    values = {"isolator.stroke": "0.5 mm", "isolator.stiffness": 4000.0,
+              "controller.crossover": 11.0, "friction.coulomb": 2.5}
+    v = m.varied(values)
+    fresh = resolve(with_values(paper_spec, values))
+    assert v.plant(True) == fresh.plant(True) and v.law == fresh.law
+    assert v.spec.isolator.stroke == 0.5e-3 and v.spec.friction.coulomb == 2.5
+    assert v.changed == () and m.spec is paper_spec  # the model it came from is unchanged
+    fast = m.at(stroke=0.5e-3, stiffness=4000.0, crossover=11.0)
+    assert fast.plant(True) == m.varied({k: x for k, x in values.items()
+                                         if k != "friction.coulomb"}).plant(True)
+    assert fast.changed and fast.spec is paper_spec
+    with pytest.raises(SpecError, match="friction.statc"):
+        m.varied({"friction.statc": 1.0})
+    with pytest.raises(SpecError, match="friction"):
+        m.varied({"friction.static": 0.5})  # below friction.coulomb (1 N)
+
+
+def test_varied_refuses_a_model_varied_by_at(paper_spec):
+    """at() leaves the spec as written, so varying its spec would drop the at() values."""
+    from fi_design.errors import ArgumentError
+
+    m = resolve(paper_spec)
+    for fast, where in ((m.at(crossover=10.0), "controller.crossover"),
+                        (m.at(delay=1e-3), "controller.delay"),
+                        (m.at(masses=(m.m1 * 1.1, m.m2)), "stage.mass, cart.mass"),
+                        (m.at(mode_scale=0.9), "mode_scale")):
+        with pytest.raises(ArgumentError, match=where):
+            fast.varied({"isolator.stroke": 1e-3})
+
+
 def test_at_refuses_isolator_values_without_an_isolator(paper_spec):
     from fi_design.spec import EFFECT_MODELS
 
@@ -314,7 +350,7 @@ def test_a_limit_case_is_judged_where_its_margins_are_computed(paper_spec):
     from fi_design.guideline.steps import step2_crossover
     from fi_design.results import Status
 
-    cases = linear.analyse(paper_spec).cases
+    cases = linear.analyse(resolve(paper_spec)).cases
     by_name = {c.name: c for c in cases}
     for c in cases:
         assert c.status == (Status.FAIL if not c.passed else
@@ -324,7 +360,7 @@ def test_a_limit_case_is_judged_where_its_margins_are_computed(paper_spec):
     stuck = by_name["stuck_limited"]  # the integrator against the bristles: crosses far below
     assert not stuck.in_band and stuck.status == Status.INFO
     assert stuck.criteria["phase margin"] == Status.INFO
-    checks = {ch.name: ch for ch in step2_crossover(paper_spec).checks}
+    checks = {ch.name: ch for ch in step2_crossover(resolve(paper_spec)).checks}
     for c in cases:
         for criterion, key in (("phase margin", "phase_margin"), ("gain margin", "gain_margin")):
             assert checks[f"{key}.{c.name}"].status == c.criteria[criterion]

@@ -31,14 +31,14 @@ import math
 
 from ..controller import discrete_controller, drive_gains
 from ..display import number, quantity
-from ..model import Model, as_model
+from ..model import Model, require_model
 from ..results import Check, Status
 from ..results.controller import ControlLaw
 from ..results.stage import STATIC_ERROR_FORMULA
 from ..results.design import (Confirmation, CrossoverResult, DesignResult, FlexureResult,
                               FrictionGapResult, IsolatorAdvice, ModeSeparation, NotchSuggestion,
                               PidResult, StiffnessResult)
-from ..spec import Spec, proposed_stiffness, stiffness_limit
+from ..spec import proposed_stiffness, stiffness_limit
 from .verdict import friction_gap_judged
 
 __all__ = [
@@ -62,13 +62,13 @@ def _g(x: float | None, digits: int = 4) -> str:
 # --------------------------------------------------------------------------- step 1
 
 
-def step1_friction_gap(model: Model | Spec) -> FrictionGapResult:
+def step1_friction_gap(model: Model) -> FrictionGapResult:
     """Guideline step 1: compare Fs - Fc with ``requirements.friction_gap``.
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
 
     Returns
     -------
@@ -80,7 +80,7 @@ def step1_friction_gap(model: Model | Spec) -> FrictionGapResult:
         (what it is there for; the simulation confirms it) or with a loop
         without integrator (no hunting by the paper's mechanism).
     """
-    model = as_model(model)
+    model = require_model(model)
     f = model.friction
     gap = f.Fs - f.Fc
     thr = model.requirements.friction_gap
@@ -109,7 +109,7 @@ def step1_friction_gap(model: Model | Spec) -> FrictionGapResult:
 # --------------------------------------------------------------------------- step 2
 
 
-def step2_crossover(model: Model | Spec) -> CrossoverResult:
+def step2_crossover(model: Model) -> CrossoverResult:
     """Guideline step 2: desired versus achievable crossover.
 
     The limit cases use the model's joint stiffness (the proposed one when the
@@ -117,8 +117,8 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
 
     Returns
     -------
@@ -133,7 +133,7 @@ def step2_crossover(model: Model | Spec) -> CrossoverResult:
     from ..loop import linear
     from ..loop.notch import limiting_mode, notched, with_notch
 
-    model = as_model(model)
+    model = require_model(model)
     req = model.requirements
     fc = model.crossover
     cases = linear.limit_cases(model)
@@ -252,7 +252,7 @@ def _criterion_check(case, criterion: str, name: str, value, limit, unit: str, m
 # --------------------------------------------------------------------------- step 3
 
 
-def step3_stiffness(model: Model | Spec) -> StiffnessResult:
+def step3_stiffness(model: Model) -> StiffnessResult:
     """Guideline step 3: maximum drive stiffness from static friction and stroke.
 
     ``k_max = Fs / (stiffness_safety * stroke)``: at full stroke the flexure must
@@ -262,8 +262,8 @@ def step3_stiffness(model: Model | Spec) -> StiffnessResult:
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved). Without an isolator the
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`). Without an isolator the
         suggested stroke (:data:`SUGGESTED_STROKE`) is used and the result is
         a suggestion.
 
@@ -272,7 +272,7 @@ def step3_stiffness(model: Model | Spec) -> StiffnessResult:
     StiffnessResult
         k_max, the chosen stiffness and why, with a check chosen <= k_max.
     """
-    model = as_model(model)
+    model = require_model(model)
     spec = model.spec
     Fs = model.friction.Fs
     safety = model.requirements.stiffness_safety
@@ -317,14 +317,14 @@ def step3_stiffness(model: Model | Spec) -> StiffnessResult:
                            checks=(check,))
 
 
-def step3_flexure(model: Model | Spec,
+def step3_flexure(model: Model,
                   stiffness: StiffnessResult | None = None) -> FlexureResult | None:
     """Guideline step 3, second half: the isolator's leaf-spring guide as a mechanism.
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
     stiffness : StiffnessResult, optional
         Unused; kept for callers that pass step 3's stiffness result.
 
@@ -336,7 +336,7 @@ def step3_flexure(model: Model | Spec,
         (:attr:`fi_design.model.Model.flexure`): six stiffnesses, gravity,
         stress and modes.
     """
-    return as_model(model).flexure
+    return require_model(model).flexure
 
 
 # --------------------------------------------------------------------------- step 4
@@ -354,7 +354,7 @@ def controller_words(c: ControlLaw) -> str:
     return ", ".join(parts)
 
 
-def step4_pid(model: Model | Spec) -> PidResult:
+def step4_pid(model: Model) -> PidResult:
     """Guideline step 4: PID gains from the moving mass and the desired crossover.
 
     With the hardware's own gains (``controller.gains``) the loop uses them;
@@ -363,8 +363,8 @@ def step4_pid(model: Model | Spec) -> PidResult:
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
 
     Returns
     -------
@@ -375,7 +375,7 @@ def step4_pid(model: Model | Spec) -> PidResult:
         static error bound (Fs + |offset|) / kp (no hunting by the paper's
         mechanism; :attr:`fi_design.model.Model.static_error_bound`).
     """
-    model = as_model(model)
+    model = require_model(model)
     ctl = model.spec.controller
     law = model.law
     g = law.rule
@@ -438,16 +438,16 @@ def step4_pid(model: Model | Spec) -> PidResult:
 # --------------------------------------------------------------------------- no isolator
 
 
-def suggested_isolator(model: Model | Spec) -> tuple[float, float]:
+def suggested_isolator(model: Model) -> tuple[float, float]:
     """Stroke [m] and drive stiffness [N/m] to start from when the spec has no isolator.
 
     The paper's 0.3 mm stroke (:data:`SUGGESTED_STROKE`) and k = Fs / (2 x
     safety x stroke), half the maximum of step 3.
     """
-    return SUGGESTED_STROKE, proposed_stiffness(as_model(model).spec, SUGGESTED_STROKE)
+    return SUGGESTED_STROKE, proposed_stiffness(require_model(model).spec, SUGGESTED_STROKE)
 
 
-def isolator_advice(model: Model | Spec, gap: FrictionGapResult, crossover: CrossoverResult,
+def isolator_advice(model: Model, gap: FrictionGapResult, crossover: CrossoverResult,
                     simulation: Confirmation | None = None) -> IsolatorAdvice:
     """For a stage without isolator: is one needed, and which one.
 
@@ -459,8 +459,8 @@ def isolator_advice(model: Model | Spec, gap: FrictionGapResult, crossover: Cros
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved) of a stage without isolator.
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`) of a stage without isolator.
     gap : FrictionGapResult
         Step 1.
     crossover : CrossoverResult
@@ -480,7 +480,7 @@ def isolator_advice(model: Model | Spec, gap: FrictionGapResult, crossover: Cros
         recommendation (``fi-design recommend``), the rule's isolator failing
         too.
     """
-    model = as_model(model)
+    model = require_model(model)
     s, k = suggested_isolator(model)
     kmax = stiffness_limit(model.spec, s)
     rule = (f"the rule's first isolator (a {quantity(s, 'm', 3)} stroke, the paper's, and k = {_g(k)} "

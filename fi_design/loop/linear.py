@@ -69,12 +69,12 @@ import numpy as np
 from ..controller.polynomials import controller_polynomials, pid_polynomials, reference_polynomials
 from ..errors import SpecError
 from ..mechanism.modes import mode_factor, mode_term
-from ..model import Model, as_model
+from ..model import Model, require_model
 from ..results import Status, frozen_array
 from ..results.controller import ControlLaw, PidGains
 from ..results.linear import (CRITERIA, AchievableCrossover, CaseMargins, GainCrossing,
                               LoopAnalysis, PhaseCrossing, loop_crossover)
-from ..spec import Spec
+from ..spec import Requirements
 
 __all__ = [
     "ISOLATED_CASES", "RIGID_CASES", "CASE_DESCRIPTIONS", "CASE_NUMBERS", "SCAN_LIMIT",
@@ -190,13 +190,13 @@ def _two_mass(m1: float, m2: float, k: float, c: float, cart_stiffness: float,
     return sys, num, den
 
 
-def limit_cases(model: Model | Spec, modes=None) -> tuple[LimitCase, ...]:
+def limit_cases(model: Model, modes=None) -> tuple[LimitCase, ...]:
     """The linear limit cases of a model.
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved): masses, friction, the joint's
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`): masses, friction, the joint's
         stiffness and damping (:meth:`~fi_design.model.Model.at` varies them),
         the parasitic modes.
     modes : sequence of fi_design.results.mechanism.Mode, optional
@@ -209,7 +209,7 @@ def limit_cases(model: Model | Spec, modes=None) -> tuple[LimitCase, ...]:
         Four cases for an isolated stage (:data:`ISOLATED_CASES`), two without
         isolator (:data:`RIGID_CASES`).
     """
-    model = as_model(model)
+    model = require_model(model)
     f = model.friction
     m1, m2, M = model.m1, model.m2, model.total_mass
     s0, s1 = f.sigma0, f.sigma1
@@ -258,13 +258,13 @@ def _case(model: Model, case) -> LimitCase:
 # --------------------------------------------------------------------------- controller, delay
 
 
-def delay_time(model: Model | Spec) -> float:
+def delay_time(model: Model) -> float:
     """Loop delay of the linear analysis.
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
 
     Returns
     -------
@@ -272,27 +272,27 @@ def delay_time(model: Model | Spec) -> float:
         The controller's computational delay plus half a sample period
         (zero-order hold) when it samples [s].
     """
-    law = as_model(model).law
+    law = require_model(model).law
     t = law.delay
     if law.sample_period > 0.0:
         t += 0.5 * law.sample_period
     return t
 
 
-def delay_polynomials(model: Model | Spec) -> tuple[np.ndarray, np.ndarray]:
+def delay_polynomials(model: Model) -> tuple[np.ndarray, np.ndarray]:
     """Pade approximation of :func:`delay_time` (order ``controller.pade_order``).
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
 
     Returns
     -------
     num, den : numpy.ndarray
         Descending powers of s [rad/s]; ``([1.], [1.])`` without delay.
     """
-    model = as_model(model)
+    model = require_model(model)
     t = delay_time(model)
     if t <= 0.0:
         return np.array([1.0]), np.array([1.0])
@@ -316,13 +316,13 @@ def controller_tf(controller: ControlLaw | PidGains):
     return control.tf(*controller_polynomials(controller))
 
 
-def delay_tf(model: Model | Spec):
+def delay_tf(model: Model):
     """The Pade delay model as a transfer function.
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
 
     Returns
     -------
@@ -332,15 +332,15 @@ def delay_tf(model: Model | Spec):
     return control.tf(*delay_polynomials(model))
 
 
-def loop_polynomials(model: Model | Spec, case,
+def loop_polynomials(model: Model, case,
                      controller: ControlLaw | PidGains | None = None) \
         -> tuple[np.ndarray, np.ndarray]:
     """Numerator and denominator of the loop L = C D P of one case.
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved); ``model.at(crossover=...,
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`); ``model.at(crossover=...,
         stiffness=...)`` gives the loop at another crossover or stiffness.
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
@@ -352,21 +352,21 @@ def loop_polynomials(model: Model | Spec, case,
     num, den : numpy.ndarray
         Descending powers of s [rad/s]; L is dimensionless.
     """
-    model = as_model(model)
+    model = require_model(model)
     lc = _case(model, case)
     cn, cd = controller_polynomials(model.law if controller is None else controller)
     dn, dd = delay_polynomials(model)
     return (np.polymul(np.polymul(cn, dn), lc.num), np.polymul(np.polymul(cd, dd), lc.den))
 
 
-def loop_transfer_function(model: Model | Spec, case,
+def loop_transfer_function(model: Model, case,
                            controller: ControlLaw | PidGains | None = None):
     """Loop transfer function L(s) = C(s) D(s) P(s) of one limit case.
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
     controller : ControlLaw or PidGains, optional
@@ -380,13 +380,13 @@ def loop_transfer_function(model: Model | Spec, case,
     return control.tf(*loop_polynomials(model, case, controller))
 
 
-def sensitivity(model: Model | Spec, case, controller: ControlLaw | PidGains | None = None):
+def sensitivity(model: Model, case, controller: ControlLaw | PidGains | None = None):
     """Sensitivity S = 1 / (1 + L) of one limit case.
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
     controller : ControlLaw or PidGains, optional
@@ -401,7 +401,7 @@ def sensitivity(model: Model | Spec, case, controller: ControlLaw | PidGains | N
     return control.tf(den, np.polyadd(den, num))
 
 
-def complementary_sensitivity(model: Model | Spec, case,
+def complementary_sensitivity(model: Model, case,
                               controller: ControlLaw | PidGains | None = None):
     """The closed loop from the reference to x1 of one limit case.
 
@@ -411,8 +411,8 @@ def complementary_sensitivity(model: Model | Spec, case,
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
     case : str, int or LimitCase
         Case name (``"stuck_free"``), number (1 to 4) or a :class:`LimitCase`.
     controller : ControlLaw or PidGains, optional
@@ -423,7 +423,7 @@ def complementary_sensitivity(model: Model | Spec, case,
     control.TransferFunction
         T(s), dimensionless.
     """
-    model = as_model(model)
+    model = require_model(model)
     ctl = model.law if controller is None else controller
     num, den = loop_polynomials(model, case, ctl)
     closed = np.polyadd(den, num)
@@ -566,28 +566,33 @@ def _judge(m: CaseMargins, requirements, band_low: float) -> CaseMargins:
                    criteria=criteria, gain_crossings=gains)
 
 
-def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None) -> LoopAnalysis:
+def analyse(model: Model, cases: Sequence[LimitCase] | None = None,
+            requirements: Requirements | None = None) -> LoopAnalysis:
     """Margins of all limit cases with the model's controller.
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved): plant, controller, delay,
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`): plant, controller, delay,
         requirements. ``model.at(crossover=..., stiffness=...)`` analyses
         another crossover or stiffness.
     cases : sequence of LimitCase, optional
         Precomputed :func:`limit_cases` of the model (saves rebuilding them
         in a loop).
+    requirements : fi_design.spec.Requirements, optional
+        The requirements the margins are judged against; default the
+        model's (the recommendation judges its candidates with the margins
+        raised by their reserve).
 
     Returns
     -------
     LoopAnalysis
         Per-case margins judged against ``requirements``.
     """
-    model = as_model(model)
+    model = require_model(model)
     lcs = limit_cases(model) if cases is None else tuple(cases)
     law = model.law
-    out = _margins(model, lcs, first_fail=False)
+    out = _margins(model, lcs, first_fail=False, requirements=requirements)
     k = model.joint.stiffness if model.joint is not None else None
     top, which = loop_crossover(out)
     return LoopAnalysis(crossover=law.crossover, stiffness=k, delay=delay_time(model),
@@ -595,8 +600,11 @@ def analyse(model: Model | Spec, cases: Sequence[LimitCase] | None = None) -> Lo
                         loop_crossover=top, loop_crossover_case=which)
 
 
-def _margins(model: Model, lcs: Sequence[LimitCase], first_fail: bool) -> list[CaseMargins]:
-    """Judged margins of each case (stopping at the first failing one when ``first_fail``)."""
+def _margins(model: Model, lcs: Sequence[LimitCase], first_fail: bool,
+             requirements: Requirements | None = None) -> list[CaseMargins]:
+    """Judged margins of each case (stopping at the first failing one when ``first_fail``),
+    against ``requirements`` (default the model's)."""
+    req = model.requirements if requirements is None else requirements
     law = model.law
     cn, cd = controller_polynomials(law)
     dn, dd = delay_polynomials(model)
@@ -606,7 +614,7 @@ def _margins(model: Model, lcs: Sequence[LimitCase], first_fail: bool) -> list[C
     for lc in lcs:
         m = _judge(loop_margins(np.polymul(ln, lc.num), np.polymul(ld, lc.den),
                                 name=lc.name, description=lc.description),
-                   model.requirements, low)
+                   req, low)
         out.append(m)
         if first_fail and not m.passed:
             break
@@ -620,7 +628,7 @@ def _units(criterion: str) -> str:
     return {"phase margin": "deg", "gain margin": "dB", "modulus margin": ""}.get(criterion, "")
 
 
-def achievable_crossover(model: Model | Spec, start: float | None = None,
+def achievable_crossover(model: Model, start: float | None = None,
                          stop: float | None = None, rtol: float = 1e-3) -> AchievableCrossover:
     """The highest crossover at which all limit cases meet the requirements.
 
@@ -635,8 +643,8 @@ def achievable_crossover(model: Model | Spec, start: float | None = None,
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved); its joint stiffness and the
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`); its joint stiffness and the
         desired crossover.
     start : float, optional
         Lowest crossover scanned [Hz]; default the smaller of :data:`SCAN_START`
@@ -653,7 +661,7 @@ def achievable_crossover(model: Model | Spec, start: float | None = None,
     AchievableCrossover
         The frequency and what limits it.
     """
-    model = as_model(model)
+    model = require_model(model)
     lcs = limit_cases(model)
     req = model.requirements
     sep = req.parasitic_separation

@@ -28,10 +28,9 @@ from typing import Sequence
 import numpy as np
 
 from . import linear
-from ..model import Model, as_model
+from ..model import Model, require_model
 from ..results import frozen_array
 from ..results.steps import CaseResponse, CrossoverResult, LoopResponses
-from ..spec import Spec
 
 __all__ = ["loop_responses", "frequency_grid"]
 
@@ -122,7 +121,7 @@ def frequency_grid(loops: Sequence[tuple[np.ndarray, np.ndarray]], lo: float, hi
     return f
 
 
-def loop_responses(model: Model | Spec, crossover: CrossoverResult,
+def loop_responses(model: Model, crossover: CrossoverResult,
                    points: int = 500) -> LoopResponses:
     """The loop of every limit case over a grid that holds every crossover, mode and peak.
 
@@ -131,8 +130,8 @@ def loop_responses(model: Model | Spec, crossover: CrossoverResult,
 
     Parameters
     ----------
-    model : fi_design.model.Model or fi_design.spec.Spec
-        The resolved model (a spec is resolved).
+    model : fi_design.model.Model
+        The resolved model (:func:`fi_design.model.resolve`).
     crossover : CrossoverResult
         Step 2 (desired crossover, the gain and phase crossings and the
         sensitivity peak of each case).
@@ -147,7 +146,7 @@ def loop_responses(model: Model | Spec, crossover: CrossoverResult,
         highest mode, on whole decades; a sampled controller's up to its
         Nyquist frequency.
     """
-    model = as_model(model)
+    model = require_model(model)
     fc = crossover.desired
     lows = [fc / 30.0] + [c / 3.0 for case in crossover.cases for c in case.crossovers
                           if c and c > 0]

@@ -16,6 +16,10 @@ Each function judges one thing and says why in words:
 - :func:`reserve_corners` -- the candidate still passes (margins met, no move
   hunting) with the masses, the stiffness, the computed modes and the delay
   off by the reserve's fractions.
+
+Every judgement takes the candidate as a :class:`~fi_design.model.Model`,
+resolved once by the search (:meth:`~fi_design.model.Model.varied` of the
+base model) and read by all of them.
 """
 
 from __future__ import annotations
@@ -24,25 +28,36 @@ import math
 from typing import Any
 
 from .. import spec as _spec
+from ..model import Model
 from ..spec.file import with_values
 
-__all__ = ["SEARCH_POINTS", "reserve_spec", "crossover_cap", "with_notch_spec", "notch_entries",
-           "guide_for", "loop_meets", "stage_answer", "margin_screen", "reserve_corners", "hunting_margin"]
+__all__ = ["SEARCH_POINTS", "reserve_values", "reserve_requirements", "crossover_cap",
+           "with_notch", "notch_entries", "guide_for", "loop_meets", "stage_answer",
+           "margin_screen", "reserve_corners", "hunting_margin"]
 
 #: Lengths of the guide's sizing grid during the search (the chosen design is sized again at
 #: full resolution).
 SEARCH_POINTS = 41
 
 
-def reserve_spec(spec: _spec.Spec) -> _spec.Spec:
-    """The spec with its margin requirements raised by ``requirements.reserve``."""
+def reserve_values(spec: _spec.Spec) -> dict[str, float]:
+    """The margin requirements raised by ``requirements.reserve``, as values at spec paths."""
     req = spec.requirements
     r = req.reserve
-    return with_values(spec, {"requirements.phase_margin": req.phase_margin + r.phase_margin,
-                              "requirements.gain_margin": req.gain_margin + r.gain_margin})
+    return {"requirements.phase_margin": req.phase_margin + r.phase_margin,
+            "requirements.gain_margin": req.gain_margin + r.gain_margin}
 
 
-def crossover_cap(base: _spec.Spec, rule: bool) -> tuple[float, str, Any]:
+def reserve_requirements(model: Model) -> _spec.Requirements:
+    """The model's requirements with the margins raised by ``requirements.reserve``.
+
+    Validated as the spec validates them (:func:`fi_design.spec.file.with_values`); the
+    model itself is not resolved again: the margins judge a loop, they do not shape it.
+    """
+    return with_values(model.spec, reserve_values(model.spec)).requirements
+
+
+def crossover_cap(base: Model, rule: bool) -> tuple[float, str, Any]:
     """The crossover the recommendation tunes to [Hz], why, and the notch it adds.
 
     The loop's limit is the hardware's: the spec's drive (sampling, delay),
@@ -56,8 +71,8 @@ def crossover_cap(base: _spec.Spec, rule: bool) -> tuple[float, str, Any]:
 
     Parameters
     ----------
-    base : Spec
-        The spec as written (its own isolator, or none).
+    base : Model
+        The spec as written (its own isolator, or none), resolved.
     rule : bool
         Whether the spec tunes by the rule (with explicit gains the crossover
         stays the gains').
@@ -68,24 +83,25 @@ def crossover_cap(base: _spec.Spec, rule: bool) -> tuple[float, str, Any]:
         The crossover [Hz], why, and the notch added to the chain (None: none).
     """
     from ..loop import linear
-    from ..loop.notch import limiting_mode, notched, with_notch
-    from ..model import resolve
+    from ..loop.notch import limiting_mode, notched
+    from ..loop.notch import with_notch as notch_for
 
-    fc = _spec.design_crossover(base)
+    fc = _spec.design_crossover(base.spec)
     if not rule:
         return fc, "the hardware's gains: the crossover stays theirs", None
     bounds = base.requirements.recommend.crossover
     reserve = base.requirements.reserve.crossover
-    loop = base
-    if base.isolator is not None and base.isolator.flexure is not None:
-        loop = with_values(base, {"isolator.flexure": None})
-    model = resolve(reserve_spec(loop))
+    values: dict[str, Any] = {}
+    if base.flexure_spec is not None:
+        values["isolator.flexure"] = None
+    model = base.varied({**values, **reserve_values(base.spec)})
     ach = linear.achievable_crossover(model)
     notch = None
-    mode = limiting_mode(model, ach) if (bounds_allow_filters(base) and ach.frequency is not None
+    mode = limiting_mode(model, ach) if (bounds_allow_filters(base.spec)
+                                        and ach.frequency is not None
                                         and ach.kind != "scan_limit") else None
     if mode is not None and not notched(model, mode):
-        filt, alt = with_notch(model, mode)
+        filt, alt = notch_for(model, mode)
         if alt.frequency is not None and alt.frequency > ach.frequency:
             notch, ach = filt, alt
     if ach.frequency is None:
@@ -114,9 +130,9 @@ def bounds_allow_filters(spec: _spec.Spec) -> bool:
     return bool(spec.requirements.recommend.filters)
 
 
-def with_notch_spec(spec: _spec.Spec, notch: Any) -> _spec.Spec:
-    """The spec with a notch appended to ``controller.filters``."""
-    return with_values(spec, {"controller.filters": notch_entries(spec, notch)})
+def with_notch(model: Model, notch: Any) -> Model:
+    """The model with a notch appended to ``controller.filters`` (its spec holding it)."""
+    return model.varied({"controller.filters": notch_entries(model.spec, notch)})
 
 
 def notch_entries(spec: _spec.Spec, notch: Any) -> list[dict]:
@@ -126,9 +142,22 @@ def notch_entries(spec: _spec.Spec, notch: Any) -> list[dict]:
                    "width": f"{notch.width:.6g} Hz"}]
 
 
-def guide_for(base: _spec.Spec, stiffness: float, stroke: float, crossover: float, *,
+def guide_for(base: Model, stiffness: float, stroke: float, crossover: float, *,
               points: int = SEARCH_POINTS) -> Any:
     """A leaf-spring guide from stock for a net drive stiffness and stroke.
+
+    Parameters
+    ----------
+    base : Model
+        The search's base (its ``isolator.flexure`` bounds, stage and cart).
+    stiffness : float
+        Net drive stiffness [N/m].
+    stroke : float
+        One-sided stroke [m].
+    crossover : float
+        The loop's crossover [Hz].
+    points : int, optional
+        Lengths of the sizing grid.
 
     Returns
     -------
@@ -137,29 +166,26 @@ def guide_for(base: _spec.Spec, stiffness: float, stroke: float, crossover: floa
         buckling factor and every parasitic mode at the separation times the
         crossover.
     """
-    from ..mechanism.geometry import stage_body
     from ..mechanism.sizing import size_guide
 
     req = base.requirements
-    return size_guide(base.isolator.flexure, stage_body(base.stage), target_stiffness=stiffness,
-                      maximum_stiffness=_spec.stiffness_limit(base, stroke), stroke=stroke,
+    return size_guide(base.flexure_spec, base.body, target_stiffness=stiffness,
+                      maximum_stiffness=_spec.stiffness_limit(base.spec, stroke), stroke=stroke,
                       required_frequency=req.parasitic_separation * crossover,
-                      required_buckling=req.buckling_factor, cart_mass=base.cart.mass,
+                      required_buckling=req.buckling_factor, cart_mass=base.m2,
                       points=points)
 
 
-def loop_meets(spec: _spec.Spec) -> tuple[bool, str]:
-    """Whether the spec's four limit cases meet the margins plus their reserve, and why not.
+def loop_meets(model: Model) -> tuple[bool, str]:
+    """Whether the model's four limit cases meet the margins plus their reserve, and why not.
 
-    The spec's own modes (a candidate: its guide's computed ones and the
+    The model's own modes (a candidate: its guide's computed ones and the
     structure's measured ones) are in the loop; every mode lies at the
     separation times the crossover.
     """
     from ..loop import linear
-    from ..model import resolve
 
-    model = resolve(reserve_spec(spec))
-    res = linear.analyse(model)
+    res = linear.analyse(model, requirements=reserve_requirements(model))
     bad = [c for c in res.cases if not c.passed]
     if bad:
         c = bad[0]
@@ -174,11 +200,11 @@ def loop_meets(spec: _spec.Spec) -> tuple[bool, str]:
     return True, ""
 
 
-def stage_answer(spec: _spec.Spec, crossover: float | None = None,
+def stage_answer(model: Model, crossover: float | None = None,
                  fold: str = "unless hunting") -> dict:
     """The stage after every move of its family, and the fold of its cycle (plain data).
 
-    A task for the executor: the isolated plant of ``spec`` (at
+    A task for the executor: the isolated plant of ``model`` (at
     ``crossover`` when given), every move run (stopping at the first that
     hunts), the hunting-free crossover found by the fold of the cycle: with
     ``fold="unless hunting"`` only where no move hunts (a hunting point has no
@@ -193,12 +219,12 @@ def stage_answer(spec: _spec.Spec, crossover: float | None = None,
     """
     from ..stage import stage_hunting
 
-    quick = stage_hunting(spec, True, crossover=crossover, first_only=True, boundary=False,
+    quick = stage_hunting(model, True, crossover=crossover, first_only=True, boundary=False,
                           trace=False)
     if fold != "always" and (quick.hunts or not quick.acceptable):  # no margin to measure
         st = quick
     else:
-        st = stage_hunting(spec, True, crossover=crossover, first_only=True, trace=False)
+        st = stage_hunting(model, True, crossover=crossover, first_only=True, trace=False)
     c = st.cycle
     return {"hunts": st.hunts, "acceptable": st.acceptable, "outcome": st.outcome,
             "free_from": st.hunting_free_from, "amplitude": None if c is None else c.amplitude,
@@ -206,7 +232,7 @@ def stage_answer(spec: _spec.Spec, crossover: float | None = None,
             "tests": 0 if st.boundary is None else st.boundary.tests}
 
 
-def margin_screen(spec: _spec.Spec, margin: float, crossover: float | None = None) -> dict:
+def margin_screen(model: Model, margin: float, crossover: float | None = None) -> dict:
     """Whether the stage keeps the hunting margin, by two quick stage-level answers (a task).
 
     No move of the family may hunt at the crossover, nor at the crossover over
@@ -224,24 +250,24 @@ def margin_screen(spec: _spec.Spec, margin: float, crossover: float | None = Non
     """
     from ..stage import stage_hunting
 
-    fc = _spec.design_crossover(spec) if crossover is None else crossover
-    at = stage_hunting(spec, True, crossover=fc, first_only=True, boundary=False, trace=False)
+    fc = model.crossover if crossover is None else crossover
+    at = stage_hunting(model, True, crossover=fc, first_only=True, boundary=False, trace=False)
     if at.hunts or not at.acceptable:
         return {"keeps": False, "hunts": at.hunts, "outcome": at.outcome, "tests": 1}
-    below = stage_hunting(spec, True, crossover=fc / margin, first_only=True, boundary=False,
+    below = stage_hunting(model, True, crossover=fc / margin, first_only=True, boundary=False,
                           trace=False)
     keeps = not below.hunts
     return {"keeps": keeps, "hunts": False,
             "outcome": "settles" if keeps else "hunts_below", "tests": 2}
 
 
-def _settles(model: Any) -> bool:
+def _settles(model: Model) -> bool:
     from ..stage import stage_hunting
 
     return stage_hunting(model, True, first_only=True, boundary=False, trace=False).acceptable
 
 
-def reserve_corners(spec: _spec.Spec) -> tuple[dict, ...]:
+def reserve_corners(model: Model) -> tuple[dict, ...]:
     """The candidate with the reserve's deviations: does it still pass?
 
     Each corner: the masses ``+-reserve.mass`` (the controller keeps its
@@ -258,9 +284,7 @@ def reserve_corners(spec: _spec.Spec) -> tuple[dict, ...]:
         ``name``, ``passed`` (bool), ``why`` (str, empty when passed).
     """
     from ..loop import linear
-    from ..model import resolve
 
-    model = resolve(spec)
     r = model.requirements.reserve
     m1, m2 = model.m1, model.m2
     corners = [(f"masses +{100 * r.mass:.3g} %", model.at(masses=(m1 * (1 + r.mass),

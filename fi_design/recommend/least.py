@@ -23,8 +23,8 @@ from typing import Any
 
 from .. import spec as _spec
 from ..display import quantity
+from ..model import Model
 from ..results.recommend import LeastChange
-from ..spec.file import with_values
 from . import constraints as _c
 
 __all__ = ["least_change", "BISECTION_STEPS", "STROKE_FACTORS"]
@@ -35,36 +35,41 @@ BISECTION_STEPS = 4
 STROKE_FACTORS = (2.0, 4.0)
 
 
-def _margin_ok(spec: _spec.Spec, margin: float) -> tuple[bool, dict]:
-    ans = _c.margin_screen(spec, margin)
+def _margin_ok(model: Model, margin: float) -> tuple[bool, dict]:
+    ans = _c.margin_screen(model, margin)
     return ans["keeps"], ans
 
 
-def _stiffest(spec: _spec.Spec, stroke: float, margin: float) -> tuple[float | None, int]:
-    """The stiffest drive stiffness at a stroke that keeps the margin (bisection on log k)."""
-    kmax = _spec.stiffness_limit(spec, stroke)
+def _stiffest(model: Model, stroke: float,
+              margin: float) -> tuple[float | None, Model | None, int]:
+    """The stiffest drive stiffness at a stroke that keeps the margin (bisection on log k),
+    the model there (resolved once, as screened) and the screens run."""
+    kmax = _spec.stiffness_limit(model.spec, stroke)
     lo, hi = math.log(kmax / 40.0), math.log(kmax)
-    at = lambda k: with_values(spec, {"isolator.stroke": stroke, "isolator.stiffness": k})
+    at = lambda k: model.varied({"isolator.stroke": stroke, "isolator.stiffness": k})
     n = 1
-    if _margin_ok(at(kmax), margin)[0]:
-        return kmax, n
+    top = at(kmax)
+    if _margin_ok(top, margin)[0]:
+        return kmax, top, n
     n += 1
-    if not _margin_ok(at(math.exp(lo)), margin)[0]:
-        return None, n
+    best = at(math.exp(lo))
+    if not _margin_ok(best, margin)[0]:
+        return None, None, n
     for _ in range(BISECTION_STEPS):
         mid = 0.5 * (lo + hi)
         n += 1
-        if _margin_ok(at(math.exp(mid)), margin)[0]:
-            lo = mid
+        m = at(math.exp(mid))
+        if _margin_ok(m, margin)[0]:
+            lo, best = mid, m
         else:
             hi = mid
-    return math.exp(lo), n
+    return math.exp(lo), best, n
 
 
-def _passes(spec: _spec.Spec, executor: Any) -> tuple[bool, str]:
+def _passes(model: Model, executor: Any) -> tuple[bool, str]:
     from ..guideline.evaluate import evaluate as design
 
-    r = design(spec, executor=executor)
+    r = design(model, executor=executor)
     if r.verdict.status == "FAIL":
         fails = [x.text for x in r.verdict.reasons if x.severity == "FAIL"]
         return False, fails[0] if fails else "the sign-off fails"
@@ -91,7 +96,8 @@ def least_change(search: Any, *, executor: Any = None,
         design is the answer).
     """
     say = progress or (lambda text: None)
-    spec = search.spec
+    model = search.model
+    spec = model.spec
     if spec.isolator is None:
         return None
     margin = search.margin
@@ -109,12 +115,12 @@ def least_change(search: Any, *, executor: Any = None,
     # 1. the crossover alone
     if search.rule:
         say("the least change: the crossover alone ...")
-        ans = _c.stage_answer(spec, fold="always")
+        ans = _c.stage_answer(model, fold="always")
         fold = ans["free_from"]
         if fold is not None:
             fc = 1.01 * margin * fold
             if fc <= search.fc:
-                cand = with_values(spec, {"controller.crossover": fc})
+                cand = model.varied({"controller.crossover": fc})
                 ok, why = _passes(cand, executor)
                 if ok:
                     return done({"controller.crossover": fc},
@@ -134,7 +140,7 @@ def least_change(search: Any, *, executor: Any = None,
         if s0 * f <= search.envelope[1]]
     for stroke, what in options:
         say(f"the least change: {what} ({quantity(stroke, 'm')}) ...")
-        k, n = _stiffest(spec, stroke, margin)
+        k, cand, n = _stiffest(model, stroke, margin)
         search.evaluations += n
         if k is None:
             tried.append(f"{what} at {quantity(stroke, 'm')}: no stiffness keeps the hunting "
@@ -142,7 +148,6 @@ def least_change(search: Any, *, executor: Any = None,
             continue
         values = {"isolator.stiffness": k} if stroke == s0 else \
             {"isolator.stroke": stroke, "isolator.stiffness": k}
-        cand = with_values(spec, values)
         ok, why = _passes(cand, executor)
         if ok:
             words = (f"a drive stiffness of {k:.4g} N/m" if stroke == s0 else

@@ -33,10 +33,11 @@ import numpy as np
 
 from .. import spec as _spec
 from ..display import quantity
+from ..model import Model
 from ..results.recommend import DesignCandidate, RecommendResult
 from . import constraints as _c
 from . import objective as _o
-from .space import STROKE_SPAN, Candidate, base_spec, damping_ratio, stroke_envelope
+from .space import STROKE_SPAN, Candidate, base_model, damping_ratio, stroke_envelope
 
 log = logging.getLogger(__name__)
 
@@ -74,6 +75,7 @@ class _Point:
     folded: bool = False
     p: float | None = None
     clearance: float | None = None
+    model: Model | None = None
 
     @property
     def stiffness(self) -> float:
@@ -102,17 +104,20 @@ def _map(executor: Any, fn: Callable, items: list) -> list:
 class _Search:
     """The state of one search (internal): the base, the crossover, the points judged."""
 
-    def __init__(self, spec: _spec.Spec, executor: Any, say: Callable[[str], None]):
-        self.spec = spec
+    def __init__(self, model: Model, executor: Any, say: Callable[[str], None]):
+        self.model = model
+        self.spec = model.spec
         self.executor = executor
         self.say = say
-        self.base, self.assumed = base_spec(spec)
-        self.rule = spec.controller.gains is None
-        self.fc, self.fc_why, self.notch = _c.crossover_cap(spec, self.rule)
+        base, self.assumed = base_model(model)
+        self.rule = self.spec.controller.gains is None
+        self.fc, self.fc_why, self.notch = _c.crossover_cap(model, self.rule)
         if self.notch is not None:  # every candidate carries the notch the search adds
-            self.base = _c.with_notch_spec(self.base, self.notch)
+            base = _c.with_notch(base, self.notch)
+        self.base_model = base
+        self.base = base.spec
         self.margin = self.base.requirements.hunting_margin
-        self.zeta = damping_ratio(self.base)
+        self.zeta = damping_ratio(base)
         m1, m2 = self.base.stage.mass, self.base.cart.mass
         self.mred = m1 * m2 / (m1 + m2)
         self.points: list[_Point] = []
@@ -135,7 +140,7 @@ class _Search:
             p.status = "bounds"
             p.violations.append("outside requirements.recommend.stiffness")
             return p
-        fx = _c.guide_for(self.base, target, stroke, self.fc)
+        fx = _c.guide_for(self.base_model, target, stroke, self.fc)
         if not fx.feasible:
             p.status = "flexure"
             p.violations.append(f"no guide: {fx.reason}")
@@ -148,6 +153,12 @@ class _Search:
         p.lowest_mode = fx.lowest_mode.frequency if fx.lowest_mode is not None else None
         return p
 
+    def candidate_model(self, p: _Point) -> Model:
+        """The point's candidate resolved into its model, once: every judgement reads it."""
+        if p.model is None:
+            p.model = p.candidate.model(self.base_model, self.rule)
+        return p.model
+
     def judge(self, points: list[_Point]) -> None:
         """Screen the points' hunting margin (two quick stage answers each, on the executor)."""
         todo = [p for p in points if p.status is None]
@@ -155,7 +166,7 @@ class _Search:
             return
         self.say(f"simulating the move family of {len(todo)} guides at {self.fc:.4g} Hz and "
                  f"{self.fc / self.margin:.4g} Hz ...")
-        tasks = [(p.candidate.spec(self.base, self.rule), self.margin) for p in todo]
+        tasks = [(self.candidate_model(p), self.margin) for p in todo]
         for p, ans in zip(todo, _map(self.executor, _c.margin_screen, tasks)):
             self.evaluations += ans["tests"]
             p.hunts = ans["hunts"]
@@ -180,7 +191,7 @@ class _Search:
         if not todo:
             return
         self.say(f"finding the hunting-free crossover of {len(todo)} guides ...")
-        tasks = [(p.candidate.spec(self.base, self.rule),) for p in todo]
+        tasks = [(self.candidate_model(p),) for p in todo]
         for p, ans in zip(todo, _map(self.executor, _c.stage_answer, tasks)):
             self.evaluations += 1 + ans["tests"]
             p.folded = True
@@ -277,23 +288,24 @@ class _Search:
         design command's verdict. Returns (passed, (guide, corners, design result))."""
         from ..guideline.evaluate import evaluate as design
 
-        fx = _c.guide_for(self.base, p.stiffness, p.stroke, self.fc, points=FULL_POINTS)
+        fx = _c.guide_for(self.base_model, p.stiffness, p.stroke, self.fc, points=FULL_POINTS)
         if fx.feasible and abs(fx.drive_stiffness / p.stiffness - 1.0) < 0.02:
             p.candidate = Candidate(stroke=p.stroke, length=fx.length, width=fx.width,
                                     thickness=fx.thickness, stiffness=fx.drive_stiffness,
                                     crossover=self.fc, damping=p.candidate.damping)
+            p.model = None  # the guide at full resolution is another candidate
             p.lowest_mode = fx.lowest_mode.frequency
         else:
-            fx = _c.guide_for(self.base, p.stiffness, p.stroke, self.fc)
-        spec = p.candidate.spec(self.base, self.rule)
-        ok, why = _c.loop_meets(spec)
+            fx = _c.guide_for(self.base_model, p.stiffness, p.stroke, self.fc)
+        model = self.candidate_model(p)
+        ok, why = _c.loop_meets(model)
         if not ok:
             p.status = "margins"
             p.violations.append(why)
             return False, (fx, None, None)
         self.say(f"checking the reserves of {quantity(p.stroke, 'm')}, "
                  f"{p.stiffness:.4g} N/m ...")
-        corners = _c.reserve_corners(spec)
+        corners = _c.reserve_corners(model)
         self.evaluations += len(corners)
         bad = [c for c in corners if not c["passed"]]
         if bad:
@@ -302,7 +314,7 @@ class _Search:
             return False, (fx, corners, None)
         self.say(f"signing off {quantity(p.stroke, 'm')}, {p.stiffness:.4g} N/m at "
                  f"{self.fc:.4g} Hz (scatter included) ...")
-        r = design(spec, executor=self.executor)
+        r = design(model, executor=self.executor)
         rob = r.robustness
         p.p = None if rob is None else rob.hunting_probability
         self.evaluations += 0 if rob is None else rob.samples
@@ -318,16 +330,19 @@ class _Search:
         return True, (fx, corners, r)
 
 
-def recommend(spec: _spec.Spec | str | Any, *, executor: Any = None,
+def recommend(spec: _spec.Spec | Model | str | Any, *, executor: Any = None,
               progress: Callable[[str], None] | None = None) -> RecommendResult:
     """Search a buildable isolator (and the rule's crossover) that the sign-off passes.
 
     Parameters
     ----------
-    spec : Spec, path or mapping
-        The design spec (a YAML path or mapping is loaded); without an isolator
-        the search is for one to add, without a flexure section for a steel
-        leaf-spring guide.
+    spec : Spec, Model, path or mapping
+        The design spec (a YAML path or mapping is loaded), or its resolved
+        model; without an isolator the search is for one to add, without a
+        flexure section for a steel leaf-spring guide. The spec is resolved
+        once here; every candidate is a variation of it
+        (:meth:`~fi_design.model.Model.varied`), resolved once and read by
+        every judgement.
     executor : concurrent.futures-style executor, optional
         Runs the stage-level evaluations and the robustness samples; None
         runs them here. The library creates no pool.
@@ -345,19 +360,29 @@ def recommend(spec: _spec.Spec | str | Any, *, executor: Any = None,
     Raises
     ------
     ArgumentError
-        ``spec`` is not a spec, a path or a mapping.
+        ``spec`` is not a spec, a model, a path or a mapping, or a model
+        varied with :meth:`~fi_design.model.Model.at` (the search varies its
+        spec).
     SpecError
         A path or mapping that does not validate.
     """
     from ..guideline.steps import step2_crossover
     from .least import least_change
 
+    from ..model import as_model
     from ..spec.file import as_spec
 
     start = _time.perf_counter()
-    spec = as_spec(spec)
+    model = as_model(spec if isinstance(spec, Model) else as_spec(spec))  # the edge: once
+    if model.changed:
+        from ..errors import ArgumentError
+
+        raise ArgumentError(f"this model differs from its spec at {', '.join(model.changed)} "
+                            "(Model.at), but the search varies the spec: recommend for the "
+                            "spec with the values written in (Model.varied)")
+    spec = model.spec
     say = progress or (lambda text: None)
-    srch = _Search(spec, executor, say)
+    srch = _Search(model, executor, say)
     srch.run()
     chosen, signed = None, (None, None, None)
     for p in sorted((p for p in srch.points if p.status is None), key=_o.order, reverse=True):
@@ -376,12 +401,12 @@ def recommend(spec: _spec.Spec | str | Any, *, executor: Any = None,
             p.status = "not_evaluated"
     fx, corners, report = signed
     if fx is None and chosen.candidate is not None:
-        fx = _c.guide_for(srch.base, chosen.stiffness, chosen.stroke, srch.fc)
+        fx = _c.guide_for(srch.base_model, chosen.stiffness, chosen.stroke, srch.fc)
     st = report.simulation.stage["isolated"] if report is not None else None
     rob = report.robustness if report is not None else None
     binding = _o.binding(srch, chosen) if feasible else ()
     least = least_change(srch, executor=executor, progress=say)
-    xo = step2_crossover(srch.base)
+    xo = step2_crossover(srch.base_model)
     kmax = _spec.stiffness_limit(srch.base, chosen.stroke)
     margins = {"hunting_margin": chosen.margin, "stiffness_factor": kmax / chosen.stiffness,
                "end_stop_clearance": chosen.clearance,

@@ -2,14 +2,14 @@
 
 A candidate is a buildable isolator: a leaf-spring guide drawn from stock
 (leaves, length, width, thickness) with its stroke, at a crossover. It is
-written into the spec as values at dotted paths (:meth:`Candidate.values`),
-so the design command on the written spec runs the same computation: the
-guide drawn, its drive stiffness its own (net of gravity), its own computed
+written into the spec as values at dotted paths (:meth:`Candidate.values`)
+and resolved once into its model (:meth:`Candidate.model`), so the design
+command on the written spec runs the same computation: the guide drawn, its drive stiffness its own (net of gravity), its own computed
 modes (the spec's measured modes that belong to the spec's own guide are
 dropped; a ``structure`` mode stays, the stage's structure does not change
 with the guide).
 
-:func:`base_spec` gives the spec the search starts from: with the spec's
+:func:`base_model` gives the model the search starts from: with the spec's
 isolator, or the guideline's suggestion when it has none, and with the spec's
 flexure section, or an assumed steel leaf-spring guide (:data:`ASSUMED_FLEXURE`)
 when it has none, so that every candidate is a mechanism that can be built.
@@ -22,10 +22,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from .. import spec as _spec
-from ..spec.file import with_values
 from ..display import quantity
+from ..model import Model
 
-__all__ = ["ASSUMED_FLEXURE", "STROKE_FLOOR", "STROKE_SPAN", "Candidate", "base_spec",
+__all__ = ["ASSUMED_FLEXURE", "STROKE_FLOOR", "STROKE_SPAN", "Candidate", "base_model",
            "stroke_envelope", "damping_ratio"]
 
 #: The guide assumed for a spec without ``isolator.flexure``: two spring-steel leaves standing
@@ -43,41 +43,46 @@ STROKE_FLOOR = 0.05e-3
 STROKE_SPAN = 3.0
 
 
-def base_spec(spec: _spec.Spec) -> tuple[_spec.Spec, tuple[str, ...]]:
-    """The spec the search starts from, and what it assumed.
+def base_model(model: Model) -> tuple[Model, tuple[str, ...]]:
+    """The model the search starts from, and what it assumed.
+
+    Parameters
+    ----------
+    model : Model
+        The spec as written, resolved.
 
     Returns
     -------
-    (Spec, tuple of str)
-        The spec with an isolator (its own, or the guideline's suggestion)
-        and a flexure section (its own, or :data:`ASSUMED_FLEXURE`); the
-        assumptions in words.
+    (Model, tuple of str)
+        The model with an isolator (its own, or the guideline's suggestion)
+        and a flexure section (its own, or :data:`ASSUMED_FLEXURE`), varied
+        once (:meth:`~fi_design.model.Model.varied`); the assumptions in words.
     """
     assumed = []
-    base = spec
-    if base.isolator is None:
+    values: dict[str, Any] = {}
+    if not model.has_isolator:
         from ..guideline.steps import suggested_isolator
 
-        s, k = suggested_isolator(spec)
-        base = with_values(base, {"isolator": {"stroke": s, "stiffness": k}})
+        s, k = suggested_isolator(model)
+        values["isolator"] = {"stroke": s, "stiffness": k}
         assumed.append("no isolator in the spec: the search starts from the guideline's "
                        "suggestion")
-    if base.isolator.flexure is None:
-        base = with_values(base, {"isolator.flexure": ASSUMED_FLEXURE})
+    if model.flexure_spec is None:
+        if "isolator" in values:
+            values["isolator"]["flexure"] = ASSUMED_FLEXURE
+        else:
+            values["isolator.flexure"] = ASSUMED_FLEXURE
         assumed.append("no isolator.flexure in the spec: a guide of two spring-steel leaves "
                        "(E 200 GPa, 300 MPa allowed, from 0.05 mm stock) standing under the "
                        "stage is assumed")
-    return base, tuple(assumed)
+    return (model.varied(values) if values else model), tuple(assumed)
 
 
-def damping_ratio(spec: _spec.Spec) -> float | None:
+def damping_ratio(model: Model) -> float | None:
     """The joint damping ratio the spec's damping gives (None: the default ratio applies)."""
-    iso = spec.isolator
+    iso = model.spec.isolator
     if iso is None or iso.damping is None:
         return None
-    from ..model import resolve
-
-    model = resolve(spec)
     k, m1, m2 = model.joint.stiffness, model.m1, model.m2
     return iso.damping / (2.0 * math.sqrt(abs(k) * m1 * m2 / (m1 + m2)))
 
@@ -140,7 +145,7 @@ class Candidate:
     damping: float | None = None
 
     def values(self, base: _spec.Spec, rule: bool) -> dict[str, Any]:
-        """The candidate as spec values at dotted paths (SI), for :func:`with_values`."""
+        """The candidate as spec values at dotted paths (SI), for :meth:`Model.varied`."""
         iso = base.isolator
         out: dict[str, Any] = {
             "isolator.stroke": self.stroke, "isolator.stiffness": None,
@@ -157,6 +162,7 @@ class Candidate:
             out["controller.crossover"] = self.crossover
         return out
 
-    def spec(self, base: _spec.Spec, rule: bool) -> _spec.Spec:
-        """The base spec with the candidate written in, validated."""
-        return with_values(base, self.values(base, rule))
+    def model(self, base: Model, rule: bool) -> Model:
+        """The base model with the candidate written into its spec, validated and resolved once
+        (:meth:`~fi_design.model.Model.varied`): every judgement of the candidate reads it."""
+        return base.varied(self.values(base.spec, rule))

@@ -42,7 +42,7 @@ import math
 from .. import spec as _spec
 from ..display import number, quantities, quantity
 from ..errors import ArgumentError
-from ..model import Model, as_model
+from ..model import Model, require_model
 from ..results import Check, Status
 from ..results.design import Confirmation, Landing, PlantVerdict
 from ..results.simulation import SimulationResult
@@ -58,13 +58,13 @@ def _hunts(v: PlantVerdict) -> bool:
     return v.metrics.verdict == "hunting"
 
 
-def landing(model: Model | _spec.Spec, result: SimulationResult) -> Landing:
+def landing(model: Model, result: SimulationResult) -> Landing:
     """Landing deflection and flexure force of an isolated simulation of ``model``.
 
     Parameters
     ----------
-    model : Model or Spec
-        The resolved model (a spec is resolved) the result simulated.
+    model : Model
+        The resolved model (:func:`fi_design.model.resolve`) the result simulated.
     result : SimulationResult
         The isolated simulation.
 
@@ -72,7 +72,7 @@ def landing(model: Model | _spec.Spec, result: SimulationResult) -> Landing:
     -------
     Landing
     """
-    model = as_model(model)
+    model = require_model(model)
     k, s = model.joint.stiffness, model.joint.stroke
     d = float(result.deflection[-1])
     return Landing(deflection=d, stroke=s, stiffness=k, force=k * min(abs(d), s),
@@ -90,7 +90,7 @@ def with_isolator(spec: _spec.Spec, stroke: float, stiffness: float) -> _spec.Sp
     return spec.with_sections(isolator={"stiffness": stiffness, "stroke": stroke})
 
 
-def static_error_bound(model: Model | _spec.Spec) -> float | None:
+def static_error_bound(model: Model) -> float | None:
     """The static error a loop without integrator may leave against friction [m].
 
     :attr:`fi_design.model.Model.static_error_bound`, ``(Fs + |offset|) / kp``
@@ -100,28 +100,28 @@ def static_error_bound(model: Model | _spec.Spec) -> float | None:
 
     Parameters
     ----------
-    model : Model or Spec
-        The resolved model (a spec is resolved).
+    model : Model
+        The resolved model (:func:`fi_design.model.resolve`).
 
     Returns
     -------
     float or None
     """
-    return as_model(model).static_error_bound
+    return require_model(model).static_error_bound
 
 
 def _other_model(model: Model) -> Model:
     return model.at(friction_model="switch" if model.friction.model == "lugre" else "lugre")
 
 
-def confirm(spec: _spec.Spec | Model, suggestion: tuple[float, float] | None = None,
+def confirm(model: Model, suggestion: tuple[float, float] | None = None,
             progress=None) -> Confirmation:
     """Simulate both plants, scan the crossover, check the landing and cross-check.
 
     Parameters
     ----------
-    spec : Spec or Model
-        The design spec, or its resolved model.
+    model : Model
+        The design's resolved model (:func:`fi_design.model.resolve`).
     suggestion : (stroke, stiffness), optional
         Isolator to simulate when the spec has none [m, N/m]; required then.
     progress : callable, optional
@@ -132,7 +132,7 @@ def confirm(spec: _spec.Spec | Model, suggestion: tuple[float, float] | None = N
     -------
     Confirmation
     """
-    model = as_model(spec)
+    model = require_model(model)
     suggested = not model.has_isolator
     if suggested:
         if suggestion is None:

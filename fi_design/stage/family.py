@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import spec as _spec
 from ..kernel.layout import PlantParameters
-from ..model import Model, as_model
+from ..model import Model, require_model
 from ..trajectory import Trajectory, from_moves, profile_duration
 from .settings import symmetric
 
@@ -38,14 +38,14 @@ def largest_move(spec: _spec.Spec) -> _spec.Move:
     return max(spec.motion.moves, key=lambda mv: abs(mv.distance))
 
 
-def family_distances(model: Model | _spec.Spec, isolated: bool,
+def family_distances(model: Model, isolated: bool,
                      params: PlantParameters | None = None) -> tuple[float, ...]:
     """Signed distances of the move family of one plant [m].
 
     Parameters
     ----------
-    model : Model or Spec
-        The resolved model (its spec's ``motion.family``; a spec is resolved).
+    model : Model
+        The resolved model (its spec's ``motion.family``).
     isolated : bool
         Which plant: the default smallest distance is a tenth of the stroke
         with the isolator, 0.1 mm without.
@@ -57,7 +57,7 @@ def family_distances(model: Model | _spec.Spec, isolated: bool,
     tuple of float
         Positive distances first, increasing, then the negative ones [m].
     """
-    model = as_model(model)
+    model = require_model(model)
     spec = model.spec
     fam = spec.motion.family
     if fam.distances is not None:

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .. import spec as _spec
-from ..model import Model, as_model
+from ..model import Model, require_model
 from ..results.forces import MoveForces, StageForces
 from ..trajectory import from_moves, profile_duration
 from .family import family_distances
@@ -61,15 +61,15 @@ def _one(model: Model, isolated: bool, moves, end: float, settle: float, rate: f
                       peak_command=peak_cmd)
 
 
-def move_forces(model: Model | _spec.Spec, isolated: bool | None = None, *,
+def move_forces(model: Model, isolated: bool | None = None, *,
                 family: Sequence[float] | None = None, settle: float = SETTLE,
                 rate: float = RATE) -> StageForces:
     """The forces of every move of the family, the spec's own motion first.
 
     Parameters
     ----------
-    model : Model or Spec
-        The resolved model (a spec is resolved).
+    model : Model
+        The resolved model (:func:`fi_design.model.resolve`).
     isolated : bool, optional
         Which plant; None follows the model.
     family : sequence of float, optional
@@ -83,7 +83,7 @@ def move_forces(model: Model | _spec.Spec, isolated: bool | None = None, *,
     -------
     StageForces
     """
-    model = as_model(model)
+    model = require_model(model)
     iso = model.has_isolator if isolated is None else bool(isolated)
     spec = model.spec
     motion = spec.motion

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import Model, as_model
+from ..model import Model, require_model
 from ..results.positioning import MovePosition, PositioningResult
 from ..results.stage import StageHunting
 from .family import family_reference, spec_reference
@@ -74,7 +74,7 @@ def positioning(model: Model, stage: StageHunting) -> PositioningResult | None:
     PositioningResult or None
         None when the spec requires no positioning.
     """
-    model = as_model(model)
+    model = require_model(model)
     req = model.requirements.positioning
     if req is None:
         return None

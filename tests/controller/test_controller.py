@@ -19,6 +19,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from fi_design.loop import linear
+from fi_design.model import resolve
 from fi_design.errors import SpecError
 from fi_design.guideline.evaluate import evaluate as design
 from fi_design.controller.pid import control_law
@@ -77,7 +78,7 @@ def test_d_on_measurement_closed_loop_poles_and_zeros_are_hand_derived():
     poles = np.sort_complex(np.roots([M, KD, KP]))
     for on, zeros in (("measurement", []), ("error", [-KP / KD])):
         spec = load_spec(axis(**{"controller.derivative_on": on}))
-        T = linear.complementary_sensitivity(spec, "sliding")
+        T = linear.complementary_sensitivity(resolve(spec), "sliding")
         assert np.allclose(np.sort_complex(T.poles()), poles, rtol=1e-9)
         z = np.real_if_close(T.zeros())
         assert np.allclose(np.sort(z), zeros, rtol=1e-9), on
@@ -86,8 +87,8 @@ def test_d_on_measurement_closed_loop_poles_and_zeros_are_hand_derived():
 
 
 def test_margins_do_not_depend_on_where_the_d_term_acts():
-    err = linear.analyse(load_spec(axis(**{"controller.derivative_on": "error"})))
-    meas = linear.analyse(load_spec(axis()))
+    err = linear.analyse(resolve(load_spec(axis(**{"controller.derivative_on": "error"}))))
+    meas = linear.analyse(resolve(load_spec(axis())))
     for a, b in zip(err.cases, meas.cases):
         assert a.phase_margin_deg == pytest.approx(b.phase_margin_deg, rel=1e-12)
     # the PD on a free mass: phase margin from |C(j w)| = m w^2 by hand
@@ -101,7 +102,7 @@ def test_pd_loop_has_no_pole_at_the_origin_and_is_stable():
     """Without an integrator the controller's s cancels: a PD loop is not 'unstable at 0'."""
     num, den = linear.controller_polynomials(control_law(load_spec(axis())))
     assert den[-1] != 0.0 or len(den) == 1
-    assert all(c.stable for c in linear.analyse(load_spec(axis())).cases)
+    assert all(c.stable for c in linear.analyse(resolve(load_spec(axis()))).cases)
 
 
 # --------------------------------------------------------------------------- the kernel
@@ -292,7 +293,7 @@ def test_a_pd_rule_is_allowed_and_reported_as_such():
     raw = axis(**{"controller": {"crossover": "10 Hz", "integrator_ratio": math.inf}})
     law = control_law(load_spec(raw))
     assert law.ki == 0.0 and not law.integrator
-    assert all(c.stable for c in linear.analyse(load_spec(raw)).cases)
+    assert all(c.stable for c in linear.analyse(resolve(load_spec(raw))).cases)
 
 
 def test_controller_needs_a_crossover_or_gains():

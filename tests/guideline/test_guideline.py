@@ -14,7 +14,9 @@ import fi_design
 from fi_design.guideline import steps as gl
 from fi_design.guideline.evaluate import evaluate
 from fi_design.results import Check, Status
+from fi_design.model import resolve
 from fi_design.spec.file import origin
+
 from conftest import variant
 
 
@@ -110,7 +112,7 @@ def test_paper_verdict(paper_design):
 
 def test_step1_small_gap(paper_spec):
     spec = variant(paper_spec, **{"friction.static": "1.5 N", "friction.coulomb": "1.2 N"})
-    s1 = gl.step1_friction_gap(spec)
+    s1 = gl.step1_friction_gap(resolve(spec))
     assert s1.gap == pytest.approx(0.3) and not s1.hunting_risk
     assert s1.checks[0].status == Status.PASS
     # below the paper's threshold: a screening rule, and only the simulation decides
@@ -131,14 +133,14 @@ def _pd(spec):
 ])
 def test_step1_warns_only_where_nothing_answers_the_risk(paper_spec, paths, pd, status):
     spec = variant(paper_spec, **paths)
-    check = gl.step1_friction_gap(_pd(spec) if pd else spec).checks[0]
+    check = gl.step1_friction_gap(resolve(_pd(spec) if pd else spec)).checks[0]
     assert check.status == status
     assert check.passed is {Status.INFO: None, Status.WARN: False, Status.PASS: True}[status]
 
 
 def test_step3_proposes_half_of_k_max_when_stiffness_is_missing(paper_spec):
     spec = variant(paper_spec, **{"isolator.stiffness": None, "isolator.damping": None})
-    s3 = gl.step3_stiffness(spec)
+    s3 = gl.step3_stiffness(resolve(spec))
     assert s3.maximum == pytest.approx(4.0 / 0.3e-3)
     assert s3.chosen == pytest.approx(s3.maximum / 2) and "proposed" in s3.source
     assert s3.force_at_stroke == pytest.approx(2.0)
@@ -170,13 +172,13 @@ def with_friction_and_stroke(spec, fs, stroke, safety):
        safety=st.floats(1.0, 3.0))
 def test_k_max_scales_as_static_friction_over_stroke(paper_spec, fs, stroke, factor, safety):
     def kmax(f, s):
-        return gl.step3_stiffness(with_friction_and_stroke(paper_spec, f, s, safety)).maximum
+        return gl.step3_stiffness(resolve(with_friction_and_stroke(paper_spec, f, s, safety))).maximum
     k = kmax(fs, stroke)
     assert k == pytest.approx(fs / (safety * stroke), rel=1e-12)
     assert kmax(fs * factor, stroke) == pytest.approx(factor * k, rel=1e-12)
     assert kmax(fs, stroke * factor) == pytest.approx(k / factor, rel=1e-12)
     # the flexure force at full stroke never exceeds static friction
-    st3 = gl.step3_stiffness(with_friction_and_stroke(paper_spec, fs, stroke, safety))
+    st3 = gl.step3_stiffness(resolve(with_friction_and_stroke(paper_spec, fs, stroke, safety)))
     assert st3.maximum * stroke <= fs * (1 + 1e-12)
 
 

@@ -397,13 +397,14 @@ def test_step_1_screens_and_the_stage_level_answer_decides(documents, name):
 def test_step_1_below_its_threshold_beside_a_hunting_stage_is_no_pass():
     """Canudas de Wit et al. (1995): Fs - Fc = 0.5 N, below the 1 N threshold, and a 127.8 mm
     cycle. Step 1 must not read as a pass the simulation refutes."""
+    from fi_design.model import resolve
     from fi_design.guideline.steps import friction_gap_judged, step1_friction_gap
     from fi_design.stage import stage_hunting
 
     from published import canudas_spec
 
     spec = canudas_spec()
-    before = step1_friction_gap(spec)
+    before = step1_friction_gap(resolve(spec))
     assert before.checks[0].status.value == "PASS"      # the rule alone
     st = stage_hunting(spec, False, family=[1.0], boundary=False)
     after = friction_gap_judged(before, st, True)

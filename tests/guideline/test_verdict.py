@@ -24,6 +24,7 @@ from fi_design.mechanism.sizing import net_stiffness
 from fi_design.guideline.evaluate import evaluate as design
 from fi_design.spec.file import load_spec
 from fi_design.studies import wilson_interval
+from fi_design.model import resolve
 
 from conftest import EXAMPLES, variant
 
@@ -198,7 +199,7 @@ def test_a_slow_integrator_settles_after_every_move_but_not_in_the_window(no_iso
     from fi_design.stage.confirm import confirm
 
     spec = variant(no_isolator_spec, **{"controller.integrator_ratio": 300})
-    c = confirm(spec, (0.3e-3, 6667.0))
+    c = confirm(resolve(spec), (0.3e-3, 6667.0))
     assert c.non_isolated.metrics.verdict == "stuck"
     assert c.stage["non_isolated"].outcome == "settles"
     check = next(x for x in c.checks if x.name == "spec_move_non_isolated")

@@ -134,7 +134,7 @@ def test_a_notch_at_the_tilt_mode_lifts_the_achievable_crossover(paper_spec):
     plain = linear.achievable_crossover(model)
     assert plain.kind == "margin" and plain.case == "stuck_limited"
     assert plain.criterion == "gain margin"
-    notched = linear.achievable_crossover(variant(paper_spec, **{"controller.filters": [NOTCH]}))
+    notched = linear.achievable_crossover(resolve(variant(paper_spec, **{"controller.filters": [NOTCH]})))
     assert notched.frequency > 2.5 * plain.frequency
     N = _notch(150.0, 75.0)
     below, above = (_control_margins(model, plain.frequency * f) for f in (0.99, 1.01))
@@ -146,7 +146,7 @@ def test_a_notch_at_the_tilt_mode_lifts_the_achievable_crossover(paper_spec):
 
 
 def test_step_2_names_the_tilt_mode_and_what_a_notch_allows(paper_spec):
-    xo = step2_crossover(paper_spec)
+    xo = step2_crossover(resolve(paper_spec))
     assert xo.limiting_mode == "stage tilt" and xo.limiting_mode_frequency == 150.0
     assert "'stage tilt'" in xo.limited_by and "case 4" in xo.limited_by
     n = xo.notch
@@ -155,21 +155,21 @@ def test_step_2_names_the_tilt_mode_and_what_a_notch_allows(paper_spec):
     # the suggestion is the spec with that notch: the same crossover
     spec = variant(paper_spec, **{"controller.filters": [
         {"type": "notch", "frequency": "150 Hz", "width": f"{n.notch.width} Hz"}]})
-    assert linear.achievable_crossover(spec).frequency == pytest.approx(n.achievable, rel=1e-9)
+    assert linear.achievable_crossover(resolve(spec)).frequency == pytest.approx(n.achievable, rel=1e-9)
     check = next(c for c in xo.checks if c.name == "crossover_achievable")
     assert "notch" in check.message and "stage tilt" in check.message
 
 
 def test_with_a_notch_there_no_second_one_is_suggested(paper_spec):
     """The spec's own notch on the tilt: the crossover rises and no notch is advised again."""
-    xo = step2_crossover(variant(paper_spec, **{"controller.filters": [NOTCH]}))
+    xo = step2_crossover(resolve(variant(paper_spec, **{"controller.filters": [NOTCH]})))
     assert xo.achievable > 30.0 and xo.notch is None
 
 
 def test_without_the_mode_no_mode_is_named(paper_spec):
     """A delay limits the rigid loop: no mode is behind it, none is named."""
     spec = variant(paper_spec, isolator=None, **{"controller.delay": "2 ms"})
-    xo = step2_crossover(spec)
+    xo = step2_crossover(resolve(spec))
     assert xo.limit_kind == "margin" and xo.limiting_mode is None and xo.notch is None
 
 

@@ -79,7 +79,7 @@ def paper_given(paper_spec):
 
 
 def test_paper_cases_equal_hand_derived_transfer_functions(paper_given):
-    cases = linear.limit_cases(paper_given)
+    cases = linear.limit_cases(resolve(paper_given))
     assert [c.name for c in cases] == list(linear.ISOLATED_CASES)
     assert [c.number for c in cases] == [1, 2, 3, 4]
     for case in cases:
@@ -100,7 +100,7 @@ def test_collocated_mode_and_default_damping(paper_spec):
     fa = mode(S, 90, 0.03) * (S ** 2 + 2 * 0.03 * wa * S + wa ** 2) / wa ** 2
     wa2 = 2 * math.pi * 250
     fb = mode(S, 400, 0.01) * (S ** 2 + 2 * 0.01 * wa2 * S + wa2 ** 2) / wa2 ** 2
-    for case in linear.limit_cases(spec):
+    for case in linear.limit_cases(resolve(spec)):
         want = hand[case.name](S) * fa * fb
         np.testing.assert_allclose(case(S), want, rtol=1e-9, err_msg=case.name)
         np.testing.assert_allclose(ss_response(case.plant, S), want, rtol=1e-9)
@@ -108,7 +108,7 @@ def test_collocated_mode_and_default_damping(paper_spec):
 
 def test_no_isolator_is_one_rigid_mass(paper_spec):
     spec = variant(paper_spec, isolator=None)
-    cases = linear.limit_cases(spec)
+    cases = linear.limit_cases(resolve(spec))
     assert [x.name for x in cases] == ["sliding", "stuck"]
     for case, hand in zip(cases, (HAND["sliding_limited"], HAND["stuck_limited"])):
         np.testing.assert_allclose(case(S), hand(S), rtol=1e-9)
@@ -126,28 +126,28 @@ def test_controller_and_loop(paper_given):
     from dataclasses import replace
     general = replace(law, source="gains")
     np.testing.assert_allclose(ss_response(linear.controller_tf(general), S), pid(S), rtol=1e-9)
-    lp = linear.loop_transfer_function(paper_given, "stuck_free")
+    lp = linear.loop_transfer_function(resolve(paper_given), "stuck_free")
     np.testing.assert_allclose(ss_response(lp, S), pid(S) * HAND["stuck_free"](S) * mode(S),
                                rtol=1e-9)
-    sens = linear.sensitivity(paper_given, 2)
+    sens = linear.sensitivity(resolve(paper_given), 2)
     np.testing.assert_allclose(ss_response(sens, S), 1 / (1 + ss_response(lp, S)), rtol=1e-9)
-    comp = linear.complementary_sensitivity(paper_given, 2)
+    comp = linear.complementary_sensitivity(resolve(paper_given), 2)
     np.testing.assert_allclose(ss_response(comp, S) + ss_response(sens, S), 1.0, rtol=1e-9)
     with pytest.raises(ValueError, match="unknown limit case"):
-        linear.loop_transfer_function(paper_given, "floating")
+        linear.loop_transfer_function(resolve(paper_given), "floating")
 
 
 def test_delay_is_a_pade_of_delay_plus_half_a_sample(paper_spec):
     spec = variant(paper_spec, **{"controller.delay": "0.2 ms", "controller.sample_rate": "5 kHz",
                                   "controller.pade_order": 4})
-    assert linear.delay_time(spec) == pytest.approx(0.2e-3 + 0.5 / 5000, rel=1e-12)
-    num, den = linear.delay_polynomials(spec)
+    assert linear.delay_time(resolve(spec)) == pytest.approx(0.2e-3 + 0.5 / 5000, rel=1e-12)
+    num, den = linear.delay_polynomials(resolve(spec))
     assert len(den) == 5
     w = np.geomspace(1, 2000, 5)
     resp = np.polyval(num, 1j * w) / np.polyval(den, 1j * w)
     np.testing.assert_allclose(np.abs(resp), 1.0, rtol=1e-9)          # all-pass
     np.testing.assert_allclose(resp, np.exp(-1j * w * 0.3e-3), atol=1e-6)
-    assert linear.delay_time(paper_spec) == 0.0
+    assert linear.delay_time(resolve(paper_spec)) == 0.0
 
 
 # --------------------------------------------------------------------------- margins
@@ -183,7 +183,7 @@ PAPER_PHASE_MARGINS = {"sliding_free": (62.451, 7.914), "stuck_free": (47.306, 1
 
 def test_paper_phase_margins_agree_with_a_hand_calculation(paper_given):
     hand = hand_phase_margins()
-    result = linear.analyse(paper_given)
+    result = linear.analyse(resolve(paper_given))
     assert result.passed and result.crossover == 8.0 and result.stiffness == 6667.0
     for case in result.cases:
         pm, fx = hand[case.name]
@@ -198,7 +198,7 @@ def test_paper_phase_margins_agree_with_a_hand_calculation(paper_given):
 
 
 def test_modulus_gain_and_delay_margin_consistent(paper_given):
-    result = linear.analyse(paper_given)
+    result = linear.analyse(resolve(paper_given))
     w = np.geomspace(1e-3, 1e4, 200001)
     for case in result.cases:
         plant = HAND[case.name]
@@ -240,7 +240,7 @@ def test_unstable_loop_is_reported(paper_spec):
 
 def test_infinite_gain_margin_is_null_in_json(paper_spec):
     spec = variant(paper_spec, isolator=None)
-    sliding = linear.analyse(spec).cases[0]
+    sliding = linear.analyse(resolve(spec)).cases[0]
     assert math.isinf(sliding.gain_margin_db)
     assert sliding.to_dict()["gain_margin_db"] is None
 
@@ -249,7 +249,7 @@ def test_infinite_gain_margin_is_null_in_json(paper_spec):
 
 
 def test_paper_achievable_crossover_and_its_boundary(paper_spec):
-    ach = linear.achievable_crossover(paper_spec)
+    ach = linear.achievable_crossover(resolve(paper_spec))
     assert ach.kind == "margin" and ach.case == "stuck_limited" and ach.criterion == "gain margin"
     assert "gain margin of case 4 (cart stuck, limiter engaged)" in ach.limited_by
     assert 8.0 < ach.frequency < 150.0 / 3
@@ -260,7 +260,7 @@ def test_paper_achievable_crossover_and_its_boundary(paper_spec):
 
 def test_nothing_limits_an_ideal_loop(paper_spec):
     spec = variant(paper_spec, **{"isolator.parasitic_modes": [], "isolator.flexure": None})
-    ach = linear.achievable_crossover(spec)
+    ach = linear.achievable_crossover(resolve(spec))
     assert ach.kind == "scan_limit" and ach.frequency == linear.SCAN_LIMIT
     assert ach.limited_by == "nothing up to the scan limit 1000 Hz"
 
@@ -285,7 +285,7 @@ def test_without_given_modes_the_guide_s_own_modes_limit_the_crossover(paper_spe
     model = resolve(spec)
     low = min(model.modes, key=lambda m: m.frequency)
     assert all(m.source == "computed" for m in model.modes) and low.direction == "y"
-    ach = linear.achievable_crossover(spec)
+    ach = linear.achievable_crossover(resolve(spec))
     assert ach.kind == "mode" and ach.mode == low.name
     assert f"'{low.name}'" in ach.limited_by and "loop's crossover" in ach.limited_by
     _separation_boundary(model, ach, low.frequency, 3.0)
@@ -296,24 +296,24 @@ def test_a_delay_lowers_the_achievable_crossover(paper_spec):
     found = []
     for delay in ("0 s", "1 ms", "3 ms"):
         spec = variant(paper_spec, **base, **{"controller.delay": delay})
-        ach = linear.achievable_crossover(spec)
+        ach = linear.achievable_crossover(resolve(spec))
         found.append(ach.frequency)
         if delay != "0 s":
             assert ach.kind == "margin"
     assert found == sorted(found, reverse=True) and len(set(found)) == 3
     # a rigid mass: the delay eats phase w tau, so the limit scales roughly as 1 / tau
     # (the viscous damping and the bristle resonance bend it a little)
-    rigid = [linear.achievable_crossover(variant(paper_spec, isolator=None,
-                                                 **{"controller.delay": d})).frequency
+    rigid = [linear.achievable_crossover(resolve(variant(paper_spec, isolator=None,
+                                                 **{"controller.delay": d}))).frequency
              for d in ("1 ms", "2 ms")]
     assert 0.45 < rigid[1] / rigid[0] < 0.6
 
 
 def test_sampling_adds_half_a_period(paper_spec):
     spec = variant(paper_spec, isolator=None, **{"controller.sample_rate": "1 kHz"})
-    ach = linear.achievable_crossover(spec)
+    ach = linear.achievable_crossover(resolve(spec))
     same = variant(paper_spec, isolator=None, **{"controller.delay": "0.5 ms"})
-    assert ach.frequency == pytest.approx(linear.achievable_crossover(same).frequency, rel=2e-3)
+    assert ach.frequency == pytest.approx(linear.achievable_crossover(resolve(same)).frequency, rel=2e-3)
     assert ach.scan_stop <= 500.0
 
 
@@ -321,7 +321,7 @@ def test_sampling_adds_half_a_period(paper_spec):
 def test_a_parasitic_mode_caps_the_crossover(paper_spec, freq, collocated):
     spec = variant(paper_spec, **{"isolator.parasitic_modes": [
         {"name": "tilt", "frequency": freq, "damping_ratio": 0.05, "collocated": collocated}]})
-    ach = linear.achievable_crossover(spec)
+    ach = linear.achievable_crossover(resolve(spec))
     sep = spec.requirements.parasitic_separation
     model = resolve(spec)
     assert sep * linear.analyse(model.at(crossover=ach.frequency)).loop_crossover <= freq
@@ -333,6 +333,6 @@ def test_a_parasitic_mode_caps_the_crossover(paper_spec, freq, collocated):
 def test_nothing_feasible_is_said(paper_spec):
     spec = variant(paper_spec, isolator=None, **{"controller.delay": "2 s",
                                                  "requirements.phase_margin": "80 deg"})
-    ach = linear.achievable_crossover(spec)
+    ach = linear.achievable_crossover(resolve(spec))
     assert ach.frequency is None and ach.kind == "infeasible"
     assert ach.limited_by.startswith("no crossover from")

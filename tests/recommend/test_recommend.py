@@ -249,18 +249,19 @@ def test_the_search_may_add_a_notch_where_the_spec_allows_it(paper_spec):
     and the notch written out here, hold the margins plus their reserve (7 dB, 35 deg) just
     below the notched limit and miss them just above it; without the key, no notch."""
     from fi_design.model import resolve
-    from fi_design.recommend.constraints import crossover_cap, reserve_spec
+    from fi_design.recommend.constraints import crossover_cap, reserve_values
+    from fi_design.spec.file import with_values
 
     loop = variant(paper_spec, **{"isolator.flexure": None})
-    plain_cap, _, plain_notch = crossover_cap(paper_spec, True)
+    plain_cap, _, plain_notch = crossover_cap(resolve(paper_spec), True)
     assert plain_notch is None
     allowed = variant(paper_spec, **{"requirements.recommend.filters": True})
-    cap, why, notch = crossover_cap(allowed, True)
+    cap, why, notch = crossover_cap(resolve(allowed), True)
     assert notch is not None and notch.kind == "notch" and notch.frequency == pytest.approx(150.0)
     assert "stage tilt" in why and "requirements.recommend.filters" in why
     assert cap > 2.5 * plain_cap
     ach = cap / paper_spec.requirements.reserve.crossover
-    model = resolve(reserve_spec(loop))
+    model = resolve(with_values(loop, reserve_values(loop)))
     req = model.requirements
 
     def meets(fc):

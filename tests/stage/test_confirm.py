@@ -12,13 +12,14 @@ from fi_design.cli.app import app
 from fi_design.stage.confirm import confirm
 from fi_design.guideline.evaluate import evaluate as design
 from fi_design.spec.file import load_spec
+from fi_design.model import resolve
 
 runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
 def paper_confirmation(paper_spec):
-    return confirm(paper_spec)
+    return confirm(resolve(paper_spec))
 
 
 def test_paper_headline_isolator_needs_far_less_bandwidth(paper_confirmation):
@@ -65,7 +66,7 @@ def test_landing_refinement(paper_confirmation, paper_spec):
     from fi_design.stage.confirm import landing
 
     low = simulate(spec, isolated=True, crossover=5.0)
-    land5 = landing(spec, low)
+    land5 = landing(resolve(spec), low)
     assert land5.on_limiter and low.metrics.verdict == "stuck"
 
 

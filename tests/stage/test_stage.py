@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from fi_design.model import resolve
 from fi_design.stage import (converge_cycle, family_distances, rest_is_final, stage_hunting,
                              stage_hunts)
 
@@ -38,11 +39,11 @@ def _upward_crossings(t, e):
 
 
 def test_family_spans_a_tenth_of_the_stroke_to_five_times_the_move(paper_spec):
-    d = family_distances(paper_spec, True)
+    d = family_distances(resolve(paper_spec), True)
     assert len(d) == 24
     assert d[0] == pytest.approx(0.03e-3) and d[-1] == pytest.approx(50e-3)
     assert np.all(np.diff(np.log(d)) == pytest.approx(np.log(d[1] / d[0])))
-    assert family_distances(paper_spec, False)[0] == pytest.approx(0.1e-3)
+    assert family_distances(resolve(paper_spec), False)[0] == pytest.approx(0.1e-3)
 
 
 def test_asymmetric_friction_tries_both_directions(paper_spec):
@@ -51,9 +52,9 @@ def test_asymmetric_friction_tries_both_directions(paper_spec):
     from fi_design.model import resolve
 
     spec = variant(paper_spec, **{"friction.coulomb_negative": "1.5 N"})
-    d = family_distances(spec, True, resolve(spec).plant(True))
+    d = family_distances(resolve(spec), True, resolve(spec).plant(True))
     assert len(d) == 48 and sum(x < 0 for x in d) == 24
-    sym = family_distances(paper_spec, True, resolve(paper_spec).plant(True))
+    sym = family_distances(resolve(paper_spec), True, resolve(paper_spec).plant(True))
     assert all(x > 0 for x in sym)
 
 
