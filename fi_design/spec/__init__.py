@@ -15,7 +15,8 @@ prints them all.
 The package, one job a module: :mod:`.fields` (quantities with units, plain
 text, the strict base model), :mod:`.sections` (every section of the file),
 :mod:`.filters` (the controller's filter chain and
-the drive's units), :mod:`.document` (the :class:`Spec` itself, its effects list and the checks
+the drive's units), :mod:`.requirements` (what the design must meet, the hunting
+metric, the scatter, the search and its reserves), :mod:`.document` (the :class:`Spec` itself, its effects list and the checks
 across sections) and :mod:`.defaults` (derived defaults and warnings). Around the spec itself:
 :mod:`.units` (pint at the YAML boundary), :mod:`.file` (reading a spec file,
 its origin and hash), :mod:`.errors` (pydantic's errors worded with the path,
@@ -32,12 +33,13 @@ from .defaults import (CROSSOVER_AGREEMENT, JOINT_DAMPING_RATIO, antiresonance, 
 from .document import EFFECT_MODELS, EffectEntry, Spec
 from .fields import OptQ, Q, StrictModel, Text
 from .filters import BUTTERWORTH, FILTER_TYPES, Drive, FilterEntry, LowPass, Notch
+from .requirements import (Hunting, Positioning, RecommendBounds, Requirements, Reserve, Ripple,
+                           Robustness)
 from .sections import (MAX_OUTPUT_SAMPLES, MAX_SCAN_POINTS, MAX_STEPS, REPORT_KINDS, Body, Bounds,
                        Controller, CrossoverScan, DocumentIds, Family, Feedforward, Flexure,
-                       Friction, Gains, Hunting, Isolator, Limiter, Material, Measurement, Motion,
-                       Move, ParasiticMode, Positioning, RecommendBounds, ReportInfo,
-                       Requirements, Reserve, Revision,
-                       Ripple, Robustness, Simulation, Stage, move_duration, scan_points)
+                       Friction, Gains, Isolator, Limiter, Material, Measurement, Motion, Move,
+                       ParasiticMode, ReportInfo, Revision, Simulation, Stage, move_duration,
+                       scan_points)
 
 __all__ = [
     "BUTTERWORTH", "Drive", "FILTER_TYPES", "FilterEntry", "LowPass", "Notch",

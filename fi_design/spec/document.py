@@ -12,8 +12,9 @@ from .. import effects as _effects
 from ..provenance import json_sha256
 from .defaults import CROSSOVER_AGREEMENT, gains_crossover, tuning_mass
 from .fields import OptQ, Q, StrictModel, Text
+from .requirements import Requirements
 from .sections import (MAX_OUTPUT_SAMPLES, Body, Controller, Stage, Friction, Isolator, Measurement,
-                       Motion, ReportInfo, Requirements, Simulation)
+                       Motion, ReportInfo, Simulation)
 
 
 # --------------------------------------------------------------------------- effects
