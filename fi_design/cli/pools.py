@@ -28,6 +28,7 @@ import multiprocessing
 import os
 import signal
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -86,6 +87,22 @@ def _process_pool(workers: int, ctx: Any, then: Callable[[], None] | None = None
     return pool, [p for p in multiprocessing.active_children() if p not in before]
 
 
+def _quiet_pool_threads() -> None:
+    """From now on, an error of a process pool's own threads taken apart under them (its
+    pipes closed while it waits on them: ``OSError``, ``ValueError``, ``EOFError``) is not
+    printed: the run is ending on an interruption or a failure, which stays its outcome."""
+    previous = threading.excepthook
+
+    def hook(args: Any) -> None:
+        pool_thread = type(args.thread).__module__.startswith("concurrent.futures") or \
+            type(args.thread).__module__.startswith("multiprocessing")
+        if pool_thread and issubclass(args.exc_type, (OSError, ValueError, EOFError)):
+            return
+        previous(args)
+
+    threading.excepthook = hook
+
+
 def _stop(pool: Any, workers: list) -> None:
     """Stop a pool at once: cancel what has not started, end its own workers (no others).
 
@@ -96,6 +113,7 @@ def _stop(pool: Any, workers: list) -> None:
     run's.
     """
     with interrupts.held():
+        _quiet_pool_threads()
         with contextlib.suppress(OSError, ValueError, RuntimeError):
             pool.shutdown(wait=False, cancel_futures=True)
         for worker in workers:

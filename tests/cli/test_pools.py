@@ -194,7 +194,7 @@ def _sweep_at(tmp_path, delays, at_once: int = 2) -> None:
         try:
             _check_interrupted(run)
         except AssertionError as exc:
-            bad.append(str(exc).splitlines()[0])
+            bad.append(repr(run))  # the whole run, its stderr included, to read what went wrong
     assert not bad, f"{len(bad)} of {len(runs)} interruptions went wrong:\n" + "\n".join(bad)
 
 
@@ -207,3 +207,28 @@ def test_ctrl_c_at_a_few_instants_of_a_sweep(tmp_path):
 @pytest.mark.slow
 def test_ctrl_c_at_many_instants_of_a_sweep(tmp_path):
     _sweep_at(tmp_path, [0.05 + 0.1 * k + 0.03 * (k % 3) for k in range(60)])
+
+
+def test_a_pool_thread_taken_apart_under_it_is_not_reported(monkeypatch):
+    """After an interrupted stop, a process pool's manager thread that finds its pipes closed
+    (OSError) is not reported; any other thread's error still is."""
+    import threading
+    import types
+    from concurrent.futures import process
+
+    from fi_design.cli.pools import _quiet_pool_threads
+
+    reported = []
+    monkeypatch.setattr(threading, "excepthook", reported.append)
+    _quiet_pool_threads()
+
+    class Manager(threading.Thread):
+        pass
+
+    Manager.__module__ = process.__name__
+    pool_error = types.SimpleNamespace(thread=Manager(), exc_type=OSError)
+    other_error = types.SimpleNamespace(thread=threading.Thread(), exc_type=OSError)
+    pool_bug = types.SimpleNamespace(thread=Manager(), exc_type=ZeroDivisionError)
+    for args in (pool_error, other_error, pool_bug):
+        threading.excepthook(args)
+    assert reported == [other_error, pool_bug]
