@@ -248,6 +248,16 @@ class Model:
         return self.joint is not None
 
     @property
+    def joint_damping_ratio(self) -> float | None:
+        """The joint mode's damping ratio c / (2 sqrt(|k| m1 m2 / (m1 + m2))) [-]; None
+        without isolator."""
+        j = self.joint
+        if j is None:
+            return None
+        return j.damping / (2.0 * math.sqrt(abs(j.stiffness) * self.m1 * self.m2
+                                            / (self.m1 + self.m2)))
+
+    @property
     def static_error_bound(self) -> float | None:
         """The largest position error a loop without integrator can rest at [m].
 

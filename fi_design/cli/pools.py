@@ -92,6 +92,8 @@ def _quiet_pool_threads() -> None:
     pipes closed while it waits on them: ``OSError``, ``ValueError``, ``EOFError``) is not
     printed: the run is ending on an interruption or a failure, which stays its outcome."""
     previous = threading.excepthook
+    if getattr(previous, "quiets_pool_threads", False):  # installed already: once is enough
+        return
 
     def hook(args: Any) -> None:
         pool_thread = type(args.thread).__module__.startswith("concurrent.futures") or \
@@ -100,6 +102,7 @@ def _quiet_pool_threads() -> None:
             return
         previous(args)
 
+    hook.quiets_pool_threads = True  # type: ignore[attr-defined]
     threading.excepthook = hook
 
 

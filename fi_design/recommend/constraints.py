@@ -32,7 +32,7 @@ from ..model import Model
 from ..spec.file import with_values
 
 __all__ = ["SEARCH_POINTS", "reserve_values", "reserve_requirements", "crossover_cap",
-           "with_notch", "notch_entries", "guide_for", "loop_meets", "stage_answer",
+           "notched_model", "notch_entries", "guide_for", "loop_meets", "stage_answer",
            "margin_screen", "reserve_corners", "hunting_margin"]
 
 #: Lengths of the guide's sizing grid during the search (the chosen design is sized again at
@@ -97,7 +97,7 @@ def crossover_cap(base: Model, rule: bool) -> tuple[float, str, Any]:
     model = base.varied({**values, **reserve_values(base.spec)})
     ach = linear.achievable_crossover(model)
     notch = None
-    mode = limiting_mode(model, ach) if (bounds_allow_filters(base.spec)
+    mode = limiting_mode(model, ach) if (base.requirements.recommend.filters
                                         and ach.frequency is not None
                                         and ach.kind != "scan_limit") else None
     if mode is not None and not notched(model, mode):
@@ -125,12 +125,7 @@ def crossover_cap(base: Model, rule: bool) -> tuple[float, str, Any]:
     return float(cap), why, notch
 
 
-def bounds_allow_filters(spec: _spec.Spec) -> bool:
-    """Whether the spec lets the search add a notch (``requirements.recommend.filters``)."""
-    return bool(spec.requirements.recommend.filters)
-
-
-def with_notch(model: Model, notch: Any) -> Model:
+def notched_model(model: Model, notch: Any) -> Model:
     """The model with a notch appended to ``controller.filters`` (its spec holding it)."""
     return model.varied({"controller.filters": notch_entries(model.spec, notch)})
 
@@ -138,8 +133,7 @@ def with_notch(model: Model, notch: Any) -> Model:
 def notch_entries(spec: _spec.Spec, notch: Any) -> list[dict]:
     """``controller.filters`` as the spec file takes it, with a notch appended."""
     own = [f.model_dump(mode="json", exclude_none=True) for f in spec.controller.filters]
-    return own + [{"type": "notch", "name": notch.name, "frequency": f"{notch.frequency:.6g} Hz",
-                   "width": f"{notch.width:.6g} Hz"}]
+    return own + [notch.spec_entry()]
 
 
 def guide_for(base: Model, stiffness: float, stroke: float, crossover: float, *,

@@ -113,7 +113,7 @@ class _Search:
         self.rule = self.spec.controller.gains is None
         self.fc, self.fc_why, self.notch = _c.crossover_cap(model, self.rule)
         if self.notch is not None:  # every candidate carries the notch the search adds
-            base = _c.with_notch(base, self.notch)
+            base = _c.notched_model(base, self.notch)
         self.base_model = base
         self.base = base.spec
         self.margin = self.base.requirements.hunting_margin

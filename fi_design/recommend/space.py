@@ -83,8 +83,7 @@ def damping_ratio(model: Model) -> float | None:
     iso = model.spec.isolator
     if iso is None or iso.damping is None:
         return None
-    k, m1, m2 = model.joint.stiffness, model.m1, model.m2
-    return iso.damping / (2.0 * math.sqrt(abs(k) * m1 * m2 / (m1 + m2)))
+    return model.joint_damping_ratio
 
 
 def stroke_envelope(base: _spec.Spec) -> tuple[float, float, str, str]:

@@ -151,6 +151,21 @@ class Filter:
             out["damping"] = self.zeta_pole
         return out
 
+    def spec_entry(self) -> dict:
+        """The filter as ``controller.filters`` takes it in the spec file: a notch by its
+        frequency and width (and depth unless full), a low-pass by its order (and damping)."""
+        out: dict = {"type": self.kind, "name": self.name,
+                     "frequency": f"{self.frequency:.6g} Hz"}
+        if self.kind == "notch":
+            out["width"] = f"{self.width:.6g} Hz"
+            if not math.isinf(self.depth):
+                out["depth"] = f"{self.depth:.6g} dB"
+        else:
+            out["order"] = self.order
+            if self.order == 2:
+                out["damping"] = self.zeta_pole
+        return out
+
 
 @dataclass(frozen=True)
 class DriveUnits:

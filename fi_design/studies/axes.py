@@ -242,8 +242,8 @@ def held_damping_note(spec: _spec.Spec, axes: Sequence[Axis]) -> str | None:
 
     A given ``isolator.damping`` c [N s/m] is a damper's: it stays as the
     stiffness (or the stroke, through the proposed stiffness, or a mass)
-    varies, so the joint's damping ratio c / (2 sqrt(k m1 m2 / (m1 + m2))) [-]
-    moves with it; a damping left to its default keeps the ratio instead.
+    varies, so the joint's damping ratio
+    (:attr:`fi_design.model.Model.joint_damping_ratio`) moves with it; a damping left to its default keeps the ratio instead.
 
     Parameters
     ----------
@@ -256,22 +256,16 @@ def held_damping_note(spec: _spec.Spec, axes: Sequence[Axis]) -> str | None:
     -------
     str or None
     """
-    import math
-
     from ..display import number
-    from ..spec.paths import with_values
+    from ..model import resolve
 
     iso = spec.isolator
     moving = [a for a in axes if a is not None and a.path in _JOINT_PATHS]
     if iso is None or iso.damping is None or not moving:
         return None
-    ratios = []
-    for a in moving:
-        for v in (float(np.min(a.values)), float(np.max(a.values))):
-            s = with_values(spec, {a.path: v})
-            k = _spec.drive_stiffness(s)
-            m1, m2 = s.stage.mass, s.cart.mass
-            ratios.append(iso.damping / (2.0 * math.sqrt(k * m1 * m2 / (m1 + m2))))
+    model = resolve(spec)
+    ratios = [model.varied({a.path: v}).joint_damping_ratio for a in moving
+              for v in (float(np.min(a.values)), float(np.max(a.values)))]
     return (f"isolator.damping is given ({number(iso.damping)} N s/m) and held as "
             f"{', '.join(a.path for a in moving)} varies: the joint's damping ratio runs "
             f"from {number(min(ratios), 3)} to {number(max(ratios), 3)} over the axes (leave "

@@ -221,6 +221,9 @@ def test_a_pool_thread_taken_apart_under_it_is_not_reported(monkeypatch):
     reported = []
     monkeypatch.setattr(threading, "excepthook", reported.append)
     _quiet_pool_threads()
+    installed = threading.excepthook
+    _quiet_pool_threads()  # a second stop in the same process installs nothing more
+    assert threading.excepthook is installed
 
     class Manager(threading.Thread):
         pass

@@ -367,3 +367,21 @@ def test_the_kernel_carries_the_filters_as_the_independent_simulator_does(paper_
     assert np.max(np.abs(run.position - plain.position)) > 1.5e-5  # the filters matter ...
     assert np.max(np.abs(run.position - rec.truth.x1)) < 2e-9     # ... and agree
     assert np.max(np.abs(run.force - rec.truth.command)) < 1e-4
+
+
+def test_a_filter_written_as_a_spec_entry_reads_back_the_same(paper_spec):
+    """Filter.spec_entry (what --write-spec and the recommendation's notch write) gives the
+    chain the spec had: frequency, width and depth of a notch, order and damping of a
+    low-pass."""
+    chain = [dict(NOTCH, depth="20 dB"),
+             {"type": "low_pass", "name": "lp2", "frequency": "400 Hz", "order": 2,
+              "damping": 0.5},
+             {"type": "low_pass", "name": "lp1", "frequency": "600 Hz", "order": 1}]
+    law = resolve(variant(paper_spec, **{"controller.filters": chain})).law
+    again = resolve(variant(paper_spec, **{"controller.filters": [f.spec_entry()
+                                                                   for f in law.filters]})).law
+    assert len(again.filters) == 3
+    for a, b in zip(law.filters, again.filters):
+        assert (a.kind, a.name, a.order) == (b.kind, b.name, b.order)
+        assert (b.frequency, b.zeta_pole, b.zeta_zero) == pytest.approx(
+            (a.frequency, a.zeta_pole, a.zeta_zero), rel=1e-5)
