@@ -18,7 +18,12 @@ axes:
 - :func:`with_error`: a value and its standard error in one unit
   (``5 ± 3.5 × 10⁻⁵ mm``);
 - :func:`percent`, :func:`unit_text` (``N*s/m`` -> ``N·s/m``) and
-  :func:`axis_unit` (the unit of a figure axis or a map's header).
+  :func:`axis_unit` (the unit of a figure axis or a map's header);
+- :func:`fixed`: a fixed number of decimals where a field reads that way
+  (margins in dB and degrees to 0.1);
+- :func:`plain`: a number a program reads back (a value written into a spec, a
+  cache key): ``%g`` notation, never a power-of-ten sign;
+- :func:`code_point`: a character by its code (``U+0007``).
 
 Pure Python on purpose: every layer may import it.
 """
@@ -29,8 +34,8 @@ import math
 from typing import Any, Iterable, Sequence
 
 __all__ = ["number", "quantity", "quantities", "scale", "display_scale", "with_error",
-           "percent", "unit_text", "axis_unit", "UNIT_TEXT", "DISPLAY_SCALES", "AXIS_UNITS",
-           "NBSP"]
+           "percent", "fixed", "plain", "code_point", "unit_text", "axis_unit", "UNIT_TEXT",
+           "DISPLAY_SCALES", "AXIS_UNITS", "NBSP"]
 
 #: No-break space: between a number and its unit in reports.
 NBSP = "\u00a0"
@@ -346,6 +351,74 @@ def percent(fraction: Any, digits: int = 3) -> str:
     if fraction is None or not _is_number(fraction):
         return "n/a"
     return f"{number(100.0 * fraction, digits)} %"
+
+
+def fixed(value: Any, decimals: int = 1) -> str:
+    """A number with a fixed count of decimals: ``fixed(6.02)`` -> ``6.0``.
+
+    For fields read to a fixed resolution (a margin in dB or degrees, a
+    percentage of a slider); otherwise prefer :func:`number`.
+
+    Parameters
+    ----------
+    value : float, None or str
+        The number; None, nan, infinities and strings as in :func:`number`.
+    decimals : int, optional
+        Digits after the point (default 1).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> fixed(6.02), fixed(47.0, 0), fixed(None), fixed(float("inf"))
+    ('6.0', '47', '–', '∞')
+    """
+    if value is None or isinstance(value, (str, bool)) or not math.isfinite(float(value)):
+        return number(value)
+    text = f"{float(value):.{decimals}f}"
+    return "0" if decimals == 0 and text == "-0" else text
+
+
+def plain(value: Any, digits: int = 6) -> str:
+    """A number a program reads back: ``%g`` notation (``3e-08``, ``0.45``), round trip by float().
+
+    For values written into a spec or a data file and for cache keys, where the
+    reader's :func:`number` (``3 × 10⁻⁸``) would not parse.
+
+    Parameters
+    ----------
+    value : float or int
+        The number.
+    digits : int, optional
+        Significant digits (default 6, as ``%g``); 17 round-trips any float.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> plain(3e-8), plain(0.45e-3), plain(1/3, 4), plain(2.0)
+    ('3e-08', '0.00045', '0.3333', '2')
+    """
+    return f"{float(value):.{digits}g}"
+
+
+def code_point(code: int) -> str:
+    """A character by its code, as Unicode names it: ``code_point(7)`` -> ``U+0007``.
+
+    Parameters
+    ----------
+    code : int
+        The character's code point.
+
+    Returns
+    -------
+    str
+    """
+    return f"U+{code:04X}"
 
 
 def axis_unit(unit: str) -> tuple[str, float]:

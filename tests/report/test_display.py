@@ -164,3 +164,83 @@ def test_units_are_converted_in_display_only():
                  for hit in hand_conversions(p.read_text(encoding="utf-8"))]
     assert not offenders, ("convert units with fi_design.display (quantity, quantities, "
                            "with_error): " + "; ".join(offenders))
+
+
+# Numbers are formatted for readers in fi_design.display only: a format spec that presents a
+# number (``{x:.3g}``, ``{f:.0%}``, ``"%.2f" % x``, ``format(x, "g")``, ``"{:.1f}".format(x)``)
+# or a percentage made by hand (``{100 * f:.3g} %``, ``{number(100 * f)} %``) outside it
+# formats by hand. Layout alone (``{name:<20}``) is not a number's format.
+
+_NUMERIC_SPEC = re.compile(r"[.,_%eEfFgGdnxXbo+]|^#?0\d")
+_PERCENT_STYLE = re.compile(r"%[-+ #0]*\d*(\.\d+)?[eEfFgGdixXo]")
+_BRACE_SPEC = re.compile(r"\{[^{}]*:([^{}]*)\}")
+
+
+def _spec_text(spec) -> str:
+    return "".join(str(v.value) if isinstance(v, ast.Constant) else "{}" for v in spec.values)
+
+
+def _numeric(spec: str) -> bool:
+    layout = spec.lstrip("<>^=") if len(spec) < 2 or spec[1] not in "<>^=" else spec[2:]
+    return bool(layout) and bool(_NUMERIC_SPEC.search(layout.replace("{}", "")))
+
+
+def _by_hundred(node) -> bool:
+    return any(isinstance(n, ast.BinOp) and isinstance(n.op, ast.Mult)
+               and any(isinstance(s, ast.Constant) and s.value in (100, 100.0)
+                       for s in (n.left, n.right)) for n in ast.walk(node))
+
+
+def hand_formats(source: str) -> list[str]:
+    """Numbers formatted outside fi_design.display: numeric format specs in f-strings,
+    ``%``-formatting, ``str.format`` and ``format()`` with a numeric spec, hand percentages."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.JoinedStr):
+            for i, part in enumerate(node.values):
+                if not isinstance(part, ast.FormattedValue):
+                    continue
+                after = node.values[i + 1] if i + 1 < len(node.values) else None
+                percent_after = isinstance(after, ast.Constant) and str(after.value).lstrip(
+                    " \u00a0").startswith("%")
+                if (part.format_spec is not None and _numeric(_spec_text(part.format_spec))) or (
+                        percent_after and _by_hundred(part.value)):
+                    found.append(f"{part.lineno}: {ast.unparse(part)}")
+        elif (isinstance(node, ast.BinOp) and isinstance(node.op, ast.Mod)
+              and isinstance(node.left, ast.Constant) and isinstance(node.left.value, str)
+              and _PERCENT_STYLE.search(node.left.value)):
+            found.append(f"{node.lineno}: {ast.unparse(node)}")
+        elif isinstance(node, ast.Call) and (
+                (isinstance(node.func, ast.Attribute) and node.func.attr == "format"
+                 and isinstance(node.func.value, ast.Constant)
+                 and isinstance(node.func.value.value, str)
+                 and any(_numeric(s) for s in _BRACE_SPEC.findall(node.func.value.value)))
+                or (isinstance(node.func, ast.Name) and node.func.id == "format"
+                    and len(node.args) > 1)):
+            found.append(f"{node.lineno}: {ast.unparse(node)}")
+    return found
+
+
+def test_the_scan_finds_each_hand_format():
+    planted = ('print(f"{x:.3g} N")\nprint(f"{f:.0%}")\nprint("%.2f" % x)\n'
+               'print(format(x, "g"))\nprint("{:.1f} dB".format(x))\n'
+               'print(f"{100 * f:.3g} %")\nprint(f"{number(f * 100, 3)}%")\nprint(f"{n:,}")\n'
+               'print(f"{x:{w}.{d}f}")\nprint(f"{n:04X}")\nprint(f"{x:8.2f}")\n')
+    assert [f.split(":")[0] for f in hand_formats(planted)] == [str(i) for i in range(1, 12)]
+    fine = ('print(f"{name:<20} {number(x, 3)} N {percent(f)} {fixed(g)} dB {plain(k)}")\n'
+            'print(f"{label:>{width}}")\nprint("%s of %d" if a else "%")\n'
+            'print(f"{100 * f} cases")\nprint("{} and {}".format(a, b))\n')
+    assert hand_formats(fine) == []
+
+
+@pytest.mark.xfail(strict=True, reason="being routed through display, package by package")
+def test_numbers_are_formatted_in_display_only():
+    import fi_design
+
+    package = Path(fi_design.__file__).parent
+    offenders = [f"{p.relative_to(package)}:{hit}" for p in sorted(package.rglob("*.py"))
+                 if p.name != "display.py"
+                 for hit in hand_formats(p.read_text(encoding="utf-8"))]
+    assert not offenders, (f"{len(offenders)} numbers formatted by hand; format them with "
+                           "fi_design.display (number, quantity, percent, fixed, plain): "
+                           + "; ".join(offenders))
