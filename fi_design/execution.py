@@ -6,17 +6,19 @@ by :class:`Executor`: a :class:`concurrent.futures.ProcessPoolExecutor`, a
 ``dask.distributed.Client``, ... or None to run in the calling process.
 :func:`chunks` groups work items so that every chunk costs about the same;
 :func:`run_chunks` submits them and hands each result back in the calling
-thread as it completes.
+thread as it completes; :class:`Background` runs such a submitting call in a
+thread of its own, so that the calling thread goes on while the executor works.
 """
 
 from __future__ import annotations
 
 import math
 import queue
+import threading
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
-__all__ = ["Executor", "Future", "chunks", "run_chunks"]
+__all__ = ["Executor", "Future", "chunks", "run_chunks", "Background"]
 
 
 class Future(Protocol):
@@ -111,3 +113,51 @@ def run_chunks(executor: Executor, fn: Callable[..., Any], arguments: Sequence[t
         for fut in futures:
             fut.cancel()
         raise
+
+
+class Background:
+    """A call run in a daemon thread of this process; :meth:`result` waits for it.
+
+    For a call that mostly waits on an executor (it submits chunks with
+    :func:`run_chunks` and collects them): the chunks start at once, and the
+    calling thread goes on with its own work meanwhile. A daemon thread: an
+    interruption of the calling thread never waits for it.
+
+    Parameters
+    ----------
+    fn : callable
+        The call; ``fn(*args, **kwargs)``.
+    *args, **kwargs
+        Its arguments.
+
+    Examples
+    --------
+    >>> job = Background(sum, [1, 2, 3])
+    >>> job.result()
+    6
+    """
+
+    def __init__(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> None:
+        self._value: Any = None
+        self._error: BaseException | None = None
+
+        def body() -> None:
+            try:
+                self._value = fn(*args, **kwargs)
+            except BaseException as exc:  # noqa: BLE001 -- handed to result()
+                self._error = exc
+
+        name = f"background {getattr(fn, '__name__', 'call')}"
+        self._thread = threading.Thread(target=body, name=name, daemon=True)
+        self._thread.start()
+
+    def result(self) -> Any:
+        """The call's return value, once it has returned; re-raises its exception.
+
+        Waits in short slices, so that Ctrl-C in the calling thread is not held up.
+        """
+        while self._thread.is_alive():
+            self._thread.join(0.2)
+        if self._error is not None:
+            raise self._error
+        return self._value

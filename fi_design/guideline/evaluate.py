@@ -14,12 +14,14 @@ from __future__ import annotations
 
 import logging
 import math
+import threading
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 from ..display import number, quantity
 from ..errors import ArgumentError
+from ..execution import Background
 from ..mechanism.checks import flexure_checks
 from ..model import Model, as_model
 from ..results import Check, Status
@@ -116,7 +118,6 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
     from .. import __version__
     from . import verdict as _verdict
     from ..stage.confirm import confirm as run_confirmation
-    from ..loop.responses import loop_responses
     from ..stage import positioning, positioning_checks
 
     if not isinstance(spec, Model):
@@ -134,44 +135,55 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
             "confirm=False, or write the values into the spec "
             "(fi_design.spec.file.with_values) and design that")
     pending = []
+    scatter = stop = None
     if confirm and executor is not None:
+        # the simulations start first: the workers run them while this process imports
+        # python-control and scans the loop (step 2)
         pending.append(executor.submit(run_confirmation, model, suggestion))
+        if robust:
+            stop = threading.Event()
+            scatter = Background(_verdict.run_robustness, model, suggestion,
+                                 _scatter_progress(progress, stop), executor=executor)
+    from ..loop.responses import loop_responses  # python-control: after the workers start
+
     try:
         gap = step1_friction_gap(model)
         xo = step2_crossover(model)
         st = step3_stiffness(model)
         fx = step3_flexure(model, st)
         pid = step4_pid(model)
+        advice = isolator_advice(model, gap, xo) if not model.has_isolator else None
+        fe = _fe_check(fx) if fe_check else None
+        checks = (gap.checks + xo.checks + st.checks
+                  + flexure_checks(fx, xo.desired, model.requirements.parasitic_separation)
+                  + pid.checks)
+        result = DesignResult(
+            spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,
+            loop=loop_responses(model, xo), isolator_advice=advice, checks=checks,
+            warnings=tuple(warnings_for(spec)),
+            conclusion=_conclusion(model, gap, xo, st, fx, pid, advice, checks),
+            fi_design_version=__version__, spec_sha256=spec.sha256(), simulation=None,
+            model=model, flexure_fe=fe)
+        sim = study = None
+        if confirm:
+            if progress is not None:
+                progress("simulating with and without the isolator ...")
+            if scatter is not None:
+                study = scatter.result()
+            elif robust:
+                if progress is not None:
+                    progress("simulating the friction scatter of requirements.robustness ...")
+                study = _verdict.run_robustness(model, suggestion,
+                                                _scatter_progress(progress, None))
+            sim = pending[0].result() if pending else \
+                run_confirmation(model, suggestion, progress=progress)
     except BaseException:
         for fut in pending:
             fut.cancel()
+        if stop is not None:
+            stop.set()  # the scatter's chunks not yet started are cancelled
         raise
-    advice = isolator_advice(model, gap, xo) if not model.has_isolator else None
-    fe = _fe_check(fx) if fe_check else None
-    checks = (gap.checks + xo.checks + st.checks
-              + flexure_checks(fx, xo.desired, model.requirements.parasitic_separation)
-              + pid.checks)
-    result = DesignResult(
-        spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,
-        loop=loop_responses(model, xo), isolator_advice=advice, checks=checks,
-        warnings=tuple(warnings_for(spec)),
-        conclusion=_conclusion(model, gap, xo, st, fx, pid, advice, checks),
-        fi_design_version=__version__, spec_sha256=spec.sha256(), simulation=None,
-        model=model, flexure_fe=fe)
-    sim = study = None
     if confirm:
-        if progress is not None:
-            progress("simulating with and without the isolator ...")
-        if robust:
-            # the samples go to the executor in chunks, beside the confirmation
-            if progress is not None:
-                progress("simulating the friction scatter of requirements.robustness ...")
-            study = _verdict.run_robustness(
-                model, suggestion, None if progress is None else
-                (lambda done, total: progress(f"friction scatter: {done}/{total} samples")),
-                executor=executor)
-        sim = pending[0].result() if pending else \
-            run_confirmation(model, suggestion, progress=progress)
         own = "isolated" if model.has_isolator else "non_isolated"
         # the stage-level answer decides: step 1 and the advice now read it
         n_gap = len(gap.checks)
@@ -204,6 +216,26 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
     log.info("design of %r: %s, %d checks, %d failed", spec.name, result.verdict.status,
              len(result.checks), len(result.failed_checks))
     return result
+
+
+class _Stopped(Exception):
+    """The design stopped before the scatter's samples were collected."""
+
+
+def _scatter_progress(progress: Callable[[str], None] | None,
+                      stop: threading.Event | None) -> Callable[[int, int], None] | None:
+    """The robustness study's ``progress(done, total)``: a message on ``progress``; once
+    ``stop`` is set it raises, which cancels the chunks not yet started."""
+    if progress is None and stop is None:
+        return None
+
+    def tell(done: int, total: int) -> None:
+        if stop is not None and stop.is_set():
+            raise _Stopped
+        if progress is not None:
+            progress(f"friction scatter: {done}/{total} samples")
+
+    return tell
 
 
 def _fe_check(fx: FlexureResult | None):

@@ -143,17 +143,24 @@ sys.exit(code)
 """
 
 
-def _interrupted_sweep(tmp_path, delay: float) -> dict:
-    """A 6-point sweep on 2 workers, output to a file, sent SIGINT ``delay`` s after the
-    command line is ready: pool start, points, the CSV written, or already finished."""
+_SWEEP = ["sweep", str(EXAMPLES / "paper_setup.yaml"), "--x", "controller.crossover=3 Hz:15 Hz:3",
+          "--y", "isolator.stroke=0.1 mm:0.9 mm:2", "--jobs", "2", "--no-cache",
+          "--csv", "map.csv"]
+#: The design run: the confirmation and the robustness study's chunks on two workers while
+#: this process scans the loop; its JSON output named map.csv so that the check below reads it.
+_DESIGN = ["design", str(EXAMPLES / "paper_setup.yaml"), "--no-recommend", "--json", "map.csv"]
+
+
+def _interrupted_sweep(tmp_path, delay: float, command: list[str] = _SWEEP) -> dict:
+    """A 6-point sweep on 2 workers (or another ``command``), output to a file, sent SIGINT
+    ``delay`` s after the command line is ready: pool start, points, the CSV written, or
+    already finished."""
     import tempfile
     from pathlib import Path
 
     work = Path(tempfile.mkdtemp(prefix=f"at_{delay:.2f}_", dir=tmp_path))
     proc = subprocess.Popen(
-        [sys.executable, "-c", _DRIVER, "sweep", str(EXAMPLES / "paper_setup.yaml"), "--x",
-         "controller.crossover=3 Hz:15 Hz:3", "--y", "isolator.stroke=0.1 mm:0.9 mm:2",
-         "--jobs", "2", "--no-cache", "--csv", "map.csv"],
+        [sys.executable, "-c", _DRIVER, *command],
         cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert proc.stdout.readline().strip() == "ready"
@@ -184,11 +191,11 @@ def _check_interrupted(run: dict) -> None:
     assert "map.csv" not in run["files"] or "it had written" in run["err"], run
 
 
-def _sweep_at(tmp_path, delays, at_once: int = 2) -> None:
+def _sweep_at(tmp_path, delays, at_once: int = 2, command: list[str] = _SWEEP) -> None:
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(at_once) as ex:
-        runs = list(ex.map(lambda d: _interrupted_sweep(tmp_path, d), delays))
+        runs = list(ex.map(lambda d: _interrupted_sweep(tmp_path, d, command), delays))
     bad = []
     for run in runs:
         try:
@@ -202,6 +209,18 @@ def test_ctrl_c_at_a_few_instants_of_a_sweep(tmp_path):
     """Of six SIGINTs sent into a sweep on a loaded machine, one printed `OSError: [Errno 9]
     Bad file descriptor`, one was lost (the sweep wrote map.csv and exited 0)."""
     _sweep_at(tmp_path, [0.2, 1.2, 2.5], at_once=3)  # parsing; the pool's start; the points
+
+
+def test_ctrl_c_at_a_few_instants_of_a_design_run(tmp_path):
+    """The robustness study's chunks are submitted by a thread of their own while the main
+    thread scans the loop: an interruption in the steps, in the study or after it ends the
+    run with 130 and the interruption's message, never a thread's error."""
+    _sweep_at(tmp_path, [0.3, 1.5, 2.5], at_once=3, command=_DESIGN)
+
+
+@pytest.mark.slow
+def test_ctrl_c_at_many_instants_of_a_design_run(tmp_path):
+    _sweep_at(tmp_path, [0.2 + 0.15 * k for k in range(30)], command=_DESIGN)
 
 
 @pytest.mark.slow

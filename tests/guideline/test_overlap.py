@@ -1,0 +1,53 @@
+"""The design's simulations start before its linear steps and stop with them.
+
+With an executor, :func:`fi_design.guideline.evaluate.evaluate` submits the confirmation and
+the robustness study's chunks first (the study from a thread of its own), so the workers
+simulate while the calling process imports python-control and scans the loop; a step that
+raises cancels the study's chunks not yet started.
+"""
+
+from __future__ import annotations
+
+import threading
+from concurrent.futures import ThreadPoolExecutor
+
+import pytest
+
+import fi_design.guideline.evaluate as evaluate_module
+import fi_design.studies.points as points
+from fi_design.execution import Background
+
+
+def test_background_hands_back_the_value_and_the_error():
+    assert Background(sorted, [3, 1, 2]).result() == [1, 2, 3]
+    with pytest.raises(ZeroDivisionError):
+        Background(lambda: 1 / 0).result()
+
+
+def test_the_study_runs_while_the_steps_do_and_a_failing_step_cancels_it(paper_spec,
+                                                                        monkeypatch):
+    started = threading.Event()
+    chunks = []
+    run_chunk = points.run_chunk
+
+    def counted(*args, **kwargs):
+        started.set()
+        out = run_chunk(*args, **kwargs)
+        chunks.append(len(out))
+        return out
+
+    def step2_fails(model):
+        # the study's first chunk starts while this step still runs
+        assert started.wait(60), "no chunk of the robustness study started during step 2"
+        raise RuntimeError("step 2 failed")
+
+    monkeypatch.setattr(points, "run_chunk", counted)
+    monkeypatch.setattr(evaluate_module, "step2_crossover", step2_fails)
+    with ThreadPoolExecutor(1) as pool:
+        with pytest.raises(RuntimeError, match="step 2 failed"):
+            evaluate_module.evaluate(paper_spec, executor=pool)
+        pool.shutdown(wait=True)
+    samples = paper_spec.requirements.robustness.samples
+    total = len(points.chunks(2 * samples, points.chunk_size(2 * samples)))  # both plants
+    # the chunks already queued when the step failed may run; the rest never start
+    assert 1 <= len(chunks) < total, (len(chunks), total)
