@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 
+from ..display import quantity
 from ..results.controller import ControlLaw, DiscreteController, DriveGains
 
 __all__ = ["drive_gains"]
@@ -34,7 +35,7 @@ def drive_gains(law: ControlLaw, discrete: DiscreteController | None = None) -> 
     if drv is None:
         return None
     per_count = drv.encoder_resolution / drv.force_per_unit
-    unit = "A" if drv.current_scaling == 1.0 else f"unit of {drv.current_scaling:.6g} A"
+    unit = "A" if drv.current_scaling == 1.0 else f"unit of {quantity(drv.current_scaling, 'A', 6)}"
     short = "A" if unit == "A" else "unit"
     limit = None if math.isinf(law.force_limit) else law.force_limit / drv.force_per_unit
     units = {"kp": f"{short}/count", "ki": f"{short}/(count s)", "kd": f"{short} s/count",

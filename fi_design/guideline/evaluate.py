@@ -258,8 +258,9 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
 
     parts = []
     where = "at or above" if gap.hunting_risk else "below"
-    first = (f"Static friction exceeds Coulomb friction by {gap.gap:.3g} N, {where} the "
-             f"{gap.threshold:.3g} N threshold of step 1 (the paper's rule for its own stage)")
+    first = (f"Static friction exceeds Coulomb friction by {quantity(gap.gap, 'N', 3)}, {where} "
+             f"the {quantity(gap.threshold, 'N', 3)} threshold of step 1 (the paper's rule for "
+             "its own stage)")
     if gap.hunting_risk and not pid.controller.integrator:
         first += (", but the loop has no integrator to push the cart through stiction, so it "
                   "cannot hunt by the paper's mechanism")
@@ -273,16 +274,16 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
     bad = [c for c in xo.cases if not c.passed]
     pms = [c.phase_margin_deg for c in xo.cases if c.in_band] or [math.inf]
     gms = [abs(c.gain_margin_db) for c in xo.cases]
-    margins = (f"phase margins of at least {min(pms):.3g} deg and gain margins of at least "
-               f"{min(gms):.3g} dB" if all(math.isfinite(x) for x in gms)
-               else f"phase margins of at least {min(pms):.3g} deg")
+    margins = (f"phase margins of at least {number(min(pms), 3)} deg and gain margins of at least "
+               f"{number(min(gms), 3)} dB" if all(math.isfinite(x) for x in gms)
+               else f"phase margins of at least {number(min(pms), 3)} deg")
     if xo.achievable is None:
         ach = f"no crossover meets the requirements ({xo.limited_by})"
     elif xo.limit_kind == "scan_limit":
         ach = (f"the linear model limits the crossover nowhere up to the scan limit of "
-               f"{xo.achievable:.4g} Hz")
+               f"{quantity(xo.achievable, 'Hz', 4)}")
     else:
-        ach = (f"the achievable crossover is {number(xo.achievable, 4)} Hz, limited by "
+        ach = (f"the achievable crossover is {quantity(xo.achievable, 'Hz', 4)}, limited by "
                f"{xo.limited_by}")
     if xo.notch is not None:
         ach += f"; {notch_words(xo.notch)}"
@@ -290,20 +291,20 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
           else "the hardware's crossover")
     if not bad:
         every = "both" if n == 2 else f"all {n}"
-        parts.append(f"At {at} of {number(xo.desired, 4)} Hz {every} linear limit "
+        parts.append(f"At {at} of {quantity(xo.desired, 'Hz', 4)} {every} linear limit "
                      f"cases are stable with {margins}; {ach}.")
     else:
         which = ", ".join(f"case {CASE_NUMBERS[c.name]} ({c.description}: "
                           f"{', '.join(c.failed)})" for c in bad)
-        parts.append(f"At {at} of {number(xo.desired, 4)} Hz the margins fail in "
+        parts.append(f"At {at} of {quantity(xo.desired, 'Hz', 4)} the margins fail in "
                      f"{which}; {ach}.")
     if model.has_isolator:
         ok = st.chosen <= st.maximum * (1 + 1e-12)
         parts.append(f"The drive stiffness of {_g(st.chosen)} N/m is "
                      + ("within" if ok else "above")
                      + f" the maximum of {_g(st.maximum)} N/m, so the flexure pushes the cart "
-                     f"with {st.force_at_stroke:.3g} N at full stroke against {st.static:.3g} N "
-                     "of static friction.")
+                     f"with {quantity(st.force_at_stroke, 'N', 3)} at full stroke against "
+                     f"{quantity(st.static, 'N', 3)} of static friction.")
         if fx is not None:
             if fx.feasible:
                 low = fx.lowest_mode
@@ -315,7 +316,7 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
                     f"{fx.guide.orientation}) "
                     + ("as drawn" if fx.drawn else "sized from stock")
                     + f" has a net drive stiffness of {_g(fx.drive_stiffness)} N/m with "
-                    f"gravity, a stress margin of {fx.stress_margin:.3g} and its lowest "
+                    f"gravity, a stress margin of {number(fx.stress_margin, 3)} and its lowest "
                     f"parasitic mode ({low.name}) at {_g(low.frequency)} Hz.")
             else:
                 parts.append(f"No leaf-spring guide within the given bounds fits ({fx.reason}).")
@@ -331,7 +332,7 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
         r = law.rule_in_this_form()
         parts.append(f"The hardware's controller (kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
                      f"N/(m s), kd = {_g(law.kd)} N s/m; {controller_words(law)}) crosses over "
-                     f"at {number(law.crossover, 4)} Hz on {_g(law.tuning_mass)} kg; the rule "
+                     f"at {quantity(law.crossover, 'Hz', 4)} on {_g(law.tuning_mass)} kg; the rule "
                      f"would tune kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), kd = "
                      f"{_g(r['kd'])} N s/m with a D roll-off of "
                      f"{_g(r['roll_off'] / (2 * math.pi))} Hz there.")

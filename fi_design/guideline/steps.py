@@ -87,8 +87,8 @@ def step1_friction_gap(model: Model) -> FrictionGapResult:
     risk = gap >= thr
     status = Status.PASS
     if risk:
-        msg = (f"Fs - Fc = {gap:.3g} N is at or above the {thr:.3g} N threshold: stick-slip "
-               "can make an integrating controller hunt")
+        msg = (f"Fs - Fc = {quantity(gap, 'N', 3)} is at or above the {quantity(thr, 'N', 3)} "
+               "threshold: stick-slip can make an integrating controller hunt")
         if not model.law.integrator:
             status = Status.INFO
             msg += "; this loop has no integrator"
@@ -98,8 +98,8 @@ def step1_friction_gap(model: Model) -> FrictionGapResult:
         else:
             status = Status.WARN
     else:
-        msg = (f"Fs - Fc = {gap:.3g} N is below the {thr:.3g} N threshold: stick-slip, and so "
-               "hunting, is unlikely")
+        msg = (f"Fs - Fc = {quantity(gap, 'N', 3)} is below the {quantity(thr, 'N', 3)} threshold: "
+               "stick-slip, and so hunting, is unlikely")
     check = Check("friction_gap", not risk if status != Status.INFO else None, gap, thr, "N",
                   msg, step="step 1 friction gap", status=status)
     return FrictionGapResult(static=f.Fs, coulomb=f.Fc, gap=gap, threshold=thr,
@@ -144,8 +144,8 @@ def step2_crossover(model: Model) -> CrossoverResult:
     limited_by = ach.limited_by
     if mode is not None and ach.kind == "margin":
         limited_by = (f"{ach.limited_by}, caused by the parasitic mode '{mode.name}' "
-                      f"({mode.frequency:.4g} Hz, {mode.source}): without that mode the case "
-                      "keeps its margins")
+                      f"({quantity(mode.frequency, 'Hz', 4)}, {mode.source}): without that mode "
+                      "the case keeps its margins")
         if not notched(model, mode):  # a notch there already: another would not be the advice
             notch, alt = with_notch(model, mode)
             if alt.frequency is not None and alt.frequency > ach.frequency:
@@ -157,49 +157,52 @@ def step2_crossover(model: Model) -> CrossoverResult:
     if ach.frequency is None:
         msg = f"no crossover is achievable: {limited_by}"
     elif ach.kind == "scan_limit":
-        msg = (f"the desired crossover {fc:.4g} Hz: the linear model limits the crossover "
-               f"nowhere below {ach.frequency:.4g} Hz, the search cap (a bound, not a result; "
-               "the hardware's sampling, delay and parasitic modes set the real limit)")
+        msg = (f"the desired crossover {quantity(fc, 'Hz', 4)}: the linear model limits the "
+               f"crossover nowhere below {quantity(ach.frequency, 'Hz', 4)}, the search cap (a "
+               "bound, not a result; the hardware's sampling, delay and parasitic modes set the "
+               "real limit)")
     elif reach:
-        msg = (f"the desired crossover {fc:.4g} Hz is at or below the achievable "
-               f"{ach.frequency:.4g} Hz (limited by {limited_by})")
+        msg = (f"the desired crossover {quantity(fc, 'Hz', 4)} is at or below the achievable "
+               f"{quantity(ach.frequency, 'Hz', 4)} (limited by {limited_by})")
     else:
-        msg = (f"the desired crossover {fc:.4g} Hz is above the achievable {ach.frequency:.4g} Hz "
-               f"(limited by {limited_by})")
+        msg = (f"the desired crossover {quantity(fc, 'Hz', 4)} is above the achievable "
+               f"{quantity(ach.frequency, 'Hz', 4)} (limited by {limited_by})")
     if suggestion is not None:
         msg += f"; {notch_words(suggestion)}"
     checks.append(Check("crossover_achievable", reach, fc, ach.frequency, "Hz", msg, step=step))
 
     for c in at.cases:
         where = f"case {linear.CASE_NUMBERS[c.name]} ({c.description})"
-        at_f = f" at {c.crossover:.3g} Hz" if c.crossover is not None else ""
+        at_f = f" at {quantity(c.crossover, 'Hz', 3)}" if c.crossover is not None else ""
         if not c.stable:
             msg = f"{where}: the closed loop is unstable"
         elif not c.in_band:
-            msg = (f"{where}: " + (f"the loop crosses 0 dB only at {c.crossover:.3g} Hz, more "
-                                   f"than {linear.BAND_FACTOR:g}x below the {fc:.4g} Hz "
-                                   "crossover (the integrator against a stiff support)"
+            msg = (f"{where}: " + ("the loop crosses 0 dB only at "
+                                   f"{quantity(c.crossover, 'Hz', 3)}, more than "
+                                   f"{number(linear.BAND_FACTOR, 6)}x below the "
+                                   f"{quantity(fc, 'Hz', 4)} crossover (the integrator against "
+                                   "a stiff support)"
                                    if c.crossover is not None else "the loop never crosses "
                                    "0 dB") + ": no phase margin in the loop's band")
         else:
-            msg = f"{where}: phase margin {c.phase_margin_deg:.3g} deg{at_f}"
+            msg = f"{where}: phase margin {number(c.phase_margin_deg, 3)} deg{at_f}"
         checks.append(_criterion_check(c, "phase margin", f"phase_margin.{c.name}",
                                        c.phase_margin_deg, req.phase_margin, "deg", msg, step))
         gm = c.gain_margin_db
         if math.isinf(gm):
             msg = f"{where}: the phase never crosses -180 deg, unlimited gain margin"
         elif gm < 0:
-            msg = (f"{where}: gain margin {gm:.3g} dB (a lower margin: the loop goes unstable "
-                   f"if the gain falls {abs(gm):.3g} dB)")
+            msg = (f"{where}: gain margin {number(gm, 3)} dB (a lower margin: the loop goes "
+                   f"unstable if the gain falls {number(abs(gm), 3)} dB)")
         else:
-            msg = f"{where}: gain margin {gm:.3g} dB"
+            msg = f"{where}: gain margin {number(gm, 3)} dB"
         checks.append(_criterion_check(c, "gain margin", f"gain_margin.{c.name}", abs(gm),
                                        req.gain_margin, "dB", msg, step))
         if req.modulus_margin is not None:
             checks.append(_criterion_check(
                 c, "modulus margin", f"modulus_margin.{c.name}", c.modulus_margin,
                 req.modulus_margin, "-",
-                f"{where}: modulus margin min|1 + L| = {c.modulus_margin:.3g}", step))
+                f"{where}: modulus margin min|1 + L| = {number(c.modulus_margin, 3)}", step))
 
     modes = []
     sep = req.parasitic_separation
@@ -207,7 +210,7 @@ def step2_crossover(model: Model) -> CrossoverResult:
     if at.loop_crossover is None:
         which = "the desired crossover (no case crosses 0 dB in the loop's band)"
     else:
-        which = (f"the loop's crossover, {loop_fc:.4g} Hz (case "
+        which = (f"the loop's crossover, {quantity(loop_fc, 'Hz', 4)} (case "
                  f"{linear.CASE_NUMBERS[at.loop_crossover_case]}, "
                  f"{linear.CASE_DESCRIPTIONS[at.loop_crossover_case]}, crosses 0 dB highest)")
     for m in model.modes:
@@ -219,9 +222,9 @@ def step2_crossover(model: Model) -> CrossoverResult:
         if m.source == "given":  # a computed mode is judged with its guide (step 3)
             checks.append(Check(
                 f"parasitic_separation.{m.name}", ok, m.frequency, need, "Hz",
-                f"parasitic mode '{m.name}' (given) at {m.frequency:.4g} Hz "
+                f"parasitic mode '{m.name}' (given) at {quantity(m.frequency, 'Hz', 4)} "
                 + ("lies above" if ok else "lies below")
-                + f" {sep:g} x {which}: {need:.4g} Hz", step=step))
+                + f" {number(sep, 6)} x {which}: {quantity(need, 'Hz', 4)}", step=step))
 
     return CrossoverResult(
         desired=fc, achievable=ach.frequency, limited_by=limited_by, limit_kind=ach.kind,
@@ -238,7 +241,7 @@ def notch_words(n: NotchSuggestion) -> str:
     head = f"a {n.notch.describe()} in controller.filters would "
     if n.achievable is None:
         return head + f"not help: {n.limited_by}"
-    return head + f"allow {n.achievable:.4g} Hz (then limited by {n.limited_by})"
+    return head + f"allow {quantity(n.achievable, 'Hz', 4)} (then limited by {n.limited_by})"
 
 
 def _criterion_check(case, criterion: str, name: str, value, limit, unit: str, message: str,
@@ -281,8 +284,8 @@ def step3_stiffness(model: Model) -> StiffnessResult:
         s = SUGGESTED_STROKE
         kmax = stiffness_limit(spec, s)
         k = proposed_stiffness(spec, s)
-        msg = (f"no isolator in the spec; for a {quantity(s, 'm', 3)} stroke (the paper's) the rule "
-               f"gives k_max = {_g(kmax)} N/m and k = k_max / 2 = {_g(k)} N/m: the isolator "
+        msg = (f"no isolator in the spec; for a {quantity(s, 'm', 3)} stroke (the paper's) the "
+               f"rule gives k_max = {_g(kmax)} N/m and k = k_max / 2 = {_g(k)} N/m: the isolator "
                "simulated beside the stage for comparison")
         check = Check("drive_stiffness", None, k, kmax, "N/m", msg, step=step)
         return StiffnessResult(maximum=kmax, chosen=k, source="suggested: k_max / 2 for the "
@@ -303,14 +306,16 @@ def step3_stiffness(model: Model) -> StiffnessResult:
         source = ("proposed: k_max / 2, so the flexure force at full stroke is Fs / 2, leaving "
                   "room for friction scatter")
     ok = 0.0 < k <= kmax * (1 + 1e-12)
-    rule = f"k_max = Fs / {'stroke' if safety == 1 else f'({safety:g} x stroke)'} = {_g(kmax)} N/m"
+    per = "stroke" if safety == 1 else f"({number(safety, 6)} x stroke)"
+    rule = f"k_max = Fs / {per} = {_g(kmax)} N/m"
     if k <= 0.0:
         msg = (f"k = {_g(k)} N/m ({source.split(':')[0].split(' (')[0]}) is not positive: "
                f"the joint has no drive stiffness left to centre the cart ({rule})")
     else:
         msg = (f"k = {_g(k)} N/m ({source.split(':')[0].split(' (')[0]}) "
                + ("is at or below " if ok else "exceeds ") + rule
-               + f"; flexure force at full stroke {k * s:.3g} N against Fs = {Fs:.3g} N")
+               + f"; flexure force at full stroke {quantity(k * s, 'N', 3)} against "
+                 f"Fs = {quantity(Fs, 'N', 3)}")
     check = Check("drive_stiffness", ok, k, kmax, "N/m", msg, step=step)
     return StiffnessResult(maximum=kmax, chosen=k, source=source, stroke=s, static=Fs,
                            safety=safety, force_at_stroke=k * s, suggested=False,
@@ -390,9 +395,10 @@ def step4_pid(model: Model) -> PidResult:
         r = law.rule_in_this_form()
         msg = (f"the hardware's gains kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s), "
                f"kd = {_g(law.kd)} N s/m ({controller_words(law)}) cross over at "
-               f"{law.crossover:.4g} Hz on {law.tuning_mass:.4g} kg; the rule there would give "
-               f"kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), kd = {_g(r['kd'])} N s/m "
-               f"with a D roll-off of {r['roll_off'] / (2 * math.pi):.4g} Hz")
+               f"{quantity(law.crossover, 'Hz', 4)} on {quantity(law.tuning_mass, 'kg', 4)}; "
+               f"the rule there would give kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), "
+               f"kd = {_g(r['kd'])} N s/m with a D roll-off of "
+               f"{quantity(r['roll_off'] / (2 * math.pi), 'Hz', 4)}")
         # the rule's gains are a recommendation beside the hardware's, not a limit: they are in
         # the message and the gains table, never in the limit column
         checks = [Check("pid", None, law.kp, None, "N/m", msg, step=step)]
@@ -416,7 +422,8 @@ def step4_pid(model: Model) -> PidResult:
         d = law.drive
         checks.append(Check(
             "pid.drive_units", None, units.kp, None, units.units["kp"],
-            f"in the drive's units ({_g(d.motor_constant)} N/A, {quantity(d.encoder_resolution, 'm')}"
+            f"in the drive's units ({_g(d.motor_constant)} N/A, "
+            f"{quantity(d.encoder_resolution, 'm')}"
             f" per count, a current unit of {_g(d.current_scaling)} A): kp = {_g(units.kp)} "
             f"{units.units['kp']}, ki = {_g(units.ki)} {units.units['ki']}, kd = {_g(units.kd)} "
             f"{units.units['kd']}", step=step))
@@ -483,25 +490,25 @@ def isolator_advice(model: Model, gap: FrictionGapResult, crossover: CrossoverRe
     model = require_model(model)
     s, k = suggested_isolator(model)
     kmax = stiffness_limit(model.spec, s)
-    rule = (f"the rule's first isolator (a {quantity(s, 'm', 3)} stroke, the paper's, and k = {_g(k)} "
-            f"N/m = Fs / (2 x stroke); k_max = {_g(kmax)} N/m)")
+    rule = (f"the rule's first isolator (a {quantity(s, 'm', 3)} stroke, the paper's, and k = "
+            f"{_g(k)} N/m = Fs / (2 x stroke); k_max = {_g(kmax)} N/m)")
     if simulation is not None:
         from .verdict import simulated_isolator_advice
 
         return simulated_isolator_advice(model.spec, gap, simulation, rule, (s, k, kmax))
     start = f"{rule} is the one to simulate first"
     if not gap.hunting_risk:
-        return IsolatorAdvice(False, f"the friction gap {gap.gap:.3g} N is below the "
-                              f"{gap.threshold:.3g} N threshold: an isolator looks not needed "
-                              "(the simulation decides)", s, k, kmax)
+        return IsolatorAdvice(False, f"the friction gap {quantity(gap.gap, 'N', 3)} is below the "
+                              f"{quantity(gap.threshold, 'N', 3)} threshold: an isolator looks not "
+                              "needed (the simulation decides)", s, k, kmax)
     if crossover.limit_kind == "scan_limit":
         return IsolatorAdvice(None, (
-            f"the friction gap {gap.gap:.3g} N is a hunting risk, but the linear model limits "
-            f"the crossover nowhere up to {_g(crossover.achievable)} Hz: a high enough crossover "
-            "may avoid hunting without an isolator (the paper needed about 3x the isolated "
-            "crossover); add the loop delay to the spec and simulate to decide; for an "
-            f"isolator, {start}"), s, k, kmax)
+            f"the friction gap {quantity(gap.gap, 'N', 3)} is a hunting risk, but the linear "
+            f"model limits the crossover nowhere up to {_g(crossover.achievable)} Hz: a high "
+            "enough crossover may avoid hunting without an isolator (the paper needed about 3x "
+            "the isolated crossover); add the loop delay to the spec and simulate to decide; "
+            f"for an isolator, {start}"), s, k, kmax)
     return IsolatorAdvice(True, (
-        f"the friction gap {gap.gap:.3g} N is a hunting risk and the crossover is limited to "
-        f"{_g(crossover.achievable)} Hz ({crossover.limited_by}): an isolator looks needed "
-        f"(the simulation decides); {start}"), s, k, kmax)
+        f"the friction gap {quantity(gap.gap, 'N', 3)} is a hunting risk and the crossover is "
+        f"limited to {_g(crossover.achievable)} Hz ({crossover.limited_by}): an isolator "
+        f"looks needed (the simulation decides); {start}"), s, k, kmax)

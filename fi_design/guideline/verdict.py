@@ -39,7 +39,7 @@ from dataclasses import replace
 from typing import Any
 
 from ..model import Model
-from ..display import number, percent, quantities, quantity
+from ..display import percent, quantities, quantity
 from ..results import Check, Status
 from ..results.design import (Confirmation, CrossoverResult, FlexureResult, FrictionGapResult,
                               Margins, PidResult,
@@ -218,7 +218,7 @@ def robustness_as_check(r: RobustnessCheck) -> Check:
     """
     p = "n/a" if r.hunting_probability is None else _pct(r.hunting_probability)
     text = (f"the stage as specified does not settle after every move in {p} of {r.valid} "
-            f"scatter samples ({100 * r.confidence:.3g} % interval {_pct(r.interval[0])} to "
+            f"scatter samples ({percent(r.confidence, 3)} interval {_pct(r.interval[0])} to "
             f"{_pct(r.interval[1])}), limit {_pct(r.limit)}")
     return Check("robustness", None if r.status == "WARN" else r.status == "PASS",
                  r.hunting_probability, r.limit, "-", text, "robustness under friction scatter",
@@ -233,12 +233,12 @@ def _scatter_words(r: RobustnessCheck) -> str:
              "controller.delay": "the delay"}
     spread = sorted(set(r.scatter.values()))
     if len(spread) == 1 and spread[0] > 0:
-        parts = [f"+-{100 * spread[0]:.3g} % on " + " and ".join(names.get(k, k)
+        parts = [f"+-{percent(spread[0], 3)} on " + " and ".join(names.get(k, k)
                                                                   for k in r.scatter)]
     else:
-        parts = [f"+-{100 * v:.3g} % on {names.get(k, k)}" for k, v in r.scatter.items()]
+        parts = [f"+-{percent(v, 3)} on {names.get(k, k)}" for k, v in r.scatter.items()]
     if r.ripple is not None:
-        parts.append(f"a {100 * r.ripple['amplitude']:.3g} % ripple every "
+        parts.append(f"a {percent(r.ripple['amplitude'], 3)} ripple every "
                      f"{quantity(r.ripple['wavelength'], 'm', 3)} along the rail")
     kind = "standard deviation" if r.distribution == "normal" else "uniform half-width"
     return f"{', '.join(parts)} ({r.distribution}, {kind}; {r.samples} samples)"
@@ -308,14 +308,16 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
     elif crossover.limit_kind == "scan_limit":
         out["achievable_crossover_bound"] = crossover.achievable
         notes.append(f"step 2: the linear model limits the crossover nowhere below "
-                     f"{crossover.achievable:.4g} Hz, the search cap: a bound, not a result "
-                     "(sampling, delay and parasitic modes in the spec would set the real limit)")
+                     f"{quantity(crossover.achievable, 'Hz', 4)}, the search cap: a bound, not a "
+                     "result (sampling, delay and parasitic modes in the spec would set the "
+                     "real limit)")
     else:
         out["achievable_factor"] = crossover.achievable / fc
     for c in crossover.cases:
         if not c.in_band:
-            where = (f"crosses 0 dB only at {c.crossover:.3g} Hz, below its band (from "
-                     f"{fc / 10:.3g} Hz)" if c.crossover is not None else "never crosses 0 dB")
+            where = (f"crosses 0 dB only at {quantity(c.crossover, 'Hz', 3)}, below its band "
+                     f"(from {quantity(fc / 10, 'Hz', 3)})" if c.crossover is not None
+                     else "never crosses 0 dB")
             notes.append(f"{c.description}: the loop {where}: no phase or delay margin to "
                          "report")
 
@@ -328,17 +330,17 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
             notes.append("the loop has no integrator: it cannot hunt by the paper's mechanism, "
                          "so there is no hunting-free crossover to keep a distance from")
         elif m is None:
+            top = simulation.min_hunting_free_crossover["search"][1]
             notes.append(f"the stage as specified hunts for some move up to the top of the "
-                         f"search ({simulation.min_hunting_free_crossover['search'][1]:g} Hz): "
-                         "no crossover factor")
+                         f"search ({quantity(top, 'Hz', 6)}): no crossover factor")
         else:
             out["hunting_free_crossover"] = m
             out["crossover_factor"] = fc / m
             out.update(_hunting_loop(model, crossover, st, m))
             if st.boundary is not None and st.boundary.kind == "bound":
                 out["crossover_factor_bound"] = True
-                notes.append(f"no move of the family hunts from {m:g} Hz, the bottom of the "
-                             "search: the crossover factor is a lower bound")
+                notes.append(f"no move of the family hunts from {quantity(m, 'Hz', 6)}, the bottom "
+                             "of the search: the crossover factor is a lower bound")
         if st.static_error_bound is not None and st.outcome in ("static_error", "stuck"):
             rest = [abs(mv.final_error) for mv in st.moves
                     if mv.outcome in ("settles", "rests", "stuck")]
@@ -416,7 +418,8 @@ def friction_gap_judged(gap: FrictionGapResult, stage: Any, integrator: bool
         rule = "stick-slip can make an integrating controller hunt"
     else:
         rule = "stick-slip, and so hunting, is less likely"
-    msg = (f"Fs - Fc = {gap.gap:.3g} N is {where} the {gap.threshold:.3g} N threshold, the "
+    msg = (f"Fs - Fc = {quantity(gap.gap, 'N', 3)} is {where} the "
+           f"{quantity(gap.threshold, 'N', 3)} threshold, the "
            f"paper's rule of thumb for its own stage: {rule}; a screening rule, not a "
            f"requirement: the simulation of every move decides, and the stage as specified "
            f"{stage.summary()}")
@@ -495,8 +498,8 @@ def simulated_isolator_advice(spec: Any, gap: Any, simulation: Confirmation, rul
     if own.acceptable:
         return IsolatorAdvice(False, (
             f"the stage as specified {own.summary()}: no isolator is needed at "
-            "this crossover" + (f", whatever the {gap.gap:.3g} N friction gap of step 1 "
-                                "suggests" if gap.hunting_risk else "")), *isolator)
+            "this crossover" + (f", whatever the {quantity(gap.gap, 'N', 3)} friction gap "
+                                "of step 1 suggests" if gap.hunting_risk else "")), *isolator)
     if iso.acceptable:
         return IsolatorAdvice(True, (
             f"the stage as specified {own.summary()}; with {rule} it "
@@ -577,7 +580,7 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
                         for k in kinds if r.counts[k])
         what = (f"Under friction scatter of {_scatter_words(r)} the stage as specified does not "
                 f"settle after every move in {_pct(r.hunting_probability)} of {r.valid} valid "
-                f"samples ({100 * r.confidence:.3g} % interval {_pct(r.interval[0])} to "
+                f"samples ({percent(r.confidence, 3)} interval {_pct(r.interval[0])} to "
                 f"{_pct(r.interval[1])}" + (f"; {why}" if why else "") + ")")
         left = r.counts["invalid"] + r.counts["failed"]
         notes = []
@@ -632,13 +635,14 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
               "NOT_CONFIRMED" if simulation is None else
               "PASS_WITH_WARNINGS" if any(r.severity == "WARN" for r in reasons) else "PASS")
     nwarn = sum(r.severity == "WARN" for r in reasons)
-    what = (f"{label} {_BEHAVIOUR.get(behaviour, behaviour)} at {number(fc, 4)} Hz"
+    what = (f"{label} {_BEHAVIOUR.get(behaviour, behaviour)} at {quantity(fc, 'Hz', 4)}"
             if behaviour is not None else f"{label} was not simulated")
     if behaviour == "hunts":
         st = simulation.stage[own]
         c = st.cycle
         what += (f" ({len(st.hunting_moves)} of {len(st.moves)} moves"
-                 + (f", a {quantity(c.amplitude, 'm', 3)} cycle of {c.period:.3g} s)" if c else ")"))
+                 + (f", a {quantity(c.amplitude, 'm', 3)} cycle of "
+                    f"{quantity(c.period, 's', 3)})" if c else ")"))
     steps = {c.name: c.step for c in checks}
     on = []
     for r in reasons:

@@ -67,6 +67,7 @@ import control
 import numpy as np
 
 from ..controller.polynomials import controller_polynomials, pid_polynomials, reference_polynomials
+from ..display import number, quantity
 from ..errors import SpecError
 from ..mechanism.modes import mode_factor, mode_term
 from ..model import Model, require_model
@@ -699,9 +700,9 @@ def achievable_crossover(model: Model, start: float | None = None,
 
     def mode_words(top: float | None, which: str | None) -> str:
         where = ("" if top is None else f" (case {CASE_NUMBERS[which]}, "
-                 f"{CASE_DESCRIPTIONS[which]}, crosses 0 dB at {top:.4g} Hz)")
-        return (f"parasitic mode '{low_mode.name}' at {low_mode.frequency:.4g} Hz, which must lie "
-                f"above {sep:g} x the loop's crossover{where}")
+                 f"{CASE_DESCRIPTIONS[which]}, crosses 0 dB at {quantity(top, 'Hz', 4)})")
+        return (f"parasitic mode '{low_mode.name}' at {quantity(low_mode.frequency, 'Hz', 4)}, "
+                f"which must lie above {number(sep, 6)} x the loop's crossover{where}")
 
     if ok[-1]:
         if f_hi < scan_limit:
@@ -711,7 +712,8 @@ def achievable_crossover(model: Model, start: float | None = None,
                 feasible_ranges=ranges, evaluations=count, mode=low_mode.name,
                 mode_frequency=low_mode.frequency)
         return AchievableCrossover(
-            frequency=float(f_hi), limited_by=f"nothing up to the scan limit {f_hi:.4g} Hz",
+            frequency=float(f_hi), limited_by="nothing up to the scan limit "
+                                              f"{quantity(f_hi, 'Hz', 4)}",
             kind="scan_limit", case=None, criterion=None, scan_start=f_lo, scan_stop=f_hi,
             feasible_ranges=ranges, evaluations=count)
     if not ok.any():
@@ -722,8 +724,8 @@ def achievable_crossover(model: Model, start: float | None = None,
             what, case, crit = _describe(bad, req), bad.name, bad.failed[0]
         return AchievableCrossover(
             frequency=None,
-            limited_by=(f"no crossover from {f_lo:.3g} Hz to {f_hi:.4g} Hz meets the "
-                        f"requirements; at {f_lo:.3g} Hz it is {what}"),
+            limited_by=(f"no crossover from {quantity(f_lo, 'Hz', 3)} to {quantity(f_hi, 'Hz', 4)} "
+                        f"meets the requirements; at {quantity(f_lo, 'Hz', 3)} it is {what}"),
             kind="infeasible", case=case, criterion=crit, scan_start=f_lo,
             scan_stop=f_hi, feasible_ranges=(), evaluations=count)
 
@@ -762,7 +764,8 @@ def _describe(m: CaseMargins, requirements, above: float | None = None) -> str:
     crit = m.failed[0]
     if crit == "stability":
         if above is not None:
-            return f"the stability of {where}: its closed loop turns unstable above {above:.4g} Hz"
+            return (f"the stability of {where}: its closed loop turns unstable above "
+                    f"{quantity(above, 'Hz', 4)}")
         return f"the stability of {where}: its closed loop is unstable"
     value, limit = {
         "phase margin": (m.phase_margin_deg, req.phase_margin),
@@ -772,8 +775,10 @@ def _describe(m: CaseMargins, requirements, above: float | None = None) -> str:
     unit = _units(crit)
     unit = f" {unit}" if unit else ""
     if above is not None:
-        return f"the {crit} of {where}, which falls below {limit:g}{unit} above {above:.4g} Hz"
-    return f"the {crit} of {where}, {value:.3g}{unit}, below the {limit:g}{unit} required"
+        return (f"the {crit} of {where}, which falls below {number(limit, 6)}{unit} above "
+                f"{quantity(above, 'Hz', 4)}")
+    return (f"the {crit} of {where}, {number(value, 3)}{unit}, below the "
+            f"{number(limit, 6)}{unit} required")
 
 
 def _ranges(grid: np.ndarray, ok: np.ndarray) -> tuple[tuple[float, float], ...]:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 
 from . import linear
+from ..display import quantity
 from ..model import Model
 from ..results.controller import Filter
 from ..results.linear import AchievableCrossover
@@ -130,9 +131,10 @@ def with_notch(model: Model, mode: Mode) -> tuple[Filter, AchievableCrossover]:
     period = model.law.sample_period
     if period > 0.0 and notch.frequency >= 0.5 / period:
         return notch, AchievableCrossover(
-            frequency=None, limited_by=f"the mode at {mode.frequency:.4g} Hz lies above the "
-                                       f"Nyquist frequency {0.5 / period:.4g} Hz: no notch "
-                                       "there", kind="infeasible", case=None, criterion=None,
+            frequency=None, limited_by=f"the mode at {quantity(mode.frequency, 'Hz', 4)} lies "
+                                       "above the Nyquist frequency "
+                                       f"{quantity(0.5 / period, 'Hz', 4)}: no notch there",
+            kind="infeasible", case=None, criterion=None,
             scan_start=0.0, scan_stop=0.0, feasible_ranges=(), evaluations=0)
     notched = model.at(filters=model.law.filters + (notch,))
     return notch, linear.achievable_crossover(notched)

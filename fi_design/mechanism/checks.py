@@ -53,17 +53,17 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
                  + ("" if k > 0 else ": the weight has buckled the guide"), step=step),
            Check("flexure.stress", m.stress <= g.allowed_stress, m.stress, g.allowed_stress,
                  "Pa", f"stress at full stroke {quantity(m.stress, 'Pa')}, allowed "
-                 f"{quantity(g.allowed_stress, 'Pa')} (margin x{m.stress_margin:.3g})",
+                 f"{quantity(g.allowed_stress, 'Pa')} (margin x{number(m.stress_margin, 3)})",
                  step=step)]
     if grav.buckling_factor is not None:
         f, need = grav.buckling_factor, fx.required_buckling
         out.append(Check(
             "flexure.buckling", f >= need, f, need, "-",
             f"buckling load {_g(grav.buckling_load)} N against the stage's weight "
-            f"{_g(g.weight)} N standing on the leaves: factor {f:.3g}"
-            + (f", at least {need:g} required" if f >= need else
+            f"{_g(g.weight)} N standing on the leaves: factor {number(f, 3)}"
+            + (f", at least {number(need, 6)} required" if f >= need else
                (f": the guide buckles under the stage" if f <= 1.0 else
-                f", below the {need:g} required")), step=step))
+                f", below the {number(need, 6)} required")), step=step))
     low = fx.lowest_mode
     need = separation * crossover
     if low is not None:
@@ -72,8 +72,8 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
             "flexure.modes", low.frequency >= need, low.frequency, need, "Hz",
             f"lowest parasitic mode of the guide: {low.name} at {_g(low.frequency)} Hz"
             + (" at full stroke" if at_stroke else "")
-            + (f", above {separation:g} x the crossover" if low.frequency >= need else
-               f", below {separation:g} x the crossover ({_g(need)} Hz)"), step=step))
+            + (f", above {number(separation, 6)} x the crossover" if low.frequency >= need else
+               f", below {number(separation, 6)} x the crossover ({_g(need)} Hz)"), step=step))
     if grav.sag > 0.0:
         out.append(Check(
             "flexure.sag", grav.sag < fx.stroke, grav.sag, fx.stroke, "m",

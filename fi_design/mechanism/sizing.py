@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..display import quantity
+from ..display import number, plain, quantity
 from ..results.mechanism import LeafGuide
 from ..results.steps import FlexureResult
 from . import guide as _guide
@@ -78,7 +78,7 @@ def stock_thicknesses(bounds: tuple[float, float], step: float | None,
         return np.geomspace(t0, t1, points)
     lo = math.ceil(t0 / step - 1e-9)
     hi = math.floor(t1 / step + 1e-9)
-    return np.array([float(f"{i * step:.12g}") for i in range(lo, hi + 1)])  # 0.45e-3, not ...04
+    return np.array([float(plain(i * step, 12)) for i in range(lo, hi + 1)])  # 0.45e-3, not ...04
 
 
 def stiffness_range(guide: LeafGuide, tolerance: float) -> tuple[float, float]:
@@ -348,22 +348,25 @@ def _why(grid: GridMechanics, guide: LeafGuide, stroke: float, kmax: float, f_re
     sa = guide.allowed_stress
     if not ok_stress.any():
         least = float(grid.stress.min())
-        return (f"stress: every leaf within the bounds reaches at least {quantity(least, 'Pa', 4, shown=('MPa', 1e-6))} at "
-                f"{_mm(stroke)} stroke, above the allowed {quantity(sa, 'Pa', 4, shown=('MPa', 1e-6))}")
+        return ("stress: every leaf within the bounds reaches at least "
+                f"{quantity(least, 'Pa', 4, shown=('MPa', 1e-6))} at {_mm(stroke)} stroke, above "
+                "the allowed "
+                f"{quantity(sa, 'Pa', 4, shown=('MPa', 1e-6))}")
     sel = ok_stress
     if not (sel & ok_stiff).any():
         least = float(np.min(np.where(sel, grid.net, np.inf)))
         return (f"stiffness with stress: leaves thin and long enough for {_mm(stroke)} stroke "
-                f"within {quantity(sa, 'Pa', 4, shown=('MPa', 1e-6))} are at least {least:.4g} N/m stiff (net of "
-                f"gravity), above k_max = {kmax:.6g} N/m")
+                f"within {quantity(sa, 'Pa', 4, shown=('MPa', 1e-6))} are at least "
+                f"{quantity(least, 'N/m', 4)} stiff (net of gravity), above k_max = "
+                f"{quantity(kmax, 'N/m', 6)}")
     sel = sel & ok_stiff
     if not (sel & ok_buckle).any():
         best = float(np.max(np.where(sel, grid.buckling, -np.inf)))
         return (f"buckling: leaves within the stress limit and below k_max carry the stage's "
-                f"{guide.weight:.3g} N {guide.orientation} with a buckling factor of at most "
-                f"{best:.3g}, below the {buckling_req:g} required")
+                f"{quantity(guide.weight, 'N', 3)} {guide.orientation} with a buckling factor of "
+                f"at most {number(best, 3)}, below the {number(buckling_req, 6)} required")
     sel = sel & ok_buckle
     best = float(np.max(np.where(sel, grid.lowest_mode, -np.inf)))
     return (f"parasitic modes: among leaves within the stress limit, below k_max and safe "
-            f"against buckling, the lowest parasitic mode reaches at most {best:.4g} Hz, below "
-            f"the required {f_req:.4g} Hz")
+            "against buckling, the lowest parasitic mode reaches at most "
+            f"{quantity(best, 'Hz', 4)}, below the required {quantity(f_req, 'Hz', 4)}")

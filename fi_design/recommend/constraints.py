@@ -28,6 +28,7 @@ import math
 from typing import Any
 
 from .. import spec as _spec
+from ..display import number, percent, quantity
 from ..model import Model
 from ..spec.file import with_values
 
@@ -108,20 +109,20 @@ def crossover_cap(base: Model, rule: bool) -> tuple[float, str, Any]:
         return fc, (f"no crossover meets the margins with their reserve ({ach.limited_by}): "
                     "the desired one is kept"), None
     if ach.kind == "scan_limit":
-        cap, why = fc, (f"kept at the desired {fc:.4g} Hz: the linear model sets no limit "
-                        "below its search cap (give the hardware's sampling, delay and "
+        cap, why = fc, (f"kept at the desired {quantity(fc, 'Hz', 4)}: the linear model sets no "
+                        "limit below its search cap (give the hardware's sampling, delay and "
                         "measured modes to let the search raise it)")
     else:
         cap = reserve * ach.frequency
-        why = (f"{reserve:g} x the achievable {ach.frequency:.4g} Hz with the margins' reserve, "
-               f"which is limited by {ach.limited_by}")
+        why = (f"{number(reserve, 6)} x the achievable {quantity(ach.frequency, 'Hz', 4)} with the "
+               f"margins' reserve, which is limited by {ach.limited_by}")
         if notch is not None:
             why += f" (with the {notch.describe()} the search adds, requirements.recommend.filters)"
     if bounds is not None:
         if cap > bounds[1]:
             cap, why = bounds[1], "the upper bound of requirements.recommend.crossover"
         elif cap < bounds[0]:
-            why += f"; below requirements.recommend.crossover ({bounds[0]:.4g} Hz)"
+            why += f"; below requirements.recommend.crossover ({quantity(bounds[0], 'Hz', 4)})"
     return float(cap), why, notch
 
 
@@ -189,8 +190,8 @@ def loop_meets(model: Model) -> tuple[bool, str]:
     low = [m for m in model.modes if m.frequency < sep * model.crossover]
     if low:
         m = min(low, key=lambda x: x.frequency)
-        return False, (f"the mode '{m.name}' at {m.frequency:.4g} Hz lies below {sep:g} x the "
-                       f"{model.crossover:.4g} Hz crossover")
+        return False, (f"the mode '{m.name}' at {quantity(m.frequency, 'Hz', 4)} lies below "
+                       f"{number(sep, 6)} x the {quantity(model.crossover, 'Hz', 4)} crossover")
     return True, ""
 
 
@@ -281,9 +282,9 @@ def reserve_corners(model: Model) -> tuple[dict, ...]:
 
     r = model.requirements.reserve
     m1, m2 = model.m1, model.m2
-    corners = [(f"masses +{100 * r.mass:.3g} %", model.at(masses=(m1 * (1 + r.mass),
+    corners = [(f"masses +{percent(r.mass, 3)}", model.at(masses=(m1 * (1 + r.mass),
                                                                  m2 * (1 + r.mass)))),
-               (f"masses -{100 * r.mass:.3g} %", model.at(masses=(m1 * (1 - r.mass),
+               (f"masses -{percent(r.mass, 3)}", model.at(masses=(m1 * (1 - r.mass),
                                                                  m2 * (1 - r.mass))))]
     fx = model.flexure
     if fx is not None and fx.stiffness_range is not None:
@@ -292,10 +293,10 @@ def reserve_corners(model: Model) -> tuple[dict, ...]:
         corners += [(f"leaves {t} thinner", model.at(stiffness=lo)),
                      (f"leaves {t} thicker", model.at(stiffness=hi))]
     if any(m.source == "computed" for m in model.modes):
-        corners.append((f"computed modes -{100 * r.modes:.3g} %",
+        corners.append((f"computed modes -{percent(r.modes, 3)}",
                         model.at(mode_scale=1.0 - r.modes)))
     if model.law.delay > 0.0 or model.law.sample_period > 0.0:
-        corners.append((f"delay +{100 * r.delay:.3g} %",
+        corners.append((f"delay +{percent(r.delay, 3)}",
                         model.at(delay=(model.law.delay + 0.5 * model.law.sample_period)
                                  * (1 + r.delay) - 0.5 * model.law.sample_period)))
     out = []
@@ -315,8 +316,6 @@ def reserve_corners(model: Model) -> tuple[dict, ...]:
 
 def quantity_mm(x: float) -> str:
     """A length in mm for a sentence."""
-    from ..display import quantity
-
     return quantity(x, "m", 3, shown=("mm", 1e3))
 
 

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from typing import Any
 
 from .. import spec as _spec
-from ..display import quantity
+from ..display import number, quantity
 from ..model import Model
 from ..results.recommend import LeastChange
 from . import constraints as _c
@@ -124,13 +124,15 @@ def least_change(search: Any, *, executor: Any = None,
                 ok, why = _passes(cand, executor)
                 if ok:
                     return done({"controller.crossover": fc},
-                                f"tune the loop to {fc:.4g} Hz ({margin:g} x the hunting-free "
-                                f"{fold:.4g} Hz)", (f"the crossover's cap {search.fc:.4g} Hz",))
-                tried.append(f"the crossover alone, {fc:.4g} Hz: {why}")
+                                f"tune the loop to {quantity(fc, 'Hz', 4)} ({number(margin, 6)} x "
+                                f"the hunting-free {quantity(fold, 'Hz', 4)})",
+                                (f"the crossover's cap {quantity(search.fc, 'Hz', 4)}",))
+                tried.append(f"the crossover alone, {quantity(fc, 'Hz', 4)}: {why}")
             else:
-                tried.append(f"the crossover alone: {margin:g} x the hunting-free {fold:.4g} Hz "
-                             f"is {margin * fold:.4g} Hz, above the loop's cap of "
-                             f"{search.fc:.4g} Hz ({search.fc_why})")
+                tried.append(f"the crossover alone: {number(margin, 6)} x the hunting-free "
+                             f"{quantity(fold, 'Hz', 4)} is {quantity(margin * fold, 'Hz', 4)}, "
+                             f"above the loop's cap of {quantity(search.fc, 'Hz', 4)} "
+                             f"({search.fc_why})")
         else:
             tried.append("the crossover alone: the spec's isolator hunts up to the top of the "
                          "crossover search")
@@ -144,16 +146,16 @@ def least_change(search: Any, *, executor: Any = None,
         search.evaluations += n
         if k is None:
             tried.append(f"{what} at {quantity(stroke, 'm')}: no stiffness keeps the hunting "
-                         f"margin at {fc0:.4g} Hz")
+                         f"margin at {quantity(fc0, 'Hz', 4)}")
             continue
         values = {"isolator.stiffness": k} if stroke == s0 else \
             {"isolator.stroke": stroke, "isolator.stiffness": k}
         ok, why = _passes(cand, executor)
         if ok:
-            words = (f"a drive stiffness of {k:.4g} N/m" if stroke == s0 else
-                     f"a {quantity(stroke, 'm')} stroke at {k:.4g} N/m")
-            return done(values, words + f", the loop at {fc0:.4g} Hz",
-                        (f"the hunting margin {margin:g} at {fc0:.4g} Hz",))
-        tried.append(f"{what} at {quantity(stroke, 'm')}, {k:.4g} N/m: {why}")
+            words = (f"a drive stiffness of {quantity(k, 'N/m', 4)}" if stroke == s0 else
+                     f"a {quantity(stroke, 'm')} stroke at {quantity(k, 'N/m', 4)}")
+            return done(values, words + f", the loop at {quantity(fc0, 'Hz', 4)}",
+                        (f"the hunting margin {number(margin, 6)} at {quantity(fc0, 'Hz', 4)}",))
+        tried.append(f"{what} at {quantity(stroke, 'm')}, {quantity(k, 'N/m', 4)}: {why}")
     return LeastChange(changes={}, feasible=False, binding=(), text="no edit of one or two "
                        "values passes: build the recommended design", tried=tuple(tried))

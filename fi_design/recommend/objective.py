@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ..display import quantity
+from ..display import number, quantity
 
 __all__ = ["order", "nearest", "pareto", "binding", "advice", "STATUS_WORDS"]
 
@@ -92,11 +92,11 @@ def binding(search: Any, chosen: Any) -> tuple[str, ...]:
 
     kmax = _spec.stiffness_limit(search.base, chosen.stroke)
     if chosen.stiffness >= 0.97 * kmax:
-        out.append(f"k_max = Fs / stroke = {kmax:.4g} N/m at "
+        out.append(f"k_max = Fs / stroke = {quantity(kmax, 'N/m', 4)} at "
                    f"{quantity(chosen.stroke, 'm')} stroke")
     elif stiffer:
         out.append(f"at {quantity(chosen.stroke, 'm')} stroke a stiffer joint "
-                   f"({stiffer[0].target:.4g} N/m) fails on {_why(stiffer[0])}")
+                   f"({quantity(stiffer[0].target, 'N/m', 4)}) fails on {_why(stiffer[0])}")
     strokes = sorted({p.stroke for p in search.points})
     i = strokes.index(chosen.stroke)
     for j, side in ((i - 1, "shorter"), (i + 1, "longer")):
@@ -109,14 +109,15 @@ def binding(search: Any, chosen: Any) -> tuple[str, ...]:
                        key=lambda p: p.target, default=None)
             if fail is not None:
                 out.append(f"a {side} stroke ({quantity(strokes[j], 'm')}) allows a softer "
-                           f"joint at most: {fail.target:.4g} N/m fails on {_why(fail)}")
+                           f"joint at most: {quantity(fail.target, 'N/m', 4)} fails on "
+                           f"{_why(fail)}")
     lo, hi = search.envelope
     if chosen.stroke <= lo * (1 + 1e-9):
         out.append(f"the stroke at {search.why_lo}")
     if chosen.stroke >= hi * (1 - 1e-9):
         out.append(f"the stroke at {search.why_hi}")
     if search.rule:
-        out.append(f"the crossover {search.fc:.4g} Hz: {search.fc_why}")
+        out.append(f"the crossover {quantity(search.fc, 'Hz', 4)}: {search.fc_why}")
     return tuple(out)
 
 
@@ -125,20 +126,19 @@ def advice(search: Any, chosen: Any, feasible: bool, binding: tuple[str, ...],
     """One sentence a person acts on."""
     c = chosen.candidate
     if feasible:
-        text = (f"Build {_dimensions(c)} "
-                f"leaves for a {quantity(chosen.stroke, 'm')} stroke (k = {chosen.stiffness:.4g}"
-                f" N/m with gravity)"
-                + (f" and tune the loop to {search.fc:.4g} Hz" if search.rule else "")
-                + (f": no move hunts from {chosen.free_from:.4g} Hz, "
-                   f"{chosen.margin:.3g} x below the crossover" if chosen.free_from else
+        text = (f"Build {_dimensions(c)} leaves for a {quantity(chosen.stroke, 'm')} stroke (k = "
+                f"{number(chosen.stiffness, 4)} N/m with gravity)"
+                + (f" and tune the loop to {quantity(search.fc, 'Hz', 4)}" if search.rule else "")
+                + (f": no move hunts from {quantity(chosen.free_from, 'Hz', 4)}, "
+                   f"{number(chosen.margin, 3)} x below the crossover" if chosen.free_from else
                    ": no move of the family hunts")
                 + (f"; it is bound by {binding[0]}" if binding else "") + ".")
         if least is not None and least.feasible:
             text += f" The least change that passes: {least.text}."
         return text
     text = (f"No design of the searched space passes; the nearest "
-            f"({quantity(chosen.stroke, 'm')}, {chosen.stiffness:.4g} N/m, "
-            f"{search.fc:.4g} Hz) fails on {_why(chosen)}.")
+            f"({quantity(chosen.stroke, 'm')}, {quantity(chosen.stiffness, 'N/m', 4)}, "
+            f"{quantity(search.fc, 'Hz', 4)}) fails on {_why(chosen)}.")
     if least is not None and least.feasible:
         text += f" The least change that passes: {least.text}."
     return text

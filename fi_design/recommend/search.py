@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from .. import spec as _spec
-from ..display import quantity
+from ..display import number, quantity
 from ..model import Model
 from ..results.recommend import DesignCandidate, RecommendResult
 from . import constraints as _c
@@ -134,7 +134,8 @@ class _Search:
         b = self.base.requirements.recommend
         if target > kmax * (1 + 1e-9):
             p.status = "k_max"
-            p.violations.append(f"k = {target:.4g} N/m exceeds k_max = {kmax:.4g} N/m")
+            p.violations.append(f"k = {quantity(target, 'N/m', 4)} exceeds k_max = "
+                                f"{quantity(kmax, 'N/m', 4)}")
             return p
         if b.stiffness is not None and not b.stiffness[0] <= target <= b.stiffness[1]:
             p.status = "bounds"
@@ -164,8 +165,8 @@ class _Search:
         todo = [p for p in points if p.status is None]
         if not todo:
             return
-        self.say(f"simulating the move family of {len(todo)} guides at {self.fc:.4g} Hz and "
-                 f"{self.fc / self.margin:.4g} Hz ...")
+        self.say(f"simulating the move family of {len(todo)} guides at "
+                 f"{quantity(self.fc, 'Hz', 4)} and {quantity(self.fc / self.margin, 'Hz', 4)} ...")
         tasks = [(self.candidate_model(p), self.margin) for p in todo]
         for p, ans in zip(todo, _map(self.executor, _c.margin_screen, tasks)):
             self.evaluations += ans["tests"]
@@ -173,17 +174,18 @@ class _Search:
             if p.hunts:
                 p.margin = 0.0
                 p.status = "hunts"
-                p.violations.append(f"at {self.fc:.4g} Hz some move of the family hunts")
+                p.violations.append(
+                    f"at {quantity(self.fc, 'Hz', 4)} some move of the family hunts")
             elif ans["outcome"] not in ("settles", "hunts_below"):
                 p.status = "hunts"
-                p.violations.append(f"at {self.fc:.4g} Hz some move of the family ends "
+                p.violations.append(f"at {quantity(self.fc, 'Hz', 4)} some move of the family ends "
                                     f"{ans['outcome'].replace('_', ' ')}")
             elif not ans["keeps"]:
                 p.status = "margin"
                 p.violations.append(
-                    f"no move hunts at {self.fc:.4g} Hz, but some does at "
-                    f"{self.fc / self.margin:.4g} Hz: the hunting-free crossover lies less than "
-                    f"{self.margin:g} x below the crossover")
+                    f"no move hunts at {quantity(self.fc, 'Hz', 4)}, but some does at "
+                    f"{quantity(self.fc / self.margin, 'Hz', 4)}: the hunting-free crossover lies "
+                    f"less than {number(self.margin, 6)} x below the crossover")
 
     def fold(self, points: list[_Point]) -> None:
         """The hunting-free crossover (the fold of the cycle) of points, and their margin."""
@@ -200,8 +202,9 @@ class _Search:
             if p.status is None and p.margin < self.margin:  # the fold: a band the screen missed
                 p.status = "margin"
                 p.violations.append(
-                    f"the crossover lies only {p.margin:.4g} x above the hunting-free "
-                    f"{p.free_from:.4g} Hz (the margin asks {self.margin:g} x)")
+                    f"the crossover lies only {number(p.margin, 4)} x above the hunting-free "
+                    f"{quantity(p.free_from, 'Hz', 4)} (the margin asks "
+                    f"{number(self.margin, 6)} x)")
 
     def stroke_row(self, strokes) -> None:
         pts = []
@@ -239,7 +242,7 @@ class _Search:
         s0 = min(max(self.base.isolator.stroke, lo), hi)
         s_lo, s_hi = max(lo, s0 / STROKE_SPAN), min(hi, s0 * STROKE_SPAN)
         self.say(f"building guides and judging the stage for strokes {quantity(s_lo, 'm')} to "
-                 f"{quantity(s_hi, 'm')} at {self.fc:.4g} Hz ...")
+                 f"{quantity(s_hi, 'm')} at {quantity(self.fc, 'Hz', 4)} ...")
         self.stroke_row(list(np.geomspace(s_lo, s_hi, STROKES)))
         self.confirm()
         for _ in range(WIDEN_ROUNDS):
@@ -304,7 +307,7 @@ class _Search:
             p.violations.append(why)
             return False, (fx, None, None)
         self.say(f"checking the reserves of {quantity(p.stroke, 'm')}, "
-                 f"{p.stiffness:.4g} N/m ...")
+                 f"{quantity(p.stiffness, 'N/m', 4)} ...")
         corners = _c.reserve_corners(model)
         self.evaluations += len(corners)
         bad = [c for c in corners if not c["passed"]]
@@ -312,8 +315,8 @@ class _Search:
             p.status = "reserve"
             p.violations += [f"with {c['name']}: {c['why']}" for c in bad]
             return False, (fx, corners, None)
-        self.say(f"signing off {quantity(p.stroke, 'm')}, {p.stiffness:.4g} N/m at "
-                 f"{self.fc:.4g} Hz (scatter included) ...")
+        self.say(f"signing off {quantity(p.stroke, 'm')}, {quantity(p.stiffness, 'N/m', 4)} at "
+                 f"{quantity(self.fc, 'Hz', 4)} (scatter included) ...")
         r = design(model, executor=self.executor)
         rob = r.robustness
         p.p = None if rob is None else rob.hunting_probability

@@ -17,6 +17,7 @@ import math
 import re
 from typing import Any
 
+from ..display import plain
 from ..errors import ArgumentError
 from ..results.recommend import RecommendResult
 
@@ -41,7 +42,7 @@ def written(spec: Any, path: str, value: float, *, down: bool = False) -> Any:
     if down and x > 0:
         scale = 10.0 ** (math.floor(math.log10(x)) - DIGITS + 1)
         x = math.floor(x / scale * (1 + 1e-12)) * scale
-    text = f"{x:.{DIGITS}g}"
+    text = plain(x, DIGITS)
     return float(text) if shown in ("", "1") else f"{text} {shown}"
 
 
