@@ -62,7 +62,7 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
             f"buckling load {_g(grav.buckling_load)} N against the stage's weight "
             f"{_g(g.weight)} N standing on the leaves: factor {number(f, 3)}"
             + (f", at least {number(need, 6)} required" if f >= need else
-               (f": the guide buckles under the stage" if f <= 1.0 else
+               (": the guide buckles under the stage" if f <= 1.0 else
                 f", below the {number(need, 6)} required")), step=step))
     low = fx.lowest_mode
     need = separation * crossover
