@@ -48,6 +48,7 @@ from typing import IO, Mapping
 
 import numpy as np
 
+from .display import number, quantity
 from .errors import DataError
 from .results import dataclass_dict, frozen_array
 
@@ -260,14 +261,15 @@ def _checked(arrays: dict, source: str | None) -> Measurement:
         if limit is not None:
             big = np.nonzero(np.abs(arr) > limit)[0]
             if len(big):
-                raise DataError(f"value {arr[big[0]]:g} is implausibly large for {UNITS[name]}: "
-                                f"the column must hold SI values (e.g. mm / 1000)", column=name,
-                                row=int(big[0]) + 1, source=source)
+                raise DataError(f"value {number(arr[big[0]], 6)} is implausibly large for "
+                                f"{UNITS[name]}: the column must hold SI values (e.g. mm / "
+                                "1000)", column=name, row=int(big[0]) + 1, source=source)
     dt = np.diff(t)
     back = np.nonzero(dt <= 0)[0]
     if len(back):
         i = int(back[0]) + 1
-        raise DataError(f"time does not increase: {t[i]:.9g} s after {t[i - 1]:.9g} s",
+        raise DataError(f"time does not increase: {quantity(t[i], 's', 9)} after "
+                        f"{quantity(t[i - 1], 's', 9)}",
                         column="time_s", row=i + 1, source=source)
     return Measurement(time=frozen_array(t), reference=frozen_array(arrays["reference_m"]),
                        position=frozen_array(arrays["position_m"]),

@@ -76,7 +76,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..display import quantity
+from ..display import number, percent, quantity, with_error
 from .lugrefit import (Branch, LsqFit, Sliding, extended, fit_branches, fit_stribeck,
                        friction_force)
 from .preprocess import Joint, Trace, trace
@@ -239,7 +239,8 @@ def dynamic_parameters(measured, proc: Processing, joint: Joint, sol, form: str,
     out = {"static": static, "stribeck_velocity": stribeck, "bristle_stiffness": stiffness}
     if ctx.tr.compliance > 0.0:  # an isolated stage recorded without its deflection
         why = ("; the record has no deflection_m column, so the stage's motion holds the joint's "
-               f"deflection (its compliance 1/k = {ctx.tr.compliance:.3g} m/N from the spec is "
+               "deflection (its compliance 1/k = "
+               f"{quantity(ctx.tr.compliance, 'm/N', 3)} from the spec is "
                "removed from the displacement, but the speeds are the stage's): a record with "
                "deflection_m measures the cart's own motion")
         out = {k: p if p.identifiable else replace(p, note=p.note + why) for k, p in out.items()}
@@ -286,10 +287,10 @@ def _breakaway(ctx: _Context, event, vs: _Fixed | None):
                 peak_force=float(s * F[ion]), creep_velocity=vp,
                 span=float(np.ptp(tr.x[idx])) if len(idx) else 0.0)
     if len(idx) < MIN_BRANCH_SAMPLES:
+        reach = quantity(tr.reach / proc.sample_rate, "s", 3, shown=("ms", 1e3))
         return _empty(base, f"its loading branch holds {len(idx)} samples "
                             f"({MIN_BRANCH_SAMPLES} needed): the force rose to the breakaway "
-                            "within the filter's reach "
-                            f"({quantity(tr.reach / proc.sample_rate, 's', 3, shown=('ms', 1e3))})"), None, None
+                            f"within the filter's reach ({reach})"), None, None
     branch = Branch(idx, s)
     fit, keys = ctx.fit([branch], None, vs)
     kappa, sigma0, sigma1 = (float(x) for x in fit.x[:3])
@@ -302,9 +303,10 @@ def _breakaway(ctx: _Context, event, vs: _Fixed | None):
     if not ok:
         why.append("the fit of its branch found no saturation level")
     elif rise < MIN_RISE or sat < SATURATION:
-        why.append(f"its branch rises from {y[0]:.4g} N to {y[-1]:.4g} N against a level of "
-                   f"{level:.4g} N (a rise of at least {MIN_RISE:.0%} of it, up to at least "
-                   f"{SATURATION:.0%}, needed: the bearing had stopped with its bristles loaded "
+        why.append(f"its branch rises from {quantity(y[0], 'N', 4)} to {quantity(y[-1], 'N', 4)} "
+                   f"against a level of {quantity(level, 'N', 4)} (a rise of at least "
+                   f"{percent(MIN_RISE, 2)} of it, up to at least {percent(SATURATION, 2)}, "
+                   "needed: the bearing had stopped with its bristles loaded "
                    "in the breakaway's direction, or broke away before they saturated)")
     else:
         used.append("static")
@@ -324,8 +326,9 @@ def _breakaway(ctx: _Context, event, vs: _Fixed | None):
 
 
 def _span_note(span: float, tr: Trace) -> str:
-    return (f"its presliding displacement spans {quantity(span, 'm', 3)}, {MIN_SPAN:g} position "
-            f"resolutions ({quantity(MIN_SPAN * tr.resolution, 'm', 3)}) needed")
+    return (f"its presliding displacement spans {quantity(span, 'm', 3)}, "
+            f"{number(MIN_SPAN)} position resolutions "
+            f"({quantity(MIN_SPAN * tr.resolution, 'm', 3)}) needed")
 
 
 def _empty(base: dict, why: str):
@@ -342,13 +345,14 @@ def _static(ctx: _Context, events, form: str, vs: _Fixed | None, exc: Excitation
     if not use:
         if not events:
             why = (f"the record holds no breakaway after a stop (a rest of at least "
-                   f"{quantity(exc.dwell, 's', 3, shown=('ms', 1e3))} after sliding, followed by motion); it moves slower "
-                   f"than the velocity threshold for {exc.low_speed_time:.3g} s in all without "
-                   "stopping, passing through")
+                   f"{quantity(exc.dwell, 's', 3, shown=('ms', 1e3))} after sliding, followed by "
+                   "motion); it moves slower than the velocity threshold for "
+                   f"{quantity(exc.low_speed_time, 's', 3)} in all without stopping, passing "
+                   "through")
         else:
             why = (f"the record holds {len(events)} breakaway(s) after a stop, none with a "
                    "resolved loading branch (" + "; ".join(
-                       f"t = {bf.time:.4g} s: {bf.note}" for bf, _, _ in events[:3])
+                       f"t = {quantity(bf.time, 's', 4)}: {bf.note}" for bf, _, _ in events[:3])
                    + (" ..." if len(events) > 3 else "") + ")")
         return Parameter(None, None, UNITS[name], False,
                          f"not identifiable: {why}; {_EXPERIMENT[name]} would identify it"), None
@@ -356,7 +360,8 @@ def _static(ctx: _Context, events, form: str, vs: _Fixed | None, exc: Excitation
     est = []
     for _, (fit, keys), _ in use:
         k = fit.x[0]
-        est.append(_Estimate(1.0 / k, fit.std_error(0)[0] / k ** 2, -ctx.row(fit, 0, keys) / k ** 2))
+        est.append(_Estimate(1.0 / k, fit.std_error(0)[0] / k ** 2,
+                             -ctx.row(fit, 0, keys) / k ** 2))
     extra = 0.0
     if len(use) == 1:  # no scatter to measure: widen by the model's share
         _, _, br = use[0]
@@ -370,7 +375,7 @@ def _static(ctx: _Context, events, form: str, vs: _Fixed | None, exc: Excitation
         value += sliding.value("offset")
         var_prop = float(g @ C @ g)
     k = len(use)
-    times = ", ".join(f"{bf.time:.4g} s" for bf, _, _ in use[:6]) + (" ..." if k > 6 else "")
+    times = ", ".join(quantity(bf.time, "s", 4) for bf, _, _ in use[:6]) + (" ..." if k > 6 else "")
     peak = float(np.mean([bf.peak_force for bf, _, _ in use]))
     creep = float(np.mean([bf.creep_velocity for bf, _, _ in use]))
     note = (f"the bristles' saturation level on the loading branch before {k} breakaway(s) "
@@ -381,15 +386,16 @@ def _static(ctx: _Context, events, form: str, vs: _Fixed | None, exc: Excitation
                "Stribeck velocity, its error propagated); " if vs is not None else
                "where the bearing creeps slowly; ")
             + (f"the mean of {k} events; standard error from their scatter (at least their fit "
-               f"errors), {math.sqrt(var_stat):.2g} N, and the propagated error of the sliding "
-               f"friction, {math.sqrt(var_prop):.2g} N" if k > 1 else
+               f"errors), {quantity(math.sqrt(var_stat), 'N', 2)}, and the propagated error of the "
+               f"sliding friction, {quantity(math.sqrt(var_prop), 'N', 2)}" if k > 1 else
                "one event only, so the scatter between events is unknown: its fit error is "
-               f"widened by {extra:.2g} N (the change of the estimate when the bristle damping "
-               "is left out of the model) and the propagated error of the sliding friction, "
-               f"{math.sqrt(var_prop):.2g} N, added; more breakaways would tighten it")
-            + f". The force at the onsets, {peak:.4g} N, is not the estimate: the bearing "
-              f"already creeps there ({quantity(creep, 'm/s', 3)}), where LuGre's friction is "
-              "g(v) < Fs, and the filter smears the drop after it")
+               f"widened by {quantity(extra, 'N', 2)} (the change of the estimate when the bristle "
+               "damping is left out of the model) and the propagated error of the sliding "
+               f"friction, {quantity(math.sqrt(var_prop), 'N', 2)}, added; more breakaways "
+               "would tighten it")
+            + f". The force at the onsets, {quantity(peak, 'N', 4)}, is not the estimate: the "
+              f"bearing already creeps there ({quantity(creep, 'm/s', 3)}), where LuGre's "
+              "friction is g(v) < Fs, and the filter smears the drop after it")
     if form == "per_direction":
         note += ("; per-direction form: the static friction of the positive direction, Fs + "
                  "offset; the spec scales the negative direction's by coulomb_negative / "
@@ -444,7 +450,8 @@ def _stiffness(ctx: _Context, events, runs, level: _Fixed | None, vs: _Fixed | N
         held = [bf for bf, _, _ in events + runs]
         if held:
             why = ("the record's breakaways and presliding runs do not resolve the presliding "
-                   "curve (" + "; ".join(f"t = {bf.time:.4g} s: {bf.note}" for bf in held[:3])
+                   "curve (" + "; ".join(f"t = {quantity(bf.time, 's', 4)}: {bf.note}"
+                                         for bf in held[:3])
                    + (" ..." if len(held) > 3 else "") + ")")
         else:
             why = (f"the record holds no presliding excitation ({exc.presliding_reversals} "
@@ -471,31 +478,31 @@ def _stiffness(ctx: _Context, events, runs, level: _Fixed | None, vs: _Fixed | N
             f"{where}; " + (f"the mean of {len(use)}; standard error from their scatter (at "
                             "least their fit errors)" if len(use) > 1 else
                             "one event only, so the scatter between events is unknown: its fit "
-                            f"error is widened by {extra:.2g} N/m (the change of the estimate "
-                            "when the bristle damping is left out of the model)")
+                            f"error is widened by {quantity(extra, 'N/m', 2)} (the change of "
+                            "the estimate when the bristle damping is left out of the model)")
             + (", the presliding curve's level fixed at the identified static friction, its "
                "error propagated" if nr and level is not None else "")
-            + f" and the propagated error of the sliding friction ({math.sqrt(var_prop):.2g} "
-              "N/m)")
+            + " and the propagated error of the sliding friction "
+              f"({quantity(math.sqrt(var_prop), 'N/m', 2)})")
     if tr.compliance > 0.0:
         own = 1.0 / value
         share = own / (own + tr.compliance)
-        note += (f"; the joint's compliance 1/k = {tr.compliance:.3g} m/N (the spec's stiffness, "
-                 "no deflection_m column) was removed from the displacement: the bristles' own "
-                 f"compliance is {share:.0%} of the total")
+        note += (f"; the joint's compliance 1/k = {quantity(tr.compliance, 'm/N', 3)} (the spec's "
+                 "stiffness, no deflection_m column) was removed from the displacement: the "
+                 f"bristles' own compliance is {percent(share, 2)} of the total")
         if share < MIN_OWN_COMPLIANCE:
             return Parameter(None, None, UNITS[name], False,
                              f"not identifiable: the joint's compliance 1/k dominates the "
-                             f"presliding displacement (the bristles' own {share:.0%} of it, "
-                             f"{MIN_OWN_COMPLIANCE:.0%} needed), so sigma0 would rest on the "
-                             "spec's stiffness; a record with the deflection_m column measures "
-                             "the cart's own displacement")
+                             f"presliding displacement (the bristles' own {percent(share, 2)} of "
+                             f"it, {percent(MIN_OWN_COMPLIANCE, 2)} needed), so sigma0 would "
+                             "rest on the spec's stiffness; a record with the deflection_m "
+                             "column measures the cart's own displacement")
     se = math.sqrt(var_stat + var_prop)
     if se > MAX_RELATIVE_ERROR * abs(value):
         return Parameter(None, None, UNITS[name], False,
-                         f"not identifiable: the presliding curve gives {value:.4g} +- {se:.2g} "
-                         f"N/m, a relative error above {MAX_RELATIVE_ERROR:.0%}; "
-                         f"{_EXPERIMENT[name]} would identify it")
+                         "not identifiable: the presliding curve gives "
+                         f"{with_error(value, se, 'N/m')}, a relative error above "
+                         f"{percent(MAX_RELATIVE_ERROR, 2)}; {_EXPERIMENT[name]} would identify it")
     return Parameter(float(value), float(se), UNITS[name], True, note)
 
 
@@ -560,9 +567,10 @@ def _stribeck(ctx: _Context, level: _Fixed | None, relax):
         return None, Parameter(
             None, None, UNITS[name], False,
             f"not identifiable: the record slides steadily below the velocity threshold "
-            f"({proc.velocity_threshold:.3g} m/s) for {len(idx)} samples "
-            f"({len(idx) / proc.sample_rate:.3g} s; steady: away from stops and reversals by "
-            f"the filter's reach, the speed changing by less than {STEADY_RATE:.0%} over the "
+            f"({quantity(proc.velocity_threshold, 'm/s', 3)}) for {len(idx)} samples "
+            f"({quantity(len(idx) / proc.sample_rate, 's', 3)}; steady: away from stops and "
+            "reversals by the filter's reach, the speed changing by less than "
+            f"{percent(STEADY_RATE, 2)} over the "
             f"relaxation distance {quantity(relax, 'm', 3)}, {relax_from}); at least "
             f"{2 * MIN_STEADY_SAMPLES} spanning the Stribeck velocity are needed: "
             f"{_EXPERIMENT[name]} would identify it"), None
@@ -588,32 +596,36 @@ def _stribeck(ctx: _Context, level: _Fixed | None, relax):
     if not fit.success:
         problems.append("the fit did not converge")
     if below < MIN_STEADY_SAMPLES or above < MIN_STEADY_SAMPLES:
-        problems.append(f"{below} samples below {STEADY_BELOW:g} x vs and {above} above "
-                        f"{STEADY_ABOVE:g} x vs ({MIN_STEADY_SAMPLES} each needed to span it)")
+        problems.append(f"{below} samples below {number(STEADY_BELOW)} x vs and {above} above "
+                        f"{number(STEADY_ABOVE)} x vs ({MIN_STEADY_SAMPLES} each needed to "
+                        "span it)")
     if se > MAX_RELATIVE_ERROR * vs:
-        problems.append(f"relative error {se / vs:.0%} (at most {MAX_RELATIVE_ERROR:.0%})")
+        problems.append(f"relative error {percent(se / vs, 2)} "
+                        f"(at most {percent(MAX_RELATIVE_ERROR, 2)})")
     if problems:
         return sweep, Parameter(
             None, None, UNITS[name], False,
             f"not identifiable: {len(idx)} samples slide steadily below the velocity threshold "
             f"at {_speed_range(speed)}, but "
-            + "; ".join(problems) + f" (a fit gave {vs:.3g} m/s); {_EXPERIMENT[name]} would "
-            "identify it"), None
+            + "; ".join(problems) + f" (a fit gave {quantity(vs, 'm/s', 3)}); "
+            f"{_EXPERIMENT[name]} would identify it"), None
     note = (f"steady-state Stribeck curve Fc + (Fs - Fc) exp(-(v/vs)^2) + viscous fitted to "
             f"{len(idx)} samples sliding steadily at "
-            f"{_speed_range(speed)} ({below} below {STEADY_BELOW:g} vs, {above} above "
-            f"{STEADY_ABOVE:g} vs; steady: the speed changing by less than {STEADY_RATE:.0%} "
-            f"over the relaxation distance {quantity(relax, 'm', 3)}, {relax_from}), Fc fixed at the "
-            "identified Coulomb friction and "
+            f"{_speed_range(speed)} ({below} below {number(STEADY_BELOW)} vs, {above} above "
+            f"{number(STEADY_ABOVE)} vs; steady: the speed changing by less than "
+            f"{percent(STEADY_RATE, 2)} over the relaxation distance {quantity(relax, 'm', 3)}, "
+            f"{relax_from}), Fc fixed at the identified Coulomb friction and "
             + ("Fs at the identified static friction, both errors propagated"
                if level is not None else
-               f"Fs fitted as well ({fs_fit:.4g} +- {sweep.static_std_error:.2g} N, not "
+               f"Fs fitted as well ({with_error(fs_fit, sweep.static_std_error, 'N')}, not "
                "reported as the static friction: no breakaway resolves it), Fc's error "
                "propagated")
-            + f"; standard error {stat:.2g} m/s statistical (autocorrelation-corrected), "
-              f"{prop:.2g} m/s from the sliding friction")
+            + f"; standard error {quantity(stat, 'm/s', 2)} statistical "
+              f"(autocorrelation-corrected), {quantity(prop, 'm/s', 2)} from the sliding "
+              "friction")
     if 3.0 * vs > proc.velocity_threshold:
-        note += (f"; the fit's velocity threshold {proc.velocity_threshold:.3g} m/s lies below "
+        note += ("; the fit's velocity threshold "
+                 f"{quantity(proc.velocity_threshold, 'm/s', 3)} lies below "
                  "3 vs, so the Stribeck effect reaches into the sliding samples and biases "
                  "the Coulomb friction: identify again with velocity_threshold above 3 vs")
     # vs with its variance and covariance with the sliding estimates (through Fs as well)

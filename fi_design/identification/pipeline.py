@@ -17,6 +17,7 @@ from typing import Callable
 import numpy as np
 
 from ..arguments import choice, integer, number
+from ..display import quantity
 from ..errors import ArgumentError, DataError
 from ..measured import Measurement, measurement_from_arrays
 from ..spec.file import as_spec
@@ -139,7 +140,7 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     for name, p in list(params.items()):
         if p.value is not None and p.value <= 0.0 and name != "offset":
             params[name] = replace(p, note=p.note + "; " + IMPLAUSIBLE)
-            notes.append(f"{name} = {p.value:.4g} {p.unit} is not positive: {IMPLAUSIBLE}")
+            notes.append(f"{name} = {quantity(p.value, p.unit, 4)} is not positive: {IMPLAUSIBLE}")
     if measured.disturbance is not None:
         notes.append("force_N is used as the force that acts (the injected disturbance_N "
                      "included); the controller's own output force_N - disturbance_N is not")
@@ -152,7 +153,7 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
         if name == "static" and p.value is not None and sliding is not None \
                 and p.value < sliding:
             p = replace(p, note=p.note + f"; below the Coulomb friction: {IMPLAUSIBLE}")
-            notes.append(f"static = {p.value:.4g} N lies below the Coulomb friction: "
+            notes.append(f"static = {quantity(p.value, 'N', 4)} lies below the Coulomb friction: "
                          f"{IMPLAUSIBLE}")
         params[name] = p
     say("done", 1.0)
@@ -193,7 +194,8 @@ def predict_force(result: IdentificationResult, measured: Measurement) -> ForceP
     proc = result.processing
     fs = 1.0 / measured.sample_period
     if abs(fs / proc.sample_rate - 1.0) > JITTER:
-        raise DataError(f"sampled at {fs:g} Hz, the identification at {proc.sample_rate:g} Hz",
+        raise DataError(f"sampled at {quantity(fs, 'Hz', 6)}, the identification at "
+                        f"{quantity(proc.sample_rate, 'Hz', 6)}",
                         column="time_s", source=measured.source)
     joint = joint_model(measured, result.spec)
     if joint.model != result.model:
@@ -234,7 +236,8 @@ def segment(measured: Measurement, start: float | None = None,
     def col(values):
         return None if values is None else np.asarray(values)[a:b]
 
-    span = f"{'' if start is None else f'{start:g} s '}to{'' if stop is None else f' {stop:g} s'}"
+    span = (f"{'' if start is None else quantity(start, 's', 6) + ' '}to"
+            f"{'' if stop is None else ' ' + quantity(stop, 's', 6)}")
     return measurement_from_arrays(
         col(measured.time), col(measured.reference), col(measured.position),
         force_N=col(measured.force), deflection_m=col(measured.deflection),

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..display import number, percent, plain, quantity
 from ..errors import DataError
 from ..measured import Measurement
 from ..results.identification import Processing
@@ -62,10 +63,11 @@ def check_record(m: Measurement) -> None:
     if worst > JITTER * med:
         i = int(np.argmax(np.abs(dt - med)))
         raise DataError(
-            f"non-uniform sampling: the step between rows {i + 1} and {i + 2} is {dt[i]:.6g} s, "
-            f"the median step {med:.6g} s (at most {JITTER:.0%} jitter is taken as uniform); the "
-            "zero-phase filter needs uniform samples: resample every column onto a uniform "
-            f"grid first (e.g. numpy.interp onto t0 + k * {med:.6g} s, or "
+            f"non-uniform sampling: the step between rows {i + 1} and {i + 2} is "
+            f"{quantity(dt[i], 's', 6)}, the median step {quantity(med, 's', 6)} (at most "
+            f"{percent(JITTER, 2)} jitter is taken as uniform); the zero-phase filter needs "
+            "uniform samples: resample every column onto a uniform grid first (e.g. "
+            f"numpy.interp onto t0 + k * {plain(med, 6)} s, or "
             "scipy.signal.resample_poly for a rational rate change)",
             column="time_s", row=i + 2, source=src)
 
@@ -109,20 +111,21 @@ def processing(measured: Measurement, spec=None, *, cutoff: float | None = None,
     if cutoff is not None:
         rule = "given"
         if not 0.0 < cutoff <= top:
-            raise DataError(f"cut-off {cutoff:g} Hz: must lie in (0, {top:g}] Hz for a record "
-                            f"sampled at {fs:g} Hz", column="time_s", source=measured.source)
+            raise DataError(f"cut-off {quantity(cutoff, 'Hz', 6)}: must lie in "
+                            f"(0, {number(top, 6)}] Hz for a record sampled at "
+                            f"{quantity(fs, 'Hz', 6)}", column="time_s", source=measured.source)
     elif spec is not None:
         from ..model import as_model
 
         fc = as_model(spec).crossover
         cutoff = CROSSOVER_FACTOR * fc
-        rule = f"{CROSSOVER_FACTOR:g} x the loop's crossover ({fc:.4g} Hz)"
+        rule = f"{number(CROSSOVER_FACTOR)} x the loop's crossover ({quantity(fc, 'Hz', 4)})"
     else:
         cutoff = CUTOFF_FRACTION * fs
-        rule = f"{CUTOFF_FRACTION:g} x the sample rate (no spec: loop crossover unknown)"
+        rule = f"{number(CUTOFF_FRACTION)} x the sample rate (no spec: loop crossover unknown)"
     if cutoff > top:
         cutoff = top
-        rule += f", capped at {MAX_CUTOFF_FRACTION:g} x the sample rate"
+        rule += f", capped at {number(MAX_CUTOFF_FRACTION)} x the sample rate"
     if decimation is None:
         decimation = _smooth_factor(max(1, int(math.floor(0.8 * fs / (2.0 * cutoff)))))
     elif decimation < 1:
@@ -218,8 +221,9 @@ def joint_model(measured: Measurement, spec) -> Joint:
     c_note = ("given" if iso.damping is not None else
               "the spec's default (damping ratio 0.05), not a measured value")
     return Joint("two_mass", iso.stiffness, c, ratio, (
-        f"two-mass record: the flexure force k d + c d' (k = {iso.stiffness:.6g} N/m from the "
-        f"spec, c = {c:.6g} N s/m, {c_note}) separates the stage equation (stage mass, offset) "
+        "two-mass record: the flexure force k d + c d' (k = "
+        f"{quantity(iso.stiffness, 'N/m', 6)} from the spec, c = {quantity(c, 'N*s/m', 6)}, "
+        f"{c_note}) separates the stage equation (stage mass, offset) "
         "from the cart equation (cart mass, friction of the bearing at the cart's velocity); "
         "their accuracy rests on k and c: an error in k biases both masses and the friction",
         "on a two-mass record the offset (stage equation) and Coulomb friction per direction "

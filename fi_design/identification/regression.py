@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..display import number, quantity
 from ..errors import DataError
 from ..results import frozen_array
 from .preprocess import Joint, Prepared
@@ -117,7 +118,7 @@ def solve(equations: list, used: np.ndarray) -> Solution:
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
     if cond > MAX_CONDITION:
         raise DataError(f"the record does not excite every parameter (the regressor's condition "
-                        f"number is {cond:.3g}, above {MAX_CONDITION:.0e}, for "
+                        f"number is {number(cond, 3)}, above {number(MAX_CONDITION, 1)}, for "
                         f"{', '.join(names)}): it needs acceleration and sliding at varied "
                         "speeds (at one speed Coulomb and viscous friction are alike)",
                         column="position_m")
@@ -166,9 +167,10 @@ def check_directions(prep: Prepared, proc: Processing, source: str | None) -> in
     if max(pos, neg) < MIN_DIRECTION_SAMPLES:
         raise DataError(
             f"too little sliding: {pos} usable samples moving in the positive direction and "
-            f"{neg} in the negative one faster than {proc.velocity_threshold:.3g} m/s (at least "
-            f"{MIN_DIRECTION_SAMPLES} in one direction after decimation by {proc.decimation}); "
-            "identification needs sliding at varied speeds", column="position_m", source=source)
+            f"{neg} in the negative one faster than {quantity(proc.velocity_threshold, 'm/s', 3)} "
+            f"(at least {MIN_DIRECTION_SAMPLES} in one direction after decimation by "
+            f"{proc.decimation}); identification needs sliding at varied speeds",
+            column="position_m", source=source)
     if min(pos, neg) >= MIN_DIRECTION_SAMPLES:
         return 0
     return 1 if pos >= MIN_DIRECTION_SAMPLES else -1
@@ -323,6 +325,7 @@ def form_note(form: str) -> str:
 
 
 def threshold_note(proc: Processing) -> str:
-    return (f"samples slower than {proc.velocity_threshold:.4g} m/s are not used: near zero "
+    return (f"samples slower than {quantity(proc.velocity_threshold, 'm/s', 4)} are not used: "
+            "near zero "
             "velocity friction is not Coulomb plus viscous (Stribeck effect, presliding, "
             "sticking)")

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 
+from ..display import number, plain, quantity
 from .regression import IMPLAUSIBLE
 from ..results.identification import DYNAMIC, IdentificationResult
 
@@ -116,11 +117,12 @@ def identified_spec(spec, params, masses, form, direction: str = "both"):
                        "friction.viscous_negative") if k in values and values[k] < 0.0
            or k in values and values[k] == 0.0 and "viscous" not in k]
     if bad:
-        raise SpecError(f"the identified value {values[bad[0]]:.4g} {_SPEC_UNITS[bad[0]]} is "
-                        f"not positive, which a spec cannot hold: {IMPLAUSIBLE}", path=bad[0])
+        raise SpecError(f"the identified value {quantity(values[bad[0]], _SPEC_UNITS[bad[0]], 4)} "
+                        f"is not positive, which a spec cannot hold: {IMPLAUSIBLE}", path=bad[0])
     if values.get("friction.static", math.inf) < values.get("friction.coulomb", 0.0):
-        raise SpecError(f"the identified static friction {values['friction.static']:.4g} N lies "
-                        f"below the Coulomb friction {values['friction.coulomb']:.4g} N, which a "
+        raise SpecError("the identified static friction "
+                        f"{quantity(values['friction.static'], 'N', 4)} lies below the Coulomb "
+                        f"friction {quantity(values['friction.coulomb'], 'N', 4)}, which a "
                         f"spec cannot hold: {IMPLAUSIBLE}", path="friction.static")
     return with_values(spec, {k: float(x) for k, x in values.items()})
 
@@ -182,7 +184,8 @@ def identified_spec_text(result: IdentificationResult) -> str:
 
 
 def _quantity(path: str, value: float) -> str:
-    return f"{value:.6g} {_SPEC_UNITS[path]}"
+    # a value in a spec's comment reads as the spec's own values do (copied into a field as is)
+    return f"{plain(value, 6)} {_SPEC_UNITS[path]}"
 
 
 def _value_comment(result: IdentificationResult, path: str) -> str:
@@ -192,7 +195,7 @@ def _value_comment(result: IdentificationResult, path: str) -> str:
         m = result.masses
         se = m.stage_std_error if section == "stage" else m.cart_std_error
         if se is not None:
-            return f"identified {_quantity(path, getattr(m, section))} +- {se:.2g} {unit}"
+            return f"identified {_quantity(path, getattr(m, section))} +- {plain(se, 2)} {unit}"
         return f"the identified total mass, {m.source}"
     if result.direction != "both":
         side = result.direction
@@ -203,9 +206,10 @@ def _value_comment(result: IdentificationResult, path: str) -> str:
             return f"the spec's own value: the record slides in the {side} direction only"
         if key in ("coulomb", "coulomb_negative"):
             p = result.parameters[key]
-            return (f"identified {_quantity(path, p.value)} +- {p.std_error:.2g} {unit} sliding "
-                    f"{side}, the offset included, {'less' if key == 'coulomb' else 'plus'} "
-                    "the spec's offset (one direction cannot separate them)")
+            return (f"identified {_quantity(path, p.value)} +- {plain(p.std_error, 2)} {unit} "
+                    f"sliding {side}, the offset included, "
+                    f"{'less' if key == 'coulomb' else 'plus'} the spec's offset (one direction "
+                    "cannot separate them)")
     if key == "coulomb_negative" and result.form == "symmetric":
         return "symmetric form: equal to coulomb"
     if key == "offset" and result.form == "per_direction":
@@ -213,16 +217,16 @@ def _value_comment(result: IdentificationResult, path: str) -> str:
     if key == "static" and not result.parameters["static"].identifiable:
         f = result.spec.friction
         return (f"not identified: the spec's friction gap Fs - Fc = "
-                f"{f.static - f.coulomb:.4g} N kept on the identified coulomb")
+                f"{plain(f.static - f.coulomb, 4)} N kept on the identified coulomb")
     p = result.parameters[key]
-    return f"identified {_quantity(path, p.value)} +- {p.std_error:.2g} {unit}"
+    return f"identified {_quantity(path, p.value)} +- {plain(p.std_error, 2)} {unit}"
 
 
 def _header(result: IdentificationResult) -> str:
     src = result.measurement.source or "a measured record"
     lines = [f"# Friction and masses identified by fi-design identify from {src}",
              f"# ({result.form.replace('_', '-')} form, {result.model} model, relative force "
-             f"error {result.fit.relative_error:.3g}); values marked 'identified' below."]
+             f"error {number(result.fit.relative_error, 3)}); values marked 'identified' below."]
     for name in DYNAMIC:
         p = result.parameters[name]
         if not p.identifiable:

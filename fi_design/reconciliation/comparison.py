@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..display import number, quantity
 from ..errors import DataError
 from ..measured import Measurement
 from ..model import as_model
@@ -150,9 +151,9 @@ class Comparison:
             worst = float(np.max(np.abs(x - self.meas.reference)))
             if worst > self.runaway:
                 ok = False
-                message = (f"runaway: the model's position error reached {worst:.3g} m, more "
-                           f"than {RUNAWAY_FACTOR:g} times the largest measured error (an "
-                           "unstable loop)")
+                message = ("runaway: the model's position error reached "
+                           f"{quantity(worst, 'm', 3)}, more than {number(RUNAWAY_FACTOR)} "
+                           "times the largest measured error (an unstable loop)")
         return ModelRun(position=x, force=u, deflection=d, ok=ok, message=message)
 
     def trace_source(self, entries) -> ModelRun:

@@ -25,6 +25,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..display import fixed, number, percent, quantity
 from .comparison import Comparison, ModelRun
 from ..results.reconciliation import Cause, Diagnosis
 from .significance import EXPLAINED_MIN
@@ -63,11 +64,11 @@ def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
     message = ""
     if mismatch:
         top = [c for c in causes if c.share >= 0.1] or causes[:1]
-        message = (f"The nominal model misses the record by {misfit:.3g} noise units (RMS), far "
-                   f"above the noise, and no catalogue effect explains most of it (the best "
-                   f"removes {100 * best_explained:.0f} % of the gap): the model's structure "
-                   f"does not match the record. Likely causes, strongest first: "
-                   + "; ".join(f"{c.name.replace('_', ' ')} ({100 * c.share:.0f} %)" for c in top)
+        message = (f"The nominal model misses the record by {number(misfit, 3)} noise units "
+                   "(RMS), far above the noise, and no catalogue effect explains most of it (the "
+                   f"best removes {percent(best_explained, 2)} of the gap): the model's "
+                   "structure does not match the record. Likely causes, strongest first: "
+                   + "; ".join(f"{c.name.replace('_', ' ')} ({percent(c.share, 2)})" for c in top)
                    + ". See the residual and its spectrum.")
     return Diagnosis(mismatch=mismatch, misfit=misfit, misfit_limit=STRUCTURE_MISFIT,
                      best_explained=float(best_explained), channel=channel,
@@ -123,19 +124,20 @@ def _causes(cmp: Comparison, r: np.ndarray, crossover: float, use_force: bool) -
     fast = _band(r, t, crossover / 3.0, None)
     high = float(fast @ fast) / total
     out.append(Cause("controller", min(high, 1.0),
-                     f"{100 * high:.0f} % of the residual's energy lies at or above a third of "
-                     f"the loop's crossover ({crossover:.3g} Hz), where the controller shapes the "
-                     "response: check the controller description (gains, the derivative's input "
-                     "and filter, sample rate, delay)."))
+                     f"{percent(high, 2)} of the residual's energy lies at or above a third of "
+                     f"the loop's crossover ({quantity(crossover, 'Hz', 3)}), where the "
+                     "controller shapes the response: check the controller description (gains, "
+                     "the derivative's input and filter, sample rate, delay)."))
     window = max(START_SHARE * cmp.duration, cmp.settle_window)
     first = t <= t[0] + window
     frac_t = float(np.mean(first))
     frac_ss = float(r[first] @ r[first]) / total
     start = max(0.0, (frac_ss - frac_t) / (1.0 - frac_t)) if frac_t < 1.0 else 0.0
     out.append(Cause("initial_state", start,
-                     f"{100 * frac_ss:.0f} % of the residual's energy lies in the first "
-                     f"{window:.3g} s ({100 * frac_t:.0f} % of the record): check the state "
-                     "the replay starts from (position, velocity, the controller's integrator)."))
+                     f"{percent(frac_ss, 2)} of the residual's energy lies in the first "
+                     f"{quantity(window, 's', 3)} ({percent(frac_t, 2)} of the record): check "
+                     "the state the replay starts from (position, velocity, the controller's "
+                     "integrator)."))
     moving = cmp.kind != "hold"
     a, v = cmp.a_ref, cmp.v_ref
     mass, slope = 0.0, 0.0
@@ -146,8 +148,8 @@ def _causes(cmp: Comparison, r: np.ndarray, crossover: float, use_force: bool) -
         mass = max(0.0, 1.0 - float(np.var(r[moving] - A @ coef)) / var)
         slope = float(coef[1])
     out.append(Cause("mass", mass,
-                     f"the residual follows the reference acceleration (R^2 {mass:.2f}, slope "
-                     f"{slope:.3g} {unit} s^2/m"
+                     "the residual follows the reference acceleration (R^2 "
+                     f"{fixed(mass, 2)}, slope {quantity(slope, f'{unit} s^2/m', 3)}"
                      + (": the moving mass or the feedforward is off by about that many kg)."
                         if use_force else ")")))
     # what velocity, direction and acceleration terms (friction, mass: the catalogue's) leave
@@ -156,8 +158,8 @@ def _causes(cmp: Comparison, r: np.ndarray, crossover: float, use_force: bool) -
     slow_part = _band(r - X @ coef, t, None, crossover / 30.0)
     slow = min(float(slow_part @ slow_part) / total, 1.0)
     out.append(Cause("disturbance", slow,
-                     f"{100 * slow:.0f} % of the residual's energy is slow (below "
-                     f"{crossover / 30.0:.3g} Hz, a constant included) and not a velocity, "
-                     "direction or acceleration term: a force the model lacks (a load, a "
+                     f"{percent(slow, 2)} of the residual's energy is slow (below "
+                     f"{quantity(crossover / 30.0, 'Hz', 3)}, a constant included) and not a "
+                     "velocity, direction or acceleration term: a force the model lacks (a load, a "
                      "cable, a drift)."))
     return out

@@ -40,7 +40,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..display import quantity
+from ..display import percent, quantities, quantity
 from ..results.reconciliation import Lattice
 
 #: Tolerance of an exact lattice, as a fraction of the step (the file's number formatting).
@@ -108,14 +108,16 @@ def find_lattice(position: np.ndarray, noise: float) -> Lattice:
         qe = found.step / math.sqrt(12.0)
         if found.exact:
             coarse = noise <= COARSE_FACTOR * qe
-            why = (f"the record's noise ({noise:.3g} m) is "
+            noise_text, qe_text = quantities([noise, qe], "m", 3)
+            why = (f"the record's noise ({noise_text}) is "
                    + ("no more than" if coarse else "well above")
-                   + f" its quantization error ({qe:.3g} m)")
+                   + f" its quantization error ({qe_text})")
         else:
             coarse = qe > COARSE_FACTOR * found.jitter
-            why = (f"its quantization error ({qe:.3g} m) is "
+            qe_text, jitter_text = quantities([qe, found.jitter], "m", 3)
+            why = (f"its quantization error ({qe_text}) is "
                    + ("coarser than" if coarse else "within")
-                   + f" the noise around it ({found.jitter:.3g} m)")
+                   + f" the noise around it ({jitter_text})")
         found = replace(found, coarse=coarse, detail=found.detail + "; " + why)
     return found
 
@@ -154,8 +156,8 @@ def _exact_lattice(x: np.ndarray, span: float) -> Lattice | None:
     return Lattice(step=q, step_error=est.error, offset=x0, fraction=on / len(x), chance=chance,
                    tested=len(x), p_value=p, jitter=jitter, exact=True,
                    detail=f"every sample is a whole number of {quantity(q, 'm')} steps "
-                          f"({100 * on / len(x):.1f} % within 1 % of a step; chance "
-                          f"{100 * chance:.0f} %)")
+                          f"({percent(on / len(x), 3)} within 1 % of a step; chance "
+                          f"{percent(chance, 2)})")
 
 
 def _noisy_lattice(x: np.ndarray, span: float) -> Lattice:
@@ -211,7 +213,7 @@ def _noisy_lattice(x: np.ndarray, span: float) -> Lattice:
     return Lattice(step=q, step_error=est.error, offset=x0, fraction=k / m, chance=0.5,
                    tested=m, p_value=p, jitter=jitter, exact=False,
                    detail=f"the samples lie on a lattice of {quantity(q, 'm')} steps with "
-                          f"{quantity(jitter, 'm', 3)} of noise around it ({100 * k / m:.1f} % of "
+                          f"{quantity(jitter, 'm', 3)} of noise around it ({percent(k / m, 3)} of "
                           f"{m} tested steps on it; chance at most 50 %)")
 
 

@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 
+from ..display import number, quantities, quantity
 from ..errors import DataError
 from ..measured import Measurement, thinned
 
@@ -60,9 +61,10 @@ def check_excitation(measured: Measurement, position_noise: float) -> None:
     band = EXCITATION * position_noise
     ref, pos = float(np.ptp(measured.reference)), float(np.ptp(measured.position))
     if ref <= band and pos <= band:
+        ref_text, pos_text, band_text = quantities([ref, pos, band], "m", 3)
         raise DataError(
-            f"no excitation: the reference spans {ref:.3g} m and the position {pos:.3g} m, "
-            f"within {EXCITATION:g} noise levels ({band:.3g} m); a record in which nothing "
+            f"no excitation: the reference spans {ref_text} and the position {pos_text}, "
+            f"within {number(EXCITATION)} noise levels ({band_text}); a record in which nothing "
             "moves cannot show where the model is wrong: record a move (or a hold that hunts)",
             column="position_m", source=measured.source)
 
@@ -95,16 +97,17 @@ def for_the_model(measured: Measurement, crossover: float) -> tuple[Measurement,
         if rate / step < least:
             longest = MAX_SAMPLES / least
             raise DataError(
-                f"{measured.n} samples over {measured.duration:.4g} s: compared at the lowest "
-                f"rate the model allows ({MIN_CROSSOVER_SAMPLES:g} x the {crossover:.3g} Hz "
-                f"crossover = {least:.4g} Hz) that is "
+                f"{measured.n} samples over {quantity(measured.duration, 's', 4)}: compared at "
+                f"the lowest rate the model allows ({number(MIN_CROSSOVER_SAMPLES)} x the "
+                f"{quantity(crossover, 'Hz', 3)} crossover = {quantity(least, 'Hz', 4)}) that is "
                 f"{math.ceil(measured.duration * least)} samples; a reconciliation holds at "
-                f"most {MAX_SAMPLES}: reconcile at most {longest:.4g} s of the record at a "
-                "time", column="time_s", source=measured.source)
+                f"most {MAX_SAMPLES}: reconcile at most {quantity(longest, 's', 4)} of the "
+                "record at a time", column="time_s", source=measured.source)
     if step == 1:
         return measured, ""
     kept = thinned(measured, step)
-    return kept, (f"The record ({measured.n} samples at {rate:.4g} Hz) was compared at every "
-                  f"{step}th sample ({kept.n} samples at {rate / step:.4g} Hz): the model needs "
-                  f"{model_rate(crossover):.4g} Hz; noise and lattice were read from every "
-                  "sample.")
+    return kept, (f"The record ({measured.n} samples at {quantity(rate, 'Hz', 4)}) was "
+                  f"compared at every {step}th sample ({kept.n} samples at "
+                  f"{quantity(rate / step, 'Hz', 4)}): the model needs "
+                  f"{quantity(model_rate(crossover), 'Hz', 4)}; noise and lattice were read "
+                  "from every sample.")

@@ -22,7 +22,7 @@ import numpy as np
 
 from .comparison import Comparison, ModelRun
 from ..results.reconciliation import Lattice, Signature
-from ..display import quantity
+from ..display import fixed, number, quantities, quantity
 
 
 class Line(NamedTuple):
@@ -142,7 +142,7 @@ def scan(cmp: Comparison, nominal: ModelRun, lattice: Lattice, params) -> Eviden
         line = fit_line(res[move], v[move])
         add("velocity", ["viscous_friction"], line.r2, line.slope, f"{unit}/(m/s)",
             f"the {'force' if use_force else 'position'} residual follows the velocity during "
-            f"moves (slope {line.slope:.3g} {unit} s/m, R^2 {line.r2:.2f})")
+            f"moves (slope {quantity(line.slope, f'{unit} s/m', 3)}, R^2 {fixed(line.r2, 2)})")
         if use_force:
             guesses.setdefault("viscous_friction", []).append(
                 {"viscous": params.sigma2 + line.slope})
@@ -150,12 +150,12 @@ def scan(cmp: Comparison, nominal: ModelRun, lattice: Lattice, params) -> Eviden
         sl = (cmp.kind != "hold") & coh
         low = fit_line(res[sl], bump[sl])
         add("low_velocity", ["stribeck_velocity"], low.r2, low.slope, unit,
-            f"the residual concentrates at low speed (amplitude {low.slope:.3g} {unit}, "
-            f"R^2 {low.r2:.2f})")
+            "the residual concentrates at low speed (amplitude "
+            f"{quantity(low.slope, unit, 3)}, R^2 {fixed(low.r2, 2)})")
         acc = fit_line(res[sl], cmp.a_ref[sl])
         add("acceleration", ["mass_error"], acc.r2, acc.slope, f"{unit}/(m/s^2)",
-            f"the residual follows the reference acceleration (slope {acc.slope:.3g}, "
-            f"R^2 {acc.r2:.2f})")
+            f"the residual follows the reference acceleration (slope {number(acc.slope, 3)}, "
+            f"R^2 {fixed(acc.r2, 2)})")
         if use_force:
             f = 1.0 + acc.slope / (params.m1 + params.m2)
             guesses.setdefault("mass_error", []).append(
@@ -169,20 +169,22 @@ def scan(cmp: Comparison, nominal: ModelRun, lattice: Lattice, params) -> Eviden
             add("spatial_period", ["position_dependent_friction", "force_ripple"], strength,
                 top.wavelength, "m",
                 f"the residual repeats along the travel with a period of "
-                f"{quantity(top.wavelength, 'm', 4)} (amplitude {top.amplitude:.3g} {unit}, "
-                f"{top.ratio:.0f} x the median spectral power)")
+                f"{quantity(top.wavelength, 'm', 4)} (amplitude "
+                f"{quantity(top.amplitude, unit, 3)}, {number(top.ratio, 2)} x the median "
+                "spectral power)")
     trend = fit_line(res[coh], x[coh] - x[0])
     add("position_trend", ["cable_force"], trend.r2, trend.slope, f"{unit}/m",
-        f"the residual grows with position (slope {trend.slope:.3g} {unit}/m, "
-        f"R^2 {trend.r2:.2f})")
+        f"the residual grows with position (slope {quantity(trend.slope, f'{unit}/m', 3)}, "
+        f"R^2 {fixed(trend.r2, 2)})")
     if use_force:
         guesses.setdefault("cable_force", []).append(
             {"stiffness": trend.slope, "preload": trend.intercept})
     if use_force and move.sum() > 50:
         lag = force_lag(meas.force, nominal.force, cmp.t, max_lag=0.02)
         add("force_lag", ["time_delay"], lag.correlation if lag.lag > 0 else 0.0, lag.lag, "s",
-            f"the measured force lags the modelled one by {quantity(lag.lag, 's', 3, shown=('ms', 1e3))} "
-            f"(correlation {lag.correlation:.2f})")
+            "the measured force lags the modelled one by "
+            f"{quantity(lag.lag, 's', 3, shown=('ms', 1e3))} "
+            f"(correlation {fixed(lag.correlation, 2)})")
         if lag.lag > 0:
             guesses.setdefault("time_delay", []).append({"delay": lag.lag})
     if lattice.found:
@@ -194,7 +196,7 @@ def scan(cmp: Comparison, nominal: ModelRun, lattice: Lattice, params) -> Eviden
         rate = np.gradient(_smooth(meas.deflection, 11), cmp.t)
         dl = fit_line(dres[coh], rate[coh])
         add("deflection_rate", ["joint_damping"], dl.r2, dl.slope, "s",
-            f"the deflection residual follows the deflection rate (R^2 {dl.r2:.2f})")
+            f"the deflection residual follows the deflection rate (R^2 {fixed(dl.r2, 2)})")
     sigs.sort(key=lambda s: -s.strength)
     return Evidence(signatures=tuple(sigs), guesses=guesses, periods=tuple(periods))
 
@@ -207,8 +209,9 @@ def _direction(res, v, move, params, add, guesses) -> None:
     m_pos, m_neg = float(np.mean(res[pos])), float(np.mean(res[neg]))
     spread = float(np.std(res[move])) or 1e-300
     strength = min(1.0, (0.5 * (m_pos ** 2 + m_neg ** 2)) / spread ** 2)
+    forward, back = quantities([m_pos, m_neg], "N", 3)
     add("direction", ["force_offset", "friction_asymmetry"], strength, m_neg - m_pos, "N",
-        f"the force residual averages {m_pos:.3g} N moving forward and {m_neg:.3g} N moving "
+        f"the force residual averages {forward} moving forward and {back} moving "
         "back (an offset shifts both alike, asymmetric friction only one)")
     guesses.setdefault("force_offset", []).append({"offset": params.offset + 0.5 * (m_pos + m_neg)})
     back = fit_line(res[neg], v[neg])
@@ -231,8 +234,8 @@ def _saturation(res, force, coh, add, guesses) -> None:
             best_r2, best_level = r2, float(level)
     if best_level is not None:
         add("force_above_level", ["force_saturation"], best_r2, best_level, "N",
-            f"the residual appears where |force| exceeds {best_level:.3g} N "
-            f"(peak {umax:.3g} N, R^2 {best_r2:.2f})")
+            f"the residual appears where |force| exceeds {quantity(best_level, 'N', 3)} "
+            f"(peak {quantity(umax, 'N', 3)}, R^2 {fixed(best_r2, 2)})")
         guesses.setdefault("force_saturation", []).append({"limit": best_level})
 
 

@@ -54,6 +54,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..display import fixed, number, percent
 from ..measured import measurement_from_arrays
 from .comparison import Comparison
 from .fitting import Baseline, FitOutcome, Objective, fit, fit_baseline
@@ -216,8 +217,8 @@ def prefer_simpler(candidates: dict) -> dict:
         extra = (b.explained - s.explained) / left if left > 0 else 0.0
         if extra < NESTED_MARGIN:
             out[big] = replace(b, eligible=False, reasons=(
-                f"contains {small} as a special case and removes only {100 * extra:.1f} % of "
-                f"the gap {small} leaves (needs {100 * NESTED_MARGIN:.0f} %)",))
+                f"contains {small} as a special case and removes only {percent(extra, 2)} of "
+                f"the gap {small} leaves (needs {percent(NESTED_MARGIN, 2)})",))
     return out
 
 
@@ -246,20 +247,22 @@ def _verdict(outcome, st, score, explained, distance, threshold, null) -> Verdic
         reasons.append(f"the fit ends on a search bound or physical limit ({outcome.note}): "
                        "no value found")
     if score <= threshold:
-        reasons.append(f"score {score:.3g} not above the threshold {threshold:g} (improvement "
-                       f"{st.value:.3g} in {st.n_effective:.0f} effective samples)")
+        reasons.append(f"score {number(score, 3)} not above the threshold "
+                       f"{number(threshold, 6)} (improvement {number(st.value, 3)} in "
+                       f"{fixed(st.n_effective, 0)} effective samples)")
     if outcome.space.from_data:
         return Verdict(status, reasons)
     if explained < EXPLAINED_MIN:
-        reasons.append(f"explains {100 * explained:.0f} % of the gap above noise, less than "
-                       f"{100 * EXPLAINED_MIN:.0f} %")
+        reasons.append(f"explains {percent(explained, 2)} of the gap above noise, less than "
+                       f"{percent(EXPLAINED_MIN, 2)}")
     z = [abs(d) for d in distance.values() if d is not None]
     if z and max(z) < Z_MIN:
-        reasons.append(f"within {max(z):.2g} standard errors of the model's own value "
-                       f"(needs {Z_MIN:g})")
+        reasons.append(f"within {number(max(z), 2)} standard errors of the model's own value "
+                       f"(needs {number(Z_MIN)})")
     if null is not None and st.value < NULL_FACTOR * max(null.statistic, 0.0):
-        reasons.append(f"a refit on noise alone improves by {null.statistic:.3g} (statistic "
-                       f"{st.value:.3g}, needs {NULL_FACTOR:g} times more)")
+        reasons.append(f"a refit on noise alone improves by {number(null.statistic, 3)} "
+                       f"(statistic {number(st.value, 3)}, needs {number(NULL_FACTOR)} times "
+                       "more)")
     return Verdict(status, reasons)
 
 

@@ -485,10 +485,11 @@ def _conclusion(steps, candidates, chi2_nom, chi2_cor, n, ambiguous, diagnosis) 
                 f"effect explains the gap beyond what noise and the fit's freedom give: the "
                 f"answer is none.{tail}")
     lines = [f"{s.name} ({_effects.values_text(s.name, s.parameters, s.uncertainty)}; misfit "
-             f"{display.number(s.misfit_before, 3)} -> {display.number(s.misfit_after, 3)})" for s in steps]
+             f"{display.number(s.misfit_before, 3)} -> {display.number(s.misfit_after, 3)})"
+             for s in steps]
     text = (f"The measurement shows {', then '.join(lines)}. With "
-            f"{'them' if len(steps) > 1 else 'it'} the misfit drops from {display.number(before, 3)} to "
-            f"{display.number(after, 3)} noise units.")
+            f"{'them' if len(steps) > 1 else 'it'} the misfit drops from "
+            f"{display.number(before, 3)} to {display.number(after, 3)} noise units.")
     if ambiguous:
         text += (" Also consistent with the data, not decisively worse: "
                  + ", ".join(ambiguous) + ".")

@@ -411,5 +411,5 @@ def test_a_record_without_excitation_is_refused_not_agreed_with(tmp_path):
                                  "--json", str(out)])
     assert result.exit_code == 2, result.output
     assert "no excitation" in result.stderr and "position_m" in result.stderr
-    assert "the reference spans 0 m" in result.stderr
+    assert "the reference spans 0 µm" in result.stderr
     assert not out.exists()

@@ -145,7 +145,7 @@ def test_a_record_logged_faster_than_the_model_needs_is_thinned():
     record = _fast_record(spec, 10_000.0)
     result = reconcile(spec, record, candidates=["viscous_friction"])
     assert result.measurement.n == math.ceil(record.n / 10)
-    assert f"({record.n} samples at 1e+04 Hz) was compared at every 10th sample" \
+    assert f"({record.n} samples at 10000 Hz) was compared at every 10th sample" \
         in result.conclusion
     assert result.effect == "none"
 
