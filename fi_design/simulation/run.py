@@ -23,7 +23,7 @@ import numpy as np
 
 from .. import spec as _spec
 from ..arguments import number
-from ..display import quantity
+from ..display import number as number_text, quantity  # number: the argument check
 from ..errors import ArgumentError, SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from ..model import Model, as_model
@@ -206,8 +206,9 @@ def _checked_arguments(spec, crossover, duration, rtol, record):
         if samples > _spec.MAX_OUTPUT_SAMPLES:
             raise ArgumentError(f"duration = {quantity(duration, 's', 6)} at "
                                 "simulation.output_rate = "
-                                f"{quantity(settings.output_rate, 'Hz', 6)} makes {samples} "
-                                f"output samples; at most {_spec.MAX_OUTPUT_SAMPLES}")
+                                f"{quantity(settings.output_rate, 'Hz', 6)} makes "
+                                f"{number_text(float(samples), 3)} output samples; at most "
+                                f"{_spec.MAX_OUTPUT_SAMPLES}")
     return spec, crossover, duration, rtol
 
 
