@@ -16,6 +16,7 @@ import numbers
 from collections.abc import Iterable
 from typing import Any
 
+from .display import number as shown_number  # this module's number() reads one
 from .errors import ArgumentError
 
 __all__ = ["number", "integer", "choice"]
@@ -63,11 +64,13 @@ def number(value: Any, name: str, unit: str, *, positive: bool = False,
     if not math.isfinite(x):
         raise ArgumentError(f"{name} must be a finite number in {unit}, got {_shown(value)}")
     if positive and not x > 0.0:
-        raise ArgumentError(f"{name} must be above zero [{unit}], got {x:g}")
+        raise ArgumentError(f"{name} must be above zero [{unit}], got {shown_number(x, 6)}")
     if minimum is not None and x < minimum:
-        raise ArgumentError(f"{name} must be at least {minimum:g} {unit}, got {x:g}")
+        raise ArgumentError(f"{name} must be at least {shown_number(minimum, 6)} {unit}, "
+                            f"got {shown_number(x, 6)}")
     if maximum is not None and x > maximum:
-        raise ArgumentError(f"{name} must be at most {maximum:g} {unit}, got {x:g}")
+        raise ArgumentError(f"{name} must be at most {shown_number(maximum, 6)} {unit}, "
+                            f"got {shown_number(x, 6)}")
     return x
 
 

@@ -22,6 +22,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from .display import plain
 from .errors import ArgumentError
 
 #: Markers around the generated spec reference in docs/spec.md.
@@ -51,7 +52,7 @@ def _default(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):
-        return f"{value:g}"
+        return plain(value)  # as a spec file would have it
     if isinstance(value, (list, tuple)):
         if not value:
             return "[]"

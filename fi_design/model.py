@@ -46,6 +46,7 @@ from typing import Any
 
 from . import effects as _effects
 from . import spec as _spec
+from .display import quantity
 from .errors import ArgumentError, SimulationError, SpecError
 from .controller.pid import at_crossover, control_law
 from .kernel.layout import PlantParameters
@@ -727,8 +728,9 @@ def _checked_filters(filters, period: float) -> tuple:
             raise SpecError(f"frequency must be a positive number [Hz], got {f.frequency!r}",
                             path=f"controller.filters[{i}].frequency")
         if period > 0.0 and f.frequency >= 0.5 / period:
-            raise SpecError(f"{f.frequency:g} Hz lies at or above the Nyquist frequency "
-                            f"{0.5 / period:g} Hz", path=f"controller.filters[{i}].frequency")
+            raise SpecError(f"{quantity(f.frequency, 'Hz', 6)} lies at or above the Nyquist "
+                            f"frequency {quantity(0.5 / period, 'Hz', 6)}",
+                            path=f"controller.filters[{i}].frequency")
     return out
 
 

@@ -199,9 +199,9 @@ def print_simulation(console: "Console", result) -> None:
     plant = "with isolator" if result.isolated else "without isolator"
     loop = "closed loop" if result.drive == "closed" else "open loop, measured force"
     what = "Simulation" if result.replay is None else f"Replay of {result.record} ({loop})"
-    t = Table(title=f"{what} {plant} at {result.crossover:.4g} Hz ({result.friction_model}, "
-                    f"{result.method} solver)", title_justify="left", box=box.SIMPLE_HEAD,
-              pad_edge=False)
+    t = Table(title=f"{what} {plant} at {quantity(result.crossover, 'Hz', 4)} "
+                    f"({result.friction_model}, {result.method} solver)",
+              title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
     t.add_column("Quantity")
     t.add_column("Value", justify="right")
     rows = []

@@ -333,7 +333,7 @@ def print_verdict(console: "Console", result) -> None:
         items = []
         if mar.crossover_factor is not None:
             items.append(f"crossover {'>= ' if mar.crossover_factor_bound else ''}"
-                         f"{mar.crossover_factor:.3g}x the hunting-free "
+                         f"{number(mar.crossover_factor, 3)}x the hunting-free "
                          f"{number(mar.hunting_free_crossover, 4)} Hz"
                          + (f" (the sliding loop crosses 0 dB at "
                             f"{number(mar.hunting_loop_crossover, 4)} Hz and "
@@ -343,10 +343,10 @@ def print_verdict(console: "Console", result) -> None:
         if mar.end_stop_clearance is not None:
             items.append(f"end stop {quantity(mar.end_stop_clearance, 'm', 3)} away at rest")
         if mar.stiffness_factor is not None:
-            items.append(f"k_max / k = {mar.stiffness_factor:.3g}")
+            items.append(f"k_max / k = {number(mar.stiffness_factor, 3)}")
         if mar.stiffness_range is not None:
             lo, hi = mar.stiffness_range
-            items.append(f"k {lo:.4g}-{hi:.4g} N/m for t = "
+            items.append(f"k {quantity((lo, hi), 'N/m', 4)} for t = "
                          f"{with_error(mar.thickness, mar.thickness_tolerance, 'm', 3, 2)}")
         if mar.static_error is not None:
             items.append(f"static error {quantity(mar.static_error, 'm', 3)} of "

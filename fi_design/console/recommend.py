@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional
 
-from ..display import number, percent, quantity
+from ..display import fixed, number, percent, quantity
 from .common import heading, table
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -101,5 +101,5 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
     for a in result.assumptions:
         console.print(Text("Assumed: ", style="dim").append(a, style="dim"))
     console.print(Text("Advice: ", style="bold").append(result.advice))
-    console.print(f"{result.evaluations} stage-level evaluations in {result.wall_time:.1f} s",
+    console.print(f"{result.evaluations} stage-level evaluations in {fixed(result.wall_time, 1)} s",
                   markup=False, highlight=False)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..display import number, quantity, scale
+from ..display import number, percent, quantity, scale
 from ..effects import values_text as _effects_text
 from .common import table
 
@@ -35,7 +35,7 @@ def print_reconcile(console: "Console", result) -> None:
             d.add_column(col, justify=just, no_wrap=col == "Share",
                          ratio=1 if col == "What was measured" else None)
         for c in result.diagnosis.causes:
-            d.add_row(Text(c.name.replace("_", " ")), f"{100 * c.share:.0f} %", Text(c.detail))
+            d.add_row(Text(c.name.replace("_", " ")), percent(c.share, 2), Text(c.detail))
         console.print(d)
     if len(result.steps) > 1:
         s = table("Effects in order")
@@ -53,7 +53,7 @@ def print_reconcile(console: "Console", result) -> None:
                      ratio=1 if col == "Fitted parameters" else None)
     for c in result.candidates:
         params = _effects_text(c.name, c.parameters, c.uncertainty)
-        t.add_row(Text(c.name), number(c.score), f"{100 * c.explained:.1f} %", Text(params))
+        t.add_row(Text(c.name), number(c.score), percent(c.explained, 3), Text(params))
     console.print(t)
     for c in result.candidates:
         if c.name not in result.effects and c.reasons:

@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional
 
-from ..display import axis_unit, number, quantity
+from ..display import axis_unit, fixed, number, percent, quantity
 from .common import heading, table
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -73,7 +73,7 @@ def sweep_grid_table(result, columns: slice | None = None):
         for j in cols:
             v, c = vrow[j], crow[j]
             if v == "hunting":
-                cells.append(Text(f"{c:.2g}" if stage else str(int(c)), style="bold red"))
+                cells.append(Text(number(c, 2) if stage else str(int(c)), style="bold red"))
             else:
                 mark, style = _CELL.get(str(v), ("", ""))
                 cells.append(Text(mark, style=style))
@@ -166,7 +166,7 @@ def _print_counts(console: "Console", counts: dict) -> None:
 
 def _print_run(console: "Console", run, executor: str) -> None:
     console.print(f"{run.points} points: {run.computed} simulated, {run.cached} from the cache; "
-                  f"{executor}; {run.wall_time:.2f} s", markup=False, highlight=False)
+                  f"{executor}; {fixed(run.wall_time, 2)} s", markup=False, highlight=False)
 
 
 def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
@@ -266,12 +266,12 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
     for sc in result.scatter:
         unit, f = axis_unit("") if sc.relative else axis_unit(
             _path_unit(sc.path, result.spec))
-        spread = f"{sc.spread:.3g} of nominal ({100 * sc.spread:.3g} %)" if sc.relative else \
-            f"{number(sc.spread * f)} {unit}"
+        spread = (f"{number(sc.spread, 3)} of nominal ({percent(sc.spread, 3)})" if sc.relative
+                  else f"{number(sc.spread * f)} {unit}")
         console.print(Text(f"scatter {sc.path}: {result.distribution}, spread {spread}"))
     if result.position_friction is not None:
         pf = result.position_friction
-        console.print(Text(f"position-dependent friction: amplitude {100 * pf.amplitude:.3g} %, "
+        console.print(Text(f"position-dependent friction: amplitude {percent(pf.amplitude, 3)}, "
                            f"wavelength {quantity(pf.wavelength, 'm', 4)}, random phase"))
     conf = result.not_isolated.confidence
     t = table(f"Probability of hunting, {result.samples} samples, seed {result.seed}")
@@ -283,8 +283,9 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
         t.add_column(Text(label), justify="right")
     rows = [
         ("Probability of hunting", lambda p: "-" if p.probability is None
-         else f"{100 * p.probability:.1f} %"),
-        (f"{conf:.0%} Wilson interval", lambda p: f"{100 * p.low:.1f} to {100 * p.high:.1f} %"),
+         else percent(p.probability, 3)),
+        (f"{percent(conf, 2)} Wilson interval",
+         lambda p: f"{percent(p.low, 3)} to {percent(p.high, 3)}"),
         ("Hunting / valid samples", lambda p: f"{p.hunting} / {p.valid}"),
     ] + [(f"  {v}", lambda p, v=v: str(p.counts[v]))
          for v in ("settled", "stuck", "undetermined", "invalid", "failed")]

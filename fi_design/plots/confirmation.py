@@ -119,7 +119,8 @@ def error_figure(confirmation: Any, spec: Any) -> Any:
         if m.settling_time is not None:
             ts = t0 + m.settling_time
             axz.axvline(ts, color="0.25", lw=0.9, ls=":", zorder=3)
-            note = f"in the band from t = {ts:.3g} s\n({m.settling_time:.3g} s after the motion)"
+            note = (f"in the band from t = {quantity(ts, 's', 3)}\n"
+                    f"({quantity(m.settling_time, 's', 3)} after the motion)")
         else:
             note = "never stays in the band"
         axz.text(0.98, 0.04, note, transform=axz.transAxes, ha="right", va="bottom",

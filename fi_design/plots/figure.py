@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from ..display import fixed, plain
+from ..display import tick_label as plain_tick  # the log axes' tick labels (FuncFormatter)
 from ..errors import ArgumentError
 
 
@@ -70,28 +72,6 @@ def styled(draw):
     return wrapper
 
 
-def plain_tick(value: float, _pos: Any = None) -> str:
-    """Tick label of a log axis as a plain number (``0.001``, ``10``, ``1000``).
-
-    Plain text instead of matplotlib's mathtext powers of ten: readable, and
-    much faster to draw.
-
-    Parameters
-    ----------
-    value : float
-        Tick value.
-
-    Returns
-    -------
-    str
-    """
-    if value <= 0:
-        return ""
-    if 1e-4 <= value < 1e5:
-        return f"{value:g}" if value >= 1 else f"{value:.{max(0, -math.floor(math.log10(value) + 1e-9))}f}"
-    return f"{value:.0e}".replace("e+0", "e").replace("e-0", "e-")
-
-
 def log_x(ax: Any, numticks: int = 12) -> None:
     """Logarithmic x axis with plain decade labels and no minor ticks (they are slow to draw)."""
     from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
@@ -119,7 +99,7 @@ def nice_ticks(lo: float, hi: float) -> list[float]:
         for m in (1.0, 2.0, 5.0):
             v = m * 10.0 ** exp
             if lo * 0.999 <= v <= hi * 1.001:
-                out.append(float(f"{v:.6g}"))
+                out.append(float(plain(v, 6)))
     return out
 
 
@@ -250,7 +230,7 @@ def png_img(png: bytes, width_pt: float | None = None, alt: str = "") -> str:
     """An ``<img>`` element carrying ``png`` as a data URL, ``width_pt`` wide [pt] if given."""
     from markupsafe import escape
 
-    style = "" if width_pt is None else f' style="width:{width_pt:.2f}pt"'
+    style = "" if width_pt is None else f' style="width:{fixed(width_pt, 2)}pt"'
     data = base64.b64encode(png).decode("ascii")
     return f'<img src="data:image/png;base64,{data}" alt="{escape(alt)}"{style}>'
 

@@ -193,11 +193,11 @@ def boundary_figure(confirmation: Any) -> Any:
             ax.axvline(m, color=col, lw=0.9, ls=":")
             # in the headroom above the curves, on the side of the line with more room
             left = m < 0.6 * x_top
-            ax.text(m, 0.96 - 0.1 * n, f" no move hunts from {m:.4g} Hz ", color=col,
+            ax.text(m, 0.96 - 0.1 * n, f" no move hunts from {quantity(m, 'Hz', 4)} ", color=col,
                     fontsize=7, transform=ax.get_xaxis_transform(), va="top",
                     ha="left" if left else "right")
     ax.axvline(fc, color="0.3", lw=0.9, ls="--")
-    ax.text(fc, 0.04, f" design {fc:g} Hz", color="0.3", fontsize=7,
+    ax.text(fc, 0.04, f" design {quantity(fc, 'Hz', 4)}", color="0.3", fontsize=7,
             transform=ax.get_xaxis_transform(), va="bottom", ha="left")
     ax.set_xlim(0.0, x_top)
     ax.set_ylim(0.0, 1.35 * top_mm if top_mm > 0 else None)

@@ -103,5 +103,6 @@ def residual_figure(result: Any) -> Any:
     ax.set_xlabel("time [s]")
     ax.set_ylabel("measured - modelled force [N]")
     ax.set_xlim(float(t[0]), float(t[-1]))
-    ax.set_title(f"grey band: ±2 RMS ({2 * rms:.3g} N)", loc="right", fontsize=7, color="0.35")
+    ax.set_title(f"grey band: ±2 RMS ({quantity(2 * rms, 'N', 3)})", loc="right", fontsize=7,
+                 color="0.35")
     return fig

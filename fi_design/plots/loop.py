@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ..display import number, quantity
 from .figure import log_x, report_figure, styled
 
 
@@ -150,7 +151,7 @@ def bode_figure(result: Any) -> Any:
     band_mag = np.concatenate([20 * np.log10(np.abs(L[inside])) for _, L in responses])
     mag.set_ylim(max(np.nanmin(band_mag), -120.0) - 5, min(np.nanmax(band_mag), 160.0) + 5)
     _mark_nyquist(result, (mag, pha))
-    mag.annotate(f"fc = {fc:g} Hz", (fc, 0.02), xycoords=mag.get_xaxis_transform(),
+    mag.annotate(f"fc = {quantity(fc, 'Hz', 4)}", (fc, 0.02), xycoords=mag.get_xaxis_transform(),
                  xytext=(3, 0), textcoords="offset points", ha="left", va="bottom",
                  fontsize=7.5, color="0.3")
     fig.legend(*mag.get_legend_handles_labels(), loc="upper center", ncols=2,
@@ -203,7 +204,7 @@ def nyquist_figure(result: Any) -> Any:
     t = np.linspace(0, 2 * math.pi, 200)
     ax.plot(-1 + m * np.cos(t), m * np.sin(t), color="0.4", lw=0.8, ls=":")
     ax.plot([-1], [0], marker="+", color="red", ms=9, mew=1.5, ls="none")
-    ax.annotate(f"|1 + L| = {m:g}", (-1 + m * math.cos(2.3), m * math.sin(2.3)),
+    ax.annotate(f"|1 + L| = {number(m, 6)}", (-1 + m * math.cos(2.3), m * math.sin(2.3)),
                 xytext=(-2.4, 1.15), fontsize=7, color="0.35",
                 arrowprops={"arrowstyle": "-", "color": "0.6", "lw": 0.6})
     ax.set_xlim(-2.5, 1.0)
@@ -244,8 +245,9 @@ def sensitivity_figure(result: Any) -> Any:
     m = req if req is not None else 0.5
     peak = -20 * math.log10(m)
     ax.axhline(peak, color="0.4", lw=0.8, ls=":")
-    ax.text(0.02, peak, f"|S| = {peak:.3g} dB (|1 + L| = {m:g})", transform=ax.get_yaxis_transform(),
-            va="bottom", ha="left", fontsize=7, color="0.35")
+    ax.text(0.02, peak, f"|S| = {quantity(peak, 'dB', 3)} (|1 + L| = {number(m, 6)})",
+            transform=ax.get_yaxis_transform(), va="bottom", ha="left", fontsize=7,
+            color="0.35")
     ax.axhline(0.0, color="0.3", lw=0.8)
     ax.axvline(result.crossover.desired, color="0.3", lw=0.9, ls="--")
     _mark_nyquist(result, (ax,))

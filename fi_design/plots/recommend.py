@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from ..display import number, quantity
 from .figure import log_x, plain_tick, report_figure, styled
 
 __all__ = ["CANDIDATE_LOOK", "recommend_figure"]
@@ -79,7 +80,7 @@ def recommend_figure(result: Any) -> Any:
     left.yaxis.set_major_formatter(FuncFormatter(plain_tick))
     left.set_xlabel("stroke [mm]")
     left.set_ylabel("net drive stiffness [N/m]")
-    left.set_title(f"design space at {d.crossover:.4g} Hz", loc="left", fontsize=7.5)
+    left.set_title(f"design space at {quantity(d.crossover, 'Hz', 4)}", loc="left", fontsize=7.5)
 
     req = spec.requirements.hunting_margin
     judged = [c for c in result.candidates
@@ -93,7 +94,7 @@ def recommend_figure(result: Any) -> Any:
         right.plot([p["stiffness"] for p in front], [p["hunting_margin"] for p in front],
                    color="0.2", lw=1.0, zorder=1)
     right.axhline(req, color="#d7301f", lw=1.0, ls="--")
-    right.text(0.02, req, f" required {req:g}", transform=right.get_yaxis_transform(),
+    right.text(0.02, req, f" required {number(req, 6)}", transform=right.get_yaxis_transform(),
                va="bottom", fontsize=7, color="#d7301f")
     if d.hunting_margin is not None and math.isfinite(d.hunting_margin) and d.hunting_margin:
         right.plot([d.stiffness], [d.hunting_margin], **star)

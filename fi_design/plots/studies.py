@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from ..display import number, percent, quantity
 from .figure import REPORT_RC, REPORT_WIDTH, cell_edges, nice_ticks, plain_tick
 from .labels import axis_label, display_unit, quantity_name
 
@@ -148,7 +149,7 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
                         color="0.1")
             elif annotate and np.isfinite(c) and c > 0:
                 dark = norm(c) > 0.6 if log_scale else c >= 0.6 * top
-                ax.text(xs[i], ys[j], f"{c:.2g}" if stage else f"{int(c)}", ha="center",
+                ax.text(xs[i], ys[j], number(c, 2) if stage else f"{int(c)}", ha="center",
                         va="center", fontsize=6, color="white" if dark else "black")
     dx, dy = result.design_point
     if dx is not None and dy is not None:
@@ -171,7 +172,7 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
         else:
             cb = ax.figure.colorbar(mesh, ax=ax, ticks=_ticks(top))
             w0, w1 = _window(result)
-            cb.set_label(f"Hunting cycles in [{w0:g} s, {w1:g} s) [-]")
+            cb.set_label(f"Hunting cycles in [{quantity(w0, 's', 6)}, {quantity(w1, 's', 6)}) [-]")
     return mesh
 
 
@@ -328,6 +329,6 @@ def robustness_figure(result: Any, *, title: str | None = None) -> Any:
     ax.set_ylabel("probability of hunting [%]")
     conf = bars[0][1].confidence if bars else 0.95
     if title != "":
-        ax.set_title(f"{result.spec.name}: {result.samples} samples, {conf:.0%} Wilson "
+        ax.set_title(f"{result.spec.name}: {result.samples} samples, {percent(conf, 2)} Wilson "
                      "interval" if title is None else title, fontsize=10)
     return fig

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ..display import percent
 from ..results.stage import STATIC_ERROR_FORMULA
 from .filters import num, qty
 
@@ -166,21 +167,21 @@ def _robustness(result: Any) -> str:
         return ("No robustness check (requirements.robustness.samples: 0): friction is "
                 "simulated at its nominal values only.")
     ripple = ("" if r.ripple is None else
-              f", and a {num(100 * r.ripple.amplitude, 3)} % ripple with a "
+              f", and a {percent(r.ripple.amplitude, 3)} ripple with a "
               f"{qty(r.ripple.wavelength, 'm')} wavelength along the rail at a random phase")
     stiff = ("the flexure's stock tolerance, k going with t\u00b3" if r.stiffness is None
-             else f"{num(100 * r.stiffness, 3)} %")
-    delay = (f", the loop delay {num(100 * r.delay, 3)} %"
+             else percent(r.stiffness, 3))
+    delay = (f", the loop delay {percent(r.delay, 3)}"
              if result.spec.controller.delay > 0 else "")
     return (f"Robustness: {r.samples} samples ({r.distribution}, seed {r.seed}), each drawing "
-            f"Coulomb friction ({num(100 * r.coulomb, 3)} %) and the gap Fs \u2212 Fc "
-            f"({num(100 * r.gap, 3)} %) together, so static friction never falls below "
+            f"Coulomb friction ({percent(r.coulomb, 3)}) and the gap Fs \u2212 Fc "
+            f"({percent(r.gap, 3)}) together, so static friction never falls below "
             "Coulomb friction and no sample is lost; the true masses "
-            f"({num(100 * r.mass, 3)} %, the controller keeping its tuning); the drive "
+            f"({percent(r.mass, 3)}, the controller keeping its tuning); the drive "
             f"stiffness ({stiff}){delay}{ripple}. The parasitic modes do not enter the "
             "nonlinear simulation, and the LuGre dynamics (sigma0, sigma1, vs, sigma2) stay "
             "nominal. The probability of not settling carries a Wilson interval at "
-            f"{num(100 * r.confidence, 3)} % confidence.")
+            f"{percent(r.confidence, 3)} confidence.")
 
 
 def _judgement(result: Any) -> list[str]:

@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from ..display import NBSP, quantity, scale
+from ..display import NBSP, percent, quantity, scale
 from ..results import Status
 from ..results.stage import STATIC_ERROR_FORMULA
 from .filters import display_scale, num, qty
@@ -248,7 +248,7 @@ def key_figures(result: Any) -> list[dict]:
                             note, css))
     if rob is not None:
         css = {"PASS": "pass", "WARN": "warn", "FAIL": "fail"}[rob.status]
-        note = (f"{num(100 * rob.confidence, 3)} % interval {_pct(rob.interval[0])} \u2013 "
+        note = (f"{percent(rob.confidence, 3)} interval {_pct(rob.interval[0])} \u2013 "
                 f"{_pct(rob.interval[1])} %; {rob.hunting} of {rob.valid} valid samples")
         if rob.comparison is not None and rob.comparison["hunting_probability"] is not None:
             other = ("without the isolator" if rob.comparison["plant"] == "non_isolated"

@@ -13,6 +13,7 @@ import os
 import re
 
 from ..cachedir import cache_dir
+from ..display import fixed, plain
 
 __all__ = ["equation", "equation_svg", "equation_img", "math_text", "EQUATION_RC", "EQUATION_SIZE"]
 
@@ -97,7 +98,7 @@ def equation_img(tex: str, dpi: float) -> str:
     str
         The ``<img>`` element (a PNG data URL), as wide in pt as the SVG.
     """
-    return _cached(tex, f"{dpi:g}.img", lambda: _draw_img(tex, dpi))
+    return _cached(tex, f"{plain(dpi)}.img", lambda: _draw_img(tex, dpi))
 
 
 def _cached(tex: str, kind: str, draw) -> str:
@@ -179,9 +180,10 @@ def _draw(tex: str) -> str:
             d.append("Z")
             continue
         xy = points.reshape(-1, 2)
-        d.append(letters[code] + " ".join(f"{x - x0:.3f} {y1 - y:.3f}" for x, y in xy))
-    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="{width:.2f}pt" '
-            f'height="{height:.2f}pt" viewBox="0 0 {width:.3f} {height:.3f}" role="img">'
+        d.append(letters[code] + " ".join(f"{fixed(x - x0, 3)} {fixed(y1 - y, 3)}" for x, y in xy))
+    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="{fixed(width, 2)}pt" '
+            f'height="{fixed(height, 2)}pt" viewBox="0 0 {fixed(width, 3)} {fixed(height, 3)}" '
+            'role="img">'
             f'<path d="{"".join(d)}" fill="currentColor"/></svg>')
 
 

@@ -18,7 +18,7 @@ from .. import effects as _effects
 from ..results.reconciliation import ReconcileResult
 from .blocks import FigureBlock, Section, Table, figure_block
 from .context import build_context, document_context
-from ..display import NBSP, scale
+from ..display import NBSP, fixed, percent, scale
 from .filters import num, qty
 
 __all__ = ["gap_sections", "gap_context", "render_gap_report", "TITLE"]
@@ -79,7 +79,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
     sections = []
     diag = result.diagnosis
     if diag.mismatch:
-        crows = tuple((c.name.replace("_", " "), f"{100 * c.share:.0f} %", c.detail)
+        crows = tuple((c.name.replace("_", " "), percent(c.share, 2), c.detail)
                       for c in diag.causes)
         figs = ()
         if len(diag.frequency):
@@ -118,8 +118,8 @@ def gap_sections(result: Any, figures: bool = True) -> list:
     lat = result.lattice
     if lat.found:
         nrows.append(("position lattice step", qty(lat.step, "m"),
-                      f"read from the data ({100 * lat.fraction:.1f} % of tested samples on it, "
-                      f"chance {100 * lat.chance:.0f} %)"))
+                      f"read from the data ({percent(lat.fraction, 3)} of tested samples on it, "
+                      f"chance {percent(lat.chance, 2)})"))
     notes = [f"Position lattice: {lat.detail}."]
     if result.ambiguous:
         notes.append("Not decisively worse than the chosen effect: "
@@ -174,9 +174,10 @@ def gap_sections(result: Any, figures: bool = True) -> list:
                       numeric=(False, False) + (True,) * 6 + (False,)),)))
     crows = []
     for i, c in enumerate(result.candidates, 1):
-        dist = ", ".join(f"{k} {v:+.3g}" for k, v in c.distance.items() if v is not None)
+        dist = ", ".join(f"{k} {'+' if v >= 0 else ''}{num(v, 3)}"  # signed: which side
+                         for k, v in c.distance.items() if v is not None)
         crows.append((str(i), c.name, "named" if c.name in result.effects else c.status,
-                      num(c.score), f"{100 * c.explained:.1f} %",
+                      num(c.score), percent(c.explained, 3),
                       _params_text(c.name, c.parameters, c.uncertainty), dist or "-",
                       f"{c.n_failed} of {c.n_simulations}" if c.n_failed else
                       str(c.n_simulations), _short(c.reasons)))
@@ -198,8 +199,8 @@ def gap_sections(result: Any, figures: bool = True) -> list:
         figures=(fig(plots.candidate_scores_figure,
                      "Candidate scores (signed log scale); named effects in blue.",
                      "gap-scores"),)))
-    srows = tuple((s.name, ", ".join(s.effects), f"{s.strength:.2f}",
-                   "-" if s.value is None else f"{s.value:.4g} {s.unit}", s.detail)
+    srows = tuple((s.name, ", ".join(s.effects), fixed(s.strength, 2),
+                   "-" if s.value is None else qty(s.value, s.unit, 4), s.detail)
                   for s in result.signatures)
     sections.append(Section(
         "signatures", "Signatures in the nominal residual",

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..display import percent
 from .blocks import figure_entry
 from .filters import num, qty
 
@@ -156,4 +157,4 @@ def _worst(mech: Any, fe: Any) -> str:
     pairs += [(m.frequency, fe_freq[m.direction]) for m in mech.modes
               if m.direction in fe_freq and m.frequency > 0]
     worst = max(abs(a / b - 1.0) for a, b in pairs if b)
-    return f"{num(100 * worst, 2)} % on the six stiffnesses and the stage's six modes"
+    return f"{percent(worst, 2)} on the six stiffnesses and the stage's six modes"

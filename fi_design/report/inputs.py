@@ -5,6 +5,7 @@ from __future__ import annotations
 import datetime
 from typing import Any, Callable
 
+from ..display import plain
 from .meta import spec_file
 
 __all__ = ["spec_inputs", "split_inputs", "SETTINGS"]
@@ -58,7 +59,7 @@ def _as_written(value: Any) -> str:
     if value is None:
         return "null"
     if isinstance(value, float):
-        return f"{value:g}"
+        return plain(value)  # as the spec file has it (YAML), not as a reader's number
     return str(value)
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..display import percent
 from ..results.studies import RobustnessResult, StudyResult, SweepResult
 from .blocks import FigureBlock, Section, Table, figure_block
 from .context import build_context, document_context
@@ -153,8 +154,8 @@ def robustness_context(result: RobustnessResult, *, date: Any = None,
         if p is None:
             continue
         rows.append((label, num(p.hunting), num(p.valid),
-                     qty(100 * p.probability, "%") if p.probability is not None else "n/a",
-                     f"{num(100 * p.low, 3)} \u2013 {num(100 * p.high, 3)}\u00a0%"))
+                     percent(p.probability, 3),
+                     f"{percent(p.low, 3)} \u2013 {percent(p.high, 3)}"))
     table = Table(("Plant", "Hunting", "Valid samples", "Probability", "Confidence interval"),
                   tuple(rows), caption="Probability of hunting under the scatter")
     figs: tuple[FigureBlock, ...] = ()

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from ..display import number, plain, quantity
 from . import dataclass_dict
 
 __all__ = ["PidGains", "Filter", "DriveUnits", "ControlLaw", "SampledFilter",
@@ -129,13 +130,13 @@ class Filter:
         """The filter in words: ``notch 'tilt' at 150 Hz, 75 Hz wide (full depth)``."""
         if self.kind == "notch":
             d = self.depth
-            depth = "full depth" if math.isinf(d) else f"{d:.3g} dB deep"
-            return (f"notch '{self.name}' at {self.frequency:.4g} Hz, {self.width:.3g} Hz wide "
-                    f"({depth})")
+            depth = "full depth" if math.isinf(d) else f"{quantity(d, 'dB', 3)} deep"
+            return (f"notch '{self.name}' at {quantity(self.frequency, 'Hz', 4)}, "
+                    f"{quantity(self.width, 'Hz', 3)} wide ({depth})")
         if self.order == 1:
-            return f"first-order low-pass '{self.name}' at {self.frequency:.4g} Hz"
-        return (f"second-order low-pass '{self.name}' at {self.frequency:.4g} Hz, damping "
-                f"{self.zeta_pole:.3g}")
+            return f"first-order low-pass '{self.name}' at {quantity(self.frequency, 'Hz', 4)}"
+        return (f"second-order low-pass '{self.name}' at {quantity(self.frequency, 'Hz', 4)}, "
+                f"damping {number(self.zeta_pole, 3)}")
 
     def to_dict(self) -> dict:
         """JSON: ``type``, ``name``, ``frequency`` [Hz], ``order``, and a notch's ``width`` [Hz],
@@ -155,11 +156,11 @@ class Filter:
         """The filter as ``controller.filters`` takes it in the spec file: a notch by its
         frequency and width (and depth unless full), a low-pass by its order (and damping)."""
         out: dict = {"type": self.kind, "name": self.name,
-                     "frequency": f"{self.frequency:.6g} Hz"}
+                     "frequency": f"{plain(self.frequency, 6)} Hz"}
         if self.kind == "notch":
-            out["width"] = f"{self.width:.6g} Hz"
+            out["width"] = f"{plain(self.width, 6)} Hz"
             if not math.isinf(self.depth):
-                out["depth"] = f"{self.depth:.6g} dB"
+                out["depth"] = f"{plain(self.depth, 6)} dB"
         else:
             out["order"] = self.order
             if self.order == 2:

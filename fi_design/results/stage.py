@@ -406,7 +406,8 @@ class StageHunting(Result):
             dist = sorted(abs(m.distance) for m in h)
             c = self.cycle
             if c is not None:
-                cyc = f"a cycle of {length_text(c.amplitude)} peak to peak, period {c.period:.3g} s"
+                cyc = (f"a cycle of {length_text(c.amplitude)} peak to peak, period "
+                       f"{quantity(c.period, 's', 3)}")
                 if c.on_limiter:
                     cyc += ", the joint on its limiter"
             else:

@@ -34,7 +34,7 @@ class VerdictStatus(str, enum.Enum):
         return self.value
 
     def __format__(self, spec: str) -> str:
-        return format(self.value, spec)
+        return self.value.__format__(spec)  # the name, padded as asked: no number
 
 
 @dataclass(frozen=True)

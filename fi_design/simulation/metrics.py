@@ -108,14 +108,16 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     elif moving:
         what = "run" if t_last <= w1 else "counting window"
         verdict = "undetermined"
-        reason = (f"not finished: the motion runs until {motion_end:.4g} s, past the end of the "
-                  f"{what} at {min(w1, t_last):.4g} s; the stage is still moving")
+        reason = (f"not finished: the motion runs until {quantity(motion_end, 's', 4)}, past "
+                  f"the end of the {what} at {quantity(min(w1, t_last), 's', 4)}; the stage is "
+                  "still moving")
     elif len(ew) < 2:
         verdict, reason = "undetermined", "the trace does not cover the counting window"
     elif cycles > 0:
         verdict = "hunting"
         reason = (f"{cycles} peak(s) of at least {quantity(min_height, 'm', 6)} in "
-                  f"[{w0:g} s, {w1:g} s)" + (f", period {period:.3g} s" if period else ""))
+                  f"[{quantity(w0, 's', 6)}, {quantity(w1, 's', 6)})"
+                  + (f", period {quantity(period, 's', 3)}" if period else ""))
     elif settled:
         verdict = "settled"
         reason = f"|x1 - r| stays within {quantity(settle_band, 'm', 3)} at the end of the window"

@@ -23,6 +23,7 @@ import numpy as np
 
 from .. import spec as _spec
 from ..arguments import number
+from ..display import number as number_text, quantity  # number: the argument check
 from ..errors import ArgumentError, SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from ..model import Model, as_model
@@ -203,9 +204,11 @@ def _checked_arguments(spec, crossover, duration, rtol, record):
         duration = number(duration, "duration", "s", positive=True)
         samples = math.floor(duration * settings.output_rate + 1e-9) + 1
         if samples > _spec.MAX_OUTPUT_SAMPLES:
-            raise ArgumentError(f"duration = {duration:g} s at simulation.output_rate = "
-                                f"{settings.output_rate:g} Hz makes {samples:.3g} output "
-                                f"samples; at most {_spec.MAX_OUTPUT_SAMPLES}")
+            raise ArgumentError(f"duration = {quantity(duration, 's', 6)} at "
+                                "simulation.output_rate = "
+                                f"{quantity(settings.output_rate, 'Hz', 6)} makes "
+                                f"{number_text(float(samples), 3)} output samples; at most "
+                                f"{_spec.MAX_OUTPUT_SAMPLES}")
     return spec, crossover, duration, rtol
 
 
@@ -277,14 +280,16 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
     window = number(window, "window", "s", positive=True)
     least = MIN_WINDOW_SAMPLES * record.sample_period
     if window < least:
-        raise ArgumentError(f"window = {window:g} s spans fewer than {MIN_WINDOW_SAMPLES} samples "
-                            f"of the record ({record.sample_period:g} s apart); give at least "
-                            f"{least:.3g} s")
+        raise ArgumentError(f"window = {quantity(window, 's', 6)} spans fewer than "
+                            f"{MIN_WINDOW_SAMPLES} samples of the record "
+                            f"({quantity(record.sample_period, 's', 6)} apart); give at least "
+                            f"{quantity(least, 's', 3)}")
     count = math.ceil(float(t_out[-1]) / window)
     if count > MAX_WINDOWS:
-        raise ArgumentError(f"window = {window:g} s cuts the {t_out[-1]:g} s record into {count} "
-                            f"windows; at most {MAX_WINDOWS}: give at least "
-                            f"{float(t_out[-1]) / MAX_WINDOWS:.3g} s")
+        raise ArgumentError(f"window = {quantity(window, 's', 6)} cuts the "
+                            f"{quantity(float(t_out[-1]), 's', 6)} record into {count} windows; "
+                            f"at most {MAX_WINDOWS}: give at least "
+                            f"{quantity(float(t_out[-1]) / MAX_WINDOWS, 's', 3)}")
     # the plant alone, driven by the measured force: no controller, no feedforward
     open_loop = replace(params, kp=0.0, ki=0.0, kd=0.0, kdm=0.0, wt=math.inf, ff_mass=0.0,
                         ff_viscous=0.0, ff_coulomb=0.0, sample_period=0.0, delay=0.0)
@@ -366,4 +371,4 @@ def _failure_message(status: str, t: float, params: PlantParameters, iso: bool) 
         "delay history overflow": "a delay much longer than the integration steps",
         "singular iteration matrix": "degenerate parameters (zero mass or stiffness)",
     }
-    return f"{status} at t = {t:.6g} s; likely cause: {causes.get(status, 'unknown')}"
+    return f"{status} at t = {quantity(t, 's', 6)}; likely cause: {causes.get(status, 'unknown')}"

@@ -223,26 +223,30 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
             ratio = abs(mv.distance) / spec.isolator.stroke
             if ratio >= MOVE_STROKE_PLAUSIBLE:
                 out.append((f"motion.moves[{i}].distance",
-                            f"a move of {quantity(mv.distance, 'm', 3)} is {ratio:,.0f} times the "
-                            f"isolator stroke of {quantity(spec.isolator.stroke, 'm', 3)}: check "
-                            "its unit (a bare number is in metres); the family of moves the "
-                            "stage is judged on grows with it"))
+                            f"a move of {quantity(mv.distance, 'm', 3)} is {number(ratio, 3)} "
+                            "times the isolator stroke of "
+                            f"{quantity(spec.isolator.stroke, 'm', 3)}: check its unit (a bare "
+                            "number is in metres); the family of moves the stage is judged on "
+                            "grows with it"))
     t_end = spec.motion.end_time
     h = spec.requirements.hunting
     if t_end > spec.motion.duration:
         out.append(("motion.duration",
-                    f"the last move ends at {t_end:.4g} s, after the run ends at "
-                    f"{spec.motion.duration:g} s: the stage is still moving when the simulation "
-                    "stops, and the spec's move is not finished (undetermined, never settled)"))
+                    f"the last move ends at {quantity(t_end, 's', 4)}, after the run ends at "
+                    f"{quantity(spec.motion.duration, 's', 6)}: the stage is still moving when "
+                    "the simulation stops, and the spec's move is not finished (undetermined, "
+                    "never settled)"))
     if t_end > h.window_start:
         whose = ("" if "window_start" in h.model_fields_set
                  else " (the default window start: set requirements.hunting.window_start and "
                       "motion.duration for this motion)")
         w1 = h.window_start + h.window_length
         where = ("inside the hunting window that starts at" if t_end < w1 else
-                 f"after the hunting window [{h.window_start:g} s, {w1:g} s) ends; it starts at")
+                 f"after the hunting window [{quantity(h.window_start, 's', 6)}, "
+                 f"{quantity(w1, 's', 6)}) ends; it starts at")
         out.append(("requirements.hunting.window_start",
-                    f"the last move ends at {t_end:.4g} s, {where} {h.window_start:g} s{whose}"))
+                    f"the last move ends at {quantity(t_end, 's', 4)}, {where} "
+                    f"{quantity(h.window_start, 's', 6)}{whose}"))
     ctl = spec.controller
     delayed = any(e.type == "time_delay" for e in spec.effects)
     if ctl.sample_rate is None and ctl.delay == 0 and not delayed:

@@ -9,6 +9,7 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import Discriminator, Field, PrivateAttr, Tag, create_model, model_validator
 
 from .. import effects as _effects
+from ..display import number, percent, quantity
 from ..provenance import json_sha256
 from .defaults import CROSSOVER_AGREEMENT, gains_crossover, tuning_mass
 from .fields import OptQ, Q, StrictModel, Text
@@ -109,15 +110,16 @@ class Spec(StrictModel):
         h = self.requirements.hunting
         end = h.window_start + h.window_length
         if end > self.motion.duration * (1 + 1e-9):
-            raise ValueError(f"the hunting window ends at {end:g} s, after motion.duration = "
-                             f"{self.motion.duration:g} s")
+            raise ValueError(f"the hunting window ends at {quantity(end, 's', 6)}, after "
+                             f"motion.duration = {quantity(self.motion.duration, 's', 6)}")
         rate = self.simulation.output_rate
         samples = math.floor(self.motion.duration * rate + 1e-9) + 1
         if samples > MAX_OUTPUT_SAMPLES:
             where = "simulation.output_rate" if "output_rate" in self.simulation.model_fields_set \
                 else "motion.duration"
-            raise ValueError(f"{where}: {rate:g} Hz over motion.duration = "
-                             f"{self.motion.duration:g} s makes {samples:.3g} output samples; at "
+            raise ValueError(f"{where}: {quantity(rate, 'Hz', 6)} over motion.duration = "
+                             f"{quantity(self.motion.duration, 's', 6)} makes "
+                             f"{number(float(samples), 3)} output samples; at "
                              f"most {MAX_OUTPUT_SAMPLES} fit in memory (about 150 bytes each): "
                              "lower simulation.output_rate or motion.duration")
         names = [e.type for e in self.effects]
@@ -139,10 +141,10 @@ class Spec(StrictModel):
             achieved = gains_crossover(self)
             if abs(achieved / ctl.crossover - 1.0) > CROSSOVER_AGREEMENT:
                 raise ValueError(
-                    f"controller.crossover: {ctl.crossover:.4g} Hz contradicts controller.gains, "
-                    f"which cross over at {achieved:.4g} Hz on the tuning mass "
-                    f"{tuning_mass(self):.4g} kg; give one of the two, or a crossover within "
-                    f"{CROSSOVER_AGREEMENT:.0%} of the gains'")
+                    f"controller.crossover: {quantity(ctl.crossover, 'Hz', 4)} contradicts "
+                    f"controller.gains, which cross over at {quantity(achieved, 'Hz', 4)} on the "
+                    f"tuning mass {quantity(tuning_mass(self), 'kg', 4)}; give one of the two, "
+                    f"or a crossover within {percent(CROSSOVER_AGREEMENT, 2)} of the gains'")
         return self
 
     # convenience views, all SI

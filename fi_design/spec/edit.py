@@ -20,6 +20,7 @@ import io
 import re
 from typing import Any, Mapping, Sequence
 
+from ..display import plain
 from ..errors import SpecError
 from . import Spec
 from .file import load_spec, origin, parse_yaml, path_unit, yaml_loader
@@ -63,7 +64,7 @@ def spec_quantity(path: str, value: float, digits: int | None = None) -> Any:
     '33073.4 N/(m*s)'
     """
     unit = path_unit(path)
-    number = repr(float(value)) if digits is None else f"{float(value):.{digits}g}"
+    number = repr(float(value)) if digits is None else plain(value, digits)
     if unit in ("", "1"):
         return float(number)
     return f"{number} {unit}"

@@ -13,6 +13,7 @@ import difflib
 import re
 from typing import Any
 
+from ..display import number
 from . import Spec
 
 
@@ -188,7 +189,7 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
         words = {"greater_than": "greater than", "greater_than_equal": "at least",
                  "less_than": "less than", "less_than_equal": "at most"}[kind]
         shown = f" {unit}" if unit not in ("", "1") else ""
-        return path, f"must be {words} {bound:g}{shown}, got {_shown(err['input'])}"
+        return path, f"must be {words} {number(bound, 6)}{shown}, got {_shown(err['input'])}"
     if kind in ("finite_number",):
         return path, "must be a finite number"
     if isinstance(err.get("input"), int) and len(str(abs(err["input"]))) > 300:

@@ -10,6 +10,7 @@ from typing import Annotated, Any, Union
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, WithJsonSchema
 
+from ..display import code_point
 from .units import to_si
 
 
@@ -47,7 +48,7 @@ def _plain_text(value: str) -> str:
     for char in value:
         code = ord(char)
         if (code < 32 and char not in "\t\n\r") or 127 <= code < 160:
-            raise ValueError(f"control character U+{code:04X} is not allowed in text (read "
+            raise ValueError(f"control character {code_point(code)} is not allowed in text (read "
                              f"{value!r}); write plain text")
     return value
 

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+from ..display import code_point
 from ..errors import SpecError, SpecFileError
 from ..provenance import json_sha256
 from . import Spec
@@ -253,7 +254,7 @@ def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, Any]:
         document = yaml.constructor.construct_document(node)
     except ReaderError as exc:  # a NUL or other control character
         line = text.count("\n", 0, exc.position) + 1
-        raise SpecError(f"control character U+{exc.character:04X} is not allowed in a YAML "
+        raise SpecError(f"control character {code_point(exc.character)} is not allowed in a YAML "
                         "spec: the file is not plain text", line=line, source=source) from None
     except MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark

@@ -20,6 +20,7 @@ from typing import Annotated, Any, Literal, Union
 
 from pydantic import Discriminator, Field, Tag, model_validator
 
+from ..display import number, quantity
 from .fields import OptQ, Q, StrictModel, Text
 
 __all__ = ["Notch", "LowPass", "FilterEntry", "Drive", "FILTER_TYPES", "BUTTERWORTH"]
@@ -56,10 +57,11 @@ class Notch(StrictModel):
             zz, zp = self.damping
             if not 0.0 <= zz < zp <= 2.0:
                 raise ValueError("damping must be [zeta of the zeros, zeta of the poles] with "
-                                 f"0 <= zeros < poles <= 2, got [{zz:g}, {zp:g}]")
+                                 f"0 <= zeros < poles <= 2, got [{number(zz, 6)}, {number(zp, 6)}]")
         elif self.width > 4.0 * self.frequency:
-            raise ValueError(f"width {self.width:g} Hz is more than 4 times the frequency "
-                             f"{self.frequency:g} Hz (pole damping above 2)")
+            raise ValueError(f"width {quantity(self.width, 'Hz', 6)} is more than 4 times the "
+                             f"frequency {quantity(self.frequency, 'Hz', 6)} (pole damping above "
+                             "2)")
         return self
 
     @property

@@ -14,6 +14,7 @@ import functools
 import re
 from typing import Any, Mapping
 
+from ..display import number
 from ..errors import SpecError
 from . import Spec
 from .errors import describe, real_errors
@@ -426,7 +427,7 @@ def _element(ann: Any, index: int) -> Any:
 
 
 def _show(value: Any) -> str:
-    return f"{value:g}" if isinstance(value, float) else repr(value) \
+    return number(value, 6) if isinstance(value, float) else repr(value) \
         if isinstance(value, str) else str(value)
 
 

@@ -9,6 +9,7 @@ from typing import Any, Literal, Union
 
 from pydantic import Field, model_validator
 
+from ..display import quantity
 from ..trajectory import profile_duration
 from .fields import OptQ, Q, StrictModel, Text
 from .filters import Drive, FilterEntry
@@ -93,8 +94,8 @@ class Friction(StrictModel):
     @model_validator(mode="after")
     def _static_above_coulomb(self) -> "Friction":
         if self.static < self.coulomb:
-            raise ValueError(f"static friction Fs = {self.static:g} N must be at least the "
-                             f"Coulomb friction Fc = {self.coulomb:g} N")
+            raise ValueError(f"static friction Fs = {quantity(self.static, 'N', 6)} must be at "
+                             f"least the Coulomb friction Fc = {quantity(self.coulomb, 'N', 6)}")
         if self.coulomb == 0 and self.coulomb_negative is not None:
             raise ValueError("coulomb_negative needs a Coulomb friction above 0: static "
                              "friction in the negative direction scales with coulomb_negative / "
@@ -327,9 +328,9 @@ class Controller(StrictModel):
         if self.sample_rate is not None:
             for i, f in enumerate(self.filters):
                 if f.frequency >= 0.5 * self.sample_rate:
-                    raise ValueError(f"filters[{i}] ({f.name}) at {f.frequency:g} Hz lies at or "
-                                     f"above the Nyquist frequency {0.5 * self.sample_rate:g} Hz "
-                                     "of sample_rate")
+                    raise ValueError(f"filters[{i}] ({f.name}) at {quantity(f.frequency, 'Hz', 6)} "
+                                     "lies at or above the Nyquist frequency "
+                                     f"{quantity(0.5 * self.sample_rate, 'Hz', 6)} of sample_rate")
         return self
 
 
@@ -398,8 +399,8 @@ class Motion(StrictModel):
         end = 0.0
         for i, (start, stop) in enumerate(self.spans()):
             if start < end - 1e-12:
-                raise ValueError(f"moves[{i}] starts at {start:g} s, before moves[{i - 1}] ends "
-                                 f"at {end:.4g} s")
+                raise ValueError(f"moves[{i}] starts at {quantity(start, 's', 6)}, before "
+                                 f"moves[{i - 1}] ends at {quantity(end, 's', 4)}")
             end = stop
         return self
 
@@ -450,9 +451,10 @@ class CrossoverScan(StrictModel):
             raise ValueError("stop must be above start")
         points = scan_points(self.start, self.stop, self.step)
         if points > MAX_SCAN_POINTS:
-            raise ValueError(f"{self.start:g} Hz to {self.stop:g} Hz in steps of {self.step:g} Hz "
-                             f"is {points} points (one simulation each); at most "
-                             f"{MAX_SCAN_POINTS}: give a coarser step or a narrower range")
+            raise ValueError(f"{quantity(self.start, 'Hz', 6)} to {quantity(self.stop, 'Hz', 6)} "
+                             f"in steps of {quantity(self.step, 'Hz', 6)} is {points} points (one "
+                             f"simulation each); at most {MAX_SCAN_POINTS}: give a coarser step "
+                             "or a narrower range")
         return self
 
 

@@ -19,6 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..display import quantity
 from ..model import Model
 from ..results import frozen_array
 from ..results.stage import Boundary, Cycle
@@ -81,14 +82,15 @@ def cycle_fold(model: Model, isolated: bool, cycle: Cycle, *, top: float | None 
         while f < top:
             f = min(top, f * FOLD_STEP)
             if progress is not None:
-                progress(f"following the cycle to {f:.3g} Hz")
+                progress(f"following the cycle to {quantity(f, 'Hz', 3)}")
             if not exists(f):
                 hi = f
                 break
         if hi is None:
             return Boundary(hunting_free_from=None, bracket=(lo, top), kind="bound",
                             resolution=0.0, tests=tests, branch=tuple(sorted(branch)),
-                            note=f"the cycle persists up to {top:.4g} Hz, the top of the search")
+                            note=f"the cycle persists up to {quantity(top, 'Hz', 4)}, "
+                                 "the top of the search")
         while hi - lo > max(FOLD_RESOLUTION, FOLD_RELATIVE * hi):
             mid = 0.5 * (lo + hi)
             if not exists(mid):
@@ -151,7 +153,7 @@ def hunting_free_boundary(model: Model, isolated: bool, cycle: Cycle | None = No
         found = None
         while f > scan.start * (1 + 1e-9):
             f = max(scan.start, f / FOLD_STEP)
-            say(f"looking for a hunting cycle below the design crossover: {f:.3g} Hz")
+            say(f"looking for a hunting cycle below the design crossover: {quantity(f, 'Hz', 3)}")
             _, runs = stage_hunts(model, isolated, crossover=f, family=family, first_only=True)
             tests += 1
             h = [r for r in runs if r.outcome.hunts]
@@ -161,7 +163,8 @@ def hunting_free_boundary(model: Model, isolated: bool, cycle: Cycle | None = No
         if found is None:
             return Boundary(hunting_free_from=scan.start, bracket=(scan.start, scan.start),
                             kind="bound", resolution=0.0, tests=tests, branch=(),
-                            note=f"no move of the family hunts from {scan.start:g} Hz up")
+                            note="no move of the family hunts from "
+                                 f"{quantity(scan.start, 'Hz', 6)} up")
         cycle = found
     for _ in range(4):
         fold = cycle_fold(model, isolated, cycle, top=top, progress=say)
@@ -171,7 +174,7 @@ def hunting_free_boundary(model: Model, isolated: bool, cycle: Cycle | None = No
         if fold.kind == "bound":
             return replace(fold, tests=tests, branch=tuple(sorted(branch)))
         # another cycle above the fold?
-        say(f"checking every move just above the fold at {hi:.4g} Hz ...")
+        say(f"checking every move just above the fold at {quantity(hi, 'Hz', 4)} ...")
         _, runs = stage_hunts(model, isolated, crossover=hi, family=family, first_only=True)
         tests += 1
         h = [r for r in runs if r.outcome.hunts]

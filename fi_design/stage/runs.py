@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..display import quantity
 from ..kernel import run
 from ..kernel.layout import (N_WATCH, W_ARM, W_BAND, W_LEVEL, W_MATCH, W_MAX_CROSSINGS,
                              W_QUIET, W_REPEAT, W_REST_ANYWHERE, W_START, Integration,
@@ -231,7 +232,7 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
             word, why = "settles", f"at rest {length_text(abs(e))} from the target for good"
         elif integrates(params):
             word, why = "stuck", (f"at rest {length_text(abs(e))} from the target with the drive "
-                                  f"at its {params.force_limit:.3g} N force limit")
+                                  f"at its {quantity(params.force_limit, 'N', 3)} force limit")
         else:
             word, why = "rests", (f"at rest {length_text(abs(e))} from the target (no "
                                   "integrator to pull it in)")
@@ -241,7 +242,7 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
         seen = owner[out.period_crossings]
         m = seen.outcome
         why = (f"a sustained cycle: {length_text(m.amplitude)} peak to peak"
-               + (f", period {m.period:.3g} s" if m.period else "")
+               + (f", period {quantity(m.period, 's', 3)}" if m.period else "")
                + f" (enters the cycle of the {length_text(abs(m.distance))} move)")
         return MoveRun(MoveOutcome(distance, label, "hunts", float(out.crossing_states[-1][0]
                                                                   - level),
@@ -256,7 +257,7 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
         how = {"repeat": "repeats at the section", "crossings": "keeps crossing the target",
                "end": "keeps crossing the target"}[out.stop]
         why = (f"a sustained cycle: {length_text(amp)} peak to peak"
-               + (f", period {period:.3g} s" if period else "") + f" ({how})")
+               + (f", period {quantity(period, 's', 3)}" if period else "") + f" ({how})")
         return MoveRun(MoveOutcome(distance, label, "hunts", float(out.crossing_states[-1][0]
                                                                   - level),
                                 amp, period, elapsed, why),
@@ -269,19 +270,20 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
         # another quiet time and without a crossing: the cart creeps with its force at the
         # static friction (not at rest for good by the static balance, but nothing breaks
         # it loose within the horizon)
-        why = (f"within the band for the rest of the {w.horizon:.3g} s horizon, "
+        why = (f"within the band for the rest of the {quantity(w.horizon, 's', 3)} horizon, "
                f"{length_text(abs(e))} from the target; the cart creeps at its static friction")
         return MoveRun(MoveOutcome(distance, label, "settles", e, None, None, elapsed, why), None,
                     0, level)
     if abs(e) > w.band:
         word = "stuck" if integrates(params) else "rests"
-        why = (f"{length_text(abs(e))} from the target after {elapsed:.3g} s, neither at rest "
-               "there for good nor cycling")
+        why = (f"{length_text(abs(e))} from the target after {quantity(elapsed, 's', 3)}, "
+               "neither at rest there for good nor cycling")
         return MoveRun(MoveOutcome(distance, label, word, e, None, None, elapsed, why), None, 0,
                     level)
     return MoveRun(MoveOutcome(distance, label, "undetermined", e, None, None, elapsed,
-                            f"neither at rest for good nor in a cycle after {elapsed:.3g} s "
-                            "(raise requirements.hunting.horizon)"), None, 0, level)
+                            "neither at rest for good nor in a cycle after "
+                            f"{quantity(elapsed, 's', 3)} (raise requirements.hunting.horizon)"),
+                   None, 0, level)
 
 
 def guess_period(states: np.ndarray, max_period: int = 4) -> int:

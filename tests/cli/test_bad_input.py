@@ -173,7 +173,7 @@ CASES = [
      ["effects[0].zzz", "allowed: type, amplitude, pitch, phase"], "type: force_ripple"),
     # sizes without a bound: refused up front, naming the limit
     ("output-rate-terahertz", BASE + "simulation: {output_rate: 1 THz}\n",
-     ["simulation.output_rate", "1e+12 Hz", "output samples", "at most"], "output_rate"),
+     ["simulation.output_rate", "10¹² Hz", "output samples", "at most"], "output_rate"),
     ("duration-without-bound", edit("duration: 20 s", "duration: 1e9 s"),
      ["motion.duration", "output samples", "at most"], "duration:"),
     ("crossover-scan-micro-step", BASE + "simulation: {crossover_scan: {step: 1e-6 Hz}}\n",
@@ -333,7 +333,7 @@ SIZES = [
      ["1000 x 1000 = 1000000 points", "at most 100000"]),
     ("replay-window", ["simulate", "MSPEC", "--record", "TRACE", "--drive", "force",
                        "--window", "1e-12", "--json", "OUT"],
-     ["window = 1e-12 s", "fewer than 10 samples"]),
+     ["window = 1\u00a0×\u00a010⁻¹² s", "fewer than 10 samples"]),
     ("robustness-samples", ["robustness", NO_SPEC, "--scatter", "friction.static=10%",
                             "--samples", "1000000000", "--json", "OUT"],
      ["--samples", "1000000000", "100000"]),

@@ -106,7 +106,7 @@ def test_study_summaries_read_at_80_columns(paper_spec_path, tmp_path):
     rob = _run(["robustness", str(paper_spec_path), "--samples", "2", "--scatter",
                 "friction.static=10%", "-j", "1"], 80)
     _readable(rob, 80)
-    for words in ("Probability of hunting", "95% Wilson interval", "undetermined",
+    for words in ("Probability of hunting", "95 % Wilson interval", "undetermined",
                   "with isolator", "without isolator"):
         assert words in rob, (words, rob)
 

@@ -79,7 +79,7 @@ def _calls():
          ArgumentError, ["spec must be a Spec", "NoneType"]),
         ("replay-window-picoseconds", lambda s, m: fi_design.simulate(
             s, record=m, drive="force", window=1e-12),
-         ArgumentError, ["window = 1e-12 s", "fewer than 10 samples"]),
+         ArgumentError, ["window = 1\u00a0×\u00a010⁻¹² s", "fewer than 10 samples"]),
         ("identify-unknown-form", lambda s, m: fi_design.identify(m, form="bogus"),
          ArgumentError, ["form", "'bogus'", "'symmetric'"]),
         ("identify-not-a-record", lambda s, m: fi_design.identify("trace.csv"),

@@ -122,7 +122,7 @@ def test_a_move_thousands_of_strokes_long_and_a_run_it_outlasts_are_warned(paper
         {"distance": "10 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2"},
         {"distance": 5, "velocity": "50 mm/s", "acceleration": "1 m/s^2", "start": "1 s"}]})
     found = dict(sp.warnings_for(spec))
-    assert "16,667 times the isolator stroke" in found["motion.moves[1].distance"]
+    assert "16667 times the isolator stroke" in found["motion.moves[1].distance"]
     assert "bare number is in metres" in found["motion.moves[1].distance"]
     assert "motion.moves[0].distance" not in found  # 33 strokes: plausible
     assert "after the run ends at 20 s" in found["motion.duration"]
