@@ -256,6 +256,11 @@ SPEC_OR_MODEL_ENTRY_POINTS = {
     ("stage/judge.py", "stage_hunting"),       # the stage-level answer
     ("stage/moves.py", "stage_hunts"),         # every move of the family
     ("recommend/search.py", "recommend"),      # fi_design.recommend
+    ("studies/points.py", "study_model"),      # the studies' edge: a spec resolved once
+    ("studies/sweeps.py", "sweep"),            # fi_design.studies.sweep
+    ("studies/paper.py", "paper_study"),       # the paper's four maps
+    ("studies/scatter.py", "robustness"),      # the probability of hunting under scatter
+    ("studies/sensitivity.py", "crossover_sensitivity"),  # the crossover over sigma0, sigma1, vs
 }
 
 

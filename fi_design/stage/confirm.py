@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import math
 
-from .. import spec as _spec
 from ..display import number, quantities, quantity
 from ..errors import ArgumentError
 from ..model import Model, require_model
@@ -80,14 +79,40 @@ def landing(model: Model, result: SimulationResult) -> Landing:
                    rule_force=k * s)
 
 
-def with_isolator(spec: _spec.Spec, stroke: float, stiffness: float) -> _spec.Spec:
-    """The spec with an isolator of the given stroke [m] and stiffness [N/m] added, validated.
+def with_isolator(model: Model, stroke: float, stiffness: float) -> Model:
+    """The model with an isolator of the given stroke and stiffness, its spec holding it.
 
-    The spec-level twin of ``resolve(spec).at(stroke=..., stiffness=...)``,
-    for the studies, which vary a spec: the same isolator (default damping
-    and limiter), checked like every spec.
+    ``model.varied({"isolator": {...}})`` (:meth:`fi_design.model.Model.varied`):
+    the spec's isolator section replaced by one of this stroke and stiffness
+    (the defaults' damping and limiter, no flexure, no given modes), the spec
+    validated again and resolved once. The same plant as the fast form
+    ``model.at(stroke=..., stiffness=...)``, which keeps the spec as it was;
+    this one is for what reads the spec too (a study varying it by dotted
+    paths and caching its points by its hash, the sign-off's robustness
+    samples).
+
+    Parameters
+    ----------
+    model : Model
+        The model resolved from its spec (:func:`fi_design.model.resolve`),
+        usually one without isolator.
+    stroke : float
+        One-sided stroke before the limiter engages [m].
+    stiffness : float
+        Drive stiffness [N/m].
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    SpecError
+        A stroke or stiffness the spec refuses; the message names the path.
+    ArgumentError
+        ``model`` was varied by :meth:`~fi_design.model.Model.at`.
     """
-    return spec.with_sections(isolator={"stiffness": stiffness, "stroke": stroke})
+    return require_model(model).varied({"isolator": {"stiffness": stiffness, "stroke": stroke}})
 
 
 def static_error_bound(model: Model) -> float | None:
