@@ -256,6 +256,11 @@ SPEC_OR_MODEL_ENTRY_POINTS = {
     ("stage/judge.py", "stage_hunting"),       # the stage-level answer
     ("stage/moves.py", "stage_hunts"),         # every move of the family
     ("recommend/search.py", "recommend"),      # fi_design.recommend
+    ("studies/points.py", "study_model"),      # the studies' edge: a spec resolved once
+    ("studies/sweeps.py", "sweep"),            # fi_design.studies.sweep
+    ("studies/paper.py", "paper_study"),       # the paper's four maps
+    ("studies/scatter.py", "robustness"),      # the probability of hunting under scatter
+    ("studies/sensitivity.py", "crossover_sensitivity"),  # the crossover over sigma0, sigma1, vs
 }
 
 
@@ -305,4 +310,63 @@ def test_an_analysis_refuses_a_spec_with_a_clear_message(paper_spec):
     assert step2_crossover(resolve(paper_spec)).desired == 8.0
     for call in (lambda: step2_crossover(paper_spec), lambda: linear.analyse(paper_spec)):
         with pytest.raises(ArgumentError, match="expected a Model, got Spec.*resolve"):
+            call()
+
+
+#: The modules outside spec/ and model.py that write values into a spec by dotted path
+#: (fi_design.spec.paths.with_values), and why: a spec as an output, never a design varied for an
+#: analysis (that is Model.varied, or its fast form Model.at).
+SPEC_EDITS = {
+    "identification/specwrite.py",   # the identified values written into the spec file's spec
+    "recommend/constraints.py",      # the reserve's requirements validated as the spec takes them
+}
+
+
+def _calls(tree: ast.AST, name: str) -> list[int]:
+    """Lines of the calls of a function or method called ``name``."""
+    return [node.lineno for node in ast.walk(tree) if isinstance(node, ast.Call) and (
+        (isinstance(node.func, ast.Name) and node.func.id == name)
+        or (isinstance(node.func, ast.Attribute) and node.func.attr == name))]
+
+
+def test_a_design_is_varied_by_the_model_only():
+    """A study axis, a robustness draw, a sensitivity step, an added isolator: each is
+    Model.varied (or Model.at) of a model resolved once; the spec is written by dotted path only
+    in spec/, model.py and the spec outputs of SPEC_EDITS (issue 32)."""
+    package = ROOT / "fi_design"
+    found = {}
+    for path in sorted(package.rglob("*.py")):
+        rel = path.relative_to(package).as_posix()
+        if rel.startswith("spec/") or rel == "model.py":
+            continue
+        lines = _calls(ast.parse(path.read_text(encoding="utf-8")), "with_values")
+        if lines:
+            found[rel] = lines
+    assert set(found) == SPEC_EDITS, (
+        f"vary a Model (Model.varied / Model.at), not its spec: {sorted(set(found) - SPEC_EDITS)}; "
+        f"no longer edit a spec: {sorted(SPEC_EDITS - set(found))}")
+
+
+def test_the_studies_points_take_a_model():
+    """Every point, draw and sensitivity step of the studies is a Model varied: the functions
+    that run one take the base Model (first parameter annotated Model), and refuse a spec."""
+    import inspect
+
+    from fi_design.errors import ArgumentError
+    from fi_design.stage.confirm import with_isolator
+    from fi_design.studies import axes, paper, points, sensitivity
+
+    for fn in (points.evaluate_point, points.run_chunk, points.evaluate, sensitivity._fold,
+               axes.design_value, axes.held_damping_note, paper.paper_axes, with_isolator):
+        first = next(iter(inspect.signature(fn).parameters.values()))
+        assert first.annotation == "Model", (fn.__qualname__, first.annotation)
+    src = (ROOT / "fi_design" / "studies" / "points.py").read_text(encoding="utf-8")
+    assert _calls(ast.parse(src), "varied"), "a point is the base model varied"
+    from fi_design.spec.file import load_spec
+
+    spec = load_spec(ROOT / "examples" / "paper_setup.yaml")
+    for call in (lambda: points.evaluate_point(spec, {}, True),
+                 lambda: points.evaluate(spec, []),
+                 lambda: with_isolator(spec, 3e-4, 5000.0)):
+        with pytest.raises(ArgumentError, match="expected a Model, got Spec"):
             call()

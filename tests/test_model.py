@@ -131,7 +131,7 @@ def test_at_adds_the_isolator_a_spec_would_get(paper_spec):
     bare = variant(paper_spec, isolator=None)
     added = resolve(bare).at(stroke=0.3e-3, stiffness=5000.0)
     assert added.has_isolator and added.modes == ()
-    assert added.plant(True) == resolve(with_isolator(bare, 0.3e-3, 5000.0)).plant(True)
+    assert added.plant(True) == with_isolator(resolve(bare), 0.3e-3, 5000.0).plant(True)
     assert resolve(bare).at(stroke=0.3e-3).joint.stiffness == pytest.approx(
         0.5 * bare.friction.static / 0.3e-3, rel=1e-14)
 
@@ -336,9 +336,16 @@ def test_with_sections_validates_what_it_replaces(paper_spec):
     # the corrected spec of a reconciliation is checked like every spec
     with pytest.raises(SpecError, match="joint_damping needs an isolator"):
         ReconcileResult.corrected_spec(SimpleNamespace(spec=bare, effect_entries=(damping,)))
-    added = with_isolator(bare, 0.3e-3, 5000.0)
-    assert (added.isolator.stroke, added.isolator.stiffness) == (0.3e-3, 5000.0)
-    assert added.controller is bare.controller  # untouched sections are shared
+    added = with_isolator(resolve(bare), 0.3e-3, 5000.0)
+    assert (added.spec.isolator.stroke, added.spec.isolator.stiffness) == (0.3e-3, 5000.0)
+    assert (added.joint.stroke, added.joint.stiffness, added.changed) == (0.3e-3, 5000.0, ())
+    assert added.spec.controller is bare.controller  # untouched sections are shared
+    # the same spec the section written by hand gives
+    assert added.spec.content_sha256() == bare.with_sections(
+        isolator={"stroke": 0.3e-3, "stiffness": 5000.0}).content_sha256()
+    with pytest.raises(SpecError) as err:
+        with_isolator(resolve(bare), -1e-3, 5000.0)
+    assert err.value.path == "isolator.stroke"
 
 
 # --------------------------------------------------------------------------- judged once

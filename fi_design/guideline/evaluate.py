@@ -128,12 +128,12 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
     spec = model.spec
     suggestion = suggested_isolator(model) if not model.has_isolator else None
     robust = confirm and model.requirements.robustness.samples > 0
-    if robust and model.changed:
+    if (robust or (confirm and sensitivity)) and model.changed:
         raise ArgumentError(
             f"this model differs from its spec at {', '.join(model.changed)} (Model.at), but "
-            "the robustness study of the sign-off varies the spec: design it with "
-            "confirm=False, or write the values into the spec "
-            "(fi_design.spec.file.with_values) and design that")
+            "the robustness study (and the sensitivity) of the sign-off vary the spec's values "
+            "(Model.varied): design it with confirm=False, or vary the model resolved from "
+            "the spec with every value in Model.varied and design that")
     pending = []
     scatter = stop = None
     if confirm and executor is not None:

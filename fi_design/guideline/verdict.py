@@ -87,8 +87,8 @@ def run_robustness(model: Model, suggestion: tuple[float, float] | None = None,
     Parameters
     ----------
     model : Model
-        The resolved model; the study varies its spec (``model.spec``) by
-        dotted paths.
+        The resolved model; the study varies it by dotted spec paths
+        (:meth:`~fi_design.model.Model.varied`).
     suggestion : (stroke, stiffness), optional
         Isolator to add when the spec has none [m, N/m].
     progress : callable, optional
@@ -102,18 +102,17 @@ def run_robustness(model: Model, suggestion: tuple[float, float] | None = None,
         None when ``samples`` is 0 or nothing scatters.
     """
     from ..stage.confirm import with_isolator
-    from ..spec.file import with_values
     from ..studies import PositionFriction, Scatter, robustness
 
-    spec = model.spec
     cfg = model.requirements.robustness
     ripple = None if cfg.ripple is None else PositionFriction(cfg.ripple.amplitude,
                                                               cfg.ripple.wavelength)
     if cfg.samples == 0:
         return None
-    target = spec
+    nominal = model
     if not model.has_isolator and suggestion is not None:
-        target = with_isolator(spec, *suggestion)
+        nominal = with_isolator(model, *suggestion)
+    target = nominal.spec
     scatter = [Scatter("friction.coulomb", cfg.coulomb)] if cfg.coulomb > 0 else []
     values: dict[str, Any] = {}
     if cfg.mass > 0:  # the true masses: the controller keeps its nominal tuning
@@ -132,11 +131,12 @@ def run_robustness(model: Model, suggestion: tuple[float, float] | None = None,
     if cfg.delay > 0 and target.controller.delay > 0:
         scatter.append(Scatter("controller.delay", cfg.delay))
     if values:
-        target = with_values(target, {k: v for k, v in values.items() if v is not None})
+        nominal = nominal.varied({k: v for k, v in values.items() if v is not None})
+        target = nominal.spec
     gap = cfg.gap if target.friction.static > target.friction.coulomb else None
     if not scatter and ripple is None and gap is None:
         return None
-    return robustness(target, scatter, cfg.samples, seed=cfg.seed,
+    return robustness(nominal, scatter, cfg.samples, seed=cfg.seed,
                       distribution=cfg.distribution, position_friction=ripple,
                       confidence=cfg.confidence, executor=executor, progress=progress,
                       cache=None, friction_gap=gap)

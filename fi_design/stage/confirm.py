@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import math
 
-from .. import spec as _spec
 from ..display import number, quantities, quantity
 from ..errors import ArgumentError
 from ..model import Model, require_model
@@ -80,14 +79,40 @@ def landing(model: Model, result: SimulationResult) -> Landing:
                    rule_force=k * s)
 
 
-def with_isolator(spec: _spec.Spec, stroke: float, stiffness: float) -> _spec.Spec:
-    """The spec with an isolator of the given stroke [m] and stiffness [N/m] added, validated.
+def with_isolator(model: Model, stroke: float, stiffness: float) -> Model:
+    """The model with an isolator of the given stroke and stiffness, its spec holding it.
 
-    The spec-level twin of ``resolve(spec).at(stroke=..., stiffness=...)``,
-    for the studies, which vary a spec: the same isolator (default damping
-    and limiter), checked like every spec.
+    ``model.varied({"isolator": {...}})`` (:meth:`fi_design.model.Model.varied`):
+    the spec's isolator section replaced by one of this stroke and stiffness
+    (the defaults' damping and limiter, no flexure, no given modes), the spec
+    validated again and resolved once. The same plant as the fast form
+    ``model.at(stroke=..., stiffness=...)``, which keeps the spec as it was;
+    this one is for what reads the spec too (a study varying it by dotted
+    paths and caching its points by its hash, the sign-off's robustness
+    samples).
+
+    Parameters
+    ----------
+    model : Model
+        The model resolved from its spec (:func:`fi_design.model.resolve`),
+        usually one without isolator.
+    stroke : float
+        One-sided stroke before the limiter engages [m].
+    stiffness : float
+        Drive stiffness [N/m].
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    SpecError
+        A stroke or stiffness the spec refuses; the message names the path.
+    ArgumentError
+        ``model`` was varied by :meth:`~fi_design.model.Model.at`.
     """
-    return spec.with_sections(isolator={"stiffness": stiffness, "stroke": stroke})
+    return require_model(model).varied({"isolator": {"stiffness": stiffness, "stroke": stroke}})
 
 
 def static_error_bound(model: Model) -> float | None:
@@ -188,12 +213,14 @@ def _force_checks(model: Model, forces) -> list[Check]:
     if forces.stop_stiffness is not None:
         limit = model.requirements.end_stop_force
         peak = forces.peak_stop_force
-        stop = (f"the end stop ({forces.stop_stiffness:.3g} N/m, {forces.stop_damping:.3g} "
-                "N s/m" + (", the spec's defaults: an assumption, the contact force goes with "
-                           "the square root of the stiffness" if forces.stop_default else "")
+        stop = (f"the end stop ({quantity(forces.stop_stiffness, 'N/m', 3)}, "
+                f"{quantity(forces.stop_damping, 'N s/m', 3)}"
+                + (", the spec's defaults: an assumption, the contact force goes with "
+                   "the square root of the stiffness" if forces.stop_default else "")
                 + ")")
         text = (f"{forces.moves_on_stop} of {n} moves run the joint onto {stop}, up to "
-                f"{forces.most_impacts} times a move; the largest contact force {peak:.3g} N"
+                f"{forces.most_impacts} times a move; the largest contact force "
+                f"{quantity(peak, 'N', 3)}"
                 if forces.moves_on_stop else f"no move of the family reaches {stop}")
         if limit is None:
             out.append(Check("end_stop_force", None, peak, None, "N", text, step))
@@ -201,19 +228,20 @@ def _force_checks(model: Model, forces) -> list[Check]:
             ok = peak <= limit
             out.append(Check("end_stop_force", ok, peak, limit, "N", text + (
                 f", within requirements.end_stop_force" if ok else
-                f", above requirements.end_stop_force = {limit:.3g} N"), step))
+                f", above requirements.end_stop_force = {quantity(limit, 'N', 3)}"), step))
     peak = forces.peak_actuator_force
     flim = model.law.force_limit
-    text = f"the largest actuator force over the {n} moves is {peak:.3g} N"
+    text = f"the largest actuator force over the {n} moves is {quantity(peak, 'N', 3)}"
     if flim is None or not math.isfinite(flim):
         out.append(Check("actuator_force", None, peak, None, "N", text, step))
     else:
         cmd = forces.peak_command
         ok = cmd < flim
         out.append(Check("actuator_force", ok, peak, flim, "N", text + (
-            f", below controller.force_limit = {flim:.3g} N" if ok else
-            f": the actuator saturates at controller.force_limit = {flim:.3g} N (the loop "
-            f"commands up to {cmd:.3g} N)"), step, status=None if ok else Status.WARN))
+            f", below controller.force_limit = {quantity(flim, 'N', 3)}" if ok else
+            f": the actuator saturates at controller.force_limit = {quantity(flim, 'N', 3)} "
+            f"(the loop commands up to {quantity(cmd, 'N', 3)})"), step,
+            status=None if ok else Status.WARN))
     return out
 
 
@@ -271,13 +299,13 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
                 ": a crossover that ends hunting was not found"), step, status=Status.WARN))
         elif fc >= margin * m:
             out.append(Check(f"min_crossover_{key}", True, m, fc / margin, "Hz", text + (
-                f", at least {margin:g} x above it (requirements.hunting_margin)"
+                f", at least {number(margin, 6)} x above it (requirements.hunting_margin)"
                 if margin > 1 else ""), step))
         elif fc >= m:
             out.append(Check(f"min_crossover_{key}", False, m, fc / margin, "Hz", text + (
-                f": the design crossover lies only {fc / m:.3g} x above it, within the "
-                f"hunting margin of {margin:g} (requirements.hunting_margin): a little more "
-                "friction gap or a little less loop gain brings the cycle back"), step))
+                f": the design crossover lies only {number(fc / m, 3)} x above it, within the "
+                f"hunting margin of {number(margin, 6)} (requirements.hunting_margin): a little "
+                "more friction gap or a little less loop gain brings the cycle back"), step))
         else:
             out.append(Check(f"min_crossover_{key}", False, m, fc / margin, "Hz", text + (
                 ": the design crossover lies below it, where the cycle exists"
@@ -296,13 +324,14 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
             text = (f"{where} lands at {d} joint deflection, on the limiter (stroke "
                     f"{quantity(land.stroke, 'm', 3)}): the end stop, not the flexure, holds "
                     "the cart, so the controller pushes on the friction again and hunting can "
-                    f"return (the flexure alone would push with k s = {land.rule_force:.3g} N "
-                    f"against Fs = {land.static_friction:.3g} N)")
+                    f"return (the flexure alone would push with k s = "
+                    f"{quantity(land.rule_force, 'N', 3)} against Fs = "
+                    f"{quantity(land.static_friction, 'N', 3)})")
         else:
             text = (f"{where} lands at {d} joint deflection (inside the stroke): flexure force "
-                    f"k min(|d|, s) = {land.force:.3g} N against Fs = "
-                    f"{land.static_friction:.3g} N (the rule's bound k s = "
-                    f"{land.rule_force:.3g} N)")
+                    f"k min(|d|, s) = {quantity(land.force, 'N', 3)} against Fs = "
+                    f"{quantity(land.static_friction, 'N', 3)} (the rule's bound k s = "
+                    f"{quantity(land.rule_force, 'N', 3)})")
         out.append(Check("landing_force", None if suggested else ok, land.force,
                          land.static_friction, "N", text, "step 3 refinement: landing"))
     if not agree:

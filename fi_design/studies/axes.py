@@ -3,7 +3,8 @@
 :class:`Axis` is one swept value; :func:`make_axis` builds one from values in
 SI, :func:`parse_axis` from the command line's text ``PATH=START:STOP:N``
 (text is read only here, at the boundary). :func:`design_value` is the spec's
-own value at a path, the design point a study is drawn around.
+own value at a path (read from the resolved model), the design point a study
+is drawn around.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 
 from .. import spec as _spec
 from ..errors import SpecError
+from ..model import Model, require_model
 from ..results.studies import Axis
 from ..spec.file import path_unit, value_at
 
@@ -200,30 +202,29 @@ _DERIVED = {
 }
 
 
-def design_value(spec: _spec.Spec, path: str) -> float | None:
-    """The spec's own value at a path, derived defaults resolved [SI].
+def design_value(model: Model, path: str) -> float | None:
+    """The design's own value at a spec path, derived defaults as resolved [SI].
 
     Parameters
     ----------
-    spec : Spec
-        The spec.
+    model : Model
+        The model resolved from its spec (:func:`fi_design.model.resolve`).
     path : str
-        Dotted path.
+        Dotted spec path.
 
     Returns
     -------
     float or None
-        The value; derived defaults (``isolator.stiffness`` left to step 3,
-        default dampings) are computed; None if the spec has no such value.
+        The spec's value; a derived default (``isolator.stiffness`` left to
+        step 3, default dampings) is the model's; None if the spec has no
+        such value.
     """
+    model = require_model(model)
     try:
-        value = value_at(spec, path)
+        value = value_at(model.spec, path)
     except SpecError:
         return None
     if value is None and path in _DERIVED:
-        from ..model import resolve
-
-        model = resolve(spec)
         if model.joint is None and path.startswith("isolator."):
             return None
         value = _DERIVED[path](model)
@@ -237,7 +238,7 @@ def design_value(spec: _spec.Spec, path: str) -> float | None:
 _JOINT_PATHS = ("isolator.stiffness", "isolator.stroke", "stage.mass", "cart.mass")
 
 
-def held_damping_note(spec: _spec.Spec, axes: Sequence[Axis]) -> str | None:
+def held_damping_note(model: Model, axes: Sequence[Axis]) -> str | None:
     """A sentence when the axes vary the joint while the spec gives its damping, else None.
 
     A given ``isolator.damping`` c [N s/m] is a damper's: it stays as the
@@ -247,8 +248,8 @@ def held_damping_note(spec: _spec.Spec, axes: Sequence[Axis]) -> str | None:
 
     Parameters
     ----------
-    spec : Spec
-        The study's spec.
+    model : Model
+        The study's base model (resolved from its spec).
     axes : sequence of Axis
         The swept axes.
 
@@ -257,13 +258,11 @@ def held_damping_note(spec: _spec.Spec, axes: Sequence[Axis]) -> str | None:
     str or None
     """
     from ..display import number
-    from ..model import resolve
 
-    iso = spec.isolator
+    iso = require_model(model).spec.isolator
     moving = [a for a in axes if a is not None and a.path in _JOINT_PATHS]
     if iso is None or iso.damping is None or not moving:
         return None
-    model = resolve(spec)
     ratios = [model.varied({a.path: v}).joint_damping_ratio for a in moving
               for v in (float(np.min(a.values)), float(np.max(a.values)))]
     return (f"isolator.damping is given ({number(iso.damping)} N s/m) and held as "

@@ -11,10 +11,11 @@ import numpy as np
 from .. import spec as _spec
 from ..errors import SpecError
 from ..execution import Executor
+from ..model import Model, require_model
 from ..results.studies import Axis, MapDefinition, StudyMap, StudyResult, SweepResult
 from .axes import design_value, make_axis
 from .cache import PointCache
-from .points import ProgressCallback, evaluate, grid, point_result, verdict_grid
+from .points import ProgressCallback, evaluate, grid, point_result, study_model, verdict_grid
 
 __all__ = ["PAPER_MAPS", "paper_axes", "paper_study"]
 
@@ -46,13 +47,13 @@ PAPER_MAPS: tuple[MapDefinition, ...] = (
 )
 
 
-def paper_axes(spec: _spec.Spec, definition: MapDefinition, resolution: int) -> tuple[Axis, Axis]:
-    """The axes of one of the paper's maps around a spec's design point.
+def paper_axes(model: Model, definition: MapDefinition, resolution: int) -> tuple[Axis, Axis]:
+    """The axes of one of the paper's maps around a design point.
 
     Parameters
     ----------
-    spec : Spec
-        The design spec.
+    model : Model
+        The design, resolved from its spec.
     definition : MapDefinition
         The map.
     resolution : int
@@ -69,10 +70,12 @@ def paper_axes(spec: _spec.Spec, definition: MapDefinition, resolution: int) -> 
     SpecError
         The spec lacks a value the map needs (an isolator for maps C and D).
     """
+    model = require_model(model)
+    spec = model.spec
     axes = []
     for path, (lo, hi), log in ((definition.x_path, definition.x_range, definition.x_log),
                                 (definition.y_path, definition.y_range, definition.y_log)):
-        ref = design_value(spec, path)
+        ref = design_value(model, path)
         if path == "friction.coulomb":  # ranges relative to Fs keep the map around the gap
             ref = spec.friction.static
             lo = min(lo, 0.5 * spec.friction.coulomb / ref)
@@ -85,7 +88,7 @@ def paper_axes(spec: _spec.Spec, definition: MapDefinition, resolution: int) -> 
     return axes[0], axes[1]
 
 
-def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
+def paper_study(spec: _spec.Spec | Model, resolution: int = 12, *, maps: str = "ABCD",
                 executor: Executor | None = None, progress: ProgressCallback | None = None,
                 cache: PointCache | str | os.PathLike | bool | None = None,
                 chunksize: int | None = None, measure: str = "stage") -> StudyResult:
@@ -100,8 +103,9 @@ def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
 
     Parameters
     ----------
-    spec : Spec
-        The design spec; maps C and D need an isolator.
+    spec : Spec, Model, path or mapping
+        The design: a spec, resolved once here, or the model resolved from it
+        (not one varied by :meth:`Model.at`); maps C and D need an isolator.
     resolution : int, optional
         Points per axis (default 12: 576 simulations).
     maps : str, optional
@@ -130,14 +134,15 @@ def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
         Resolution below 2, an unknown map letter, or maps C/D for a spec
         without isolator.
     ArgumentError
-        A resolution that is not a whole number or above :data:`MAX_RESOLUTION`.
+        A resolution that is not a whole number or above :data:`MAX_RESOLUTION`, or a
+        model varied by :meth:`Model.at`.
     """
     from .. import __version__
 
     from ..arguments import integer
-    from ..spec.file import as_spec
 
-    spec = as_spec(spec)
+    model = study_model(spec)
+    spec = model.spec
     if isinstance(resolution, int) and resolution < 2:
         raise SpecError(f"the resolution must be at least 2 points per axis, got {resolution}")
     resolution = integer(resolution, "resolution", minimum=2, maximum=MAX_RESOLUTION)
@@ -155,12 +160,12 @@ def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
     layouts = []
     tasks: list = []
     for d in defs:
-        ax, ay = paper_axes(spec, d, resolution)
+        ax, ay = paper_axes(model, d, resolution)
         cells = [((j, i), (float(vx), float(vy))) for j, vy in enumerate(ay.values)
                 for i, vx in enumerate(ax.values)]
         layouts.append((d, ax, ay, cells, len(tasks)))
         tasks += [(((ax.path, vals[0]), (ay.path, vals[1])), d.isolated) for _, vals in cells]
-    ev = evaluate(spec, tasks, executor=executor, progress=progress, cache=cache,
+    ev = evaluate(model, tasks, executor=executor, progress=progress, cache=cache,
                   chunksize=chunksize, measure=measure)
     info = replace(ev.run, wall_time=_time.perf_counter() - start)
     out_maps = []
@@ -173,7 +178,7 @@ def paper_study(spec: _spec.Spec, resolution: int = 12, *, maps: str = "ABCD",
             hunting_cycles=grid(points, shape, "hunting_cycles"),
             amplitude=grid(points, shape, "amplitude"), period=grid(points, shape, "period"),
             verdict=verdict_grid(points, shape),
-            design_point=(design_value(spec, ax.path), design_value(spec, ay.path)),
+            design_point=(design_value(model, ax.path), design_value(model, ay.path)),
             run=info, fi_design_version=__version__, measure=measure)
         out_maps.append(StudyMap(d, res))
     return StudyResult(spec=spec, maps=tuple(out_maps), resolution=resolution, run=info)

@@ -1,8 +1,10 @@
 """Points of a parameter study: simulate one, run many in chunks, record the outcomes.
 
-Every point is the base spec with some values replaced
-(:func:`fi_design.spec.file.with_values`), simulated with the fast kernel and
-judged (:func:`evaluate_point`) by one of two measures: ``"stage"`` (the
+Every point is the study's base model, resolved once from the spec at the
+study's edge (:func:`study_model`), varied by the point's values
+(:meth:`fi_design.model.Model.varied`: the spec validated again and resolved
+once), simulated with the fast kernel and judged (:func:`evaluate_point`) by
+one of two measures: ``"stage"`` (the
 default: whether any move of the family ends in a sustained cycle, and that
 cycle's amplitude, :mod:`fi_design.stage`) or ``"move"`` (the paper's hunting
 metric on the spec's own move). A point whose values the
@@ -10,7 +12,9 @@ spec refuses is ``invalid``, a simulation that does not complete (or raises)
 ``failed``: neither stops the study. :func:`evaluate` takes the finished
 points from the cache and runs the rest in chunks on the caller's executor
 (:func:`fi_design.execution.run_chunks`); the outcomes do not depend on where
-they ran.
+they ran. A chunk sends the base model to its worker once (about the spec's
+size pickled: the spec and a kilobyte of resolved numbers) with the values of
+its points.
 """
 
 from __future__ import annotations
@@ -28,14 +32,15 @@ from .. import spec as _spec
 from ..display import quantity
 from ..errors import ArgumentError, FiDesignError, SpecError
 from ..execution import Executor, chunks, run_chunks
+from ..model import Model, require_model, resolve
 from ..results import frozen_array
 from ..results.studies import PointResult, RunInfo
-from ..spec.file import with_values
 from .cache import METHOD, PointCache, open_cache, point_key
 
 __all__ = ["MEASURES", "MAX_CHUNK", "MAX_POINTS", "TARGET_CHUNKS", "Task", "ProgressCallback",
            "Evaluation",
-           "evaluate_point", "run_chunk", "warm_up", "chunk_size", "evaluate", "point_result",
+           "study_model", "evaluate_point", "run_chunk", "warm_up", "chunk_size", "evaluate",
+           "point_result",
            "grid", "verdict_grid"]
 
 #: ``progress(done, total)`` in points.
@@ -53,16 +58,55 @@ STAGE_FIRST = "stage_first"
 _MEASURES = MEASURES + (STAGE_FIRST,)
 
 
-def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
+def study_model(spec: _spec.Spec | Model, name: str = "spec") -> Model:
+    """The base model of a study: a spec (or what :func:`fi_design.spec.file.load_spec`
+    reads) resolved once, or a model resolved from its spec.
+
+    The studies' edge: every point is this model varied (:meth:`Model.varied`),
+    and the cache keys every point by this model's spec (:func:`.cache.point_key`),
+    so the model must be its spec's own: one varied by :meth:`Model.at`
+    (values that are not in its spec) is refused.
+
+    Parameters
+    ----------
+    spec : Spec, Model, path or mapping
+        The design.
+    name : str, optional
+        The argument's name, for the message.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    ArgumentError
+        A model varied by :meth:`Model.at`, or neither a spec nor a model.
+    """
+    from ..spec.file import as_spec
+
+    if not isinstance(spec, Model):
+        return resolve(as_spec(spec, name))
+    if spec.changed or spec.mode_scale != 1.0:
+        what = ", ".join(spec.changed + (("mode_scale",) if spec.mode_scale != 1.0 else ()))
+        raise ArgumentError(f"{name}: this model differs from its spec at {what} (Model.at), "
+                            "so a study cannot vary it by spec paths nor cache its points: "
+                            "give the spec (or the model resolved from it) and sweep these "
+                            "values as axes")
+    return spec
+
+
+def evaluate_point(model: Model, values: Mapping[str, Any], isolated: bool,
                    measure: str = "move") -> dict:
     """Simulate one point and return its outcome as plain data (the cached form).
 
     Parameters
     ----------
-    spec : Spec
-        The base spec.
+    model : Model
+        The base model (:func:`study_model`).
     values : mapping of str to value
-        Dotted path to value, applied with :func:`~fi_design.spec.file.with_values`.
+        Dotted spec path to value: the point is ``model.varied(values)``
+        (:meth:`fi_design.model.Model.varied`), the base model itself when empty.
     isolated : bool
         Simulate the isolated plant (True) or the stage without isolator.
     measure : {"move", "stage", "stage_first"}
@@ -85,10 +129,11 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
     """
     from ..simulation.run import simulate
 
+    model = require_model(model)
     if measure not in _MEASURES:
         raise ArgumentError(f"measure must be one of {MEASURES}, got {measure!r}")
     try:
-        point = with_values(spec, values) if values else spec
+        point = model.varied(values) if values else model
     except SpecError as exc:
         return _outcome("invalid", "invalid", message=str(exc))
     if measure != "move":
@@ -110,7 +155,7 @@ def evaluate_point(spec: _spec.Spec, values: Mapping[str, Any], isolated: bool,
                     message=m.reason)
 
 
-def _stage_point(point: _spec.Spec, isolated: bool, first_only: bool = False) -> dict:
+def _stage_point(point: Model, isolated: bool, first_only: bool = False) -> dict:
     """The stage-level outcome of one point (see :func:`evaluate_point`)."""
     from ..stage import stage_hunts
 
@@ -167,14 +212,14 @@ def _outcome(status: str, verdict: str, *, hunting_cycles: int | None = None,
             "final_error": final_error, "message": message, "cacheable": True}
 
 
-def run_chunk(spec: _spec.Spec, tasks: Sequence[tuple[tuple[tuple[str, Any], ...], bool]],
+def run_chunk(model: Model, tasks: Sequence[tuple[tuple[tuple[str, Any], ...], bool]],
               measure: str = "move") -> list[dict]:
     """Evaluate a chunk of points (the unit of work sent to an executor).
 
     Parameters
     ----------
-    spec : Spec
-        The base spec.
+    model : Model
+        The base model (:func:`study_model`).
     tasks : sequence of (values, isolated)
         ``values`` is a tuple of ``(path, value)`` pairs.
     measure : {"move", "stage"}
@@ -185,7 +230,7 @@ def run_chunk(spec: _spec.Spec, tasks: Sequence[tuple[tuple[tuple[str, Any], ...
     list of dict
         One outcome per task (see :func:`evaluate_point`), in order.
     """
-    return [evaluate_point(spec, dict(values), isolated, measure)
+    return [evaluate_point(model, dict(values), isolated, measure)
             for values, isolated in tasks]
 
 
@@ -259,7 +304,7 @@ class Evaluation:
     run: RunInfo
 
 
-def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | None = None,
+def evaluate(model: Model, tasks: Sequence[Task], *, executor: Executor | None = None,
              progress: ProgressCallback | None = None,
              cache: PointCache | str | os.PathLike | bool | None = None,
              chunksize: int | None = None, measure: str = "move") -> Evaluation:
@@ -267,8 +312,10 @@ def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | No
 
     Parameters
     ----------
-    spec : Spec
-        The base spec.
+    model : Model
+        The base model (:func:`study_model`): its spec's own, so that the
+        cache keys of its points (its spec's hash and the point's values)
+        decide them.
     tasks : sequence of (values, isolated)
         The points: ``(path, value)`` pairs and the plant.
     executor : Executor, optional
@@ -287,6 +334,7 @@ def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | No
     -------
     Evaluation
     """
+    model = study_model(require_model(model), "model")
     if measure not in _MEASURES:
         raise ArgumentError(f"measure must be one of {MEASURES}, got {measure!r}")
     start = _time.perf_counter()
@@ -295,7 +343,7 @@ def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | No
     outcomes: list[dict | None] = [None] * n
     keys: list[str] = []
     if store is not None:
-        shash = spec.content_sha256()
+        shash = model.spec.content_sha256()
         keys = [point_key(shash, values, iso, measure) for values, iso in tasks]
         hits = store.get_many(keys)
         for i, k in enumerate(keys):
@@ -327,7 +375,7 @@ def evaluate(spec: _spec.Spec, tasks: Sequence[Task], *, executor: Executor | No
         return [dict(_outcome("failed", "failed", message=msg), cacheable=False)
                 for _ in groups[g]]
 
-    arguments = [(spec, [tasks[i] for i in group], measure) for group in groups]
+    arguments = [(model, [tasks[i] for i in group], measure) for group in groups]
     if executor is None:
         for g, args in enumerate(arguments):
             finish(g, run_chunk(*args))

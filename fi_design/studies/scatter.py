@@ -1,8 +1,10 @@
 """Robustness: the probability of hunting when spec values scatter around the design.
 
-:func:`robustness` draws samples of the spec (:class:`Scatter` per value,
-optionally friction that varies along the rail, :class:`PositionFriction`),
-simulates each with and without the isolator, and estimates the probability
+:func:`robustness` resolves the design once and draws samples of it
+(:class:`Scatter` per spec value, optionally friction that varies along the
+rail, :class:`PositionFriction`), each the model varied by its draws
+(:meth:`fi_design.model.Model.varied`), simulates each with and without the
+isolator, and estimates the probability
 of hunting with a Wilson confidence interval (:func:`wilson_interval`).
 :func:`parse_scatter` and :func:`parse_position_friction` read the command
 line's text.
@@ -23,13 +25,15 @@ import numpy as np
 from .. import spec as _spec
 from ..errors import ArgumentError, SpecError
 from ..execution import Executor
+from ..model import Model
 from ..results import frozen_array
 from ..results.studies import (POINT_VERDICTS, HuntingProbability, PointResult, PositionFriction,
                                RobustnessResult, Scatter)
-from ..spec.file import path_unit, with_values
+from ..spec.file import path_unit
 from .axes import design_value, is_number
 from .cache import PointCache
-from .points import MAX_POINTS, STAGE_FIRST, ProgressCallback, evaluate, point_result
+from .points import (MAX_POINTS, STAGE_FIRST, ProgressCallback, evaluate, point_result,
+                     study_model)
 
 __all__ = ["DISTRIBUTIONS", "parse_scatter", "parse_position_friction", "wilson_interval",
            "robustness"]
@@ -163,7 +167,7 @@ def wilson_interval(successes: int, trials: int, confidence: float = 0.95) \
 _PDF = "position_dependent_friction"
 
 
-def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int = 100, *,
+def robustness(spec: _spec.Spec | Model, scatter: Sequence[Scatter] = (), samples: int = 100, *,
                seed: int = 0, distribution: str = "normal",
                position_friction: PositionFriction | None = None, confidence: float = 0.95,
                executor: Executor | None = None, progress: ProgressCallback | None = None,
@@ -183,8 +187,9 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
 
     Parameters
     ----------
-    spec : Spec
-        The nominal design.
+    spec : Spec, Model, path or mapping
+        The nominal design: a spec, resolved once here, or the model resolved
+        from it (not one varied by :meth:`Model.at`).
     scatter : sequence of Scatter
         Scattered values (text such as ``"friction.static=10%"`` is read by
         :func:`parse_scatter`).
@@ -227,13 +232,13 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
         than one sample or more than :data:`~.points.MAX_POINTS`, an unknown
         distribution, a confidence outside (0, 1).
     ArgumentError
-        A scatter that is not a :class:`Scatter`.
+        A scatter that is not a :class:`Scatter`, or a model varied by :meth:`Model.at`.
     """
     from .. import __version__
-    from ..spec.file import as_spec
 
     start = _time.perf_counter()
-    spec = as_spec(spec)
+    model = study_model(spec)
+    spec = model.spec
     items = tuple(scatter)
     if not all(isinstance(s, Scatter) for s in items):
         raise ArgumentError("scatter must be a list of Scatter values; read text such as "
@@ -260,7 +265,7 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
                         f"{', '.join(DISTRIBUTIONS)}")
     if not 0 < confidence < 1:
         raise SpecError(f"confidence must lie between 0 and 1, got {confidence}")
-    base = spec
+    base = model
     if position_friction is not None:
         entries = [e.model_dump() for e in spec.effects if e.type != _PDF]
         entries.append({"type": _PDF, "amplitude": position_friction.amplitude,
@@ -268,7 +273,7 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
         for e in entries:  # bare numbers the validators refuse (angles) as text
             if e.get("phase") is not None and not isinstance(e["phase"], str):
                 e["phase"] = f"{float(e['phase'])!r} rad"
-        base = with_values(spec, {"effects": entries})
+        base = model.varied({"effects": entries})
     nominal = []
     for sc in items:
         v = design_value(base, sc.path)
@@ -289,7 +294,7 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
     if friction_gap is not None:  # Fs = Fc + the gap, each drawn and clipped at zero
         gap_unit = rng.standard_normal(samples) if distribution == "normal" else \
             rng.uniform(-1.0, 1.0, samples)
-        f = base.friction
+        f = base.spec.friction
         if "friction.coulomb" in paths:
             i = paths.index("friction.coulomb")
             draws[:, i] = np.maximum(draws[:, i], 0.0)
@@ -317,9 +322,7 @@ def robustness(spec: _spec.Spec, scatter: Sequence[Scatter] = (), samples: int =
                   chunksize=chunksize, measure=STAGE_FIRST if measure == "stage" else measure)
     points = tuple(point_result((n % samples,), sample_values[n % samples], iso, out)
                    for n, ((_, iso), out) in enumerate(zip(all_tasks, ev.outcomes)))
-    from ..controller.pid import control_law
-
-    integrates = control_law(spec).integrator
+    integrates = model.law.integrator
     probs = {}
     for iso in plants:
         pts = [p for p in points if p.isolated == iso]

@@ -5,7 +5,7 @@ hunting cycle and its fold; a datasheet gives none of them, and an
 identification needs a record that holds the excitation (presliding
 reversals, slow breakaways). :func:`crossover_sensitivity` divides and
 multiplies each by a factor (3 by default), the others held at the values the
-design used, and finds the stage-level hunting-free crossover of the spec's
+design used (the design's model varied, :meth:`fi_design.model.Model.varied`), and finds the stage-level hunting-free crossover of the spec's
 own plant for each (:func:`fi_design.stage.stage_hunting`, the fold of the
 cycle by bisection): six stage-level answers, about a second each on the
 paper setup.
@@ -15,9 +15,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..model import Model, as_model
+from .. import spec as _spec
+from ..model import Model
 from ..results.sensitivity import SENSITIVITY_PARAMETERS, CrossoverSensitivity, SensitivityPoint
-from ..spec.paths import with_values
+from .points import study_model
 
 __all__ = ["crossover_sensitivity", "DEFAULT_FACTORS"]
 
@@ -31,16 +32,16 @@ def _nominal(model: Model) -> dict[str, float]:
             "friction.stribeck_velocity": f.vs}
 
 
-def _fold(spec: Any, isolated: bool, values: dict) -> tuple[float | None, str]:
-    """The hunting-free crossover of a spec with some values replaced (one task)."""
+def _fold(model: Model, isolated: bool, values: dict) -> tuple[float | None, str]:
+    """The hunting-free crossover of the model with some spec values varied (one task)."""
     from ..stage import stage_hunting
 
-    st = stage_hunting(with_values(spec, values), isolated, converge=False, trace=False)
+    st = stage_hunting(model.varied(values), isolated, converge=False, trace=False)
     kind = "none" if st.boundary is None else st.boundary.kind
     return st.hunting_free_from, kind
 
 
-def crossover_sensitivity(model: Model | Any, nominal: float | None = None, *,
+def crossover_sensitivity(model: Model | _spec.Spec, nominal: float | None = None, *,
                           factors: tuple[float, ...] = DEFAULT_FACTORS,
                           executor: Any = None) -> CrossoverSensitivity | None:
     """The spec's own plant's hunting-free crossover with sigma0, sigma1 and vs scaled.
@@ -48,7 +49,9 @@ def crossover_sensitivity(model: Model | Any, nominal: float | None = None, *,
     Parameters
     ----------
     model : Model or Spec
-        The resolved model (a spec is resolved); its spec is varied.
+        The resolved model (a spec is resolved once here); it is varied by
+        :meth:`~fi_design.model.Model.varied`, so it must not be one varied by
+        :meth:`~fi_design.model.Model.at`.
     nominal : float, optional
         The nominal hunting-free crossover [Hz] when already known (the
         design's); computed when None.
@@ -64,11 +67,10 @@ def crossover_sensitivity(model: Model | Any, nominal: float | None = None, *,
         mechanism, no crossover to find) or a friction model without these
         parameters (the switch model).
     """
-    model = as_model(model)
+    model = study_model(model, "model")
     if not model.law.integrator or model.friction.model != "lugre":
         return None
     iso = model.has_isolator
-    spec = model.spec
     base = _nominal(model)
     # the others held at the values the design used (sigma1's default follows sigma0 otherwise)
     jobs = []
@@ -78,11 +80,11 @@ def crossover_sensitivity(model: Model | Any, nominal: float | None = None, *,
             values[path] = base[path] * f
             jobs.append((path, f, values[path], values))
     if nominal is None:
-        nominal = _fold(spec, iso, base)[0]
+        nominal = _fold(model, iso, base)[0]
     if executor is None:
-        found = [_fold(spec, iso, values) for *_, values in jobs]
+        found = [_fold(model, iso, values) for *_, values in jobs]
     else:
-        futures = [executor.submit(_fold, spec, iso, values) for *_, values in jobs]
+        futures = [executor.submit(_fold, model, iso, values) for *_, values in jobs]
         found = [fut.result() for fut in futures]
     points = tuple(SensitivityPoint(path=path, factor=float(f), value=float(v),
                                     hunting_free_from=m, kind=kind)

@@ -1,8 +1,10 @@
 """Sweeps: the hunting metric over a grid of one or two spec values (paper Figure 4).
 
-:func:`sweep` simulates every point of the grid (:mod:`.points`) and returns a
-:class:`SweepResult`; :func:`design_map` is the small crossover x stroke map
-around a design point that the sign-off report shows.
+:func:`sweep` resolves the design once (:func:`~.points.study_model`),
+simulates every point of the grid, the model varied by the point's values
+(:mod:`.points`), and returns a :class:`SweepResult`; :func:`design_map` is
+the small crossover x stroke map around a design point that the sign-off
+report shows.
 """
 
 from __future__ import annotations
@@ -16,11 +18,13 @@ import numpy as np
 from .. import spec as _spec
 from ..errors import ArgumentError, SpecError
 from ..execution import Executor
+from ..model import Model
 from ..results.design import DesignResult
 from ..results.studies import Axis, DesignMap, SweepResult
 from .axes import design_value, held_damping_note, make_axis
 from .cache import PointCache
-from .points import MAX_POINTS, ProgressCallback, evaluate, grid, point_result, verdict_grid
+from .points import (MAX_POINTS, ProgressCallback, evaluate, grid, point_result, study_model,
+                     verdict_grid)
 
 __all__ = ["AxisLike", "sweep", "design_map"]
 
@@ -38,7 +42,7 @@ def _as_axis(value: AxisLike, spec: _spec.Spec, name: str) -> Axis:
                         "'controller.crossover=2 Hz:30 Hz:15' with parse_axis")
 
 
-def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
+def sweep(spec: _spec.Spec | Model, x: AxisLike, y: AxisLike | None = None, *,
           isolated: bool | None = None, executor: Executor | None = None,
           progress: ProgressCallback | None = None,
           cache: PointCache | str | os.PathLike | bool | None = None,
@@ -47,8 +51,9 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
 
     Parameters
     ----------
-    spec : Spec
-        The design spec (the design point).
+    spec : Spec, Model, path or mapping
+        The design (the design point): a spec, resolved once here, or the
+        model resolved from it (not one varied by :meth:`Model.at`).
     x : Axis or (path, values)
         First swept value: an :class:`~.axes.Axis` or a ``(dotted path, values
         in SI)`` pair (text ``"PATH=START:STOP:N"`` is read by
@@ -88,12 +93,12 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
         :data:`~.points.MAX_POINTS` points.
     ArgumentError
         An axis that is neither an :class:`~.axes.Axis` nor a ``(path, values)``
-        pair.
+        pair, or a model varied by :meth:`Model.at`.
     """
     from .. import __version__
-    from ..spec.file import as_spec
 
-    spec = as_spec(spec)
+    model = study_model(spec)
+    spec = model.spec
     ax = _as_axis(x, spec, "x")
     ay = _as_axis(y, spec, "y") if y is not None else None
     if ay is not None and ay.path == ax.path:
@@ -116,18 +121,18 @@ def sweep(spec: _spec.Spec, x: AxisLike, y: AxisLike | None = None, *,
         shape = (len(ay.values), len(ax.values))
     paths = (ax.path,) if ay is None else (ax.path, ay.path)
     tasks = [(tuple(zip(paths, vals)), iso) for _, vals in cells]
-    ev = evaluate(spec, tasks, executor=executor, progress=progress, cache=cache,
+    ev = evaluate(model, tasks, executor=executor, progress=progress, cache=cache,
                   chunksize=chunksize, measure=measure)
     points = tuple(point_result(idx, vals, iso, out)
                    for (idx, vals), out in zip(cells, ev.outcomes))
-    design = tuple(design_value(spec, p) for p in paths)
+    design = tuple(design_value(model, p) for p in paths)
     return SweepResult(
         spec=spec, x=ax, y=ay, isolated=iso, points=points,
         hunting_cycles=grid(points, shape, "hunting_cycles"),
         amplitude=grid(points, shape, "amplitude"), period=grid(points, shape, "period"),
         verdict=verdict_grid(points, shape), design_point=design, run=ev.run,
         fi_design_version=__version__, measure=measure,
-        notes=tuple(n for n in (held_damping_note(spec, (ax, ay)),) if n))
+        notes=tuple(n for n in (held_damping_note(model, (ax, ay)),) if n))
 
 
 def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
@@ -156,20 +161,19 @@ def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),
     DesignMap
     """
     from ..stage.confirm import with_isolator
-    from ..model import resolve
 
-    spec = result.spec
-    suggested = spec.isolator is None
+    model = study_model(result.model if result.model is not None else result.spec, "result")
+    fc = model.crossover  # the design's (the control law does not depend on the isolator)
+    suggested = not model.has_isolator
     if suggested:
         adv = result.isolator_advice
-        spec = with_isolator(spec, adv.stroke, adv.stiffness)
-    fc = (result.model if result.model is not None else resolve(spec)).crossover
-    s = spec.isolator.stroke
+        model = with_isolator(model, adv.stroke, adv.stiffness)
+    iso = model.spec.isolator
+    s = iso.stroke
     nx, ny = resolution
-    x = make_axis("controller.crossover", np.linspace(0.125 * fc, 2.5 * fc, nx), spec=spec)
+    x = make_axis("controller.crossover", np.linspace(0.125 * fc, 2.5 * fc, nx), spec=model.spec)
     y = make_axis("isolator.stroke", np.geomspace(s / 6.0, s * 10.0 / 3.0, ny), log=True,
-                  spec=spec)
-    out = sweep(spec, x, y, isolated=True, executor=executor, progress=progress, cache=cache,
+                  spec=model.spec)
+    out = sweep(model, x, y, isolated=True, executor=executor, progress=progress, cache=cache,
                 measure=measure)
-    return DesignMap(sweep=out, suggested=suggested, stroke=s,
-                     stiffness=spec.isolator.stiffness)
+    return DesignMap(sweep=out, suggested=suggested, stroke=s, stiffness=iso.stiffness)

@@ -127,8 +127,10 @@ def test_result_is_frozen_and_json_ready(paper_spec, kernel):
 
 
 def test_design_point_resolves_derived_stiffness(paper_spec):
+    from fi_design.model import resolve
+
     spec = with_values(paper_spec, {"isolator.stiffness": None})
-    assert sw.design_value(spec, "isolator.stiffness") == pytest.approx(4 / 3e-4 / 2)
+    assert sw.design_value(resolve(spec), "isolator.stiffness") == pytest.approx(4 / 3e-4 / 2)
 
 
 def test_library_is_silent_and_reports_progress(paper_spec, kernel, capsys):
@@ -418,6 +420,53 @@ def test_cache_skips_finished_points(paper_spec, kernel, tmp_path):
     assert sw.sweep(moved, x, cache=cache).run.computed == 4
 
 
+def test_a_study_given_the_model_is_the_study_given_its_spec(paper_spec, kernel, tmp_path):
+    """A study resolves its spec once and varies that model; given the resolved model it is the
+    same study: the same cache keys (the model's spec's hash), the same points. A model varied
+    by Model.at is refused: its values are not in its spec, which keys the cache, and a point's
+    spec-path values would be applied to the spec it no longer is."""
+    from fi_design.model import resolve
+
+    model = resolve(paper_spec)
+    x = sw.parse_axis("controller.crossover=4:12:3")
+    first = sw.sweep(paper_spec, x, cache=tmp_path, measure="move")
+    again = sw.sweep(model, x, cache=tmp_path, measure="move")
+    assert (again.run.computed, again.run.cached) == (0, 3)
+    assert _same(first, again) and again.spec is paper_spec
+    moved = model.at(stroke=2 * model.joint.stroke)
+    for call in (lambda: sw.sweep(moved, x), lambda: sw.paper_study(moved, 2, maps="A"),
+                 lambda: sw.robustness(moved, [sw.Scatter("friction.static", 0.1)], 2),
+                 lambda: sw.crossover_sensitivity(moved)):
+        with pytest.raises(ArgumentError, match=r"isolator.stroke \(Model.at\)"):
+            call()
+
+
+def test_a_point_is_the_spec_with_its_values_simulated(paper_spec, kernel):
+    """Each point of a sweep and each robustness draw is the base model varied by its values
+    (Model.varied): the same outcome as the spec with the values written in
+    (fi_design.spec.file.with_values) and simulated from scratch, number for number."""
+    from fi_design.simulation.run import simulate
+
+    x = sw.parse_axis("controller.crossover=5:11:2")
+    y = sw.parse_axis("isolator.stroke=0.1 mm:0.6 mm:2")
+    res = sw.sweep(paper_spec, x, y, measure="move")
+    rob = sw.robustness(paper_spec, [sw.Scatter("friction.coulomb", 0.2)], 2, seed=5,
+                        measure="move")
+    cases = [(dict(zip((x.path, y.path), p.values)), p) for p in res.points]
+    cases += [({"friction.coulomb": p.values[0]}, p) for p in rob.points]
+    assert len(cases) == 8
+
+    def num(v):  # a result's number as a point stores it (None for none or not finite)
+        return None if v is None or not math.isfinite(v) else float(v)
+
+    for values, p in cases:
+        m = simulate(with_values(paper_spec, values), p.isolated, "fast").metrics
+        assert (p.verdict, p.hunting_cycles) == (m.verdict, m.hunting_cycles), values
+        assert (p.amplitude, p.period, p.final_error) == (
+            num(m.amplitude), num(m.period), num(m.final_error)), values
+    assert {p.verdict for p in res.points} == {"hunting", "settled"}
+
+
 def test_cache_key_covers_version_and_code(paper_spec, monkeypatch):
     h = paper_spec.content_sha256()
     key = cachemod.point_key(h, (("controller.crossover", 8.0),), True)
@@ -560,6 +609,7 @@ def test_stage_cell_is_the_largest_cycle_over_the_family(paper_spec, monkeypatch
     its own repeat, their cycles differ in the fourth digit, where the run left them; the
     match rule, off here, would give every move entering a known cycle that cycle's
     values)."""
+    from fi_design.model import resolve
     from fi_design.stage import runs as stage_runs
     from fi_design.stage import stage_hunts
     from fi_design.studies.points import evaluate_point
@@ -569,7 +619,7 @@ def test_stage_cell_is_the_largest_cycle_over_the_family(paper_spec, monkeypatch
     amps = [m.amplitude for m in moves if m.hunts]
     first = next(m.amplitude for m in moves if m.hunts)
     assert len(amps) >= 2 and max(amps) > first * (1 + 1e-5)
-    out = evaluate_point(paper_spec, {}, False, measure="stage")
+    out = evaluate_point(resolve(paper_spec), {}, False, measure="stage")
     assert out["verdict"] == "hunting"
     assert out["amplitude"] == pytest.approx(max(amps), rel=1e-12)
     assert f"{len(amps)} of {len(moves)} moves hunt" in out["message"]
@@ -578,13 +628,15 @@ def test_stage_cell_is_the_largest_cycle_over_the_family(paper_spec, monkeypatch
 def test_a_robustness_sample_stops_at_the_first_hunting_move_with_the_same_verdict(paper_spec):
     """Robustness samples and the recommendation's screen stop a family at its first hunting
     move: the verdict is that of the whole family, the cycle no larger than its largest."""
+    from fi_design.model import resolve
     from fi_design.studies.points import STAGE_FIRST, evaluate_point
 
+    model = resolve(paper_spec)
     seen = set()
     for values in ({}, {"controller.crossover": 11.0}, {"controller.crossover": 12.0},
                    {"friction.static": 1.8}):
-        full = evaluate_point(paper_spec, values, True, "stage")
-        first = evaluate_point(paper_spec, values, True, STAGE_FIRST)
+        full = evaluate_point(model, values, True, "stage")
+        first = evaluate_point(model, values, True, STAGE_FIRST)
         assert first["verdict"] == full["verdict"], values
         seen.add(full["verdict"])
         if full["verdict"] == "hunting":
