@@ -233,7 +233,6 @@ def test_the_scan_finds_each_hand_format():
     assert hand_formats(fine) == []
 
 
-@pytest.mark.xfail(strict=True, reason="being routed through display, package by package")
 def test_numbers_are_formatted_in_display_only():
     import fi_design
 
