@@ -443,7 +443,27 @@ def load(spec: Path) -> Any:
     from ..spec.file import load_spec
 
     check_spec_path(spec)
+    import_pint()
     return load_spec(spec)
+
+
+def import_pint() -> None:
+    """Import pint with dask hidden, unless either is imported already.
+
+    pint imports ``dask.base`` at its own import when dask is installed (for
+    dask arrays of quantities): about 0.15 s of every command's start. A command
+    never hands pint a dask array (units are read at the spec's boundary only),
+    so the command line imports pint while ``import dask`` fails; dask itself
+    imports normally afterwards (``--executor dask``). The library does not do
+    this: a program that imports fi_design keeps pint's dask support.
+    """
+    if "pint" in sys.modules or "dask" in sys.modules:
+        return
+    sys.modules["dask"] = None  # type: ignore[assignment]  # import dask -> ImportError
+    try:
+        import pint  # noqa: F401
+    finally:
+        del sys.modules["dask"]
 
 
 def json_text(result: Any) -> str:

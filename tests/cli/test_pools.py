@@ -254,3 +254,17 @@ def test_a_pool_thread_taken_apart_under_it_is_not_reported(monkeypatch):
     for args in (pool_error, other_error, pool_bug):
         threading.excepthook(args)
     assert reported == [other_error, pool_bug]
+
+
+def test_a_command_reads_its_spec_without_importing_dask(paper_spec_path):
+    """pint imports dask.base at its import when dask is installed (0.15 s of every start):
+    the command line imports pint with dask hidden, and dask still imports afterwards."""
+    pytest.importorskip("dask")
+    code = ("import sys\nfrom pathlib import Path\nfrom fi_design.cli.parts import load\n"
+            f"load(Path({str(paper_spec_path)!r}))\n"
+            "print('dask' in sys.modules, 'pint' in sys.modules)\n"
+            "import dask.distributed, pint.compat\n"
+            "print(pint.compat.HAS_DASK)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == ["False", "True", "False"], out
