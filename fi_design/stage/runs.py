@@ -21,13 +21,14 @@ from ..kernel.layout import (N_WATCH, W_ARM, W_BAND, W_LEVEL, W_MATCH, W_MAX_CRO
                              W_QUIET, W_REPEAT, W_REST_ANYWHERE, W_START, Integration,
                              PlantParameters, state_index)
 from ..results.stage import MoveOutcome, length_text
+from ..simulation.run import tolerances
 from ..trajectory import Trajectory
 from .family import hold
 from .rest import rest_ends_run
-from .settings import (CROSSINGS, H_MAX, MATCH, REPEAT, Watch, integrates, kernel_arrays,
-                       restartable, translation_invariant)
+from .settings import (CROSSINGS, H_MAX, MATCH, MATCH_CAP, MATCH_SHARE, REPEAT, Watch, integrates,
+                       kernel_arrays, restartable, translation_invariant)
 
-__all__ = ["MoveRun", "watch_array", "kernel_run", "move_outcome", "guess_period"]
+__all__ = ["MoveRun", "watch_array", "kernel_run", "match_tolerance", "move_outcome", "guess_period"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -156,6 +157,35 @@ def kernel_run(params: PlantParameters, y0: np.ndarray, ref: Trajectory, t_end: 
                max_steps, _x_bound(ref, y0), watch=watch, crossings=crossings)
 
 
+def match_tolerance(params: PlantParameters, known: Sequence[MoveRun]) -> float:
+    """How close to a known cycle a move's section state must come to have entered it [-].
+
+    :data:`~fi_design.stage.settings.MATCH_SHARE` of the smallest known cycle's
+    peak-to-peak amplitude, in the physical scale of positions (1 mm), between
+    :data:`~fi_design.stage.settings.MATCH` and
+    :data:`~fi_design.stage.settings.MATCH_CAP`: a cycle of millimetres draws in
+    a state within a few tenths of a millimetre as surely as one of 10 um draws in
+    a state within a hundredth; :data:`MATCH` 0 turns the rule off.
+
+    Parameters
+    ----------
+    params : PlantParameters
+        The plant (its scales).
+    known : sequence of MoveRun
+        The cycles found so far.
+
+    Returns
+    -------
+    float
+        The tolerance in physical scales [-].
+    """
+    amplitudes = [r.outcome.amplitude for r in known if r.outcome.amplitude]
+    if MATCH <= 0.0 or not amplitudes:
+        return MATCH
+    scale = float(tolerances(params, 1.0)[0])  # positions [m]
+    return min(MATCH_CAP, max(MATCH, MATCH_SHARE * min(amplitudes) / scale))
+
+
 def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: Watch, *,
                  distance: float, label: str = "family", repeat: float = REPEAT,
                  known: Sequence[MoveRun] = ()) -> MoveRun:
@@ -179,7 +209,7 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
         Repeat tolerance of the section state [-].
     known : sequence of MoveRun
         Hunting runs of earlier moves of the same plant: once the section
-        state comes within :data:`MATCH` of one of their cycles, the move has
+        state comes within :func:`match_tolerance` of one of their cycles, the move has
         entered that cycle and the run stops there; its outcome takes that
         cycle's amplitude and period (for a plant whose state vector is whole
         and whose forces do not depend on where the stage is; otherwise the
@@ -199,12 +229,14 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
         if restart and translation_invariant(params) else []
     table = np.concatenate([r.cycle_states for r in known]) if known else None
     owner = [r for r in known for _ in range(len(r.cycle_states))]
+    match = match_tolerance(params, known)
     start, offset, elapsed = move_end, 0.0, 0.0
     cur_ref, cur_y0, cur_end = ref, y0, t_end
     rested_at = None  # when the stage last came to rest inside the band, not for good [s]
     while True:
         out = kernel_run(params, cur_y0, cur_ref, cur_end,
-                         watch_array(w, start, level, repeat=repeat, known=table), w.tolerance,
+                         watch_array(w, start, level, repeat=repeat, known=table, match=match),
+                         w.tolerance,
                          w.max_steps)
         elapsed = offset + out.t_reached - move_end
         y = out.final_state

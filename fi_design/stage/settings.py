@@ -19,7 +19,7 @@ from ..kernel.layout import PlantParameters
 from ..model import Model
 from ..simulation.run import tolerances
 
-__all__ = ["CROSSINGS", "REPEAT", "MATCH", "ORBIT_RTOL", "PERTURBATION", "MULTIPLIER_AGREEMENT",
+__all__ = ["CROSSINGS", "REPEAT", "MATCH", "MATCH_SHARE", "MATCH_CAP", "ORBIT_RTOL", "PERTURBATION", "MULTIPLIER_AGREEMENT",
            "FOLD_RESOLUTION", "FOLD_RELATIVE", "FOLD_STEP", "H_MAX", "Watch", "watch_settings",
            "integrates", "restartable", "translation_invariant", "symmetric", "kernel_arrays"]
 
@@ -28,11 +28,17 @@ CROSSINGS = 400
 #: Repeat tolerance of the family runs: the section state repeats within this
 #: fraction of the physical scales (1 mm, 1 cm/s, Fs / sigma0, Fs) [-].
 REPEAT = 1e-3
-#: Match tolerance of the family runs: a move whose section state comes within this
-#: fraction of the physical scales of a cycle an earlier move of the same plant repeated
-#: has entered that cycle (an attracting cycle draws it in, by the cycle's multiplier,
-#: about 0.5, at every crossing; the repeat rule needs about five crossings more) [-].
+#: Match tolerance of the family runs, its floor: a move whose section state comes within
+#: this fraction of the physical scales of a cycle an earlier move of the same plant
+#: repeated has entered that cycle (an attracting cycle draws it in, by the cycle's
+#: multiplier, about 0.5, at every crossing; the repeat rule needs about five crossings
+#: more) [-]. 0 turns the rule off.
 MATCH = 1e-2
+#: ... widened with the size of the known cycles: to this share of the smallest cycle's
+#: peak-to-peak amplitude in the position scale (a 1.8 mm cycle: 0.54, capped) [-] ...
+MATCH_SHARE = 0.3
+#: ... and never beyond this [-].
+MATCH_CAP = 0.3
 #: Relative tolerance of the orbit computations (shooting, multipliers) [-].
 ORBIT_RTOL = 1e-9
 #: Finite-difference perturbation of the return map, in physical scales [-].

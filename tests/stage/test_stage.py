@@ -318,3 +318,27 @@ def test_a_move_entering_a_known_cycle_stops_there_with_the_same_answer(paper_sp
     # and it stopped earlier: the point of the rule
     assert sum(f.time for f, _ in matched) < 0.8 * sum(s.time for _, s in matched)
     assert all(r.cycle_states is not None for r in runs if r.outcome.hunts)
+
+
+def test_the_match_tolerance_grows_with_the_known_cycle(paper_spec, monkeypatch):
+    """A share of the smallest known cycle's peak-to-peak amplitude in the position scale
+    (1 mm), between the floor MATCH and the cap; none known or MATCH 0: the floor."""
+    from fi_design.results.stage import MoveOutcome
+    from fi_design.stage import runs as stage_runs
+    from fi_design.stage.settings import MATCH, MATCH_CAP, MATCH_SHARE
+
+    params = resolve(paper_spec).plant(True)
+
+    def cycle(amplitude):
+        out = MoveOutcome(1e-3, "family", "hunts", 0.0, amplitude, 2.0, 10.0, "a cycle")
+        return stage_runs.MoveRun(out, np.zeros(params.n_states), 1, 0.0,
+                                  np.zeros((1, params.n_states)))
+
+    tol = stage_runs.match_tolerance
+    assert tol(params, []) == MATCH
+    assert tol(params, [cycle(20e-6)]) == MATCH  # 0.3 x 0.02: below the floor
+    assert tol(params, [cycle(0.2e-3)]) == pytest.approx(MATCH_SHARE * 0.2)
+    assert tol(params, [cycle(0.2e-3), cycle(5e-3)]) == pytest.approx(MATCH_SHARE * 0.2)
+    assert tol(params, [cycle(5e-3)]) == MATCH_CAP
+    monkeypatch.setattr(stage_runs, "MATCH", 0.0)
+    assert tol(params, [cycle(5e-3)]) == 0.0  # the rule off
