@@ -115,9 +115,11 @@ def test_an_interrupt_delivered_to_another_thread_leaves_no_temporary_file(tmp_p
     def mkstemp(*args, **kwargs):
         made = real(*args, **kwargs)
         signal.pthread_kill(other.ident, signal.SIGINT)
-        time.sleep(0.05)  # the other thread runs the C handler; the main thread then checks
-        for _ in range(1000):
-            pass
+        # the other thread runs the C handler when it is scheduled (late on a loaded
+        # machine); the main thread raises at its next check, inside this loop
+        deadline = time.monotonic() + 1.0
+        while time.monotonic() < deadline:
+            time.sleep(0.001)
         return made
 
     monkeypatch.setattr(output.tempfile, "mkstemp", mkstemp)
