@@ -244,6 +244,16 @@ class Model:
         return self.m1 + self.m2
 
     @property
+    def departures(self) -> tuple[str, ...]:
+        """Where this model departs from its spec: the paths :meth:`at` changed, and
+        ``mode_scale`` when the guide's modes are scaled; empty for the spec's own model.
+
+        What reads the spec (a study varying it by paths, the search, the sign-off's
+        robustness study) would not see these values: such callers refuse a model that
+        departs, naming them."""
+        return self.changed + (("mode_scale",) if self.mode_scale != 1.0 else ())
+
+    @property
     def has_isolator(self) -> bool:
         """Whether the model has the isolator's joint."""
         return self.joint is not None
@@ -335,9 +345,9 @@ class Model:
         >>> m.joint.stroke, m.crossover, m.spec.isolator.stroke, m.changed
         (0.0005, 10.0, 0.0005, ())
         """
-        if self.changed or self.mode_scale != 1.0:
-            what = ", ".join(self.changed + (("mode_scale",) if self.mode_scale != 1.0 else ()))
-            raise ArgumentError(f"this model differs from its spec at {what} (Model.at): "
+        if self.departures:
+            raise ArgumentError(f"this model differs from its spec at "
+                                f"{', '.join(self.departures)} (Model.at): "
                                 "vary the model resolved from the spec, with every value "
                                 "in Model.varied")
         from .spec.paths import with_values

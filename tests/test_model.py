@@ -473,3 +473,22 @@ def test_a_varied_model_says_what_it_changed_and_design_takes_it(paper_spec):
     assert result.model is varied and result.spec is paper_spec
     with pytest.raises(ArgumentError, match="controller.crossover, isolator.stiffness"):
         design(varied)  # the robustness study would vary the spec, not the model
+
+
+def test_a_model_names_where_it_departs_from_its_spec(paper_spec):
+    """Model.at's paths and a mode scale are departures; a study, the search and the
+    sign-off's robustness study refuse such a model with their names."""
+    from fi_design.errors import ArgumentError
+    from fi_design.model import resolve
+    from fi_design.studies.points import study_model
+
+    model = resolve(paper_spec)
+    assert model.departures == ()
+    assert model.varied({"controller.crossover": 9.0}).departures == ()
+    moved = model.at(crossover=9.0, mode_scale=0.9)
+    assert moved.departures == ("controller.crossover", "mode_scale")
+    assert model.at(mode_scale=0.9).departures == ("mode_scale",)
+    for refuse in (lambda: study_model(model.at(mode_scale=0.9)),
+                   lambda: model.at(mode_scale=0.9).varied({"isolator.stroke": 4e-4})):
+        with pytest.raises(ArgumentError, match="mode_scale"):
+            refuse()

@@ -128,9 +128,9 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
     spec = model.spec
     suggestion = suggested_isolator(model) if not model.has_isolator else None
     robust = confirm and model.requirements.robustness.samples > 0
-    if (robust or (confirm and sensitivity)) and model.changed:
+    if (robust or (confirm and sensitivity)) and model.departures:
         raise ArgumentError(
-            f"this model differs from its spec at {', '.join(model.changed)} (Model.at), but "
+            f"this model differs from its spec at {', '.join(model.departures)} (Model.at), but "
             "the robustness study (and the sensitivity) of the sign-off vary the spec's values "
             "(Model.varied): design it with confirm=False, or vary the model resolved from "
             "the spec with every value in Model.varied and design that")

@@ -377,10 +377,10 @@ def recommend(spec: _spec.Spec | Model | str | Any, *, executor: Any = None,
 
     start = _time.perf_counter()
     model = as_model(spec if isinstance(spec, Model) else as_spec(spec))  # the edge: once
-    if model.changed:
+    if model.departures:
         from ..errors import ArgumentError
 
-        raise ArgumentError(f"this model differs from its spec at {', '.join(model.changed)} "
+        raise ArgumentError(f"this model differs from its spec at {', '.join(model.departures)} "
                             "(Model.at), but the search varies the spec: recommend for the "
                             "spec with the values written in (Model.varied)")
     spec = model.spec

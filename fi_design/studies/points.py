@@ -87,9 +87,9 @@ def study_model(spec: _spec.Spec | Model, name: str = "spec") -> Model:
 
     if not isinstance(spec, Model):
         return resolve(as_spec(spec, name))
-    if spec.changed or spec.mode_scale != 1.0:
-        what = ", ".join(spec.changed + (("mode_scale",) if spec.mode_scale != 1.0 else ()))
-        raise ArgumentError(f"{name}: this model differs from its spec at {what} (Model.at), "
+    if spec.departures:
+        raise ArgumentError(f"{name}: this model differs from its spec at "
+                            f"{', '.join(spec.departures)} (Model.at), "
                             "so a study cannot vary it by spec paths nor cache its points: "
                             "give the spec (or the model resolved from it) and sweep these "
                             "values as axes")
