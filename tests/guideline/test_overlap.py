@@ -26,6 +26,9 @@ def test_background_hands_back_the_value_and_the_error():
 
 def test_the_study_runs_while_the_steps_do_and_a_failing_step_cancels_it(paper_spec,
                                                                         monkeypatch):
+    from fi_design.spec.paths import with_values
+
+    spec = with_values(paper_spec, {"requirements.robustness.samples": 32})
     started = threading.Event()
     chunks = []
     run_chunk = points.run_chunk
@@ -45,9 +48,9 @@ def test_the_study_runs_while_the_steps_do_and_a_failing_step_cancels_it(paper_s
     monkeypatch.setattr(evaluate_module, "step2_crossover", step2_fails)
     with ThreadPoolExecutor(1) as pool:
         with pytest.raises(RuntimeError, match="step 2 failed"):
-            evaluate_module.evaluate(paper_spec, executor=pool)
+            evaluate_module.evaluate(spec, executor=pool)
         pool.shutdown(wait=True)
-    samples = paper_spec.requirements.robustness.samples
+    samples = spec.requirements.robustness.samples
     total = len(points.chunks(2 * samples, points.chunk_size(2 * samples)))  # both plants
     # the chunks already queued when the step failed may run; the rest never start
     assert 1 <= len(chunks) < total, (len(chunks), total)
