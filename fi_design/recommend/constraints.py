@@ -246,11 +246,13 @@ def margin_screen(model: Model, margin: float, crossover: float | None = None) -
     from ..stage import stage_hunting
 
     fc = model.crossover if crossover is None else crossover
-    at = stage_hunting(model, True, crossover=fc, first_only=True, boundary=False, trace=False)
+    # the moves' outcomes decide: the cycle is not converged as an orbit (converge=False)
+    at = stage_hunting(model, True, crossover=fc, first_only=True, converge=False,
+                       boundary=False, trace=False)
     if at.hunts or not at.acceptable:
         return {"keeps": False, "hunts": at.hunts, "outcome": at.outcome, "tests": 1}
-    below = stage_hunting(model, True, crossover=fc / margin, first_only=True, boundary=False,
-                          trace=False)
+    below = stage_hunting(model, True, crossover=fc / margin, first_only=True, converge=False,
+                          boundary=False, trace=False)
     keeps = not below.hunts
     return {"keeps": keeps, "hunts": False,
             "outcome": "settles" if keeps else "hunts_below", "tests": 2}
@@ -259,7 +261,8 @@ def margin_screen(model: Model, margin: float, crossover: float | None = None) -
 def _settles(model: Model) -> bool:
     from ..stage import stage_hunting
 
-    return stage_hunting(model, True, first_only=True, boundary=False, trace=False).acceptable
+    return stage_hunting(model, True, first_only=True, converge=False, boundary=False,
+                         trace=False).acceptable
 
 
 def reserve_corners(model: Model) -> tuple[dict, ...]:
