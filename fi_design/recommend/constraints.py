@@ -248,11 +248,11 @@ def margin_screen(model: Model, margin: float, crossover: float | None = None) -
     fc = model.crossover if crossover is None else crossover
     # the moves' outcomes decide: the cycle is not converged as an orbit (converge=False)
     at = stage_hunting(model, True, crossover=fc, first_only=True, converge=False,
-                       boundary=False, trace=False)
+                       boundary=False, trace=False, order="spread")
     if at.hunts or not at.acceptable:
         return {"keeps": False, "hunts": at.hunts, "outcome": at.outcome, "tests": 1}
     below = stage_hunting(model, True, crossover=fc / margin, first_only=True, converge=False,
-                          boundary=False, trace=False)
+                          boundary=False, trace=False, order="spread")
     keeps = not below.hunts
     return {"keeps": keeps, "hunts": False,
             "outcome": "settles" if keeps else "hunts_below", "tests": 2}
@@ -262,7 +262,7 @@ def _settles(model: Model) -> bool:
     from ..stage import stage_hunting
 
     return stage_hunting(model, True, first_only=True, converge=False, boundary=False,
-                         trace=False).acceptable
+                         trace=False, order="spread").acceptable
 
 
 def reserve_corners(model: Model) -> tuple[dict, ...]:

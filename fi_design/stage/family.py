@@ -10,6 +10,8 @@ held alone (:func:`hold`, to continue a run from a state).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .. import spec as _spec
@@ -96,9 +98,17 @@ def family_reference(spec: _spec.Spec, distance: float, horizon: float) \
         The reference, and when the move ends [s].
     """
     mv = largest_move(spec)
-    move = _spec.Move(distance=distance, velocity=mv.velocity, acceleration=mv.acceleration,
-                      jerk=mv.jerk)
-    end = profile_duration(distance, mv.velocity, mv.acceleration, mv.jerk)
+    return _reference(float(distance), mv.velocity, mv.acceleration, mv.jerk, float(horizon))
+
+
+@functools.lru_cache(maxsize=512)
+def _reference(distance: float, velocity: float, acceleration: float, jerk: float | None,
+               horizon: float) -> tuple[Trajectory, float]:
+    """:func:`family_reference` of a profile, made once per process (a Trajectory is
+    read-only: the runs of every sample and candidate share it)."""
+    move = _spec.Move(distance=distance, velocity=velocity, acceleration=acceleration,
+                      jerk=jerk)
+    end = profile_duration(distance, velocity, acceleration, jerk)
     return from_moves((move,), end + horizon), end
 
 

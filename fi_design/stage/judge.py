@@ -16,7 +16,7 @@ from ..kernel.layout import PlantParameters
 from ..model import Model, as_model
 from ..results.stage import Cycle, StageHunting
 from .boundary import hunting_free_boundary
-from .moves import stage_hunts
+from .moves import ORDERS, stage_hunts
 from .orbit import converge_cycle
 from .runs import MoveRun
 from .settings import integrates
@@ -27,7 +27,7 @@ def stage_hunting(model: Model | _spec.Spec, isolated: bool | None = None, *,
                   crossover: float | None = None,
                   family: Sequence[float] | None = None, first_only: bool = False,
                   converge: bool = True, boundary: bool = True, trace: bool = True,
-                  progress: Callable[[str], None] | None = None) -> StageHunting:
+                  order: str = ORDERS[0], progress: Callable[[str], None] | None = None) -> StageHunting:
     """The stage-level hunting answer of one plant.
 
     Parameters
@@ -49,6 +49,10 @@ def stage_hunting(model: Model | _spec.Spec, isolated: bool | None = None, *,
         Find the hunting-free crossover (the cycle's fold).
     trace : bool
         Keep one period of the cycle for plots.
+    order : {"size", "spread"}
+        The order the family's moves are run in
+        (:func:`~fi_design.stage.moves.stage_hunts`); with ``first_only`` it
+        decides which hunting move is met first, never whether one is.
     progress : callable, optional
         ``progress(text)`` as the work proceeds.
 
@@ -67,7 +71,8 @@ def stage_hunting(model: Model | _spec.Spec, isolated: bool | None = None, *,
     plant = "isolated" if iso else "non_isolated"
     say = progress or (lambda text: None)
     say(f"simulating the move family ({plant.replace('_', '-')} plant) ...")
-    outcomes, runs = stage_hunts(model, iso, family=family, first_only=first_only)
+    outcomes, runs = stage_hunts(model, iso, family=family, first_only=first_only,
+                                  order=order)
     hunting = [r for r in runs if r.outcome.hunts]
     cycle = None
     others: list[Cycle] = []

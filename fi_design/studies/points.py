@@ -117,7 +117,8 @@ def evaluate_point(model: Model, values: Mapping[str, Any], isolated: bool,
         largest of their cycles' peak to peak (``hunting_cycles`` None); when
         all come to rest, ``settled`` with amplitude 0; a move that sticks or
         cannot be judged makes the point ``stuck`` or ``undetermined``.
-        ``"stage_first"``: the same, but the moves stop at the first that
+        ``"stage_first"``: the same, but the moves, the largest first
+        (:func:`~fi_design.stage.moves.spread`), stop at the first that
         hunts (``amplitude`` is that move's cycle).
 
     Returns
@@ -160,7 +161,8 @@ def _stage_point(point: Model, isolated: bool, first_only: bool = False) -> dict
     from ..stage import stage_hunts
 
     try:
-        moves, _ = stage_hunts(point, isolated, first_only=first_only)
+        moves, _ = stage_hunts(point, isolated, first_only=first_only,
+                               order="spread" if first_only else "size")
     except FiDesignError as exc:
         return _outcome("failed", "failed", message=str(exc))
     except Exception as exc:  # noqa: BLE001 -- one bad point must not stop a sweep

@@ -208,9 +208,9 @@ def robustness(spec: _spec.Spec | Model, scatter: Sequence[Scatter] = (), sample
         As for :func:`~.sweeps.sweep`.
     measure : {"stage", "move"}, optional
         ``"stage"`` (default): per point, whether any move of the family ends
-        in a sustained cycle (:mod:`fi_design.stage`; the moves stop at the
-        first that does, so the amplitude is that move's cycle, not the
-        largest); ``"move"``: the paper's hunting metric on the spec's own
+        in a sustained cycle (:mod:`fi_design.stage`; the moves, the largest
+        first (:func:`~fi_design.stage.moves.spread`), stop at the first that
+        does, so the amplitude is that move's cycle, not the largest); ``"move"``: the paper's hunting metric on the spec's own
         move.
     friction_gap : float, optional
         Draw friction jointly: static friction is the sample's Coulomb

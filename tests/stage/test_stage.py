@@ -342,3 +342,42 @@ def test_the_match_tolerance_grows_with_the_known_cycle(paper_spec, monkeypatch)
     assert tol(params, [cycle(5e-3)]) == MATCH_CAP
     monkeypatch.setattr(stage_runs, "MATCH", 0.0)
     assert tol(params, [cycle(5e-3)]) == 0.0  # the rule off
+
+
+# --------------------------------------------------------------------------- the order of the moves
+
+
+def test_spread_order_is_a_permutation_that_starts_large_and_halves_the_sizes():
+    from fi_design.stage.moves import spread
+
+    d = tuple(float(x) for x in np.geomspace(1e-5, 1e-2, 8))
+    out = spread(d)
+    assert sorted(out) == sorted(d)
+    # the largest, then the middle of the rest, then the middles of its halves
+    assert [d.index(x) for x in out] == [7, 3, 1, 5, 0, 2, 4, 6]
+    both = d + tuple(-x for x in d)
+    out2 = spread(both)
+    assert sorted(out2) == sorted(both)
+    assert out2[:2] == (d[7], -d[7])  # one size, both directions, together
+    assert spread(()) == ()
+
+
+@pytest.mark.parametrize("crossover", [5.0, 8.0, 14.0])
+def test_the_spread_order_changes_which_hunting_move_is_met_first_never_whether(
+        paper_spec, crossover):
+    """A caller that reads only whether some move hunts (first_only) gets the same answer in
+    either order; the spread order meets it after fewer moves where the large moves hunt.
+    At 14 Hz no move hunts: both run every move and agree move for move."""
+    size, _ = stage_hunts(paper_spec, True, crossover=crossover, first_only=True)
+    fast, _ = stage_hunts(paper_spec, True, crossover=crossover, first_only=True,
+                          order="spread")
+    assert any(m.hunts for m in size) == any(m.hunts for m in fast)
+    assert fast[0].label == "spec" and size[0].label == "spec"
+    if any(m.hunts for m in size):
+        assert len(fast) < len(size)
+        assert fast[-1].hunts and sum(m.hunts for m in fast) == 1
+    else:
+        assert sorted((m.distance, m.outcome) for m in fast) == \
+            sorted((m.distance, m.outcome) for m in size)
+    with pytest.raises(Exception, match="order must be one of"):
+        stage_hunts(paper_spec, True, order="random")
