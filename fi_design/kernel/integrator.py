@@ -110,9 +110,12 @@ FAC_MAX = 6.0  # hnew / h <= 6
 # --------------------------------------------------------------------------- small helpers
 
 
-@kernel_function((f8, A1, A2, i8))
+@kernel_function((f8, A1, A2, i8), inline=True)
 def reference_at(t, breaks, coeffs, k):
     """Reference position, velocity, acceleration and jerk at ``t``, and the segment index.
+
+    Inlined into its callers: as a call it made the integrator a third slower
+    (around a call the caller keeps its live values in memory).
 
     ``k`` is a hint (the last segment used); the search walks from there.
     Before the first break the reference holds ``coeffs[0, 0]`` and after the
@@ -191,10 +194,10 @@ def law_rate(y, p, modes, r, rd, rdd, f, ii):
     return p[P_KI] * e + p[P_KP] * (rd - xd) + p[P_KD] * (rdd - xdd) - p[P_KDM] * xdd
 
 
-@kernel_function((A2, I1))
-def lu_factor(A, piv):
-    """In-place LU decomposition with partial pivoting; returns False if singular."""
-    n = A.shape[0]
+@kernel_function((A2, I1, i8), inline=True)
+def _lu(A, piv, n):
+    """:func:`lu_factor` of the leading ``n`` x ``n`` block (inlined: a constant ``n``
+    unrolls its loops)."""
     for k in range(n):
         m = k
         big = abs(A[k, k])
@@ -220,20 +223,15 @@ def lu_factor(A, piv):
     return True
 
 
-@kernel_function((A2, f8, A2, I1, A2))
-def struct_factor(J, sigma, M, piv, w):
-    """Factor E = sigma I - J using the plant's structure.
+@kernel_function((A2, I1))
+def lu_factor(A, piv):
+    """In-place LU decomposition with partial pivoting; returns False if singular."""
+    return _lu(A, piv, A.shape[0])
 
-    The last three states (bristle z, integrator I, controller output u) are
-    "leaves": each depends only on the mechanical core and itself (u also on
-    I), and the core sees them through its own rows of J. Eliminating them
-    leaves a Schur complement on the core (4 x 4 isolated, 2 x 2 rigid),
-    factored with partial pivoting, U's diagonal stored as its reciprocal.
-    ``w`` (shape (4, max(nc, 3))) keeps the elimination coefficients for
-    :func:`struct_solve`. Returns False if singular.
-    """
-    n = J.shape[0]
-    nc = n - 3
+
+@kernel_function((A2, f8, A2, I1, A2, i8), inline=True)
+def _struct_factor(J, sigma, M, piv, w, nc):
+    """:func:`struct_factor` with a core of ``nc`` states."""
     iz = nc
     ii = nc + 1
     iu = nc + 2
@@ -254,7 +252,7 @@ def struct_factor(J, sigma, M, piv, w):
             if i == c:
                 v += sigma
             M[i, c] = v
-    if not lu_factor(M, piv):
+    if not _lu(M, piv, nc):
         return False
     # the diagonal of U as its reciprocal: the six solves of a step multiply instead of
     # dividing (a division's latency, four in a row per solve, was much of their time)
@@ -263,11 +261,30 @@ def struct_factor(J, sigma, M, piv, w):
     return True
 
 
-@kernel_function((A2, A2, I1, A2, A1, A1))
-def struct_solve(J, M, piv, w, b, tmp):
-    """Solve (sigma I - J) x = b in place with the factors of :func:`struct_factor`."""
-    n = J.shape[0]
-    nc = n - 3
+@kernel_function((A2, f8, A2, I1, A2), inline=True)
+def struct_factor(J, sigma, M, piv, w):
+    """Factor E = sigma I - J using the plant's structure.
+
+    The last three states (bristle z, integrator I, controller output u) are
+    "leaves": each depends only on the mechanical core and itself (u also on
+    I), and the core sees them through its own rows of J. Eliminating them
+    leaves a Schur complement on the core (4 x 4 isolated, 2 x 2 rigid),
+    factored with partial pivoting, U's diagonal stored as its reciprocal.
+    ``w`` (shape (4, max(nc, 3))) keeps the elimination coefficients for
+    :func:`struct_solve`. Returns False if singular.
+
+    Each plant's core size is a constant in its branch (:func:`_struct_factor`
+    inlined), so the small loops unroll; this function is inlined into
+    :func:`factor_e` in turn.
+    """
+    if J.shape[0] - 3 == N_CORE_RIGID:
+        return _struct_factor(J, sigma, M, piv, w, N_CORE_RIGID)
+    return _struct_factor(J, sigma, M, piv, w, N_CORE_ISO)
+
+
+@kernel_function((A2, A2, I1, A2, A1, A1, i8), inline=True)
+def _struct_solve(J, M, piv, w, b, tmp, nc):
+    """:func:`struct_solve` with a core of ``nc`` states."""
     iz = nc
     ii = nc + 1
     iu = nc + 2
@@ -305,6 +322,16 @@ def struct_solve(J, M, piv, w, b, tmp):
     b[ii] = yI
     b[iu] = yu
     b[iz] = yz
+
+
+@kernel_function((A2, A2, I1, A2, A1, A1), inline=True)
+def struct_solve(J, M, piv, w, b, tmp):
+    """Solve (sigma I - J) x = b in place with the factors of :func:`struct_factor`
+    (the core's size a constant in each branch, as there)."""
+    if J.shape[0] - 3 == N_CORE_RIGID:
+        _struct_solve(J, M, piv, w, b, tmp, N_CORE_RIGID)
+    else:
+        _struct_solve(J, M, piv, w, b, tmp, N_CORE_ISO)
 
 
 @kernel_function((A2, f8, A2, I1, A2, b1))
@@ -758,8 +785,9 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
         modes[MODE_STICK] = 1 if y[iv2] == 0.0 else 0
     hints = np.zeros(N_HINTS, dtype=np.int64)
 
-    # delay history of the continuous controller's output (rows HT, HU, HDU, HUR, HDUR)
-    hist = np.zeros((5, HIST))
+    # delay history of the continuous controller's output (rows HT, HU, HDU, HUR, HDUR);
+    # only a delayed continuous controller reads it (no need to zero 320 kB every run)
+    hist = np.zeros((5, HIST if cont_delay else 1))
     head = 0
     count = 0
     jump_pending = False

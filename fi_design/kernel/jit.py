@@ -31,16 +31,21 @@ I1 = _nt.int64[::1]
 SIGNATURES: dict[str, tuple] = {}
 
 
-def kernel_function(signature, *, refcounted: bool = False):
+def kernel_function(signature, *, refcounted: bool = False, inline: bool = False):
     """numba's ``njit`` for a kernel function with its explicit ``signature`` (argument types).
 
     ``refcounted`` keeps numba's reference counting (a function that
     allocates arrays); the helpers go without it, since counting the array
-    arguments of every call was half the kernel's run time.
+    arguments of every call was half the kernel's run time. ``inline``
+    inlines the function into its callers (numba's ``inline="always"``): a
+    caller that passes a constant size gets loops of a constant length,
+    which the compiler unrolls.
     """
     options = dict(error_model="numpy")
     if not refcounted:
         options["_nrt"] = False
+    if inline:
+        options["inline"] = "always"
     lazy = bool(os.environ.get(AOT_BUILD_ENV))
 
     def decorate(fn):
