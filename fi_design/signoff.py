@@ -25,7 +25,7 @@ __all__ = ["design"]
 def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
            executor: Any = None, progress: Callable[[str], None] | None = None,
            recommend: bool = True, fe_check: bool = False,
-           sensitivity: bool = False) -> DesignResult:
+           sensitivity: bool = False, cache: Any = None) -> DesignResult:
     """Run the guideline on a spec, confirm it by simulation, and recommend when it fails.
 
     Parameters
@@ -53,6 +53,11 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
         LuGre values sigma0, sigma1 and vs (see
         :func:`fi_design.guideline.evaluate.evaluate`; a few seconds). Default False;
         the design command runs it for a report.
+    cache : bool, path or fi_design.recommend.stored.SearchStore, optional
+        Where design searches are kept (see :func:`fi_design.recommend.recommend`):
+        None or False (default) none, True the user cache folder, a path that
+        folder; the design command keeps them there, so its next step
+        (``fi-design recommend``) reads the search back.
 
     Returns
     -------
@@ -72,5 +77,5 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
 
     if progress is not None:
         progress("searching for a design that passes ...")
-    found = search(result.spec, executor=executor, progress=progress)
+    found = search(result.spec, executor=executor, progress=progress, cache=cache)
     return replace(result, recommendation=recommendation(found))

@@ -179,9 +179,11 @@ def sharing_designs():
             spec, confirm=confirm, executor=executor, progress=progress, **kwargs), confirm,
             *sorted(kwargs.items()))
 
-    def recommend(spec, *, executor=None, progress=None, **kwargs):
+    def recommend(spec, *, executor=None, progress=None, cache=None, **kwargs):
+        # the cache changes where a search comes from, not what it finds
         if kwargs:
-            return real_recommend(spec, executor=executor, progress=progress, **kwargs)
+            return real_recommend(spec, executor=executor, progress=progress, cache=cache,
+                                  **kwargs)
         return shared("recommend", spec, lambda: real_recommend(
             spec, executor=executor, progress=progress))
 

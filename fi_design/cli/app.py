@@ -82,6 +82,7 @@ def design_command(
         "--no-recommend", help="On a FAIL verdict, skip the search for a design that passes "
                                "(it takes seconds to a minute; the command fi-design recommend "
                                "runs it alone).")] = False,
+    no_cache: NoCache = False,
     force: Force = False,
 ) -> None:
     """Run the four-step guideline on a spec and confirm it by simulation (the default command).
@@ -93,7 +94,9 @@ def design_command(
     with its reasons, the hunting probability under friction scatter, the
     margins and, when it fails, a design that passes, found by search);
     writes JSON and the sign-off report (HTML or PDF) on request. With
-    --fail-on, exits 3 when the verdict is at or below that level.
+    --fail-on, exits 3 when the verdict is at or below that level. The design
+    search is kept in the result cache: run again on the same spec, or as
+    fi-design recommend, it is read back.
     """
     levels = {"fail": "NOT_CONFIRMED", "warn": "PASS_WITH_WARNINGS"}
     if fail_on is not None and fail_on not in levels:
@@ -120,7 +123,7 @@ def design_command(
             Status(err, "running the design guideline ...") as status:
         result = design(spec_obj, confirm=not no_simulation, executor=pool, progress=status,
                         recommend=not no_recommend, fe_check=outs["report"] is not None,
-                        sensitivity=outs["report"] is not None)
+                        sensitivity=outs["report"] is not None, cache=not no_cache)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
     if outs["spec"] is not None:
         from ..controller.handoff import gains_spec_text
@@ -480,6 +483,7 @@ def recommend_command(
     jobs: Jobs = 0,
     executor: ExecutorKind = "local",
     scheduler: Scheduler = None,
+    no_cache: NoCache = False,
     force: Force = False,
 ) -> None:
     """Search a buildable isolator (and the rule's crossover) for the stiffest design that passes.
@@ -490,7 +494,9 @@ def recommend_command(
     requirements.hunting_margin with the reserves of requirements.reserve.
     Prints the design beside the spec's, its guide, what binds it and the
     least change of the spec that passes; with none feasible, the nearest
-    design and what it violates.
+    design and what it violates. A search of the same spec by the same code
+    (this command's, or the design command's on a failing spec) is read from
+    the result cache.
     """
     outs = check_outputs((spec,), force, json=(json_out, (".json",)),
                          report=(report_out, (".html", ".pdf")),
@@ -505,7 +511,7 @@ def recommend_command(
     console, err = make_console(), make_console(stderr=True)
     # the pool's workers fork before the spinner's thread starts (fork and threads do not mix)
     with pool as ex, Status(err, "searching the design space ...") as status:
-        result = recommend(spec_obj, executor=ex, progress=status)
+        result = recommend(spec_obj, executor=ex, progress=status, cache=not no_cache)
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
     if outs["spec"] is not None and result.feasible:
         payloads["spec"] = recommended_spec_text(result)

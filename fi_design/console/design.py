@@ -11,6 +11,7 @@ from ..display import number, percent, quantity, with_error
 from ..results.stage import STATIC_ERROR_FORMULA
 from .common import heading, status_text, table
 from .confirmation import moves_strips, simulation_table
+from .recommend import search_origin
 
 if TYPE_CHECKING:  # pragma: no cover
     from rich.console import Console
@@ -359,6 +360,10 @@ def print_verdict(console: "Console", result) -> None:
         body.add_row(Text("Next", style="bold"), Text(v.next_step))
     console.print(Panel(body, title=Text(f"Verdict: {v.status}", style=f"bold {colour}"),
                         title_align="left", border_style=colour, box=getattr(box, frame)))
+    search = None if result.recommendation is None else result.recommendation.search
+    cached = None if search is None else search_origin(search)
+    if cached is not None:  # the advice's search read from the cache: where from (a path folds)
+        console.print(f"The design search: {cached}", markup=False, highlight=False)
 
 
 def _spec_name(result) -> str:

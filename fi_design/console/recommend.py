@@ -24,6 +24,26 @@ def _margin(x: float | None) -> str:
     return "no cycle found" if math.isinf(x) else number(x, 3)
 
 
+def search_origin(result) -> str | None:
+    """Where a design search's result came from, when it was read from the cache.
+
+    Parameters
+    ----------
+    result : fi_design.results.recommend.RecommendResult
+        The search.
+
+    Returns
+    -------
+    str or None
+        ``from the cache (FOLDER), run earlier with N stage-level evaluations
+        in T s``; None for a search run by this call.
+    """
+    if result.from_cache is None:
+        return None
+    return (f"from the cache ({Path(result.from_cache).parent}), run earlier with "
+            f"{result.evaluations} stage-level evaluations in {fixed(result.wall_time, 1)} s")
+
+
 def print_recommendation(console: "Console", result, spec_path: Optional[Path] = None) -> None:
     """Print a design search: the design beside the spec's, its guide, reserves, least change.
 
@@ -101,5 +121,7 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
     for a in result.assumptions:
         console.print(Text("Assumed: ", style="dim").append(a, style="dim"))
     console.print(Text("Advice: ", style="bold").append(result.advice))
-    console.print(f"{result.evaluations} stage-level evaluations in {fixed(result.wall_time, 1)} s",
+    cached = search_origin(result)
+    console.print(f"The design search: {cached}" if cached is not None else
+                  f"{result.evaluations} stage-level evaluations in {fixed(result.wall_time, 1)} s",
                   markup=False, highlight=False)

@@ -16,7 +16,9 @@ the spec that passes:
 - :mod:`.objective`: the stiffest joint first, what binds, the trade-off;
 - :mod:`.search`: the search itself;
 - :mod:`.least`: the least change of the spec that passes;
-- :mod:`.write`: the design written into the user's spec.
+- :mod:`.write`: the design written into the user's spec;
+- :mod:`.stored`: the searches kept on disk, read back for the same spec and
+  code (``recommend(..., cache=True)``).
 """
 
 from __future__ import annotations

@@ -334,7 +334,8 @@ class _Search:
 
 
 def recommend(spec: _spec.Spec | Model | str | Any, *, executor: Any = None,
-              progress: Callable[[str], None] | None = None) -> RecommendResult:
+              progress: Callable[[str], None] | None = None,
+              cache: Any = None) -> RecommendResult:
     """Search a buildable isolator (and the rule's crossover) that the sign-off passes.
 
     Parameters
@@ -351,6 +352,14 @@ def recommend(spec: _spec.Spec | Model | str | Any, *, executor: Any = None,
         runs them here. The library creates no pool.
     progress : callable, optional
         ``progress(text)`` as the search proceeds.
+    cache : bool, path or fi_design.recommend.stored.SearchStore, optional
+        Where searches are kept (:mod:`fi_design.recommend.stored`): a search
+        of the same spec by the same code is read back instead of run again
+        (its result's ``from_cache`` says so), a search run is stored. None or
+        False (default): none; True: the user cache folder
+        (``$FI_DESIGN_CACHE_DIR/recommend`` when the variable is set); a path:
+        that folder. The executor and ``progress`` do not change the result,
+        so they are not part of its key.
 
     Returns
     -------
@@ -369,11 +378,9 @@ def recommend(spec: _spec.Spec | Model | str | Any, *, executor: Any = None,
     SpecError
         A path or mapping that does not validate.
     """
-    from ..guideline.steps import step2_crossover
-    from .least import least_change
-
     from ..model import as_model
     from ..spec.file import as_spec
+    from .stored import open_store
 
     start = _time.perf_counter()
     model = as_model(spec if isinstance(spec, Model) else as_spec(spec))  # the edge: once
@@ -383,8 +390,28 @@ def recommend(spec: _spec.Spec | Model | str | Any, *, executor: Any = None,
         raise ArgumentError(f"this model differs from its spec at {', '.join(model.departures)} "
                             "(Model.at), but the search varies the spec: recommend for the "
                             "spec with the values written in (Model.varied)")
-    spec = model.spec
     say = progress or (lambda text: None)
+    store = open_store(cache)
+    if store is not None:
+        found = store.get(model.spec)
+        if found is not None:
+            say(f"the design search: from the cache ({store.directory})")
+            log.info("recommendation for %r read from %s", model.spec.name, found.from_cache)
+            return found
+    result = _searched(model, executor, say, start)
+    if store is not None:
+        store.put(model.spec, result)
+    return result
+
+
+def _searched(model: Model, executor: Any, say: Callable[[str], None],
+              start: float) -> RecommendResult:
+    """The search itself on a resolved model (:func:`recommend` without the cache); ``start``
+    is when the call began (:func:`time.perf_counter`), for its wall time."""
+    from ..guideline.steps import step2_crossover
+    from .least import least_change
+
+    spec = model.spec
     srch = _Search(model, executor, say)
     srch.run()
     chosen, signed = None, (None, None, None)

@@ -121,7 +121,9 @@ def recommend_context(result: RecommendResult, *, date: Any = None, command: str
               "after every move of its family with the fold of its cycle; the stiffest that "
               "keeps the hunting margin refined, then signed off with its reserves, stiffest "
               f"first. {result.evaluations} stage-level evaluations in "
-              f"{num(result.wall_time, 3)} s.")
+              f"{num(result.wall_time, 3)} s"
+              + (" (read from the result cache: the same search of the same spec by the same "
+                 "code, run earlier)." if result.from_cache is not None else "."))
     sections = [Section("recommendation", head, paragraphs=tuple(paras + least_paras),
                         tables=tuple(tables)),
                 Section("design-space", "The design space and the trade-off",

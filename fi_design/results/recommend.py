@@ -173,12 +173,18 @@ class RecommendResult(Result):
     evaluations : int
         Stage-level evaluations (one move family each) the search made.
     wall_time : float
-        Time the search took [s].
+        Time the search took when it ran [s] (a result read from the cache
+        keeps the time of the run that computed it: see ``from_cache``).
     notch : fi_design.results.controller.Filter or None
         The notch the search added to the drive's chain
         (``requirements.recommend.filters``); None: the chain as the spec has it.
+    from_cache : str or None
+        The cache entry this result was read from
+        (:mod:`fi_design.recommend.stored`): a search of the same spec by the
+        same code, run earlier; None when the search ran in this call.
     fi_design_source : fi_design.provenance.Source
-        The code that produced it.
+        The code that produced it (for a result read from the cache, the run
+        that computed it: the same version and code digest).
     """
 
     spec: "Spec" = field(repr=False)
@@ -205,6 +211,7 @@ class RecommendResult(Result):
     evaluations: int
     wall_time: float
     notch: Any = None
+    from_cache: str | None = None
     fi_design_source: Source = field(default_factory=current_source)
 
     @property
@@ -222,7 +229,9 @@ class RecommendResult(Result):
         """The contract: ``feasible``, ``isolator``, ``crossover``, ``flexure``, ``binding``,
         ``least_change``, ``stage_hunting``, ``robustness``, ``reserves``, ``forces``,
         ``margins``, ``pareto``, the ``notch`` the search added (null: none); the nearest
-        design's ``violates``, the ``advice`` and every judged ``candidate``."""
+        design's ``violates``, the ``advice``, every judged ``candidate``, the search's
+        ``evaluations`` and ``wall_time`` [s], and ``from_cache`` (the cache entry it was read
+        from; null: computed by this run)."""
         return {
             "feasible": self.feasible, "isolator": to_jsonable(self.isolator),
             "crossover": self.crossover,
@@ -241,4 +250,5 @@ class RecommendResult(Result):
             "map": {"strokes": list(self.strokes), "stiffnesses": list(self.stiffnesses),
                     "candidates": [c.to_dict() for c in self.candidates]},
             "evaluations": self.evaluations, "wall_time": self.wall_time,
+            "from_cache": self.from_cache,
             **header(source=self.fi_design_source)}

@@ -72,6 +72,87 @@ def test_json_contract(design_run, paper_spec_path):
     assert sorted(p.name for p in out.parent.iterdir()) == ["result.json"]
 
 
+def test_the_design_command_and_recommend_share_the_search_in_the_cache(
+        tmp_path, monkeypatch, caplog, design_run, paper_spec_path):
+    """The design command on a failing spec keeps its design search in the result cache; its
+    next step (`fi-design recommend`) and the same command again read it back, their JSON
+    that of the search computed; --no-cache neither reads nor writes it; a damaged entry is
+    computed again, a cache that cannot be written is a warning. The design and the search are
+    the session's (computed once, :func:`shared`), the search counted where it runs."""
+    import importlib
+    import logging
+    import pickle
+
+    from fi_design.guideline import evaluate as guideline
+
+    from conftest import shared
+
+    search = importlib.import_module("fi_design.recommend.search")
+    real_search, real_design = search._searched, guideline.evaluate
+    runs = []
+
+    def searched(model, executor, say, start):
+        runs.append(model.spec.name)
+        return shared("recommend", model.spec, lambda: real_search(model, executor, say, start))
+
+    def evaluate(spec, *, confirm=True, executor=None, progress=None, **kwargs):
+        return shared("design", spec, lambda: real_design(
+            spec, confirm=confirm, executor=executor, progress=progress, **kwargs), confirm,
+            *sorted(kwargs.items()))
+
+    monkeypatch.setattr(search, "_searched", searched)
+    monkeypatch.setattr(guideline, "evaluate", evaluate)
+    monkeypatch.setenv("FI_DESIGN_CACHE_DIR", str(tmp_path / "cache"))
+    folder, spec = tmp_path / "cache" / "recommend", str(paper_spec_path)
+
+    def run(*args):  # the output, and the output without line breaks (a long path folds)
+        r = runner.invoke(app, [*args, "--force"])
+        assert r.exit_code == 0, r.output
+        return " ".join(r.stdout.split()), "".join(r.stdout.split())
+
+    def read(name):
+        return json.loads((tmp_path / name).read_text())
+
+    # the design command on a failing spec searches and keeps the search
+    out, _ = run(spec, "--json", str(tmp_path / "a.json"))
+    assert len(runs) == 1 and "from the cache" not in out
+    [entry] = folder.iterdir()
+    kept = (entry.stat().st_ino, entry.stat().st_mtime_ns, entry.read_bytes())
+    # its next step reads it back, and so does the same command again
+    out, joined = run("recommend", spec, "--json", str(tmp_path / "r.json"), "-j", "1")
+    assert len(runs) == 1 and "The design search: from the cache (" in out
+    assert f"({folder})" in joined
+    out, joined = run(spec, "--json", str(tmp_path / "b.json"))
+    assert len(runs) == 1 and "The design search: from the cache (" in out
+    assert f"({folder})" in joined
+    computed, again, alone = read("a.json"), read("b.json"), read("r.json")
+    assert computed["recommendation"].pop("from_cache") is None
+    assert again["recommendation"].pop("from_cache") == str(entry)
+    assert again == computed
+    assert alone.pop("from_cache") == str(entry)
+    assert alone == {k: v for k, v in computed["recommendation"].items() if k != "text"}
+    # --no-cache: the search runs, the entry is neither read nor written
+    run(spec, "--json", str(tmp_path / "c.json"), "--no-cache")
+    out, _ = run("recommend", spec, "-j", "1", "--no-cache")
+    assert len(runs) == 3 and "from the cache" not in out
+    assert list(folder.iterdir()) == [entry]
+    assert (entry.stat().st_ino, entry.stat().st_mtime_ns, entry.read_bytes()) == kept
+    # a damaged entry is computed again and replaced, never an error
+    entry.write_bytes(b"not a pickle")
+    with caplog.at_level(logging.WARNING, logger="fi_design.recommend.stored"):
+        out, _ = run("recommend", spec, "-j", "1")
+    assert len(runs) == 4 and "from the cache" not in out and "runs again" in caplog.text
+    assert pickle.loads(entry.read_bytes())["key"] == entry.stem
+    # a cache that cannot be written: a warning; the command does its work
+    blocked = tmp_path / "blocked"
+    blocked.write_text("")
+    monkeypatch.setenv("FI_DESIGN_CACHE_DIR", str(blocked))
+    with caplog.at_level(logging.WARNING, logger="fi_design.recommend.stored"):
+        run("recommend", spec, "--json", str(tmp_path / "d.json"), "-j", "1")
+    assert len(runs) == 5 and "was not cached" in caplog.text
+    assert read("d.json") == {**alone, "from_cache": None}
+
+
 def test_options_before_spec_and_explicit_command(tmp_path, paper_spec_path, monkeypatch):
     calls = []
     _fake_design(monkeypatch, calls)

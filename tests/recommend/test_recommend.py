@@ -34,10 +34,18 @@ def paper_file(paper_spec_path, tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def paper_recommendation(paper_file):
+def search_cache(tmp_path_factory):
+    """The folder the paper setup's search is kept in (``FI_DESIGN_CACHE_DIR/recommend``)."""
+    return tmp_path_factory.mktemp("cache") / "recommend"
+
+
+@pytest.fixture(scope="module")
+def paper_recommendation(paper_file, search_cache):
+    """The search of the paper setup (30 scatter samples), run once and kept in
+    :func:`search_cache`."""
     from fi_design.spec.file import load_spec
 
-    return recommend(load_spec(paper_file))
+    return recommend(load_spec(paper_file), cache=search_cache)
 
 
 def test_the_recommendation_is_a_buildable_stiff_joint_bound_by_physics(paper_recommendation):
@@ -293,3 +301,55 @@ def test_a_recommendation_with_the_notch_writes_it_and_passes(paper_spec, tmp_pa
     assert [f.type for f in written.controller.filters] == ["notch"]
     assert written.controller.filters[0].frequency == pytest.approx(150.0)
     assert evaluate(written).verdict.status != "FAIL"
+
+
+# --------------------------------------------------------------------------- read back
+
+
+def test_the_search_read_back_is_the_search_computed(paper_recommendation, paper_file,
+                                                     search_cache, monkeypatch):
+    """The paper setup's search, computed once and kept, read back by the next search of its
+    spec (the search itself would fail): its JSON and its report are those of the search
+    computed, but for saying where the result came from; through the command too."""
+    import importlib
+    from datetime import date
+
+    from typer.testing import CliRunner
+
+    from fi_design.cli.app import app
+    from fi_design.report import build_context
+    from fi_design.spec.file import load_spec
+
+    search = importlib.import_module("fi_design.recommend.search")
+
+    def searched(*args, **kwargs):
+        raise AssertionError("the search ran again")
+
+    monkeypatch.setattr(search, "_searched", searched)
+    computed = paper_recommendation
+    again = recommend(load_spec(paper_file), cache=search_cache)
+    assert computed.from_cache is None and again.from_cache is not None
+    assert again.from_cache.startswith(str(search_cache))
+    data, expected = again.to_dict(), computed.to_dict()
+    assert data.pop("from_cache") == again.from_cache and expected.pop("from_cache") is None
+    assert data == expected                     # wall time and evaluations: the computing run's
+    day = date(2024, 5, 1)
+    report, report_computed = (json.dumps(build_context(r, date=day, figures=False),
+                                          sort_keys=True, default=str)
+                               for r in (again, computed))
+    note = " (read from the result cache: the same search of the same spec by the same code, " \
+           "run earlier)."
+    assert note in report and note not in report_computed
+    assert report.replace(note, ".") == report_computed
+    # the command reads the same entry (FI_DESIGN_CACHE_DIR/recommend)
+    monkeypatch.setenv("FI_DESIGN_CACHE_DIR", str(search_cache.parent))
+    out = paper_file.parent / "read_back.json"
+    r = CliRunner().invoke(app, ["recommend", str(paper_file), "--json", str(out), "-j", "1",
+                                 "--force"])
+    assert r.exit_code == 0, r.output
+    assert "The design search: from the cache (" in " ".join(r.stdout.split())
+    assert f"({search_cache})" in "".join(r.stdout.split())       # a long path folds
+    data = json.loads(out.read_text())
+    assert data.pop("from_cache") == again.from_cache
+    assert data == json.loads(json.dumps(expected))
+
