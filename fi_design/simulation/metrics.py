@@ -78,12 +78,16 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     a, b = np.searchsorted(t, (w0, w1))
     tw, ew = _finite(t[a:b], e[a:b])
     idx = np.zeros(0, dtype=int)
-    if len(tw) > 1:
+    amplitude = float(np.ptp(ew)) if len(ew) else float("nan")
+    # a peak's prominence is at most the trace's range: below min_height, no side has one
+    if len(tw) > 1 and amplitude >= min_height:
         distance = _peak_distance(np.diff(tw), min_distance)
         # a peak must stand out by min_height from its surroundings (prominence), so a
         # plateau's numerical noise or a secondary bump of one period is no cycle; a cycle
         # below the target shows its negative peaks: count the side that shows more
         for y in (ew, -ew):
+            if y.max() < min_height:
+                continue  # no sample reaches the least peak height on this side
             found, _ = find_peaks(y, height=min_height, prominence=min_height,
                                   distance=distance)
             found = _one_per_plateau(y, found, min_height)
@@ -91,7 +95,6 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
                 idx = found
     peaks_t, peaks_h = tw[idx], ew[idx]
     cycles = int(len(idx))
-    amplitude = float(np.ptp(ew)) if len(ew) else float("nan")
     period = float(np.mean(np.diff(peaks_t))) if cycles >= 2 else None
     # the last finite error (a failed run ends in NaN)
     end = e[-1:] if len(e) and np.isfinite(e[-1]) else e[np.isfinite(e)][-1:]
