@@ -47,12 +47,11 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     """
     from .build import compiled  # not at import: `python -m fi_design.kernel.build` runs it
 
-    # fresh writable copies: compiled code types read-only arrays differently
-    p = np.array(params, dtype=np.float64)
-    y = np.array(y0, dtype=np.float64)
-    t_out = np.array(t_out, dtype=np.float64)
-    in_t = np.zeros(0) if input_time is None else np.array(input_time, dtype=np.float64)
-    in_f = np.zeros(0) if input_force is None else np.array(input_force, dtype=np.float64)
+    p = _taken(params)
+    y = _taken(y0)
+    t_out = _taken(t_out)
+    in_t = np.zeros(0) if input_time is None else _taken(input_time)
+    in_f = np.zeros(0) if input_force is None else _taken(input_force)
     n = y.shape[0]
     m = t_out.shape[0]
     # the kernel writes every output row up to where it stopped; the rest is NaN (below)
@@ -73,10 +72,9 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     cross_e = np.full((k, 2), np.nan)
     y_end = np.full(n, np.nan)
     status = compiled().integrate(
-        p, y, np.array(breaks, dtype=np.float64), np.array(coeffs, dtype=np.float64, order="C"),
-        bool(land), float(t_end), t_out, float(rtol), np.array(atol, dtype=np.float64),
-        float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r, out_fa, out_cmd,
-        stats, w, cross_t, cross_y, cross_e, y_end)
+        p, y, _taken(breaks), _taken(coeffs), bool(land), float(t_end), t_out, float(rtol),
+        _taken(atol), float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r,
+        out_fa, out_cmd, stats, w, cross_t, cross_y, cross_e, y_end)
     written = int(stats[ST_OUT])
     for arr in (out_y, out_r, out_fa, out_cmd):
         arr[written:] = np.nan
@@ -88,3 +86,9 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
                        final_state=y_end, stop=STOP_TEXT[int(stats[ST_STOP])],
                        crossing_times=cross_t[:c], crossing_states=cross_y[:c],
                        crossing_extremes=cross_e[:c], period_crossings=int(stats[ST_PERIOD]))
+
+
+def _taken(values) -> np.ndarray:
+    """``values`` as the compiled code takes them: float64, C-contiguous and writable (it
+    types read-only arrays differently); copied only when they are not (it only reads them)."""
+    return np.require(values, dtype=np.float64, requirements=("C", "W"))

@@ -97,9 +97,13 @@ class Check(Result):
             object.__setattr__(self, "status", st)
 
 
-def frozen_array(values, dtype=float) -> np.ndarray:
-    """Copy ``values`` into a new read-only array."""
-    arr = np.array(values, dtype=dtype, copy=True)
+def frozen_array(values, dtype=float, copy: bool = True) -> np.ndarray:
+    """Copy ``values`` into a new read-only array.
+
+    ``copy=False`` hands over an array nobody else writes to (a trace the kernel
+    has just filled): a read-only view of it, copied only to change its dtype.
+    """
+    arr = np.array(values, dtype=dtype, copy=True) if copy else np.asarray(values, dtype).view()
     arr.flags.writeable = False
     return arr
 

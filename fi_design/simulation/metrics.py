@@ -74,33 +74,38 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     t = np.asarray(time_s, dtype=float)
     e = np.asarray(error_m, dtype=float)
     w0, w1 = window_start, window_start + window_length
-    inside = (t >= w0) & (t < w1) & np.isfinite(e)
-    tw, ew = t[inside], e[inside]
+    # the times increase: the window and its last quarter are slices
+    a, b = np.searchsorted(t, (w0, w1))
+    tw, ew = _finite(t[a:b], e[a:b])
     idx = np.zeros(0, dtype=int)
-    if len(tw) > 1:
-        dt = float(np.median(np.diff(tw)))
-        distance = max(1, int(round(min_distance / dt)))
+    amplitude = float(np.ptp(ew)) if len(ew) else float("nan")
+    # a peak's prominence is at most the trace's range: below min_height, no side has one
+    if len(tw) > 1 and amplitude >= min_height:
+        distance = _peak_distance(np.diff(tw), min_distance)
         # a peak must stand out by min_height from its surroundings (prominence), so a
         # plateau's numerical noise or a secondary bump of one period is no cycle; a cycle
         # below the target shows its negative peaks: count the side that shows more
-        for side in (1.0, -1.0):
-            found, _ = find_peaks(side * ew, height=min_height, prominence=min_height,
+        for y in (ew, -ew):
+            if y.max() < min_height:
+                continue  # no sample reaches the least peak height on this side
+            found, _ = find_peaks(y, height=min_height, prominence=min_height,
                                   distance=distance)
-            found = _one_per_plateau(side * ew, found, min_height)
+            found = _one_per_plateau(y, found, min_height)
             if len(found) > len(idx):
                 idx = found
     peaks_t, peaks_h = tw[idx], ew[idx]
     cycles = int(len(idx))
-    amplitude = float(np.ptp(ew)) if len(ew) else float("nan")
     period = float(np.mean(np.diff(peaks_t))) if cycles >= 2 else None
-    finite = np.isfinite(e)
-    final_error = float(e[finite][-1]) if finite.any() else float("nan")
+    # the last finite error (a failed run ends in NaN)
+    end = e[-1:] if len(e) and np.isfinite(e[-1]) else e[np.isfinite(e)][-1:]
+    final_error = float(end[0]) if len(end) else float("nan")
 
     t_last = float(t[-1]) if len(t) else 0.0
     moving = motion_end > min(w1, t_last)  # the motion outlasts the window or the run
-    tail = inside & (t >= w1 - window_length / 4.0)
-    settled = bool(success and not moving and tail.any()
-                   and np.all(np.abs(e[tail]) <= settle_band))
+    c = max(a, int(np.searchsorted(t, w1 - window_length / 4.0)))
+    _, tail = _finite(t[c:b], e[c:b])
+    settled = bool(success and not moving and len(tail)
+                   and np.all(np.abs(tail) <= settle_band))
     settling_time = _settling_time(t, e, settle_band, motion_end) if success else None
 
     if not success:
@@ -121,13 +126,13 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     elif settled:
         verdict = "settled"
         reason = f"|x1 - r| stays within {quantity(settle_band, 'm', 3)} at the end of the window"
-    elif np.ptp(ew) <= settle_band:
+    elif amplitude <= settle_band:
         verdict = "stuck"
         reason = (f"the stage rests {quantity(abs(final_error), 'm', 3)} from its target: no peaks, "
                   "but not settled either (the integrator has not broken it loose in the window)")
     else:
         verdict = "undetermined"
-        reason = (f"no peaks counted, but the error still moves by {quantity(np.ptp(ew), 'm', 3)} in "
+        reason = (f"no peaks counted, but the error still moves by {quantity(amplitude, 'm', 3)} in "
                   "the window: a cycle or creep too slow to judge in this window")
     return HuntingMetrics(
         hunting_cycles=cycles, peak_times=frozen_array(peaks_t), peak_heights=frozen_array(peaks_h),
@@ -164,32 +169,74 @@ def _one_per_plateau(y: np.ndarray, peaks: np.ndarray, min_height: float) -> np.
     """
     if len(peaks) == 0:
         return peaks
-    groups = [[int(peaks[0])]]
-    for a, b in zip(peaks[:-1], peaks[1:]):
-        if min(y[a], y[b]) - float(np.min(y[a:b + 1])) < min_height:
-            groups[-1].append(int(b))
-        else:
-            groups.append([int(b)])
+    heights = y[peaks]
+    # the lowest sample between neighbours (both ends included), and whether it parts them
+    dips = np.minimum(np.minimum.reduceat(y, peaks)[:-1], heights[1:])
+    parted = np.minimum(heights[:-1], heights[1:]) - dips >= min_height
+    starts = [0, *(np.flatnonzero(parted) + 1)]
     keep = []
-    for g in groups:
-        top = g[int(np.argmax(y[g]))]
-        below = y < y[top] - 1e-6 * min_height
-        left = np.nonzero(below[:top])[0]
-        right = np.nonzero(below[top:])[0]
-        lo = int(left[-1]) + 1 if len(left) else 0
-        hi = top + int(right[0]) - 1 if len(right) else len(y) - 1
+    for a, b in zip(starts, [*starts[1:], len(peaks)]):
+        top = int(peaks[a + int(np.argmax(heights[a:b]))])
+        lo, hi = _flat_top(y, top, y[top] - 1e-6 * min_height)
         keep.append((lo + hi) // 2)
     return np.asarray(keep, dtype=int)
 
 
+def _flat_top(y: np.ndarray, top: int, level: float) -> tuple[int, int]:
+    """First and last index of the samples around ``top`` that stay at or above ``level``.
+
+    Searched outwards in growing chunks: a top is short next to the trace, and
+    comparing the whole trace once per peak was much of the metric's time.
+    """
+    if (top == 0 or y[top - 1] < level) and (top == len(y) - 1 or y[top + 1] < level):
+        return top, top  # a sharp top, the common case: no array search
+    lo, step = top, 1024
+    while lo > 0:
+        start = max(0, lo - step)
+        below = np.flatnonzero(y[start:lo] < level)
+        if len(below):
+            lo = start + int(below[-1]) + 1
+            break
+        lo, step = start, 4 * step
+    hi, step = top, 1024
+    while hi < len(y) - 1:
+        stop = min(len(y), hi + 1 + step)
+        below = np.flatnonzero(y[hi + 1:stop] < level)
+        if len(below):
+            hi += int(below[0])
+            break
+        hi, step = stop - 1, 4 * step
+    return lo, hi
+
+
+def _finite(t: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The samples of ``t`` and ``e`` where ``e`` is finite (the arrays themselves if all are)."""
+    ok = np.isfinite(e)
+    return (t, e) if ok.all() else (t[ok], e[ok])
+
+
+def _peak_distance(steps: np.ndarray, min_distance: float) -> int:
+    """The least distance between peaks in samples: ``min_distance`` over the median step.
+
+    The median is taken only when the steps' range leaves a choice (the
+    rounded count of the smallest and of the largest step differ): on a
+    uniform trace they agree, and a median costs more than the peak search.
+    """
+    def samples(dt: float) -> int:
+        return max(1, int(round(min_distance / dt)))
+
+    few, many = samples(float(steps.max())), samples(float(steps.min()))
+    return few if few == many else samples(float(np.median(steps)))
+
+
 def _settling_time(t: np.ndarray, e: np.ndarray, band: float, start: float) -> float | None:
-    after = t >= start
-    if not after.any():
+    after = int(np.searchsorted(t, start))  # the times increase
+    if after == len(t):
         return None
-    outside = np.nonzero(after & ~(np.abs(e) <= band))[0]
+    outside = np.flatnonzero(~(np.abs(e[after:]) <= band))
     if len(outside) == 0:
         return 0.0
-    last = outside[-1]
+    last = after + outside[-1]
     if last == len(t) - 1:
         return None
     return float(t[last + 1] - start)

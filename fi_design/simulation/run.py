@@ -155,7 +155,8 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
         return _replay(model, iso, method, params, record, drive, window, rtol, initial_command)
     if drive != "closed":
         raise SimulationError("drive='force' replays a record: give record=")
-    params = replace(params, x1_initial=float(initial_position))
+    if params.x1_initial != initial_position:
+        params = replace(params, x1_initial=float(initial_position))
     motion = model.spec.motion
     if reference is None:
         t_end = motion.duration if duration is None else duration
@@ -244,15 +245,19 @@ def _result(model, iso, method, params, out, t_out, wall, *, move_end,
     message = "" if success else _failure_message(out.status, out.t_reached, params, iso)
     Y, R = out.states, out.reference
     idx = state_index(iso)
-    t = t_out + time_offset
+    t = t_out + time_offset if time_offset else t_out
     metrics = _metrics(model, t, Y[:, idx["x1"]] - R, success, message, move_end)
+
+    def trace(values):  # the integration's own arrays, handed over without a copy
+        return frozen_array(values, copy=False)
+
     return SimulationResult(
         spec=model.spec, isolated=iso, method=method, friction_model=model.friction.model,
         crossover=model.crossover, effects=tuple(e.type for e in model.effects),
-        time=frozen_array(t), reference=frozen_array(R), position=frozen_array(Y[:, idx["x1"]]),
-        cart_position=frozen_array(Y[:, idx["x2"]]), velocity=frozen_array(Y[:, idx["v1"]]),
-        cart_velocity=frozen_array(Y[:, idx["v2"]]), force=frozen_array(out.command),
-        applied_force=frozen_array(out.applied_force), bristle=frozen_array(Y[:, idx["z"]]),
+        time=trace(t), reference=trace(R), position=trace(Y[:, idx["x1"]]),
+        cart_position=trace(Y[:, idx["x2"]]), velocity=trace(Y[:, idx["v1"]]),
+        cart_velocity=trace(Y[:, idx["v2"]]), force=trace(out.command),
+        applied_force=trace(out.applied_force), bristle=trace(Y[:, idx["z"]]),
         success=success, status=out.status, message=message, t_reached=out.t_reached + time_offset,
         n_steps=out.n_steps, n_rejected=out.n_rejected, n_events=out.n_events, wall_time=wall,
         metrics=metrics, parameters=params, drive=drive,
