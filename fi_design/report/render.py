@@ -10,9 +10,12 @@ filters of :mod:`fi_design.report.filters`. Files are written atomically
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import gc
 import logging
 import os
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, Callable
 
@@ -161,15 +164,35 @@ def write_document(html: str, path: str | os.PathLike, *, figures: Any = None) -
     from weasyprint.urls import FatalURLFetchingError
 
     fetcher = _self_contained(figures)
-    try:
-        document = HTML(string=html, base_url=None, url_fetcher=fetcher).render()
-    except FatalURLFetchingError:
-        if fetcher.failed is not None:  # a figure's own error, not WeasyPrint's wrapping of it
-            raise fetcher.failed from None
-        raise
-    with atomic_path(out) as tmp:
-        document.write_pdf(str(tmp))
+    with _collector_paused():
+        try:
+            document = HTML(string=html, base_url=None, url_fetcher=fetcher).render()
+        except FatalURLFetchingError:
+            if fetcher.failed is not None:  # a figure's own error, not WeasyPrint's wrapping
+                raise fetcher.failed from None
+            raise
+        with atomic_path(out) as tmp:
+            document.write_pdf(str(tmp))
     return out
+
+
+@contextlib.contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector paused for the block (reference counting goes on).
+
+    WeasyPrint builds some 10^5 objects for a report of 26 pages (styles, boxes, lines),
+    and the collector traversed them, and the process's own, again and again as they
+    grew: about a fifth of the PDF's time (the paper setup's, written in a process
+    holding a design: 0.6 s of CPU of about 3 s). What is left in reference cycles is
+    collected after the block, when the collector next runs (peak memory +8 MB).
+    """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
 
 
 def _self_contained(figures: Any = None) -> Any:

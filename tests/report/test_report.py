@@ -536,6 +536,42 @@ def test_pdf_is_the_same_with_its_figures_drawn_by_a_worker(paper_confirmed_desi
     assert text[0] == text[1]
 
 
+def test_the_garbage_collector_rests_while_weasyprint_works(tmp_path, monkeypatch):
+    """WeasyPrint lays the PDF out with the cyclic collector paused (it traversed WeasyPrint's
+    growing objects again and again), and the collector's state is restored after, also when
+    the layout fails."""
+    import gc
+
+    import weasyprint
+
+    seen = []
+    real = weasyprint.HTML.render
+
+    def render(self, *args, **kwargs):
+        seen.append(gc.isenabled())
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(weasyprint.HTML, "render", render)
+    html = "<!DOCTYPE html><html><body><p>one page</p></body></html>"
+    assert gc.isenabled()
+    report.write_document(html, tmp_path / "a.pdf")
+    assert seen == [False] and gc.isenabled()
+    gc.disable()
+    try:
+        report.write_document(html, tmp_path / "b.pdf")
+        assert not gc.isenabled()  # a caller's choice is kept
+    finally:
+        gc.enable()
+
+    def broken(self, *args, **kwargs):
+        raise RuntimeError("layout failed")
+
+    monkeypatch.setattr(weasyprint.HTML, "render", broken)
+    with pytest.raises(RuntimeError, match="layout failed"):
+        report.write_document(html, tmp_path / "c.pdf")
+    assert gc.isenabled() and not (tmp_path / "c.pdf").exists()
+
+
 class _FailedFuture:
     def result(self):
         raise RuntimeError("worker gone")
