@@ -309,7 +309,8 @@ def report_figures(result: Any, options: dict) -> dict[str, bytes]:
 
     with deferred_figures() as figures:
         build_context(result, **options)
-    return figures.all_png()
+    with _collector_paused():  # a forked worker's collector would traverse the parent's heap
+        return figures.all_png()
 
 
 class _Figures:
