@@ -280,10 +280,11 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     from ..plots import deferred_figures
 
     with deferred_figures() as figures:
-        html = render_html(build_context(result, date=date, command=command, **options))
+        context = build_context(result, date=date, command=command, **options)
     drawn = None
-    if executor is not None and figures.makers:
+    if executor is not None and figures.makers:  # drawn there while the HTML is made here
         drawn = executor.submit(report_figures, result, options)
+    html = render_html(context)
     if progress is not None:
         progress("writing the PDF ...")
     return write_document(html, out, figures=_Figures(figures, drawn))
