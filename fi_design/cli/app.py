@@ -139,7 +139,7 @@ def design_command(
         with Status(err, "computing the hunting map ...") as status:
             design_map = make_map(result, progress=lambda done, total: status(
                 f"hunting map: {done}/{total} simulations"))
-    write_report(console, outs["report"], result, design_map=design_map)
+    write_report(console, outs["report"], result, design_map=design_map, figure_worker=True)
     if fail_on is not None and result.verdict.at_or_below(levels[fail_on]):
         raise typer.Exit(EXIT_VERDICT)
 

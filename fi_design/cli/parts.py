@@ -497,7 +497,8 @@ def write_outputs(console: "Console", outs: dict, payloads: dict) -> None:
         console.print(f"wrote {outs[name]}", markup=False)
 
 
-def write_report(console: "Console", path: Optional[Path], result: Any, **options: Any) -> None:
+def write_report(console: "Console", path: Optional[Path], result: Any, *,
+                 figure_worker: bool = False, **options: Any) -> None:
     """The report of a result (:func:`fi_design.report.render_report`), written atomically.
 
     Parameters
@@ -508,6 +509,10 @@ def write_report(console: "Console", path: Optional[Path], result: Any, **option
         The checked report path; None: no report.
     result : object
         The result.
+    figure_worker : bool, optional
+        A PDF's figures drawn by a worker process while this one lays the report
+        out (:func:`fi_design.cli.pools.report_pool`): for reports with figures
+        placed by name (the design report).
     **options
         Passed on (``design_map`` of a design report).
     """
@@ -515,9 +520,13 @@ def write_report(console: "Console", path: Optional[Path], result: Any, **option
         return
     from ..console import Status, make_console
     from ..report import render_report
+    from .pools import report_pool
 
-    with Status(make_console(stderr=True), "writing the report ...") as status:
-        render_report(result, path, command=command_line(), progress=status, **options)
+    # the worker forks before the spinner's thread starts (fork and threads do not mix)
+    with report_pool(path if figure_worker else None) as pool, \
+            Status(make_console(stderr=True), "writing the report ...") as status:
+        render_report(result, path, command=command_line(), progress=status, executor=pool,
+                      **options)
     console.print(f"wrote {path}", markup=False)
 
 

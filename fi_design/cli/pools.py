@@ -7,10 +7,12 @@ CLI makes them here, as context managers that close them again:
 - :func:`confirmation_pool`: up to two forked worker processes that run a
   design's nonlinear confirmation and its robustness study while the calling
   process does the linear analysis;
+- :func:`report_pool`: one forked worker that draws a PDF report's figures
+  while the calling process lays the report out;
 - :class:`StudyPool`: the executor of a parameter study, a local process pool
   or a dask.distributed client.
 
-Both start their worker processes at once, when entered, before the caller
+They start their worker processes at once, when entered, before the caller
 starts a progress display's thread (fork and threads do not mix), with the
 signals held (:func:`fi_design.interrupts.held`): a Ctrl-C while a pool
 starts comes when it has started, and then stops it. The workers end with
@@ -35,7 +37,7 @@ from typing import Any
 from .. import interrupts
 from ..errors import ArgumentError, FiDesignError
 
-__all__ = ["EXECUTORS", "confirmation_pool", "StudyPool"]
+__all__ = ["EXECUTORS", "confirmation_pool", "report_pool", "StudyPool"]
 
 #: Kinds of study executor (``--executor``).
 EXECUTORS = ("local", "dask")
@@ -154,23 +156,61 @@ def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
     concurrent.futures.ProcessPoolExecutor or None
         None where processes cannot be forked.
     """
+    def load() -> None:
+        from ..studies import warm_up
+
+        # scipy.signal (the metric's peak finder; python-control needs it here anyway) is
+        # the larger part of every import the work needs: loaded once before the fork, the
+        # workers inherit it instead of each importing it again on two cores (measured in
+        # BENCHMARKS.md)
+        warm_up()
+
+    with _forked_pool(enabled, min(2, os.cpu_count() or 1), load) as pool:
+        yield pool
+
+
+@contextlib.contextmanager
+def report_pool(path: Any) -> Iterator[Any]:
+    """One forked worker that draws a PDF report's figures while this process lays the
+    report out (:func:`fi_design.report.render_report`), or None.
+
+    Forked when entered, after the work the report shows: the worker inherits the loaded
+    modules (matplotlib among them). Enter it before a progress display (a spinner's
+    thread); stopped at once when the report fails or is interrupted.
+
+    Parameters
+    ----------
+    path : pathlib.Path or None
+        The report; a worker only for a ``.pdf`` (an HTML report's figures are drawn
+        as SVG while its context is built).
+
+    Yields
+    ------
+    concurrent.futures.ProcessPoolExecutor or None
+        None without a PDF or where processes cannot be forked.
+    """
+    pdf = path is not None and str(path).lower().endswith(".pdf")
+    with _forked_pool(pdf, 1) as pool:
+        yield pool
+
+
+@contextlib.contextmanager
+def _forked_pool(enabled: bool, workers: int,
+                 load: Callable[[], None] | None = None) -> Iterator[Any]:
+    """``workers`` forked worker processes, started when entered (after ``load()``), or None
+    (not ``enabled``, or no fork); stopped at once on a failure or an interruption."""
     ctx = _fork_context() if enabled else None
     if ctx is None:
         yield None
         return
-    from ..studies import warm_up
-
     started: list = []
     try:
         # held: an interruption inside the import of a compiled module or a fork is no
         # interruption but an ImportError or a half-started pool; it comes at the end
         with interrupts.held():
-            # scipy.signal (the metric's peak finder; python-control needs it here anyway) is
-            # the larger part of every import the work needs: loaded once before the fork, the
-            # workers inherit it instead of each importing it again on two cores (measured in
-            # BENCHMARKS.md)
-            warm_up()
-            started.extend(_process_pool(min(2, os.cpu_count() or 1), ctx))
+            if load is not None:
+                load()
+            started.extend(_process_pool(workers, ctx))
         yield started[0]
     except BaseException:
         if started:

@@ -27,7 +27,8 @@ from __future__ import annotations
 
 from .confirmation import (PLANT_COLOURS, SETTLE_ZOOM, deflection_figure, error_figure,
                            motion_end, plant_names)
-from .figure import (RASTER_DPI, REPORT_RC, REPORT_WIDTH, cell_edges, decimate, figure_bytes,
+from .figure import (FIGURE_SCHEME, RASTER_DPI, REPORT_RC, REPORT_WIDTH, DeferredFigures,
+                     cell_edges, decimate, deferred_figures, figure_bytes, figure_from,
                      figure_markup, figure_svg, log_x, nice_ticks, plain_tick, png_img,
                      raster_dpi, raster_figures, report_figure, rgb_png, styled)
 from .guide import guide_figure
@@ -43,13 +44,13 @@ from .studies import (VERDICT_MARKS, design_map_figure, draw_sweep, robustness_f
                       study_figure, sweep_figure)
 
 __all__ = [
-    "BAND_FACTOR", "CANDIDATE_LOOK", "CASE_COLOURS", "CASE_STYLES", "GAP_COLOURS", "GAP_ORDER",
+    "BAND_FACTOR", "CANDIDATE_LOOK", "DeferredFigures", "FIGURE_SCHEME", "CASE_COLOURS", "CASE_STYLES", "GAP_COLOURS", "GAP_ORDER",
     "GAP_WIDTHS", "MOVE_MARKS", "PLANT_COLOURS", "QUANTITY_NAMES", "RASTER_DPI", "REPORT_RC",
     "REPORT_WIDTH",
     "SETTLE_ZOOM", "VERDICT_MARKS", "axis_label", "bode_figure", "boundary_figure",
     "candidate_scores_figure", "case_label", "cell_edges", "cycle_figure", "decimate",
-    "deflection_figure", "design_band", "design_map_figure", "display_unit", "draw_sweep",
-    "error_figure", "figure_bytes", "figure_markup", "figure_svg", "force_velocity_figure", "gap_overlay_figure",
+    "deferred_figures", "deflection_figure", "design_band", "design_map_figure", "display_unit", "draw_sweep",
+    "error_figure", "figure_bytes", "figure_from", "figure_markup", "figure_svg", "force_velocity_figure", "gap_overlay_figure",
     "gap_residual_figure", "guide_figure", "log_x", "motion_end", "moves_figure", "nice_ticks", "positioning_figure", "nyquist_figure",
     "out_of_band_crossovers", "plain_tick", "plant_names", "png_img", "raster_dpi",
     "raster_figures", "rgb_png", "quantity_name", "recommend_figure",

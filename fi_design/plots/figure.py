@@ -6,7 +6,9 @@ plain tick labels on log axes, the thinning of long traces
 (:func:`decimate`), cell edges of a map, and the two renderings
 (:func:`figure_svg` for inlining in HTML, :func:`figure_bytes` for files),
 both reproducible, and :func:`figure_markup`, which places a figure as inline
-SVG or, inside :func:`raster_figures` (a PDF), as a PNG image.
+SVG or, inside :func:`raster_figures` (a PDF), as a PNG image, and
+:func:`figure_from`, which within :func:`deferred_figures` places it by name,
+to be drawn when the PDF's layout reaches it.
 matplotlib is imported inside the functions.
 """
 
@@ -17,7 +19,7 @@ import contextlib
 import contextvars
 import io
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numpy as np
@@ -224,6 +226,93 @@ def raster_figures(dpi: float = RASTER_DPI) -> Iterator[None]:
 def raster_dpi() -> float | None:
     """The resolution of :func:`raster_figures` in force [dots per inch], or None (SVG)."""
     return _RASTER.get()
+
+
+#: Scheme of the address a deferred figure's ``<img>`` points at (``figure:NAME``).
+FIGURE_SCHEME = "figure"
+
+
+class DeferredFigures:
+    """The figures of a report placed by name and drawn when asked for (:func:`deferred_figures`).
+
+    Attributes
+    ----------
+    dpi : float
+        Resolution of the images [dots per inch].
+    makers : dict
+        Name -> a callable returning the :class:`matplotlib.figure.Figure`, in the
+        order the figures were placed.
+    """
+
+    def __init__(self, dpi: float) -> None:
+        self.dpi = float(dpi)
+        self.makers: dict[str, Callable[[], Any]] = {}
+
+    def png(self, name: str) -> bytes:
+        """The figure ``name`` drawn now (:func:`rgb_png`)."""
+        return rgb_png(self.makers[name](), self.dpi)
+
+    def all_png(self) -> dict[str, bytes]:
+        """Every figure placed, drawn now: name -> PNG bytes."""
+        return {name: self.png(name) for name in self.makers}
+
+
+_DEFERRED: contextvars.ContextVar[DeferredFigures | None] = contextvars.ContextVar(
+    "fi_design_deferred", default=None)
+
+
+@contextlib.contextmanager
+def deferred_figures(dpi: float = RASTER_DPI) -> Iterator[DeferredFigures]:
+    """Within this block, :func:`figure_from` places a figure as ``<img src="figure:NAME">``
+    and keeps its maker, to be drawn later or elsewhere; figures are PNG images of ``dpi``
+    (:func:`raster_figures` holds too).
+
+    A PDF report's layout needs a figure only when WeasyPrint reaches it: drawn by
+    another process meanwhile (:func:`fi_design.report.render_report` with an executor),
+    the figures cost the layout no time.
+
+    Parameters
+    ----------
+    dpi : float, optional
+        Resolution [dots per inch] (default :data:`RASTER_DPI`).
+
+    Yields
+    ------
+    DeferredFigures
+        The figures placed within the block.
+    """
+    figures = DeferredFigures(dpi)
+    token = _DEFERRED.set(figures)
+    try:
+        with raster_figures(dpi):
+            yield figures
+    finally:
+        _DEFERRED.reset(token)
+
+
+def figure_from(make: Callable[[], Any], name: str) -> str:
+    """A figure for a report page from its maker: :func:`figure_markup` of ``make()``, or
+    within :func:`deferred_figures` an ``<img>`` pointing at ``figure:NAME`` (not drawn).
+
+    Parameters
+    ----------
+    make : callable
+        Returns the :class:`matplotlib.figure.Figure`.
+    name : str
+        The figure's name, unique within the report (letters, digits, ``-``, ``_``).
+
+    Returns
+    -------
+    str
+        An ``<svg>`` or ``<img>`` element.
+    """
+    figures = _DEFERRED.get()
+    if figures is None:
+        return figure_markup(make(), name)
+    if name in figures.makers:
+        raise ArgumentError(f"two report figures are named {name!r}")
+    figures.makers[name] = make
+    return f'<img src="{FIGURE_SCHEME}:{name}" alt="">'
 
 
 def png_img(png: bytes, width_pt: float | None = None, alt: str = "") -> str:

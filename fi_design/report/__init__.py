@@ -18,7 +18,9 @@ How a report is made
 2. Figures come from :mod:`fi_design.plots` (``matplotlib.figure.Figure``,
    never pyplot) and are inlined as SVG; equations are drawn by matplotlib's
    mathtext to SVG as well (:mod:`.equations`), so the HTML and the PDF show
-   the same pictures and the HTML makes no external request.
+   the same pictures and the HTML makes no external request. A PDF carries
+   them as 200 dpi images, the figures placed by name and drawn when the
+   layout reaches them, or meanwhile by a worker (:func:`report_figures`).
 3. :mod:`.render` holds the one jinja environment (autoescape,
    ``StrictUndefined``, the number filters of :mod:`.filters`) and writes the
    HTML, or the PDF through WeasyPrint (A4, page numbers, the document id and
@@ -53,12 +55,13 @@ from .gap import gap_context, gap_sections, render_gap_report
 from .identify import identification_context, identification_sections
 from .meta import report_date
 from .render import (FORMATS, environment, output_format, render_document, render_html,
-                     render_report, template_dir, write_document)
+                     render_report, report_figures, template_dir, write_document)
 
 __all__ = [
     "FORMATS", "FigureBlock", "Section", "Table", "build_context", "check_label", "check_row",
     "display_scale", "document_context", "environment", "figure_block", "gap_context",
     "gap_sections", "identification_context", "identification_sections", "math_text", "num", "output_format", "qty", "render_document",
-    "render_gap_report", "render_html", "render_report", "report_date", "template_dir",
+    "render_gap_report", "render_html", "render_report", "report_date", "report_figures",
+    "template_dir",
     "tex_num", "tex_qty", "unit_text", "write_document",
 ]

@@ -128,7 +128,8 @@ def figure_entry(make: Callable[[], Any] | None, name: str, caption: str, number
     ----------
     make : callable or None
         Returns the :class:`matplotlib.figure.Figure`; None leaves ``svg``
-        None (contexts without figures).
+        None (contexts without figures). Called here, or later within
+        :func:`fi_design.plots.deferred_figures` (a PDF's figures).
     name : str
         Identifier (``fig-NAME`` anchor and SVG id prefix).
     caption : str
@@ -147,7 +148,7 @@ def figure_entry(make: Callable[[], Any] | None, name: str, caption: str, number
 
     svg = None
     if make is not None:
-        from ..plots import figure_markup
+        from ..plots import figure_from
 
-        svg = Markup(figure_markup(make(), name))
+        svg = Markup(figure_from(make, name))
     return {"name": name, "number": number, "caption": caption, "svg": svg, "width": width}

@@ -143,7 +143,7 @@ def _outline(tex: str):
     return outline, outline.get_extents()
 
 
-#: Colour of a rasterised formula: the report's ink (report.css ``--ink``).
+#: Colour of a rasterised formula: the report's ink (report.css).
 _INK = "#1d2329"
 
 

@@ -10,8 +10,12 @@ filters of :mod:`fi_design.report.filters`. Files are written atomically
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import gc
+import logging
 import os
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, Callable
 
@@ -20,7 +24,9 @@ from .context import build_context
 from .filters import FILTERS
 
 __all__ = ["FORMATS", "template_dir", "environment", "render_html", "output_format",
-           "write_document", "render_report", "render_document"]
+           "write_document", "render_report", "report_figures", "render_document"]
+
+log = logging.getLogger(__name__)
 
 #: Output formats by file extension.
 FORMATS = {".html": "html", ".pdf": "pdf"}
@@ -121,7 +127,7 @@ def output_format(path: str | os.PathLike) -> str:
     return FORMATS[ext]
 
 
-def write_document(html: str, path: str | os.PathLike) -> Path:
+def write_document(html: str, path: str | os.PathLike, *, figures: Any = None) -> Path:
     """Write a rendered report as HTML, or as a PDF (A4, WeasyPrint) made from it, atomically.
 
     Parameters
@@ -130,6 +136,10 @@ def write_document(html: str, path: str | os.PathLike) -> Path:
         The document (:func:`render_html`).
     path : str or os.PathLike
         ``.html`` or ``.pdf``; an existing file is replaced.
+    figures : object, optional
+        A PDF's figures placed by name (``<img src="figure:NAME">``, see
+        :func:`fi_design.plots.deferred_figures`): ``figures.png(name)`` gives
+        the PNG bytes when the layout reaches the figure.
 
     Returns
     -------
@@ -146,31 +156,75 @@ def write_document(html: str, path: str | os.PathLike) -> Path:
     out = Path(path)
     if output_format(out) == "html":
         return write_atomic(out, html)
-    import logging
-
     # WeasyPrint logs every CSS property it does not know at WARNING; the report's
     # screen-only rules are expected to be skipped.
     logging.getLogger("weasyprint").setLevel(logging.ERROR)
     logging.getLogger("fontTools").setLevel(logging.ERROR)
     from weasyprint import HTML
+    from weasyprint.urls import FatalURLFetchingError
 
-    document = HTML(string=html, base_url=None, url_fetcher=_self_contained()).render()
-    with atomic_path(out) as tmp:
-        document.write_pdf(str(tmp))
+    fetcher = _self_contained(figures)
+    with _collector_paused():
+        try:
+            document = HTML(string=html, base_url=None, url_fetcher=fetcher).render()
+        except FatalURLFetchingError:
+            if fetcher.failed is not None:  # a figure's own error, not WeasyPrint's wrapping
+                raise fetcher.failed from None
+            raise
+        with atomic_path(out) as tmp:
+            document.write_pdf(str(tmp))
     return out
 
 
-def _self_contained() -> Any:
-    """WeasyPrint's URL fetcher limited to ``data:`` URLs (the PDF's figures): the report is
-    self-contained by design and makes no external request (any other URL is refused)."""
-    from weasyprint.urls import URLFetcher
+@contextlib.contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector paused for the block (reference counting goes on).
 
-    return URLFetcher(allowed_protocols={"data"}, fail_on_errors=True)
+    WeasyPrint builds some 10^5 objects for a report of 26 pages (styles, boxes, lines),
+    and the collector traversed them, and the process's own, again and again as they
+    grew: about a fifth of the PDF's time (the paper setup's, written in a process
+    holding a design: 0.6 s of CPU of about 3 s). What is left in reference cycles is
+    collected after the block, when the collector next runs (peak memory +8 MB).
+    """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def _self_contained(figures: Any = None) -> Any:
+    """WeasyPrint's URL fetcher limited to ``data:`` URLs and the figures placed by name
+    (``figure:NAME``, from ``figures``): the report is self-contained by design and makes no
+    external request (any other URL is refused)."""
+    from weasyprint.urls import URLFetcher, URLFetcherResponse
+
+    from ..plots import FIGURE_SCHEME
+
+    prefix = FIGURE_SCHEME + ":"
+
+    class Fetcher(URLFetcher):
+        failed: Exception | None = None  # what drawing a figure raised
+
+        def fetch(self, url: str, headers: Any = None) -> Any:
+            if figures is not None and url.startswith(prefix):
+                try:
+                    png = figures.png(url[len(prefix):])
+                except Exception as exc:
+                    self.failed = exc
+                    raise
+                return URLFetcherResponse(url, png, {"Content-Type": "image/png"})
+            return super().fetch(url, headers)
+
+    return Fetcher(allowed_protocols={"data"}, fail_on_errors=True)
 
 
 def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
                   command: str | None = None, design_map: Any = None,
-                  progress: Callable[[str], None] | None = None) -> Path:
+                  progress: Callable[[str], None] | None = None,
+                  executor: Any = None) -> Path:
     """Write the report of a result as HTML or PDF (chosen by the extension).
 
     Presentation only: every number comes from ``result`` (and
@@ -195,6 +249,11 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
         point (:func:`fi_design.studies.design_map`), shown in its own section.
     progress : callable, optional
         ``progress(text)`` with a short message as the work proceeds.
+    executor : concurrent.futures-style executor, optional
+        A PDF's figures are drawn there (``submit``; the result and
+        ``design_map`` are sent to it) while this process lays the report out;
+        they are needed only when the layout reaches them. None draws them here
+        as the layout reaches them. An HTML report does not use it.
 
     Returns
     -------
@@ -213,22 +272,68 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     if progress is not None:
         progress("drawing the report's figures ...")
     options = {} if design_map is None else {"design_map": design_map}
-    with _figures_for(fmt):
+    if fmt == "html":
         html = render_html(build_context(result, date=date, command=command, **options))
+        if progress is not None:
+            progress("writing the HTML ...")
+        return write_document(html, out)
+    from ..plots import deferred_figures
+
+    with deferred_figures() as figures:
+        context = build_context(result, date=date, command=command, **options)
+    drawn = None
+    if executor is not None and figures.makers:  # drawn there while the HTML is made here
+        drawn = executor.submit(report_figures, result, options)
+    html = render_html(context)
     if progress is not None:
-        progress("writing the PDF ..." if fmt == "pdf" else "writing the HTML ...")
-    return write_document(html, out)
+        progress("writing the PDF ...")
+    return write_document(html, out, figures=_Figures(figures, drawn))
 
 
-def _figures_for(fmt: str) -> Any:
-    """Figures and equations as inline SVG for HTML, as PNG images for a PDF
-    (:func:`fi_design.plots.raster_figures`: WeasyPrint draws them in a fraction of the
-    time)."""
-    import contextlib
+def report_figures(result: Any, options: dict) -> dict[str, bytes]:
+    """The figures of a PDF report, drawn: name -> PNG bytes (what an executor runs for
+    :func:`render_report`).
 
-    from ..plots import raster_figures
+    Parameters
+    ----------
+    result : object
+        What the report is of (:func:`render_report`).
+    options : dict
+        ``design_map`` when the report has one.
 
-    return raster_figures() if fmt == "pdf" else contextlib.nullcontext()
+    Returns
+    -------
+    dict
+        The figures in the order the report places them.
+    """
+    from ..plots import deferred_figures
+
+    with deferred_figures() as figures:
+        build_context(result, **options)
+    with _collector_paused():  # a forked worker's collector would traverse the parent's heap
+        return figures.all_png()
+
+
+class _Figures:
+    """A PDF's figures by name: from ``drawn`` (a future of :func:`report_figures`, run
+    elsewhere) when it has them, else drawn here from ``placed`` (the makers)."""
+
+    def __init__(self, placed: Any, drawn: Any) -> None:
+        self._placed = placed
+        self._drawn = drawn
+        self._got: dict[str, bytes] = {}
+
+    def png(self, name: str) -> bytes:
+        if self._drawn is not None:
+            try:
+                self._got = self._drawn.result()
+            except Exception:  # the worker failed or is gone: the figures are drawn here
+                log.info("the report's figures could not be drawn in a worker; drawing them "
+                         "here", exc_info=True)
+            self._drawn = None
+        if name in self._got:
+            return self._got[name]
+        return self._placed.png(name)
 
 
 def render_document(path: str | os.PathLike, *, title: str, spec: Any, sections: Any,

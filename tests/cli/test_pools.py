@@ -79,11 +79,44 @@ def test_the_design_pool_starts_before_the_spinner(paper_spec_path, tmp_path, mo
     assert design and design[0] >= 1, seen
 
 
+def test_the_report_pool_starts_before_the_spinner(paper_spec_path, tmp_path, monkeypatch,
+                                                   shared_designs):
+    """A PDF's figures are drawn by a worker forked for the report: it runs when the
+    report's spinner (a thread on a terminal) starts, and the PDF is written."""
+    from typer.testing import CliRunner
+
+    import fi_design.console as console
+    from fi_design.cli.app import app
+
+    seen = []
+    real = console.Status.__enter__
+
+    def enter(self):
+        seen.append((self._text, len(multiprocessing.active_children())))
+        return real(self)
+
+    monkeypatch.setattr(console.Status, "__enter__", enter)
+    out = tmp_path / "r.pdf"
+    result = CliRunner().invoke(app, [str(paper_spec_path), "--no-recommend", "--report",
+                                      str(out)])
+    assert result.exit_code == 0, result.output
+    report = [n for text, n in seen if text.startswith("writing the report")]
+    assert report and report[0] >= 1, seen
+    assert out.read_bytes().startswith(b"%PDF")
+
+
 def _children(pid: int) -> set[int]:
     out = set()
-    for task in os.listdir(f"/proc/{pid}/task"):
-        with open(f"/proc/{pid}/task/{task}/children") as fh:
-            out.update(int(c) for c in fh.read().split())
+    try:
+        tasks = os.listdir(f"/proc/{pid}/task")
+    except FileNotFoundError:  # the process ended
+        return out
+    for task in tasks:
+        try:
+            with open(f"/proc/{pid}/task/{task}/children") as fh:
+                out.update(int(c) for c in fh.read().split())
+        except FileNotFoundError:  # a thread that ended meanwhile
+            pass
     return out
 
 
@@ -226,6 +259,71 @@ def test_ctrl_c_at_many_instants_of_a_design_run(tmp_path):
 @pytest.mark.slow
 def test_ctrl_c_at_many_instants_of_a_sweep(tmp_path):
     _sweep_at(tmp_path, [0.05 + 0.1 * k + 0.03 * (k % 3) for k in range(60)])
+
+
+def _interrupted_report(tmp_path, delay: float) -> dict:
+    """The design run with a PDF report, sent SIGINT ``delay`` s after the report's worker
+    (a child forked once the design's workers exist no more) appears."""
+    import tempfile
+    from pathlib import Path
+
+    work = Path(tempfile.mkdtemp(prefix=f"report_{delay:.2f}_", dir=tmp_path))
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _DRIVER, "design", str(EXAMPLES / "paper_setup.yaml"),
+         "--no-recommend", "--report", "map.pdf"],
+        cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    design: set[int] = set()
+    report: set[int] = set()
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None and not report:
+            children = _children(proc.pid)
+            if not design:
+                design = children
+            report = children - design
+            time.sleep(0.01)
+        time.sleep(delay)
+        sent = time.time()
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    finished = [float(line.split()[1]) for line in out.splitlines()
+                if line.startswith("finished ")]
+    return dict(delay=delay, code=proc.returncode, err=err, design=design, report=report,
+                files=sorted(p.name for p in work.iterdir()),
+                before=bool(finished) and finished[0] < sent)
+
+
+def _report_at(tmp_path, delays) -> None:
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(2) as ex:
+        runs = list(ex.map(lambda d: _interrupted_report(tmp_path, d), delays))
+    bad = []
+    for run in runs:
+        try:
+            assert run["design"] and run["report"], run  # the report's worker was seen
+            assert not any(_running(w) for w in run["report"]), run
+            _check_interrupted({**run, "files": [f.replace("map.pdf", "map.csv")
+                                                 for f in run["files"]]})
+        except AssertionError:
+            bad.append(repr(run))
+    assert not bad, f"{len(bad)} of {len(runs)} interruptions went wrong:\n" + "\n".join(bad)
+
+
+def test_ctrl_c_while_a_pdf_report_is_written(tmp_path):
+    """A Ctrl-C while the report's worker draws the figures, or while WeasyPrint lays the PDF
+    out, ends the run with 130 and the interruption's message, no PDF and no temporary file,
+    and the worker with it."""
+    _report_at(tmp_path, [0.0, 1.0])
+
+
+@pytest.mark.slow
+def test_ctrl_c_at_many_instants_of_a_pdf_report(tmp_path):
+    _report_at(tmp_path, [0.1 * k for k in range(30)])
 
 
 def test_a_pool_thread_taken_apart_under_it_is_not_reported(monkeypatch):

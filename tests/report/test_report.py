@@ -481,6 +481,133 @@ def test_pdf_never_ends_a_page_with_a_heading(design_html):
     assert headings > 15
 
 
+def _pdf_images(pdf: Path) -> list[tuple[str, ...]]:
+    """(page, width, height, colour, x-ppi) of every image of a PDF, from poppler's pdfimages."""
+    out = subprocess.run(["pdfimages", "-list", str(pdf)], capture_output=True, text=True,
+                         check=True, timeout=60).stdout.splitlines()[2:]
+    return [(f[0], f[3], f[4], f[5], f[12]) for f in (line.split() for line in out)]
+
+
+@pytest.fixture(scope="module")
+def fork_pool():
+    """One forked worker, as the command line's report pool (fi_design.cli.pools)."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    if "fork" not in multiprocessing.get_all_start_methods():
+        pytest.skip("no fork start method")
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as pool:
+        yield pool
+
+
+def test_pdf_figures_drawn_by_a_worker_are_the_ones_drawn_here(paper_confirmed_design,
+                                                                fork_pool):
+    """A PDF's figures are placed by name and drawn apart (render_report with an executor):
+    the worker's figures are those this process places, in the same order, byte for byte."""
+    from fi_design.plots import deferred_figures
+
+    with deferred_figures() as figures:
+        html = report.render_html(report.build_context(paper_confirmed_design, date=DATE))
+    names = list(figures.makers)
+    assert len(names) >= 8 and len(set(names)) == len(names)
+    for name in names:  # placed by name, not drawn into the page
+        assert f'<img src="figure:{name}"' in html
+    assert "data:image/png" in html  # the equations stay inline images
+    drawn = fork_pool.submit(report.report_figures, paper_confirmed_design, {}).result()
+    assert list(drawn) == names
+    for name in names:
+        assert drawn[name] == figures.png(name), name
+        assert drawn[name].startswith(b"\x89PNG")
+
+
+@pytest.mark.skipif(shutil.which("pdfimages") is None, reason="poppler-utils is not installed")
+def test_pdf_is_the_same_with_its_figures_drawn_by_a_worker(paper_confirmed_design, fork_pool,
+                                                            design_pdf, tmp_path):
+    """The PDF written with the figures drawn by a worker holds the images of the one drawn
+    in one process (every figure and equation, at 200 dpi, RGB, on the same pages) and the
+    same text."""
+    apart = report.render_report(paper_confirmed_design, tmp_path / "apart.pdf", date=DATE,
+                                 command=COMMAND, executor=fork_pool)
+    images = _pdf_images(apart)
+    assert images == _pdf_images(design_pdf)
+    assert len(images) >= 20 and {i[3] for i in images} == {"rgb"}
+    text = [subprocess.run(["pdftotext", "-layout", str(p), "-"], capture_output=True,
+                           text=True, check=True, timeout=60).stdout for p in (apart, design_pdf)]
+    assert text[0] == text[1]
+
+
+def test_the_garbage_collector_rests_while_weasyprint_works(tmp_path, monkeypatch):
+    """WeasyPrint lays the PDF out with the cyclic collector paused (it traversed WeasyPrint's
+    growing objects again and again), and the collector's state is restored after, also when
+    the layout fails."""
+    import gc
+
+    import weasyprint
+
+    seen = []
+    real = weasyprint.HTML.render
+
+    def render(self, *args, **kwargs):
+        seen.append(gc.isenabled())
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(weasyprint.HTML, "render", render)
+    html = "<!DOCTYPE html><html><body><p>one page</p></body></html>"
+    assert gc.isenabled()
+    report.write_document(html, tmp_path / "a.pdf")
+    assert seen == [False] and gc.isenabled()
+    gc.disable()
+    try:
+        report.write_document(html, tmp_path / "b.pdf")
+        assert not gc.isenabled()  # a caller's choice is kept
+    finally:
+        gc.enable()
+
+    def broken(self, *args, **kwargs):
+        raise RuntimeError("layout failed")
+
+    monkeypatch.setattr(weasyprint.HTML, "render", broken)
+    with pytest.raises(RuntimeError, match="layout failed"):
+        report.write_document(html, tmp_path / "c.pdf")
+    assert gc.isenabled() and not (tmp_path / "c.pdf").exists()
+
+
+class _FailedFuture:
+    def result(self):
+        raise RuntimeError("worker gone")
+
+
+class _Gone:
+    """An executor whose every task fails (a worker killed under it)."""
+
+    def submit(self, *args, **kwargs):
+        return _FailedFuture()
+
+
+@pytest.mark.skipif(shutil.which("pdfimages") is None, reason="poppler-utils is not installed")
+def test_pdf_figures_drawn_here_when_the_worker_fails(paper_confirmed_design, design_pdf,
+                                                      tmp_path):
+    out = report.render_report(paper_confirmed_design, tmp_path / "here.pdf", date=DATE,
+                               command=COMMAND, executor=_Gone())
+    assert _pdf_images(out) == _pdf_images(design_pdf)
+
+
+def test_a_figure_that_fails_raises_its_own_error_and_writes_no_pdf(paper_confirmed_design,
+                                                                    tmp_path, monkeypatch):
+    """A figure drawn while WeasyPrint lays the PDF out fails with its own error (not
+    WeasyPrint's 'Error fetching figure:...'), and no file is left."""
+    from fi_design import plots
+
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("the Bode plot broke")
+
+    monkeypatch.setattr(plots, "bode_figure", broken)
+    out = tmp_path / "broken.pdf"
+    with pytest.raises(ZeroDivisionError, match="Bode plot broke"):
+        report.render_report(paper_confirmed_design, out, date=DATE)
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
 # --------------------------------------------------------------------------- Chromium
 
 
