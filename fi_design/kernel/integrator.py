@@ -111,17 +111,10 @@ FAC_MAX = 6.0  # hnew / h <= 6
 
 
 @kernel_function((f8, A1, A2, i8), inline=True)
-def reference_at(t, breaks, coeffs, k):
-    """Reference position, velocity, acceleration and jerk at ``t``, and the segment index.
-
-    Inlined into its callers: as a call it made the integrator a third slower
-    (around a call the caller keeps its live values in memory).
-
-    ``k`` is a hint (the last segment used); the search walks from there.
-    Before the first break the reference holds ``coeffs[0, 0]`` and after the
-    last its end value, at rest; at a break it takes the values of the segment
-    that starts there (right-continuous).
-    """
+def _reference_at(t, breaks, coeffs, k):
+    """:func:`reference_at`, inlined where the integrator steps and writes its outputs: as a
+    call there it made the integrator a third slower (around a call the caller keeps its
+    live values in memory)."""
     nseg = coeffs.shape[0]
     if t >= breaks[nseg]:
         k = nseg - 1
@@ -140,6 +133,18 @@ def reference_at(t, breaks, coeffs, k):
     rd = c1 + tau * (2.0 * c2 + 3.0 * tau * c3)
     rdd = 2.0 * c2 + 6.0 * tau * c3
     return r, rd, rdd, 6.0 * c3, k
+
+
+@kernel_function((f8, A1, A2, i8))
+def reference_at(t, breaks, coeffs, k):
+    """Reference position, velocity, acceleration and jerk at ``t``, and the segment index.
+
+    ``k`` is a hint (the last segment used); the search walks from there.
+    Before the first break the reference holds ``coeffs[0, 0]`` and after the
+    last its end value, at rest; at a break it takes the values of the segment
+    that starts there (right-continuous).
+    """
+    return _reference_at(t, breaks, coeffs, k)
 
 
 @kernel_function((f8, A1, A1, i8))
@@ -920,7 +925,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 t_land = in_t[i_in] + delay
 
         # ---------------------------------------------------- f, J, f_t at (t, y)
-        r0, rd0, rdd0, _, kref = reference_at(t, breaks, coeffs, kref)
+        r0, rd0, rdd0, _, kref = _reference_at(t, breaks, coeffs, kref)
         fa0 = 0.0
         dfa0 = 0.0
         if need_cmd:
@@ -1005,7 +1010,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             for j in range(n):
                 ytmp[j] = y[j] + A21 * k1[j]
             ts = t + C2 * h
-            rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
+            rs, rds, _, _, kref = _reference_at(ts, breaks, coeffs, kref)
             fas = 0.0
             if held:
                 fas = fa_hold
@@ -1020,7 +1025,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             for j in range(n):
                 ytmp[j] = y[j] + A31 * k1[j] + A32 * k2[j]
             ts = t + C3 * h
-            rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
+            rs, rds, _, _, kref = _reference_at(ts, breaks, coeffs, kref)
             if need_cmd and not held:
                 fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
                                           hist, head, count)
@@ -1032,7 +1037,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             for j in range(n):
                 ytmp[j] = y[j] + A41 * k1[j] + A42 * k2[j] + A43 * k3[j]
             ts = t + C4 * h
-            rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
+            rs, rds, _, _, kref = _reference_at(ts, breaks, coeffs, kref)
             if need_cmd and not held:
                 fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
                                           hist, head, count)
@@ -1044,7 +1049,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             for j in range(n):
                 ytmp[j] = y[j] + A51 * k1[j] + A52 * k2[j] + A53 * k3[j] + A54 * k4[j]
             ts = t + h
-            rs, rds, _, _, kref = reference_at(ts, breaks, coeffs, kref)
+            rs, rds, _, _, kref = _reference_at(ts, breaks, coeffs, kref)
             if need_cmd and not held:
                 fas, _, _ = stage_command(ts, p, breaks, coeffs, in_t, in_f, hints, fa_hold,
                                           hist, head, count)
@@ -1172,7 +1177,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                     for j in range(n):  # the dense output, as dense() computes it
                         out_y[i_out, j] = y[j] * s1 + th * (ynew[j] + s1 * (cd2[j] + th * cd3[j]))
                         ybuf[j] = out_y[i_out, j]
-                    rr, rdr, _, _, kref = reference_at(t_out[i_out], breaks, coeffs, kref)
+                    rr, rdr, _, _, kref = _reference_at(t_out[i_out], breaks, coeffs, kref)
                     out_r[i_out] = rr
                     if held:
                         out_cmd[i_out] = ybuf[iu]

@@ -39,14 +39,15 @@ def kernel_function(signature, *, refcounted: bool = False, inline: bool = False
     arguments of every call was half the kernel's run time. ``inline``
     inlines the function into its callers (numba's ``inline="always"``): a
     caller that passes a constant size gets loops of a constant length,
-    which the compiler unrolls.
+    which the compiler unrolls. An inlined function is compiled on its own
+    only if Python calls it (a test): its callers need only its source.
     """
     options = dict(error_model="numpy")
     if not refcounted:
         options["_nrt"] = False
     if inline:
         options["inline"] = "always"
-    lazy = bool(os.environ.get(AOT_BUILD_ENV))
+    lazy = bool(os.environ.get(AOT_BUILD_ENV)) or inline
 
     def decorate(fn):
         SIGNATURES[fn.__name__] = tuple(signature)

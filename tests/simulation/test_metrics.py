@@ -129,6 +129,21 @@ def test_a_stick_plateau_with_round_off_counts_once():
     assert m.peak_times == pytest.approx(middles, abs=0.05)
 
 
+def test_a_plateau_of_thousands_of_samples_counts_once_in_its_middle():
+    """A stage stuck for 3.6 s (3600 samples at 1 kHz, rounding steps on its top) between
+    two slips: one peak, in the middle of the stuck stretch, however long it is."""
+    a = 0.5e-3
+    rise = np.clip((T - 10.2) / 0.8, 0.0, 1.0)  # -a at 10.2 s to +a at 11 s
+    fall = np.clip((T - 14.6) / 0.8, 0.0, 1.0)  # +a at 14.6 s to -a at 15.4 s
+    e = -a * np.cos(np.pi * rise) * np.cos(np.pi * fall)
+    rng = np.random.default_rng(5)
+    top = (T >= 11.0) & (T <= 14.6)
+    e = np.where(top, a + rng.integers(-1, 2, T.shape) * 1.1e-16, e)
+    m = hunting_metrics(T, e)
+    assert m.hunting_cycles == 1
+    assert m.peak_times[0] == pytest.approx((11.0 + 14.6) / 2.0, abs=2e-3)
+
+
 @pytest.mark.parametrize("motion_end", [250.0, 20.5, 25.0])
 def test_a_motion_that_outlasts_the_run_or_window_is_not_finished(motion_end):
     """A stage on its ramp follows the reference within the band: no cycles, error zero. The
