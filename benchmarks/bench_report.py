@@ -174,7 +174,8 @@ def main(argv: list[str] | None = None) -> int:
                      ("WeasyPrint's output (`write_pdf`), the same", write_t)):
         print(f"| {label} | {t[0]:.2f} | {t[1]:.2f} |")
     print(f"| the report written in one process (`render_report`) | {here_t[0]:.2f} | "
-          f"{here_t[1]:.2f} + {here_t[3]:.2f} in child processes (git) |")
+          f"{here_t[1]:.2f} + {here_t[3]:.2f} in child processes (git, run once per "
+          "process) |")
     print(f"| the report written, its figures drawn by a worker (`report_pool`) | "
           f"{apart_t[0]:.2f} | {apart_t[1]:.2f} + {apart_t[3]:.2f} in child processes "
           "(the worker, git) |")

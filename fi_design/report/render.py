@@ -160,6 +160,7 @@ def write_document(html: str, path: str | os.PathLike, *, figures: Any = None) -
     # screen-only rules are expected to be skipped.
     logging.getLogger("weasyprint").setLevel(logging.ERROR)
     logging.getLogger("fontTools").setLevel(logging.ERROR)
+    _import_weasyprint()
     from weasyprint import HTML
     from weasyprint.urls import FatalURLFetchingError
 
@@ -193,6 +194,40 @@ def _collector_paused() -> Iterator[None]:
     finally:
         if enabled:
             gc.enable()
+
+
+def _import_weasyprint() -> None:
+    """Import WeasyPrint, on Linux without ctypes' search for its libraries.
+
+    WeasyPrint opens GLib, Pango, HarfBuzz and fontconfig by several names in turn
+    through cffi, which asks :func:`ctypes.util.find_library` for every name that is
+    not a file it can open; on Linux each such call runs ``ldconfig -p``, then gcc and
+    ld when the name is unknown: some 200 processes, 0.3 s of the import's 0.7 s. Every
+    list of names also holds the library's soname (``libpango-1.0.so.0``), which the
+    dynamic loader finds by itself, as find_library would have: while WeasyPrint is
+    imported, find_library answers None, and if that import fails it is made again the
+    usual way.
+    """
+    import importlib
+    import sys
+
+    if "weasyprint" in sys.modules or not sys.platform.startswith("linux"):
+        importlib.import_module("weasyprint")
+        return
+    import ctypes.util
+    import io
+
+    search = ctypes.util.find_library
+    ctypes.util.find_library = lambda name: None
+    try:  # WeasyPrint prints its installation advice when a library is missing
+        with contextlib.redirect_stdout(io.StringIO()):
+            importlib.import_module("weasyprint")
+        return
+    except Exception:  # a library only ctypes' search finds: the usual import below
+        pass
+    finally:
+        ctypes.util.find_library = search
+    importlib.import_module("weasyprint")
 
 
 def _self_contained(figures: Any = None) -> Any:

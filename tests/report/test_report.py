@@ -536,6 +536,52 @@ def test_pdf_is_the_same_with_its_figures_drawn_by_a_worker(paper_confirmed_desi
     assert text[0] == text[1]
 
 
+_IMPORT_WEASYPRINT = """\
+import ctypes.util, json, resource, sys
+calls = []
+search = ctypes.util.find_library
+def counted(name):
+    calls.append(name)
+    return search(name)
+ctypes.util.find_library = counted
+if sys.argv[1] == "fail-once":  # the first import of WeasyPrint's library module fails
+    class FailOnce:
+        done = False
+        def find_spec(self, name, path=None, target=None):
+            if name == "weasyprint.text.ffi" and not FailOnce.done:
+                FailOnce.done = True
+                raise OSError("no such library")
+    sys.meta_path.insert(0, FailOnce())
+from fi_design.report.render import _import_weasyprint
+_import_weasyprint()
+import weasyprint.text.ffi as ffi
+children = resource.getrusage(resource.RUSAGE_CHILDREN)
+print(json.dumps(dict(calls=len(calls), restored=ctypes.util.find_library is counted,
+                      subset=ffi.harfbuzz_subset is not None, pango=ffi.pango is not None,
+                      children=children.ru_utime + children.ru_stime > 0)))
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the search skipped on Linux")
+def test_weasyprint_is_imported_without_a_library_search():
+    """WeasyPrint's import asked ctypes.util.find_library for each name it tries (ldconfig,
+    gcc and ld: some 200 processes, 0.3 s); the report imports it with the search skipped,
+    the same libraries loaded by their sonames, the search restored after; when that import
+    fails, the usual one follows, quietly."""
+    import json
+
+    def run(mode):
+        out = subprocess.run([sys.executable, "-c", _IMPORT_WEASYPRINT, mode],
+                             capture_output=True, text=True, timeout=120, check=True).stdout
+        return json.loads(out.strip().splitlines()[-1]), out
+
+    fast, out = run("fast")
+    assert fast == dict(calls=0, restored=True, subset=True, pango=True, children=False), out
+    again, out = run("fail-once")
+    assert again["calls"] > 0 and again["restored"] and again["pango"] and again["children"]
+    assert len(out.strip().splitlines()) == 1, out  # no installation advice printed
+
+
 def test_the_garbage_collector_rests_while_weasyprint_works(tmp_path, monkeypatch):
     """WeasyPrint lays the PDF out with the cyclic collector paused (it traversed WeasyPrint's
     growing objects again and again), and the collector's state is restored after, also when
