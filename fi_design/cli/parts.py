@@ -261,6 +261,19 @@ def run_app(application: typer.Typer) -> None:
         _say_interrupted(exc, "outside the command")
         raise SystemExit(128 + exc.signum if isinstance(exc, Terminated) else
                          EXIT_INTERRUPTED) from None
+    finally:
+        _spare_the_last_collection()
+
+
+def _spare_the_last_collection() -> None:
+    """Freeze what the run built (:func:`gc.freeze`): the interpreter's exit then skips its
+    last garbage collection over the whole heap, which took 0.35 s after a design run and
+    0.6 s after a PDF report (WeasyPrint's objects, collected nowhere else). The outputs
+    are written and closed by then (:mod:`fi_design.output`), and the atexit handlers
+    still run."""
+    import gc
+
+    gc.freeze()
 
 
 def _say_interrupted(exc: KeyboardInterrupt, where: str = "") -> None:
