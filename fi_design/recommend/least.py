@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 from .. import spec as _spec
@@ -27,12 +28,50 @@ from ..model import Model
 from ..results.recommend import LeastChange
 from . import constraints as _c
 
-__all__ = ["least_change", "BISECTION_STEPS", "STROKE_FACTORS"]
+__all__ = ["least_change", "least_change_task", "Scope", "BISECTION_STEPS", "STROKE_FACTORS"]
 
 #: Bisection steps of the stiffness.
 BISECTION_STEPS = 4
 #: Strokes tried for the stroke-and-stiffness change, as factors on the spec's [-].
 STROKE_FACTORS = (2.0, 4.0)
+
+
+@dataclass
+class Scope:
+    """What the least change reads of the search (picklable, for a worker).
+
+    Attributes
+    ----------
+    model : Model
+        The spec's own resolved model.
+    margin : float
+        ``requirements.hunting_margin`` [-].
+    rule : bool
+        Whether the spec's loop is tuned by the rule (its crossover may change).
+    fc : float
+        The loop's crossover cap [Hz].
+    fc_why : str
+        What sets the cap.
+    envelope : tuple of float
+        The strokes the search may reach (lowest, highest) [m].
+    evaluations : int
+        Stage-level evaluations run (counted up by :func:`least_change`).
+    """
+
+    model: Model
+    margin: float
+    rule: bool
+    fc: float
+    fc_why: str
+    envelope: tuple[float, float]
+    evaluations: int = 0
+
+
+def least_change_task(scope: Scope) -> tuple[LeastChange | None, int]:
+    """:func:`least_change` as one task (on a worker, beside the search): its result and the
+    stage-level evaluations it ran. Its design verdicts run in the task's process."""
+    found = least_change(scope)
+    return found, scope.evaluations
 
 
 def _margin_ok(model: Model, margin: float) -> tuple[bool, dict]:
@@ -82,8 +121,9 @@ def least_change(search: Any, *, executor: Any = None,
 
     Parameters
     ----------
-    search : fi_design.recommend.search._Search
-        The search (its base spec, crossover cap and margin).
+    search : Scope or fi_design.recommend.search._Search
+        The search's spec model, crossover cap, margin and stroke envelope (its
+        ``evaluations`` are counted up).
     executor : concurrent.futures-style executor, optional
         Runs the sign-off's simulations.
     progress : callable, optional

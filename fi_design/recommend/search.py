@@ -18,6 +18,10 @@ stiffnesses up to k_max = Fs / stroke, each point is:
 4. signed off, stiffest first until one passes: the loop's margins with their
    reserve (its own modes in), the reserve corners (masses, stiffness, modes,
    delay) and the design command's verdict (robustness included).
+
+On an executor, each stroke row's guides are sized as tasks, and the least
+change of the spec (:mod:`.least`, which reads none of the search's points)
+runs as one task beside the search; the result is the same as in one process.
 """
 
 from __future__ import annotations
@@ -128,6 +132,23 @@ class _Search:
     # ---- points
 
     def build(self, stroke: float, target: float) -> _Point:
+        """A point with its guide from stock (or the reason it has none)."""
+        p = self.planned(stroke, target)
+        if p.status is None:
+            self.place(p, _c.guide_for(self.base_model, target, stroke, self.fc))
+        return p
+
+    def build_all(self, pairs: list[tuple[float, float]]) -> list[_Point]:
+        """:meth:`build` over (stroke, target) pairs, the guides sized on the executor."""
+        pts = [self.planned(s, k) for s, k in pairs]
+        todo = [p for p in pts if p.status is None]
+        tasks = [(self.base_model, p.target, p.stroke, self.fc) for p in todo]
+        for p, fx in zip(todo, _map(self.executor, _c.guide_for, tasks)):
+            self.place(p, fx)
+        return pts
+
+    def planned(self, stroke: float, target: float) -> _Point:
+        """A new point of the search, out already where its target breaks k_max or the bounds."""
         p = _Point(stroke=stroke, target=target, crossover=self.fc)
         self.points.append(p)
         kmax = _spec.stiffness_limit(self.base, stroke)
@@ -140,19 +161,21 @@ class _Search:
         if b.stiffness is not None and not b.stiffness[0] <= target <= b.stiffness[1]:
             p.status = "bounds"
             p.violations.append("outside requirements.recommend.stiffness")
-            return p
-        fx = _c.guide_for(self.base_model, target, stroke, self.fc)
+        return p
+
+    def place(self, p: _Point, fx: Any) -> None:
+        """The point's guide (:func:`~.constraints.guide_for`'s answer): its candidate, or out
+        (``flexure``) where no guide realises it."""
         if not fx.feasible:
             p.status = "flexure"
             p.violations.append(f"no guide: {fx.reason}")
-            return p
+            return
         k = fx.drive_stiffness
         c = None if self.zeta is None else 2.0 * self.zeta * math.sqrt(k * self.mred)
-        p.candidate = Candidate(stroke=stroke, length=fx.length, width=fx.width,
+        p.candidate = Candidate(stroke=p.stroke, length=fx.length, width=fx.width,
                                 thickness=fx.thickness, stiffness=k, crossover=self.fc,
                                 damping=c)
         p.lowest_mode = fx.lowest_mode.frequency if fx.lowest_mode is not None else None
-        return p
 
     def candidate_model(self, p: _Point) -> Model:
         """The point's candidate resolved into its model, once: every judgement reads it."""
@@ -207,12 +230,12 @@ class _Search:
                     f"{number(self.margin, 6)} x)")
 
     def stroke_row(self, strokes) -> None:
-        pts = []
+        pairs = []
         for s in strokes:
             kmax = _spec.stiffness_limit(self.base, s)
-            for k in np.geomspace(kmax / STIFFNESS_SPAN, TOP * kmax, STIFFNESSES):
-                pts.append(self.build(float(s), float(k)))
-        self.judge(pts)
+            pairs += [(float(s), float(k))
+                      for k in np.geomspace(kmax / STIFFNESS_SPAN, TOP * kmax, STIFFNESSES)]
+        self.judge(self.build_all(pairs))
 
     def best(self) -> _Point | None:
         ok = [p for p in self.points if p.status is None]
@@ -409,10 +432,10 @@ def _searched(model: Model, executor: Any, say: Callable[[str], None],
     """The search itself on a resolved model (:func:`recommend` without the cache); ``start``
     is when the call began (:func:`time.perf_counter`), for its wall time."""
     from ..guideline.steps import step2_crossover
-    from .least import least_change
-
+    
     spec = model.spec
     srch = _Search(model, executor, say)
+    aside = _least_aside(srch, executor, say)
     srch.run()
     chosen, signed = None, (None, None, None)
     for p in sorted((p for p in srch.points if p.status is None), key=_o.order, reverse=True):
@@ -435,7 +458,7 @@ def _searched(model: Model, executor: Any, say: Callable[[str], None],
     st = report.simulation.stage["isolated"] if report is not None else None
     rob = report.robustness if report is not None else None
     binding = _o.binding(srch, chosen) if feasible else ()
-    least = least_change(srch, executor=executor, progress=say)
+    least = _least_collected(aside, srch, executor, say)
     xo = step2_crossover(srch.base_model)
     kmax = _spec.stiffness_limit(srch.base, chosen.stroke)
     margins = {"hunting_margin": chosen.margin, "stiffness_factor": kmax / chosen.stiffness,
@@ -461,3 +484,33 @@ def _searched(model: Model, executor: Any, say: Callable[[str], None],
         candidates=tuple(p.result() for p in srch.points), spec_design=spec_design,
         crossover_limit=srch.fc_why, assumptions=srch.assumed, rule=srch.rule,
         evaluations=srch.evaluations, wall_time=_time.perf_counter() - start, notch=srch.notch)
+
+
+def _least_aside(srch: _Search, executor: Any, say: Callable[[str], None]) -> Any:
+    """The least change of the spec started as one task on the executor, beside the search:
+    it reads the spec's model, the crossover cap, the margin and the stroke envelope, none of
+    the search's points, so the two share the cores. None without an executor or an isolator
+    (it then runs after the search)."""
+    from .least import Scope, least_change_task
+
+    if executor is None or srch.spec.isolator is None:
+        return None
+    say("the least change of the spec: on a worker, beside the search ...")
+    return executor.submit(least_change_task,
+                           Scope(srch.model, srch.margin, srch.rule, srch.fc, srch.fc_why,
+                                 srch.envelope))
+
+
+def _least_collected(aside: Any, srch: _Search, executor: Any,
+                     say: Callable[[str], None]) -> Any:
+    """The least change: the task's result (its evaluations counted into the search's), or
+    computed here when it was not started aside."""
+    from .least import least_change
+
+    if aside is None:
+        return least_change(srch, executor=executor, progress=say)
+    if not aside.done():
+        say("waiting for the least change of the spec ...")
+    found, evaluations = aside.result()
+    srch.evaluations += evaluations
+    return found
