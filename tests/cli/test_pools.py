@@ -184,19 +184,23 @@ _SWEEP = ["sweep", str(EXAMPLES / "paper_setup.yaml"), "--x", "controller.crosso
 _DESIGN = ["design", str(EXAMPLES / "paper_setup.yaml"), "--no-recommend", "--json", "map.csv"]
 
 
-def _interrupted_sweep(tmp_path, delay: float, command: list[str] = _SWEEP) -> dict:
-    """A 6-point sweep on 2 workers (or another ``command``), output to a file, sent SIGINT
-    ``delay`` s after the command line is ready: pool start, points, the CSV written, or
-    already finished."""
+def _interrupt(tmp_path, prefix: str, command: list[str], delay: float,
+               watch=None) -> dict:
+    """``command`` run by the driver in a folder of its own under ``tmp_path``, sent SIGINT
+    ``delay`` s after the command line is ready (and after ``watch(pid)`` returns, when
+    given). Returns its exit code, stderr, the files left, whether it had finished before the
+    signal, and what ``watch`` returned (``watched``)."""
     import tempfile
     from pathlib import Path
 
-    work = Path(tempfile.mkdtemp(prefix=f"at_{delay:.2f}_", dir=tmp_path))
-    proc = subprocess.Popen(
-        [sys.executable, "-c", _DRIVER, *command],
-        cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    work = Path(tempfile.mkdtemp(prefix=f"{prefix}_{delay:.2f}_", dir=tmp_path))
+    proc = subprocess.Popen([sys.executable, "-c", _DRIVER, *command],
+                            cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    watched = None
     try:
         assert proc.stdout.readline().strip() == "ready"
+        if watch is not None:
+            watched = watch(proc)
         time.sleep(delay)
         sent = time.time()
         proc.send_signal(signal.SIGINT)
@@ -206,8 +210,16 @@ def _interrupted_sweep(tmp_path, delay: float, command: list[str] = _SWEEP) -> d
             proc.kill()
     finished = [float(line.split()[1]) for line in out.splitlines()
                 if line.startswith("finished ")]
-    return dict(delay=delay, code=proc.returncode, err=err, files=sorted(
-        p.name for p in work.iterdir()), before=bool(finished) and finished[0] < sent)
+    return dict(delay=delay, code=proc.returncode, err=err, watched=watched,
+                files=sorted(p.name for p in work.iterdir()),
+                before=bool(finished) and finished[0] < sent)
+
+
+def _interrupted_sweep(tmp_path, delay: float, command: list[str] = _SWEEP) -> dict:
+    """A 6-point sweep on 2 workers (or another ``command``), output to a file, sent SIGINT
+    ``delay`` s after the command line is ready: pool start, points, the CSV written, or
+    already finished."""
+    return _interrupt(tmp_path, "at", command, delay)
 
 
 def _check_interrupted(run: dict) -> None:
@@ -264,18 +276,10 @@ def test_ctrl_c_at_many_instants_of_a_sweep(tmp_path):
 def _interrupted_report(tmp_path, delay: float) -> dict:
     """The design run with a PDF report, sent SIGINT ``delay`` s after the report's worker
     (a child forked once the design's workers exist no more) appears."""
-    import tempfile
-    from pathlib import Path
 
-    work = Path(tempfile.mkdtemp(prefix=f"report_{delay:.2f}_", dir=tmp_path))
-    proc = subprocess.Popen(
-        [sys.executable, "-c", _DRIVER, "design", str(EXAMPLES / "paper_setup.yaml"),
-         "--no-recommend", "--report", "map.pdf"],
-        cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    design: set[int] = set()
-    report: set[int] = set()
-    try:
-        assert proc.stdout.readline().strip() == "ready"
+    def report_worker(proc) -> tuple[set[int], set[int]]:
+        design: set[int] = set()
+        report: set[int] = set()
         deadline = time.monotonic() + 120
         while time.monotonic() < deadline and proc.poll() is None and not report:
             children = _children(proc.pid)
@@ -283,18 +287,13 @@ def _interrupted_report(tmp_path, delay: float) -> dict:
                 design = children
             report = children - design
             time.sleep(0.01)
-        time.sleep(delay)
-        sent = time.time()
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=120)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    finished = [float(line.split()[1]) for line in out.splitlines()
-                if line.startswith("finished ")]
-    return dict(delay=delay, code=proc.returncode, err=err, design=design, report=report,
-                files=sorted(p.name for p in work.iterdir()),
-                before=bool(finished) and finished[0] < sent)
+        return design, report
+
+    run = _interrupt(tmp_path, "report", ["design", str(EXAMPLES / "paper_setup.yaml"),
+                                          "--no-recommend", "--report", "map.pdf"],
+                     delay, watch=report_worker)
+    run["design"], run["report"] = run.pop("watched")
+    return run
 
 
 def _report_at(tmp_path, delays) -> None:
