@@ -120,7 +120,7 @@ def main(argv: list[str] | None = None) -> int:
                 return drawn[name]
 
         from fi_design.report.render import (_collector_paused, _import_weasyprint,
-                                             _self_contained)
+                                             _png_as_is, _self_contained)
 
         c0, t0, k0 = time.process_time(), time.perf_counter(), _children_cpu()
         _import_weasyprint()  # as write_document imports it
@@ -131,8 +131,8 @@ def main(argv: list[str] | None = None) -> int:
             with _collector_paused():
                 return weasyprint.HTML(string=html, url_fetcher=_self_contained(Drawn)).render()
 
-        def write():
-            with _collector_paused():
+        def write():  # as write_document runs it: the PNG figures' rows taken as they are
+            with _collector_paused(), _png_as_is():
                 layout_t[2].write_pdf(str(pdf))
 
         layout_t = phase(layout, args.rounds)

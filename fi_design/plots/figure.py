@@ -347,11 +347,12 @@ def figure_markup(fig: Any, prefix: str) -> str:
 
 
 def rgb_png(fig: Any, dpi: float) -> bytes:
-    """A figure drawn at ``dpi`` as an opaque RGB PNG, quickly compressed.
+    """A figure drawn at ``dpi`` as an opaque 8-bit RGB PNG (zlib's default compression).
 
-    For a PDF: WeasyPrint decodes every image and compresses it again
-    (an RGBA image twice, colour and alpha apart), so an opaque image with
-    light compression here saves two of the three encodings.
+    For a PDF: an opaque RGB PNG goes into the file as it is (its compressed
+    rows, see :func:`fi_design.report.render.write_document`), where WeasyPrint
+    would decode any other image and compress it again (an RGBA image twice,
+    colour and alpha apart); compressed as WeasyPrint would, the PDF keeps its size.
 
     Parameters
     ----------
@@ -372,7 +373,7 @@ def rgb_png(fig: Any, dpi: float) -> bytes:
     canvas.draw()
     rgba = np.asarray(canvas.buffer_rgba())
     buf = io.BytesIO()
-    Image.fromarray(rgba[..., :3]).save(buf, format="png", compress_level=1)
+    Image.fromarray(rgba[..., :3]).save(buf, format="png")
     return buf.getvalue()
 
 

@@ -334,6 +334,71 @@ def test_the_run_is_frozen_before_the_interpreter_exits(tmp_path, paper_spec_pat
         assert json.loads((tmp_path / "r.json").read_text())["spec_sha256"]
 
 
+_REPORT_GARBAGE = """\
+import atexit, gc, json, sys
+import fi_design.report as report
+seen = {}
+real = report.render_report
+def spy(*args, **kwargs):
+    seen["during"] = [gc.isenabled(), gc.get_freeze_count()]
+    out = real(*args, **kwargs)
+    seen["written"] = out.stat().st_size
+    return out
+report.render_report = spy
+def after():
+    seen["after"] = [gc.isenabled(), gc.get_freeze_count()]
+atexit.register(lambda: print("seen", json.dumps(seen), flush=True))
+import fi_design.cli.parts as parts
+real_freeze = parts._spare_the_last_collection
+def at_end():
+    after()
+    real_freeze()
+parts._spare_the_last_collection = at_end
+from fi_design.cli.app import main
+sys.argv = ["fi-design"] + sys.argv[1:]
+main()
+"""
+
+
+def test_the_report_garbage_is_frozen_not_collected(tmp_path, paper_spec_path):
+    """In the console script's process, the report is made with the cyclic collector paused
+    and what it built is frozen after it, not collected (the command ends with it): the
+    collector is enabled again, the report whole. A caller of the same steps in its own
+    process (CliRunner) keeps its collector as it was."""
+    import json
+
+    p = subprocess.run([sys.executable, "-c", _REPORT_GARBAGE, str(paper_spec_path),
+                        "--no-simulation", "--report", "r.html"],
+                       capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    seen = json.loads(next(line[5:] for line in p.stdout.splitlines()
+                           if line.startswith("seen ")))
+    assert seen["during"] == [False, 0], seen
+    assert seen["after"][0] is True and seen["after"][1] > 10_000, seen
+    assert seen["written"] > 10_000 and "</html>" in (tmp_path / "r.html").read_text()
+
+    import gc
+
+    import fi_design.report as report
+
+    states = []
+    real = report.render_report
+
+    def spy(*args, **kwargs):
+        states.append((gc.isenabled(), gc.get_freeze_count()))
+        return real(*args, **kwargs)
+
+    before = gc.get_freeze_count()
+    try:
+        report.render_report = spy
+        r = runner.invoke(app, [str(paper_spec_path), "--no-simulation", "--report",
+                                str(tmp_path / "in.html")])
+    finally:
+        report.render_report = real
+    assert r.exit_code == 0, r.output
+    assert states == [(True, before)] and gc.isenabled() and gc.get_freeze_count() == before
+
+
 def test_python_dash_m(tmp_path):
     p = subprocess.run([sys.executable, "-m", "fi_design", "--version"], capture_output=True,
                        text=True, timeout=60, cwd=ROOT)

@@ -618,6 +618,128 @@ def test_the_garbage_collector_rests_while_weasyprint_works(tmp_path, monkeypatc
     assert gc.isenabled() and not (tmp_path / "c.pdf").exists()
 
 
+def _idat(png: bytes) -> bytes:
+    """The joined IDAT chunks of a PNG (its compressed pixel rows), read chunk by chunk."""
+    import struct
+
+    at, rows = 8, []
+    while at < len(png):
+        length, kind = struct.unpack("!I4s", png[at:at + 8])
+        if kind == b"IDAT":
+            rows.append(png[at + 8:at + 8 + length])
+        at += 12 + length
+    return b"".join(rows)
+
+
+def _pixels(png_path: Path):
+    import numpy as np
+    from PIL import Image
+
+    with Image.open(png_path) as image:
+        return np.asarray(image.convert("RGB"))
+
+
+@pytest.mark.skipif(shutil.which("pdfimages") is None, reason="poppler-utils is not installed")
+def test_pdf_takes_the_figures_rows_as_they_are(paper_confirmed_design, design_pdf, tmp_path):
+    """An opaque 8-bit RGB PNG goes into the PDF as it is: each figure's compressed rows are in
+    the file byte for byte (not decoded and compressed again), and poppler reads every image
+    back with the figure's own pixels."""
+    import io
+
+    from PIL import Image
+
+    from fi_design.plots import deferred_figures
+
+    with deferred_figures() as figures:
+        report.build_context(paper_confirmed_design, date=DATE)
+    drawn = figures.all_png()
+    pdf = design_pdf.read_bytes()
+    for name, png in drawn.items():
+        assert _idat(png) in pdf, name
+    subprocess.run(["pdfimages", "-png", str(design_pdf), str(tmp_path / "img")], check=True,
+                   timeout=120)
+    extracted = [_pixels(p) for p in sorted(tmp_path.glob("img-*.png"))]
+    for name, png in drawn.items():
+        with Image.open(io.BytesIO(png)) as image:
+            want = __import__("numpy").asarray(image.convert("RGB"))
+        assert any(e.shape == want.shape and (e == want).all() for e in extracted), name
+
+
+def _png(width: int, height: int, depth: int, colour: int, rows: bytes,
+         interlace: int = 0) -> bytes:
+    """A PNG written chunk by chunk (``rows``: each scanline with its filter byte)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return (struct.pack("!I", len(body)) + kind + body
+                + struct.pack("!I", zlib.crc32(kind + body)))
+
+    head = struct.pack("!IIBBBBB", width, height, depth, colour, 0, 0, interlace)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", head) + chunk(b"IDAT", zlib.compress(rows))
+            + chunk(b"IEND", b""))
+
+
+@pytest.mark.skipif(shutil.which("pdfimages") is None, reason="poppler-utils is not installed")
+def test_pdf_encodes_other_images_again(tmp_path):
+    """Images that are not opaque 8-bit RGB PNGs (alpha, a palette, grey, 16 bits per
+    channel) are decoded and encoded again by WeasyPrint, as before: each reads back with
+    its own pixels; interlaced or damaged files are not taken as they are either; and
+    WeasyPrint's encoder is as it was once the PDF is written."""
+    import base64
+    import io
+
+    import numpy as np
+    from PIL import Image
+    from weasyprint.images import RasterImage
+
+    from fi_design.report.render import _rgb_png_rows
+
+    rng = np.random.default_rng(0)
+    rgb = rng.integers(0, 256, (24, 40, 3), dtype=np.uint8)
+
+    def pillow_png(image: Image.Image) -> bytes:
+        buf = io.BytesIO()
+        image.save(buf, format="png")
+        return buf.getvalue()
+
+    rows16 = b"".join(b"\0" + (row.astype(">u2") * 257).tobytes() for row in rgb)
+    plain = _png(40, 24, 8, 2, b"".join(b"\0" + row.tobytes() for row in rgb))
+    others = {
+        "alpha": pillow_png(Image.fromarray(np.dstack([rgb, rgb[..., :1]]))),
+        "palette": pillow_png(Image.fromarray(rgb).quantize(16)),
+        "grey": pillow_png(Image.fromarray(rgb[..., 0])),
+        "sixteen": _png(40, 24, 16, 2, rows16),
+    }
+    interlaced = _png(40, 24, 8, 2, b"", interlace=1)
+    damaged = bytearray(plain)
+    damaged[45] ^= 0xFF  # in the IDAT chunk: its CRC no longer matches
+    for name, data in [*others.items(), ("interlaced", interlaced), ("damaged", damaged)]:
+        with Image.open(io.BytesIO(bytes(data))) as image:
+            assert _rgb_png_rows(image) is None, name
+    with Image.open(io.BytesIO(others["sixteen"])) as image:
+        assert image.mode == "RGB"  # what Pillow calls it: the depth is read from the file
+    with Image.open(io.BytesIO(plain)) as image:
+        assert _rgb_png_rows(image) == _idat(plain)
+    assert _rgb_png_rows(Image.fromarray(rgb)) is None  # no file behind it
+
+    encoder = RasterImage.__dict__["_get_png_data"]
+    images = [plain, *others.values()]
+    tags = "".join(f'<img src="data:image/png;base64,{base64.b64encode(d).decode()}" '
+                   f'style="width:40px">' for d in images)
+    out = report.write_document(f"<!DOCTYPE html><html><body>{tags}</body></html>",
+                                tmp_path / "images.pdf")
+    assert RasterImage.__dict__["_get_png_data"] is encoder
+    assert _idat(plain) in out.read_bytes()
+    subprocess.run(["pdfimages", "-png", str(out), str(tmp_path / "img")], check=True,
+                   timeout=60)
+    got = [_pixels(p) for p in sorted(tmp_path.glob("img-*.png"))]
+    for data in images:
+        with Image.open(io.BytesIO(data)) as image:
+            want = np.asarray(image.convert("RGB"))
+        assert any(g.shape == want.shape and (g == want).all() for g in got)
+
+
 class _FailedFuture:
     def result(self):
         raise RuntimeError("worker gone")
