@@ -206,11 +206,15 @@ def _png_as_is() -> Iterator[None]:
     images. A PNG that is already 8-bit RGB, not interlaced (what
     :func:`fi_design.plots.rgb_png` writes) has those rows: they are taken from the
     file. Any other image (a palette, an alpha channel, 16 bits, interlacing) is
-    encoded again as before.
+    encoded again as before. The method taken over is WeasyPrint's own (60 and later);
+    a WeasyPrint without it writes the PDF its own way.
     """
     from weasyprint.images import RasterImage
 
-    encode = RasterImage.__dict__["_get_png_data"]
+    encode = RasterImage.__dict__.get("_get_png_data")
+    if not isinstance(encode, staticmethod):  # another WeasyPrint: its own encoding, untouched
+        yield
+        return
 
     def rows(pillow_image: Any) -> bytes:
         data = _rgb_png_rows(pillow_image)

@@ -740,6 +740,33 @@ def test_pdf_encodes_other_images_again(tmp_path):
         assert any(g.shape == want.shape and (g == want).all() for g in got)
 
 
+def test_pdf_leaves_an_encoder_of_another_form_alone(tmp_path, monkeypatch):
+    """The rows are taken over only where WeasyPrint's encoder is the static method of the
+    versions this was written for: another form (here a class method) is left in place,
+    called for every image, and the PDF is written as WeasyPrint writes it."""
+    import base64
+    import io
+
+    import numpy as np
+    from PIL import Image
+    from weasyprint.images import RasterImage
+
+    encode = RasterImage.__dict__["_get_png_data"].__func__
+    calls = []
+
+    def counted(cls, pillow_image):
+        calls.append(pillow_image.size)
+        return encode(pillow_image)
+
+    monkeypatch.setattr(RasterImage, "_get_png_data", classmethod(counted))
+    buf = io.BytesIO()
+    Image.fromarray(np.full((24, 40, 3), 90, np.uint8)).save(buf, format="png")
+    tag = f'<img src="data:image/png;base64,{base64.b64encode(buf.getvalue()).decode()}">'
+    out = report.write_document(f"<!DOCTYPE html><html><body>{tag}</body></html>",
+                                tmp_path / "other.pdf")
+    assert calls == [(40, 24)] and out.read_bytes().startswith(b"%PDF")
+
+
 class _FailedFuture:
     def result(self):
         raise RuntimeError("worker gone")
