@@ -428,7 +428,9 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
         # figure it reaches, not for the last one
         key = f"{os.getpid()}-{id(context)}-{time.monotonic_ns()}"
         sizes = executor.submit(report_figure_sizes, result, options, key=key)
-        drawn = {name: executor.submit(report_figures, result, options, names=(name,), key=key)
+        # the result goes with the first task only (3 MB for the paper setup): the worker
+        # keeps what it made under the key
+        drawn = {name: executor.submit(report_figures, None, options, names=(name,), key=key)
                  for name in figures.makers}
     html = render_html(context)
     if progress is not None:
@@ -444,8 +446,9 @@ def report_figures(result: Any, options: dict, names: Any = None,
 
     Parameters
     ----------
-    result : object
-        What the report is of (:func:`render_report`).
+    result : object or None
+        What the report is of (:func:`render_report`); None: the report of ``key``,
+        whose figures this process has made already (:func:`report_figure_sizes`).
     options : dict
         ``design_map`` when the report has one.
     names : sequence of str, optional
@@ -464,6 +467,8 @@ def report_figures(result: Any, options: dict, names: Any = None,
     ------
     KeyError
         A name the report does not place.
+    LookupError
+        ``result`` None, and no report of ``key`` in this process.
     """
     from ..plots import rgb_png
 
@@ -512,6 +517,8 @@ def _placed(result: Any, options: dict, key: str | None) -> tuple[Any, dict]:
 
     if key is not None and _PLACED is not None and _PLACED[0] == key:
         return _PLACED[1], _PLACED[2]
+    if result is None:
+        raise LookupError(f"no report {key!r} made in this process")
     with deferred_figures() as figures:
         build_context(result, **options)
     made: dict = {}

@@ -549,6 +549,8 @@ def test_a_figure_stand_in_is_an_rgb_png_of_its_size_that_names_it():
         assert image.info[_STAND_IN_KEY] == "bode"
         assert _rgb_png_rows(image) is not None
         assert (np.asarray(image) == 255).all()
+    with pytest.raises(LookupError):  # a task without the result, in a process without it
+        report.report_figures(None, {}, names=("bode",), key="a report never made here")
 
 
 @pytest.mark.skipif(shutil.which("pdfimages") is None, reason="poppler-utils is not installed")
