@@ -564,22 +564,18 @@ def test_pdf_laid_out_with_stand_ins_holds_the_figures_drawn_by_the_worker(
     import io
 
     import numpy as np
+    import weasyprint
     from PIL import Image
 
-    import fi_design.report.render as render
     from fi_design.plots import deferred_figures
+    from fi_design.report import render
 
-    asked = []
-    real_png, real_write = render._Figures.png, None
+    asked, writing = [], [False]
+    real_png, real_write = render._Figures.png, weasyprint.Document.write_pdf
 
     def png(self, name):
         asked.append((name, writing[0]))
         return real_png(self, name)
-
-    writing = [False]
-    import weasyprint
-
-    real_write = weasyprint.Document.write_pdf
 
     def write_pdf(self, *args, **kwargs):
         writing[0] = True
@@ -613,7 +609,7 @@ class _Here:
         future = Future()
         try:
             future.set_result(fn(*args, **kwargs))
-        except Exception as exc:
+        except Exception as exc:  # noqa: BLE001 (a future carries any error, as a pool's)
             future.set_exception(exc)
         return future
 
@@ -626,7 +622,7 @@ def test_a_figure_drawn_at_another_size_than_laid_out_fails_and_writes_no_pdf(
 
     from PIL import Image
 
-    import fi_design.report.render as render
+    from fi_design.report import render
 
     real = render.report_figures
 
