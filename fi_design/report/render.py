@@ -428,9 +428,9 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
         # figure it reaches, not for the last one
         key = f"{os.getpid()}-{id(context)}-{time.monotonic_ns()}"
         sizes = executor.submit(report_figure_sizes, result, options, key=key)
-        # the result goes with the first task only (3 MB for the paper setup): the worker
-        # keeps what it made under the key
-        drawn = {name: executor.submit(report_figures, None, options, names=(name,), key=key)
+        # the result and the map go with the first task only (3 MB for the paper setup):
+        # the worker keeps what it made under the key
+        drawn = {name: executor.submit(report_figures, None, {}, names=(name,), key=key)
                  for name in figures.makers}
     html = render_html(context)
     if progress is not None:
