@@ -29,7 +29,7 @@ from .confirmation import (PLANT_COLOURS, SETTLE_ZOOM, deflection_figure, error_
                            motion_end, plant_names)
 from .figure import (FIGURE_SCHEME, RASTER_DPI, REPORT_RC, REPORT_WIDTH, DeferredFigures,
                      cell_edges, decimate, deferred_figures, figure_bytes, figure_from,
-                     figure_markup, figure_svg, log_x, nice_ticks, plain_tick, png_img,
+                     figure_markup, figure_svg, log_x, nice_ticks, plain_tick, png_img, png_size,
                      raster_dpi, raster_figures, report_figure, rgb_png, styled)
 from .guide import guide_figure
 from .hunting import MOVE_MARKS, boundary_figure, cycle_figure, moves_figure, positioning_figure
@@ -53,7 +53,7 @@ __all__ = [
     "error_figure", "figure_bytes", "figure_from", "figure_markup", "figure_svg", "force_velocity_figure", "gap_overlay_figure",
     "gap_residual_figure", "guide_figure", "log_x", "motion_end", "moves_figure", "nice_ticks", "positioning_figure", "nyquist_figure",
     "out_of_band_crossovers", "plain_tick", "plant_names", "png_img", "raster_dpi",
-    "raster_figures", "rgb_png", "quantity_name", "recommend_figure",
+    "raster_figures", "png_size", "rgb_png", "quantity_name", "recommend_figure",
     "report_figure", "residual_figure", "robustness_figure", "sensitivity_figure",
     "structure_figure", "study_figure", "styled", "sweep_figure",
 ]

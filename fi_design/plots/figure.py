@@ -377,6 +377,28 @@ def rgb_png(fig: Any, dpi: float) -> bytes:
     return buf.getvalue()
 
 
+def png_size(fig: Any, dpi: float) -> tuple[int, int]:
+    """The size of :func:`rgb_png`'s image of a figure at ``dpi`` [pixels], without drawing it.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    dpi : float
+        Resolution [dots per inch].
+
+    Returns
+    -------
+    tuple of int
+        (width, height).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig.set_dpi(dpi)
+    width, height = FigureCanvasAgg(fig).get_width_height(physical=True)
+    return int(width), int(height)
+
+
 def figure_bytes(fig: Any, fmt: str = "svg") -> bytes:
     """Render a figure to SVG or PNG bytes, reproducibly (no date, fixed SVG ids).
 

@@ -15,6 +15,7 @@ import functools
 import gc
 import logging
 import os
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, Callable
@@ -139,7 +140,10 @@ def write_document(html: str, path: str | os.PathLike, *, figures: Any = None) -
     figures : object, optional
         A PDF's figures placed by name (``<img src="figure:NAME">``, see
         :func:`fi_design.plots.deferred_figures`): ``figures.png(name)`` gives
-        the PNG bytes when the layout reaches the figure.
+        the PNG bytes when the layout reaches the figure; where
+        ``figures.stand_in(name)`` gives PNG bytes (an image of the figure's
+        size only, drawn elsewhere meanwhile), the layout takes those and the
+        PDF the figure's own rows, asked for when the PDF is written.
 
     Returns
     -------
@@ -172,7 +176,7 @@ def write_document(html: str, path: str | os.PathLike, *, figures: Any = None) -
             if fetcher.failed is not None:  # a figure's own error, not WeasyPrint's wrapping
                 raise fetcher.failed from None
             raise
-        with atomic_path(out) as tmp, _png_as_is():
+        with atomic_path(out) as tmp, _png_as_is(getattr(figures, "png", None)):
             document.write_pdf(str(tmp))
     return out
 
@@ -197,7 +201,7 @@ def _collector_paused() -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def _png_as_is() -> Iterator[None]:
+def _png_as_is(figure: Callable[[str], bytes] | None = None) -> Iterator[None]:
     """While WeasyPrint writes a PDF, an opaque 8-bit RGB PNG goes into it as it is.
 
     WeasyPrint decodes every PNG and encodes it again to take the compressed pixel rows
@@ -206,17 +210,30 @@ def _png_as_is() -> Iterator[None]:
     images. A PNG that is already 8-bit RGB, not interlaced (what
     :func:`fi_design.plots.rgb_png` writes) has those rows: they are taken from the
     file. Any other image (a palette, an alpha channel, 16 bits, interlacing) is
-    encoded again as before. The method taken over is WeasyPrint's own (60 and later);
-    a WeasyPrint without it writes the PDF its own way.
+    encoded again as before. A figure's stand-in (:func:`_stand_in`) is replaced by the
+    figure, ``figure(name)`` (PNG bytes), which must be an RGB image of its size. The
+    method taken over is WeasyPrint's own (60 and later, :func:`_rows_replaceable`); a
+    WeasyPrint without it writes the PDF its own way, and no stand-in is laid out.
     """
+    import io
+
+    from PIL import Image
     from weasyprint.images import RasterImage
 
-    encode = RasterImage.__dict__.get("_get_png_data")
-    if not isinstance(encode, staticmethod):  # another WeasyPrint: its own encoding, untouched
+    if not _rows_replaceable():  # another WeasyPrint: its own encoding, untouched
         yield
         return
+    encode = RasterImage.__dict__["_get_png_data"]
 
     def rows(pillow_image: Any) -> bytes:
+        name = getattr(pillow_image, "info", {}).get(_STAND_IN_KEY)
+        if name is not None and figure is not None:
+            with Image.open(io.BytesIO(figure(name))) as real:
+                if real.size != pillow_image.size or real.mode != "RGB":
+                    raise RuntimeError(f"figure {name!r}: drawn {real.mode} {real.size}, "
+                                       f"laid out as RGB {pillow_image.size}")
+                data = _rgb_png_rows(real)
+                return encode.__func__(real) if data is None else data
         data = _rgb_png_rows(pillow_image)
         return encode.__func__(pillow_image) if data is None else data
 
@@ -225,6 +242,14 @@ def _png_as_is() -> Iterator[None]:
         yield
     finally:
         RasterImage._get_png_data = encode
+
+
+def _rows_replaceable() -> bool:
+    """Whether WeasyPrint's PNG encoder is the static method :func:`_png_as_is` takes over
+    (WeasyPrint 60 and later): only then are figures' stand-ins laid out."""
+    from weasyprint.images import RasterImage
+
+    return isinstance(RasterImage.__dict__.get("_get_png_data"), staticmethod)
 
 
 def _rgb_png_rows(pillow_image: Any) -> bytes | None:
@@ -260,6 +285,29 @@ def _rgb_png_rows(pillow_image: Any) -> bytes | None:
             break
         at += 12 + length
     return b"".join(chunks) if chunks else None
+
+
+#: The tEXt key of a figure's stand-in PNG; its value is the figure's name.
+_STAND_IN_KEY = "fi-design-figure"
+
+
+def _stand_in(name: str, width: int, height: int) -> bytes:
+    """A white 8-bit RGB PNG of ``width`` x ``height`` pixels that names the figure it
+    stands in for (a tEXt chunk): what WeasyPrint lays out while the figure is drawn
+    elsewhere; :func:`_png_as_is` puts the figure's own rows into the PDF."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return (struct.pack("!I", len(body)) + kind + body
+                + struct.pack("!I", zlib.crc32(kind + body)))
+
+    row = b"\0" + b"\xff" * (3 * width)
+    return (b"\x89PNG\r\n\x1a\n"
+            + chunk(b"IHDR", struct.pack("!IIBBBBB", width, height, 8, 2, 0, 0, 0))
+            + chunk(b"tEXt", _STAND_IN_KEY.encode("latin-1") + b"\0"
+                    + name.encode("latin-1", "replace"))
+            + chunk(b"IDAT", zlib.compress(row * height, 1)) + chunk(b"IEND", b""))
 
 
 def _import_weasyprint() -> None:
@@ -305,14 +353,19 @@ def _self_contained(figures: Any = None) -> Any:
     from ..plots import FIGURE_SCHEME
 
     prefix = FIGURE_SCHEME + ":"
+    # a stand-in only where the PDF's writing puts the figure in its place (_png_as_is)
+    stand_in = getattr(figures, "stand_in", None) if _rows_replaceable() else None
 
     class Fetcher(URLFetcher):
         failed: Exception | None = None  # what drawing a figure raised
 
         def fetch(self, url: str, headers: Any = None) -> Any:
             if figures is not None and url.startswith(prefix):
+                name = url[len(prefix):]
                 try:
-                    png = figures.png(url[len(prefix):])
+                    png = stand_in(name) if stand_in is not None else None
+                    if png is None:
+                        png = figures.png(name)
                 except Exception as exc:
                     self.failed = exc
                     raise
@@ -351,10 +404,11 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     progress : callable, optional
         ``progress(text)`` with a short message as the work proceeds.
     executor : concurrent.futures-style executor, optional
-        A PDF's figures are drawn there (``submit``; the result and
-        ``design_map`` are sent to it) while this process lays the report out;
-        they are needed only when the layout reaches them. None draws them here
-        as the layout reaches them. An HTML report does not use it.
+        A PDF's figures are drawn there (``submit``, one task a figure in the
+        order the report places them; the result and ``design_map`` are sent
+        with each) while this process lays the report out; the layout waits
+        for a figure only when it reaches it. None draws them here as the
+        layout reaches them. An HTML report does not use it.
 
     Returns
     -------
@@ -384,16 +438,66 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
         context = build_context(result, date=date, command=command, **options)
     drawn = None
     if executor is not None and figures.makers:  # drawn there while the HTML is made here
-        drawn = executor.submit(report_figures, result, options)
+        # one task a figure, in the order the layout needs them: the layout waits for the
+        # figure it reaches, not for the last one
+        key = f"{os.getpid()}-{id(context)}-{time.monotonic_ns()}"
+        sizes = executor.submit(report_figure_sizes, result, options, key=key)
+        # the result and the map go with the first task only (3 MB for the paper setup):
+        # the worker keeps what it made under the key
+        drawn = {name: executor.submit(report_figures, None, {}, names=(name,), key=key)
+                 for name in figures.makers}
     html = render_html(context)
     if progress is not None:
         progress("writing the PDF ...")
-    return write_document(html, out, figures=_Figures(figures, drawn))
+    return write_document(html, out, figures=_Figures(figures, drawn,
+                                                      None if drawn is None else sizes))
 
 
-def report_figures(result: Any, options: dict) -> dict[str, bytes]:
+def report_figures(result: Any, options: dict, names: Any = None,
+                   key: str | None = None) -> dict[str, bytes]:
     """The figures of a PDF report, drawn: name -> PNG bytes (what an executor runs for
-    :func:`render_report`).
+    :func:`render_report`, one figure a task).
+
+    Parameters
+    ----------
+    result : object or None
+        What the report is of (:func:`render_report`); None: the report of ``key``,
+        whose figures this process has made already (:func:`report_figure_sizes`).
+    options : dict
+        ``design_map`` when the report has one.
+    names : sequence of str, optional
+        Only these figures (default: every one).
+    key : str, optional
+        Names one report: the figures placed for it are kept in this process for the
+        next call with the same key (the tasks of one report in one worker), so the
+        report's context is built once.
+
+    Returns
+    -------
+    dict
+        The figures in the order the report places them.
+
+    Raises
+    ------
+    KeyError
+        A name the report does not place.
+    LookupError
+        ``result`` None, and no report of ``key`` in this process.
+    """
+    from ..plots import rgb_png
+
+    figures, made = _placed(result, options, key)
+    wanted = list(figures.makers) if names is None else list(names)
+    with _collector_paused():  # a forked worker's collector would traverse the parent's heap
+        return {name: rgb_png(made.pop(name), figures.dpi) if name in made
+                else figures.png(name) for name in wanted}
+
+
+def report_figure_sizes(result: Any, options: dict, key: str | None = None
+                        ) -> dict[str, tuple[int, int]]:
+    """The size of each figure of a PDF report as :func:`report_figures` draws it [pixels]:
+    name -> (width, height); the figures are made (not drawn) and kept for
+    :func:`report_figures` with the same ``key``.
 
     Parameters
     ----------
@@ -401,39 +505,79 @@ def report_figures(result: Any, options: dict) -> dict[str, bytes]:
         What the report is of (:func:`render_report`).
     options : dict
         ``design_map`` when the report has one.
+    key : str, optional
+        Names the report (:func:`report_figures`).
 
     Returns
     -------
     dict
-        The figures in the order the report places them.
+        The figures' sizes in the order the report places them.
     """
+    from ..plots import png_size
+
+    figures, made = _placed(result, options, key)
+    with _collector_paused():
+        for name, make in figures.makers.items():
+            made.setdefault(name, make())
+        return {name: png_size(made[name], figures.dpi) for name in figures.makers}
+
+
+def _placed(result: Any, options: dict, key: str | None) -> tuple[Any, dict]:
+    """The figures placed for a report (DeferredFigures) and those made so far (name ->
+    Figure), kept in this process for the report named ``key``."""
+    global _PLACED
+
     from ..plots import deferred_figures
 
+    if key is not None and _PLACED is not None and _PLACED[0] == key:
+        return _PLACED[1], _PLACED[2]
+    if result is None:
+        raise LookupError(f"no report {key!r} made in this process")
     with deferred_figures() as figures:
         build_context(result, **options)
-    with _collector_paused():  # a forked worker's collector would traverse the parent's heap
-        return figures.all_png()
+    made: dict = {}
+    _PLACED = None if key is None else (key, figures, made)
+    return figures, made
+
+
+#: What a worker keeps of the last report it draws for: (key, DeferredFigures, made).
+_PLACED: tuple[str, Any, dict] | None = None
 
 
 class _Figures:
-    """A PDF's figures by name: from ``drawn`` (a future of :func:`report_figures`, run
-    elsewhere) when it has them, else drawn here from ``placed`` (the makers)."""
+    """A PDF's figures by name: from ``drawn`` (name -> a future of :func:`report_figures`
+    for that figure, run elsewhere) when it has them, else drawn here from ``placed`` (the
+    makers). With ``sizes`` (a future of :func:`report_figure_sizes`), the layout takes a
+    stand-in of each figure's size (:meth:`stand_in`) and the figure itself is asked for
+    when the PDF is written."""
 
-    def __init__(self, placed: Any, drawn: Any) -> None:
+    def __init__(self, placed: Any, drawn: Any, sizes: Any = None) -> None:
         self._placed = placed
-        self._drawn = drawn
-        self._got: dict[str, bytes] = {}
+        self._drawn = dict(drawn or {})
+        self._sizes = sizes
+
+    def stand_in(self, name: str) -> bytes | None:
+        """A PNG of the figure's size that names it (:func:`_stand_in`), or None (no sizes:
+        the figure itself is laid out)."""
+        if self._sizes is None:
+            return None
+        try:
+            size = self._sizes.result().get(name)
+        except Exception:  # the worker failed or is gone: the figures are laid out as drawn
+            log.info("the report's figure sizes could not be had from a worker",
+                     exc_info=True)
+            self._sizes = None
+            return None
+        return None if size is None else _stand_in(name, *size)
 
     def png(self, name: str) -> bytes:
-        if self._drawn is not None:
+        future = self._drawn.pop(name, None)
+        if future is not None:
             try:
-                self._got = self._drawn.result()
-            except Exception:  # the worker failed or is gone: the figures are drawn here
-                log.info("the report's figures could not be drawn in a worker; drawing them "
-                         "here", exc_info=True)
-            self._drawn = None
-        if name in self._got:
-            return self._got[name]
+                return future.result()[name]
+            except Exception:  # the worker failed or is gone: the figure is drawn here
+                log.info("the report's figure %r could not be drawn in a worker; drawing it "
+                         "here", name, exc_info=True)
         return self._placed.png(name)
 
 

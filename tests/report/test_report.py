@@ -536,6 +536,111 @@ def test_pdf_is_the_same_with_its_figures_drawn_by_a_worker(paper_confirmed_desi
     assert text[0] == text[1]
 
 
+def test_a_figure_stand_in_is_an_rgb_png_of_its_size_that_names_it():
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    from fi_design.report.render import _STAND_IN_KEY, _rgb_png_rows, _stand_in
+
+    with Image.open(io.BytesIO(_stand_in("bode", 37, 11))) as image:
+        assert image.format == "PNG" and image.mode == "RGB" and image.size == (37, 11)
+        assert image.info[_STAND_IN_KEY] == "bode"
+        assert _rgb_png_rows(image) is not None
+        assert (np.asarray(image) == 255).all()
+    with pytest.raises(LookupError):  # a task without the result, in a process without it
+        report.report_figures(None, {}, names=("bode",), key="a report never made here")
+
+
+@pytest.mark.skipif(shutil.which("pdfimages") is None, reason="poppler-utils is not installed")
+def test_pdf_laid_out_with_stand_ins_holds_the_figures_drawn_by_the_worker(
+        paper_confirmed_design, fork_pool, tmp_path, monkeypatch):
+    """With a worker, WeasyPrint lays the page out with a stand-in of each figure's size (it
+    asks for every image while it builds the page's boxes, long before the worker has drawn
+    them all) and takes the figures themselves when it writes the PDF: every figure is in
+    the PDF with its own pixels (as drawn here), no stand-in is left, and the layout asked
+    for no figure before the output."""
+    import io
+
+    import numpy as np
+    import weasyprint
+    from PIL import Image
+
+    from fi_design.plots import deferred_figures
+    from fi_design.report import render
+
+    asked, writing = [], [False]
+    real_png, real_write = render._Figures.png, weasyprint.Document.write_pdf
+
+    def png(self, name):
+        asked.append((name, writing[0]))
+        return real_png(self, name)
+
+    def write_pdf(self, *args, **kwargs):
+        writing[0] = True
+        return real_write(self, *args, **kwargs)
+
+    monkeypatch.setattr(render._Figures, "png", png)
+    monkeypatch.setattr(weasyprint.Document, "write_pdf", write_pdf)
+    out = report.render_report(paper_confirmed_design, tmp_path / "apart.pdf", date=DATE,
+                               command=COMMAND, executor=fork_pool)
+    with deferred_figures() as figures:
+        report.build_context(paper_confirmed_design, date=DATE)
+    names = list(figures.makers)
+    assert sorted(n for n, _ in asked) == sorted(names)
+    assert all(during_output for _, during_output in asked)  # none while laying out
+    subprocess.run(["pdfimages", "-png", str(out), str(tmp_path / "img")], check=True,
+                   timeout=120)
+    got = [_pixels(p) for p in sorted(tmp_path.glob("img-*.png"))]
+    for name in names:
+        with Image.open(io.BytesIO(figures.png(name))) as image:
+            want = np.asarray(image.convert("RGB"))
+        assert any(g.shape == want.shape and (g == want).all() for g in got), name
+    assert not any(g.size > 100_000 and (g == 255).all() for g in got)  # no white stand-in
+
+
+class _Here:
+    """An executor that runs each task at once, here."""
+
+    def submit(self, fn, *args, **kwargs):
+        from concurrent.futures import Future
+
+        future = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except Exception as exc:  # noqa: BLE001 (a future carries any error, as a pool's)
+            future.set_exception(exc)
+        return future
+
+
+def test_a_figure_drawn_at_another_size_than_laid_out_fails_and_writes_no_pdf(
+        paper_confirmed_design, tmp_path, monkeypatch):
+    """The layout took the figure's size from the worker; a figure drawn at another size
+    (a bug) fails loudly when the PDF is written, and no file is left."""
+    import io
+
+    from PIL import Image
+
+    from fi_design.report import render
+
+    real = render.report_figures
+
+    def resized(*args, **kwargs):
+        drawn = real(*args, **kwargs)
+        if "bode" in drawn:
+            buf = io.BytesIO()
+            Image.new("RGB", (50, 40), "white").save(buf, format="png")
+            drawn["bode"] = buf.getvalue()
+        return drawn
+
+    monkeypatch.setattr(render, "report_figures", resized)
+    out = tmp_path / "resized.pdf"
+    with pytest.raises(RuntimeError, match="figure 'bode': drawn RGB \\(50, 40\\)"):
+        report.render_report(paper_confirmed_design, out, date=DATE, executor=_Here())
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
 _IMPORT_WEASYPRINT = """\
 import ctypes.util, json, resource, sys
 calls = []
@@ -765,6 +870,25 @@ def test_pdf_leaves_an_encoder_of_another_form_alone(tmp_path, monkeypatch):
     out = report.write_document(f"<!DOCTYPE html><html><body>{tag}</body></html>",
                                 tmp_path / "other.pdf")
     assert calls == [(40, 24)] and out.read_bytes().startswith(b"%PDF")
+
+    # nor is a figure laid out as a stand-in: nothing would put the figure in its place
+    from fi_design.plots import FIGURE_SCHEME
+    from fi_design.report.render import _self_contained
+
+    class Figures:
+        asked: list = []
+
+        def stand_in(self, name):
+            self.asked.append(("stand_in", name))
+            return b"stand-in"
+
+        def png(self, name):
+            self.asked.append(("png", name))
+            return buf.getvalue()
+
+    figures = Figures()
+    _self_contained(figures).fetch(f"{FIGURE_SCHEME}:bode")
+    assert figures.asked == [("png", "bode")]
 
 
 class _FailedFuture:
