@@ -26,17 +26,15 @@ The public API (imported lazily, so ``import fi_design`` stays fast):
 
 All values are SI floats; units are stated in the docstrings.
 
-These names are stable: ``fi_design.recommend`` is the function before and
-after its module ``fi_design.recommend`` is imported (reach the module with
-``from fi_design.recommend import ...``), and a subpackage such as
+These names are stable: ``fi_design.recommend`` is the package of the design
+search, called as the search itself (``fi_design.recommend(spec)``), however
+it was imported; its submodules are its attributes; and a subpackage such as
 ``fi_design.report`` is imported on first use (``fi_design.report.build_context``
 after a plain ``import fi_design``).
 """
 
 from __future__ import annotations
 
-import sys
-import types
 from importlib import import_module
 from importlib.metadata import PackageNotFoundError, version as _version
 from importlib.util import find_spec
@@ -72,30 +70,19 @@ _API = {
 __all__ = sorted(_API) + ["__version__"]
 
 
+#: Public names that are a subpackage called as its own function (the package's
+#: ``__call__``): the name and the package are one object.
+_CALLED_PACKAGES = {"recommend"}
+
+
 def __getattr__(name: str):
+    if name in _CALLED_PACKAGES:
+        return import_module(f"{__name__}.{name}")
     if name in _API:
         return getattr(import_module(_API[name]), name)
     if not name.startswith("_") and find_spec(f"{__name__}.{name}") is not None:
         return import_module(f"{__name__}.{name}")
     raise AttributeError(f"module 'fi_design' has no attribute {name!r}")
-
-
-class _Package(types.ModuleType):
-    """The package, whose public names a submodule of the same name does not replace.
-
-    Importing ``fi_design.recommend`` (the module) binds it as the package's
-    attribute ``recommend``, which would hide the function from then on; the
-    binding is skipped, so the name still reaches the function through
-    :func:`__getattr__` (the module stays in ``sys.modules``).
-    """
-
-    def __setattr__(self, name: str, value) -> None:
-        if name in _API and isinstance(value, types.ModuleType):
-            return
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package
 
 
 def __dir__() -> list[str]:

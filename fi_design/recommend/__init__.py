@@ -23,7 +23,26 @@ the spec that passes:
 
 from __future__ import annotations
 
+import inspect
+import sys
+import types
+
 from .search import recommend
 from .write import recommended_spec_text, recommended_values
 
 __all__ = ["recommend", "recommended_values", "recommended_spec_text"]
+
+
+class _Searching(types.ModuleType):
+    """This package, called as its search: ``fi_design.recommend(spec, ...)`` runs
+    :func:`recommend`, whether the name was reached as the package's attribute, by
+    ``import fi_design.recommend`` or by ``from fi_design import recommend``; its
+    submodules stay attributes (``import fi_design.recommend.search as s``)."""
+
+    def __call__(self, *args, **kwargs):
+        return self.recommend(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _Searching
+#: What :func:`inspect.signature` and ``help`` show for the package called: the search's.
+__signature__ = inspect.signature(recommend)
