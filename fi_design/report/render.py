@@ -168,16 +168,25 @@ def write_document(html: str, path: str | os.PathLike, *, figures: Any = None) -
     from weasyprint import HTML
     from weasyprint.urls import FatalURLFetchingError
 
-    fetcher = _self_contained(figures)
-    with _collector_paused():
+    def laid_out(stand_ins: bool) -> tuple[Any, Any]:
+        fetcher = _self_contained(figures, stand_ins=stand_ins)
         try:
-            document = HTML(string=html, base_url=None, url_fetcher=fetcher).render()
+            return HTML(string=html, base_url=None, url_fetcher=fetcher).render(), fetcher
         except FatalURLFetchingError:
             if fetcher.failed is not None:  # a figure's own error, not WeasyPrint's wrapping
                 raise fetcher.failed from None
             raise
-        with atomic_path(out) as tmp, _png_as_is(getattr(figures, "png", None)):
-            document.write_pdf(str(tmp))
+
+    with _collector_paused():
+        document, fetcher = laid_out(True)
+        with atomic_path(out) as tmp:
+            with _png_as_is(getattr(figures, "png", None)) as replaced:
+                document.write_pdf(str(tmp))
+            if fetcher.stood_in - replaced:  # a stand-in went into the file as it was laid out
+                log.warning("the PDF's figures were not put in place of their stand-ins "
+                            "(%s): the report is laid out again with the figures",
+                            ", ".join(sorted(fetcher.stood_in - replaced)))
+                laid_out(False)[0].write_pdf(str(tmp))
     return out
 
 
@@ -201,7 +210,7 @@ def _collector_paused() -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def _png_as_is(figure: Callable[[str], bytes] | None = None) -> Iterator[None]:
+def _png_as_is(figure: Callable[[str], bytes] | None = None) -> Iterator[set[str]]:
     """While WeasyPrint writes a PDF, an opaque 8-bit RGB PNG goes into it as it is.
 
     WeasyPrint decodes every PNG and encodes it again to take the compressed pixel rows
@@ -214,14 +223,17 @@ def _png_as_is(figure: Callable[[str], bytes] | None = None) -> Iterator[None]:
     figure, ``figure(name)`` (PNG bytes), which must be an RGB image of its size. The
     method taken over is WeasyPrint's own (60 and later, :func:`_rows_replaceable`); a
     WeasyPrint without it writes the PDF its own way, and no stand-in is laid out.
+    Yields the set of the figures put in place of their stand-ins (filled as the PDF is
+    written), which :func:`write_document` checks against the stand-ins laid out.
     """
     import io
 
     from PIL import Image
     from weasyprint.images import RasterImage
 
+    replaced: set[str] = set()
     if not _rows_replaceable():  # another WeasyPrint: its own encoding, untouched
-        yield
+        yield replaced
         return
     encode = RasterImage.__dict__["_get_png_data"]
 
@@ -233,13 +245,14 @@ def _png_as_is(figure: Callable[[str], bytes] | None = None) -> Iterator[None]:
                     raise RuntimeError(f"figure {name!r}: drawn {real.mode} {real.size}, "
                                        f"laid out as RGB {pillow_image.size}")
                 data = _rgb_png_rows(real)
+                replaced.add(name)
                 return encode.__func__(real) if data is None else data
         data = _rgb_png_rows(pillow_image)
         return encode.__func__(pillow_image) if data is None else data
 
     RasterImage._get_png_data = staticmethod(rows)
     try:
-        yield
+        yield replaced
     finally:
         RasterImage._get_png_data = encode
 
@@ -344,20 +357,23 @@ def _import_weasyprint() -> None:
     importlib.import_module("weasyprint")
 
 
-def _self_contained(figures: Any = None) -> Any:
+def _self_contained(figures: Any = None, *, stand_ins: bool = True) -> Any:
     """WeasyPrint's URL fetcher limited to ``data:`` URLs and the figures placed by name
-    (``figure:NAME``, from ``figures``): the report is self-contained by design and makes no
-    external request (any other URL is refused)."""
+    (``figure:NAME``, from ``figures``; their stand-ins where ``figures`` has them, the
+    writing can replace them and ``stand_ins``; the fetcher's ``stood_in`` names them): the
+    report is self-contained by design and makes no external request (any other URL is
+    refused)."""
     from weasyprint.urls import URLFetcher, URLFetcherResponse
 
     from ..plots import FIGURE_SCHEME
 
     prefix = FIGURE_SCHEME + ":"
     # a stand-in only where the PDF's writing puts the figure in its place (_png_as_is)
-    stand_in = getattr(figures, "stand_in", None) if _rows_replaceable() else None
+    stand_in = getattr(figures, "stand_in", None) if stand_ins and _rows_replaceable() else None
 
     class Fetcher(URLFetcher):
         failed: Exception | None = None  # what drawing a figure raised
+        stood_in: set[str] = set()  # the figures laid out as stand-ins
 
         def fetch(self, url: str, headers: Any = None) -> Any:
             if figures is not None and url.startswith(prefix):
@@ -366,6 +382,8 @@ def _self_contained(figures: Any = None) -> Any:
                     png = stand_in(name) if stand_in is not None else None
                     if png is None:
                         png = figures.png(name)
+                    else:
+                        self.stood_in = self.stood_in | {name}
                 except Exception as exc:
                     self.failed = exc
                     raise

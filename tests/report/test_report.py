@@ -891,6 +891,51 @@ def test_pdf_leaves_an_encoder_of_another_form_alone(tmp_path, monkeypatch):
     assert figures.asked == [("png", "bode")]
 
 
+@pytest.mark.skipif(shutil.which("pdfimages") is None, reason="poppler-utils is not installed")
+def test_a_stand_in_the_writing_did_not_replace_is_laid_out_again_with_its_figure(
+        tmp_path, monkeypatch, caplog):
+    """Should a WeasyPrint write the stand-in itself (its encoder not called for it), the PDF
+    is laid out again with the figure: never a blank box in a sign-off document."""
+    import contextlib
+    import io
+    import logging
+
+    import numpy as np
+    from PIL import Image
+
+    from fi_design.plots import FIGURE_SCHEME
+    from fi_design.report import render
+
+    drawn = np.zeros((30, 50, 3), np.uint8)
+    drawn[:, :25] = (200, 30, 30)
+    buf = io.BytesIO()
+    Image.fromarray(drawn).save(buf, format="png")
+
+    class Figures:
+        asked: list = []
+
+        def stand_in(self, name):
+            return render._stand_in(name, 50, 30)
+
+        def png(self, name):
+            self.asked.append(name)
+            return buf.getvalue()
+
+    @contextlib.contextmanager
+    def untouched(figure=None):
+        yield set()  # as a WeasyPrint that never asks the encoder for the stand-in's rows
+
+    monkeypatch.setattr(render, "_png_as_is", untouched)
+    html = f'<!DOCTYPE html><html><body><img src="{FIGURE_SCHEME}:bode"></body></html>'
+    with caplog.at_level(logging.WARNING, logger="fi_design.report.render"):
+        out = render.write_document(html, tmp_path / "again.pdf", figures=Figures())
+    assert Figures.asked == ["bode"] and "laid out again" in caplog.text
+    subprocess.run(["pdfimages", "-png", str(out), str(tmp_path / "img")], check=True,
+                   timeout=60)
+    (got,) = [_pixels(p) for p in sorted(tmp_path.glob("img-*.png"))]
+    assert got.shape == drawn.shape and (got == drawn).all()
+
+
 class _FailedFuture:
     def result(self):
         raise RuntimeError("worker gone")
