@@ -460,9 +460,9 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
         # figure it reaches, not for the last one
         key = f"{os.getpid()}-{id(context)}-{time.monotonic_ns()}"
         sizes = executor.submit(report_figure_sizes, result, options, key=key)
-        # the result and the map go with the first task only (3 MB for the paper setup):
-        # the worker keeps what it made under the key
-        drawn = {name: executor.submit(report_figures, None, {}, names=(name,), key=key)
+        # the result goes with every task (any worker of any pool can draw any figure); a
+        # worker that made the report's figures for an earlier task keeps them by the key
+        drawn = {name: executor.submit(report_figures, result, options, names=(name,), key=key)
                  for name in figures.makers}
     html = render_html(context)
     if progress is not None:
@@ -478,9 +478,9 @@ def report_figures(result: Any, options: dict, names: Any = None,
 
     Parameters
     ----------
-    result : object or None
-        What the report is of (:func:`render_report`); None: the report of ``key``,
-        whose figures this process has made already (:func:`report_figure_sizes`).
+    result : object
+        What the report is of (:func:`render_report`); its figures are made once per
+        ``key`` in this process.
     options : dict
         ``design_map`` when the report has one.
     names : sequence of str, optional
@@ -499,8 +499,6 @@ def report_figures(result: Any, options: dict, names: Any = None,
     ------
     KeyError
         A name the report does not place.
-    LookupError
-        ``result`` None, and no report of ``key`` in this process.
     """
     from ..plots import rgb_png
 
@@ -549,8 +547,6 @@ def _placed(result: Any, options: dict, key: str | None) -> tuple[Any, dict]:
 
     if key is not None and _PLACED is not None and _PLACED[0] == key:
         return _PLACED[1], _PLACED[2]
-    if result is None:
-        raise LookupError(f"no report {key!r} made in this process")
     with deferred_figures() as figures:
         build_context(result, **options)
     made: dict = {}

@@ -536,6 +536,24 @@ def test_pdf_is_the_same_with_its_figures_drawn_by_a_worker(paper_confirmed_desi
     assert text[0] == text[1]
 
 
+@pytest.mark.skipif(shutil.which("pdfimages") is None, reason="poppler-utils is not installed")
+def test_pdf_figures_drawn_by_a_pool_of_two_workers(paper_confirmed_design, design_pdf,
+                                                    tmp_path, caplog):
+    """A library caller's pool of several workers: each figure's task may land on a worker
+    that did not make the report's figures; every one is drawn there (none falls back to
+    this process) and the PDF holds the images of the one drawn in one process."""
+    import logging
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    with caplog.at_level(logging.INFO, logger="fi_design.report.render"), \
+            ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("fork")) as pool:
+        out = report.render_report(paper_confirmed_design, tmp_path / "two.pdf", date=DATE,
+                                   command=COMMAND, executor=pool)
+    assert "could not" not in caplog.text, caplog.text
+    assert _pdf_images(out) == _pdf_images(design_pdf)
+
+
 def test_a_figure_stand_in_is_an_rgb_png_of_its_size_that_names_it():
     import io
 
@@ -549,8 +567,6 @@ def test_a_figure_stand_in_is_an_rgb_png_of_its_size_that_names_it():
         assert image.info[_STAND_IN_KEY] == "bode"
         assert _rgb_png_rows(image) is not None
         assert (np.asarray(image) == 255).all()
-    with pytest.raises(LookupError):  # a task without the result, in a process without it
-        report.report_figures(None, {}, names=("bode",), key="a report never made here")
 
 
 @pytest.mark.skipif(shutil.which("pdfimages") is None, reason="poppler-utils is not installed")
