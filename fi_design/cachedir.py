@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 #: Environment variable naming the cache root.
 CACHE_ENV = "FI_DESIGN_CACHE_DIR"
@@ -24,3 +25,14 @@ def cache_dir(kind: str) -> Path:
     from platformdirs import user_cache_dir
 
     return Path(user_cache_dir("fi_design")) / kind
+
+
+def opened(kind: type, cache: Any) -> Any:
+    """The cache a computation was asked to use: ``cache`` itself when it is a ``kind``,
+    None for None or False, ``kind()`` (its default folder) for True, else ``kind(cache)``
+    (a folder's path)."""
+    if cache is None or cache is False:
+        return None
+    if isinstance(cache, kind):
+        return cache
+    return kind() if cache is True else kind(cache)

@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import interrupts
-from ..cachedir import cache_dir
+from ..cachedir import cache_dir, opened
 from ..provenance import json_sha256
 from ..results.recommend import RecommendResult
 
@@ -209,10 +209,4 @@ def open_store(cache: SearchStore | str | os.PathLike | bool | None) -> SearchSt
     -------
     SearchStore or None
     """
-    if cache is None or cache is False:
-        return None
-    if isinstance(cache, SearchStore):
-        return cache
-    if cache is True:
-        return SearchStore()
-    return SearchStore(cache)
+    return opened(SearchStore, cache)

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import provenance
-from ..cachedir import CACHE_ENV, cache_dir
+from ..cachedir import CACHE_ENV, cache_dir, opened
 from ..errors import CacheError
 
 __all__ = ["CACHE_ENV", "METHOD", "PointCache", "default_cache_dir", "open_cache", "code_digest",
@@ -228,10 +228,4 @@ def open_cache(cache: PointCache | str | os.PathLike | bool | None) -> PointCach
     -------
     PointCache or None
     """
-    if cache is None or cache is False:
-        return None
-    if isinstance(cache, PointCache):
-        return cache
-    if cache is True:
-        return PointCache()
-    return PointCache(cache)
+    return opened(PointCache, cache)
