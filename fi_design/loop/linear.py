@@ -629,6 +629,14 @@ def _units(criterion: str) -> str:
     return {"phase margin": "deg", "gain margin": "dB", "modulus margin": ""}.get(criterion, "")
 
 
+#: The achievable crossovers last worked out for models that are their spec's own (no
+#: :meth:`~fi_design.model.Model.at`), by the spec's content and the scan's arguments: a
+#: design run, the search's cap and its account of the spec ask for the same ones.
+_ACHIEVED: dict[tuple, AchievableCrossover] = {}
+#: How many :data:`_ACHIEVED` keeps.
+ACHIEVED_KEPT = 16
+
+
 def achievable_crossover(model: Model, start: float | None = None,
                          stop: float | None = None, rtol: float = 1e-3) -> AchievableCrossover:
     """The highest crossover at which all limit cases meet the requirements.
@@ -660,9 +668,27 @@ def achievable_crossover(model: Model, start: float | None = None,
     Returns
     -------
     AchievableCrossover
-        The frequency and what limits it.
+        The frequency and what limits it. A model that is its spec's own (no
+        :meth:`~fi_design.model.Model.at`) is a function of the spec: the answer
+        for a spec of the same content is kept and given again (the last
+        :data:`ACHIEVED_KEPT`), the scan not repeated.
     """
     model = require_model(model)
+    key = None if model.departures else (model.spec.model_dump_json(), start, stop, rtol)
+    found = _ACHIEVED.get(key) if key is not None else None
+    if found is not None:
+        return found
+    out = _achievable(model, start, stop, rtol)
+    if key is not None:
+        while len(_ACHIEVED) >= ACHIEVED_KEPT:
+            del _ACHIEVED[next(iter(_ACHIEVED))]
+        _ACHIEVED[key] = out
+    return out
+
+
+def _achievable(model: Model, start: float | None, stop: float | None,
+                rtol: float) -> AchievableCrossover:
+    """:func:`achievable_crossover` worked out."""
     lcs = limit_cases(model)
     req = model.requirements
     sep = req.parasitic_separation

@@ -183,13 +183,6 @@ def drive_stiffness(K: np.ndarray):
     return 1.0 / np.linalg.inv(K)[..., 0, 0]
 
 
-def _stable(K: np.ndarray) -> np.ndarray:
-    """Whether each stiffness matrix is positive definite (its smallest scaled eigenvalue)."""
-    d = 1.0 / np.sqrt(np.abs(np.diagonal(K, axis1=-2, axis2=-1)))
-    A = K * d[..., :, None] * d[..., None, :]
-    return np.linalg.eigvalsh(0.5 * (A + np.swapaxes(A, -1, -2)))[..., 0] > 0.0
-
-
 def buckling_factor(guide: LeafGuide, *, length=None, width=None, thickness=None,
                     rtol: float = 1e-4):
     """Lowest factor on the weight at which the guide's stiffness turns singular [-].
@@ -198,7 +191,13 @@ def buckling_factor(guide: LeafGuide, *, length=None, width=None, thickness=None
     stiffness under lambda times their force, exact, and the load stiffness)
     loses positive definiteness at the buckling load. Bracketed from the
     linear eigenproblem of the consistent geometric stiffness (a close upper
-    estimate), then bisected to ``rtol``.
+    estimate), then narrowed to ``rtol`` by the Illinois method on the smallest
+    eigenvalue of the stiffness scaled by its unloaded diagonal (positive
+    exactly where the guide is stable): a regula falsi whose kept end is
+    halved when it is kept twice, so both ends close in. The bracket is kept
+    throughout (its lower end stable, its upper end not), as bisection's: the
+    answer is its middle, within ``rtol`` of the buckling load, in about a
+    third of bisection's steps.
 
     Parameters
     ----------
@@ -224,18 +223,58 @@ def buckling_factor(guide: LeafGuide, *, length=None, width=None, thickness=None
     mu = np.linalg.eigvals(np.linalg.solve(K, -Kg1))
     top = np.where(np.abs(mu.imag) <= 1e-9 * np.abs(mu).max(axis=-1, keepdims=True) + 1e-300,
                    mu.real, 0.0).max(axis=-1)
-    hi = 1.1 / np.where(top > 0.0, top, 1e-300)
+    shape = K.shape[:-2]
+    # flat, each leaf size apart: the search works on the sizes not yet resolved only
+    L, b, t = (np.broadcast_to(v, shape).ravel() for v in _dims(guide, length, width, thickness))
+    Kf = K.reshape(-1, 6, 6)
+    d = 1.0 / np.sqrt(np.abs(np.diagonal(Kf, axis1=-2, axis2=-1)))
+
+    def smallest(load: np.ndarray, at: np.ndarray) -> np.ndarray:
+        """The smallest eigenvalue of the stiffness of sizes ``at`` under ``load`` times the
+        weight, scaled by the unloaded diagonal (a congruence: its sign is definiteness)."""
+        s = d[at]
+        A = (Kf[at] + clamp_geometric_stiffness(guide, load=load, length=L[at], width=b[at],
+                                                thickness=t[at])) * s[:, :, None] * s[:, None, :]
+        return np.linalg.eigvalsh(0.5 * (A + np.swapaxes(A, -1, -2)))[:, 0]
+
+    every = np.arange(L.size)
+    hi = 1.1 / np.where(top > 0.0, top, 1e-300).ravel()
+    f_hi = smallest(hi, every)
     for _ in range(8):  # widen where the exact stiffness still holds at the estimate
-        ok = _stable(K + clamp_geometric_stiffness(guide, load=hi, **dims))
-        if not ok.any():
+        at = np.flatnonzero(f_hi > 0.0)
+        if not at.size:
             break
-        hi = np.where(ok, 2.0 * hi, hi)
-    lo = np.zeros_like(hi)
-    while np.any(hi - lo > rtol * hi):
-        mid = 0.5 * (lo + hi)
-        ok = _stable(K + clamp_geometric_stiffness(guide, load=mid, **dims))
-        lo, hi = np.where(ok, mid, lo), np.where(ok, hi, mid)
-    out = 0.5 * (lo + hi)
+        hi[at] *= 2.0
+        f_hi[at] = smallest(hi[at], at)
+    # the estimate is close: a lower end just below it (else 0) starts the bracket narrow
+    lo = 0.85 * hi / 1.1
+    f_lo = smallest(lo, every)
+    at = np.flatnonzero(f_lo <= 0.0)
+    if at.size:
+        hi[at], f_hi[at], lo[at] = lo[at], f_lo[at], 0.0
+        f_lo[at] = smallest(lo[at], at)
+    kept = np.zeros(hi.shape, dtype=int)  # +1: lo kept last, -1: hi kept last
+    at = np.flatnonzero(hi - lo > rtol * hi)
+    while at.size:
+        lo_, hi_, fl, fh = lo[at], hi[at], f_lo[at], f_hi[at]
+        # the false position where the ends bracket a sign change, else (an upper end still
+        # stable after the widening) the middle; never within 1e-3 of the bracket of an end
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = np.where((fl > 0.0) & (fh <= 0.0), (lo_ * fh - hi_ * fl) / (fh - fl),
+                         0.5 * (lo_ + hi_))
+        w = hi_ - lo_
+        x = np.clip(np.where(np.isfinite(x), x, 0.5 * (lo_ + hi_)), lo_ + 1e-3 * w,
+                    hi_ - 1e-3 * w)
+        fx = smallest(x, at)
+        ok, k = fx > 0.0, kept[at]
+        # Illinois: an end kept a second time in a row has its value halved
+        f_hi[at] = np.where(ok, np.where(k == -1, 0.5 * fh, fh), fx)
+        f_lo[at] = np.where(ok, fx, np.where(k == 1, 0.5 * fl, fl))
+        lo[at] = np.where(ok, x, lo_)
+        hi[at] = np.where(ok, hi_, x)
+        kept[at] = np.where(ok, -1, 1)
+        at = at[hi[at] - lo[at] > rtol * hi[at]]
+    out = (0.5 * (lo + hi)).reshape(shape)
     return float(out) if out.ndim == 0 else out
 
 

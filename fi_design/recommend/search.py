@@ -431,8 +431,8 @@ def _searched(model: Model, executor: Any, say: Callable[[str], None],
               start: float) -> RecommendResult:
     """The search itself on a resolved model (:func:`recommend` without the cache); ``start``
     is when the call began (:func:`time.perf_counter`), for its wall time."""
-    from ..guideline.steps import step2_crossover
-    
+    from ..loop.linear import achievable_crossover
+
     spec = model.spec
     srch = _Search(model, executor, say)
     aside = _least_aside(srch, executor, say)
@@ -459,11 +459,11 @@ def _searched(model: Model, executor: Any, say: Callable[[str], None],
     rob = report.robustness if report is not None else None
     binding = _o.binding(srch, chosen) if feasible else ()
     least = _least_collected(aside, srch, executor, say)
-    xo = step2_crossover(srch.base_model)
+    achievable = achievable_crossover(srch.base_model).frequency
     kmax = _spec.stiffness_limit(srch.base, chosen.stroke)
     margins = {"hunting_margin": chosen.margin, "stiffness_factor": kmax / chosen.stiffness,
                "end_stop_clearance": chosen.clearance,
-               "achievable_factor": (xo.achievable / srch.fc if xo.achievable else None)}
+               "achievable_factor": (achievable / srch.fc if achievable else None)}
     spec_design = {"stroke": srch.base.isolator.stroke,
                    "stiffness": _spec.drive_stiffness(srch.base),
                    "crossover": _spec.design_crossover(srch.base),

@@ -258,6 +258,26 @@ def test_paper_achievable_crossover_and_its_boundary(paper_spec):
     assert not linear.analyse(model.at(crossover=ach.frequency * 1.003)).passed
 
 
+def test_the_achievable_crossover_of_a_spec_is_worked_out_once(paper_spec, monkeypatch):
+    """A design run and the search ask for the achievable crossover of the same spec: the
+    scan runs once a spec's content; a model varied with at() (the spec kept, its values
+    not) and a spec of other content are scanned afresh, and get their own answers."""
+    scans = []
+    real = linear._achievable
+    monkeypatch.setattr(linear, "_achievable", lambda *a: scans.append(a[0]) or real(*a))
+    monkeypatch.setattr(linear, "_ACHIEVED", {})
+    first = linear.achievable_crossover(resolve(paper_spec))
+    again = linear.achievable_crossover(resolve(paper_spec))  # another model, the same spec
+    assert again is first and len(scans) == 1
+    late = resolve(paper_spec).at(delay=2e-3)
+    other = linear.achievable_crossover(late)
+    assert len(scans) == 2 and abs(other.frequency / first.frequency - 1.0) > 0.05
+    assert linear.achievable_crossover(late) is not other and len(scans) == 3
+    delayed = linear.achievable_crossover(resolve(variant(paper_spec,
+                                                          **{"controller.delay": "2 ms"})))
+    assert len(scans) == 4 and delayed.frequency == pytest.approx(other.frequency, rel=1e-9)
+
+
 def test_nothing_limits_an_ideal_loop(paper_spec):
     spec = variant(paper_spec, **{"isolator.parasitic_modes": [], "isolator.flexure": None})
     ach = linear.achievable_crossover(resolve(spec))

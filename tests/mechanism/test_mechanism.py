@@ -281,6 +281,45 @@ def test_evaluate_on_a_grid_matches_the_single_guide():
     assert grid.stress[1, 1] == pytest.approx(one.stress, rel=1e-12)
 
 
+def _bisected_buckling(g, L, t, rtol=1e-6):
+    """The buckling factor by plain bisection of where K + Kg(lambda) stops being positive
+    definite (Cholesky), independent of the product's root search."""
+    def stable(lam):
+        A = gd.clamp_stiffness(g, length=L, thickness=t) \
+            + gd.clamp_geometric_stiffness(g, load=lam, length=L, thickness=t)
+        try:
+            np.linalg.cholesky(0.5 * (A + A.T))
+            return True
+        except np.linalg.LinAlgError:
+            return False
+    hi = 1.0
+    while stable(hi):
+        hi *= 2.0
+    lo = 0.0
+    while hi - lo > rtol * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+@pytest.mark.parametrize("name", ["paper, standing", "slender, hanging", "near buckling",
+                                  "heavy stage, four leaves"])
+def test_buckling_factor_on_a_grid_is_bisection_of_definiteness(name):
+    """The Illinois root of the scaled smallest eigenvalue, on a grid of lengths and
+    thicknesses at once, lies within its rtol (1e-4) of bisecting positive definiteness."""
+    g = FE_GEOMETRIES[name]
+    L = np.array([[0.6], [1.0], [1.7]]) * g.length
+    t = np.array([[0.7, 1.0, 1.4]]) * g.thickness
+    grid = gd.buckling_factor(g, length=L, thickness=t)
+    if np.all(np.isinf(grid)):  # hanging: the weight stretches the leaves
+        assert g.orientation == "hanging"
+        return
+    for i in range(3):
+        for j in range(3):
+            ref = _bisected_buckling(g, float(L[i, 0]), float(t[0, j]))
+            assert grid[i, j] == pytest.approx(ref, rel=1e-4), (i, j)
+
+
 # --------------------------------------------------------------------------- against the FE model
 
 
