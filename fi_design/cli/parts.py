@@ -558,9 +558,9 @@ def write_report(console: "Console", path: Optional[Path], result: Any, *,
     result : object
         The result.
     figure_worker : bool, optional
-        A PDF's figures drawn by a worker process while this one lays the report
-        out (:func:`fi_design.cli.pools.report_pool`): for reports with figures
-        placed by name (the design report).
+        The figures drawn by a worker process too (:func:`fi_design.cli.pools.report_pool`):
+        a PDF's while this one lays the report out, an HTML's beside this one; for
+        reports with figures placed by name (the design report).
     **options
         Passed on (``design_map`` of a design report).
     """

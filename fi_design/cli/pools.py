@@ -172,7 +172,8 @@ def confirmation_pool(enabled: bool = True) -> Iterator[Any]:
 @contextlib.contextmanager
 def report_pool(path: Any) -> Iterator[Any]:
     """One forked worker that draws a PDF report's figures while this process lays the
-    report out (:func:`fi_design.report.render_report`), or None.
+    report out, or an HTML report's beside this process (:func:`fi_design.report.render_report`),
+    or None.
 
     Forked when entered, after the work the report shows: the worker inherits the loaded
     modules (matplotlib among them). Enter it before a progress display (a spinner's
@@ -181,16 +182,14 @@ def report_pool(path: Any) -> Iterator[Any]:
     Parameters
     ----------
     path : pathlib.Path or None
-        The report; a worker only for a ``.pdf`` (an HTML report's figures are drawn
-        as SVG while its context is built).
+        The report (``.pdf`` or ``.html``).
 
     Yields
     ------
     concurrent.futures.ProcessPoolExecutor or None
-        None without a PDF or where processes cannot be forked.
+        None without a report or where processes cannot be forked.
     """
-    pdf = path is not None and str(path).lower().endswith(".pdf")
-    with _forked_pool(pdf, 1) as pool:
+    with _forked_pool(path is not None, 1) as pool:
         yield pool
 
 

@@ -131,6 +131,7 @@ def step2_crossover(model: Model) -> CrossoverResult:
         (:attr:`fi_design.results.linear.CaseMargins.criteria`).
     """
     from ..loop import linear
+    from ..loop.achievable import achievable_crossover
     from ..loop.notch import limiting_mode, notched, with_notch
 
     model = require_model(model)
@@ -138,7 +139,7 @@ def step2_crossover(model: Model) -> CrossoverResult:
     fc = model.crossover
     cases = linear.limit_cases(model)
     at = linear.analyse(model, cases=cases)
-    ach = linear.achievable_crossover(model)
+    ach = achievable_crossover(model)
     mode = limiting_mode(model, ach)
     suggestion = None
     limited_by = ach.limited_by

@@ -4,7 +4,7 @@ A lightly damped mode that does not sit where the sensor and the actuator
 are (non-collocated) turns the loop's phase through -180 deg at its
 resonance: a loop that keeps its margins there is phase-stabilised, and its
 gain margin at the mode sets the achievable crossover
-(:func:`fi_design.loop.linear.achievable_crossover`). A motion engineer
+(:func:`fi_design.loop.achievable.achievable_crossover`). A motion engineer
 gain-stabilises such a mode with a notch. :func:`limiting_mode` finds the
 mode behind a margin limit by taking it out: the mode is the one without
 which the failing case passes at the crossover that fails.
@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 
 from . import linear
+from .achievable import achievable_crossover
 from ..display import quantity
 from ..model import Model
 from ..results.controller import Filter
@@ -137,4 +138,4 @@ def with_notch(model: Model, mode: Mode) -> tuple[Filter, AchievableCrossover]:
             kind="infeasible", case=None, criterion=None,
             scan_start=0.0, scan_stop=0.0, feasible_ranges=(), evaluations=0)
     notched = model.at(filters=model.law.filters + (notch,))
-    return notch, linear.achievable_crossover(notched)
+    return notch, achievable_crossover(notched)

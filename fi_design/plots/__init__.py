@@ -27,8 +27,9 @@ from __future__ import annotations
 
 from .confirmation import (PLANT_COLOURS, SETTLE_ZOOM, deflection_figure, error_figure,
                            motion_end, plant_names)
-from .figure import (FIGURE_SCHEME, RASTER_DPI, REPORT_RC, REPORT_WIDTH, DeferredFigures,
-                     cell_edges, decimate, deferred_figures, figure_bytes, figure_from,
+from .figure import (FIGURE_MARK, FIGURE_SCHEME, RASTER_DPI, REPORT_RC, REPORT_WIDTH,
+                     DeferredFigures, cell_edges, decimate, deferred_figures, figure_bytes,
+                     figure_from, figure_mark,
                      figure_markup, figure_svg, log_x, nice_ticks, plain_tick, png_img, png_size,
                      raster_dpi, raster_figures, report_figure, rgb_png, styled)
 from .guide import guide_figure
@@ -49,7 +50,7 @@ __all__ = [
     "REPORT_WIDTH",
     "SETTLE_ZOOM", "VERDICT_MARKS", "axis_label", "bode_figure", "boundary_figure",
     "candidate_scores_figure", "case_label", "cell_edges", "cycle_figure", "decimate",
-    "deferred_figures", "deflection_figure", "design_band", "design_map_figure", "display_unit", "draw_sweep",
+    "deferred_figures", "deflection_figure", "figure_mark", "FIGURE_MARK", "design_band", "design_map_figure", "display_unit", "draw_sweep",
     "error_figure", "figure_bytes", "figure_from", "figure_markup", "figure_svg", "force_velocity_figure", "gap_overlay_figure",
     "gap_residual_figure", "guide_figure", "log_x", "motion_end", "moves_figure", "nice_ticks", "positioning_figure", "nyquist_figure",
     "out_of_band_crossovers", "plain_tick", "plant_names", "png_img", "raster_dpi",

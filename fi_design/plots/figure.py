@@ -232,25 +232,41 @@ def raster_dpi() -> float | None:
 FIGURE_SCHEME = "figure"
 
 
+#: What :func:`figure_from` places for an SVG figure drawn later (``deferred_figures(None)``):
+#: an HTML comment that :func:`figure_mark` names and the figure's markup replaces.
+FIGURE_MARK = "<!--fi_design figure:{name}-->"
+
+
+def figure_mark(name: str) -> str:
+    """Where the deferred SVG figure ``name`` goes in an HTML page (:data:`FIGURE_MARK`)."""
+    return FIGURE_MARK.format(name=name)
+
+
 class DeferredFigures:
     """The figures of a report placed by name and drawn when asked for (:func:`deferred_figures`).
 
     Attributes
     ----------
-    dpi : float
-        Resolution of the images [dots per inch].
+    dpi : float or None
+        Resolution of the images [dots per inch]; None: the figures are inline
+        SVG, placed by :func:`figure_mark`.
     makers : dict
         Name -> a callable returning the :class:`matplotlib.figure.Figure`, in the
         order the figures were placed.
     """
 
-    def __init__(self, dpi: float) -> None:
-        self.dpi = float(dpi)
+    def __init__(self, dpi: float | None) -> None:
+        self.dpi = None if dpi is None else float(dpi)
         self.makers: dict[str, Callable[[], Any]] = {}
 
     def png(self, name: str) -> bytes:
         """The figure ``name`` drawn now (:func:`rgb_png`)."""
         return rgb_png(self.makers[name](), self.dpi)
+
+    def svg(self, name: str) -> str:
+        """The figure ``name`` drawn now as the inline SVG :func:`figure_from` would have
+        placed without deferring it (:func:`figure_svg`, its ids prefixed by the name)."""
+        return figure_svg(self.makers[name](), name)
 
     def all_png(self) -> dict[str, bytes]:
         """Every figure placed, drawn now: name -> PNG bytes."""
@@ -262,19 +278,21 @@ _DEFERRED: contextvars.ContextVar[DeferredFigures | None] = contextvars.ContextV
 
 
 @contextlib.contextmanager
-def deferred_figures(dpi: float = RASTER_DPI) -> Iterator[DeferredFigures]:
+def deferred_figures(dpi: float | None = RASTER_DPI) -> Iterator[DeferredFigures]:
     """Within this block, :func:`figure_from` places a figure as ``<img src="figure:NAME">``
     and keeps its maker, to be drawn later or elsewhere; figures are PNG images of ``dpi``
-    (:func:`raster_figures` holds too).
+    (:func:`raster_figures` holds too). With ``dpi`` None the figures stay inline SVG,
+    each placed as its :func:`figure_mark` for the markup to replace.
 
     A PDF report's layout needs a figure only when WeasyPrint reaches it: drawn by
     another process meanwhile (:func:`fi_design.report.render_report` with an executor),
-    the figures cost the layout no time.
+    the figures cost the layout no time; an HTML report's are drawn by several
+    processes at once.
 
     Parameters
     ----------
-    dpi : float, optional
-        Resolution [dots per inch] (default :data:`RASTER_DPI`).
+    dpi : float or None, optional
+        Resolution [dots per inch] (default :data:`RASTER_DPI`); None: SVG.
 
     Yields
     ------
@@ -284,7 +302,7 @@ def deferred_figures(dpi: float = RASTER_DPI) -> Iterator[DeferredFigures]:
     figures = DeferredFigures(dpi)
     token = _DEFERRED.set(figures)
     try:
-        with raster_figures(dpi):
+        with raster_figures(dpi) if dpi is not None else contextlib.nullcontext():
             yield figures
     finally:
         _DEFERRED.reset(token)
@@ -304,7 +322,7 @@ def figure_from(make: Callable[[], Any], name: str) -> str:
     Returns
     -------
     str
-        An ``<svg>`` or ``<img>`` element.
+        An ``<svg>`` or ``<img>`` element (deferred SVG: its :func:`figure_mark`).
     """
     figures = _DEFERRED.get()
     if figures is None:
@@ -312,6 +330,8 @@ def figure_from(make: Callable[[], Any], name: str) -> str:
     if name in figures.makers:
         raise ArgumentError(f"two report figures are named {name!r}")
     figures.makers[name] = make
+    if figures.dpi is None:
+        return figure_mark(name)
     return f'<img src="{FIGURE_SCHEME}:{name}" alt="">'
 
 

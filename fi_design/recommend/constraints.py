@@ -83,7 +83,7 @@ def crossover_cap(base: Model, rule: bool) -> tuple[float, str, Any]:
     (float, str, Filter or None)
         The crossover [Hz], why, and the notch added to the chain (None: none).
     """
-    from ..loop import linear
+    from ..loop.achievable import achievable_crossover
     from ..loop.notch import limiting_mode, notched
     from ..loop.notch import with_notch as notch_for
 
@@ -96,7 +96,7 @@ def crossover_cap(base: Model, rule: bool) -> tuple[float, str, Any]:
     if base.flexure_spec is not None:
         values["isolator.flexure"] = None
     model = base.varied({**values, **reserve_values(base.spec)})
-    ach = linear.achievable_crossover(model)
+    ach = achievable_crossover(model)
     notch = None
     mode = limiting_mode(model, ach) if (base.requirements.recommend.filters
                                         and ach.frequency is not None

@@ -431,7 +431,7 @@ def _searched(model: Model, executor: Any, say: Callable[[str], None],
               start: float) -> RecommendResult:
     """The search itself on a resolved model (:func:`recommend` without the cache); ``start``
     is when the call began (:func:`time.perf_counter`), for its wall time."""
-    from ..loop.linear import achievable_crossover
+    from ..loop.achievable import achievable_crossover
 
     spec = model.spec
     srch = _Search(model, executor, say)

@@ -9,18 +9,37 @@ report contexts.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import os
 import re
+from collections.abc import Iterator
 
 from ..cachedir import cache_dir
 from ..display import fixed, plain
 
-__all__ = ["equation", "equation_svg", "equation_img", "math_text", "EQUATION_RC", "EQUATION_SIZE"]
+__all__ = ["equation", "equation_svg", "equation_img", "equations_left_out", "math_text",
+           "EQUATION_RC", "EQUATION_SIZE"]
 
 #: matplotlib settings of the equations: STIX, a Times-like face that matches the body text.
 EQUATION_RC = {"mathtext.fontset": "stix"}
 #: Font size of the equations [pt].
 EQUATION_SIZE = 11.5
+
+
+_LEFT_OUT: contextvars.ContextVar[bool] = contextvars.ContextVar("fi_design_equations_left_out",
+                                                                  default=False)
+
+
+@contextlib.contextmanager
+def equations_left_out() -> Iterator[None]:
+    """Within this block :func:`equation` draws nothing (its ``svg`` None): for a report's
+    context built only for what else it holds (a worker's figures, placed by name)."""
+    token = _LEFT_OUT.set(True)
+    try:
+        yield
+    finally:
+        _LEFT_OUT.reset(token)
 
 
 def equation(tex: str, name: str, render: bool = True) -> dict:
@@ -33,7 +52,8 @@ def equation(tex: str, name: str, render: bool = True) -> dict:
     name : str
         Identifier, unique within the report (prefixes the SVG's ids).
     render : bool, optional
-        Draw the SVG (default); False leaves ``svg`` None (golden tests).
+        Draw the SVG (default); False, or within :func:`equations_left_out`,
+        leaves ``svg`` None (golden tests, a worker's figures).
 
     Returns
     -------
@@ -42,7 +62,7 @@ def equation(tex: str, name: str, render: bool = True) -> dict:
         (markup, or None).
     """
     svg = None
-    if render:
+    if render and not _LEFT_OUT.get():
         from markupsafe import Markup
 
         from ..plots import raster_dpi

@@ -426,7 +426,8 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
         order the report places them; the result and ``design_map`` are sent
         with each) while this process lays the report out; the layout waits
         for a figure only when it reaches it. None draws them here as the
-        layout reaches them. An HTML report does not use it.
+        layout reaches them. An HTML report's figures are drawn there from the
+        first and here from the last at once (the same SVG).
 
     Returns
     -------
@@ -445,12 +446,18 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     if progress is not None:
         progress("drawing the report's figures ...")
     options = {} if design_map is None else {"design_map": design_map}
+    from ..plots import deferred_figures
+
     if fmt == "html":
-        html = render_html(build_context(result, date=date, command=command, **options))
+        if executor is None:
+            html = render_html(build_context(result, date=date, command=command, **options))
+        else:  # the figures drawn there and here at once, each put in its place
+            with deferred_figures(None) as figures:
+                context = build_context(result, date=date, command=command, **options)
+            html = _svg_placed(render_html(context), figures, executor, result, options)
         if progress is not None:
             progress("writing the HTML ...")
         return write_document(html, out)
-    from ..plots import deferred_figures
 
     with deferred_figures() as figures:
         context = build_context(result, date=date, command=command, **options)
@@ -471,10 +478,41 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
                                                       None if drawn is None else sizes))
 
 
+def _svg_placed(html: str, figures: Any, executor: Any, result: Any, options: dict) -> str:
+    """An HTML report's page with its deferred SVG figures in place (their
+    :func:`~fi_design.plots.figure_mark`), drawn by the executor from the first and by this
+    process from the last: this process takes each figure whose task it can still cancel,
+    the executor the rest (a figure its worker fails is drawn here)."""
+    from ..plots import figure_mark
+
+    names = list(figures.makers)
+    key = f"{os.getpid()}-{id(figures)}-{time.monotonic_ns()}"
+    tasks = {name: executor.submit(report_figures, result, options, names=(name,), key=key,
+                                   svg=True) for name in names}
+    svg: dict[str, str] = {}
+    for name in reversed(names):
+        cancel = getattr(tasks[name], "cancel", None)
+        if cancel is None or cancel() is not True:  # started there: so are those before it
+            break
+        svg[name] = figures.svg(name)
+    for name in names:
+        if name not in svg:
+            try:
+                svg[name] = tasks[name].result()[name]
+            except Exception:  # the worker failed or is gone: the figure is drawn here
+                log.info("the report's figure %r could not be drawn in a worker; drawing it "
+                         "here", name, exc_info=True)
+                svg[name] = figures.svg(name)
+    for name in names:
+        html = html.replace(figure_mark(name), svg[name], 1)
+    return html
+
+
 def report_figures(result: Any, options: dict, names: Any = None,
-                   key: str | None = None) -> dict[str, bytes]:
+                   key: str | None = None, svg: bool = False) -> dict[str, Any]:
     """The figures of a PDF report, drawn: name -> PNG bytes (what an executor runs for
-    :func:`render_report`, one figure a task).
+    :func:`render_report`, one figure a task); with ``svg``, an HTML report's: name -> the
+    inline SVG (:meth:`fi_design.plots.DeferredFigures.svg`).
 
     Parameters
     ----------
@@ -489,6 +527,8 @@ def report_figures(result: Any, options: dict, names: Any = None,
         Names one report: the figures placed for it are kept in this process for the
         next call with the same key (the tasks of one report in one worker), so the
         report's context is built once.
+    svg : bool, optional
+        Inline SVG for an HTML report instead of PNG bytes.
 
     Returns
     -------
@@ -500,11 +540,14 @@ def report_figures(result: Any, options: dict, names: Any = None,
     KeyError
         A name the report does not place.
     """
-    from ..plots import rgb_png
+    from ..plots import figure_svg, rgb_png
 
     figures, made = _placed(result, options, key)
     wanted = list(figures.makers) if names is None else list(names)
     with _collector_paused():  # a forked worker's collector would traverse the parent's heap
+        if svg:
+            return {name: figure_svg(made.pop(name), name) if name in made
+                    else figures.svg(name) for name in wanted}
         return {name: rgb_png(made.pop(name), figures.dpi) if name in made
                 else figures.png(name) for name in wanted}
 
@@ -547,7 +590,9 @@ def _placed(result: Any, options: dict, key: str | None) -> tuple[Any, dict]:
 
     if key is not None and _PLACED is not None and _PLACED[0] == key:
         return _PLACED[1], _PLACED[2]
-    with deferred_figures() as figures:
+    from .equations import equations_left_out
+
+    with deferred_figures() as figures, equations_left_out():  # the figures' makers only
         build_context(result, **options)
     made: dict = {}
     _PLACED = None if key is None else (key, figures, made)

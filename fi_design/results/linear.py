@@ -1,7 +1,7 @@
 """Results of the linear analysis: the margins of the limit cases and the achievable crossover.
 
 Produced by :mod:`fi_design.loop.linear` (:func:`~fi_design.loop.linear.loop_margins`,
-:func:`~fi_design.loop.linear.analyse`, :func:`~fi_design.loop.linear.achievable_crossover`).
+:func:`~fi_design.loop.linear.analyse`, :func:`~fi_design.loop.achievable.achievable_crossover`).
 A limit case is judged where its margins are computed: :class:`CaseMargins`
 carries the status of each requirement and of the case, and the guideline's
 checks, the report and the console read them.

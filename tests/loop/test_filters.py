@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from fi_design.loop import linear
+from fi_design.loop.achievable import achievable_crossover
 from fi_design.controller import (controller_polynomials, discrete_controller,
                                   filter_polynomials, pid_polynomials, tustin_biquad)
 from fi_design.controller.discrete import pid_z
@@ -131,10 +132,10 @@ def test_a_notch_at_the_tilt_mode_lifts_the_achievable_crossover(paper_spec):
     case 4 at its resonance; a notch there gain-stabilises it. python-control's own margins
     on the same plant, with the PID and the notch built here, agree on both boundaries."""
     model = resolve(paper_spec)
-    plain = linear.achievable_crossover(model)
+    plain = achievable_crossover(model)
     assert plain.kind == "margin" and plain.case == "stuck_limited"
     assert plain.criterion == "gain margin"
-    notched = linear.achievable_crossover(resolve(variant(paper_spec, **{"controller.filters": [NOTCH]})))
+    notched = achievable_crossover(resolve(variant(paper_spec, **{"controller.filters": [NOTCH]})))
     assert notched.frequency > 2.5 * plain.frequency
     N = _notch(150.0, 75.0)
     below, above = (_control_margins(model, plain.frequency * f) for f in (0.99, 1.01))
@@ -155,7 +156,7 @@ def test_step_2_names_the_tilt_mode_and_what_a_notch_allows(paper_spec):
     # the suggestion is the spec with that notch: the same crossover
     spec = variant(paper_spec, **{"controller.filters": [
         {"type": "notch", "frequency": "150 Hz", "width": f"{n.notch.width} Hz"}]})
-    assert linear.achievable_crossover(resolve(spec)).frequency == pytest.approx(n.achievable, rel=1e-9)
+    assert achievable_crossover(resolve(spec)).frequency == pytest.approx(n.achievable, rel=1e-9)
     check = next(c for c in xo.checks if c.name == "crossover_achievable")
     assert "notch" in check.message and "stage tilt" in check.message
 

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from fi_design.loop import linear
+from fi_design.loop import achievable, linear
+from fi_design.loop.achievable import achievable_crossover
 from fi_design.model import resolve
 
 from conftest import variant
@@ -249,7 +250,7 @@ def test_infinite_gain_margin_is_null_in_json(paper_spec):
 
 
 def test_paper_achievable_crossover_and_its_boundary(paper_spec):
-    ach = linear.achievable_crossover(resolve(paper_spec))
+    ach = achievable_crossover(resolve(paper_spec))
     assert ach.kind == "margin" and ach.case == "stuck_limited" and ach.criterion == "gain margin"
     assert "gain margin of case 4 (cart stuck, limiter engaged)" in ach.limited_by
     assert 8.0 < ach.frequency < 150.0 / 3
@@ -263,25 +264,25 @@ def test_the_achievable_crossover_of_a_spec_is_worked_out_once(paper_spec, monke
     scan runs once a spec's content; a model varied with at() (the spec kept, its values
     not) and a spec of other content are scanned afresh, and get their own answers."""
     scans = []
-    real = linear._achievable
-    monkeypatch.setattr(linear, "_achievable", lambda *a: scans.append(a[0]) or real(*a))
-    monkeypatch.setattr(linear, "_ACHIEVED", {})
-    first = linear.achievable_crossover(resolve(paper_spec))
-    again = linear.achievable_crossover(resolve(paper_spec))  # another model, the same spec
+    real = achievable._achievable
+    monkeypatch.setattr(achievable, "_achievable", lambda *a: scans.append(a[0]) or real(*a))
+    monkeypatch.setattr(achievable, "_ACHIEVED", {})
+    first = achievable_crossover(resolve(paper_spec))
+    again = achievable_crossover(resolve(paper_spec))  # another model, the same spec
     assert again is first and len(scans) == 1
     late = resolve(paper_spec).at(delay=2e-3)
-    other = linear.achievable_crossover(late)
+    other = achievable_crossover(late)
     assert len(scans) == 2 and abs(other.frequency / first.frequency - 1.0) > 0.05
-    assert linear.achievable_crossover(late) is not other and len(scans) == 3
-    delayed = linear.achievable_crossover(resolve(variant(paper_spec,
+    assert achievable_crossover(late) is not other and len(scans) == 3
+    delayed = achievable_crossover(resolve(variant(paper_spec,
                                                           **{"controller.delay": "2 ms"})))
     assert len(scans) == 4 and delayed.frequency == pytest.approx(other.frequency, rel=1e-9)
 
 
 def test_nothing_limits_an_ideal_loop(paper_spec):
     spec = variant(paper_spec, **{"isolator.parasitic_modes": [], "isolator.flexure": None})
-    ach = linear.achievable_crossover(resolve(spec))
-    assert ach.kind == "scan_limit" and ach.frequency == linear.SCAN_LIMIT
+    ach = achievable_crossover(resolve(spec))
+    assert ach.kind == "scan_limit" and ach.frequency == achievable.SCAN_LIMIT
     assert ach.limited_by == "nothing up to the scan limit 1000 Hz"
 
 
@@ -305,7 +306,7 @@ def test_without_given_modes_the_guide_s_own_modes_limit_the_crossover(paper_spe
     model = resolve(spec)
     low = min(model.modes, key=lambda m: m.frequency)
     assert all(m.source == "computed" for m in model.modes) and low.direction == "y"
-    ach = linear.achievable_crossover(resolve(spec))
+    ach = achievable_crossover(resolve(spec))
     assert ach.kind == "mode" and ach.mode == low.name
     assert f"'{low.name}'" in ach.limited_by and "loop's crossover" in ach.limited_by
     _separation_boundary(model, ach, low.frequency, 3.0)
@@ -316,14 +317,14 @@ def test_a_delay_lowers_the_achievable_crossover(paper_spec):
     found = []
     for delay in ("0 s", "1 ms", "3 ms"):
         spec = variant(paper_spec, **base, **{"controller.delay": delay})
-        ach = linear.achievable_crossover(resolve(spec))
+        ach = achievable_crossover(resolve(spec))
         found.append(ach.frequency)
         if delay != "0 s":
             assert ach.kind == "margin"
     assert found == sorted(found, reverse=True) and len(set(found)) == 3
     # a rigid mass: the delay eats phase w tau, so the limit scales roughly as 1 / tau
     # (the viscous damping and the bristle resonance bend it a little)
-    rigid = [linear.achievable_crossover(resolve(variant(paper_spec, isolator=None,
+    rigid = [achievable_crossover(resolve(variant(paper_spec, isolator=None,
                                                  **{"controller.delay": d}))).frequency
              for d in ("1 ms", "2 ms")]
     assert 0.45 < rigid[1] / rigid[0] < 0.6
@@ -331,9 +332,9 @@ def test_a_delay_lowers_the_achievable_crossover(paper_spec):
 
 def test_sampling_adds_half_a_period(paper_spec):
     spec = variant(paper_spec, isolator=None, **{"controller.sample_rate": "1 kHz"})
-    ach = linear.achievable_crossover(resolve(spec))
+    ach = achievable_crossover(resolve(spec))
     same = variant(paper_spec, isolator=None, **{"controller.delay": "0.5 ms"})
-    assert ach.frequency == pytest.approx(linear.achievable_crossover(resolve(same)).frequency, rel=2e-3)
+    assert ach.frequency == pytest.approx(achievable_crossover(resolve(same)).frequency, rel=2e-3)
     assert ach.scan_stop <= 500.0
 
 
@@ -341,7 +342,7 @@ def test_sampling_adds_half_a_period(paper_spec):
 def test_a_parasitic_mode_caps_the_crossover(paper_spec, freq, collocated):
     spec = variant(paper_spec, **{"isolator.parasitic_modes": [
         {"name": "tilt", "frequency": freq, "damping_ratio": 0.05, "collocated": collocated}]})
-    ach = linear.achievable_crossover(resolve(spec))
+    ach = achievable_crossover(resolve(spec))
     sep = spec.requirements.parasitic_separation
     model = resolve(spec)
     assert sep * linear.analyse(model.at(crossover=ach.frequency)).loop_crossover <= freq
@@ -353,6 +354,6 @@ def test_a_parasitic_mode_caps_the_crossover(paper_spec, freq, collocated):
 def test_nothing_feasible_is_said(paper_spec):
     spec = variant(paper_spec, isolator=None, **{"controller.delay": "2 s",
                                                  "requirements.phase_margin": "80 deg"})
-    ach = linear.achievable_crossover(resolve(spec))
+    ach = achievable_crossover(resolve(spec))
     assert ach.frequency is None and ach.kind == "infeasible"
     assert ach.limited_by.startswith("no crossover from")
