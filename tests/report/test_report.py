@@ -994,6 +994,27 @@ def test_html_figures_drawn_here_when_the_worker_fails(paper_confirmed_design, d
     assert out.read_text(encoding="utf-8") == design_html
 
 
+def test_an_html_figure_that_fails_raises_its_own_error_and_writes_no_file(
+        paper_confirmed_design, tmp_path, monkeypatch):
+    """A figure that fails (in the worker and drawn again here) raises its own error from an
+    HTML report drawn with an executor, and no file is left."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from fi_design import plots
+
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("the Bode plot broke")
+
+    monkeypatch.setattr(plots, "bode_figure", broken)
+    out = tmp_path / "broken.html"
+    # forked after the patch, as the command forks its report worker after the design
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as pool, \
+            pytest.raises(ZeroDivisionError, match="Bode plot broke"):
+        report.render_report(paper_confirmed_design, out, date=DATE, executor=pool)
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
 def test_a_worker_builds_the_report_for_its_figures_without_the_equations(
         paper_confirmed_design, monkeypatch):
     """A worker makes the report's context only for its figures' makers: it draws none of
