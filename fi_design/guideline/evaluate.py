@@ -135,7 +135,7 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
             "(Model.varied): design it with confirm=False, or vary the model resolved from "
             "the spec with every value in Model.varied and design that")
     pending = []
-    scatter = stop = None
+    scatter = stop = sens = None
     if confirm and executor is not None:
         # the simulations start first: the workers run them while this process imports
         # python-control and scans the loop (step 2)
@@ -144,6 +144,11 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
             stop = threading.Event()
             scatter = Background(_verdict.run_robustness, model, suggestion,
                                  _scatter_progress(progress, stop), executor=executor)
+        if sensitivity:
+            from ..studies.sensitivity import started_sensitivity
+
+            # its six answers need none of the others: they fill the workers' idle time
+            sens = started_sensitivity(model, executor=executor)
     from ..loop.responses import loop_responses  # python-control: after the workers start
 
     try:
@@ -180,6 +185,8 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
     except BaseException:
         for fut in pending:
             fut.cancel()
+        if sens is not None:
+            sens.cancel()
         if stop is not None:
             stop.set()  # the scatter's chunks not yet started are cancelled
         raise
@@ -202,13 +209,16 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
     if rob is not None:  # a check like the others: the tally counts it
         result = replace(result, checks=result.checks + (_verdict.robustness_as_check(rob),))
     if sensitivity and sim is not None:
-        from ..studies import crossover_sensitivity
+        from ..studies.sensitivity import started_sensitivity
 
         if progress is not None:
             progress("the hunting-free crossover over sigma0, sigma1 and vs ...")
         own = "isolated" if model.has_isolator else "non_isolated"
-        result = replace(result, sensitivity=crossover_sensitivity(
-            model, sim.stage[own].hunting_free_from, executor=executor))
+        if sens is None:
+            sens = started_sensitivity(model, executor=executor)
+        result = replace(result, sensitivity=sens.result(sim.stage[own].hunting_free_from))
+    elif sens is not None:
+        sens.cancel()
     margins = _verdict.margins(model, xo, st, fx, pid, sim)
     result = replace(
         result, robustness=rob, margins=margins,

@@ -20,7 +20,7 @@ from ..model import Model
 from ..results.sensitivity import SENSITIVITY_PARAMETERS, CrossoverSensitivity, SensitivityPoint
 from .points import study_model
 
-__all__ = ["crossover_sensitivity", "DEFAULT_FACTORS"]
+__all__ = ["crossover_sensitivity", "started_sensitivity", "PendingSensitivity", "DEFAULT_FACTORS"]
 
 #: The factors each parameter is scaled by [-].
 DEFAULT_FACTORS = (1.0 / 3.0, 3.0)
@@ -67,27 +67,73 @@ def crossover_sensitivity(model: Model | _spec.Spec, nominal: float | None = Non
         mechanism, no crossover to find) or a friction model without these
         parameters (the switch model).
     """
-    model = study_model(model, "model")
-    if not model.law.integrator or model.friction.model != "lugre":
-        return None
-    iso = model.has_isolator
-    base = _nominal(model)
-    # the others held at the values the design used (sigma1's default follows sigma0 otherwise)
-    jobs = []
-    for path in SENSITIVITY_PARAMETERS:
-        for f in factors:
-            values = dict(base)
-            values[path] = base[path] * f
-            jobs.append((path, f, values[path], values))
-    if nominal is None:
-        nominal = _fold(model, iso, base)[0]
-    if executor is None:
-        found = [_fold(model, iso, values) for *_, values in jobs]
-    else:
-        futures = [executor.submit(_fold, model, iso, values) for *_, values in jobs]
-        found = [fut.result() for fut in futures]
-    points = tuple(SensitivityPoint(path=path, factor=float(f), value=float(v),
-                                    hunting_free_from=m, kind=kind)
-                   for (path, f, v, _), (m, kind) in zip(jobs, found))
-    return CrossoverSensitivity(plant="isolated" if iso else "non_isolated", nominal=nominal,
-                                factors=tuple(sorted((1.0, *factors))), points=points)
+    return started_sensitivity(model, factors=factors, executor=executor).result(nominal)
+
+
+def started_sensitivity(model: Model | _spec.Spec, *,
+                        factors: tuple[float, ...] = DEFAULT_FACTORS,
+                        executor: Any = None) -> "PendingSensitivity":
+    """:func:`crossover_sensitivity` with its six answers submitted to ``executor`` now and
+    read later (:meth:`PendingSensitivity.result`): a design submits them with its other
+    simulations, so that they fill the workers' idle time instead of following them.
+
+    Parameters
+    ----------
+    model, factors, executor
+        As :func:`crossover_sensitivity`.
+
+    Returns
+    -------
+    PendingSensitivity
+    """
+    return PendingSensitivity(study_model(model, "model"), factors, executor)
+
+
+class PendingSensitivity:
+    """The six answers of :func:`crossover_sensitivity`, submitted (:func:`started_sensitivity`)."""
+
+    def __init__(self, model: Model, factors: tuple[float, ...], executor: Any) -> None:
+        self._model = model
+        self._jobs: list[tuple[str, float, float, dict]] = []
+        self._futures: list[Any] | None = None
+        if not model.law.integrator or model.friction.model != "lugre":
+            return
+        base = _nominal(model)
+        # the others held at the values the design used (sigma1's default follows sigma0
+        # otherwise)
+        for path in SENSITIVITY_PARAMETERS:
+            for f in factors:
+                values = dict(base)
+                values[path] = base[path] * f
+                self._jobs.append((path, f, values[path], values))
+        self._factors = factors
+        if executor is not None:
+            iso = model.has_isolator
+            self._futures = [executor.submit(_fold, model, iso, values)
+                             for *_, values in self._jobs]
+
+    def result(self, nominal: float | None = None) -> CrossoverSensitivity | None:
+        """The sensitivity (None where :func:`crossover_sensitivity` gives none); ``nominal``
+        the nominal hunting-free crossover [Hz] when known, else computed here."""
+        model = self._model
+        if not self._jobs:
+            return None
+        iso = model.has_isolator
+        if nominal is None:
+            nominal = _fold(model, iso, _nominal(model))[0]
+        if self._futures is None:
+            found = [_fold(model, iso, values) for *_, values in self._jobs]
+        else:
+            found = [fut.result() for fut in self._futures]
+        points = tuple(SensitivityPoint(path=path, factor=float(f), value=float(v),
+                                        hunting_free_from=m, kind=kind)
+                       for (path, f, v, _), (m, kind) in zip(self._jobs, found))
+        return CrossoverSensitivity(plant="isolated" if iso else "non_isolated",
+                                    nominal=nominal,
+                                    factors=tuple(sorted((1.0, *self._factors))),
+                                    points=points)
+
+    def cancel(self) -> None:
+        """Cancel the answers not yet started (the design failed, or needs none)."""
+        for fut in self._futures or ():
+            fut.cancel()

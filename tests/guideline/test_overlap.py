@@ -54,3 +54,47 @@ def test_the_study_runs_while_the_steps_do_and_a_failing_step_cancels_it(paper_s
     total = len(points.chunks(2 * samples, points.chunk_size(2 * samples)))  # both plants
     # the chunks already queued when the step failed may run; the rest never start
     assert 1 <= len(chunks) < total, (len(chunks), total)
+
+
+def test_the_sensitivity_starts_with_the_simulations_and_stops_with_a_failing_step(
+        paper_spec, monkeypatch):
+    """With an executor the sensitivity's six answers are submitted with the confirmation
+    (they need none of its results, only the nominal they are reported beside), so they
+    run while the steps do; a step that raises cancels those not yet started."""
+    import fi_design.studies.sensitivity as sensitivity
+    from fi_design.spec.paths import with_values
+
+    spec = with_values(paper_spec, {"requirements.robustness.samples": 0})
+    started = threading.Event()
+    folds = []
+    fold = sensitivity._fold
+
+    def counted(*args, **kwargs):
+        started.set()
+        folds.append(args[2])
+        return fold(*args, **kwargs)
+
+    def step2_fails(model):
+        assert started.wait(60), "no answer of the sensitivity started during step 2"
+        raise RuntimeError("step 2 failed")
+
+    monkeypatch.setattr(sensitivity, "_fold", counted)
+    monkeypatch.setattr(evaluate_module, "step2_crossover", step2_fails)
+    with ThreadPoolExecutor(1) as pool:
+        with pytest.raises(RuntimeError, match="step 2 failed"):
+            evaluate_module.evaluate(spec, executor=pool, sensitivity=True)
+        pool.shutdown(wait=True)
+    assert 1 <= len(folds) < 6, len(folds)
+
+
+def test_the_sensitivity_started_early_is_the_one_computed_after(paper_spec):
+    """The sensitivity submitted with the design's simulations and read at its end is the one
+    the design computes without an executor, answer for answer."""
+    from fi_design.spec.paths import with_values
+
+    spec = with_values(paper_spec, {"requirements.robustness.samples": 0})
+    with ThreadPoolExecutor(2) as pool:
+        early = evaluate_module.evaluate(spec, executor=pool, sensitivity=True)
+    after = evaluate_module.evaluate(spec, sensitivity=True)
+    assert early.sensitivity is not None and len(early.sensitivity.points) == 6
+    assert early.sensitivity == after.sensitivity
