@@ -67,11 +67,11 @@ def crossover_sensitivity(model: Model | _spec.Spec, nominal: float | None = Non
         mechanism, no crossover to find) or a friction model without these
         parameters (the switch model).
     """
-    return started_sensitivity(model, factors=factors, executor=executor).result(nominal)
+    return started_sensitivity(study_model(model, "model"), factors=factors,
+                               executor=executor).result(nominal)
 
 
-def started_sensitivity(model: Model | _spec.Spec, *,
-                        factors: tuple[float, ...] = DEFAULT_FACTORS,
+def started_sensitivity(model: Model, *, factors: tuple[float, ...] = DEFAULT_FACTORS,
                         executor: Any = None) -> "PendingSensitivity":
     """:func:`crossover_sensitivity` with its six answers submitted to ``executor`` now and
     read later (:meth:`PendingSensitivity.result`): a design submits them with its other
@@ -79,7 +79,9 @@ def started_sensitivity(model: Model | _spec.Spec, *,
 
     Parameters
     ----------
-    model, factors, executor
+    model : Model
+        The resolved model, not one varied by :meth:`~fi_design.model.Model.at`.
+    factors, executor
         As :func:`crossover_sensitivity`.
 
     Returns
