@@ -15,7 +15,7 @@ from ..kernel.build import compiled
 from ..kernel.layout import PlantParameters, state_index
 from .settings import integrates, kernel_arrays
 
-__all__ = ["rest_is_final", "rest_ends_run"]
+__all__ = ["rest_is_final", "rest_ends_run", "presliding_shift"]
 
 
 def _joint_force(p: PlantParameters, d: float) -> float:
@@ -26,6 +26,23 @@ def _joint_force(p: PlantParameters, d: float) -> float:
     elif d < -p.s:
         f += p.k_stop * (d + p.s)
     return f
+
+
+def presliding_shift(p: PlantParameters, z: float, d0: float) -> float:
+    """The stuck cart's presliding displacement D [m] at which its bristles balance the joint
+    held at the deflection ``d0`` [m] less D: sigma0 (z + D) = k (d0 - D) + F_stop.
+
+    With e = d0 - D the balance reads k e + F_stop(e) + sigma0 e = sigma0 (z + d0), its left
+    side rising in straight pieces (the limiter's contact adds k_stop beyond +-s): the
+    piece whose e lies in its own range is the answer, exactly.
+    """
+    target = p.sigma0 * (z + d0)
+    e = target / (p.k + p.sigma0)
+    if e > p.s:
+        e = (target + p.k_stop * p.s) / (p.k + p.k_stop + p.sigma0)
+    elif e < -p.s:
+        e = (target - p.k_stop * p.s) / (p.k + p.k_stop + p.sigma0)
+    return d0 - e
 
 
 def rest_is_final(params: PlantParameters, y: np.ndarray, level: float) -> bool:
@@ -66,16 +83,7 @@ def rest_is_final(params: PlantParameters, y: np.ndarray, level: float) -> bool:
     if p.isolated:
         x2 = float(y[idx["x2"]])
         d0 = level - x2
-        if switch:
-            shift = 0.0
-        else:
-            def gap(dd: float) -> float:
-                return p.sigma0 * (z + dd) - _joint_force(p, d0 - dd)
-
-            span = abs(d0) + abs(z) + p.s + 1e-6
-            from scipy.optimize import brentq
-
-            shift = brentq(gap, -span, span, xtol=1e-15, rtol=1e-12)
+        shift = 0.0 if switch else presliding_shift(p, z, d0)
         force = _joint_force(p, d0 - shift)
         x_cart = x2 + shift
     else:

@@ -273,9 +273,9 @@ def test_ctrl_c_at_many_instants_of_a_sweep(tmp_path):
     _sweep_at(tmp_path, [0.05 + 0.1 * k + 0.03 * (k % 3) for k in range(60)])
 
 
-def _interrupted_report(tmp_path, delay: float) -> dict:
-    """The design run with a PDF report, sent SIGINT ``delay`` s after the report's worker
-    (a child forked once the design's workers exist no more) appears."""
+def _interrupted_report(tmp_path, delay: float, name: str = "map.pdf") -> dict:
+    """The design run with a report (``name``, PDF or HTML), sent SIGINT ``delay`` s after
+    the report's worker (a child forked once the design's workers exist no more) appears."""
 
     def report_worker(proc) -> tuple[set[int], set[int]]:
         design: set[int] = set()
@@ -290,23 +290,23 @@ def _interrupted_report(tmp_path, delay: float) -> dict:
         return design, report
 
     run = _interrupt(tmp_path, "report", ["design", str(EXAMPLES / "paper_setup.yaml"),
-                                          "--no-recommend", "--report", "map.pdf"],
+                                          "--no-recommend", "--report", name],
                      delay, watch=report_worker)
     run["design"], run["report"] = run.pop("watched")
     return run
 
 
-def _report_at(tmp_path, delays) -> None:
+def _report_at(tmp_path, delays, name: str = "map.pdf") -> None:
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(2) as ex:
-        runs = list(ex.map(lambda d: _interrupted_report(tmp_path, d), delays))
+        runs = list(ex.map(lambda d: _interrupted_report(tmp_path, d, name), delays))
     bad = []
     for run in runs:
         try:
             assert run["design"] and run["report"], run  # the report's worker was seen
             assert not any(_running(w) for w in run["report"]), run
-            _check_interrupted({**run, "files": [f.replace("map.pdf", "map.csv")
+            _check_interrupted({**run, "files": [f.replace(name, "map.csv")
                                                  for f in run["files"]]})
         except AssertionError:
             bad.append(repr(run))
@@ -318,6 +318,12 @@ def test_ctrl_c_while_a_pdf_report_is_written(tmp_path):
     out, ends the run with 130 and the interruption's message, no PDF and no temporary file,
     and the worker with it."""
     _report_at(tmp_path, [0.0, 1.0])
+
+
+def test_ctrl_c_while_an_html_report_is_written(tmp_path):
+    """An HTML report's figures are drawn by a worker and this process at once: a Ctrl-C
+    then ends the run with 130, no HTML and no temporary file, and the worker with it."""
+    _report_at(tmp_path, [0.0, 0.15], name="map.html")
 
 
 @pytest.mark.slow

@@ -9,8 +9,11 @@ dense move scan for the boundary.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from fi_design.model import resolve
 from fi_design.stage import (converge_cycle, family_distances, rest_is_final, stage_hunting,
@@ -381,3 +384,41 @@ def test_the_spread_order_changes_which_hunting_move_is_met_first_never_whether(
             sorted((m.distance, m.outcome) for m in size)
     with pytest.raises(Exception, match="order must be one of"):
         stage_hunts(paper_spec, True, order="random")
+
+
+@functools.lru_cache(maxsize=1)
+def _isolated_plant():
+    from pathlib import Path
+
+    from fi_design.spec.file import load_spec
+
+    spec = load_spec(Path(__file__).resolve().parents[2] / "examples" / "paper_setup.yaml")
+    return resolve(spec).plant(True)
+
+
+@settings(max_examples=200, deadline=None)
+@given(z=st.floats(-5e-6, 5e-6), d0=st.floats(-1e-3, 1e-3), k=st.floats(10.0, 1e5),
+       k_stop=st.floats(0.0, 1e8), s=st.floats(1e-5, 1e-3), sigma0=st.floats(1e5, 1e8))
+def test_the_presliding_shift_balances_the_bristles_and_the_joint(z, d0, k, k_stop, s, sigma0):
+    """The closed form of the stuck cart's shift against a root finder on the force balance
+    sigma0 (z + D) = k (d0 - D) + the limiter's contact beyond +-s."""
+    from dataclasses import replace as _replace
+
+    from scipy.optimize import brentq
+
+    from fi_design.model import resolve
+    from fi_design.stage.rest import presliding_shift
+
+    p = _replace(_isolated_plant(), k=k, k_stop=k_stop, s=s, sigma0=sigma0)
+
+    def joint(e):
+        return k * e + (k_stop * (e - s) if e > s else k_stop * (e + s) if e < -s else 0.0)
+
+    def gap(dd):
+        return sigma0 * (z + dd) - joint(d0 - dd)
+
+    span = abs(d0) + abs(z) + s + 1e-6
+    ref = brentq(gap, -span, span, xtol=1e-18, rtol=1e-14)
+    got = presliding_shift(p, z, d0)
+    assert got == pytest.approx(ref, rel=1e-9, abs=1e-16)
+    assert abs(gap(got)) <= 1e-9 * (sigma0 * (abs(z) + span) + 1e-12)
