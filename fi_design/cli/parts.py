@@ -259,14 +259,51 @@ def run_app(application: typer.Typer) -> None:
     global _PROCESS_ENDS_WITH_COMMAND
     _PROCESS_ENDS_WITH_COMMAND = True
     try:
-        with signals_to_exceptions(_signal_exception):
-            application(prog_name="fi-design")
-    except KeyboardInterrupt as exc:  # before the command began, or as it ended
-        _say_interrupted(exc, "outside the command")
-        raise SystemExit(128 + exc.signum if isinstance(exc, Terminated) else
-                         EXIT_INTERRUPTED) from None
+        try:
+            with signals_to_exceptions(_signal_exception):
+                application(prog_name="fi-design")
+        except KeyboardInterrupt as exc:  # before the command began, or as it ended
+            _say_interrupted(exc, "outside the command")
+            raise SystemExit(128 + exc.signum if isinstance(exc, Terminated) else
+                             EXIT_INTERRUPTED) from None
+    except SystemExit as exc:
+        if exc.code in _INTERRUPTED_CODES:
+            _end_without_stuck_threads(exc.code)
+        raise
     finally:
         _spare_the_last_collection()
+
+
+#: The exit codes of an interrupted run: 128 + SIGHUP, SIGINT or SIGTERM.
+_INTERRUPTED_CODES = (129, EXIT_INTERRUPTED, 143)
+#: How long an interrupted run waits for its threads before it ends without them [s].
+THREADS_GRACE = 2.0
+
+
+def _end_without_stuck_threads(code: int) -> None:
+    """End an interrupted run now (``os._exit``) when a thread it would wait for at exit has
+    not ended within :data:`THREADS_GRACE`; return when none is left.
+
+    A worker process ended while it wrote its result to its pool (a chunk of points, a
+    figure) leaves part of it in the pool's pipe, and the pool's manager thread, a thread
+    the interpreter joins at exit, waits for the rest for ever: an interrupted design run
+    then never ended (once in 30 Ctrl-Cs into a report's run). By now the run is over:
+    its outputs are written or removed, its message is out, its workers are stopped.
+    """
+    import threading
+    import time
+
+    me = threading.current_thread()
+    deadline = time.monotonic() + THREADS_GRACE
+    for thread in threading.enumerate():
+        if thread is me or thread.daemon:
+            continue
+        thread.join(max(0.0, deadline - time.monotonic()))
+        if thread.is_alive():
+            for stream in (sys.stdout, sys.stderr):
+                with contextlib.suppress(Exception):
+                    stream.flush()
+            os._exit(code)
 
 
 #: True in the process :func:`run_app` runs (the console script): it ends when its command

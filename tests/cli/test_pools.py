@@ -371,3 +371,34 @@ def test_a_command_reads_its_spec_without_importing_dask(paper_spec_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.split()
     assert out == ["False", "True", "False"], out
+
+
+_STUCK_DRIVER = """
+import sys, threading
+import fi_design.signoff as signoff
+
+def design(*args, **kwargs):
+    # a thread the interpreter would join at exit, waiting for ever (a pool's manager
+    # thread reading the rest of a result its killed worker never wrote), then Ctrl-C
+    threading.Thread(target=threading.Event().wait, name="stuck").start()
+    raise KeyboardInterrupt
+
+signoff.design = design
+from fi_design.cli.app import main
+sys.argv = ["fi-design"] + sys.argv[1:]
+main()
+"""
+
+
+def test_an_interrupted_run_ends_with_a_thread_stuck_in_its_pool(tmp_path):
+    """Once in some 30 Ctrl-Cs into a report's design run the process never ended: a worker
+    killed while it wrote its result left the pool's manager thread reading on for ever, and
+    the interpreter waits for that thread at exit. The run now ends with 130 and its message
+    within the threads' grace, whatever thread is left."""
+    started = time.monotonic()
+    proc = subprocess.run([sys.executable, "-c", _STUCK_DRIVER, "design",
+                           str(EXAMPLES / "paper_setup.yaml"), "--no-recommend"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 130, (proc.returncode, proc.stderr)
+    assert "interrupted" in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
+    assert time.monotonic() - started < 30
