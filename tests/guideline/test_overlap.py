@@ -24,32 +24,40 @@ def test_background_hands_back_the_value_and_the_error():
         Background(lambda: 1 / 0).result()
 
 
+def _failing_step2_with(monkeypatch, module, name: str, what: str, spec, **options) -> list:
+    """Run the design with ``module.name`` counted (what it returns, in order) and step 2
+    failing once the first of them has started; the values the ones that ran returned."""
+    started = threading.Event()
+    ran = []
+    real = getattr(module, name)
+
+    def counted(*args, **kwargs):
+        started.set()
+        out = real(*args, **kwargs)
+        ran.append(out)
+        return out
+
+    def step2_fails(model):
+        # the first task starts while this step still runs
+        assert started.wait(60), f"no {what} started during step 2"
+        raise RuntimeError("step 2 failed")
+
+    monkeypatch.setattr(module, name, counted)
+    monkeypatch.setattr(evaluate_module, "step2_crossover", step2_fails)
+    with ThreadPoolExecutor(1) as pool:
+        with pytest.raises(RuntimeError, match="step 2 failed"):
+            evaluate_module.evaluate(spec, executor=pool, **options)
+        pool.shutdown(wait=True)
+    return ran
+
+
 def test_the_study_runs_while_the_steps_do_and_a_failing_step_cancels_it(paper_spec,
                                                                         monkeypatch):
     from fi_design.spec.paths import with_values
 
     spec = with_values(paper_spec, {"requirements.robustness.samples": 32})
-    started = threading.Event()
-    chunks = []
-    run_chunk = points.run_chunk
-
-    def counted(*args, **kwargs):
-        started.set()
-        out = run_chunk(*args, **kwargs)
-        chunks.append(len(out))
-        return out
-
-    def step2_fails(model):
-        # the study's first chunk starts while this step still runs
-        assert started.wait(60), "no chunk of the robustness study started during step 2"
-        raise RuntimeError("step 2 failed")
-
-    monkeypatch.setattr(points, "run_chunk", counted)
-    monkeypatch.setattr(evaluate_module, "step2_crossover", step2_fails)
-    with ThreadPoolExecutor(1) as pool:
-        with pytest.raises(RuntimeError, match="step 2 failed"):
-            evaluate_module.evaluate(spec, executor=pool)
-        pool.shutdown(wait=True)
+    chunks = _failing_step2_with(monkeypatch, points, "run_chunk",
+                                 "chunk of the robustness study", spec)
     samples = spec.requirements.robustness.samples
     total = len(points.chunks(2 * samples, points.chunk_size(2 * samples)))  # both plants
     # the chunks already queued when the step failed may run; the rest never start
@@ -65,25 +73,8 @@ def test_the_sensitivity_starts_with_the_simulations_and_stops_with_a_failing_st
     from fi_design.spec.paths import with_values
 
     spec = with_values(paper_spec, {"requirements.robustness.samples": 0})
-    started = threading.Event()
-    folds = []
-    fold = sensitivity._fold
-
-    def counted(*args, **kwargs):
-        started.set()
-        folds.append(args[2])
-        return fold(*args, **kwargs)
-
-    def step2_fails(model):
-        assert started.wait(60), "no answer of the sensitivity started during step 2"
-        raise RuntimeError("step 2 failed")
-
-    monkeypatch.setattr(sensitivity, "_fold", counted)
-    monkeypatch.setattr(evaluate_module, "step2_crossover", step2_fails)
-    with ThreadPoolExecutor(1) as pool:
-        with pytest.raises(RuntimeError, match="step 2 failed"):
-            evaluate_module.evaluate(spec, executor=pool, sensitivity=True)
-        pool.shutdown(wait=True)
+    folds = _failing_step2_with(monkeypatch, sensitivity, "_fold",
+                                "answer of the sensitivity", spec, sensitivity=True)
     assert 1 <= len(folds) < 6, len(folds)
 
 
