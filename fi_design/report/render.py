@@ -465,7 +465,7 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     if executor is not None and figures.makers:  # drawn there while the HTML is made here
         # one task a figure, in the order the layout needs them: the layout waits for the
         # figure it reaches, not for the last one
-        key = f"{os.getpid()}-{id(context)}-{time.monotonic_ns()}"
+        key = _report_key(context)
         sizes = executor.submit(report_figure_sizes, result, options, key=key)
         # the result goes with every task (any worker of any pool can draw any figure); a
         # worker that made the report's figures for an earlier task keeps them by the key
@@ -478,6 +478,12 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
                                                       None if drawn is None else sizes))
 
 
+def _report_key(placed: Any) -> str:
+    """A name for one report's figure tasks (:func:`report_figures`' ``key``), unique across
+    this process's reports and its workers' earlier ones."""
+    return f"{os.getpid()}-{id(placed)}-{time.monotonic_ns()}"
+
+
 def _svg_placed(html: str, figures: Any, executor: Any, result: Any, options: dict) -> str:
     """An HTML report's page with its deferred SVG figures in place (their
     :func:`~fi_design.plots.figure_mark`), drawn by the executor from the first and by this
@@ -486,7 +492,7 @@ def _svg_placed(html: str, figures: Any, executor: Any, result: Any, options: di
     from ..plots import figure_mark
 
     names = list(figures.makers)
-    key = f"{os.getpid()}-{id(figures)}-{time.monotonic_ns()}"
+    key = _report_key(figures)
     tasks = {name: executor.submit(report_figures, result, options, names=(name,), key=key,
                                    svg=True) for name in names}
     svg: dict[str, str] = {}

@@ -96,6 +96,7 @@ class PendingSensitivity:
 
     def __init__(self, model: Model, factors: tuple[float, ...], executor: Any) -> None:
         self._model = model
+        self._factors = factors
         self._jobs: list[tuple[str, float, float, dict]] = []
         self._futures: list[Any] | None = None
         if not model.law.integrator or model.friction.model != "lugre":
@@ -108,7 +109,6 @@ class PendingSensitivity:
                 values = dict(base)
                 values[path] = base[path] * f
                 self._jobs.append((path, f, values[path], values))
-        self._factors = factors
         if executor is not None:
             iso = model.has_isolator
             self._futures = [executor.submit(_fold, model, iso, values)
