@@ -21,6 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .comparison import Comparison, ModelRun
+from .periodogram import lomb_scargle
 from ..results.reconciliation import Lattice, Signature
 from ..display import fixed, number, quantities, quantity
 
@@ -79,8 +80,6 @@ def spatial_periods(x: np.ndarray, y: np.ndarray, lo: float, hi: float,
     The ratio of a peak is its power over the median power; the amplitude
     is in the unit of y.
     """
-    from scipy.signal import lombscargle
-
     if len(x) < 50 or np.ptp(x) < 2 * lo:
         return []
     span = float(np.ptp(x))
@@ -96,7 +95,7 @@ def spatial_periods(x: np.ndarray, y: np.ndarray, lo: float, hi: float,
     if len(x) > 6000:
         sel = np.linspace(0, len(x) - 1, 6000).astype(int)
         x, yc = x[sel], yc[sel]
-    p = lombscargle(x, yc, k)
+    p = lomb_scargle(x, yc, k)
     med = float(np.median(p)) or 1e-300
     out: list[Period] = []
     for j in np.argsort(p)[::-1]:
