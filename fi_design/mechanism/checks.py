@@ -21,8 +21,13 @@ def _mm(x: float) -> str:
     return quantity(x, "m", 3, shown=("mm", 1e3))
 
 
+#: Slack beyond the stock's stiffness range within which a guide still realises the joint's
+#: stiffness [-] (the sizing solves the width to about 1e-3 of its target).
+STIFFNESS_MATCH = 0.02
+
+
 def flexure_checks(fx: FlexureResult | None, crossover: float,
-                   separation: float) -> tuple[Check, ...]:
+                   separation: float, joint_stiffness: float | None = None) -> tuple[Check, ...]:
     """Step 3's checks of the guide: stiffness, stress, buckling, modes, sag.
 
     Parameters
@@ -34,6 +39,11 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
         ``separation`` times it.
     separation : float
         ``requirements.parasitic_separation`` [-].
+    joint_stiffness : float, optional
+        The joint's drive stiffness the analysis uses [N/m] (``isolator.stiffness``, or the
+        one step 3 chose). When it is not the guide's own, a check that the guide realises
+        it: within the guide's range over the stock's thickness tolerance, widened by
+        :data:`STIFFNESS_MATCH`.
     """
     if fx is None:
         return ()
@@ -50,11 +60,13 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
     out = [Check("flexure.stiffness", 0.0 < k <= kmax * (1 + 1e-9), k, kmax, "N/m",
                  f"{dims}: net drive stiffness {_g(k)} N/m (elastic {_g(m.stiffness.x)} N/m, "
                  f"gravity {_g(grav.geometric_stiffness)} N/m), k_max {_g(kmax)} N/m"
-                 + ("" if k > 0 else ": the weight has buckled the guide"), step=step),
-           Check("flexure.stress", m.stress <= g.allowed_stress, m.stress, g.allowed_stress,
+                 + ("" if k > 0 else ": the weight has buckled the guide"), step=step)]
+    if joint_stiffness is not None and joint_stiffness != k:
+        out.append(_realises(fx, k, float(joint_stiffness), step))
+    out.append(Check("flexure.stress", m.stress <= g.allowed_stress, m.stress, g.allowed_stress,
                  "Pa", f"stress at full stroke {quantity(m.stress, 'Pa')}, allowed "
                  f"{quantity(g.allowed_stress, 'Pa')} (margin x{number(m.stress_margin, 3)})",
-                 step=step)]
+                 step=step))
     if grav.buckling_factor is not None:
         f, need = grav.buckling_factor, fx.required_buckling
         out.append(Check(
@@ -81,3 +93,27 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
             f"{_mm(grav.sag)} of its {_mm(fx.stroke)} stroke"
             + ("" if grav.sag < fx.stroke else ": it rests on its end stop"), step=step))
     return tuple(out)
+
+
+def _realises(fx: FlexureResult, k: float, joint: float, step: str) -> Check:
+    """Whether the guide's net drive stiffness ``k`` realises the joint's ``joint`` [N/m]."""
+    lo, hi = fx.stiffness_range or (k, k)
+    lo, hi = min(lo, k), max(hi, k)
+    ok = lo * (1.0 - STIFFNESS_MATCH) <= joint <= hi * (1.0 + STIFFNESS_MATCH)
+    made = "sized" if not fx.drawn else "drawn"
+    text = (f"the {made} guide's net drive stiffness {_g(k)} N/m"
+            + (f" ({_g(lo)} to {_g(hi)} N/m over the stock's thickness tolerance)"
+               if hi > lo else "")
+            + f" against the joint's {_g(joint)} N/m that the analysis simulates")
+    if ok:
+        return Check("flexure.joint", True, k, joint, "N/m", text + ": it realises it",
+                     step=step)
+    if fx.drawn:
+        why = ("; the analysis uses isolator.stiffness: leave it out to use the drawn guide's "
+               "own stiffness, or redraw the guide")
+    else:
+        why = (f"; {number(k / joint, 3)} x: no guide within the flexure's bounds reaches it "
+               "while meeting k_max, the stress, buckling and the parasitic modes (this is the "
+               "closest that does): widen the bounds (longer or narrower leaves, thinner "
+               "stock) or choose a drive stiffness near this one")
+    return Check("flexure.joint", False, k, joint, "N/m", text + why, step=step)

@@ -56,7 +56,7 @@ STEP_SOURCES = {
 SENSE = {
     "friction_gap": "<", "crossover_achievable": "\u2264", "phase_margin": "\u2265",
     "gain_margin": "\u2265", "modulus_margin": "\u2265", "parasitic_separation": "\u2265",
-    "drive_stiffness": "\u2264", "flexure.stiffness": "\u2264", "flexure.stress": "\u2264",
+    "drive_stiffness": "\u2264", "flexure.stiffness": "\u2264", "flexure.joint": "\u2248", "flexure.stress": "\u2264",
     "flexure.buckling": "\u2265", "flexure.modes": "\u2265", "flexure.sag": "<",
     "simulation_isolated": "=", "min_crossover_isolated": "\u2264", "landing_force": "<",
     "simulation_non_isolated": "=", "min_crossover_non_isolated": "\u2264", "robustness": "\u2264",
@@ -122,6 +122,7 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
         return {"settle_time": "Settle time after every move",
                 "static_error": "Static error after every move"}.get(tail, name)
     flex = {"stiffness": "Flexure net drive stiffness within k_max",
+            "joint": "Flexure realises the joint's drive stiffness",
             "stress": "Flexure stress at full stroke",
             "buckling": "Flexure buckling load over the stage's weight",
             "modes": "Flexure's lowest parasitic mode above the crossover",

@@ -107,6 +107,33 @@ def test_paper_verdict(paper_design):
     assert "8 Hz" in r.conclusion and "3 N" in r.conclusion
 
 
+def test_step3_fails_a_guide_that_does_not_realise_the_joints_stiffness(paper_spec):
+    """The analysis simulates the joint's stiffness; the guide must be that joint.
+
+    The paper guide is sized to 6627 N/m for the 6667 N/m the spec asks (within its stock
+    tolerance); for 300 N/m no guide within the bounds meets the 24 Hz modes, and the closest
+    (about 7200 N/m) passed every check before. A drawn guide under a stiffness it does not
+    have fails too; without ``isolator.stiffness`` the drawn guide is the joint (no check).
+    """
+    def joint_check(spec):
+        checks = {c.name: c for c in evaluate(spec, confirm=False).checks}
+        return checks.get("flexure.joint"), checks
+
+    ok, _ = joint_check(paper_spec)
+    assert ok.passed and ok.limit == 6667.0 and ok.value == pytest.approx(6627, rel=1e-3)
+    soft, checks = joint_check(variant(paper_spec, **{"isolator.stiffness": "300 N/m"}))
+    assert soft.status == Status.FAIL and soft.limit == 300.0 and soft.value > 20 * 300
+    assert checks["flexure.stiffness"].passed  # within k_max: not what was wrong
+    assert "closest" in soft.message and "widen the bounds" in soft.message
+    drawn = {"isolator.flexure.length": "12 mm", "isolator.flexure.width": "10 mm",
+             "isolator.flexure.thickness": "0.3 mm"}
+    given, _ = joint_check(variant(paper_spec, **drawn))
+    assert given.status == Status.FAIL and "leave it out" in given.message
+    own, _ = joint_check(variant(paper_spec, **drawn, **{"isolator.stiffness": None,
+                                                         "isolator.damping": None}))
+    assert own is None
+
+
 # --------------------------------------------------------------------------- steps
 
 
