@@ -221,9 +221,12 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
     elif sens is not None:
         sens.cancel()
     margins = _verdict.margins(model, xo, st, fx, pid, sim)
+    # the simulated stage stands for the hardware only where step 2's loop is stable
+    note = _verdict.linear_loop_note(xo) if sim is not None or rob is not None else None
+    result = replace(result, checks=_verdict.beyond_the_linear_loop(result.checks, note))
     result = replace(
         result, robustness=rob, margins=margins,
-        verdict=_verdict.judge(model, result.checks, result.warnings, sim, rob, margins))
+        verdict=_verdict.judge(model, result.checks, result.warnings, sim, rob, margins, note))
     log.info("design of %r: %s, %d checks, %d failed", spec.name, result.verdict.status,
              len(result.checks), len(result.failed_checks))
     return result

@@ -269,6 +269,34 @@ def test_warnings_only_pass_with_warnings(cases):
     assert r.verdict.at_or_below("PASS_WITH_WARNINGS") and not r.verdict.at_or_below("FAIL")
 
 
+def test_a_simulation_without_the_modes_never_passes_a_loop_step_2_finds_unstable(cases,
+                                                                                  paper_spec):
+    """At 60 Hz the paper stage's 150 Hz tilt makes every limit case unstable; the simulation,
+    which leaves the modes out, came to rest and passed its checks, the scatter at 0 %, and the
+    verdict said so. Its passing answers are now warnings naming the unstable cases."""
+    from fi_design.guideline import steps, verdict as v
+
+    assert v.linear_loop_note(steps.step2_crossover(resolve(paper_spec))) is None
+    note = v.linear_loop_note(steps.step2_crossover(resolve(variant(
+        paper_spec, **{"controller.crossover": "60 Hz"}))))
+    assert "unstable (case 1, case 2, case 3, case 4)" in note
+    r = cases["settling_isolated"]  # every move settles, the scatter within its limit
+    checks = v.beyond_the_linear_loop(r.checks, note)
+    simulated = [c for c in checks if c.step.startswith("simulation")]
+    assert simulated and all(c.passed is None and note in c.message for c in simulated)
+    assert [c for c in checks if c.name == "robustness"][0].status.value == "WARN"
+    assert [c.status for c in checks if not c.step.startswith(("simulation", "robustness",
+                                                               "step 3 refinement"))] == \
+        [c.status for c in r.checks if not c.step.startswith(("simulation", "robustness",
+                                                              "step 3 refinement"))]
+    judged = v.judge(resolve(r.spec), checks, r.warnings, r.simulation, r.robustness,
+                     r.margins, note)
+    assert not any(x.severity == "PASS" and x.source in ("simulation", "robustness")
+                   for x in judged.reasons)
+    assert sum(note in x.text for x in judged.reasons if x.source == "simulation") == 1
+    assert judged.status == "PASS_WITH_WARNINGS"  # nothing fails here but the loop's own checks
+
+
 def test_without_simulation_the_verdict_cannot_pass(paper_spec):
     r = design(paper_spec, confirm=False)
     assert r.verdict.behaviour is None and r.robustness is None
