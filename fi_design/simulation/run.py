@@ -144,7 +144,8 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
         raise SimulationError(f"method must be one of {METHODS}, got {method!r}")
     if drive not in DRIVES:
         raise SimulationError(f"drive must be one of {DRIVES}, got {drive!r}")
-    spec, crossover, duration, rtol = _checked_arguments(spec, crossover, duration, rtol, record)
+    spec, crossover, duration, rtol, rate = _checked_arguments(spec, crossover, duration, rtol,
+                                                             record, rate)
     initial_position = number(initial_position, "initial_position", "m")
     model = as_model(spec)
     if crossover is not None or effects is not None:
@@ -181,7 +182,7 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
                    move_end=motion.end_time if reference is None else 0.0)
 
 
-def _checked_arguments(spec, crossover, duration, rtol, record):
+def _checked_arguments(spec, crossover, duration, rtol, record, rate=None):
     """The spec or model (a spec loaded when given as a path or mapping) and the numeric
     arguments, checked."""
     from ..measured import Measurement
@@ -201,16 +202,19 @@ def _checked_arguments(spec, crossover, duration, rtol, record):
         raise ArgumentError(f"the record has {record.n} samples; a replay holds at most "
                             f"{_spec.MAX_OUTPUT_SAMPLES} (about 150 bytes each): replay a part "
                             "of it (fi_design.identification.segment)")
+    if rate is not None:
+        rate = number(rate, "rate", "Hz", positive=True)
     if duration is not None:
         duration = number(duration, "duration", "s", positive=True)
-        samples = math.floor(duration * settings.output_rate + 1e-9) + 1
+        at = settings.output_rate if rate is None else rate
+        samples = math.floor(duration * at + 1e-9) + 1
         if samples > _spec.MAX_OUTPUT_SAMPLES:
             raise ArgumentError(f"duration = {quantity(duration, 's', 6)} at "
-                                "simulation.output_rate = "
-                                f"{quantity(settings.output_rate, 'Hz', 6)} makes "
+                                + ("simulation.output_rate" if rate is None else "rate")
+                                + f" = {quantity(at, 'Hz', 6)} makes "
                                 f"{number_text(float(samples), 3)} output samples; at most "
                                 f"{_spec.MAX_OUTPUT_SAMPLES}")
-    return spec, crossover, duration, rtol
+    return spec, crossover, duration, rtol, rate
 
 
 def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=None,

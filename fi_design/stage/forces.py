@@ -7,7 +7,9 @@ seconds after it, with traces at ``rate``: the end stop's contact force
 ``|d|`` exceeds the stroke s (the kernel's own contact law), the number of
 contacts, the time in contact, and the largest force the controller commands.
 The contact lasts milliseconds (a 1e6 N/m stop under a 1.6 kg stage rings at
-about 125 Hz), so the traces are sampled at 5 kHz by default.
+about 125 Hz), so the traces are sampled at 5 kHz by default; a family of long
+moves (slow scans of hundreds of seconds) at a lower rate, so that no run holds
+more than :data:`MAX_SAMPLES` samples.
 """
 
 from __future__ import annotations
@@ -22,12 +24,14 @@ from ..results.forces import MoveForces, StageForces
 from ..trajectory import from_moves, profile_duration
 from .family import family_distances
 
-__all__ = ["SETTLE", "RATE", "move_forces"]
+__all__ = ["SETTLE", "RATE", "MAX_SAMPLES", "move_forces"]
 
 #: Time simulated after each move's end [s].
 SETTLE = 2.0
 #: Output rate of the force runs [Hz].
 RATE = 5000.0
+#: Output samples of the longest force run at most: the rate is lowered to keep it.
+MAX_SAMPLES = 1_000_000
 
 
 def _one(model: Model, isolated: bool, moves, end: float, settle: float, rate: float,
@@ -77,7 +81,9 @@ def move_forces(model: Model, isolated: bool | None = None, *,
     settle : float, optional
         Time after each move's end [s]. Default :data:`SETTLE`.
     rate : float, optional
-        Output rate [Hz]. Default :data:`RATE`.
+        Output rate [Hz]. Default :data:`RATE`, lowered where the longest run
+        would hold more than :data:`MAX_SAMPLES` samples (the result's ``rate``
+        is the one used).
 
     Returns
     -------
@@ -87,15 +93,19 @@ def move_forces(model: Model, isolated: bool | None = None, *,
     iso = model.has_isolator if isolated is None else bool(isolated)
     spec = model.spec
     motion = spec.motion
-    out = [_one(model, iso, motion.moves, motion.end_time, settle, rate,
-                float(sum(m.distance for m in motion.moves)), "spec")]
     dists = family_distances(model, iso, model.plant(iso)) if family is None else family
     big = max(motion.moves, key=lambda m: abs(m.distance))
+    runs = [(motion.moves, motion.end_time, float(sum(m.distance for m in motion.moves)),
+             "spec")]
     for d in dists:
         mv = _spec.Move(distance=float(d), velocity=big.velocity,
                         acceleration=big.acceleration, jerk=big.jerk)
         end = profile_duration(float(d), big.velocity, big.acceleration, big.jerk)
-        out.append(_one(model, iso, (mv,), end, settle, rate, float(d), "family"))
+        runs.append(((mv,), end, float(d), "family"))
+    longest = max(end for _, end, _, _ in runs) + settle
+    rate = min(float(rate), MAX_SAMPLES / longest)
+    out = [_one(model, iso, moves, end, settle, rate, d, label)
+           for moves, end, d, label in runs]
     lim = model.limiter if iso else None
     given = spec.isolator.limiter.model_fields_set if iso and spec.isolator is not None \
         else set()
