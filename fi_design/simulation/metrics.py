@@ -22,7 +22,10 @@ The count alone is blind in two ways, and the verdict here is not:
 Only a stage whose error stays inside the settle band at the end of the
 window is ``settled``; a run that ends, or a window that closes, before the
 motion does is never settled: ``undetermined`` ("not finished"), since a
-stage on its ramp follows the reference within the band.
+stage on its ramp follows the reference within the band. A motion that ends
+inside the window, or a trace that ends inside it, is ``undetermined`` too:
+the count would take the move's own overshoot for a cycle, or see part of
+the window only.
 """
 
 from __future__ import annotations
@@ -102,6 +105,11 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
 
     t_last = float(t[-1]) if len(t) else 0.0
     moving = motion_end > min(w1, t_last)  # the motion outlasts the window or the run
+    # the motion ends after the window opens: the count would take its own overshoot
+    late = not moving and motion_end > w0
+    # the trace ends inside the window (more than a step and a half before its end)
+    step = float(t[-1] - t[-2]) if len(t) > 1 else 0.0
+    short = not moving and w0 < t_last < w1 - 1.5 * step
     c = max(a, int(np.searchsorted(t, w1 - window_length / 4.0)))
     _, tail = _finite(t[c:b], e[c:b])
     settled = bool(success and not moving and len(tail)
@@ -116,8 +124,18 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
         reason = (f"not finished: the motion runs until {quantity(motion_end, 's', 4)}, past "
                   f"the end of the {what} at {quantity(min(w1, t_last), 's', 4)}; the stage is "
                   "still moving")
+    elif late:
+        verdict = "undetermined"
+        reason = (f"the motion ends at {quantity(motion_end, 's', 4)}, after the counting window "
+                  f"opens at {quantity(w0, 's', 4)}: the count would take the move's own "
+                  "overshoot for hunting (start the window after the motion)")
     elif len(ew) < 2:
         verdict, reason = "undetermined", "the trace does not cover the counting window"
+    elif short:
+        verdict = "undetermined"
+        reason = (f"the trace ends at {quantity(t_last, 's', 4)}, inside the counting window "
+                  f"[{quantity(w0, 's', 6)}, {quantity(w1, 's', 6)}): it covers the window in "
+                  "part only")
     elif cycles > 0:
         verdict = "hunting"
         reason = (f"{cycles} peak(s) of at least {quantity(min_height, 'm', 6)} in "

@@ -158,3 +158,24 @@ def test_a_motion_that_outlasts_the_run_or_window_is_not_finished(motion_end):
     longer = np.arange(40001) / 1000.0  # a 40 s run, the window [10 s, 20 s) inside the move
     w = hunting_metrics(longer, 1e-9 * np.sin(longer), motion_end=motion_end)
     assert w.verdict == "undetermined" and "counting window at 20 s" in w.reason
+
+
+def test_a_motion_that_ends_inside_the_window_is_not_counted():
+    """A 0.99 m move at 50 mm/s ends at 19.85 s in a [10 s, 20 s) window: its deceleration
+    overshoot (0.15 mm) was counted as one hunting cycle. Now undetermined."""
+    after = np.maximum(T - 19.85, 0.0)
+    e = np.where(T > 19.85, 0.15e-3 * np.exp(-after / 0.02) * np.sin(2 * np.pi * after / 0.1),
+                 0.0)
+    m = hunting_metrics(T, e, motion_end=19.85)
+    assert m.verdict == "undetermined" and m.hunting_cycles >= 0
+    assert "after the counting window opens at 10 s" in m.reason
+
+
+def test_a_trace_that_ends_inside_the_window_is_undetermined():
+    """A 12 s run at rest within the band read 'stuck' (a 5 s run 'does not cover the
+    window'); a record sampled at 1 kHz up to 19.999 s still covers [10 s, 20 s)."""
+    short = T[T <= 12.0]
+    m = hunting_metrics(short, 3.5e-12 + 0.0 * short, motion_end=0.3)
+    assert m.verdict == "undetermined" and "covers the window in part only" in m.reason
+    record = T[:-1]  # ends one step before the window's end
+    assert hunting_metrics(record, 0.0 * record, motion_end=0.3).verdict == "settled"
