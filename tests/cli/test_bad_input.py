@@ -142,6 +142,14 @@ CASES = [
      ["stage.mass", "5000 digits", "too large"], "stage: {mass"),
     ("mass-5000-digits-kg", edit("stage: {mass: 1.6 kg}", "stage: {mass: " + "1" * 5000 + " kg}"),
      ["stage.mass", "not a finite number"], "stage: {mass"),
+    # lists too short or too long, in the tool's words; a dimensionless bound without a unit
+    ("empty-family", edit("  duration: 20 s", "  duration: 20 s\n  family: {distances: []}"),
+     ["motion.family.distances", "an empty list", "at least one distance", "null"], "family:"),
+    ("five-filters", edit("  integrator_ratio: 10", "  integrator_ratio: 10\n  filters: ["
+                          + ", ".join(["{type: low_pass, frequency: 300 Hz}"] * 5) + "]"),
+     ["controller.filters", "takes at most 4 filters, got 5"], "filters:"),
+    ("hunting-margin-below-1", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting_margin: 0.5"),
+     ["requirements.hunting_margin", "must be at least 1, got 0.5"], "hunting_margin:"),
     # effects with impossible parameters
     ("effect-negative-delay", BASE + "effects:\n  - {type: time_delay, delay: -1 ms}\n",
      ["effects[0].delay", "at least 0 s", "-0.001"], "type: time_delay"),
@@ -274,7 +282,8 @@ def test_a_spec_without_moves_is_still_told_so(tmp_path, monkeypatch):
     spec.write_text(edit("    - {distance: 10 mm, velocity: 50 mm/s, acceleration: 1 m/s^2}\n",
                          "").replace("moves:", "moves: []"))
     result, out = _run(str(spec), tmp_path)
-    _assert_refused(result, out, tmp_path, ["motion.moves", "at least 1 item"])
+    _assert_refused(result, out, tmp_path, ["motion.moves", "needs at least one move, got none"])
+    assert "Tuple" not in result.stderr and "item" not in result.stderr, result.stderr
 
 
 def test_missing_file(tmp_path):
