@@ -150,6 +150,15 @@ CASES = [
      ["controller.filters", "takes at most 4 filters, got 5"], "filters:"),
     ("hunting-margin-below-1", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting_margin: 0.5"),
      ["requirements.hunting_margin", "must be at least 1, got 0.5"], "hunting_margin:"),
+    # checks across sections name the field the user gave, and its line
+    ("run-shorter-than-window", edit("duration: 20 s", "duration: 1 ms"),
+     ["motion.duration", "hunting window ends at 20 s"], "duration: 1 ms"),
+    ("window-after-run", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting: "
+                                                   "{window_start: 15 s}"),
+     ["requirements.hunting.window_start", "hunting window ends at 25 s"], "window_start:"),
+    ("effect-twice", BASE + "effects: [{type: time_delay, delay: 1 ms}, "
+                            "{type: time_delay, delay: 2 ms}]\n",
+     ["effects", "listed twice"], "effects:"),
     # effects with impossible parameters
     ("effect-negative-delay", BASE + "effects:\n  - {type: time_delay, delay: -1 ms}\n",
      ["effects[0].delay", "at least 0 s", "-0.001"], "type: time_delay"),

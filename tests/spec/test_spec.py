@@ -56,7 +56,7 @@ def test_derived_defaults(paper_spec):
     ({"friction.static": "0.5 N"}, "friction", ["at least the Coulomb"]),
     ({"stage.mass": "-1 kg"}, "stage.mass", ["greater than 0"]),
     ({"friction.statc": "4 N"}, "friction.statc", ["unknown"]),
-    ({"motion.duration": "5 s"}, "", ["hunting window ends"]),
+    ({"motion.duration": "5 s"}, "motion.duration", ["hunting window ends"]),
     ({"isolator.stroke": "3 N"}, "isolator.stroke", ["not a length"]),
 ])
 def test_validation_errors_name_the_field(paper_spec, paths, where, words):
