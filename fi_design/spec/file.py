@@ -15,6 +15,7 @@ and are named here too.
 from __future__ import annotations
 
 import hashlib
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -125,7 +126,16 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
     SpecError
         Not valid YAML, not a mapping, or a value is missing or wrong; the
         message names the field path and line.
+    ArgumentError
+        ``source`` is neither a path nor a mapping (None, a number, a list, bytes).
     """
+    from ..errors import ArgumentError
+
+    if not isinstance(source, (str, os.PathLike, Mapping)):
+        hint = " (write the YAML to a file, or parse it into a mapping)" \
+            if isinstance(source, (bytes, bytearray)) else ""
+        raise ArgumentError(f"source must be a path to a YAML spec or a mapping, got "
+                            f"{type(source).__name__}{hint}")
     if isinstance(source, Mapping):
         raw = plain(source)
         return _validate(raw, SpecOrigin(None, json_sha256(raw), raw))

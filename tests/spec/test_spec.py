@@ -78,6 +78,14 @@ def test_errors_in_a_file_carry_the_line(tmp_path):
     assert str(err.value).startswith(f"{path}:{line}: friction.static:")
 
 
+def test_numpy_numbers_in_a_mapping_read_as_numbers(paper_spec):
+    """np.float64 was read and np.int64 refused ("got int64")."""
+    import numpy as np
+
+    spec = variant(paper_spec, **{"stage.mass": np.int64(2), "cart.mass": np.float64(0.5)})
+    assert spec.stage.mass == 2.0 and spec.cart.mass == 0.5
+
+
 def test_file_and_mapping_give_the_same_spec(paper_spec, paper_spec_path):
     org = origin(paper_spec)
     assert org.path == paper_spec_path
