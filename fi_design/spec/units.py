@@ -58,9 +58,10 @@ KNOWN_UNITS = {
 }
 
 #: Plausible magnitudes (SI) of a nonzero mass, force, stiffness and damping, ``(least,
-#: most)``: far beyond any positioning stage (a milligram to a thousand tonnes); a value outside
-#: is a slip of unit or exponent, and the analysis's matrices overflow on it (1e300 kg).
-PLAUSIBLE = {"kg": (1e-6, 1e6), "N": (0.0, 1e9), "N/m": (1e-6, 1e15), "N*s/m": (1e-9, 1e12)}
+#: most)``: far beyond any positioning stage (a milligram to a thousand tonnes; 1e12 N is a
+#: force limit never reached); a value outside is a slip of unit or exponent, and the
+#: analysis's matrices overflow on it (1e300 kg).
+PLAUSIBLE = {"kg": (1e-6, 1e6), "N": (0.0, 1e15), "N/m": (1e-6, 1e15), "N*s/m": (1e-9, 1e15)}
 
 _DB = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*dB\s*$")
 #: A comma between digits: a decimal comma ("1,25 kg") or a thousands separator ("6,667 N/m").
@@ -117,10 +118,10 @@ def _plausible(x: float, unit: str, path: str | None, text) -> float:
     least, most = PLAUSIBLE.get(unit, (0.0, math.inf))
     if x != 0 and not least <= abs(x) <= most:
         shown = _cut(text) if isinstance(text, str) else repr(float(text))
-        span = (f"{quantity(least, unit)} to {quantity(most, unit)}" if least > 0 else
-                f"up to {quantity(most, unit)}")
-        raise UnitError(f"{shown} is not a plausible {KNOWN_UNITS[unit]}: a nonzero one lies "
-                        f"within {span}; check its unit and exponent", path=path)
+        span = (f"lies within {quantity(least, unit)} to {quantity(most, unit)}" if least > 0
+                else f"is at most {quantity(most, unit)}")
+        raise UnitError(f"{shown} is not a plausible {KNOWN_UNITS[unit]}: a nonzero one {span}; "
+                        "check its unit and exponent", path=path)
     return x
 
 
