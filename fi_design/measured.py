@@ -255,7 +255,7 @@ def _checked(arrays: dict, source: str | None) -> Measurement:
             continue
         bad = np.nonzero(~np.isfinite(arr))[0]
         if len(bad):
-            raise DataError(f"value {arr[bad[0]]!r} is not a finite number", column=name,
+            raise DataError(f"value {float(arr[bad[0]])!r} is not a finite number", column=name,
                             row=int(bad[0]) + 1, source=source)
         limit = PLAUSIBLE.get(name)
         if limit is not None:
@@ -440,7 +440,7 @@ def _number(cell: str, column: str, row: int, source: str) -> float:
         if text.lower() in ("nan", "inf", "+inf", "-inf", "infinity", "-infinity"):
             raise DataError(f"value {text!r} is not a finite number", column=column, row=row,
                             source=source)
-        if re.match(r"^[+-]?[\d.]+([eE][+-]?\d+)?\s*[A-Za-z]", text):
+        if re.match(r"^[+-]?[\d.]+([eE][+-]?\d+)?\s*[A-Za-zµ](?:[^\d^]|\^-?\d)*$", text):  # not 0x10
             raise DataError(f"value {text!r} carries a unit: write plain SI numbers "
                             f"({UNITS[column]})", column=column, row=row, source=source)
         raise DataError(f"value {text!r} is not a number", column=column, row=row, source=source)

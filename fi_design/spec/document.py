@@ -110,8 +110,11 @@ class Spec(StrictModel):
         h = self.requirements.hunting
         end = h.window_start + h.window_length
         if end > self.motion.duration * (1 + 1e-9):
-            raise ValueError(f"the hunting window ends at {quantity(end, 's', 6)}, after "
-                             f"motion.duration = {quantity(self.motion.duration, 's', 6)}")
+            # name the value the user gave: the window's start or length, else the duration
+            given = [k for k in ("window_start", "window_length") if k in h.model_fields_set]
+            where = f"requirements.hunting.{given[0]}" if given else "motion.duration"
+            raise ValueError(f"{where}: the hunting window ends at {quantity(end, 's', 6)}, "
+                             f"after motion.duration = {quantity(self.motion.duration, 's', 6)}")
         rate = self.simulation.output_rate
         samples = math.floor(self.motion.duration * rate + 1e-9) + 1
         if samples > MAX_OUTPUT_SAMPLES:
@@ -125,9 +128,9 @@ class Spec(StrictModel):
         names = [e.type for e in self.effects]
         dupes = sorted({n for n in names if names.count(n) > 1})
         if dupes:
-            raise ValueError(f"effect listed twice: {', '.join(dupes)}")
+            raise ValueError(f"effects: effect listed twice: {', '.join(dupes)}")
         if "joint_damping" in names and self.isolator is None:
-            raise ValueError("effect joint_damping needs an isolator")
+            raise ValueError("effects: effect joint_damping needs an isolator")
         flex = self.isolator.flexure if self.isolator is not None else None
         if flex is not None and self.stage.size is None and self.stage.inertia is not None:
             if flex.spacing is None:

@@ -190,6 +190,13 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
                  "less_than": "less than", "less_than_equal": "at most"}[kind]
         shown = f" {unit}" if unit not in ("", "1") else ""
         return path, f"must be {words} {number(bound, 6)}{shown}, got {_shown(err['input'])}"
+    if kind in ("too_short", "too_long"):
+        ctx = err.get("ctx") or {}
+        given = ctx.get("actual_length")
+        if kind == "too_short":
+            return path, (f"needs at least {_items(ctx.get('min_length'), loc)}, got "
+                          f"{given or 'none'}")
+        return path, f"takes at most {_items(ctx.get('max_length'), loc)}, got {given}"
     if kind in ("finite_number",):
         return path, "must be a finite number"
     if isinstance(err.get("input"), int) and len(str(abs(err["input"]))) > 300:
@@ -203,6 +210,13 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
         return path, (f"expected a mapping{' with keys ' + keys if keys else ''}, got "
                       f"{_shown(err['input'])}")
     return path, msg
+
+
+def _items(count: Any, loc: tuple) -> str:
+    """``count`` entries of the list at ``loc`` in words: ``one move``, ``4 filters``."""
+    key = next((str(p) for p in reversed(loc) if isinstance(p, str)), "")
+    item = key[:-1].replace("_", " ") if key.endswith("s") else "value"
+    return f"one {item}" if count == 1 else f"{count} {item}s"
 
 
 def _shown(value: Any) -> str:
@@ -227,10 +241,13 @@ _NAMED = re.compile(r"^([A-Za-z_][A-Za-z0-9_.\[\]=]*): (.+)$", re.S)
 
 
 def _unit_at(loc: tuple, raw: Any = None) -> str:
+    """The unit of the field at ``loc`` as its description states it (``[N/m]``); empty for
+    none and for a dimensionless field (``[-]``), whose bounds are plain numbers."""
     model = _model_at(loc, raw)
     if model is None or not loc or loc[-1] not in model.model_fields:
         return ""
     desc = model.model_fields[loc[-1]].description or ""
     if "[" in desc and "]" in desc:
-        return desc[desc.rindex("[") + 1: desc.rindex("]")]
+        unit = desc[desc.rindex("[") + 1: desc.rindex("]")]
+        return "" if unit in ("-", "1") else unit
     return ""

@@ -15,6 +15,7 @@ and are named here too.
 from __future__ import annotations
 
 import hashlib
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -125,7 +126,16 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
     SpecError
         Not valid YAML, not a mapping, or a value is missing or wrong; the
         message names the field path and line.
+    ArgumentError
+        ``source`` is neither a path nor a mapping (None, a number, a list, bytes).
     """
+    from ..errors import ArgumentError
+
+    if not isinstance(source, (str, os.PathLike, Mapping)):
+        hint = " (write the YAML to a file, or parse it into a mapping)" \
+            if isinstance(source, (bytes, bytearray)) else ""
+        raise ArgumentError(f"source must be a path to a YAML spec or a mapping, got "
+                            f"{type(source).__name__}{hint}")
     if isinstance(source, Mapping):
         raw = plain(source)
         return _validate(raw, SpecOrigin(None, json_sha256(raw), raw))
@@ -333,6 +343,33 @@ def _check_nodes(node, loc: tuple, source: str, seen: set | None = None) -> None
     elif isinstance(node, SequenceNode):
         for i, item in enumerate(node.value):
             _check_nodes(item, loc + (i,), source, seen)
+    elif isinstance(node, ScalarNode):
+        _check_scalar(node, loc, source)
+
+
+#: Most digits of an integer read from a spec: a float holds up to about 1.8e308.
+MAX_DIGITS = 400
+
+
+def _check_scalar(node, loc: tuple, source: str) -> None:
+    """Refuse a scalar that YAML cannot construct: a date that is no date (``2026-13-45``), an
+    integer of more digits than Python turns into a number (:data:`MAX_DIGITS`)."""
+    from ruamel.yaml.constructor import RoundTripConstructor
+
+    tag = str(node.tag)
+    line = node.start_mark.line + 1
+    if tag == "tag:yaml.org,2002:timestamp":
+        try:
+            RoundTripConstructor().construct_yaml_timestamp(node)
+        except ValueError as exc:
+            raise SpecError(f"{node.value!r} is not a valid date ({exc}); write YYYY-MM-DD",
+                            path=dotted(loc) or None, line=line, source=source) from None
+    elif tag == "tag:yaml.org,2002:int":
+        digits = sum(c.isdigit() for c in node.value)
+        if digits > MAX_DIGITS:
+            raise SpecError(f"the number {node.value[:12]}... ({digits} digits) is too large for "
+                            "a physical value", path=dotted(loc) or None, line=line,
+                            source=source)
 
 
 def plain(obj: Any) -> Any:

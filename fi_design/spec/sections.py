@@ -7,7 +7,7 @@ import datetime
 import math
 from typing import Any, Literal, Union
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from ..display import quantity
 from ..trajectory import profile_duration
@@ -373,6 +373,14 @@ class Family(StrictModel):
     directions: Literal["auto", "both", "positive"] = Field(
         "auto", description="Move directions: both, positive only, or auto (both when the "
                             "friction or the loads are not symmetric). Default auto.")
+
+    @field_validator("distances")
+    @classmethod
+    def _not_empty(cls, distances: tuple[float, ...] | None) -> tuple[float, ...] | None:
+        if distances is not None and not distances:
+            raise ValueError("an empty list judges no move of the family: give at least one "
+                             "distance, or null (or leave the key out) for log-spaced ones")
+        return distances
 
     @model_validator(mode="after")
     def _sane(self) -> "Family":

@@ -15,14 +15,23 @@ Three kinds of quantity need care:
   radians, bare or with a unit.
 - Gain ratios given in decibels (``"6 dB"``) are stored in dB; a bare number is
   refused for the same reason.
+
+A string is one number followed by its unit (``"1e6 N/m"``, ``"2 1/s"``,
+``"1 m/s^2"``): pint reads only the unit, never an expression (``"2 kg * 2"``,
+``"9**9**9 kg"`` are refused). Masses, forces, stiffnesses and dampings must
+lie within :data:`PLAUSIBLE`.
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 import re
+import sys
+import tokenize
 from functools import lru_cache
 
+from ..display import quantity
 from ..errors import ArgumentError, UnitError
 
 #: Target units understood by :func:`to_si`, with the dimension users see in messages.
@@ -48,11 +57,24 @@ KNOWN_UNITS = {
     "N/A": "motor force constant (force per current)",
 }
 
+#: Plausible magnitudes (SI) of a nonzero mass, force, stiffness and damping, ``(least,
+#: most)``: far beyond any positioning stage (a milligram to a thousand tonnes; 1e12 N is a
+#: force limit never reached); a value outside is a slip of unit or exponent, and the
+#: analysis's matrices overflow on it (1e300 kg).
+PLAUSIBLE = {"kg": (1e-6, 1e6), "N": (0.0, 1e15), "N/m": (1e-6, 1e15), "N*s/m": (1e-9, 1e15)}
+
 _DB = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*dB\s*$")
 #: A comma between digits: a decimal comma ("1,25 kg") or a thousands separator ("6,667 N/m").
 _COMMA = re.compile(r"\d\s*,\s*\d")
 #: Two numbers side by side ("3 5 N"), which pint multiplies; "2 1/s" (a reciprocal unit) is fine.
 _TWO_NUMBERS = re.compile(r"(?:\d|\d\.)\s+[-+]?\.?\d(?![\d.eE+-]*\s*/)")
+#: A quantity as written: one number, then its unit (possibly none).
+_QUANTITY = re.compile(r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*)", re.S)
+#: nan or inf as YAML or Python write them (``.nan``, ``-inf``, ``Infinity``), a unit or not.
+_NOT_FINITE = re.compile(r"[-+]?\.?(?:nan|inf(?:inity)?)(?![A-Za-z])", re.I)
+#: The digits a unit may hold: a unit's power (``m/s^2``, ``s**-1``, not ``9**9``) and a
+#: reciprocal's 1 (``1/s``).
+_UNIT_DIGITS = re.compile(r"(?:(?<=[^\W\d_])|(?<=\)))(?:\^|\*\*)[-+]?\d(?![\d.])|^1\s*/")
 
 
 @lru_cache(maxsize=1)
@@ -72,13 +94,35 @@ def registry():
 
 
 def _is_number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
+    """A real number: Python's or numpy's (``np.int64``, ``np.float32``), not a bool."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)  # np.bool_ is no Real
+
+
+def _cut(text: str) -> str:
+    """Text read from the spec, quoted for a message and cut to about 40 characters."""
+    text = repr(text)
+    return text if len(text) <= 40 else text[:28] + "..." + text[-8:]
 
 
 def _finite(x: float, path: str | None, text) -> float:
     if not math.isfinite(x):
-        raise UnitError(f"value {text!r} is not a finite number", path=path)
+        shown = _cut(text) if isinstance(text, str) else repr(float(text))
+        overflow = isinstance(text, str) and not _NOT_FINITE.match(text.strip())
+        raise UnitError(f"value {shown} is not a finite number"
+                        + (" (too large to hold)" if overflow else ""), path=path)
     return float(x)
+
+
+def _plausible(x: float, unit: str, path: str | None, text) -> float:
+    """``x``, refused when it lies outside :data:`PLAUSIBLE` (zero is always plausible)."""
+    least, most = PLAUSIBLE.get(unit, (0.0, math.inf))
+    if x != 0 and not least <= abs(x) <= most:
+        shown = _cut(text) if isinstance(text, str) else repr(float(text))
+        span = (f"lies within {quantity(least, unit)} to {quantity(most, unit)}" if least > 0
+                else f"is at most {quantity(most, unit)}")
+        raise UnitError(f"{shown} is not a plausible {KNOWN_UNITS[unit]}: a nonzero one {span}; "
+                        "check its unit and exponent", path=path)
+    return x
 
 
 def to_si(value, unit: str, path: str | None = None) -> float:
@@ -87,7 +131,8 @@ def to_si(value, unit: str, path: str | None = None) -> float:
     Parameters
     ----------
     value : float, int or str
-        A bare number (taken as already in ``unit``) or a string with units.
+        A bare number (taken as already in ``unit``; numpy's numbers too) or a
+        string of one number and its unit (``"0.3 mm"``, ``"1e6 N/m"``).
     unit : str
         Target unit, one of :data:`KNOWN_UNITS`.
     path : str, optional
@@ -101,22 +146,23 @@ def to_si(value, unit: str, path: str | None = None) -> float:
     Raises
     ------
     UnitError
-        Unparsable text, wrong dimension, not finite, or a bare number where a
-        unit is required (angles, decibels).
+        Unparsable text, no number or more than one (an expression), wrong
+        dimension, not finite, outside :data:`PLAUSIBLE`, or a bare number
+        where a unit is required (angles, decibels).
     """
     if unit not in KNOWN_UNITS:  # programming error, not user input
         raise ArgumentError(f"unknown target unit {unit!r}")
     if _is_number(value):
-        if isinstance(value, int) and abs(value) > 2 ** 1023:
-            raise UnitError(f"the number {str(value)[:12]}... ({len(str(abs(value)))} digits) is too "
-                            "large for a physical value", path=path)
+        if isinstance(value, numbers.Integral) and abs(int(value)) > 2 ** 1023:
+            raise UnitError(f"the number {_digits(int(value))} is too large for a physical value",
+                            path=path)
         if unit == "deg":
             raise UnitError(f"a bare number is ambiguous for an angle; write e.g. '{value} deg'",
                             path=path)
         if unit == "dB":
             raise UnitError(f"a bare number is ambiguous for a gain; write e.g. '{value} dB'",
                             path=path)
-        return _finite(float(value), path, value)
+        return _plausible(_finite(float(value), path, value), unit, path, value)
     if not isinstance(value, str):
         raise UnitError(f"expected a number or a string with units, got {type(value).__name__}",
                         path=path)
@@ -129,7 +175,16 @@ def to_si(value, unit: str, path: str | None = None) -> float:
         if not m:
             raise UnitError(f"cannot read {value!r} as a gain in dB (write e.g. '6 dB')", path=path)
         return _finite(float(m.group(1)), path, value)
-    return _finite(_convert(text, unit, path), path, value)
+    return _plausible(_finite(_convert(text, unit, path), path, value), unit, path, value)
+
+
+def _digits(value: int) -> str:
+    """A huge integer for a message: its first digits and how many it has."""
+    try:
+        text = str(abs(value))
+    except ValueError:  # beyond Python's limit of digits for str()
+        return f"of more than {sys.get_int_max_str_digits()} digits"
+    return f"{text[:12]}... ({len(text)} digits)"
 
 
 def _refuse_misread(text: str, path: str | None) -> None:
@@ -165,11 +220,13 @@ def _quantity(text: str, unit: str, path: str | None) -> float:
     import pint
 
     ureg = registry()
+    magnitude, unit_text = _number_and_unit(text, unit, path)
     try:
-        q = ureg.Quantity(text)
+        q = ureg.Quantity(magnitude, unit_text)
     except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError,
-            AssertionError, KeyError, ZeroDivisionError) as exc:
-        raise UnitError(f"cannot read {text!r} as a quantity in {unit} ({exc})", path=path) from None
+            AssertionError, KeyError, ZeroDivisionError, tokenize.TokenError) as exc:
+        raise UnitError(f"cannot read {_cut(text)} as a quantity in {unit} ({exc})",
+                        path=path) from None
     if unit == "1":
         if not q.dimensionless:
             raise UnitError(f"{text!r} has units of {q.dimensionality}, expected a plain number",
@@ -187,6 +244,45 @@ def _quantity(text: str, unit: str, path: str | None) -> float:
     except pint.errors.DimensionalityError:
         raise UnitError(f"{text!r} is not a {KNOWN_UNITS[unit]} (expected units convertible to {unit},"
                         f" got {q.dimensionality})", path=path) from None
+
+
+def _number_and_unit(text: str, unit: str, path: str | None) -> tuple[float, str]:
+    """The number and the unit of a quantity as written: ``"1e6 N/m"`` is ``(1e6, "N/m")``.
+
+    Only the unit goes to pint, so an expression (``"2 kg * 2"``, ``"9**9**9 kg"``) is never
+    evaluated: the unit may hold digits only in a power (``m/s^2``, ``s**-1``) and as the
+    1 of a reciprocal (``1/s``).
+
+    Raises
+    ------
+    UnitError
+        No number (``"kg"``), nan or inf, or more than one number.
+    """
+    m = _QUANTITY.fullmatch(text)
+    if m is None:
+        if _NOT_FINITE.match(text):
+            raise UnitError(f"value {_cut(text)} is not a finite number", path=path)
+        if _is_unit(text):
+            raise UnitError(f"{_cut(text)} needs a number before its unit, e.g. '1 {text}'",
+                            path=path)
+        raise UnitError(f"cannot read {_cut(text)} as a quantity in {unit}: write a number and "
+                        "its unit", path=path)
+    number, unit_text = m.groups()
+    if re.search(r"\d", _UNIT_DIGITS.sub("", unit_text)):
+        raise UnitError(f"cannot read {_cut(text)}: write one number followed by its unit (e.g. "
+                        "'2 kg', '1e6 N/m'); arithmetic on numbers is not read", path=path)
+    return float(number), unit_text
+
+
+def _is_unit(text: str) -> bool:
+    """True if ``text`` is a unit that pint knows, without a number (``"kg"``, ``"mm/s"``)."""
+    if re.search(r"\d", _UNIT_DIGITS.sub("", text)):
+        return False
+    try:
+        registry().parse_units(text)
+    except Exception:  # noqa: BLE001  (pint raises assorted errors on odd text)
+        return False
+    return True
 
 
 def from_si(value: float, unit: str, shown: str) -> float:

@@ -125,6 +125,40 @@ CASES = [
      ["isolator.stiffness", "'6,667 N/m'", "comma"], "6,667"),
     ("space-in-number", edit("static: 4 N", 'static: "3 5 N"'),
      ["friction.static", "'3 5 N'", "two numbers"], "static:"),
+    # a value is one number and its unit, never an expression; absurd values are refused
+    ("mass-without-number", edit("stage: {mass: 1.6 kg}", "stage: {mass: kg}"),
+     ["stage.mass", "'kg' needs a number"], "stage: {mass"),
+    ("mass-expression", edit("stage: {mass: 1.6 kg}", "stage: {mass: 2 kg * 2}"),
+     ["stage.mass", "one number followed by its unit"], "stage: {mass"),
+    ("mass-power-tower", edit("stage: {mass: 1.6 kg}", 'stage: {mass: "9**9**9 kg"}'),
+     ["stage.mass", "one number followed by its unit"], "stage: {mass"),
+    ("mass-absurd", edit("stage: {mass: 1.6 kg}", "stage: {mass: 1e300 kg}"),
+     ["stage.mass", "not a plausible mass"], "stage: {mass"),
+    ("mass-tiny", edit("stage: {mass: 1.6 kg}", "stage: {mass: 1e-300 kg}"),
+     ["stage.mass", "not a plausible mass"], "stage: {mass"),
+    ("bristle-stiffness-absurd", edit("bristle_stiffness: 1e6 N/m", "bristle_stiffness: 1e300 N/m"),
+     ["friction.bristle_stiffness", "not a plausible stiffness"], "bristle_stiffness:"),
+    ("mass-5000-digits", edit("stage: {mass: 1.6 kg}", "stage: {mass: " + "1" * 5000 + "}"),
+     ["stage.mass", "5000 digits", "too large"], "stage: {mass"),
+    ("mass-5000-digits-kg", edit("stage: {mass: 1.6 kg}", "stage: {mass: " + "1" * 5000 + " kg}"),
+     ["stage.mass", "not a finite number"], "stage: {mass"),
+    # lists too short or too long, in the tool's words; a dimensionless bound without a unit
+    ("empty-family", edit("  duration: 20 s", "  duration: 20 s\n  family: {distances: []}"),
+     ["motion.family.distances", "an empty list", "at least one distance", "null"], "family:"),
+    ("five-filters", edit("  integrator_ratio: 10", "  integrator_ratio: 10\n  filters: ["
+                          + ", ".join(["{type: low_pass, frequency: 300 Hz}"] * 5) + "]"),
+     ["controller.filters", "takes at most 4 filters, got 5"], "filters:"),
+    ("hunting-margin-below-1", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting_margin: 0.5"),
+     ["requirements.hunting_margin", "must be at least 1, got 0.5"], "hunting_margin:"),
+    # checks across sections name the field the user gave, and its line
+    ("run-shorter-than-window", edit("duration: 20 s", "duration: 1 ms"),
+     ["motion.duration", "hunting window ends at 20 s"], "duration: 1 ms"),
+    ("window-after-run", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting: "
+                                                   "{window_start: 15 s}"),
+     ["requirements.hunting.window_start", "hunting window ends at 25 s"], "window_start:"),
+    ("effect-twice", BASE + "effects: [{type: time_delay, delay: 1 ms}, "
+                            "{type: time_delay, delay: 2 ms}]\n",
+     ["effects", "listed twice"], "effects:"),
     # effects with impossible parameters
     ("effect-negative-delay", BASE + "effects:\n  - {type: time_delay, delay: -1 ms}\n",
      ["effects[0].delay", "at least 0 s", "-0.001"], "type: time_delay"),
@@ -188,6 +222,10 @@ CASES = [
      ["stage.mass", "too large"], "stage: {mass"),
     ("huge-integer-ratio", edit("derivative_ratio: 3", "derivative_ratio: " + "9" * 401),
      ["controller.derivative_ratio", "401 digits", "too large"], "derivative_ratio:"),
+    ("impossible-date", edit("date: 2026-01-15", "date: 2026-13-45"),
+     ["report.revisions[0].date", "'2026-13-45' is not a valid date", "month"], "date: 2026-13-45"),
+    ("thirtieth-of-february", edit("date: 2026-01-15", "date: 2026-02-30"),
+     ["report.revisions[0].date", "not a valid date"], "date: 2026-02-30"),
     # text that reaches the report
     ("nul-escape-in-text", edit("author: A. Engineer ", 'approved_by: "X\\u0000Y"\n  author: '
                                                         'A. Engineer '),
@@ -253,7 +291,8 @@ def test_a_spec_without_moves_is_still_told_so(tmp_path, monkeypatch):
     spec.write_text(edit("    - {distance: 10 mm, velocity: 50 mm/s, acceleration: 1 m/s^2}\n",
                          "").replace("moves:", "moves: []"))
     result, out = _run(str(spec), tmp_path)
-    _assert_refused(result, out, tmp_path, ["motion.moves", "at least 1 item"])
+    _assert_refused(result, out, tmp_path, ["motion.moves", "needs at least one move, got none"])
+    assert "Tuple" not in result.stderr and "item" not in result.stderr, result.stderr
 
 
 def test_missing_file(tmp_path):

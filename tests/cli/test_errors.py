@@ -77,6 +77,12 @@ def _calls():
          ArgumentError, ["duration", "output samples", "at most 4000000"]),
         ("simulate-spec-none", lambda s, m: fi_design.simulate(None),
          ArgumentError, ["spec must be a Spec", "NoneType"]),
+        ("load-spec-none", lambda s, m: fi_design.load_spec(None),
+         ArgumentError, ["source must be a path to a YAML spec or a mapping", "NoneType"]),
+        ("load-spec-number", lambda s, m: fi_design.load_spec(5), ArgumentError, ["got int"]),
+        ("load-spec-list", lambda s, m: fi_design.load_spec([1, 2]), ArgumentError, ["got list"]),
+        ("load-spec-bytes", lambda s, m: fi_design.load_spec(b"name: x"),
+         ArgumentError, ["got bytes", "write the YAML to a file"]),
         ("replay-window-picoseconds", lambda s, m: fi_design.simulate(
             s, record=m, drive="force", window=1e-12),
          ArgumentError, ["window = 1\u00a0×\u00a010⁻¹² s", "fewer than 10 samples"]),

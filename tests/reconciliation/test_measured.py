@@ -95,6 +95,25 @@ def test_bad_files_name_column_and_row(tmp_path, text, column, row, words):
     assert "trace.csv" in str(err)
 
 
+@pytest.mark.parametrize("cell,words", [
+    ("nan", "value nan is not a finite number"), ("-inf", "value -inf is not a finite number"),
+    ("0x10", "value '0x10' is not a number"), ("1e3x", "value '1e3x' carries a unit"),
+    ("2 m/s^2", "value '2 m/s^2' carries a unit"),
+])
+def test_a_bad_cell_is_said_in_plain_words(tmp_path, cell, words):
+    """Numpy's repr (np.float64(nan)) and a hexadecimal number read as "carries a unit" were
+    the messages."""
+    lines = [HEADER] + _rows()[:4] + [f"0.004,{cell},0,0,0"] + _rows()[5:]
+    with pytest.raises(DataError) as err:
+        load_measurement(_write(tmp_path, "\n".join(lines) + "\n"))
+    assert words in str(err.value) and "np." not in str(err.value), str(err.value)
+    assert err.value.column == "reference_m" and err.value.row == 5
+    if cell in ("nan", "-inf"):  # arrays are checked alike
+        with pytest.raises(DataError, match=f"value {cell} is not"):
+            reference = np.r_[np.zeros(4), float(cell), np.zeros(25)]
+            measurement_from_arrays(np.arange(30) * 1e-3, reference, np.zeros(30))
+
+
 def test_missing_file_and_directory(tmp_path):
     with pytest.raises(DataError, match="no such file"):
         load_measurement(tmp_path / "nope.csv")

@@ -56,7 +56,7 @@ def test_derived_defaults(paper_spec):
     ({"friction.static": "0.5 N"}, "friction", ["at least the Coulomb"]),
     ({"stage.mass": "-1 kg"}, "stage.mass", ["greater than 0"]),
     ({"friction.statc": "4 N"}, "friction.statc", ["unknown"]),
-    ({"motion.duration": "5 s"}, "", ["hunting window ends"]),
+    ({"motion.duration": "5 s"}, "motion.duration", ["hunting window ends"]),
     ({"isolator.stroke": "3 N"}, "isolator.stroke", ["not a length"]),
 ])
 def test_validation_errors_name_the_field(paper_spec, paths, where, words):
@@ -76,6 +76,14 @@ def test_errors_in_a_file_carry_the_line(tmp_path):
         load_spec(path)
     assert err.value.line == line and err.value.path == "friction.static"
     assert str(err.value).startswith(f"{path}:{line}: friction.static:")
+
+
+def test_numpy_numbers_in_a_mapping_read_as_numbers(paper_spec):
+    """np.float64 was read and np.int64 refused ("got int64")."""
+    import numpy as np
+
+    spec = variant(paper_spec, **{"stage.mass": np.int64(2), "cart.mass": np.float64(0.5)})
+    assert spec.stage.mass == 2.0 and spec.cart.mass == 0.5
 
 
 def test_file_and_mapping_give_the_same_spec(paper_spec, paper_spec_path):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
@@ -89,3 +90,45 @@ def test_unknown_target_unit_is_a_programming_error():
 def test_lengths_scale_by_their_prefix(x, prefix):
     unit, factor = prefix
     assert to_si(f"{x!r} {unit}", "m") == pytest.approx(x * factor, rel=1e-12, abs=1e-300)
+
+
+@pytest.mark.parametrize("value,unit,expected", [
+    # the forms examples/ and docs/ write, read as before
+    ("1e6 N/m", "N/m", 1e6), ("1.371e6 N/m", "N/m", 1.371e6), ("0 N/(m*s)", "N/(m*s)", 0.0),
+    ("0.5 m/s^2", "m/s**2", 0.5), ("7800 kg/m^3", "kg/m**3", 7800.0), ("20 %", "1", 0.2),
+    ("10%", "1", 0.1), ("1e-6", "1", 1e-6), ("-0.2 N", "N", -0.2), ("-3 dB", "dB", -3.0),
+    ("50.26 rad/s", "Hz", 50.26 / (2 * math.pi)), ("2 s^-1", "Hz", 2.0), ("2Hz", "Hz", 2.0),
+    ("4 (m/s)^2/m", "m/s**2", 4.0),
+    # numpy's numbers as Python's
+    (np.int64(2), "kg", 2.0), (np.float32(1.5), "kg", 1.5), (np.float64(1.6), "kg", 1.6),
+])
+def test_one_number_and_its_unit_reads(value, unit, expected):
+    assert to_si(value, unit) == pytest.approx(expected, rel=1e-6)
+
+
+@pytest.mark.parametrize("value,unit,words", [
+    # pint evaluated these as expressions: 1 kg, 1 kg, 4 kg, a hang, a number of 302 digits
+    ("kg", "kg", ["'kg' needs a number", "'1 kg'"]),
+    ("kg kg/kg", "kg", ["needs a number"]), ("mm/s", "m/s", ["needs a number"]),
+    ("2 kg * 2", "kg", ["'2 kg * 2'", "one number followed by its unit"]),
+    ("9**9**9 kg", "kg", ["one number followed by its unit"]),
+    ("2**1000 kg", "kg", ["one number followed by its unit"]),
+    ("2 kg^9^9", "kg", ["one number followed by its unit"]),
+    # not finite, or overflowing: refused as such
+    (".nan", "kg", ["'.nan' is not a finite number"]), ("-.inf", "kg", ["not a finite number"]),
+    ("1e400 kg", "kg", ["not a finite number", "too large"]),
+    ("1" * 5000 + " kg", "kg", ["not a finite number", "too large", "..."]),
+    # finite but absurd: the analysis overflowed on these
+    ("1e300 kg", "kg", ["not a plausible mass"]), ("1e-300 kg", "kg", ["not a plausible mass"]),
+    (1e300, "kg", ["not a plausible mass"]), ("1e300 N/m", "N/m", ["not a plausible stiffness"]),
+    ("1e-300 N*s/m", "N*s/m", ["not a plausible damping"]),
+    ("1e300 N", "N", ["not a plausible force"]),
+    (np.bool_(True), "kg", ["got bool"]),
+])
+def test_a_value_is_one_number_and_its_unit(value, unit, words):
+    with pytest.raises(UnitError) as err:
+        to_si(value, unit, path="stage.mass")
+    assert err.value.path == "stage.mass"
+    for w in words:
+        assert w in str(err.value), str(err.value)
+    assert len(str(err.value)) < 300
