@@ -526,7 +526,8 @@ def check_outputs(inputs: tuple[Path, ...], force: bool, **paths: Any) -> dict:
     force : bool
         ``--force``.
     **paths : (path or None, extensions)
-        The outputs by name.
+        The outputs by name (``json``, ``report``, ``spec`` ...), named in a
+        message by their option (:data:`OUTPUT_OPTIONS`).
 
     Returns
     -------
@@ -535,7 +536,14 @@ def check_outputs(inputs: tuple[Path, ...], force: bool, **paths: Any) -> dict:
     """
     from ..output import check_outputs as check
 
-    return check(inputs, force=force, **paths)
+    flags = {name: OUTPUT_OPTIONS.get(name, name) for name in paths}
+    checked = check(inputs, force=force, **{flags[name]: p for name, p in paths.items()})
+    return {name: checked[flags[name]] for name in paths}
+
+
+#: The option of each output a command's :func:`check_outputs` names.
+OUTPUT_OPTIONS = {"json": "--json", "report": "--report", "spec": "--write-spec",
+                  "fixed": "--write-spec", "csv": "--csv", "figure": "--figure"}
 
 
 def load(spec: Path) -> Any:
