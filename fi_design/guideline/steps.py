@@ -243,7 +243,8 @@ def _gain_margin_check(case, where: str, required: float, step: str) -> Check:
     (:func:`fi_design.loop.linear.analyse` judges ``|gain_margin_db|``): an upper
     margin is held against ``+required``; the lower margin of a stable, conditionally
     stable loop against ``-required`` (it must lie at or below it, shown ``≤``); the
-    margin of an unstable loop against ``+required``, which it fails with its sign.
+    margin of an unstable loop, negative (:attr:`~fi_design.results.linear.CaseMargins.gain_margin_db`),
+    against ``+required``, which it fails.
     """
     gm = case.gain_margin_db
     limit = required
