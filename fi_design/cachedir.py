@@ -28,11 +28,49 @@ def cache_dir(kind: str) -> Path:
 
 
 def opened(kind: type, cache: Any) -> Any:
-    """The cache a computation was asked to use: ``cache`` itself when it is a ``kind``,
-    None for None or False, ``kind()`` (its default folder) for True, else ``kind(cache)``
-    (a folder's path)."""
+    """The cache a computation was asked to use.
+
+    Parameters
+    ----------
+    kind : type
+        The cache's class (``PointCache``, ``SearchStore``): built from a
+        folder's path, or without one for its default folder, and holding it
+        as ``directory``.
+    cache : kind, bool, str, os.PathLike or None
+        ``cache`` itself when it is a ``kind``; None or False for none; True
+        for the default folder; a folder's path (created when missing).
+
+    Returns
+    -------
+    kind or None
+
+    Raises
+    ------
+    fi_design.errors.ArgumentError
+        ``cache`` is none of these, or a path to a file (or into one), not a folder.
+    """
+    from .errors import ArgumentError
+
     if cache is None or cache is False:
         return None
     if isinstance(cache, kind):
         return cache
-    return kind() if cache is True else kind(cache)
+    if cache is True:  # the user's folder: one that cannot be made is the cache's to report
+        return kind()
+    if not isinstance(cache, (str, os.PathLike)):
+        raise ArgumentError(f"cache must be None, True or False, a folder's path or a "
+                            f"{kind.__name__}, got {type(cache).__name__} {cache!r}")
+    blocker = _file_in_the_way(Path(cache))
+    if blocker is not None:
+        raise ArgumentError(f"cache must be a folder (created when missing), but {blocker} is "
+                            "a file")
+    return kind(cache)
+
+
+def _file_in_the_way(folder: Path) -> Path | None:
+    """The file at ``folder`` or at the nearest of its parents that exists; None when that
+    is a folder."""
+    for path in (folder, *folder.parents):
+        if path.exists():
+            return None if path.is_dir() else path
+    return None

@@ -18,7 +18,7 @@ import threading
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
-__all__ = ["Executor", "Future", "chunks", "run_chunks", "Background"]
+__all__ = ["Executor", "Future", "chunks", "run_chunks", "Background", "check_executor"]
 
 
 class Future(Protocol):
@@ -39,6 +39,27 @@ class Executor(Protocol):
 
     def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
         """Schedule ``fn(*args, **kwargs)``."""
+
+
+def check_executor(executor: Any) -> None:
+    """Refuse an ``executor`` argument that is neither None nor an :class:`Executor`.
+
+    Parameters
+    ----------
+    executor : Executor or None
+        What the caller passed.
+
+    Raises
+    ------
+    fi_design.errors.ArgumentError
+        ``executor`` has no callable ``submit``.
+    """
+    if executor is not None and not callable(getattr(executor, "submit", None)):
+        from .errors import ArgumentError
+
+        raise ArgumentError("executor must be None or a concurrent.futures-style executor (a "
+                            "ProcessPoolExecutor, a dask.distributed Client: submit(fn, *args) "
+                            f"returning a future), got {type(executor).__name__} {executor!r}")
 
 
 def chunks(n: int, size: int) -> list[list[int]]:

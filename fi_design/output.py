@@ -159,6 +159,8 @@ def check_outputs(inputs: Iterable[str | os.PathLike], *, force: bool = False,
         Allow overwriting existing files.
     **paths : (path or None, extensions)
         Each output by name, with its allowed extensions; None when not asked.
+        The names are those the error message gives (the command line passes
+        its options', ``"--json"``).
 
     Returns
     -------
@@ -171,14 +173,16 @@ def check_outputs(inputs: Iterable[str | os.PathLike], *, force: bool = False,
         A path is refused, or two outputs name the same file.
     """
     out: dict = {}
-    seen: list[Path] = []
     protect = tuple(inputs)
     for name, (path, exts) in paths.items():
         if path is None:
             out[name] = None
             continue
-        out[name] = check_output(path, force=force, protect=(*protect, *seen), extensions=exts)
-        seen.append(out[name])
+        for other, seen in out.items():
+            if seen is not None and _same_file(Path(path), seen):
+                raise OutputError(f"{path}: {other} and {name} name the same file; give each "
+                                  "output its own file")
+        out[name] = check_output(path, force=force, protect=protect, extensions=exts)
     return out
 
 

@@ -67,7 +67,13 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
     ------
     fi_design.errors.SpecError
         When ``spec`` is a path or mapping that does not validate.
+    fi_design.errors.ArgumentError
+        ``executor`` is no executor, or ``cache`` none of the above (a file's
+        path), before any work.
     """
+    from .recommend.stored import open_store
+
+    store = open_store(cache) if recommend else None  # a bad cache refused before the work
     result = guideline.evaluate(spec, confirm=confirm, executor=executor, progress=progress,
                                 fe_check=fe_check, sensitivity=sensitivity)
     if not (recommend and result.simulation is not None and result.verdict.status == "FAIL"):
@@ -77,5 +83,5 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
 
     if progress is not None:
         progress("searching for a design that passes ...")
-    found = search(result.spec, executor=executor, progress=progress, cache=cache)
+    found = search(result.spec, executor=executor, progress=progress, cache=store)
     return replace(result, recommendation=recommendation(found))

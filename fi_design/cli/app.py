@@ -149,6 +149,7 @@ def design_command(
 
 @app.command("simulate")
 def simulate_command(
+    ctx: typer.Context,
     spec: SpecArg,
     no_isolator: NoIsolator = False,
     csv_out: Optional[Path] = output_option("--csv", "TRACE.csv",
@@ -177,6 +178,10 @@ def simulate_command(
     windows.
     """
     check_drive(drive, record)
+    if drive != "force" and ctx.get_parameter_source("window").name != "DEFAULT":
+        raise typer.BadParameter("only an open-loop replay has windows: give --record "
+                                 "MEASURED.csv --drive force, or leave --window out",
+                                 param_hint="--window")
     if not window > 0:
         raise typer.BadParameter(f"must be a positive time in seconds, got {window!r}",
                                  param_hint="--window")

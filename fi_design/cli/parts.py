@@ -88,7 +88,9 @@ class DefaultCommandGroup(TyperGroup):
     SPEC.yaml --json out.json``; ``fi-design schema`` still runs ``schema``.
     The group's own flags (``--version``, ``--debug``, ``--help``) may come
     first; ``--debug`` is also accepted anywhere before ``--``. A spec file
-    whose name equals a command name can be given as ``./NAME``.
+    whose name equals a command name can be given as ``./NAME``; a first
+    argument that is no file but close to a command's name (``recomend``) is
+    refused as a mistyped command (exit 2), not read as a spec.
 
     The group also translates errors for every command: a
     :class:`~fi_design.errors.FiDesignError` exits 2 with its message, any
@@ -124,6 +126,9 @@ class DefaultCommandGroup(TyperGroup):
             args = ["--debug"] + head + args[end:]
         i = self._skip_group_options(ctx, args)
         if i < len(args) and args[i] != "--" and args[i] not in self.commands:
+            close = close_command(Path(args[i]), list(self.commands))
+            if close:  # a mistyped command, not a spec: its arguments would confuse design's
+                ctx.fail(f"no such command '{args[i]}'; did you mean '{close}'?")
             args.insert(i, self.default_command)
         return super().parse_args(ctx, args)
 
@@ -480,15 +485,35 @@ def check_spec_path(spec: Path) -> None:
     spec : pathlib.Path
         The SPEC.yaml argument as given.
     """
-    if spec.exists() or spec.suffix or os.sep in str(spec):
-        return
-    close = difflib.get_close_matches(str(spec), [c for c in app_commands()
-                                                  if c != DEFAULT_COMMAND], n=1)
+    close = close_command(spec, [c for c in app_commands() if c != DEFAULT_COMMAND])
     if close:
         from ..errors import SpecFileError
 
         raise SpecFileError(f"{spec}: no such spec file, and not a command; "
-                            f"did you mean 'fi-design {close[0]}'?")
+                            f"did you mean 'fi-design {close}'?")
+
+
+def close_command(spec: Path, commands: list[str]) -> str | None:
+    """The command a SPEC.yaml argument is a misspelling of, if it is one.
+
+    Parameters
+    ----------
+    spec : pathlib.Path
+        The argument as given.
+    commands : list of str
+        The command names it may be a misspelling of.
+
+    Returns
+    -------
+    str or None
+        The closest command name (:func:`difflib.get_close_matches`), when the
+        argument is no existing file and has neither an extension nor a folder;
+        else None.
+    """
+    if spec.exists() or spec.suffix or os.sep in str(spec):
+        return None
+    close = difflib.get_close_matches(str(spec), commands, n=1)
+    return close[0] if close else None
 
 
 def check_outputs(inputs: tuple[Path, ...], force: bool, **paths: Any) -> dict:
@@ -501,7 +526,8 @@ def check_outputs(inputs: tuple[Path, ...], force: bool, **paths: Any) -> dict:
     force : bool
         ``--force``.
     **paths : (path or None, extensions)
-        The outputs by name.
+        The outputs by name (``json``, ``report``, ``spec`` ...), named in a
+        message by their option (:data:`OUTPUT_OPTIONS`).
 
     Returns
     -------
@@ -510,7 +536,14 @@ def check_outputs(inputs: tuple[Path, ...], force: bool, **paths: Any) -> dict:
     """
     from ..output import check_outputs as check
 
-    return check(inputs, force=force, **paths)
+    flags = {name: OUTPUT_OPTIONS.get(name, name) for name in paths}
+    checked = check(inputs, force=force, **{flags[name]: p for name, p in paths.items()})
+    return {name: checked[flags[name]] for name in paths}
+
+
+#: The option of each output a command's :func:`check_outputs` names.
+OUTPUT_OPTIONS = {"json": "--json", "report": "--report", "spec": "--write-spec",
+                  "fixed": "--write-spec", "csv": "--csv", "figure": "--figure"}
 
 
 def load(spec: Path) -> Any:

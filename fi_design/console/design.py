@@ -325,7 +325,11 @@ def print_verdict(console: "Console", result) -> None:
     for r in v.reasons:
         body.add_row(status_text(r.severity), Text(r.text))
     rob, mar = result.robustness, result.margins
-    if rob is not None:
+    if rob is not None and rob.hunting_probability is None:
+        body.add_row(Text("Scatter", style="bold"), Text(
+            f"not determined: none of the {rob.samples} samples was simulated to the end, "
+            f"limit {percent(rob.limit)}"))
+    elif rob is not None:
         body.add_row(Text("Scatter", style="bold"), Text(
             f"does not settle in {percent(rob.hunting_probability)} of {rob.valid} samples "
             f"({percent(rob.interval[0])} to {percent(rob.interval[1])} at "

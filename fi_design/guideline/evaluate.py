@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 from ..display import number, quantity
 from ..errors import ArgumentError
-from ..execution import Background
+from ..execution import Background, check_executor
 from ..mechanism.checks import flexure_checks
 from ..model import Model, as_model
 from ..results import Check, Status
@@ -113,13 +113,14 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
         When ``spec`` is a path or mapping that does not validate.
     fi_design.errors.ArgumentError
         A model varied with :meth:`~fi_design.model.Model.at` with the
-        robustness study to run.
+        robustness study to run; an ``executor`` that is none.
     """
     from .. import __version__
     from . import verdict as _verdict
     from ..stage.confirm import confirm as run_confirmation
     from ..stage import positioning, positioning_checks
 
+    check_executor(executor)
     if not isinstance(spec, Model):
         from ..spec.file import as_spec
 

@@ -189,16 +189,7 @@ def step2_crossover(model: Model) -> CrossoverResult:
             msg = f"{where}: phase margin {number(c.phase_margin_deg, 3)} deg{at_f}"
         checks.append(_criterion_check(c, "phase margin", f"phase_margin.{c.name}",
                                        c.phase_margin_deg, req.phase_margin, "deg", msg, step))
-        gm = c.gain_margin_db
-        if math.isinf(gm):
-            msg = f"{where}: the phase never crosses -180 deg, unlimited gain margin"
-        elif gm < 0:
-            msg = (f"{where}: gain margin {number(gm, 3)} dB (a lower margin: the loop goes "
-                   f"unstable if the gain falls {number(abs(gm), 3)} dB)")
-        else:
-            msg = f"{where}: gain margin {number(gm, 3)} dB"
-        checks.append(_criterion_check(c, "gain margin", f"gain_margin.{c.name}", abs(gm),
-                                       req.gain_margin, "dB", msg, step))
+        checks.append(_gain_margin_check(c, where, req.gain_margin, step))
         if req.modulus_margin is not None:
             checks.append(_criterion_check(
                 c, "modulus margin", f"modulus_margin.{c.name}", c.modulus_margin,
@@ -243,6 +234,32 @@ def notch_words(n: NotchSuggestion) -> str:
     if n.achievable is None:
         return head + f"not help: {n.limited_by}"
     return head + f"allow {quantity(n.achievable, 'Hz', 4)} (then limited by {n.limited_by})"
+
+
+def _gain_margin_check(case, where: str, required: float, step: str) -> Check:
+    """The gain-margin check of a limit case, its value the signed margin [dB].
+
+    The requirement is a distance from instability of ``required`` dB either way
+    (:func:`fi_design.loop.linear.analyse` judges ``|gain_margin_db|``): an upper
+    margin is held against ``+required``; the lower margin of a stable, conditionally
+    stable loop against ``-required`` (it must lie at or below it, shown ``≤``); the
+    margin of an unstable loop, negative (:attr:`~fi_design.results.linear.CaseMargins.gain_margin_db`),
+    against ``+required``, which it fails.
+    """
+    gm = case.gain_margin_db
+    limit = required
+    if math.isinf(gm):
+        msg = f"{where}: the phase never crosses -180 deg, unlimited gain margin"
+    elif not case.stable:
+        msg = f"{where}: the closed loop is unstable (gain margin {number(gm, 3)} dB)"
+    elif gm < 0:
+        limit = -required
+        msg = (f"{where}: gain margin {number(gm, 3)} dB (a lower margin: the loop goes "
+               f"unstable if the gain falls {number(abs(gm), 3)} dB)")
+    else:
+        msg = f"{where}: gain margin {number(gm, 3)} dB"
+    return _criterion_check(case, "gain margin", f"gain_margin.{case.name}", gm, limit, "dB",
+                            msg, step)
 
 
 def _criterion_check(case, criterion: str, name: str, value, limit, unit: str, message: str,

@@ -34,6 +34,7 @@ resting within the friction scatter of its end stop, or no simulation.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
@@ -216,10 +217,14 @@ def robustness_as_check(r: RobustnessCheck) -> Check:
     Check
         Named ``robustness``; value and limit as probabilities [-].
     """
-    p = "n/a" if r.hunting_probability is None else _pct(r.hunting_probability)
-    text = (f"the stage as specified does not settle after every move in {p} of {r.valid} "
-            f"scatter samples ({percent(r.confidence, 3)} interval {_pct(r.interval[0])} to "
-            f"{_pct(r.interval[1])}), limit {_pct(r.limit)}")
+    if r.hunting_probability is None:
+        text = (f"no scatter sample was simulated to the end ({r.samples} drawn, none valid): "
+                f"the hunting probability could not be determined, limit {_pct(r.limit)}")
+    else:
+        text = (f"the stage as specified does not settle after every move in "
+                f"{_pct(r.hunting_probability)} of {r.valid} scatter samples "
+                f"({percent(r.confidence, 3)} interval {_pct(r.interval[0])} to "
+                f"{_pct(r.interval[1])}), limit {_pct(r.limit)}")
     return Check("robustness", None if r.status == "WARN" else r.status == "PASS",
                  r.hunting_probability, r.limit, "-", text, "robustness under friction scatter",
                  status=Status(r.status))
@@ -347,7 +352,7 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
             out["static_error"] = max(rest) if rest else 0.0
             out["static_error_bound"] = st.static_error_bound
         land = simulation.landing
-        if model.has_isolator and land is not None:
+        if model.has_isolator and land is not None and math.isfinite(land.deflection):
             out["resting_deflection"] = land.deflection
             out["end_stop_clearance"] = land.stroke - abs(land.deflection)
     if model.has_isolator:

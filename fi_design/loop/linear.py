@@ -505,6 +505,7 @@ def loop_margins(num: Sequence[float], den: Sequence[float], scale: float | None
     if finite.size:
         db = 20.0 * np.log10(finite)
         gain = float(db[int(np.argmin(np.abs(db)))])
+        gain = gain if stable else -abs(gain)  # as the phase margin: no margin when unstable
     else:
         gain = math.inf
     phases = tuple(PhaseCrossing(frequency=float(w * hz), gain_margin_db=float(20 * np.log10(g)))

@@ -397,15 +397,19 @@ def recommend(spec: _spec.Spec | Model | str | Any, *, executor: Any = None,
     ArgumentError
         ``spec`` is not a spec, a model, a path or a mapping, or a model
         varied with :meth:`~fi_design.model.Model.at` (the search varies its
-        spec).
+        spec); ``executor`` is no executor; ``cache`` is none of the above
+        (a file's path, not a folder).
     SpecError
         A path or mapping that does not validate.
     """
+    from ..execution import check_executor
     from ..model import as_model
     from ..spec.file import as_spec
     from .stored import open_store
 
     start = _time.perf_counter()
+    check_executor(executor)
+    store = open_store(cache)
     model = as_model(spec if isinstance(spec, Model) else as_spec(spec))  # the edge: once
     if model.departures:
         from ..errors import ArgumentError
@@ -414,7 +418,6 @@ def recommend(spec: _spec.Spec | Model | str | Any, *, executor: Any = None,
                             "(Model.at), but the search varies the spec: recommend for the "
                             "spec with the values written in (Model.varied)")
     say = progress or (lambda text: None)
-    store = open_store(cache)
     if store is not None:
         found = store.get(model.spec)
         if found is not None:

@@ -140,7 +140,9 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
     return labels.get(head, name.replace("_", " ").capitalize())
 
 
-def _sense(name: str) -> str:
+def _sense(name: str, limit: Any = None) -> str:
+    if name.startswith("gain_margin.") and isinstance(limit, (int, float)) and limit < 0:
+        return "\u2264"  # a stable loop's lower gain margin: at or below -required
     if name in SENSE:
         return SENSE[name]
     return SENSE.get(name.split(".")[0], "")
@@ -184,7 +186,7 @@ def check_row(check: Any, cases: Mapping[str, Any] | None = None) -> dict:
         "css": status.lower(),
         "value": conv(check.value),
         "limit": conv(check.limit),
-        "sense": _sense(check.name) if check.limit is not None else "",
+        "sense": _sense(check.name, check.limit) if check.limit is not None else "",
         "unit": shown,
         "source": STEP_SOURCES.get(check.step, check.step),
         "message": check.message,

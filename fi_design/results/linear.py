@@ -86,7 +86,9 @@ class CaseMargins(Result):
         positive, the gain may rise by this much; negative, the loop goes
         unstable when the gain falls by this much (a conditionally stable
         loop: the integrator on an undamped mass starts the phase below
-        -180 deg). ``inf`` without a phase crossover (``None`` in JSON).
+        -180 deg). Negative when the closed loop is unstable, as the phase
+        margin (its size that of the crossing). ``inf`` without a phase
+        crossover (``None`` in JSON).
     modulus_margin : float
         Smallest distance of L(j w) from -1, min |1 + L| = 1 / max |S| [-].
     delay_margin : float

@@ -45,6 +45,11 @@ STATIC_ERROR_FORMULA = "(Fs + |offset|) / kp"
 MOVE_OUTCOMES = ("settles", "hunts", "rests", "stuck", "undetermined")
 
 
+#: What the stage does after a move of each outcome (:data:`MOVE_OUTCOMES`), after "it".
+_OWN_MOTION = {"settles": "settles", "hunts": "hunts", "rests": "comes to rest off its target",
+               "stuck": "sticks away from its target", "undetermined": "cannot be judged"}
+
+
 @dataclass(frozen=True)
 class MoveOutcome(Result):
     """How the stage ends after one move of the family.
@@ -417,8 +422,10 @@ class StageHunting(Result):
                      f"{len(h)} of {n} moves, from {length_range(dist[0], dist[-1])},")
             sm = self.spec_move
             own = ("" if sm is None or sm.hunts else
-                   f"; after the spec's own motion it {'settles' if sm.outcome == 'settles' else sm.outcome}")
-            return f"{label} hunts at {number(fc, 4)} Hz: {moves} end in {cyc}{own}"
+                   f"; after the spec's own motion it {_OWN_MOTION[sm.outcome]}"
+                   + (f" ({sm.reason})" if sm.outcome == "undetermined" and sm.reason else ""))
+            end = "ends" if len(dist) == 1 else "end"
+            return f"{label} hunts at {number(fc, 4)} Hz: {moves} {end} in {cyc}{own}"
         if self.outcome == "stuck":
             m = self._first_bad()
             return (f"{label} sticks at {number(fc, 4)} Hz: after the {length_text(abs(m.distance))} move it "

@@ -273,8 +273,12 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
     for key in ("isolated", "non_isolated"):
         st = stage[key]
         judged = key == own_key
+        # the hunting moves counted against none; a stage that sticks or cannot be judged
+        # fails on that (the message says which move and why), not on a count of 0 = 0
+        counted = st.hunts or st.acceptable
         out.append(Check(f"simulation_{key}", st.acceptable if judged else None,
-                         float(len(st.hunting_moves)), 0.0 if judged else None, "moves",
+                         float(len(st.hunting_moves)) if counted else None,
+                         0.0 if judged and counted else None, "moves",
                          st.describe(labels[key]), step))
     for key in ("isolated", "non_isolated"):
         v = plants[key]
@@ -283,7 +287,9 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
         if slow:  # every move comes to rest, but the spec's not within the metric's window
             text += ("; every move comes to rest in the end, but not within the window of the "
                      "metric: a slow settling to review")
-        out.append(Check(f"spec_move_{key}", None, float(v.metrics.hunting_cycles), None,
+        counted = v.metrics.verdict != "undetermined"  # no count of a run that did not finish
+        out.append(Check(f"spec_move_{key}", None,
+                         float(v.metrics.hunting_cycles) if counted else None, None,
                          "cycles", text, step, status=Status.WARN if slow else None))
     for key in ("isolated", "non_isolated"):
         st = stage[key]
@@ -316,7 +322,13 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
         out.append(Check("isolator_needed", None, None, None, "-",
                          f"the stage without isolator {stn.summary()}: the isolator is not "
                          "needed at this crossover", step))
-    if land is not None:
+    if land is not None and not math.isfinite(land.deflection):
+        where = "the rule's isolator's cart" if suggested else "the cart"
+        out.append(Check("landing_force", None, None, None, "N",
+                         f"where {where} comes to rest could not be determined "
+                         f"({iso.metrics.reason})",
+                         "step 3 refinement: landing"))
+    elif land is not None:
         ok = (not land.on_limiter) and land.force < land.static_friction
         where = "the rule's isolator's cart" if suggested else "the cart"
         d = quantity(land.deflection, 'm', 3)

@@ -31,7 +31,7 @@ import numpy as np
 from .. import spec as _spec
 from ..display import quantity
 from ..errors import ArgumentError, FiDesignError, SpecError
-from ..execution import Executor, chunks, run_chunks
+from ..execution import Executor, check_executor, chunks, run_chunks
 from ..model import Model, require_model, resolve
 from ..results import frozen_array
 from ..results.studies import PointResult, RunInfo
@@ -339,6 +339,7 @@ def evaluate(model: Model, tasks: Sequence[Task], *, executor: Executor | None =
     model = study_model(require_model(model), "model")
     if measure not in _MEASURES:
         raise ArgumentError(f"measure must be one of {MEASURES}, got {measure!r}")
+    check_executor(executor)
     start = _time.perf_counter()
     store = open_cache(cache)
     n = len(tasks)

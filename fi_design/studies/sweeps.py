@@ -21,6 +21,7 @@ from ..execution import Executor
 from ..model import Model
 from ..results.design import DesignResult
 from ..results.studies import Axis, DesignMap, SweepResult
+from ..spec.file import value_at
 from .axes import design_value, held_damping_note, make_axis
 from .cache import PointCache
 from .points import (MAX_POINTS, ProgressCallback, evaluate, grid, point_result, study_model,
@@ -88,8 +89,9 @@ def sweep(spec: _spec.Spec | Model, x: AxisLike, y: AxisLike | None = None, *,
     Raises
     ------
     SpecError
-        Unknown path, a path to a non-numeric value, the same path twice, an
-        isolated sweep of a spec without isolator, or a grid of more than
+        Unknown path, a path to a non-numeric value, a path the spec cannot
+        hold (a list entry out of range, a section it does not have), the same
+        path twice, an isolated sweep of a spec without isolator, or a grid of more than
         :data:`~.points.MAX_POINTS` points.
     ArgumentError
         An axis that is neither an :class:`~.axes.Axis` nor a ``(path, values)``
@@ -103,6 +105,9 @@ def sweep(spec: _spec.Spec | Model, x: AxisLike, y: AxisLike | None = None, *,
     ay = _as_axis(y, spec, "y") if y is not None else None
     if ay is not None and ay.path == ax.path:
         raise SpecError("x and y sweep the same value", path=ax.path)
+    for axis in (ax, ay):
+        if axis is not None:  # a list entry or section the spec lacks fails every point: say so now
+            value_at(spec, axis.path)
     n_points = len(ax.values) * (1 if ay is None else len(ay.values))
     if n_points > MAX_POINTS:
         raise SpecError(f"{len(ax.values)} x {len(ay.values)} = {n_points} points; a study holds "

@@ -416,6 +416,18 @@ def test_the_record_is_an_input_not_an_output(tmp_path):
     assert record.read_bytes() == before
 
 
+def test_two_options_naming_one_file_are_refused_as_such(tmp_path, paper_spec_path):
+    """`--json o.json --write-spec o.json` said "refusing to overwrite the input file o.json":
+    o.json is no input; the message names the two options, and nothing is written."""
+    out = tmp_path / "o.json"
+    for second in (out, tmp_path / "." / "o.json"):
+        result = runner.invoke(app, [str(paper_spec_path), "--json", str(out), "--write-spec",
+                                     str(second), "--no-simulation"])
+        assert result.exit_code == 2, result.output
+        assert "--json and --write-spec name the same file" in result.stderr
+        assert "input" not in result.stderr and not out.exists()
+
+
 def test_a_file_that_appears_during_the_run_is_kept(tmp_path, paper_spec_path, monkeypatch):
     """A file created after the start-up check (another program, another run) is not replaced
     without --force; the run says so and exits 2."""

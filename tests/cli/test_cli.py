@@ -286,10 +286,17 @@ def test_version_and_help():
     assert "Usage" in r.output
 
 
-def test_mistyped_command_gets_a_hint():
+def test_mistyped_command_gets_a_hint(paper_spec_path):
     r = runner.invoke(app, ["shcema"])
     assert r.exit_code == 2
-    assert "did you mean 'fi-design schema'" in r.stderr
+    assert "no such command 'shcema'; did you mean 'schema'?" in r.stderr
+    # with the command's arguments after it: not design's "unexpected extra argument"
+    r = runner.invoke(app, ["recomend", str(paper_spec_path)])
+    assert r.exit_code == 2 and "extra argument" not in r.stderr
+    assert "no such command 'recomend'; did you mean 'recommend'?" in r.stderr
+    # a spec argument of another command still gets its hint
+    r = runner.invoke(app, ["sweep", "recomend", "--x", "controller.crossover=1,2"])
+    assert r.exit_code == 2 and "did you mean 'fi-design recommend'" in r.stderr
 
 
 def test_installed_entry_point(tmp_path, paper_spec_path):

@@ -10,6 +10,8 @@ from fi_design import errors
 from fi_design.errors import (ArgumentError, DataError, FiDesignError, OutputError, ReportError,
                               SpecError)
 
+from conftest import EXAMPLES
+
 
 def _error_classes():
     return [obj for _, obj in inspect.getmembers(errors, inspect.isclass)
@@ -97,7 +99,24 @@ def _calls():
          ArgumentError, ["resolution", "at most 150"]),
         ("reconcile-max-effects-text", lambda s, m: fi_design.reconcile(s, m, max_effects="2"),
          ArgumentError, ["max_effects", "whole number"]),
+        # a TypeError, an AttributeError, and warnings logged on a file given as the cache
+        ("recommend-cache-number", lambda s, m: fi_design.recommend(s, cache=5),
+         ArgumentError, ["cache must be None, True or False, a folder's path", "int 5"]),
+        ("design-executor-number", lambda s, m: fi_design.design(s, executor=5),
+         ArgumentError, ["executor must be None or a concurrent.futures-style executor",
+                         "int 5"]),
+        ("sweep-executor-number", lambda s, m: sweep(s, ("controller.crossover", [8.0]),
+                                                     executor=5),
+         ArgumentError, ["executor must be None"]),
+        ("recommend-cache-file", lambda s, m: fi_design.recommend(s, cache=TRACE),
+         ArgumentError, ["cache must be a folder", f"{TRACE} is a file"]),
+        ("design-cache-file", lambda s, m: fi_design.design(s, cache=TRACE, executor=_NoWork()),
+         ArgumentError, ["cache must be a folder"]),
     ]
+
+
+#: A file, not a folder, given as a cache.
+TRACE = str(EXAMPLES / "measured_trace.csv")
 
 
 @pytest.mark.parametrize("case", range(len(_calls())), ids=[c[0] for c in _calls()])

@@ -233,6 +233,28 @@ def test_desired_crossover_above_achievable_fails(paper_spec):
     assert r.crossover.achievable < 60.0
 
 
+def test_gain_margin_checks_state_the_signed_margin(paper_spec):
+    """An unstable case's gain-margin row reads -16.58 >= 6 dB FAIL (not 16.58), and a
+    stable loop's lower margin is held at or below -6 dB, so value, limit and status agree."""
+    from fi_design.report.checks import check_row
+
+    from fi_design.loop import linear
+
+    cases = {c.name: c for c in linear.analyse(resolve(paper_spec).at(crossover=60.0)).cases}
+    assert len(cases) == 4
+    for case in cases.values():
+        check = gl._gain_margin_check(case, case.name, 6.0, "step 2 crossover")
+        assert not case.stable and case.gain_margin_db < 0
+        assert check.value == case.gain_margin_db and check.limit == 6.0
+        assert check.status == Status.FAIL and "unstable" in check.message
+        assert check_row(check)["sense"] == "\u2265"
+    lower = dataclasses.replace(cases["sliding_free"], stable=True, gain_margin_db=-24.0,
+                                criteria={"gain margin": Status.PASS})
+    check = gl._gain_margin_check(lower, "case 1", 6.0, "step 2 crossover")
+    assert (check.value, check.limit, check.status) == (-24.0, -6.0, Status.PASS)
+    assert check_row(check)["sense"] == "\u2264" and "a lower margin" in check.message
+
+
 # --------------------------------------------------------------------------- no isolator
 
 

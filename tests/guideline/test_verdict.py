@@ -433,3 +433,19 @@ def test_fail_on_exit_codes(quick_specs, tmp_path, name, option, code, shared_de
 def test_fail_on_refuses_other_levels_before_any_work(quick_specs):
     r = runner.invoke(app, [str(quick_specs["small_gap"]), "--fail-on", "info"])
     assert r.exit_code == 2 and "--fail-on" in r.output
+
+
+def test_robustness_without_a_valid_sample_says_it_could_not_be_determined():
+    """'does not settle after every move in n/a of 0 scatter samples (interval 0 % to 100 %)'
+    when no sample finished: the check now says the probability could not be determined."""
+    from fi_design.guideline.verdict import robustness_as_check
+    from fi_design.results.verdict import RobustnessCheck
+
+    r = RobustnessCheck(plant="isolated", samples=100, valid=0, hunting=0,
+                        hunting_probability=None, interval=(0.0, 1.0), confidence=0.95,
+                        limit=0.05, status="WARN", scatter={}, distribution="normal",
+                        ripple=None, seed=0, counts={"failed": 100}, comparison=None, study=None)
+    check = robustness_as_check(r)
+    assert check.value is None and check.status.value == "WARN"
+    assert "n/a" not in check.message and "could not be determined" in check.message
+    assert check.message.startswith("no scatter sample was simulated to the end (100 drawn")

@@ -233,10 +233,15 @@ def test_unstable_loop_is_reported(paper_spec):
     assert bad and not result.passed
     for case in bad:
         assert case.phase_margin_deg < 0 and case.delay_margin == 0.0
+        assert case.gain_margin_db < 0  # no margin either, whatever the crossing's sign
         assert "stability" in case.failed
         poles = control.feedback(
             linear.loop_transfer_function(at30, case.name), 1).poles()
         assert np.max(poles.real) > 0
+    # sampled at 1 Hz, case 2's nearest phase crossing lies 8.65 dB below 0 dB: still no margin
+    slow = linear.analyse(resolve(variant(paper_spec, **{"controller.sample_rate": "1 Hz"})))
+    stuck = next(c for c in slow.cases if c.name == "stuck_free")
+    assert not stuck.stable and stuck.gain_margin_db == pytest.approx(-8.65, abs=0.01)
 
 
 def test_infinite_gain_margin_is_null_in_json(paper_spec):

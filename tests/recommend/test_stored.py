@@ -15,6 +15,7 @@ from dataclasses import replace
 
 import pytest
 
+from fi_design.errors import ArgumentError
 from fi_design.recommend import recommend
 from fi_design.recommend.stored import SearchStore, open_store, search_key
 from fi_design.results.recommend import DesignCandidate, RecommendResult
@@ -141,11 +142,12 @@ def test_a_folder_that_cannot_be_written_costs_the_entry_not_the_search(paper_sp
                                                                         searches, caplog):
     blocked = tmp_path / "a file"
     blocked.write_text("not a folder")
+    store = SearchStore(blocked / "recommend")  # a path into a file is refused up front
     with caplog.at_level(logging.WARNING, logger="fi_design.recommend.stored"):
-        result = recommend(paper_spec, cache=blocked / "recommend")
+        result = recommend(paper_spec, cache=store)
     assert result.advice == "build it" and result.from_cache is None
     assert "was not cached" in caplog.text
-    assert recommend(paper_spec, cache=blocked / "recommend").from_cache is None
+    assert recommend(paper_spec, cache=store).from_cache is None
     assert len(searches) == 2 and blocked.read_text() == "not a folder"
 
 
@@ -171,3 +173,10 @@ def test_the_cache_argument_takes_a_store_a_folder_true_or_nothing(tmp_path, mon
     assert open_store(str(tmp_path)).directory == tmp_path
     assert open_store(True).directory == tmp_path / "root" / "recommend"
     assert open_store(None) is None and open_store(False) is None
+    # a file, or a path into one, is no folder: refused, not logged and searched anyway
+    (tmp_path / "f.yaml").write_text("a file")
+    for wrong in (tmp_path / "f.yaml", str(tmp_path / "f.yaml" / "sub")):
+        with pytest.raises(ArgumentError, match="cache must be a folder"):
+            open_store(wrong)
+    with pytest.raises(ArgumentError, match="a folder's path or a SearchStore, got int 5"):
+        open_store(5)

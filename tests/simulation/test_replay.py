@@ -200,13 +200,18 @@ def test_cli_simulate_record(tmp_path, emps_path, emps_identification):
     (["--drive", "torque"], "--drive"),
     (["--drive", "force"], "give --record"),
     (["--window", "0"], "--window"),
+    # --window without an open-loop replay was ignored while --drive force was refused
+    (["--window", "0.2"], "only an open-loop replay has windows"),
+    (["--record", "RECORD", "--window", "0.2"], "only an open-loop replay has windows"),
 ])
 def test_cli_simulate_bad_replay_options(paper_spec_path, args, words):
     from typer.testing import CliRunner
 
     from fi_design.cli.app import app
 
-    res = CliRunner().invoke(app, ["simulate", str(paper_spec_path), *args])
+    record = str(EXAMPLES / "measured_trace.csv")
+    res = CliRunner().invoke(app, ["simulate", str(paper_spec_path),
+                                   *(record if a == "RECORD" else a for a in args)])
     assert res.exit_code == 2 and words in res.output
 
 

@@ -70,6 +70,43 @@ def test_landing_refinement(paper_confirmation, paper_spec):
     assert land5.on_limiter and low.metrics.verdict == "stuck"
 
 
+def test_rows_of_a_stage_that_cannot_be_judged_read_as_such(paper_confirmation, paper_spec):
+    """A failed or stuck run has no count and no landing: the rows said 'n/a ... FAIL', 'FAIL 0
+    = 0 moves' and 'after the spec's own motion it undetermined'. Built from the paper's
+    confirmation with the outcomes replaced: no simulation here."""
+    import dataclasses
+    import math
+
+    from fi_design.results.stage import MoveOutcome
+    from fi_design.stage.confirm import _checks
+
+    c = paper_confirmation
+    why = "the simulation did not complete: solution diverged at t = 1.7 s"
+    diverged = MoveOutcome(10e-3, "spec", "undetermined", math.nan, None, None, 1.7, why,
+                           failed=True)
+    hunting = MoveOutcome(57.2e-6, "family", "hunts", 0.0, 0.1e-3, 0.187, 1.0, "a cycle")
+    stuck = MoveOutcome(10e-3, "spec", "stuck", 0.2e-3, None, None, 5.0, "at the force limit")
+    iso = c.stage["isolated"]
+    hunts = dataclasses.replace(iso, moves=(hunting, diverged), cycle=None, other_cycles=())
+    text = hunts.describe("The stage")
+    assert "the 57.2 µm move ends in" in text
+    assert text.endswith(f"after the spec's own motion it cannot be judged ({why})")
+    failed = dataclasses.replace(c.isolated, metrics=dataclasses.replace(
+        c.isolated.metrics, verdict="undetermined", hunting_cycles=0, reason=why))
+    for stage in (dataclasses.replace(iso, moves=(stuck,), cycle=None, other_cycles=()),
+                  dataclasses.replace(iso, moves=(diverged,), cycle=None, other_cycles=())):
+        checks = {ch.name: ch for ch in _checks(
+            resolve(paper_spec), failed, c.non_isolated, {**c.stage, "isolated": stage},
+            c.min_hunting_free_crossover, dataclasses.replace(c.landing, deflection=math.nan),
+            True, c.isolated, c.non_isolated, False)}
+        sim = checks["simulation_isolated"]
+        assert sim.status.value == "FAIL" and sim.value is None and sim.limit is None
+        assert checks["spec_move_isolated"].value is None
+        land = checks["landing_force"]
+        assert land.value is None and land.status.value == "INFO" and "n/a" not in land.message
+        assert land.message == f"where the cart comes to rest could not be determined ({why})"
+
+
 def test_friction_models_agree_on_the_paper_setup(paper_confirmation):
     assert paper_confirmation.models_agree
     assert paper_confirmation.cross_check["non_isolated"].friction_model == "switch"

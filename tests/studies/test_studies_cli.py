@@ -67,6 +67,7 @@ def test_sweep_one_dimensional_with_invalid_points(paper_spec_path, tmp_path):
     (["--x", "isolator.stroke=1 N:2 N:3"], "not a length"),
     (["--x", "isolator.stroke=1 mm:2 mm:0"], "at least 1"),
     (["--x", "isolator.stroke=0.2:1 mm:3"], "'0.2' is a bare number"),
+    (["--x", "motion.moves[5].distance=1 mm,2 mm"], "index 5 is out of range"),
     (["--x", "isolator.stroke=1 mm:2 mm:2", "--log", "z"], "expected x or y"),
     (["--x", "isolator.stroke=1 mm:2 mm:2", "--executor", "spark"], "local, dask"),
     (["--x", "isolator.stroke=1 mm:2 mm:2", "--scheduler", "tcp://x:1"], "--executor dask"),
