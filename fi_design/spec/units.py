@@ -61,7 +61,7 @@ KNOWN_UNITS = {
 #: most)``: far beyond any positioning stage (a milligram to a thousand tonnes; 1e12 N is a
 #: force limit never reached); a value outside is a slip of unit or exponent, and the
 #: analysis's matrices overflow on it (1e300 kg).
-PLAUSIBLE = {"kg": (1e-6, 1e6), "N": (0.0, 1e15), "N/m": (1e-6, 1e15), "N*s/m": (1e-9, 1e15)}
+PLAUSIBLE = {"kg": (1e-6, 1e6), "N": (0.0, 1e15), "N/m": (1e-6, 1e15), "N*s/m": (0.0, 1e15)}
 
 _DB = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*dB\s*$")
 #: A comma between digits: a decimal comma ("1,25 kg") or a thousands separator ("6,667 N/m").
