@@ -22,12 +22,23 @@ class Hunting(StrictModel):
     min_height: Q("m") = Field(1e-4, gt=0, description="Minimum peak height of x1 - r [m]. "
                                                        "Default 0.1 mm.")
     settle_band: Q("m") = Field(1e-5, gt=0, description="Error band for 'settled' and the "
-                                                        "settling time [m]. Default 10 µm.")
+                                                        "settling time [m], below "
+                                                        "min_height. Default 10 µm.")
     horizon: Q("s") = Field(300.0, gt=0, le=1e5,
                             description="Stage-level hunting: the longest time after a move to "
                                         "wait for the stage to come to rest or repeat a cycle "
                                         "[s]; runs stop as soon as either is certain. Default "
                                         "300 s.")
+
+    @model_validator(mode="after")
+    def _band_below_cycles(self) -> "Hunting":
+        if self.settle_band >= self.min_height:
+            raise ValueError(
+                f"settle_band = {self.settle_band * 1e3:g} mm is not below min_height = "
+                f"{self.min_height * 1e3:g} mm: a cycle within the band would count as rest "
+                "(the stage judged settled while it hunts); give a band below the least peak "
+                "height that counts as a cycle")
+        return self
 
 
 class Ripple(StrictModel):

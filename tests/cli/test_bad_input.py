@@ -156,6 +156,11 @@ CASES = [
     ("window-after-run", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting: "
                                                    "{window_start: 15 s}"),
      ["requirements.hunting.window_start", "hunting window ends at 25 s"], "window_start:"),
+    # a band wider than the least cycle counted would take a 1.8 mm cycle for rest
+    ("band-hides-cycles", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting: "
+                                                    "{settle_band: 5 mm}"),
+     ["requirements.hunting", "settle_band = 5 mm is not below min_height = 0.1 mm"],
+     "settle_band:"),
     ("effect-twice", BASE + "effects: [{type: time_delay, delay: 1 ms}, "
                             "{type: time_delay, delay: 2 ms}]\n",
      ["effects", "listed twice"], "effects:"),
