@@ -19,7 +19,7 @@ from . import Spec
 
 def clean_loc(loc: tuple, raw: dict) -> tuple:
     """Drop union tags that pydantic inserts (``effects.0.time_delay.delay``,
-    ``controller.filters.0.notch.width``).
+    ``controller.filters.0.notch.width``, a value-or-range's ``tuple[...]``).
 
     The tag is the entry's own ``type`` right after its index, even where a
     parameter has the effect's name (``effects.0.stribeck_velocity.stribeck_velocity``).
@@ -28,6 +28,8 @@ def clean_loc(loc: tuple, raw: dict) -> tuple:
     node: Any = raw
     tagged = False
     for part in loc:
+        if isinstance(part, str) and not part.isidentifier():
+            continue  # a union member's tag: "tuple[...]", "function-before[parse(), float]"
         if isinstance(node, dict) and isinstance(part, str) and not tagged and len(out) >= 2 \
                 and isinstance(out[-1], int) and out[-2] in ("effects", "filters") \
                 and node.get("type") == part:
@@ -42,6 +44,19 @@ def clean_loc(loc: tuple, raw: dict) -> tuple:
         else:
             node = None
     return tuple(out)
+
+
+def _value_at(loc: tuple, raw: Any) -> Any:
+    """The value of the validated data at ``loc`` (None where it has none)."""
+    node = raw
+    for part in loc:
+        if isinstance(node, dict):
+            node = node.get(part)
+        elif isinstance(node, (list, tuple)) and isinstance(part, int) and part < len(node):
+            node = node[part]
+        else:
+            return None
+    return node
 
 
 def dotted(loc: tuple) -> str:
@@ -151,6 +166,11 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
     path = dotted(loc)
     kind = err["type"]
     msg = err["msg"]
+    if kind == "missing" and loc and isinstance(loc[-1], int):  # a fixed list too short
+        given = _value_at(loc[:-1], raw)
+        count = len(given) if isinstance(given, (list, tuple)) else 0
+        return dotted(loc[:-1]), (f"too few values: the list gives {count}, value "
+                                  f"{loc[-1] + 1} is missing")
     if kind == "missing":
         model = _model_at(loc, raw)
         desc = ""

@@ -156,6 +156,11 @@ CASES = [
     ("window-after-run", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting: "
                                                    "{window_start: 15 s}"),
      ["requirements.hunting.window_start", "hunting window ends at 25 s"], "window_start:"),
+    # a fixed list too short; a value-or-range with three values: no pydantic internals
+    ("size-too-short", edit("stage: {mass: 1.6 kg}", "stage: {mass: 1.6 kg, size: [10 mm, 20 mm]}"),
+     ["stage.size: too few values: the list gives 2, value 3 is missing"], "stage: {"),
+    ("range-of-three", edit("length: [10 mm, 60 mm]", "length: [10 mm, 60 mm, 70 mm]"),
+     ["isolator.flexure.length: takes at most 2 values, got 3"], "length: [10 mm"),
     # a band wider than the least cycle counted would take a 1.8 mm cycle for rest
     ("band-hides-cycles", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting: "
                                                     "{settle_band: 5 mm}"),
