@@ -33,9 +33,12 @@ class Hunting(StrictModel):
     @model_validator(mode="after")
     def _band_below_cycles(self) -> "Hunting":
         if self.settle_band >= self.min_height:
+            from ..display import quantities
+
+            band, height = quantities((self.settle_band, self.min_height), "m", 6)
             raise ValueError(
-                f"settle_band = {self.settle_band * 1e3:g} mm is not below min_height = "
-                f"{self.min_height * 1e3:g} mm: a cycle within the band would count as rest "
+                f"settle_band = {band} is not below min_height = "
+                f"{height}: a cycle within the band would count as rest "
                 "(the stage judged settled while it hunts); give a band below the least peak "
                 "height that counts as a cycle")
         return self
