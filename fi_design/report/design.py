@@ -198,8 +198,11 @@ def _plant_rows(sim: Any) -> list[dict]:
             "plant": name, "verdict": v.outcome.replace("_", " "),
             "css": {"settled": "pass", "static_error": "pass",
                     "hunting": "fail"}.get(v.outcome, "warn"),
-            "cycles": m.hunting_cycles, "amplitude": m.amplitude, "period": m.period,
-            "settling_time": m.settling_time, "final_error": m.final_error,
+            # a run that did not complete counted nothing and ended nowhere: no values
+            "cycles": m.hunting_cycles if v.success else None,
+            "amplitude": m.amplitude if v.success else None, "period": m.period,
+            "settling_time": m.settling_time,
+            "final_error": m.final_error if v.success else None,
             "other": other.outcome.replace("_", " ") if other is not None else "",
             "other_model": other.friction_model if other is not None else "",
             "reason": m.reason if v.outcome != "static_error" else (

@@ -243,3 +243,18 @@ def test_numbers_are_formatted_in_display_only():
     assert not offenders, (f"{len(offenders)} numbers formatted by hand; format them with "
                            "fi_design.display (number, quantity, percent, fixed, plain): "
                            + "; ".join(offenders))
+
+
+def test_a_run_that_did_not_complete_shows_no_cycles_or_final_error(paper_confirmed_design):
+    """Sampled at 1 Hz the loop diverges: the table read '0' cycles and a final error of
+    2015 mm (the last finite sample of the diverging run). Such a run shows no values."""
+    from dataclasses import replace
+
+    from fi_design.report.design import _plant_rows
+
+    sim = paper_confirmed_design.simulation
+    failed = replace(sim, isolated=replace(sim.isolated, success=False))
+    ok, bad = (next(r for r in _plant_rows(s) if r["plant"].startswith("with isolator"))
+               for s in (sim, failed))
+    assert ok["cycles"] == 0 and ok["final_error"] is not None
+    assert bad["cycles"] is None and bad["final_error"] is None and bad["amplitude"] is None
