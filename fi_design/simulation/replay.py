@@ -16,6 +16,7 @@ integration itself stays in :mod:`fi_design.simulation.run`.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, replace
 from typing import NamedTuple
 
@@ -112,6 +113,21 @@ def _local_fit(record: Measurement, values: np.ndarray, index: int, span: float)
     return LocalFit(coef, s2 * np.linalg.pinv(A.T @ A), int(dof))
 
 
+#: Local fits kept per record (a frozen Measurement of read-only arrays): an open-loop
+#: replay anchors every window at the same samples in each of a fit's many simulations.
+_FITS: "weakref.WeakKeyDictionary[Measurement, dict]" = weakref.WeakKeyDictionary()
+
+
+def _fit_of(record: Measurement, column: str, index: int, span: float) -> LocalFit:
+    """:func:`_local_fit` of the record's ``column`` at ``index``, worked out once per record."""
+    kept = _FITS.setdefault(record, {})
+    key = (column, int(index), float(span))
+    fit = kept.get(key)
+    if fit is None:
+        fit = kept[key] = _local_fit(record, getattr(record, column), index, span)
+    return fit
+
+
 @dataclass(frozen=True)
 class ReplayFit:
     """How a replay agrees with the record it replays.
@@ -183,7 +199,7 @@ def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPA
     if n < MIN_FIT_SAMPLES:
         raise DataError(f"too short to estimate the initial velocity: {n} sample(s), at least "
                         f"{MIN_FIT_SAMPLES} needed", column="position_m", source=record.source)
-    fit = _local_fit(record, record.position, index, span)
+    fit = _fit_of(record, "position", index, span)
     return RecordState(index=int(index), time=float(record.time[index]),
                        position=float(record.position[index]), velocity=float(fit.coef[1]),
                        velocity_error=float(np.sqrt(max(fit.cov[1, 1], 0.0))), dof=fit.dof)
@@ -203,7 +219,7 @@ def reference_state(record: Measurement, index: int = 0,
     (r, r', r'') : tuple of float
         [m, m/s, m/s^2].
     """
-    coef = _local_fit(record, record.reference, index, span).coef
+    coef = _fit_of(record, "reference", index, span).coef
     return float(record.reference[index]), float(coef[1]), float(2.0 * coef[2])
 
 
