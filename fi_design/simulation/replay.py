@@ -26,6 +26,7 @@ from ..errors import DataError
 from ..kernel.build import compiled
 from ..kernel.layout import P_SIGMA2_NEG, PlantParameters, state_index
 from ..measured import Measurement
+from ..trajectory import Trajectory, from_samples
 from ..controller.pid import ControlLaw
 
 #: Span of samples the local velocity estimate fits [s].
@@ -113,19 +114,34 @@ def _local_fit(record: Measurement, values: np.ndarray, index: int, span: float)
     return LocalFit(coef, s2 * np.linalg.pinv(A.T @ A), int(dof))
 
 
-#: Local fits kept per record (a frozen Measurement of read-only arrays): an open-loop
-#: replay anchors every window at the same samples in each of a fit's many simulations.
-_FITS: "weakref.WeakKeyDictionary[Measurement, dict]" = weakref.WeakKeyDictionary()
+#: What a replay works out of its record alone, kept per record (a frozen Measurement of
+#: read-only arrays): a reconciliation replays one record in each of its many simulations,
+#: an open-loop replay anchoring every window at the same samples.
+_KEPT: "weakref.WeakKeyDictionary[Measurement, dict]" = weakref.WeakKeyDictionary()
 
 
 def _fit_of(record: Measurement, column: str, index: int, span: float) -> LocalFit:
     """:func:`_local_fit` of the record's ``column`` at ``index``, worked out once per record."""
-    kept = _FITS.setdefault(record, {})
+    kept = _KEPT.setdefault(record, {})
     key = (column, int(index), float(span))
     fit = kept.get(key)
     if fit is None:
         fit = kept[key] = _local_fit(record, getattr(record, column), index, span)
     return fit
+
+
+def record_reference(record: Measurement) -> Trajectory:
+    """The record's reference as a C2 cubic spline over its time from its first sample.
+
+    :func:`fi_design.trajectory.from_samples` of ``reference_m``, worked out once per
+    record.
+    """
+    kept = _KEPT.setdefault(record, {})
+    ref = kept.get("reference")
+    if ref is None:
+        t = np.asarray(record.time, dtype=float)
+        ref = kept["reference"] = from_samples(t - t[0], record.reference)
+    return ref
 
 
 @dataclass(frozen=True)

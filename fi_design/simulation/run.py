@@ -28,10 +28,11 @@ from ..errors import ArgumentError, SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from ..model import Model, as_model
 from ..kernel.layout import PlantParameters, state_index
-from .replay import DRIVES, command_state, initial_state, record_state, reference_state, replay_fit
+from .replay import (DRIVES, command_state, initial_state, record_reference, record_state,
+                     reference_state, replay_fit)
 from ..results import frozen_array
 from ..results.simulation import SimulationResult
-from ..trajectory import Trajectory, from_moves, from_samples
+from ..trajectory import Trajectory, from_moves
 
 METHODS = ("fast", "reference")
 
@@ -274,7 +275,7 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
     """Replay a measured record, closed loop or open loop in re-anchored windows."""
     t0 = float(record.time[0])
     t_out = np.asarray(record.time, dtype=float) - t0
-    ref = from_samples(t_out, record.reference)
+    ref = record_reference(record)
     if drive == "closed":
         dist = record.disturbance
         command = command_state(record, 0) if initial_command is None else float(initial_command)

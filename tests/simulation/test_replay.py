@@ -105,8 +105,9 @@ def test_emps_open_loop_replay_in_windows(emps_record, emps_axis):
 def test_an_open_loop_replay_fits_its_anchors_once_per_record(emps_record, emps_axis,
                                                                monkeypatch):
     """A reconciliation replays one record many times; each window's start (the local fits of
-    position and reference) is worked out once per record: the second replay fits nothing and
-    gives the same trace (the EMPS open-loop reconciliation 14.6 -> 9.4 s)."""
+    position and reference) and the reference's spline are worked out once per record: the
+    second replay fits nothing and gives the same trace (the EMPS open-loop reconciliation
+    14.6 -> 9.4 s)."""
     from fi_design.simulation import replay
 
     from fi_design.measured import measurement_from_arrays
@@ -122,6 +123,10 @@ def test_an_open_loop_replay_fits_its_anchors_once_per_record(emps_record, emps_
     again = simulate(emps_axis, record=rec, drive="force")
     assert fits >= 2 * len(np.unique(first.window)) and len(calls) == fits
     np.testing.assert_array_equal(first.position, again.position)
+    # the reference spline too: one per record, through the record's reference
+    ref = replay.record_reference(rec)
+    assert replay.record_reference(rec) is ref
+    np.testing.assert_allclose(ref(rec.time - rec.time[0]), rec.reference, rtol=0, atol=1e-15)
 
 
 def test_replay_of_a_trace_that_starts_moving(paper_spec):
