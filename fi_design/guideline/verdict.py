@@ -708,6 +708,9 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
     nwarn = sum(r.severity == "WARN" for r in reasons)
     what = (f"{label} {_BEHAVIOUR.get(behaviour, behaviour)} at {quantity(fc, 'Hz', 4)}"
             if behaviour is not None else f"{label} was not simulated")
+    if behaviour is not None and not_valid is not None:
+        what += (" in the simulation, which leaves out the parasitic modes with which step 2 "
+                 "finds the loop unstable")
     if behaviour == "hunts":
         st = simulation.stage[own]
         c = st.cycle

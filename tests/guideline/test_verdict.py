@@ -295,6 +295,7 @@ def test_a_simulation_without_the_modes_never_passes_a_loop_step_2_finds_unstabl
                    for x in judged.reasons)
     assert sum(note in x.text for x in judged.reasons if x.source == "simulation") == 1
     assert judged.status == "PASS_WITH_WARNINGS"  # nothing fails here but the loop's own checks
+    assert "in the simulation, which leaves out the parasitic modes" in judged.headline
 
 
 def test_without_simulation_the_verdict_cannot_pass(paper_spec):
