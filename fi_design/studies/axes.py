@@ -20,7 +20,8 @@ from ..model import Model, require_model
 from ..results.studies import Axis
 from ..spec.file import path_unit, value_at
 
-__all__ = ["make_axis", "parse_axis", "design_value", "is_number", "held_damping_note"]
+__all__ = ["make_axis", "parse_axis", "design_value", "is_number", "held_damping_note",
+           "crossover_note"]
 
 
 def make_axis(path: str, values: Sequence[float], log: bool = False,
@@ -270,3 +271,27 @@ def held_damping_note(model: Model, axes: Sequence[Axis]) -> str | None:
             f"from {number(min(ratios), 3)} to {number(max(ratios), 3)} over the axes (leave "
             "the key out to keep the ratio of the default instead)")
 
+
+
+def crossover_note(axes: Sequence[Axis]) -> str | None:
+    """A sentence when an axis varies the crossover, else None.
+
+    The map's simulations carry the loop without the parasitic modes; step 2
+    (the design run, which holds them) bounds the crossover from above, and
+    beyond its achievable crossover the hardware's loop loses its margins or
+    its stability whatever the map shows.
+
+    Parameters
+    ----------
+    axes : sequence of Axis
+        The swept axes (None entries are skipped).
+
+    Returns
+    -------
+    str or None
+    """
+    if not any(a is not None and a.path == "controller.crossover" for a in axes):
+        return None
+    return ("the map simulates the loop without the parasitic modes: above the achievable "
+            "crossover of step 2 (the design run gives it), the hardware's loop loses its "
+            "margins or its stability, whatever the map shows there")

@@ -22,7 +22,7 @@ from ..model import Model
 from ..results.design import DesignResult
 from ..results.studies import Axis, DesignMap, SweepResult
 from ..spec.file import value_at
-from .axes import design_value, held_damping_note, make_axis
+from .axes import crossover_note, design_value, held_damping_note, make_axis
 from .cache import PointCache
 from .points import (MAX_POINTS, ProgressCallback, evaluate, grid, point_result, study_model,
                      verdict_grid)
@@ -137,7 +137,8 @@ def sweep(spec: _spec.Spec | Model, x: AxisLike, y: AxisLike | None = None, *,
         amplitude=grid(points, shape, "amplitude"), period=grid(points, shape, "period"),
         verdict=verdict_grid(points, shape), design_point=design, run=ev.run,
         fi_design_version=__version__, measure=measure,
-        notes=tuple(n for n in (held_damping_note(model, (ax, ay)),) if n))
+        notes=tuple(n for n in (held_damping_note(model, (ax, ay)), crossover_note((ax, ay)))
+                    if n))
 
 
 def design_map(result: DesignResult, *, resolution: tuple[int, int] = (8, 6),

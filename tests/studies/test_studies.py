@@ -124,6 +124,11 @@ def test_result_is_frozen_and_json_ready(paper_spec, kernel):
     assert data["design_point"] == [8.0]
     assert data["isolated"] is True
     assert len(res.table()["verdict"]) == 2
+    # a crossover axis: the map leaves out the parasitic modes that bound it from above
+    assert data["notes"] == ["the map simulates the loop without the parasitic modes: above the "
+                             "achievable crossover of step 2 (the design run gives it), the "
+                             "hardware's loop loses its margins or its stability, whatever the "
+                             "map shows there"]
 
 
 def test_design_point_resolves_derived_stiffness(paper_spec):
