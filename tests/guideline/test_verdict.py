@@ -334,6 +334,17 @@ def test_stiffness_range_follows_thickness_cubed(cases):
                                       (k - kg) * (1 + dt / t) ** 3 + kg), rel=2e-3)
     assert m.stiffness_factor == pytest.approx(r.stiffness.maximum / r.stiffness.chosen)
     assert m.stiffness_factor_worst == pytest.approx(r.stiffness.maximum / hi)
+    assert not any("thick end" in n for n in m.notes)  # 7052 N/m within k_max = 13333 N/m
+    # a k_max between the nominal and the thick end (the recommendation's 4400 N/m against
+    # 4444 N/m, 4720 N/m at the thick end): said in the margins' notes
+    from dataclasses import replace
+
+    from fi_design.guideline import verdict as v
+
+    low = replace(r.stiffness, maximum=0.5 * (fx.drive_stiffness + hi))
+    tight = v.margins(resolve(r.spec), r.crossover, low, fx, r.pid, r.simulation)
+    (note,) = [n for n in tight.notes if "thick end" in n]
+    assert "above k_max" in note and "robustness study draws k" in note
 
 
 def test_crossover_factor_and_the_bounds_that_are_not_results(cases):
