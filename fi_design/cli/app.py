@@ -98,7 +98,8 @@ def design_command(
     search is kept in the result cache: run again on the same spec, or as
     fi-design recommend, it is read back.
     """
-    levels = {"fail": "NOT_CONFIRMED", "warn": "PASS_WITH_WARNINGS"}
+    from ..results.verdict import FAIL_ON_LEVELS as levels
+
     if fail_on is not None and fail_on not in levels:
         raise typer.BadParameter(f"expected 'fail' or 'warn', got {fail_on!r}",
                                  param_hint="--fail-on")

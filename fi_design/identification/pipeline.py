@@ -78,8 +78,8 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     ------
     DataError
         No ``force_N`` column, too few samples, a constant position, sampling
-        the filter cannot take, motion in one direction only, too few sliding
-        samples; the message names the column and what is needed.
+        the filter cannot take, too few sliding samples in both directions;
+        the message names the column and what is needed.
     ArgumentError
         An unknown ``form``, a ``spec`` that is not a spec, path or mapping,
         a cut-off, decimation or threshold that is not a positive number.

@@ -12,12 +12,15 @@ from typing import Any
 
 from . import Result, to_jsonable
 
-__all__ = ["VERDICT_STATUSES", "VerdictStatus", "Reason", "Verdict", "RobustnessCheck",
-           "Margins", "Recommendation"]
+__all__ = ["VERDICT_STATUSES", "FAIL_ON_LEVELS", "VerdictStatus", "Reason", "Verdict",
+           "RobustnessCheck", "Margins", "Recommendation"]
 
 
 #: Statuses of a design verdict, from best to worst.
 VERDICT_STATUSES = ("PASS", "PASS_WITH_WARNINGS", "NOT_CONFIRMED", "FAIL")
+#: The command line's ``--fail-on`` words and the status each means: ``fail`` whatever does
+#: not pass, ``warn`` a pass with warnings too.
+FAIL_ON_LEVELS = {"fail": "NOT_CONFIRMED", "warn": "PASS_WITH_WARNINGS"}
 
 
 class VerdictStatus(str, enum.Enum):
@@ -110,15 +113,30 @@ class Verdict(Result):
 
         Parameters
         ----------
-        level : {"PASS", "PASS_WITH_WARNINGS", "NOT_CONFIRMED", "FAIL"}
+        level : {"PASS", "PASS_WITH_WARNINGS", "NOT_CONFIRMED", "FAIL", "fail", "warn"}
             In the order of :data:`VERDICT_STATUSES`: NOT_CONFIRMED is below
-            PASS_WITH_WARNINGS (it does not pass) and above FAIL.
+            PASS_WITH_WARNINGS (it does not pass) and above FAIL, in any case; the
+            command line's ``--fail-on`` words, lower case, as :data:`FAIL_ON_LEVELS`
+            reads them (``"fail"``: NOT_CONFIRMED or worse).
 
         Returns
         -------
         bool
+
+        Raises
+        ------
+        ArgumentError
+            A level that is none of these.
         """
-        return VERDICT_STATUSES.index(self.status) >= VERDICT_STATUSES.index(level)
+        word = str(level).strip() if isinstance(level, (str, VerdictStatus)) else None
+        name = None if word is None else FAIL_ON_LEVELS.get(word, word.upper())
+        if name not in VERDICT_STATUSES:
+            from ..errors import ArgumentError
+
+            raise ArgumentError(f"level {level!r}: expected one of "
+                                f"{', '.join(VERDICT_STATUSES)} or the --fail-on words "
+                                f"{', '.join(FAIL_ON_LEVELS)}")
+        return VERDICT_STATUSES.index(self.status) >= VERDICT_STATUSES.index(name)
 
     def to_dict(self) -> dict:
         """JSON: ``status``, ``reasons`` (their texts), ``findings`` (severity, source and

@@ -20,7 +20,9 @@ from typer.testing import CliRunner
 
 from fi_design import report
 from fi_design.cli.app import app
+from fi_design.errors import ArgumentError
 from fi_design.mechanism.sizing import net_stiffness
+from fi_design.results.verdict import VerdictStatus
 from fi_design.guideline.evaluate import evaluate as design
 from fi_design.spec.file import load_spec
 from fi_design.studies import wilson_interval
@@ -303,6 +305,14 @@ def test_without_simulation_the_verdict_cannot_pass(paper_spec):
     assert r.verdict.behaviour is None and r.robustness is None
     assert r.verdict.status == "NOT_CONFIRMED" and not r.passed
     assert any(x.source == "confirmation" for x in r.verdict.reasons)
+    # the levels a caller may give: statuses in any case and the --fail-on words ('fail' was
+    # a ValueError of tuple.index)
+    v = r.verdict
+    assert v.at_or_below("fail") and v.at_or_below("warn") and v.at_or_below("not_confirmed")
+    assert not v.at_or_below("FAIL") and v.at_or_below(VerdictStatus.PASS)
+    for bad in ("failed", None, 3):
+        with pytest.raises(ArgumentError, match="--fail-on words fail, warn"):
+            v.at_or_below(bad)
 
 
 # --------------------------------------------------------------------------- margins
