@@ -318,19 +318,31 @@ def with_error(value: Any, error: Any, unit: str = "", digits: int = 4, error_di
     sep : str, optional
         Between number and unit.
 
+    The value is shown to the error's last significant decimal, both in plain
+    decimals where the value is plain (``5.000013 ± 0.000031 mm``, not ``5 ±
+    3.1 × 10⁻⁵ mm``, which reads as a value of 5 × 10⁻⁵); an error above the
+    value's units place, or numbers outside the plain range, as :func:`number`
+    writes them.
+
     Examples
     --------
-    >>> with_error(0.005, 3.5e-8, "m")
-    '5 ± 3.5\xa0×\xa010⁻⁵ mm'
-    >>> with_error(0.25, 1.1e-5, "1")
-    '0.25 ± 1.1\xa0×\xa010⁻⁵'
+    >>> with_error(0.005000013, 3.1e-8, "m")
+    '5.000013 ± 0.000031 mm'
+    >>> with_error(0.249993, 1.1e-5, "1"), with_error(94.62, 0.234, "kg")
+    ('0.249993 ± 0.000011', '94.62 ± 0.23 kg')
     """
     if value is None or not _is_number(value):
         return number(value, digits)
     shown, factor = display_scale(unit, value) if unit not in ("", "1", "-") else ("", 1.0)
-    text = number(value * factor, digits)
+    v = float(value) * factor
+    text = number(v, digits)
     if error is not None and _is_number(error) and error != 0 and math.isfinite(error):
-        text += f" \u00b1 {number(abs(error) * factor, error_digits)}"
+        e = abs(float(error)) * factor
+        decimals = error_digits - 1 - math.floor(math.log10(e))
+        if 0 <= decimals <= 12 and (v == 0 or 1e-4 <= abs(v) < 1e6):
+            text = f"{v:.{decimals}f} \u00b1 {e:.{decimals}f}"
+        else:
+            text += f" \u00b1 {number(e, error_digits)}"
     return _attach(text, shown, sep)
 
 

@@ -117,7 +117,7 @@ def test_reconcile_and_identify_summaries_read_at_80_columns():
     _readable(rec, 80)
     assert "position_dependent_friction" in rec
     assert re.search(r"position_rms_move\s+µm\s", rec), "lengths of the gap table in µm"
-    assert re.search(r"wavelength = 5 ± [\d.]+(\s×\s10[⁻⁰¹²³⁴⁵⁶⁷⁸⁹]+)?\s+mm", rec)
+    assert re.search(r"wavelength = 5\.0000\d+ ± 0\.0000\d+\s+mm", rec), "to the error's last digit"
     # no bare SI in the headline, the noise levels in reading units
     assert "SI" not in rec and "wavelength = 0.005" not in rec
     assert re.search(r"Noise: position [\d.]+\s+µm", rec), rec

@@ -45,7 +45,11 @@ def test_values_read_together_share_one_unit():
     assert scale("m", [22e-6, 278e-6, 300e-6]) == ("mm", 1e3)
     assert quantities([22e-6, 278e-6, 300e-6], "m", 3) == ["0.022 mm", "0.278 mm", "0.3 mm"]
     assert quantities([22e-6, 31e-6], "m") == ["22 µm", "31 µm"]
-    assert with_error(0.005, 3.1e-8, "m") == f"5 ± 3.1{NBSP}×{NBSP}10⁻⁵ mm"
+    # the value to the error's last digit, both plain: "5 ± 3.1 x 10^-5 mm" read as 5e-5 mm
+    assert with_error(0.005, 3.1e-8, "m") == "5.000000 ± 0.000031 mm"
+    assert with_error(0.800041, 1.2e-4, "rad") == "0.80004 ± 0.00012 rad"
+    assert with_error(0.768, 21.9, "kg") == "1 ± 22 kg"  # the error swamps the decimals
+    assert with_error(2.0e6, 3.0e3, "N/m") == f"2{NBSP}×{NBSP}10⁶ ± 3000 N/m"  # not plain
 
 
 def test_an_effect_value_and_its_error_share_a_unit():
@@ -56,7 +60,7 @@ def test_an_effect_value_and_its_error_share_a_unit():
                         {"amplitude": 1.1e-5, "wavelength": 3.1e-8})
     wave = text.split("wavelength = ")[1]
     assert wave.count("mm") == 1 and "µm" not in wave, text
-    assert wave.startswith("5 ± 3.1"), text
+    assert wave.startswith("5.000000 ± 0.000031"), text  # to the error's last digit
 
 
 def test_prose_and_tables_print_a_number_alike(paper_spec, capsys):
