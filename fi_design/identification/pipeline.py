@@ -141,6 +141,10 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
         if p.value is not None and p.value <= 0.0 and name != "offset":
             params[name] = replace(p, note=p.note + "; " + IMPLAUSIBLE)
             notes.append(f"{name} = {quantity(p.value, p.unit, 4)} is not positive: {IMPLAUSIBLE}")
+    for name, m in (("stage mass", masses.stage), ("cart mass", masses.cart)):
+        if masses.stage_std_error is not None and m <= 0.0:  # both fitted (a two-mass record)
+            notes.append(f"the {name} = {quantity(m, 'kg', 4)} is not positive: {IMPLAUSIBLE}; "
+                         "a negative mass also follows from force_N of the wrong sign")
     if measured.disturbance is not None:
         notes.append("force_N is used as the force that acts (the injected disturbance_N "
                      "included); the controller's own output force_N - disturbance_N is not")

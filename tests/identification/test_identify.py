@@ -160,6 +160,14 @@ def test_two_mass_record_with_the_specs_stiffness():
     assert m.source == "identified"
     assert abs(m.stage - 8.0) < 3 * m.stage_std_error
     assert abs(m.cart - 2.0) < 3 * m.cart_std_error
+    assert not any("mass =" in n and "not positive" in n for n in r.notes)
+    # force_N of the wrong sign: a negative mass, said in the notes (it was silent)
+    from dataclasses import replace
+
+    flipped = identify(replace(rec, force=-rec.force), spec)
+    assert min(flipped.masses.stage, flipped.masses.cart) < 0
+    assert any("mass =" in n and "not positive" in n and "wrong sign" in n
+               for n in flipped.notes)
     # without the flexure's stiffness: the sum equation, the split is not identified
     s = identify(rec, load_spec(_two_mass_spec(stiffness=None)))
     assert s.model == "two_mass_sum"
