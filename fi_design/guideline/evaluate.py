@@ -31,6 +31,7 @@ from ..spec import Spec, warnings_for
 from .steps import (controller_words, isolator_advice, notch_words, step1_friction_gap,
                     step2_crossover, step3_flexure, step3_stiffness, step4_pid,
                     suggested_isolator)
+from .validity import beyond_the_linear_loop, linear_loop_note
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..execution import Executor
@@ -223,8 +224,8 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
         sens.cancel()
     margins = _verdict.margins(model, xo, st, fx, pid, sim)
     # the simulated stage stands for the hardware only where step 2's loop is stable
-    note = _verdict.linear_loop_note(xo) if sim is not None or rob is not None else None
-    result = replace(result, checks=_verdict.beyond_the_linear_loop(result.checks, note))
+    note = linear_loop_note(xo) if sim is not None or rob is not None else None
+    result = replace(result, checks=beyond_the_linear_loop(result.checks, note))
     result = replace(
         result, robustness=rob, margins=margins,
         verdict=_verdict.judge(model, result.checks, result.warnings, sim, rob, margins, note))

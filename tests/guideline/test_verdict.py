@@ -276,14 +276,14 @@ def test_a_simulation_without_the_modes_never_passes_a_loop_step_2_finds_unstabl
     """At 60 Hz the paper stage's 150 Hz tilt makes every limit case unstable; the simulation,
     which leaves the modes out, came to rest and passed its checks, the scatter at 0 %, and the
     verdict said so. Its passing answers are now warnings naming the unstable cases."""
-    from fi_design.guideline import steps, verdict as v
+    from fi_design.guideline import steps, validity, verdict as v
 
-    assert v.linear_loop_note(steps.step2_crossover(resolve(paper_spec))) is None
-    note = v.linear_loop_note(steps.step2_crossover(resolve(variant(
+    assert validity.linear_loop_note(steps.step2_crossover(resolve(paper_spec))) is None
+    note = validity.linear_loop_note(steps.step2_crossover(resolve(variant(
         paper_spec, **{"controller.crossover": "60 Hz"}))))
     assert "unstable (case 1, case 2, case 3, case 4)" in note
     r = cases["settling_isolated"]  # every move settles, the scatter within its limit
-    checks = v.beyond_the_linear_loop(r.checks, note)
+    checks = validity.beyond_the_linear_loop(r.checks, note)
     simulated = [c for c in checks if c.step.startswith("simulation")]
     assert simulated and all(c.passed is None and note in c.message for c in simulated)
     assert [c for c in checks if c.name == "robustness"][0].status.value == "WARN"
