@@ -23,9 +23,9 @@ Only a stage whose error stays inside the settle band at the end of the
 window is ``settled``; a run that ends, or a window that closes, before the
 motion does is never settled: ``undetermined`` ("not finished"), since a
 stage on its ramp follows the reference within the band. A motion that ends
-inside the window, or a trace that ends inside it, is ``undetermined`` too:
-the count would take the move's own overshoot for a cycle, or see part of
-the window only.
+inside the window is ``undetermined`` too (the count would take the move's
+own overshoot for a cycle); so is a trace that ends inside the window
+without a counted peak (it sees part of the window only).
 """
 
 from __future__ import annotations
@@ -131,16 +131,16 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
                   "overshoot for hunting (start the window after the motion)")
     elif len(ew) < 2:
         verdict, reason = "undetermined", "the trace does not cover the counting window"
-    elif short:
-        verdict = "undetermined"
-        reason = (f"the trace ends at {quantity(t_last, 's', 4)}, inside the counting window "
-                  f"[{quantity(w0, 's', 6)}, {quantity(w1, 's', 6)}): it covers the window in "
-                  "part only")
     elif cycles > 0:
         verdict = "hunting"
         reason = (f"{cycles} peak(s) of at least {quantity(min_height, 'm', 6)} in "
                   f"[{quantity(w0, 's', 6)}, {quantity(w1, 's', 6)})"
                   + (f", period {quantity(period, 's', 3)}" if period else ""))
+    elif short:
+        verdict = "undetermined"
+        reason = (f"the trace ends at {quantity(t_last, 's', 4)}, inside the counting window "
+                  f"[{quantity(w0, 's', 6)}, {quantity(w1, 's', 6)}): it covers the window in "
+                  "part only")
     elif settled:
         verdict = "settled"
         reason = f"|x1 - r| stays within {quantity(settle_band, 'm', 3)} at the end of the window"

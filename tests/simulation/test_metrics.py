@@ -177,5 +177,7 @@ def test_a_trace_that_ends_inside_the_window_is_undetermined():
     short = T[T <= 12.0]
     m = hunting_metrics(short, 3.5e-12 + 0.0 * short, motion_end=0.3)
     assert m.verdict == "undetermined" and "covers the window in part only" in m.reason
+    cycling = 0.5e-3 * np.sin(2 * np.pi * short / 0.7)  # peaks counted in part: hunting
+    assert hunting_metrics(short, cycling, motion_end=0.3).verdict == "hunting"
     record = T[:-1]  # ends one step before the window's end
     assert hunting_metrics(record, 0.0 * record, motion_end=0.3).verdict == "settled"
