@@ -76,6 +76,41 @@ def _why(p: Any) -> str:
     return word + (f" ({p.violations[0]})" if p.violations else "")
 
 
+#: Statuses of a point nothing is known against: signed off, or kept the margin and not
+#: signed off because a stiffer design was (every other status fails a constraint).
+_KEPT = ("feasible", "not_evaluated")
+
+
+def _neighbour(search: Any, stroke: float, side: str) -> str | None:
+    """Why a neighbouring stroke gives no stiffer joint than the chosen one.
+
+    k_max = Fs / stroke rises at a shorter stroke and falls at a longer one; what
+    stops the joint there is said with the numbers of that stroke's own points:
+    the stiffest that keeps the margin (``kept``) and the softest stiffer one that
+    fails (``fails``), or, where none is kept, the stiffest judged and why it fails.
+    """
+    from .. import spec as _spec
+
+    row = sorted((p for p in search.points if p.stroke == stroke), key=lambda p: p.target)
+    if not row:
+        return None
+    kmax = _spec.stiffness_limit(search.base, stroke)
+    head = (f"a {side} stroke ({quantity(stroke, 'm')}) "
+            f"{'raises' if side == 'shorter' else 'lowers'} k_max to {quantity(kmax, 'N/m', 4)}")
+    kept = max((p for p in row if p.status in _KEPT), key=lambda p: p.stiffness, default=None)
+    if kept is None:
+        judged = [p for p in row if p.candidate is not None] or row
+        worst = max(judged, key=lambda p: p.stiffness)
+        return (f"{head}, but no joint there passes: {quantity(worst.stiffness, 'N/m', 4)} "
+                f"fails on {_why(worst)}")
+    fails = next((p for p in row if p.status not in _KEPT and p.target > kept.target), None)
+    text = f"the stiffest joint there that keeps the margin is {quantity(kept.stiffness, 'N/m', 4)}"
+    if fails is None:
+        return f"{head}, and {text}"
+    return (f"{head}, but {text}: {quantity(fails.stiffness, 'N/m', 4)} fails on "
+            f"{_why(fails)}")
+
+
 def binding(search: Any, chosen: Any) -> tuple[str, ...]:
     """What stops a stiffer joint than the chosen one, each a physical limit.
 
@@ -101,16 +136,9 @@ def binding(search: Any, chosen: Any) -> tuple[str, ...]:
     i = strokes.index(chosen.stroke)
     for j, side in ((i - 1, "shorter"), (i + 1, "longer")):
         if 0 <= j < len(strokes):
-            others = [p for p in search.points if p.stroke == strokes[j]]
-            good = [p for p in others if p.status in ("feasible", "not_evaluated", "reserve",
-                                                      "robustness", "checks")]
-            top = max(good, key=lambda p: p.stiffness) if good else None
-            fail = min((p for p in others if top is None or p.target > top.target),
-                       key=lambda p: p.target, default=None)
-            if fail is not None:
-                out.append(f"a {side} stroke ({quantity(strokes[j], 'm')}) allows a softer "
-                           f"joint at most: {quantity(fail.target, 'N/m', 4)} fails on "
-                           f"{_why(fail)}")
+            text = _neighbour(search, strokes[j], side)
+            if text is not None:
+                out.append(text)
     lo, hi = search.envelope
     if chosen.stroke <= lo * (1 + 1e-9):
         out.append(f"the stroke at {search.why_lo}")

@@ -71,6 +71,35 @@ def test_the_recommendation_is_a_buildable_stiff_joint_bound_by_physics(paper_re
     assert {"least_change", "pareto", "reserves", "binding", "flexure"} <= set(data)
 
 
+def test_what_binds_it_agrees_with_the_front_and_k_max(paper_recommendation):
+    """'Binds it' read 'a shorter stroke (0.5196 mm) allows a softer joint at most: 3652 N/m'
+    beside a front with 7611 N/m at 0.52 mm. Each stroke's sentence gives that stroke's k_max
+    (higher at the shorter one) and its stiffest joint that keeps the margin, as the candidates
+    and the Pareto front have them: no joint of the front stiffer than that keeps the margin."""
+    from fi_design import spec as _spec
+    from fi_design.display import quantity
+
+    r = paper_recommendation
+    d, need = r.design, r.spec.requirements.hunting_margin
+    kmax = d.stiffness * r.margins["stiffness_factor"]
+    assert r.binding[0].startswith(f"k_max = Fs / stroke = {quantity(kmax, 'N/m', 4)} at")
+    i = r.strokes.index(d.stroke)
+    for s, side, word in ((r.strokes[i - 1], "shorter", "raises"),
+                          (r.strokes[i + 1], "longer", "lowers")):
+        text = next(b for b in r.binding if b.startswith(f"a {side} stroke"))
+        k_s = _spec.stiffness_limit(r.spec, s)
+        assert (k_s > kmax) == (side == "shorter")
+        assert text.startswith(f"a {side} stroke ({quantity(s, 'm')}) {word} k_max to "
+                               f"{quantity(k_s, 'N/m', 4)}")
+        kept = max(c.stiffness for c in r.candidates if c.stroke == s
+                   and c.status in ("feasible", "not_evaluated"))
+        assert f"keeps the margin is {quantity(kept, 'N/m', 4)}" in text
+        assert kept < d.stiffness
+        for p in r.pareto:
+            if p["stroke"] == s and p["stiffness"] > kept * (1 + 1e-9):
+                assert p["hunting_margin"] < need, p        # the front's stiffer ones fail it
+
+
 def test_the_recommended_guide_stands_and_keeps_its_modes_in_the_fe_model(
         paper_recommendation):
     """The FE model (pyfe3d) of the recommended guide: buckling and modes as the search saw."""
