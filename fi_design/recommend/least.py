@@ -146,9 +146,9 @@ def least_change(search: Any, *, executor: Any = None,
     s0 = spec.isolator.stroke
 
     def done(changes: dict, text: str, binding: tuple[str, ...]) -> LeastChange:
-        from .write import written
+        from .write import DIGITS, written
 
-        shown = {p: written(spec, p, v) for p, v in changes.items()}
+        shown = {p: written(spec, p, v, digits=DIGITS) for p, v in changes.items()}
         return LeastChange(changes=shown, feasible=True, binding=binding, text=text,
                            tried=tuple(tried))
 

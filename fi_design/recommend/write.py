@@ -1,49 +1,40 @@
-"""The recommended design written into the user's spec: their units, a drawing's digits.
+"""The recommended design written into the user's spec: their units, every digit.
 
 :func:`recommended_values` gives the design's values at dotted paths as the
 spec file takes them, in the unit the user wrote at that path (``mm`` stays
-``mm``) and rounded to what a drawing carries (:data:`DIGITS` significant
-digits); :func:`recommended_spec_text` writes them into the spec's own text
-(comments and layout kept), replaces the comments of the keys it changes
-(they stated the old values) and adds a revision to the document's history.
-The design command on the written spec runs the same computation that signed
-the design off.
+``mm``) and with every digit (the spec reads each back as the design's value,
+:func:`fi_design.spec.edit.spec_quantity`); :func:`recommended_spec_text`
+writes them into the spec's own text (comments and layout kept), replaces the
+comments of the keys it changes (they stated the old values) and adds a
+revision to the document's history. The design command on the written spec
+runs the same computation that signed the design off: the same guide, joint
+stiffness and crossover, not a drawing's rounding of them (a width rounded to
+four digits gave 4399 N/m for the 4400 N/m signed off).
 """
 
 from __future__ import annotations
 
 import datetime
-import math
 import re
 from typing import Any
 
-from ..display import plain
 from ..errors import ArgumentError
 from ..results.recommend import RecommendResult
 
 __all__ = ["DIGITS", "written", "recommended_values", "recommended_spec_text", "next_revision"]
 
-#: Significant digits of a written value: what a drawing carries.
+#: Significant digits of a value shown to a person (the least change's edits); a value written
+#: into a spec carries every digit.
 DIGITS = 4
 
 
-def written(spec: Any, path: str, value: float, *, down: bool = False) -> Any:
-    """The value at a path in the unit the spec wrote there (else its field's), DIGITS digits;
-    ``down`` rounds towards zero (a leaf's width: the stiffness stays at or below the
-    design's)."""
-    from ..spec.file import path_unit
-    from ..spec.edit import written_unit
-    from ..spec.units import from_si
+def written(spec: Any, path: str, value: float, *, digits: int | None = None) -> Any:
+    """The value at a path in the unit the spec wrote there (else its field's), as the spec
+    file takes it: every digit, the spec reading it back as ``value``
+    (:func:`fi_design.spec.edit.spec_quantity`); or ``digits`` significant digits."""
+    from ..spec.edit import spec_quantity, written_unit
 
-    unit = written_unit(spec, path)
-    si = path_unit(path)
-    shown = si if unit is None else unit
-    x = value if unit is None or unit == si else from_si(value, si, unit)
-    if down and x > 0:
-        scale = 10.0 ** (math.floor(math.log10(x)) - DIGITS + 1)
-        x = math.floor(x / scale * (1 + 1e-12)) * scale
-    text = plain(x, DIGITS)
-    return float(text) if shown in ("", "1") else f"{text} {shown}"
+    return spec_quantity(path, value, digits, unit=written_unit(spec, path))
 
 
 def recommended_values(result: RecommendResult) -> dict[str, Any]:
@@ -75,8 +66,7 @@ def recommended_values(result: RecommendResult) -> dict[str, Any]:
     if iso is None or iso.flexure is None:
         from .space import ASSUMED_FLEXURE
 
-        flexure = {**ASSUMED_FLEXURE, **{k: written(spec, f"isolator.flexure.{k}", v,
-                                                    down=k == "width")
+        flexure = {**ASSUMED_FLEXURE, **{k: written(spec, f"isolator.flexure.{k}", v)
                                          for k, v in guide.items()}}
         flexure["material"] = {"youngs_modulus": "200 GPa", "allowed_stress": "300 MPa",
                                "density": "7800 kg/m^3"}
@@ -92,8 +82,7 @@ def recommended_values(result: RecommendResult) -> dict[str, Any]:
             values["isolator.flexure"] = flexure
         else:
             for k, v in guide.items():
-                values[f"isolator.flexure.{k}"] = written(spec, f"isolator.flexure.{k}", v,
-                                                          down=k == "width")
+                values[f"isolator.flexure.{k}"] = written(spec, f"isolator.flexure.{k}", v)
         if d.damping is not None:
             values["isolator.damping"] = written(spec, "isolator.damping", d.damping)
         kept = [m for m in iso.parasitic_modes if m.direction == "structure"]

@@ -17,6 +17,7 @@ reader opens it (a bare ``1e-05`` is a string to YAML 1.1 readers).
 from __future__ import annotations
 
 import io
+import math
 import re
 from typing import Any, Mapping, Sequence
 
@@ -25,6 +26,7 @@ from ..errors import SpecError
 from . import Spec
 from .file import load_spec, origin, parse_yaml, path_unit, yaml_loader
 from .paths import parse_path
+from .units import from_si, to_si
 
 __all__ = ["edited_spec_text", "spec_quantity", "written_unit", "REMOVE"]
 
@@ -38,8 +40,9 @@ class _Remove:
 REMOVE = _Remove()
 
 
-def spec_quantity(path: str, value: float, digits: int | None = None) -> Any:
-    """A value as the spec file takes it: a string with its field's unit.
+def spec_quantity(path: str, value: float, digits: int | None = None, *,
+                  unit: str | None = None) -> Any:
+    """A value as the spec file takes it: a string with its field's unit (or ``unit``).
 
     Parameters
     ----------
@@ -48,13 +51,23 @@ def spec_quantity(path: str, value: float, digits: int | None = None) -> Any:
     value : float
         SI value (Hz for frequencies).
     digits : int, optional
-        Significant digits; default all of them (``repr``: the file gives the
-        same float back).
+        Significant digits; default all of them: the file gives the same
+        float back (``repr`` in the field's unit; in another unit the
+        shortest text the spec reads back as ``value``).
+    unit : str, optional
+        The unit to write it in, of the field's dimension (``"mm"`` for a
+        length: the unit the user wrote, :func:`written_unit`); default the
+        field's own.
 
     Returns
     -------
     str or float
         ``"6842.912 N/m"``; a plain number for a value without a unit.
+
+    Raises
+    ------
+    UnitError
+        ``unit`` is not of the field's dimension.
 
     Examples
     --------
@@ -62,12 +75,41 @@ def spec_quantity(path: str, value: float, digits: int | None = None) -> Any:
     '0.0003 m'
     >>> spec_quantity("controller.gains.ki", 33073.41, digits=6)
     '33073.4 N/(m*s)'
+    >>> spec_quantity("isolator.flexure.width", 0.02794631884116351, unit="mm")
+    '27.94631884116351 mm'
+    >>> spec_quantity("isolator.stroke", 0.0009, unit="mm")
+    '0.9 mm'
     """
-    unit = path_unit(path)
-    number = repr(float(value)) if digits is None else plain(value, digits)
-    if unit in ("", "1"):
+    si = path_unit(path)
+    shown = si if unit is None or si in ("", "1") else unit
+    if shown == si:
+        number = repr(float(value)) if digits is None else plain(value, digits)
+    else:
+        number = _exact(path, float(value), si, shown) if digits is None else \
+            plain(from_si(value, si, shown), digits)
+    if shown in ("", "1"):
         return float(number)
-    return f"{number} {unit}"
+    return f"{number} {shown}"
+
+
+def _exact(path: str, value: float, si: str, shown: str) -> str:
+    """The number of ``value`` [si] in ``shown`` that the spec reads back closest to ``value``
+    (the same float where a text does; the unit's conversion may leave an ulp), the shortest
+    such text, without an exponent where the value's own has none: ``0.9`` mm for 0.0009 m,
+    not ``0.90000000000000002``; ``60`` mm, not ``6e+01``."""
+    x = from_si(value, si, shown)
+    best, error = repr(x), math.inf
+    exponent = "e" in best
+    for n in range(1, 18):
+        text = plain(x, n)
+        if "e" in text and not exponent:  # 6e+01: 60 follows
+            continue
+        e = abs(to_si(f"{text} {shown}", si, path) - value)
+        if e < error:
+            best, error = text, e
+        if e == 0.0:
+            break
+    return best
 
 
 def written_unit(spec: Spec, path: str) -> str | None:

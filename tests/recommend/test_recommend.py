@@ -154,20 +154,48 @@ def test_recommended_design_dense_scan_in_the_independent_simulator(paper_recomm
             assert np.max(np.abs(e[rec.time > 15.0])) < 1e-5, (distance, case)
 
 
+def test_the_written_spec_carries_every_digit_of_the_design(paper_recommendation, tmp_path):
+    """--write-spec wrote a drawing's four digits (crossover 10.6 Hz for 10.6018 Hz, width
+    27.94 mm for 27.946 mm), so the written spec's joint was 4398.99 N/m, not the 4400 N/m signed
+    off. Read back, it is the design: the joint stiffness, the crossover, the stroke and the guide
+    to the last digits, in the units the input wrote (mm stays mm)."""
+    import re
+
+    from fi_design import spec as _spec
+    from fi_design.model import resolve
+    from fi_design.recommend import recommended_spec_text
+    from fi_design.spec.file import load_spec
+
+    d = paper_recommendation.design
+    path = tmp_path / "written.yaml"
+    path.write_text(recommended_spec_text(paper_recommendation), encoding="utf-8")
+    text = path.read_text(encoding="utf-8")
+    for key in ("stroke", "length", "width", "thickness"):
+        assert re.search(rf"^ +{key}: [0-9.]+ mm ", text, re.M), key
+    spec = load_spec(path)
+    assert resolve(spec).joint.stiffness == pytest.approx(d.stiffness, rel=1e-9, abs=0)
+    assert _spec.design_crossover(spec) == pytest.approx(d.crossover, rel=1e-9, abs=0)
+    g = spec.isolator.flexure
+    assert (spec.isolator.stroke, g.length, g.width, g.thickness, spec.isolator.damping) == \
+        pytest.approx((d.stroke, d.length, d.width, d.thickness, d.damping), rel=1e-12, abs=0)
+
+
 def test_the_written_spec_passes_the_design_command(paper_recommendation, tmp_path):
-    """--write-spec: the input's text with the guide drawn in its own units (mm stays mm, four
-    digits), the comments of the keys replaced, a revision added; the design command on it
-    runs the computation that signed the design off, and passes."""
+    """--write-spec: the input's text with the guide drawn in its own units (mm stays mm), the
+    comments of the keys replaced, a revision added; the design command on it runs the
+    computation that signed the design off, and passes."""
     from fi_design.guideline.evaluate import evaluate as design
     from fi_design.recommend import recommended_spec_text
+    from fi_design.spec.edit import spec_quantity
     from fi_design.spec.file import load_spec
 
     text = recommended_spec_text(paper_recommendation)
     assert "# m1: actuated, carries the encoder" in text      # the input's comments stay
     assert "Fs / 2" not in text                                 # the replaced value's comment
     d = paper_recommendation.design
-    assert f"stroke: {d.stroke * 1e3:.4g} mm" in text
-    assert f"thickness: {d.thickness * 1e3:.4g} mm" in text
+    assert f"stroke: {spec_quantity('isolator.stroke', d.stroke, unit='mm')} " in text
+    assert f"thickness: {spec_quantity('isolator.flexure.thickness', d.thickness, unit='mm')} " \
+        in text
     assert "revision: B" in text
     written = tmp_path / "written.yaml"
     written.write_text(text, encoding="utf-8")
@@ -176,7 +204,7 @@ def test_the_written_spec_passes_the_design_command(paper_recommendation, tmp_pa
     r = design(spec)
     assert r.verdict.status != "FAIL", [x.text for x in r.verdict.reasons]
     assert not r.simulation.stage["isolated"].hunts
-    assert r.model.joint.stiffness == pytest.approx(d.stiffness, rel=2e-3)
+    assert r.model.joint.stiffness == pytest.approx(d.stiffness, rel=1e-9)
 
 
 def test_the_least_change_passes(paper_recommendation, paper_spec):

@@ -120,6 +120,24 @@ def test_spec_quantity_keeps_every_digit():
     assert spec_unit == "1e-05 m"
 
 
+
+@pytest.mark.parametrize("path, value, unit, text", [
+    ("isolator.flexure.width", 0.02794601559143691, "mm", "27.94601559143691 mm"),
+    ("isolator.stroke", 0.0009, "mm", "0.9 mm"),                 # not 0.90000000000000002
+    ("isolator.flexure.length", 0.06, "mm", "60 mm"),            # not 6e+01
+    ("isolator.stiffness", 4399.999999966574, "N/mm", "4.399999999966575 N/mm"),
+    ("controller.crossover", 10.601806058103774, "Hz", "10.601806058103774 Hz"),
+    ("isolator.stroke", 1e-7, "um", "0.1 um"),
+])
+def test_spec_quantity_in_the_users_unit_reads_back_as_the_value(path, value, unit, text):
+    """In the unit the user wrote (mm stays mm), the shortest text the spec reads back as the
+    value: the same float, or within the ulp the unit's conversion leaves."""
+    from fi_design.spec.file import path_unit
+    from fi_design.spec.units import to_si
+
+    assert spec_quantity(path, value, unit=unit) == text
+    assert to_si(text, path_unit(path)) == pytest.approx(value, rel=4e-16, abs=0)
+
 def test_a_recommended_isolator_and_crossover_written_into_a_spec_without_one():
     """What `recommend --write-spec` needs: a section added, values replaced, comments kept."""
     spec = load_spec(EXAMPLES / "no_isolator.yaml")
