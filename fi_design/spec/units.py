@@ -18,8 +18,8 @@ Three kinds of quantity need care:
 
 A string is one number followed by its unit (``"1e6 N/m"``, ``"2 1/s"``,
 ``"1 m/s^2"``): pint reads only the unit, never an expression (``"2 kg * 2"``,
-``"9**9**9 kg"`` are refused). Masses, forces, stiffnesses and dampings must
-lie within :data:`PLAUSIBLE`.
+``"9**9**9 kg"`` are refused). Values of every dimensioned kind must lie within
+:data:`PLAUSIBLE`.
 """
 
 from __future__ import annotations
@@ -57,11 +57,16 @@ KNOWN_UNITS = {
     "N/A": "motor force constant (force per current)",
 }
 
-#: Plausible magnitudes (SI) of a nonzero mass, force, stiffness and damping, ``(least,
+#: Plausible magnitudes (SI; Hz for frequencies) of a nonzero value of each kind, ``(least,
 #: most)``: far beyond any positioning stage (a milligram to a thousand tonnes; 1e12 N is a
-#: force limit never reached); a value outside is a slip of unit or exponent, and the
-#: analysis's matrices overflow on it (1e300 kg).
-PLAUSIBLE = {"kg": (1e-6, 1e6), "N": (0.0, 1e15), "N/m": (1e-6, 1e15), "N*s/m": (0.0, 1e15)}
+#: force limit never reached; a femtometre to a kilometre; a nanohertz to a gigahertz); a
+#: value outside is a slip of unit or exponent, and the analysis overflows on it (1e300 kg,
+#: a 1e300 m stroke, a 1e300 Hz crossover, a leaf 1e300 mm long).
+PLAUSIBLE = {"kg": (1e-6, 1e6), "N": (0.0, 1e15), "N/m": (1e-6, 1e15), "N*s/m": (0.0, 1e15),
+             "N/(m*s)": (0.0, 1e20), "m": (1e-15, 1e3), "s": (1e-15, 1e9),
+             "m/s": (1e-15, 1e4), "m/s**2": (1e-12, 1e8), "m/s**3": (1e-12, 1e12),
+             "Hz": (1e-9, 1e9), "Pa": (1e-3, 1e14), "kg/m**3": (1e-3, 1e6),
+             "A": (0.0, 1e6), "N/A": (0.0, 1e6)}
 
 _DB = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*dB\s*$")
 #: A comma between digits: a decimal comma ("1,25 kg") or a thousands separator ("6,667 N/m").
