@@ -172,3 +172,19 @@ def test_motion_spans_and_end_time(paper_spec):
             {"distance": "10 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2"},
             {"distance": "5 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2",
              "start": "0.1 s"}]})
+
+
+def test_the_stage_given_by_its_inertia_reads_and_checks_it(paper_spec):
+    """stage.inertia was refused whatever its value ("unknown target unit 'kg*m**2'"): the
+    unit was missing from the spec's units."""
+    spec = variant(paper_spec, **{"stage.inertia": ["1e-3 kg*m^2", "1000 kg*mm^2", 0.002],
+                                  "stage.centre_of_mass_height": "30 mm",
+                                  "isolator.flexure.spacing": "40 mm"})
+    assert spec.stage.inertia == pytest.approx((1e-3, 1e-3, 2e-3))
+    with pytest.raises(SpecError) as err:
+        variant(spec, **{"stage.inertia": [0.001, "0.001 N", 0.001]})
+    assert err.value.path == "stage.inertia[1]" and "not a moment of inertia" in str(err.value)
+    # Ixx = 1 with Iyy = Izz = 1e-3 kg m^2 is no rigid body's (Iyy + Izz >= Ixx)
+    with pytest.raises(SpecError) as err:
+        variant(spec, **{"stage.inertia": [1.0, 1e-3, 1e-3]})
+    assert err.value.path == "stage" and "sum of the other two" in str(err.value)
