@@ -447,3 +447,25 @@ def test_given_modes_replace_or_join_the_computed_ones(paper_spec):
     plain = _paper_variant(paper_spec, **{"isolator.parasitic_modes": [
         {"name": "tilt", "frequency": "150 Hz"}]})
     assert [m.source for m in resolve(plain).modes] == ["given"]
+
+
+def test_the_guide_s_modes_are_judged_on_the_loop_s_crossover_as_step_2_judges_them(paper_spec):
+    """A drawn guide of 9 mm wide leaves has its lateral mode at 30 Hz: step 2 judged it
+    against 3 x the loop's crossover (12 Hz, case 2 crossing highest: 36 Hz) and found the
+    crossover limited by it, while step 3's check passed it against 3 x the desired 8 Hz."""
+    from fi_design import design
+
+    spec = _paper_variant(paper_spec, **{
+        "isolator.stiffness": None, "isolator.damping": None, "isolator.parasitic_modes": [],
+        "isolator.flexure.length": "50.7 mm", "isolator.flexure.width": "9 mm",
+        "isolator.flexure.thickness": "0.45 mm"})
+    r = design(spec, confirm=False)
+    check = next(c for c in r.checks if c.name == "flexure.modes")
+    low = r.flexure.lowest_mode
+    assert low.direction == "y" and 25.0 < low.frequency < 35.0
+    separation = next(m for m in r.crossover.parasitic_modes if m.name == low.name)
+    assert r.crossover.loop_crossover > r.crossover.desired
+    assert check.limit == pytest.approx(3.0 * r.crossover.loop_crossover)
+    assert check.limit == pytest.approx(separation.required)
+    assert not check.passed and not separation.passed
+    assert "loop's crossover" in check.message
