@@ -262,12 +262,26 @@ def test_sized_guides_meet_their_constraints(k_target, headroom, stroke, f_req, 
      ["buckling:", "standing", "below the 3 required"]),
     (dict(required_frequency=5000.0), dict(),
      ["parasitic modes:", "below the required 5000 Hz"]),
+    # leaves no thinner than wide: none is a leaf (the torsion constant of such leaves was
+    # negative, their mode nan, and the reason read "reaches at most n/a")
+    (dict(), dict(width=(1e-3, 2e-3), thickness=(2e-3, 3e-3), length=(50e-3, 200e-3)),
+     ["shape: every leaf within the bounds is at least as thick as it is wide"]),
+    (dict(), dict(width=(1e-3, 3e-3), thickness=(1e-3, 3e-3), length=(50e-3, 200e-3)),
+     ["parasitic modes:", "reaches at most 7.7", "below the required"]),
 ])
 def test_an_infeasible_sizing_names_the_binding_constraint(kwargs, bounds, words):
     r = size_guide(make_flexure(**bounds), BODY, **{**PAPER, **kwargs})
     assert not r.feasible and r.mechanics is None and r.length is None
     for w in words:
         assert w in r.reason, r.reason
+
+
+def test_the_torsion_constant_of_a_rectangle_takes_its_shorter_side_as_thickness():
+    # Roark: a c^3 / 3 (1 - 0.63 c / a), a the longer side; a square 1 x 1: 0.123 (exact 0.141)
+    assert leaf.torsion_constant(1.0, 1.0) == pytest.approx(0.37 / 3)
+    assert leaf.torsion_constant(3e-3, 1e-3) == leaf.torsion_constant(1e-3, 3e-3) > 0
+    with np.errstate(invalid="raise"):
+        assert leaf.torsion_frequency(200e9 / 2.6, RHO, 0.1, 1e-3, 3e-3) > 0
 
 
 def test_evaluate_on_a_grid_matches_the_single_guide():
