@@ -148,8 +148,10 @@ def _parasitic_low(guide: LeafGuide, K: np.ndarray) -> np.ndarray:
 def net_stiffness(guide: LeafGuide, length, width, thickness) -> np.ndarray:
     """Net drive stiffness at the centre of mass, gravity included, over broadcast arrays [N/m]."""
     dims = dict(length=length, width=width, thickness=thickness)
-    K = _guide.clamp_stiffness(guide, **dims) + _guide.clamp_geometric_stiffness(guide, **dims)
-    return _guide.drive_stiffness(_guide.at_centre(K, guide.com_height))
+    h = guide.com_height
+    return _guide.net_drive_stiffness(_guide.at_centre(_guide.clamp_stiffness(guide, **dims), h),
+                                      _guide.at_centre(_guide.clamp_geometric_stiffness(
+                                          guide, **dims), h))
 
 
 def evaluate(guide: LeafGuide, stroke: float, length, width, thickness) -> GridMechanics:
@@ -176,7 +178,7 @@ def evaluate(guide: LeafGuide, stroke: float, length, width, thickness) -> GridM
     Kgc = _guide.clamp_geometric_stiffness(guide, **dims)
     K, Kg = _guide.at_centre(Kc, h), _guide.at_centre(Kgc, h)
     Ks = _guide.at_centre(_guide.clamp_stiffness(guide, deflection=stroke, **dims), h)
-    net = _guide.drive_stiffness(K + Kg)
+    net = _guide.net_drive_stiffness(K, Kg)
     force = _guide.leaf_force(guide)
     buckling = np.broadcast_to(_guide.buckling_factor(guide, **dims), L.shape)
     E, G, rho = guide.youngs_modulus, guide.shear_modulus, guide.density
