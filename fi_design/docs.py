@@ -81,8 +81,22 @@ def _kind(node: dict) -> str:
     if "x-unit" in node:
         return _unit(node["x-unit"])
     if "prefixItems" in node:
-        units = {_unit(p.get("x-unit", "")) for p in node["prefixItems"]}
-        return f"[min, max] in {units.pop()}" if len(units) == 1 else "pair"
+        items = node["prefixItems"]
+        units = {_unit(p.get("x-unit", "")) for p in items}
+        if len(units) != 1:
+            return "pair" if len(items) == 2 else f"{len(items)} values"
+        unit = units.pop()
+        kind = "pair" if len(items) == 2 else f"{len(items)} values"
+        if len(items) == 2 and "[min, max]" in node.get("description", "[min, max]"):
+            kind = "[min, max]"
+        return f"{kind} in {unit}" if unit and unit != "-" else f"{kind} of numbers"
+    if "anyOf" in node and "type" not in node:
+        # a value or a [min, max] pair (a leaf dimension), or a list that may be null
+        kinds = [_kind({**o, "description": node.get("description", "")})
+                 for o in node["anyOf"] if o.get("type") != "null"]
+        if kinds and all(k != "None" for k in kinds) and any(
+                "prefixItems" in o for o in node["anyOf"]):
+            return " or ".join(sorted(kinds, key=lambda k: k.startswith("[")))
     if "enum" in node:
         return " | ".join(str(v) for v in node["enum"])
     if "const" in node:

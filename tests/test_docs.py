@@ -87,6 +87,19 @@ def test_generated_reference_tables_match_the_code(name):
         f"`python -m fi_design.docs {name}`")
 
 
+def test_the_spec_table_names_what_a_list_of_values_holds():
+    """The table called the sensor's [y, z] offset '[min, max] in m', and a leaf dimension
+    (one value or bounds) 'array or None'."""
+    kinds = {row.split(" | ")[0].strip("| `"): row.split(" | ")[1]
+             for row in docs.spec_table().splitlines() if row.startswith("| `")}
+    assert kinds["stage.sensor_offset"] == "pair in m"
+    assert kinds["stage.size"] == "3 values in m"
+    assert kinds["stage.inertia"] == "3 values in kg m^2"
+    assert kinds["isolator.flexure.length"] == "m or [min, max] in m"
+    assert kinds["requirements.recommend.stroke"] == "[min, max] in m"
+    assert kinds["controller.filters[type=notch].damping"] == "pair of numbers"
+
+
 def test_readme_commands_marked(readme):
     for marker in ("<!-- test-command -->", "<!-- run-command -->"):
         assert marker in readme

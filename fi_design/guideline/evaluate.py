@@ -162,7 +162,9 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
         advice = isolator_advice(model, gap, xo) if not model.has_isolator else None
         fe = _fe_check(fx) if fe_check else None
         checks = (gap.checks + xo.checks + st.checks
-                  + flexure_checks(fx, xo.desired, model.requirements.parasitic_separation,
+                  + flexure_checks(fx, xo.desired if xo.loop_crossover is None
+                                   else xo.loop_crossover,
+                                   model.requirements.parasitic_separation,
                                    model.joint.stiffness if model.joint else None)
                   + pid.checks)
         result = DesignResult(

@@ -58,7 +58,7 @@ def mechanics(guide: LeafGuide, stroke: float) -> GuideMechanics:
     K, Kg = _guide.at_centre(Kc, h), _guide.at_centre(Kgc, h)
     K_stroke = _guide.at_centre(_guide.clamp_stiffness(guide, deflection=stroke), h)
     elastic = float(_guide.drive_stiffness(K))
-    net = float(_guide.drive_stiffness(K + Kg))
+    net = float(_guide.net_drive_stiffness(K, Kg))
     force = _guide.leaf_force(guide)
     compressed = force < 0.0
     factor = _guide.buckling_factor(guide) if compressed else None

@@ -35,8 +35,9 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
     fx : FlexureResult or None
         The guide (:func:`step3_flexure`).
     crossover : float
-        The loop's crossover [Hz]; every parasitic mode must lie at
-        ``separation`` times it.
+        The loop's crossover [Hz] (the highest 0 dB crossing of the limit cases in the loop's
+        band, as step 2 judges the given modes on it; the desired crossover when no case
+        crosses there); every parasitic mode must lie at ``separation`` times it.
     separation : float
         ``requirements.parasitic_separation`` [-].
     joint_stiffness : float, optional
@@ -84,8 +85,9 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
             "flexure.modes", low.frequency >= need, low.frequency, need, "Hz",
             f"lowest parasitic mode of the guide: {low.name} at {_g(low.frequency)} Hz"
             + (" at full stroke" if at_stroke else "")
-            + (f", above {number(separation, 6)} x the crossover" if low.frequency >= need else
-               f", below {number(separation, 6)} x the crossover ({_g(need)} Hz)"), step=step))
+            + (", above" if low.frequency >= need else ", below")
+            + f" {number(separation, 6)} x the loop's crossover {quantity(crossover, 'Hz', 4)}: "
+            + quantity(need, 'Hz', 4), step=step))
     if grav.sag > 0.0:
         out.append(Check(
             "flexure.sag", grav.sag < fx.stroke, grav.sag, fx.stroke, "m",

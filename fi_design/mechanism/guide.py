@@ -40,7 +40,7 @@ from . import leaf
 
 __all__ = ["EFFECTIVE_MASS", "MODE_NAMES", "leaf_force", "weight_vector", "clamp_stiffness",
            "clamp_geometric_stiffness", "at_centre", "mass_matrix", "stiffness6",
-           "drive_stiffness", "buckling_factor", "stage_modes", "leaf_modes"]
+           "drive_stiffness", "net_drive_stiffness", "buckling_factor", "stage_modes", "leaf_modes"]
 
 #: Effective modal mass of a clamped-clamped beam's first bending mode over its mass [-];
 #: half of it is taken to act on the stage's clamp (the other half on the cart's).
@@ -181,6 +181,21 @@ def stiffness6(K: np.ndarray) -> Stiffness6 | np.ndarray:
 def drive_stiffness(K: np.ndarray):
     """x stiffness at the centre of mass with the other directions free [N/m]."""
     return 1.0 / np.linalg.inv(K)[..., 0, 0]
+
+
+def net_drive_stiffness(K: np.ndarray, Kg: np.ndarray):
+    """x stiffness at the centre of mass with gravity's stiffness, the others free [N/m].
+
+    Where gravity's share is round-off (within 1e-9 of the elastic drive
+    stiffness: a weight across the drive direction, ``flat``), the elastic one.
+
+    Parameters
+    ----------
+    K, Kg : numpy.ndarray, shape (..., 6, 6)
+        Elastic and gravity's stiffness at the centre of mass.
+    """
+    elastic, net = drive_stiffness(K), drive_stiffness(K + Kg)
+    return np.where(np.abs(net - elastic) <= 1e-9 * np.abs(elastic), elastic, net)
 
 
 def buckling_factor(guide: LeafGuide, *, length=None, width=None, thickness=None,

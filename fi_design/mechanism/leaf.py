@@ -51,14 +51,24 @@ BCM_AXIAL = 700.0
 
 
 def torsion_constant(width, thickness):
-    """Saint-Venant torsion constant of a thin rectangle, ``b t^3 / 3 (1 - 0.63 t / b)`` [m^4].
+    """Saint-Venant torsion constant of a rectangle, ``a c^3 / 3 (1 - 0.63 c / a)`` [m^4].
+
+    ``a`` the longer side and ``c`` the shorter: ``b t^3 / 3 (1 - 0.63 t / b)``
+    for a leaf (b >= t); a section thicker than wide takes its sides the
+    other way round (the formula with b < t turns negative).
 
     Parameters
     ----------
     width, thickness : float or numpy.ndarray
-        b >= t [m].
+        b, t [m].
+
+    Examples
+    --------
+    >>> float(torsion_constant(2.0, 1.0)) == float(torsion_constant(1.0, 2.0))
+    True
     """
-    return width * thickness ** 3 / 3.0 * (1.0 - 0.63 * thickness / width)
+    a, c = np.maximum(width, thickness), np.minimum(width, thickness)
+    return a * c ** 3 / 3.0 * (1.0 - 0.63 * c / a)
 
 
 def _zeros(*arrays):

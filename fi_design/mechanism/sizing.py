@@ -148,8 +148,10 @@ def _parasitic_low(guide: LeafGuide, K: np.ndarray) -> np.ndarray:
 def net_stiffness(guide: LeafGuide, length, width, thickness) -> np.ndarray:
     """Net drive stiffness at the centre of mass, gravity included, over broadcast arrays [N/m]."""
     dims = dict(length=length, width=width, thickness=thickness)
-    K = _guide.clamp_stiffness(guide, **dims) + _guide.clamp_geometric_stiffness(guide, **dims)
-    return _guide.drive_stiffness(_guide.at_centre(K, guide.com_height))
+    h = guide.com_height
+    return _guide.net_drive_stiffness(_guide.at_centre(_guide.clamp_stiffness(guide, **dims), h),
+                                      _guide.at_centre(_guide.clamp_geometric_stiffness(
+                                          guide, **dims), h))
 
 
 def evaluate(guide: LeafGuide, stroke: float, length, width, thickness) -> GridMechanics:
@@ -176,7 +178,7 @@ def evaluate(guide: LeafGuide, stroke: float, length, width, thickness) -> GridM
     Kgc = _guide.clamp_geometric_stiffness(guide, **dims)
     K, Kg = _guide.at_centre(Kc, h), _guide.at_centre(Kgc, h)
     Ks = _guide.at_centre(_guide.clamp_stiffness(guide, deflection=stroke, **dims), h)
-    net = _guide.drive_stiffness(K + Kg)
+    net = _guide.net_drive_stiffness(K, Kg)
     force = _guide.leaf_force(guide)
     buckling = np.broadcast_to(_guide.buckling_factor(guide, **dims), L.shape)
     E, G, rho = guide.youngs_modulus, guide.shear_modulus, guide.density
@@ -317,7 +319,9 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
         slope = np.maximum(net - k_geo, 1e-12) / b
         b = np.clip(b + (kt - net) / slope, b0, b1)
     grid = evaluate(base, stroke, L, b, t)
-    ok_stress = grid.stress <= base.allowed_stress
+    # a leaf thinner than wide, as a drawn one must be: else it bends across its width
+    ok_shape = grid.thickness < grid.width
+    ok_stress = ok_shape & (grid.stress <= base.allowed_stress)
     ok_stiff = (grid.net > 0.0) & (grid.net <= kmax * (1.0 + 1e-9))
     ok_buckle = grid.buckling >= required_buckling
     ok_modes = grid.lowest_mode >= required_frequency
@@ -325,7 +329,7 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
     if not ok.any():
         return FlexureResult(feasible=False, drawn=False, mechanics=None, reason=_why(
             grid, base, stroke, kmax, required_frequency, required_buckling,
-            (ok_stress, ok_stiff, ok_buckle, ok_modes)), **terms)
+            (ok_shape, ok_stress, ok_stiff, ok_buckle, ok_modes)), **terms)
     err = np.where(ok, np.abs(np.log(np.maximum(grid.net, 1e-300) / kt)), np.inf)
     margin = np.minimum(np.minimum(base.allowed_stress / grid.stress,
                                    grid.lowest_mode / required_frequency),
@@ -342,12 +346,16 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
 
 def _why(grid: GridMechanics, guide: LeafGuide, stroke: float, kmax: float, f_req: float,
          buckling_req: float, oks) -> str:
-    """Name the binding constraint of an infeasible sizing: the first, in the order stress,
-    stiffness, buckling, modes, that no design meeting the ones before it can meet."""
-    ok_stress, ok_stiff, ok_buckle, ok_modes = oks
+    """Name the binding constraint of an infeasible sizing: the first, in the order shape,
+    stress, stiffness, buckling, modes, that no design meeting the ones before it can meet."""
+    ok_shape, ok_stress, ok_stiff, ok_buckle, ok_modes = oks
     sa = guide.allowed_stress
-    if not ok_stress.any():
-        least = float(grid.stress.min())
+    if not ok_shape.any():
+        return ("shape: every leaf within the bounds is at least as thick as it is wide "
+                f"(thickness from {_mm(float(grid.thickness.min()))}, width at most "
+                f"{_mm(float(grid.width.max()))}); a leaf must be thinner than wide")
+    if not ok_stress.any():  # ok_stress holds the shape: the least stress of shaped leaves
+        least = float(np.min(np.where(ok_shape, grid.stress, np.inf)))
         return ("stress: every leaf within the bounds reaches at least "
                 f"{quantity(least, 'Pa', 4, shown=('MPa', 1e-6))} at {_mm(stroke)} stroke, above "
                 "the allowed "

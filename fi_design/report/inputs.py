@@ -5,7 +5,7 @@ from __future__ import annotations
 import datetime
 from typing import Any, Callable
 
-from ..display import plain
+from ..display import NBSP, plain, quantity
 from .meta import spec_file
 
 __all__ = ["spec_inputs", "split_inputs", "SETTINGS"]
@@ -129,6 +129,11 @@ def spec_inputs(spec: Any, model: Any) -> list[dict]:
                 row["source"] = "not given"
         if isinstance(value, tuple) and not value:
             row["value"] = "none"
+        elif (isinstance(value, tuple) and len(value) > 1
+              and "[min, max]" not in (getattr(info, "description", "") or "")
+              and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
+            # a list of values ([y, z], [x, y, z]), not a range: commas, not an en dash
+            row["value"] = quantity(value, unit, sep=NBSP, joiner=", ")
         if path == "report.revision" and not given and spec.report.revisions:
             row["source"] = "derived default: the last entry of report.revisions"
         if isinstance(value, datetime.date):

@@ -174,6 +174,11 @@ def antiresonance(mode: ParasiticMode) -> float:
 #: long-stroke stage moves up to about a metre on a stroke of half a millimetre, 2000 times).
 MOVE_STROKE_PLAUSIBLE = 2000.0
 
+#: An end stop's contact stiffness at least this many times the joint's (its given drive
+#: stiffness, else k_max) limits the stroke, as the limit cases with the joint on its limiter
+#: (rigid there) assume.
+LIMITER_STIFFER = 10.0
+
 
 
 def warnings_for(spec: Spec) -> list[tuple[str, str]]:
@@ -188,7 +193,8 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     deliberately and is not warned about when left out, nor when given at
     its value), a stroke within five presliding ranges, a move
     :data:`MOVE_STROKE_PLAUSIBLE` times the stroke or more, a motion that
-    outlasts the run, a hunting window that starts before the last move ends,
+    outlasts the run, a hunting window that starts before the last move ends, an end stop
+    the user made less than :data:`LIMITER_STIFFER` times stiffer than the joint,
     and a loop without the hardware's sampling and delay (a
     continuous controller without delay: the margins and the hunting depend
     on both).
@@ -218,6 +224,18 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
             out.append(("isolator.stroke",
                         f"stroke {quantity(spec.isolator.stroke, 'm', 3)} is within 5x the presliding "
                         f"range Fs/sigma0 = {quantity(presl, 'm', 3)}: the joint can hardly isolate"))
+    iso = spec.isolator
+    if iso is not None and "stiffness" in iso.limiter.model_fields_set:
+        k = iso.stiffness if iso.stiffness is not None else stiffness_limit(spec)
+        if iso.limiter.stiffness < LIMITER_STIFFER * k:
+            whose = ("the joint's drive stiffness" if iso.stiffness is not None else
+                     "k_max = Fs / stroke (the stiffest joint step 3 allows)")
+            out.append(("isolator.limiter.stiffness",
+                        "the end stop's contact stiffness "
+                        f"{quantity(iso.limiter.stiffness, 'N/m')} is less than "
+                        f"{number(LIMITER_STIFFER)} times {whose}, {quantity(k, 'N/m')}: it "
+                        "hardly limits the stroke, while the limit cases with the limiter "
+                        "engaged (3 and 4) take the joint on its end stop as rigid"))
     if spec.isolator is not None:
         for i, mv in enumerate(spec.motion.moves):
             ratio = abs(mv.distance) / spec.isolator.stroke

@@ -55,6 +55,12 @@ class Stage(Body):
             value = getattr(self, name)
             if value is not None and not all(v > 0 for v in value):
                 raise ValueError(f"{name} must be positive in all three directions")
+        if self.inertia is not None and all(v > 0 for v in self.inertia):
+            total = sum(self.inertia)
+            # a rigid body's principal moments: each at most the sum of the other two
+            if any(v > (total - v) * (1 + 1e-9) for v in self.inertia):
+                raise ValueError("inertia is no rigid body's: each of Ixx, Iyy, Izz must be at "
+                                 "most the sum of the other two")
         if self.inertia is not None and self.centre_of_mass_height is None:
             raise ValueError("inertia needs centre_of_mass_height (the size gives it otherwise)")
         return self

@@ -50,6 +50,7 @@ KNOWN_UNITS = {
     "Hz": "frequency",
     "Pa": "pressure or stress",
     "kg/m**3": "density",
+    "kg*m**2": "moment of inertia",
     "rad": "angle",
     "deg": "angle",
     "dB": "gain in decibels",

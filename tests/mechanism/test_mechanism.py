@@ -13,7 +13,7 @@ from hypothesis import given, settings, strategies as st
 
 from fi_design.mechanism import guide as gd
 from fi_design.mechanism import leaf, mechanics
-from fi_design.mechanism.sizing import evaluate, size_guide, stock_thicknesses
+from fi_design.mechanism.sizing import evaluate, net_stiffness, size_guide, stock_thicknesses
 from fi_design.mechanism.geometry import stage_body
 from fi_design.results.mechanism import GRAVITY, LeafGuide, box_inertia, steel_cube
 from fi_design.spec import Flexure, Stage
@@ -79,7 +79,12 @@ def test_gravity_softens_a_standing_guide_and_stiffens_a_hanging_one():
     for orientation in ("flat", "vertical_axis"):
         m = mechanics(make_guide(orientation=orientation), 0.3e-3)
         assert m.gravity.axial_load == 0.0 and m.gravity.buckling_factor is None
-        assert abs(m.gravity.geometric_stiffness) < 1e-6 * m.stiffness.x
+        # exactly none: the report printed 'gravity -1.364 × 10⁻¹⁰ N/m' for a flat guide
+        assert m.gravity.geometric_stiffness == 0.0 and m.net_drive_stiffness == m.stiffness.x
+    flat = make_guide(orientation="flat", spacing=59e-3)
+    assert mechanics(flat, 0.3e-3).gravity.geometric_stiffness == 0.0
+    assert float(net_stiffness(flat, flat.length, flat.width, flat.thickness)) == \
+        mechanics(flat, 0.3e-3).stiffness.x
 
 
 def test_buckling_of_a_low_stage_is_the_euler_sway_load():
@@ -262,12 +267,26 @@ def test_sized_guides_meet_their_constraints(k_target, headroom, stroke, f_req, 
      ["buckling:", "standing", "below the 3 required"]),
     (dict(required_frequency=5000.0), dict(),
      ["parasitic modes:", "below the required 5000 Hz"]),
+    # leaves no thinner than wide: none is a leaf (the torsion constant of such leaves was
+    # negative, their mode nan, and the reason read "reaches at most n/a")
+    (dict(), dict(width=(1e-3, 2e-3), thickness=(2e-3, 3e-3), length=(50e-3, 200e-3)),
+     ["shape: every leaf within the bounds is at least as thick as it is wide"]),
+    (dict(), dict(width=(1e-3, 3e-3), thickness=(1e-3, 3e-3), length=(50e-3, 200e-3)),
+     ["parasitic modes:", "reaches at most 7.7", "below the required"]),
 ])
 def test_an_infeasible_sizing_names_the_binding_constraint(kwargs, bounds, words):
     r = size_guide(make_flexure(**bounds), BODY, **{**PAPER, **kwargs})
     assert not r.feasible and r.mechanics is None and r.length is None
     for w in words:
         assert w in r.reason, r.reason
+
+
+def test_the_torsion_constant_of_a_rectangle_takes_its_shorter_side_as_thickness():
+    # Roark: a c^3 / 3 (1 - 0.63 c / a), a the longer side; a square 1 x 1: 0.123 (exact 0.141)
+    assert leaf.torsion_constant(1.0, 1.0) == pytest.approx(0.37 / 3)
+    assert leaf.torsion_constant(3e-3, 1e-3) == leaf.torsion_constant(1e-3, 3e-3) > 0
+    with np.errstate(invalid="raise"):
+        assert leaf.torsion_frequency(200e9 / 2.6, RHO, 0.1, 1e-3, 3e-3) > 0
 
 
 def test_evaluate_on_a_grid_matches_the_single_guide():
@@ -447,3 +466,25 @@ def test_given_modes_replace_or_join_the_computed_ones(paper_spec):
     plain = _paper_variant(paper_spec, **{"isolator.parasitic_modes": [
         {"name": "tilt", "frequency": "150 Hz"}]})
     assert [m.source for m in resolve(plain).modes] == ["given"]
+
+
+def test_the_guide_s_modes_are_judged_on_the_loop_s_crossover_as_step_2_judges_them(paper_spec):
+    """A drawn guide of 9 mm wide leaves has its lateral mode at 30 Hz: step 2 judged it
+    against 3 x the loop's crossover (12 Hz, case 2 crossing highest: 36 Hz) and found the
+    crossover limited by it, while step 3's check passed it against 3 x the desired 8 Hz."""
+    from fi_design import design
+
+    spec = _paper_variant(paper_spec, **{
+        "isolator.stiffness": None, "isolator.damping": None, "isolator.parasitic_modes": [],
+        "isolator.flexure.length": "50.7 mm", "isolator.flexure.width": "9 mm",
+        "isolator.flexure.thickness": "0.45 mm"})
+    r = design(spec, confirm=False)
+    check = next(c for c in r.checks if c.name == "flexure.modes")
+    low = r.flexure.lowest_mode
+    assert low.direction == "y" and 25.0 < low.frequency < 35.0
+    separation = next(m for m in r.crossover.parasitic_modes if m.name == low.name)
+    assert r.crossover.loop_crossover > r.crossover.desired
+    assert check.limit == pytest.approx(3.0 * r.crossover.loop_crossover)
+    assert check.limit == pytest.approx(separation.required)
+    assert not check.passed and not separation.passed
+    assert "loop's crossover" in check.message

@@ -1301,3 +1301,20 @@ def test_no_markup_of_another_format_in_the_html(design_html):
     text = _visible_text(design_html)
     for mark in ("`", ":func:", ":class:", "DESIGN.md"):
         assert mark not in text, (mark, text[max(0, text.find(mark) - 80):text.find(mark) + 80])
+
+
+def test_the_inputs_table_lists_values_with_commas_and_ranges_with_a_dash(paper_spec):
+    """The stage's [x, y, z] size and [y, z] offsets read '40 – 50 – 60 mm' and '0 – 0 mm',
+    as if they were ranges, beside the flexure's real [min, max] bounds."""
+    from fi_design.model import resolve
+    from fi_design.report.filters import qty
+    from fi_design.report.inputs import spec_inputs
+
+    from conftest import variant
+
+    spec = variant(paper_spec, **{"stage.size": ["40 mm", "50 mm", "60 mm"]})
+    rows = {r["path"]: qty(r["value"], r["unit"])
+            for g in spec_inputs(spec, resolve(spec)) for r in g["rows"]}
+    assert rows["stage.size"] == "40, 50, 60\u00a0mm"
+    assert rows["stage.sensor_offset"] == "0, 0\u00a0mm"
+    assert rows["isolator.flexure.length"] == "10 \u2013 60\u00a0mm"

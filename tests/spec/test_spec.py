@@ -172,3 +172,35 @@ def test_motion_spans_and_end_time(paper_spec):
             {"distance": "10 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2"},
             {"distance": "5 mm", "velocity": "50 mm/s", "acceleration": "1 m/s^2",
              "start": "0.1 s"}]})
+
+
+def test_the_stage_given_by_its_inertia_reads_and_checks_it(paper_spec):
+    """stage.inertia was refused whatever its value ("unknown target unit 'kg*m**2'"): the
+    unit was missing from the spec's units."""
+    spec = variant(paper_spec, **{"stage.inertia": ["1e-3 kg*m^2", "1000 kg*mm^2", 0.002],
+                                  "stage.centre_of_mass_height": "30 mm",
+                                  "isolator.flexure.spacing": "40 mm"})
+    assert spec.stage.inertia == pytest.approx((1e-3, 1e-3, 2e-3))
+    with pytest.raises(SpecError) as err:
+        variant(spec, **{"stage.inertia": [0.001, "0.001 N", 0.001]})
+    assert err.value.path == "stage.inertia[1]" and "not a moment of inertia" in str(err.value)
+    # Ixx = 1 with Iyy = Izz = 1e-3 kg m^2 is no rigid body's (Iyy + Izz >= Ixx)
+    with pytest.raises(SpecError) as err:
+        variant(spec, **{"stage.inertia": [1.0, 1e-3, 1e-3]})
+    assert err.value.path == "stage" and "sum of the other two" in str(err.value)
+
+
+def test_an_end_stop_softer_than_the_joint_is_warned_about(paper_spec):
+    """A 1 N/m end stop on a 6667 N/m joint passed without a word, its limit cases 3 and 4
+    (the joint rigid on its limiter) judged as if it stopped the stroke."""
+    soft = variant(paper_spec, **{"isolator.limiter": {"stiffness": "1 N/m"}})
+    found = dict(sp.warnings_for(soft))
+    assert "1 N/m" in found["isolator.limiter.stiffness"]
+    assert "6667 N/m" in found["isolator.limiter.stiffness"]
+    # without isolator.stiffness it is held against k_max = Fs / stroke = 13333 N/m
+    drawn = variant(soft, **{"isolator.stiffness": None, "isolator.damping": None})
+    assert "13333 N/m" in dict(sp.warnings_for(drawn))["isolator.limiter.stiffness"]
+    # the default 1e6 N/m, and a given one 10 times the joint's, are stiff enough
+    for stop in (None, {"stiffness": "66670 N/m"}):
+        assert "isolator.limiter.stiffness" not in dict(
+            sp.warnings_for(variant(paper_spec, **{"isolator.limiter": stop})))
