@@ -67,7 +67,7 @@ PLAUSIBLE = {"kg": (1e-6, 1e6), "N": (0.0, 1e15), "N/m": (1e-6, 1e15), "N*s/m": 
              "N/(m*s)": (0.0, 1e20), "m": (1e-15, 1e3), "s": (1e-15, 1e9),
              "m/s": (1e-15, 1e4), "m/s**2": (1e-12, 1e8), "m/s**3": (1e-12, 1e12),
              "Hz": (1e-9, 1e9), "Pa": (1e-3, 1e14), "kg/m**3": (1e-3, 1e6),
-             "A": (0.0, 1e6), "N/A": (0.0, 1e6)}
+             "kg*m**2": (1e-15, 1e6), "A": (0.0, 1e6), "N/A": (0.0, 1e6)}
 
 _DB = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*dB\s*$")
 #: A comma between digits: a decimal comma ("1,25 kg") or a thousands separator ("6,667 N/m").
