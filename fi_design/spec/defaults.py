@@ -180,6 +180,12 @@ MOVE_STROKE_PLAUSIBLE = 2000.0
 LIMITER_STIFFER = 10.0
 
 
+#: Mean densities of a stage given by its box (``stage.size``), ``(least, most)`` [kg/m^3]:
+#: denser than osmium (22,590) no solid is; an open frame in its bounding box is lighter than
+#: a solid block, but not a hundredth of water. Outside, the size's unit is the likely slip,
+#: and the inertia on the guide (its tilt modes) is off by as much.
+STAGE_DENSITY = (10.0, 22600.0)
+
 
 def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     """Suspicious but legal input, as ``(path, message)`` pairs.
@@ -194,7 +200,8 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     its value), a stroke within five presliding ranges, a move
     :data:`MOVE_STROKE_PLAUSIBLE` times the stroke or more, a motion that
     outlasts the run, a hunting window that starts before the last move ends, an end stop
-    the user made less than :data:`LIMITER_STIFFER` times stiffer than the joint,
+    the user made less than :data:`LIMITER_STIFFER` times stiffer than the joint, a stage
+    box whose mean density lies outside :data:`STAGE_DENSITY`,
     and a loop without the hardware's sampling and delay (a
     continuous controller without delay: the margins and the hunting depend
     on both).
@@ -236,6 +243,20 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
                         f"{number(LIMITER_STIFFER)} times {whose}, {quantity(k, 'N/m')}: it "
                         "hardly limits the stroke, while the limit cases with the limiter "
                         "engaged (3 and 4) take the joint on its end stop as rigid"))
+    size = spec.stage.size
+    if size is not None:
+        rho = spec.stage.mass / (size[0] * size[1] * size[2])
+        least, most = STAGE_DENSITY
+        if not least <= rho <= most:
+            out.append(("stage.size",
+                        f"the stage's {quantity(spec.stage.mass, 'kg', 4)} in a box of "
+                        + " x ".join(quantity(v, 'm', 4) for v in size)
+                        + f" is a mean density of {quantity(rho, 'kg/m**3', 3)}, "
+                        + (f"denser than any solid (osmium, the densest, about {quantity(most, 'kg/m**3', 3)})"
+                           if rho > most else
+                           "less than a hundredth of water's")
+                        + ": check the size's unit; the stage's inertia on the guide, and "
+                        "so its tilt modes, follow from it"))
     if spec.isolator is not None:
         for i, mv in enumerate(spec.motion.moves):
             ratio = abs(mv.distance) / spec.isolator.stroke

@@ -204,3 +204,19 @@ def test_an_end_stop_softer_than_the_joint_is_warned_about(paper_spec):
     for stop in (None, {"stiffness": "66670 N/m"}):
         assert "isolator.limiter.stiffness" not in dict(
             sp.warnings_for(variant(paper_spec, **{"isolator.limiter": stop})))
+
+
+def test_a_stage_box_no_solid_fills_is_warned_about(paper_spec):
+    """1.6 kg in a 1 mm cube (a size written in mm where metres were meant, or the reverse)
+    passed without a word, its inertia on the guide, and so its tilt modes, wrong by the
+    same factor."""
+    dense = variant(paper_spec, **{"stage.size": ["1 mm", "1 mm", "1 mm"]})
+    text = dict(sp.warnings_for(dense))["stage.size"]
+    assert "1.6 kg" in text and "denser than any solid" in text
+    assert "1.6\xa0×\xa010⁹ kg/m³" in text  # 1.6 kg / 1e-9 m^3
+    light = variant(paper_spec, **{"stage.size": ["1 m", "1 m", "1 m"]})
+    assert "less than a hundredth of water" in dict(sp.warnings_for(light))["stage.size"]
+    # a solid steel block (7800 kg/m^3) and an open frame in its box (about 200) are plausible
+    for size in (["60 mm", "58.5 mm", "58.5 mm"], ["200 mm", "200 mm", "200 mm"], None):
+        assert "stage.size" not in dict(sp.warnings_for(variant(paper_spec,
+                                                               **{"stage.size": size})))
