@@ -196,8 +196,9 @@ class Model:
         A guide drawn in the spec is evaluated; one given by bounds is sized
         for the joint's stiffness and stroke (:func:`fi_design.mechanism.sizing.size_guide`:
         k_max, the stress, ``requirements.buckling_factor`` and every parasitic mode at
-        ``parasitic_separation`` x the crossover). Worked out on first use and
-        kept by :meth:`at` while the joint stays.
+        ``parasitic_separation`` x the loop's crossover, :attr:`sizing_crossover`, as
+        step 3 judges it). Worked out on first use and kept by :meth:`at` while the
+        joint stays.
         """
         flex = self.flexure_spec
         if flex is None:
@@ -207,11 +208,23 @@ class Model:
         req = self.requirements
         common = dict(stroke=self.joint.stroke, cart_mass=self.m2,
                       maximum_stiffness=_spec.stiffness_limit(self.spec, self.joint.stroke),
-                      required_frequency=req.parasitic_separation * self.crossover,
+                      required_frequency=req.parasitic_separation * self.sizing_crossover,
                       required_buckling=req.buckling_factor)
         if flex.drawn:
             return drawn_guide(flex, self.body, **common)
         return size_guide(flex, self.body, target_stiffness=self.joint.stiffness, **common)
+
+    @property
+    def sizing_crossover(self) -> float:
+        """The loop's crossover a guide is sized against [Hz]: the highest 0 dB crossing of the
+        rigid limit cases in the loop's band (with the cart stuck and the joint free it lies
+        well above the crossover the PID is tuned for: the joint's resonance lifts |L|), else
+        the controller's crossover (:func:`fi_design.mechanism.plants.rigid_loop_crossover`).
+        """
+        from .mechanism.plants import rigid_loop_crossover
+
+        top = rigid_loop_crossover(self)
+        return self.crossover if top is None else top
 
     @cached_property
     def modes(self) -> tuple[Mode, ...]:

@@ -68,6 +68,8 @@ import numpy as np
 from ..controller.polynomials import controller_polynomials, pid_polynomials, reference_polynomials
 from ..errors import SpecError
 from ..mechanism.modes import mode_factor, mode_term
+from ..mechanism.plants import (BAND_FACTOR, balanced_scale, rigid_plant, scaled,
+                                two_mass_plant)
 from ..model import Model, require_model
 from ..results import Status, frozen_array
 from ..results.controller import ControlLaw, PidGains
@@ -106,9 +108,6 @@ CASE_NUMBERS = {**{n: i for i, n in enumerate(ISOLATED_CASES, 1)},
 #: A -180 deg crossing where |L| is below 1 / MUTE (120 dB down: a full notch's zero, where the
 #: phase flips) is no crossing to report [-].
 MUTE = 1e6
-#: A gain crossover more than this factor below the controller's crossover lies outside the
-#: loop's band (:attr:`CaseMargins.in_band`) [-].
-BAND_FACTOR = 10.0
 
 
 # --------------------------------------------------------------------------- plants
@@ -153,7 +152,8 @@ class LimitCase:
 def _rigid(mass: float, damping: float, stiffness: float):
     A = np.array([[0.0, 1.0], [-stiffness / mass, -damping / mass]])
     B = np.array([[0.0], [1.0 / mass]])
-    return control.ss(A, B, np.array([[1.0, 0.0]]), 0.0), [1.0], [mass, damping, stiffness]
+    return (control.ss(A, B, np.array([[1.0, 0.0]]), 0.0),
+            *rigid_plant(mass, damping, stiffness))
 
 
 def _two_mass(m1: float, m2: float, k: float, c: float, cart_stiffness: float,
@@ -168,13 +168,7 @@ def _two_mass(m1: float, m2: float, k: float, c: float, cart_stiffness: float,
     B = np.array([[0.0], [0.0], [1.0 / m1], [0.0]])
     C = np.array([[1.0, 0.0, 0.0, 0.0]])
     sys = control.ss(A, B, C, 0.0)
-    # P = (m2 s^2 + (c + cd) s + k + kc) / det, expanded by hand so that the
-    # cancelling terms (k^2, 2 c k) never meet in floating point.
-    kc, cd = cart_stiffness, cart_damping
-    num = [m2, c + cd, k + kc]
-    den = [m1 * m2, m1 * (c + cd) + m2 * c, m1 * (k + kc) + m2 * k + c * cd,
-           c * kc + k * cd, k * kc]
-    return sys, num, den
+    return (sys, *two_mass_plant(m1, m2, k, c, cart_stiffness, cart_damping))
 
 
 def limit_cases(model: Model, modes=None) -> tuple[LimitCase, ...]:
@@ -428,26 +422,6 @@ def complementary_sensitivity(model: Model, case,
 # --------------------------------------------------------------------------- margins
 
 
-def _scaled(p: np.ndarray, w0: float) -> np.ndarray:
-    """Coefficients of p(w0 s') in s' (descending powers)."""
-    n = len(p) - 1
-    return np.asarray(p, float) * w0 ** np.arange(n, -1, -1, dtype=float)
-
-
-def _balanced_scale(den: np.ndarray) -> float:
-    """The geometric mean of the magnitudes of the nonzero roots of ``den`` [rad/s] (1 without).
-
-    Scaling s by it makes the polynomial's leading and trailing coefficients alike, which
-    keeps the squared polynomials of python-control's margin search finite when the loop
-    holds both a millihertz integrator and kilohertz filters."""
-    d = np.trim_zeros(np.asarray(den, float), "f")
-    d = np.trim_zeros(d, "b")
-    if d.size < 2:
-        return 1.0
-    lead, tail = abs(d[0]), abs(d[-1])
-    return float((tail / lead) ** (1.0 / (d.size - 1)))
-
-
 def loop_margins(num: Sequence[float], den: Sequence[float], scale: float | None = None,
                  name: str = "", description: str = "") -> CaseMargins:
     """Margins and closed-loop stability of a loop L = num/den.
@@ -459,7 +433,7 @@ def loop_margins(num: Sequence[float], den: Sequence[float], scale: float | None
     scale : float, optional
         Frequency [rad/s] the Laplace variable is scaled by before the
         polynomial root finding; default the geometric mean of the
-        denominator's nonzero roots (:func:`_balanced_scale`), which keeps the
+        denominator's nonzero roots (:func:`fi_design.mechanism.plants.balanced_scale`), which keeps the
         coefficients balanced. Results are reported unscaled.
     name, description : str, optional
         Labels copied into the result.
@@ -470,8 +444,8 @@ def loop_margins(num: Sequence[float], den: Sequence[float], scale: float | None
         The margins; ``passed`` is left True (see :func:`analyse`).
     """
     if scale is None:
-        scale = _balanced_scale(den)
-    ns, ds = _scaled(num, scale), _scaled(den, scale)
+        scale = balanced_scale(den)
+    ns, ds = scaled(num, scale), scaled(den, scale)
     lead = ds[np.nonzero(ds)[0][0]]
     ns, ds = ns / lead, ds / lead
     sys = control.tf(ns, ds)

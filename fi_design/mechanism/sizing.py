@@ -15,7 +15,9 @@ modes and the stress. :func:`size_guide` searches that grid for step 3:
   every parasitic mode (the stage's five, undeflected and at full stroke, and
   the leaves' own) at or above the required frequency;
 - among the designs that meet them, those within :data:`STIFFNESS_TIE` of the
-  closest stiffness; of these the one with the largest smallest margin.
+  closest stiffness; of these the one with the largest smallest margin (the
+  stress's, the modes', buckling's, and k_max over the drive stiffness of the
+  stock's thickest leaves: thin stock's tolerance scatters k the most).
 
 A dimension given as one value (a drawn guide) is not searched;
 :func:`drawn_guide` evaluates a guide drawn in full. The stock's thickness
@@ -334,6 +336,9 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
     margin = np.minimum(np.minimum(base.allowed_stress / grid.stress,
                                    grid.lowest_mode / required_frequency),
                         grid.buckling / required_buckling)
+    dt = flexure.thickness_tolerance
+    if dt > 0.0:  # k_max over the stock's thickest leaves: thin stock scatters k the most
+        margin = np.minimum(margin, kmax / np.maximum(net_stiffness(base, L, b, t + dt), 1e-300))
     close = err <= err.min() + STIFFNESS_TIE
     i, j = np.unravel_index(np.argmax(np.where(close, margin, -np.inf)), err.shape)
     chosen = leaf_guide(flexure, body, length=float(grid.length[i, j]),

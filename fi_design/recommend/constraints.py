@@ -150,7 +150,8 @@ def guide_for(base: Model, stiffness: float, stroke: float, crossover: float, *,
     stroke : float
         One-sided stroke [m].
     crossover : float
-        The loop's crossover [Hz].
+        The controller's crossover [Hz]; the guide's modes are held at the separation
+        times the loop's crossover there (:attr:`fi_design.model.Model.sizing_crossover`).
     points : int, optional
         Lengths of the sizing grid.
 
@@ -159,16 +160,29 @@ def guide_for(base: Model, stiffness: float, stroke: float, crossover: float, *,
     fi_design.results.steps.FlexureResult
         Sized within the base's flexure bounds: k_max, the stress, the
         buckling factor and every parasitic mode at the separation times the
-        crossover.
+        loop's crossover.
     """
     from ..mechanism.sizing import size_guide
 
     req = base.requirements
     return size_guide(base.flexure_spec, base.body, target_stiffness=stiffness,
                       maximum_stiffness=_spec.stiffness_limit(base.spec, stroke), stroke=stroke,
-                      required_frequency=req.parasitic_separation * crossover,
+                      required_frequency=req.parasitic_separation
+                      * _loop_at(base, stiffness, stroke, crossover).sizing_crossover,
                       required_buckling=req.buckling_factor, cart_mass=base.m2,
                       points=points)
+
+
+def _loop_at(base: Model, stiffness: float, stroke: float, crossover: float) -> Model:
+    """The base at a candidate's joint and crossover, its damping as the search gives a
+    candidate's: the spec's damping ratio kept where the spec gives a damping (else the
+    default ratio, which :meth:`~fi_design.model.Model.at` keeps itself)."""
+    iso = base.spec.isolator
+    c = None
+    if iso is not None and iso.damping is not None:
+        m1, m2 = base.m1, base.m2
+        c = 2.0 * base.joint_damping_ratio * math.sqrt(stiffness * m1 * m2 / (m1 + m2))
+    return base.at(stiffness=stiffness, stroke=stroke, crossover=crossover, damping=c)
 
 
 def loop_meets(model: Model) -> tuple[bool, str]:
