@@ -120,18 +120,22 @@ def _message(misfit: float, misfit_after: float, best_explained: float, best_fit
     """The paragraph of a mismatch: how far, what the catalogue does, the likely causes."""
     text = (f"The nominal model misses the record by {number(misfit, 3)} noise units (RMS)"
             + (", far above the noise" if misfit >= STRUCTURE_MISFIT else ""))
+    verdict = "the model's structure does not match the record"
     if best_explained < EXPLAINED_MIN:
         text += (", and no catalogue effect explains most of it (the best removes "
                  f"{percent(best_explained, 2)} of the gap)")
     elif misfit_after >= STRUCTURE_MISFIT:
         text += (f", and the best fit of the catalogue ({best_fit or 'none'}) still leaves "
-                 f"{number(misfit_after, 3)} noise units: no catalogue effect explains the record")
+                 f"{number(misfit_after, 3)} noise units")
+        verdict = ("no catalogue effect explains the record" if check.cause is not None else
+                   "the model's structure does not match the record, and no catalogue effect "
+                   "closes the gap")
     if check.cause is not None:
-        return (text + f". {check.cause.detail} No effect is named from such a record; "
-                "correct the column and reconcile again.")
+        return (text + (f": {verdict}" if verdict.startswith("no catalogue") else "")
+                + f". {check.cause.detail} No effect is named from such a record; correct the "
+                "column and reconcile again.")
     top = [c for c in causes if c.share >= 0.1] or causes[:1]
-    return (text + ": the model's structure does not match the record. Likely causes, "
-            "strongest first: "
+    return (text + f": {verdict}. Likely causes, strongest first: "
             + "; ".join(f"{c.name.replace('_', ' ')} ({percent(c.share, 2)})" for c in top)
             + ". See the residual and its spectrum.")
 
@@ -150,8 +154,10 @@ def force_check(cmp: Comparison, run: ModelRun) -> ForceCheck:
     squares over every sample). A fault is reported only when the force
     residual stays :data:`STRUCTURE_MISFIT` noise levels (RMS) or more and
     that fit removes :data:`FORCE_FIX_SHARE` or more of its energy: then a
-    negative ``scale`` is a flipped sign, one beyond :data:`FORCE_SCALE_LIMIT`
-    either way a unit or gain slip.
+    negative ``scale`` is a flipped sign (its size is not judged: the replay
+    started from the flipped first sample, which bends the model's force
+    too), a positive one beyond :data:`FORCE_SCALE_LIMIT` either way a unit
+    or gain slip.
 
     Parameters
     ----------
@@ -173,21 +179,22 @@ def force_check(cmp: Comparison, run: ModelRun) -> ForceCheck:
     rms0, rms1 = math.sqrt(float(r0 @ r0) / len(r0)), math.sqrt(float(r1 @ r1) / len(r1))
     share = 1.0 - (rms1 / rms0) ** 2 if rms0 > 0 else 0.0
     flipped = scale < 0
-    scaled = not 1.0 / FORCE_SCALE_LIMIT <= abs(scale) <= FORCE_SCALE_LIMIT
+    # a flipped record starts the replay's controller from the wrong first force sample, so
+    # the model's force is bent too and the factor's size says nothing: its sign alone counts
+    scaled = not flipped and not 1.0 / FORCE_SCALE_LIMIT <= scale <= FORCE_SCALE_LIMIT
     if rms0 < STRUCTURE_MISFIT * cmp.noise.force or share < FORCE_FIX_SHARE or \
             not (flipped or scaled):
         return ForceCheck(float(scale), None)
     corr = float(np.corrcoef(meas, model)[0, 1])
-    what = ("sign and scale" if flipped and scaled else "sign" if flipped else "scale")
+    what = "sign" if flipped else "scale"
     detail = (f"force_N's {what} looks wrong: the measured force is {number(scale, 3)} times "
               f"the model's (correlation {fixed(corr, 2)}, after the best fit); with that "
               f"factor and an offset of {quantity(offset, 'N', 3)} its residual drops from "
               f"{quantity(rms0, 'N', 3)} to {quantity(rms1, 'N', 3)} RMS (noise "
               f"{quantity(cmp.noise.force, 'N', 3)}). ")
-    advice = (["Check the sign convention of the logged force (positive pushes the stage "
-               "towards positive position_m) and flip force_N."] if flipped else []) + \
-        (["Check force_N's unit (N) and the logger's gain."] if scaled else [])
-    detail += " ".join(advice)
+    detail += ("Check the sign convention of the logged force (positive pushes the stage "
+               "towards positive position_m) and flip force_N." if flipped else
+               "Check force_N's unit (N) and the logger's gain.")
     return ForceCheck(float(scale), Cause("force_sign" if flipped else "force_scale",
                                           float(min(max(share, 0.0), 1.0)), detail))
 

@@ -89,7 +89,9 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
         The named effect (or ``"none"``), its parameters and honest
         uncertainty, the ranked candidates with the tests each passed, the
         gaps before and after (per named effect too), the lattice, the
-        structure diagnosis and the model traces.
+        structure diagnosis and the model traces. A record whose force_N
+        has the wrong sign or scale (:func:`.diagnosis.force_check`) names
+        no effect.
 
     Raises
     ------
