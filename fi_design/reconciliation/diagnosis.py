@@ -116,7 +116,7 @@ def record_fault(diagnosis: Diagnosis) -> Cause | None:
 
 
 def _message(misfit: float, misfit_after: float, best_explained: float, best_fit: str,
-             causes: list, check: "ForceCheck") -> str:
+             causes: list, check: ForceCheck) -> str:
     """The paragraph of a mismatch: how far, what the catalogue does, the likely causes."""
     text = (f"The nominal model misses the record by {number(misfit, 3)} noise units (RMS)"
             + (", far above the noise" if misfit >= STRUCTURE_MISFIT else ""))

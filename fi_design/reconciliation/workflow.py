@@ -349,7 +349,7 @@ class BestFit(NamedTuple):
     name: str
 
 
-def _best_fit(first, final: "Final", nominal: Baseline) -> BestFit:
+def _best_fit(first, final: Final, nominal: Baseline) -> BestFit:
     """The chosen effects' fit, else the best candidate that ran (the nominal model's when
     none did)."""
     if final.steps:

@@ -344,7 +344,7 @@ def test_the_example_record_with_its_force_negated_names_no_effect(tmp_path):
     lines = (EXAMPLES / "measured_trace.csv").read_text().splitlines()
     out = []
     for line in lines:
-        if line.startswith("#") or line.startswith("time_s"):
+        if line.startswith(("#", "time_s")):
             out.append(line)
             continue
         cells = line.split(",")

@@ -262,7 +262,7 @@ def _shifted(tmp_path, reference: float, position: float):
     lines = (EXAMPLES / "measured_trace.csv").read_text().splitlines()
     out = []
     for line in lines:
-        if line.startswith("#") or line.startswith("time_s"):
+        if line.startswith(("#", "time_s")):
             out.append(line)
             continue
         cells = line.split(",")
