@@ -235,6 +235,8 @@ def print_simulation(console: "Console", result) -> None:
     for k, v in rows:
         t.add_row(Text(k), Text(str(v)))
     console.print(t)
+    for note in () if fit is None else fit.notes:
+        console.print(Text("warning: ", style="bold yellow").append(Text(note)))
     if result.replay is None:
         console.print(Text(m.reason))
         console.print(Text(

@@ -25,8 +25,8 @@ from .dynamic import dynamic_parameters
 from .events import excitation
 from .preprocess import JITTER, check_record, joint_model, prepare, processing
 from .regression import (IMPLAUSIBLE, Solution, check_directions, direction_words, equations,
-                         fit_statistics, force_rss, form_note, rigid_parameters, split_masses,
-                         solve, symmetric_view, threshold_note)
+                         fit_statistics, force_rss, form_note, mass_note, rigid_parameters,
+                         split_masses, solve, symmetric_view, threshold_note)
 from ..results.identification import FORMS, NAMES, ForcePrediction, IdentificationResult
 
 ProgressCallback = Callable[[str, float], None]
@@ -145,6 +145,11 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
         if masses.stage_std_error is not None and m <= 0.0:  # both fitted (a two-mass record)
             notes.append(f"the {name} = {quantity(m, 'kg', 4)} is not positive: {IMPLAUSIBLE}; "
                          "a negative mass also follows from force_N of the wrong sign")
+    far = mass_note(params["mass"], spec, proc, fit)
+    if far:
+        params["mass"] = replace(params["mass"], note=params["mass"].note + "; far from the "
+                                 "spec's moving mass (see the notes)")
+        notes.append(far)
     if measured.disturbance is not None:
         notes.append("force_N is used as the force that acts (the injected disturbance_N "
                      "included); the controller's own output force_N - disturbance_N is not")

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..display import number, quantity
+from ..display import number, percent, quantity, with_error
 from ..errors import DataError
 from ..results import frozen_array
 from .preprocess import Joint, Prepared
@@ -30,6 +30,50 @@ IMPLAUSIBLE = ("physically impossible, so the model (mass, Coulomb and viscous f
                "constant along the travel) does not describe this record; an unmodelled effect "
                "(friction varying along the rail, a cable force, force ripple) or too little "
                "sliding can cause it, and fi-design reconcile names such effects")
+
+#: An identified total mass beyond this factor of the spec's moving mass, either way, is
+#: flagged: a spec's mass is a designer's estimate (drawing or CAD, within some ten or twenty
+#: per cent, a referred screw or rotor inertia included), and a clean record identifies the
+#: mass to a per cent or better; a factor of 1.5 is beyond both, and below the factor of two
+#: at which a force logged in other units (reconcile's force check) is suspected first.
+MASS_FACTOR = 1.5
+#: Relative force residual of the fit from which the model leaves a force unexplained (a
+#: clean simulated record fits to a fraction of a per cent, the real EMPS axis to 2.6 %):
+#: such a force leaks into the mass through the filter, and the mass follows the cut-off.
+FIT_LEAK = 0.05
+
+
+def mass_note(total: Parameter, spec, proc: Processing, fit: Fit) -> str:
+    """A note when the identified total mass is far from the spec's moving mass, with the cause.
+
+    Empty without a spec, without a positive identified mass (a mass that is not positive
+    has a note of its own), or within :data:`MASS_FACTOR` of the spec's stage plus cart mass.
+    The likely cause is read from the fit: a relative force residual of :data:`FIT_LEAK` or
+    more says the model lacks a force (the mass then depends on the low-pass cut-off, which
+    the spec's crossover sets); a close fit says the record is consistent with that mass.
+    """
+    if spec is None or total.value is None or total.value <= 0.0:
+        return ""
+    moving = float(spec.total_mass)
+    ratio = total.value / moving
+    if 1.0 / MASS_FACTOR <= ratio <= MASS_FACTOR:
+        return ""
+    text = (f"mass = {with_error(total.value, total.std_error, 'kg', 3)} is "
+            f"{number(ratio, 3)} times the spec's moving mass (stage + cart = "
+            f"{quantity(moving, 'kg', 4)}), beyond a factor of {number(MASS_FACTOR)} either way: ")
+    if fit.relative_error >= FIT_LEAK:
+        return text + (
+            f"the fit leaves {percent(fit.relative_error, 2)} of the force unexplained, so a "
+            "force the model lacks (force ripple, a cable force, friction varying along the "
+            "rail) most likely leaks into the mass through the low-pass filter, and the mass "
+            f"follows its cut-off ({quantity(proc.cutoff, 'Hz', 3)}: {proc.cutoff_rule}), "
+            "so another spec's crossover (or identify's cutoff argument) gives another mass. "
+            "fi-design reconcile names such effects; do not write this mass into the spec")
+    return text + (
+        f"the fit leaves only {percent(fit.relative_error, 2)} of the force unexplained, so "
+        "the record is consistent with this mass: most likely the spec's stage and cart masses are off "
+        "(the payload, a screw's or rotor's inertia referred to the axis), or force_N is "
+        "not in N (a unit slip or the drive's gain)")
 
 
 def friction_columns(p: Prepared, form: str) -> dict[str, np.ndarray]:

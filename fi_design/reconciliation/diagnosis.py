@@ -1,10 +1,12 @@
 """Structure diagnosis: when no missing effect explains the gap, what might.
 
 When the nominal misfit is far above the noise (:data:`STRUCTURE_MISFIT`
-noise units or more) and no candidate removes most of it, no effect of the
-catalogue is "the" answer: the model's structure does not match the record.
-The nominal residual (force when recorded, else position) then points at
-likely causes, each with the share of the residual that points there:
+noise units or more) and no candidate removes most of it, or the best fit of
+the catalogue still leaves :data:`STRUCTURE_MISFIT` noise units or more, no
+effect of the catalogue is "the" answer: the model's structure (or the
+record) does not match. The nominal residual (force when recorded, else
+position) then points at likely causes, each with the share of the residual
+that points there:
 
 - **controller**: energy at and above a third of the loop's crossover, where
   the controller shapes the response (gains, the derivative's filter and
@@ -16,6 +18,15 @@ likely causes, each with the share of the residual that points there:
 - **disturbance**: slow residual (below a thirtieth of the crossover) left
   after the velocity, direction and acceleration terms are taken out (a
   force the model lacks: cable, drift, a load).
+
+The record itself is checked too (:func:`force_check`): when the force
+channel stays :data:`STRUCTURE_MISFIT` noise units (RMS) or more from the
+model after the best fit, and a factor and an offset on the measured force
+remove :data:`FORCE_FIX_SHARE` or more of that residual's energy, a negative
+factor says that ``force_N``'s sign looks wrong (**force sign**), a factor
+beyond :data:`FORCE_SCALE_LIMIT` either way that its scale does (**force
+scale**: a unit or gain slip). Such a record cannot be explained by any
+effect, and the reconciliation names none.
 """
 
 from __future__ import annotations
@@ -34,10 +45,22 @@ from .significance import EXPLAINED_MIN
 STRUCTURE_MISFIT = 10.0
 #: Share of the record that counts as its start, at least the settle window.
 START_SHARE = 0.05
+#: A factor on the measured force within this ratio of 1 either way is the model's scale:
+#: a spec's mass or friction off by up to a factor of two (the catalogue's mass_error and
+#: friction effects) scales the force that much; a unit or gain slip (mN, kN, kgf: 9.81,
+#: lbf: 4.45, a drive's current in A) scales it further.
+FORCE_SCALE_LIMIT = 2.0
+#: Share of the force residual's energy a factor and an offset on force_N must remove for
+#: its sign or scale to be called wrong (two numbers that explain most of a channel the best
+#: fit of the catalogue leaves far above noise).
+FORCE_FIX_SHARE = 0.75
+#: Causes that are faults of the record, not of the model: no effect is named with one.
+RECORD_CAUSES = ("force_sign", "force_scale")
 
 
 def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
-             best_explained: float) -> Diagnosis:
+             best_explained: float, after: ModelRun | None = None,
+             chi2_after: float | None = None, best_fit: str = "") -> Diagnosis:
     """Whether the model's structure misses the record, and the likely causes.
 
     Parameters
@@ -50,8 +73,17 @@ def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
         Its weighted squared residual [-].
     best_explained : float
         Largest share of the gap above noise a candidate removes, 0-1.
+    after : ModelRun, optional
+        The run of the model after the best fit of the catalogue (default
+        the nominal run): the record's force is checked against it.
+    chi2_after : float, optional
+        The weighted squared residual of the best fit of the catalogue [-]
+        (default ``chi2_nominal``).
+    best_fit : str
+        The effect(s) of that fit, for the message.
     """
     misfit = math.sqrt(chi2_nominal / cmp.n_points)
+    misfit_after = misfit if chi2_after is None else math.sqrt(chi2_after / cmp.n_points)
     use_force = cmp.has_force
     channel = "force" if use_force else "position"
     meas = cmp.meas.force if use_force else cmp.meas.position
@@ -59,21 +91,112 @@ def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
     r = np.where(np.isfinite(model), meas - model, 0.0)
     crossover = cmp.model.crossover
     spec = _spectrum(r, cmp.t)
-    causes = sorted(_causes(cmp, r, crossover, use_force), key=lambda c: -c.share)
-    mismatch = misfit >= STRUCTURE_MISFIT and best_explained < EXPLAINED_MIN
+    check = force_check(cmp, nominal if after is None else after)
+    causes = _causes(cmp, r, crossover, use_force)
+    if check.cause is not None:
+        causes.append(check.cause)
+    causes = sorted(causes, key=lambda c: -c.share)
+    record = check.cause is not None
+    unexplained = best_explained < EXPLAINED_MIN or misfit_after >= STRUCTURE_MISFIT
+    mismatch = record or (misfit >= STRUCTURE_MISFIT and unexplained)
     message = ""
     if mismatch:
-        top = [c for c in causes if c.share >= 0.1] or causes[:1]
-        message = (f"The nominal model misses the record by {number(misfit, 3)} noise units "
-                   "(RMS), far above the noise, and no catalogue effect explains most of it (the "
-                   f"best removes {percent(best_explained, 2)} of the gap): the model's "
-                   "structure does not match the record. Likely causes, strongest first: "
-                   + "; ".join(f"{c.name.replace('_', ' ')} ({percent(c.share, 2)})" for c in top)
-                   + ". See the residual and its spectrum.")
+        message = _message(misfit, misfit_after, best_explained, best_fit, causes, check)
     return Diagnosis(mismatch=mismatch, misfit=misfit, misfit_limit=STRUCTURE_MISFIT,
                      best_explained=float(best_explained), channel=channel,
                      causes=tuple(causes), message=message, frequency=_frozen(spec.frequency),
-                     spectrum=_frozen(spec.density), crossover=float(crossover))
+                     spectrum=_frozen(spec.density), crossover=float(crossover),
+                     misfit_after=float(misfit_after), best_fit=best_fit,
+                     force_scale=check.scale)
+
+
+def record_fault(diagnosis: Diagnosis) -> Cause | None:
+    """The cause that faults the record itself (force_N's sign or scale), if any."""
+    return next((c for c in diagnosis.causes if c.name in RECORD_CAUSES), None)
+
+
+def _message(misfit: float, misfit_after: float, best_explained: float, best_fit: str,
+             causes: list, check: ForceCheck) -> str:
+    """The paragraph of a mismatch: how far, what the catalogue does, the likely causes."""
+    text = (f"The nominal model misses the record by {number(misfit, 3)} noise units (RMS)"
+            + (", far above the noise" if misfit >= STRUCTURE_MISFIT else ""))
+    verdict = "the model's structure does not match the record"
+    if best_explained < EXPLAINED_MIN:
+        text += (", and no catalogue effect explains most of it (the best removes "
+                 f"{percent(best_explained, 2)} of the gap)")
+    elif misfit_after >= STRUCTURE_MISFIT:
+        text += (f", and the best fit of the catalogue ({best_fit or 'none'}) still leaves "
+                 f"{number(misfit_after, 3)} noise units")
+        verdict = ("no catalogue effect explains the record" if check.cause is not None else
+                   "the model's structure does not match the record, and no catalogue effect "
+                   "closes the gap")
+    if check.cause is not None:
+        return (text + (f": {verdict}" if verdict.startswith("no catalogue") else "")
+                + f". {check.cause.detail} No effect is named from such a record; correct the "
+                "column and reconcile again.")
+    top = [c for c in causes if c.share >= 0.1] or causes[:1]
+    return (text + f": {verdict}. Likely causes, strongest first: "
+            + "; ".join(f"{c.name.replace('_', ' ')} ({percent(c.share, 2)})" for c in top)
+            + ". See the residual and its spectrum.")
+
+
+class ForceCheck(NamedTuple):
+    """The record's force against the model's: the factor, and a fault when there is one."""
+
+    scale: float | None
+    cause: Cause | None
+
+
+def force_check(cmp: Comparison, run: ModelRun) -> ForceCheck:
+    """Whether force_N's sign or scale looks wrong against the model after the best fit.
+
+    The measured force is fitted as ``scale * model + offset`` (least
+    squares over every sample). A fault is reported only when the force
+    residual stays :data:`STRUCTURE_MISFIT` noise levels (RMS) or more and
+    that fit removes :data:`FORCE_FIX_SHARE` or more of its energy: then a
+    negative ``scale`` is a flipped sign (its size is not judged: the replay
+    started from the flipped first sample, which bends the model's force
+    too), a positive one beyond :data:`FORCE_SCALE_LIMIT` either way a unit
+    or gain slip.
+
+    Parameters
+    ----------
+    cmp : Comparison
+        The comparison (a compared force channel: closed loop with force_N).
+    run : ModelRun
+        The model after the best fit of the catalogue.
+    """
+    if not cmp.has_force or not run.ok:
+        return ForceCheck(None, None)
+    ok = np.isfinite(run.force)
+    meas, model = cmp.meas.force[ok], run.force[ok]
+    if len(model) < 3 or np.ptp(model) <= 0:
+        return ForceCheck(None, None)
+    A = np.column_stack([model, np.ones(len(model))])
+    (scale, offset), *_ = np.linalg.lstsq(A, meas, rcond=None)
+    r0 = meas - model
+    r1 = meas - A @ np.array([scale, offset])
+    rms0, rms1 = math.sqrt(float(r0 @ r0) / len(r0)), math.sqrt(float(r1 @ r1) / len(r1))
+    share = 1.0 - (rms1 / rms0) ** 2 if rms0 > 0 else 0.0
+    flipped = scale < 0
+    # a flipped record starts the replay's controller from the wrong first force sample, so
+    # the model's force is bent too and the factor's size says nothing: its sign alone counts
+    scaled = not flipped and not 1.0 / FORCE_SCALE_LIMIT <= scale <= FORCE_SCALE_LIMIT
+    if rms0 < STRUCTURE_MISFIT * cmp.noise.force or share < FORCE_FIX_SHARE or \
+            not (flipped or scaled):
+        return ForceCheck(float(scale), None)
+    corr = float(np.corrcoef(meas, model)[0, 1])
+    what = "sign" if flipped else "scale"
+    detail = (f"force_N's {what} looks wrong: the measured force is {number(scale, 3)} times "
+              f"the model's (correlation {fixed(corr, 2)}, after the best fit); with that "
+              f"factor and an offset of {quantity(offset, 'N', 3)} its residual drops from "
+              f"{quantity(rms0, 'N', 3)} to {quantity(rms1, 'N', 3)} RMS (noise "
+              f"{quantity(cmp.noise.force, 'N', 3)}). ")
+    detail += ("Check the sign convention of the logged force (positive pushes the stage "
+               "towards positive position_m) and flip force_N." if flipped else
+               "Check force_N's unit (N) and the logger's gain.")
+    return ForceCheck(float(scale), Cause("force_sign" if flipped else "force_scale",
+                                          float(min(max(share, 0.0), 1.0)), detail))
 
 
 def _frozen(a):

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import time as _time
 from dataclasses import dataclass, replace
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 
@@ -26,14 +26,14 @@ from ..model import resolve
 from ..simulation.replay import DRIVES
 from ..spec.file import as_spec
 from .comparison import MAX_POINTS, Comparison, ModelRun
-from .diagnosis import diagnose
+from .diagnosis import diagnose, record_fault
 from .fitting import (Baseline, FitOutcome, JointObjective, fit, fit_baseline, joint_fit,
                       marginal_covariance, polish_jointly)
 from .gaps import gap_metrics
 from .lattice import find_lattice
 from .noise import channels_autocorrelation_time, estimate_noise, noise_levels
-from ..results.reconciliation import (Candidate, Diagnosis, EffectStep, ReconcileResult,
-                                      SearchRound)
+from ..results.reconciliation import (Candidate, Cause, Diagnosis, EffectStep,
+                                      ReconcileResult, SearchRound)
 from .signatures import Evidence, scan
 from .significance import (NESTED, NULL_SEED, THRESHOLD, block_jackknife, judge,
                            noise_only_refit, numerical_error, passes_primary, prefer_simpler)
@@ -89,7 +89,9 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
         The named effect (or ``"none"``), its parameters and honest
         uncertainty, the ranked candidates with the tests each passed, the
         gaps before and after (per named effect too), the lattice, the
-        structure diagnosis and the model traces.
+        structure diagnosis and the model traces. A record whose force_N
+        has the wrong sign or scale (:func:`.diagnosis.force_check`) names
+        no effect.
 
     Raises
     ------
@@ -137,10 +139,18 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     search = _search(cmp, evidence, args.names, nominal, max_effects, threshold, max_points, say)
     say("corrected model", 0.97)
     final = _final(cmp, search, nominal)
-    gaps = gap_metrics(cmp, nominal.run, final.run, nominal.chi2, final.chi2)
     first = search.rounds[0].candidates if search.rounds else ()
     best = max((c.explained for c in first if c.success), default=0.0)
-    diagnosis = diagnose(cmp, nominal.run, nominal.chi2, best)
+    fitted = _best_fit(first, final, nominal)
+    diagnosis = diagnose(cmp, nominal.run, nominal.chi2, best, after=final.run,
+                         chi2_after=fitted.chi2, best_fit=fitted.name)
+    fault = record_fault(diagnosis)
+    if fault is not None and search.chosen:
+        # a force channel no effect can produce: nothing is named from it
+        search = _withdrawn(search, fault)
+        final = _final(cmp, search, nominal)
+        first = search.rounds[0].candidates
+    gaps = gap_metrics(cmp, nominal.run, final.run, nominal.chi2, final.chi2)
     ambiguous = _ambiguous(first, search.chosen, threshold)
     conclusion = _conclusion(final.steps, first, nominal.chi2, final.chi2, cmp.n_points,
                              ambiguous, diagnosis)
@@ -330,6 +340,40 @@ def _search_round(cmp, spaces, baseline: Baseline, earlier: list, base: list, th
     if ranked and ranked[0].eligible:
         pick = Chosen(outcomes[ranked[0].name], ranked[0], baseline)
     return RoundResult(ranked, pick, n_sims)
+
+
+class BestFit(NamedTuple):
+    """The best fit of the catalogue: its chi2 and its effect(s), comma-separated."""
+
+    chi2: float
+    name: str
+
+
+def _best_fit(first, final: Final, nominal: Baseline) -> BestFit:
+    """The chosen effects' fit, else the best candidate that ran (the nominal model's when
+    none did)."""
+    if final.steps:
+        return BestFit(final.chi2, ", ".join(s.name for s in final.steps))
+    ran = [c for c in first if c.success and math.isfinite(c.chi2)]
+    if not ran:
+        return BestFit(nominal.chi2, "")
+    top = min(ran, key=lambda c: c.chi2)
+    return BestFit(min(top.chi2, nominal.chi2), top.name)
+
+
+def _withdrawn(search: Search, fault: Cause) -> Search:
+    """The search with nothing chosen: the record's fault makes every fitted value suspect.
+
+    Only the first pass is kept (a later one searched the gap a withdrawn effect left); its
+    candidates that could have been named say why they are not.
+    """
+    why = (f"force_N looks wrong ({fault.name.replace('_', ' ')}, see the diagnosis): no "
+           "effect is named from a force channel the model cannot produce")
+    first = search.rounds[0]
+    cands = tuple(sorted((replace(c, eligible=False, reasons=(why,)) if c.eligible else c
+                         for c in first.candidates), key=_rank))
+    return Search([replace(first, candidates=cands, selected=None)], [], search.skipped,
+                  search.n_simulations)
 
 
 def _ambiguous(first, chosen: list[Chosen], threshold: float) -> tuple:

@@ -8,6 +8,7 @@ the structure diagnosis, with the model traces at the measured times.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -358,9 +359,13 @@ class Cause(Result):
     Attributes
     ----------
     name : str
-        ``"controller"``, ``"initial_state"``, ``"mass"`` or ``"disturbance"``.
+        ``"controller"``, ``"initial_state"``, ``"mass"`` or ``"disturbance"``
+        (the model), or ``"force_sign"`` or ``"force_scale"`` (the record's
+        ``force_N`` column, against the model after the best fit).
     share : float
-        Share of the nominal residual's variance that points at it, 0-1.
+        Share of the nominal residual's variance that points at it, 0-1
+        (``force_sign``, ``force_scale``: the share of the force residual's
+        energy that a factor and an offset on the measured force remove).
     detail : str
         What was measured and what to check, one or two sentences.
     """
@@ -378,7 +383,10 @@ class Diagnosis(Result):
     ----------
     mismatch : bool
         True when the nominal misfit is far above noise (at least
-        ``misfit_limit``) and no candidate explains most of it.
+        ``misfit_limit``) and no candidate explains most of it or the best
+        fit of the catalogue still leaves ``misfit_limit`` or more
+        (``misfit_after``); or when the record's force looks wrong (a cause
+        ``force_sign`` or ``force_scale``).
     misfit : float
         RMS weighted residual of the nominal model (1 = noise).
     misfit_limit : float
@@ -398,6 +406,17 @@ class Diagnosis(Result):
         channel / sqrt(Hz)].
     crossover : float
         The loop's crossover [Hz], marked in the spectrum.
+    misfit_after : float
+        RMS weighted residual left by the best fit of the catalogue (the
+        model with the chosen effects, else the best candidate's fit; the
+        nominal misfit when no candidate ran) (1 = noise).
+    best_fit : str
+        The effect(s) of that fit, comma-separated; empty when none ran.
+    force_scale : float or None
+        Least-squares factor of the measured force on the force of the model
+        after the best fit (with an offset) [-]: about 1 when ``force_N``
+        and the model agree in sign and scale, negative when the column's
+        sign is flipped. None without a compared force channel.
     """
 
     mismatch: bool
@@ -410,6 +429,9 @@ class Diagnosis(Result):
     frequency: np.ndarray = field(repr=False)
     spectrum: np.ndarray = field(repr=False)
     crossover: float = 0.0
+    misfit_after: float = math.nan
+    best_fit: str = ""
+    force_scale: float | None = None
 
 
 

@@ -22,6 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..display import percent, quantity
 from ..errors import DataError
 from ..kernel.build import compiled
 from ..kernel.layout import P_SIGMA2_NEG, PlantParameters, state_index
@@ -162,6 +163,8 @@ class ReplayFit:
         RMS tracking error r - x1 of the measurement [m].
     force_rms : float or None
         RMS of model minus measured commanded force [N]; None without ``force_N``.
+    notes : tuple of str
+        Warnings about the record as the replay reads it (:func:`start_note`).
     """
 
     samples: int
@@ -170,10 +173,60 @@ class ReplayFit:
     tracking_rms_model: float
     tracking_rms_measured: float
     force_rms: float | None
+    notes: tuple[str, ...] = ()
 
 
-def replay_fit(record: Measurement, position: np.ndarray, force: np.ndarray) -> ReplayFit:
-    """Compare a replay's position [m] and commanded force [N] with the record."""
+#: A first position_m farther than this share of the move distance from the first reference_m
+#: is an offset between the two columns, not the loop's error: a stage at rest sits within its
+#: settle band (micrometres), one in motion within its following error (a few per cent of the
+#: move for a sluggish loop), while two zeros (an encoder or homing offset, another unit)
+#: differ by the order of the travel.
+START_OFFSET_SHARE = 0.1
+
+
+def start_note(record: Measurement, distance: float) -> str:
+    """A warning when the record's first position is far from where its motion starts.
+
+    A closed-loop replay starts from the position in the data and drives the
+    model's controller with ``reference_m``, so its first control error is
+    ``reference_m - position_m`` at the first sample. Far means more than
+    :data:`START_OFFSET_SHARE` of the move distance: the larger of the
+    record's reference travel and ``distance``.
+
+    Parameters
+    ----------
+    record : Measurement
+        The record.
+    distance : float
+        The spec's largest move distance [m] (the scale of a record whose
+        reference does not move).
+
+    Returns
+    -------
+    str
+        The warning, empty when the start is near.
+    """
+    x0, r0 = float(record.position[0]), float(record.reference[0])
+    travel = max(float(np.ptp(record.reference)), abs(float(distance)))
+    offset = x0 - r0
+    if travel <= 0.0 or abs(offset) <= START_OFFSET_SHARE * travel:
+        return ""
+    return (f"the record's first position_m ({quantity(x0, 'm', 4)}) lies "
+            f"{quantity(offset, 'm', 4)} from its first reference_m ({quantity(r0, 'm', 4)}), "
+            f"more than {percent(START_OFFSET_SHARE, 2)} of the move distance "
+            f"({quantity(travel, 'm', 4)}): the replay starts at the measured position, so "
+            "the model's controller starts with that error and closes it. Different zeros of "
+            "position_m and reference_m (an encoder or homing offset) give such a start, and "
+            "the measured error then never closes: if so, subtract the offset from one column "
+            "and replay again")
+
+
+def replay_fit(record: Measurement, position: np.ndarray, force: np.ndarray,
+               notes: tuple[str, ...] = ()) -> ReplayFit:
+    """Compare a replay's position [m] and commanded force [N] with the record.
+
+    ``notes``: warnings about the record (:func:`start_note`), kept with the comparison.
+    """
     ok = np.isfinite(position)
 
     def rms(x):
@@ -185,7 +238,8 @@ def replay_fit(record: Measurement, position: np.ndarray, force: np.ndarray) -> 
         position_max=float(np.max(np.abs(dx[ok]))) if ok.any() else math.nan,
         tracking_rms_model=rms(record.reference - position),
         tracking_rms_measured=rms(record.reference - record.position),
-        force_rms=None if record.force is None else rms(force - record.force))
+        force_rms=None if record.force is None else rms(force - record.force),
+        notes=tuple(notes))
 
 
 def record_state(record: Measurement, index: int = 0, span: float = VELOCITY_SPAN) -> RecordState:

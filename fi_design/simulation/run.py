@@ -29,7 +29,7 @@ from .metrics import HuntingMetrics, hunting_metrics
 from ..model import Model, as_model
 from ..kernel.layout import PlantParameters, state_index
 from .replay import (DRIVES, command_state, initial_state, record_reference, record_state,
-                     reference_state, replay_fit)
+                     reference_state, replay_fit, start_note)
 from ..results import frozen_array
 from ..results.simulation import SimulationResult
 from ..trajectory import Trajectory, from_moves
@@ -268,7 +268,16 @@ def _result(model, iso, method, params, out, t_out, wall, *, move_end,
         metrics=metrics, parameters=params, drive=drive,
         record=None if record is None else (record.source or "record"),
         window=None if window is None else frozen_array(window, dtype=int),
-        replay=None if record is None else replay_fit(record, Y[:, idx["x1"]], out.command))
+        replay=None if record is None else replay_fit(
+            record, Y[:, idx["x1"]], out.command, _record_notes(model, record, drive)))
+
+
+def _record_notes(model, record, drive: str) -> tuple[str, ...]:
+    """Warnings about a replayed record: a closed loop that starts far from its reference."""
+    if drive != "closed":  # open loop the reference drives nothing
+        return ()
+    note = start_note(record, max(abs(m.distance) for m in model.spec.motion.moves))
+    return (note,) if note else ()
 
 
 def _replay(model, iso, method, params, record, drive, window, rtol, initial_command=None):

@@ -255,3 +255,50 @@ def test_cli_simulate_record_with_nan_disturbance_names_the_row(tmp_path, paper_
     assert res.exit_code == 2
     assert "disturbance_N" in res.output and "row 31" in res.output
     assert "Traceback" not in res.output
+
+
+def _shifted(tmp_path, reference: float, position: float):
+    """examples/measured_trace.csv with offsets added to reference_m and position_m [m]."""
+    lines = (EXAMPLES / "measured_trace.csv").read_text().splitlines()
+    out = []
+    for line in lines:
+        if line.startswith(("#", "time_s")):
+            out.append(line)
+            continue
+        cells = line.split(",")
+        cells[1] = repr(float(cells[1]) + reference)
+        cells[2] = repr(float(cells[2]) + position)
+        out.append(",".join(cells))
+    path = tmp_path / f"shifted_{reference}_{position}.csv"
+    path.write_text("\n".join(out) + "\n")
+    return path
+
+
+def test_cli_simulate_warns_when_the_record_starts_far_from_its_reference(tmp_path):
+    """position_m 50 mm off its reference_m (another zero) replayed without a word; the
+    replay starts at the measured position and its controller chases the 50 mm."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from fi_design.cli.app import app
+    from fi_design.display import quantity
+    from fi_design.measured import load_measurement
+
+    spec = EXAMPLES / "measured_stage.yaml"
+    rec = _shifted(tmp_path, 0.0, 0.05)
+    res = CliRunner().invoke(app, ["simulate", str(spec), "--record", str(rec),
+                                   "--json", str(tmp_path / "r.json")])
+    assert res.exit_code == 0, res.output
+    assert "warning: the record's first position_m" in res.output
+    (note,) = json.loads((tmp_path / "r.json").read_text())["replay"]["notes"]
+    offset = float(load_measurement(rec).position[0] - load_measurement(rec).reference[0])
+    assert f"lies {quantity(offset, 'm', 4)} from its first reference_m" in note
+    assert "move distance (15 mm)" in note and "subtract the offset" in note
+    # the record as measured, and in machine coordinates (both columns shifted): no warning
+    spec_obj = load_spec(spec)
+    for path in (EXAMPLES / "measured_trace.csv", _shifted(tmp_path, 0.05, 0.05)):
+        assert simulate(spec_obj, record=load_measurement(path)).replay.notes == ()
+    # open loop the reference drives nothing
+    far = load_measurement(rec)
+    assert simulate(spec_obj, record=far, drive="force").replay.notes == ()
