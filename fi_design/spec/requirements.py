@@ -187,7 +187,11 @@ class Requirements(StrictModel):
     friction_gap: Q("N") = Field(1.0, gt=0, description="Fs - Fc above which hunting is a risk "
                                                         "[N]. Default 1 N (paper).")
     parasitic_separation: float = Field(3.0, ge=1, description="Parasitic modes must lie above "
-                                                               "this times the crossover. "
+                                                               "this times the loop's "
+                                                               "crossover (the highest 0 dB "
+                                                               "crossing of the limit cases, "
+                                                               "which may lie above "
+                                                               "controller.crossover). "
                                                                "Default 3.")
     phase_margin: Q("deg") = Field(30.0, ge=0, lt=180, description="Minimum phase margin "
                                                                   "[deg]. Default 30 deg.")
