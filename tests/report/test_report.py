@@ -1318,3 +1318,24 @@ def test_the_inputs_table_lists_values_with_commas_and_ranges_with_a_dash(paper_
     assert rows["stage.size"] == "40, 50, 60\u00a0mm"
     assert rows["stage.sensor_offset"] == "0, 0\u00a0mm"
     assert rows["isolator.flexure.length"] == "10 \u2013 60\u00a0mm"
+
+
+def test_step3_says_the_resting_deflection_was_not_determined_when_the_run_failed(
+        paper_confirmed_design):
+    """A run that did not complete (diverged: its traces end in nan) showed 'n/a' for the
+    deflection at rest and its force, and an equation 'k x n/a = n/a'."""
+    from dataclasses import replace
+
+    from fi_design.report.steps import guideline_steps
+
+    r = paper_confirmed_design
+    failed = replace(r, simulation=replace(r.simulation, landing=replace(
+        r.simulation.landing, deflection=float("nan"), force=float("nan"))))
+    step3 = next(s for s in guideline_steps(failed, figures=False) if s["number"] == 3)
+    rows = {row["quantity"]: row["value"] for row in step3["results"]}
+    assert rows["simulated deflection at rest d"].startswith("not determined")
+    assert "flexure force on the resting cart" not in rows
+    assert not any("nan" in str(e).lower() or "n/a" in str(e) for e in step3["equations"])
+    ok = next(s for s in guideline_steps(r, figures=False) if s["number"] == 3)
+    assert {row["quantity"]: row["value"] for row in ok["results"]}[
+        "simulated deflection at rest d"] == r.simulation.landing.deflection
