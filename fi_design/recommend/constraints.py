@@ -190,7 +190,9 @@ def loop_meets(model: Model) -> tuple[bool, str]:
 
     The model's own modes (a candidate: its guide's computed ones and the
     structure's measured ones) are in the loop; every mode lies at the
-    separation times the crossover.
+    separation times the loop's crossover (the highest 0 dB crossing of the
+    cases in the band, as step 2 and step 3 judge them; the controller's
+    crossover when no case crosses there).
     """
     from ..loop import linear
 
@@ -201,11 +203,12 @@ def loop_meets(model: Model) -> tuple[bool, str]:
         return False, (f"case {linear.CASE_NUMBERS[c.name]} ({c.description}) misses its "
                        f"{', '.join(c.failed)} with the reserve")
     sep = model.requirements.parasitic_separation
-    low = [m for m in model.modes if m.frequency < sep * model.crossover]
+    top = model.crossover if res.loop_crossover is None else res.loop_crossover
+    low = [m for m in model.modes if m.frequency < sep * top]
     if low:
         m = min(low, key=lambda x: x.frequency)
         return False, (f"the mode '{m.name}' at {quantity(m.frequency, 'Hz', 4)} lies below "
-                       f"{number(sep, 6)} x the {quantity(model.crossover, 'Hz', 4)} crossover")
+                       f"{number(sep, 6)} x the loop's crossover {quantity(top, 'Hz', 4)}")
     return True, ""
 
 
