@@ -88,7 +88,8 @@ def guide_section(result: Any, figures: bool, number: int) -> dict | None:
     mech, g = fx.mechanics, fx.guide
     fe = getattr(result, "flexure_fe", None)
     req = result.spec.requirements
-    need = req.parasitic_separation * result.crossover.desired
+    # the requirement step 2 and the flexure check judge: n_sep x the loop's crossover
+    need = req.parasitic_separation * result.crossover.separation_crossover
     how = ("as the spec draws it" if fx.drawn else
            f"sized from stock for the net drive stiffness {qty(fx.target_stiffness, 'N/m')}")
     intro = (f"The isolator's joint is a parallel leaf-spring guide of {g.leaves} leaves, "

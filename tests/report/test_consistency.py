@@ -1,0 +1,40 @@
+"""The design report says one thing once: a quantity quoted in two sections (the verdict box,
+the checks table, the step sections, the guide, the captions) is the same number in both.
+
+Each test reads the context of the paper setup's report (computed once per session by
+``paper_confirmed_design``, figures off) and compares what two of its parts state.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from fi_design import report
+
+DATE = "2026-01-01"
+
+
+@pytest.fixture(scope="module")
+def ctx(paper_confirmed_design) -> dict:
+    return report.build_context(paper_confirmed_design, date=DATE, figures=False)
+
+
+def _check(ctx: dict, name: str) -> dict:
+    return next(r for g in ctx["verdict"]["groups"] for r in g["rows"] if r["name"] == name)
+
+
+def _step_row(ctx: dict, number: int, start: str) -> dict:
+    step = next(s for s in ctx["steps"] if s["number"] == number)
+    return next(r for r in step["results"] if r["quantity"].startswith(start))
+
+
+def test_one_required_parasitic_frequency(ctx):
+    """Step 2, step 3, the flexure check and the guide's mode table ask the same frequency of
+    a parasitic mode (step 3 quoted the sizing's 46.11 Hz and the guide 3 x 8 = 24 Hz while
+    step 2 and the check ask 3 x 15.43 = 46.28 Hz)."""
+    limit = _check(ctx, "flexure.modes")["limit"]
+    assert _step_row(ctx, 2, "lowest allowed parasitic frequency")["value"] == limit
+    assert _step_row(ctx, 3, "required parasitic frequency")["value"] == limit
+    required = {m["required"] for m in ctx["guide"]["modes"] if m["required"] is not None}
+    assert required == {limit}
+    assert ctx["guide"]["required"] == limit
