@@ -38,3 +38,16 @@ def test_one_required_parasitic_frequency(ctx):
     required = {m["required"] for m in ctx["guide"]["modes"] if m["required"] is not None}
     assert required == {limit}
     assert ctx["guide"]["required"] == limit
+
+
+def test_the_guide_names_the_stiffness_the_analysis_uses(ctx, paper_confirmed_design):
+    """The guide section said the guide's net 6627 N/m is 'the joint the loop and the simulation
+    see', the step 3 check that the analysis simulates the joint's given 6667 N/m."""
+    joint = paper_confirmed_design.model.joint.stiffness
+    net = paper_confirmed_design.flexure.mechanics.net_drive_stiffness
+    assert joint != net
+    words = ctx["guide"]["gravity"]
+    assert "the joint the loop and the simulation see" not in words
+    assert f"use the joint's {report.filters.qty(joint, 'N/m')}" in words
+    assert "the joint's 6667 N/m that the analysis simulates" in _check(ctx, "flexure.joint")[
+        "message"]
