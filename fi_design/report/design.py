@@ -149,7 +149,9 @@ def _bode_caption(result: Any) -> str:
     far = plots.out_of_band_crossovers(result)
     if far:
         text += " Below the band, not drawn: " + "; ".join(
-            f"case {numbers.get(c.name, '?')} also crosses 0 dB at {qty(x, 'Hz', 3)}"
+            f"case {numbers.get(c.name, '?')} "
+            + ("also crosses" if any(y and y >= lo for y in c.crossovers) else "crosses")
+            + f" 0 dB at {qty(x, 'Hz', 3)}"
             for c, x in far) + " (the integrator against a stiff support, outside the loop's band)."
     return text
 

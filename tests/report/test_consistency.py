@@ -51,3 +51,13 @@ def test_the_guide_names_the_stiffness_the_analysis_uses(ctx, paper_confirmed_de
     assert f"use the joint's {report.filters.qty(joint, 'N/m')}" in words
     assert "the joint's 6667 N/m that the analysis simulates" in _check(ctx, "flexure.joint")[
         "message"]
+
+
+def test_the_bode_caption_says_also_only_beside_a_drawn_crossover(ctx):
+    """Case 4 crosses 0 dB once, at 0.00135 Hz (the linear table: 1 crossing; the verdict's
+    note: 'only at'), but the Bode caption said it 'also crosses 0 dB' there."""
+    case4 = next(c for c in ctx["linear"]["cases"] if c["number"] == 4)
+    assert case4["crossovers"] == 1
+    caption = ctx["linear"]["bode"]["caption"]
+    assert "case 4 crosses 0 dB at 0.00135\u00a0Hz" in caption
+    assert "also" not in caption
