@@ -61,3 +61,12 @@ def test_the_bode_caption_says_also_only_beside_a_drawn_crossover(ctx):
     caption = ctx["linear"]["bode"]["caption"]
     assert "case 4 crosses 0 dB at 0.00135\u00a0Hz" in caption
     assert "also" not in caption
+
+
+def test_the_forces_table_says_it_lists_only_some_moves(ctx, paper_confirmed_design):
+    """'17 of 25 moves run the joint onto its end stop' above a table of 13 moves, 9 of them on
+    the stop, without saying the table left moves out."""
+    forces = ctx["nonlinear"]["forces"]
+    n = len(paper_confirmed_design.simulation.forces.moves)
+    assert len(forces["rows"]) < n
+    assert f"The table lists {len(forces['rows'])} of the {n} moves" in forces["intro"]
