@@ -70,3 +70,42 @@ def test_the_forces_table_says_it_lists_only_some_moves(ctx, paper_confirmed_des
     n = len(paper_confirmed_design.simulation.forces.moves)
     assert len(forces["rows"]) < n
     assert f"The table lists {len(forces['rows'])} of the {n} moves" in forces["intro"]
+
+
+def _robustness_reason(ctx: dict) -> str:
+    return next(r["text"] for r in ctx["verdict"]["reasons"]
+                if r["text"].startswith("Under friction scatter"))
+
+
+def _robustness_assumption(ctx: dict) -> str:
+    return next(t for t in ctx["assumptions"]["model"] if t.startswith("Robustness:"))
+
+
+def test_the_scatter_on_k_is_stated_alike_in_the_verdict_and_the_assumptions(ctx):
+    """The verdict's reason and the assumptions name the same spread of k (6 %, the stock's
+    thickness tolerance on t = 0.5 mm), with the same sign as the other reasons (±)."""
+    assert "\u00b16 % on k" in _robustness_reason(ctx)
+    assert "+-" not in _robustness_reason(ctx)
+    assert "the drive stiffness (6" in _robustness_assumption(ctx)
+    assert "the flexure's stock tolerance" in _robustness_assumption(ctx)
+
+
+def test_without_the_isolator_k_does_not_scatter_on_the_stage_as_specified(
+        paper_confirmed_design):
+    """A stage without isolator was said to scatter '+-5 % on k' (only the comparison's isolator
+    has a k), and the assumptions called that 5 % 'the flexure's stock tolerance' for specs
+    without a flexure."""
+    import dataclasses
+
+    r = paper_confirmed_design.robustness
+    plain = dataclasses.replace(r, plant="non_isolated", scatter={**r.scatter,
+                                                                  "isolator.stiffness": 0.05})
+    result = dataclasses.replace(paper_confirmed_design, robustness=plain, flexure=None)
+    from fi_design.guideline.verdict import _scatter_words
+    from fi_design.report.assumptions import _robustness
+
+    assert " on k" not in _scatter_words(plain)
+    words = _robustness(result)
+    assert "stock tolerance" not in words
+    assert ("the drive stiffness (5 %, the default without a sized flexure, of the isolator "
+            "simulated for comparison only)") in words
