@@ -187,11 +187,12 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
             {"quantity": "net drive stiffness at \u00b1\u0394t", "value":
              list(fx.stiffness_range), "unit": "N/m"},
             {"quantity": "stress at full stroke", "value": m.stress, "unit": "Pa"},
-            {"quantity": "stress margin allowed / actual", "value": m.stress_margin,
+            # factors to 3 digits, as the flexure checks, the conclusion and the guide quote them
+            {"quantity": "stress margin allowed / actual", "value": num(m.stress_margin, 3),
              "unit": "1"},
             {"quantity": "buckling factor (load / weight)",
              "value": "no compression" if m.gravity.buckling_factor is None
-             else m.gravity.buckling_factor, "unit": "1"},
+             else num(m.gravity.buckling_factor, 3), "unit": "1"},
             {"quantity": f"lowest parasitic mode ({low.name})", "value": low.frequency,
              "unit": "Hz"},
             {"quantity": "required parasitic frequency (step 2: n_sep f_loop)",

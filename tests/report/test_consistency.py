@@ -121,3 +121,22 @@ def test_a_phase_margin_outside_the_band_is_not_denied_beside_its_value(ctx):
     assert row["status"] == "INFO" and math.isfinite(row["value"])
     assert "no phase margin" not in row["message"]
     assert f"its phase margin there, {report.filters.num(row['value'], 3)} deg" in row["message"]
+
+
+def test_the_flexure_factors_read_alike_in_step_3_the_check_and_the_conclusion(ctx):
+    """Step 3 quoted the stress margin 11.75 and the buckling factor 21.83, the flexure checks,
+    the conclusion, the guide and the assumptions 11.8 and 21.8."""
+    margin = _step_row(ctx, 3, "stress margin")["value"]
+    factor = _step_row(ctx, 3, "buckling factor")["value"]
+    assert f"(margin x{margin})" in _check(ctx, "flexure.stress")["message"]
+    assert f"a stress margin of {margin} " in ctx["verdict"]["conclusion"]
+    assert f"factor {factor}," in _check(ctx, "flexure.buckling")["message"]
+    assert f"{factor} times the weight" in ctx["guide"]["gravity"]
+
+
+def test_the_end_stop_force_reads_alike_in_the_check_and_the_forces_section(ctx):
+    """The forces section said 'a contact force of up to 9.612 N', the end-stop check '9.61 N'."""
+    row = _check(ctx, "end_stop_force")
+    words = report.filters.qty(row["value"], "N")
+    assert f"with a contact force of up to {words}" in ctx["nonlinear"]["forces"]["intro"]
+    assert f"the largest contact force {words.replace(chr(0xa0), ' ')}" in row["message"]
