@@ -140,3 +140,24 @@ def test_the_end_stop_force_reads_alike_in_the_check_and_the_forces_section(ctx)
     words = report.filters.qty(row["value"], "N")
     assert f"with a contact force of up to {words}" in ctx["nonlinear"]["forces"]["intro"]
     assert f"the largest contact force {words.replace(chr(0xa0), ' ')}" in row["message"]
+
+
+def test_the_crossover_factor_figure_asks_the_hunting_margin(paper_confirmed_design):
+    """The key figure asked '> 1' of design / lowest hunting-free crossover (green from 1 on)
+    while the checks table judges it against requirements.hunting_margin (1.2): a design at
+    1.1 read PASS in the verdict box beside a FAIL row."""
+    import dataclasses
+
+    from fi_design.report.checks import key_figures
+
+    def figure(factor):
+        m = dataclasses.replace(paper_confirmed_design.margins, crossover_factor=factor)
+        rows = key_figures(dataclasses.replace(paper_confirmed_design, margins=m))
+        return next(r for r in rows if r["label"].startswith("Crossover factor"))
+
+    need = paper_confirmed_design.spec.requirements.hunting_margin
+    assert need == 1.2
+    assert figure(1.1)["requirement"].startswith("\u2265 1.2")
+    assert figure(1.1)["css"] == "fail"
+    assert figure(1.3)["css"] == "pass"
+    assert figure(0.709)["css"] == "warn"
