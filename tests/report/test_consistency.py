@@ -161,3 +161,16 @@ def test_the_crossover_factor_figure_asks_the_hunting_margin(paper_confirmed_des
     assert figure(1.1)["css"] == "fail"
     assert figure(1.3)["css"] == "pass"
     assert figure(0.709)["css"] == "warn"
+
+
+def test_the_legend_does_not_call_an_info_row_s_limit_a_requirement(ctx):
+    """Step 1's row reads 'INFO, 3 N, limit < 1 N' (and says: 'a screening rule, not a
+    requirement') under a legend saying 'the limit column states the requirement the value
+    must meet'."""
+    import html
+
+    row = _check(ctx, "friction_gap")
+    assert row["status"] == "INFO" and row["limit"] is not None
+    text = html.unescape(report.render_html(ctx))
+    assert "on an INFO row, the threshold the value is compared with, which it need not meet" \
+        in text
