@@ -631,8 +631,9 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
         if rise <= spread:
             reasons.append(Reason(
                 "WARN", "end_stop_clearance",
-                "The cart rests {} from its end stop (joint deflection {} of the {} stroke): "
-                "a friction force ".format(*quantities((clearance, d, d + clearance), "m", 3))
+                "The cart rests {} from its end stop (joint deflection {} of the \u00b1{} "
+                "stroke): a friction force ".format(*quantities(
+                    (clearance, margin.resting_deflection, d + clearance), "m", 3))
                 + f"{percent(rise, 2)} higher would put it on the limiter, within the "
                 f"\u00b1{percent(spread)} scatter of Fc."))
     if not_valid is not None:  # what the simulation shows passing does not hold here

@@ -174,3 +174,14 @@ def test_the_legend_does_not_call_an_info_row_s_limit_a_requirement(ctx):
     text = html.unescape(report.render_html(ctx))
     assert "on an INFO row, the threshold the value is compared with, which it need not meet" \
         in text
+
+
+def test_the_resting_deflection_keeps_its_sign_in_the_verdict(ctx):
+    """The end-stop reason said 'joint deflection 0.278 mm of the 0.3 mm stroke', the key
+    figure beside it and step 3 '-0.278 mm' (of the ±0.3 mm stroke)."""
+    reason = next(r["text"] for r in ctx["verdict"]["reasons"]
+                  if r["text"].startswith("The cart rests"))
+    note = next(f["note"] for f in ctx["verdict"]["figures"]
+                if f["label"] == "End-stop clearance at rest")
+    assert note.replace("\u00a0", " ") in reason.replace("\u00a0", " ")
+    assert "-0.278" in reason
