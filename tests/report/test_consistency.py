@@ -185,3 +185,28 @@ def test_the_resting_deflection_keeps_its_sign_in_the_verdict(ctx):
                 if f["label"] == "End-stop clearance at rest")
     assert note.replace("\u00a0", " ") in reason.replace("\u00a0", " ")
     assert "-0.278" in reason
+
+
+@pytest.fixture(scope="module")
+def no_isolator_steps():
+    """Step 2 of examples/no_isolator.yaml (no isolator, no modes: the achievable crossover
+    is not limited below the search cap), without the simulation."""
+    from conftest import EXAMPLES, shared
+    from fi_design.guideline.evaluate import evaluate
+    from fi_design.report.steps import guideline_steps
+    from fi_design.spec.file import load_spec
+
+    spec = load_spec(EXAMPLES / "no_isolator.yaml")
+    design = shared("design", spec, lambda: evaluate(spec, confirm=False), False)
+    assert design.crossover.limit_kind == "scan_limit"
+    return design, guideline_steps(design, figures=False)
+
+
+def test_a_search_cap_is_no_achievable_crossover(no_isolator_steps):
+    """The verdict box says '≥ 1000 Hz ... a bound, not a result', step 2 said 'achievable
+    crossover 1000 Hz' and f_c ≤ f_c,ach = 1000 Hz."""
+    design, steps = no_isolator_steps
+    step2 = next(s for s in steps if s["number"] == 2)
+    row = next(r for r in step2["results"] if r["quantity"] == "achievable crossover")
+    assert isinstance(row["value"], str) and row["value"].startswith("\u2265 1000")
+    assert not any("f_c,ach = " in e["text"] for e in step2["equations"])
