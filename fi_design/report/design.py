@@ -356,8 +356,7 @@ def _forces(forces: Any) -> dict | None:
                    f"at {qty(forces.rate, 'Hz')}.")
     if thinned:
         intro += (f" The table lists {len(rows)} of the {n} moves: the spec's motion and every "
-                  "second move of the family; the counts and largest forces above are over all "
-                  f"{n}.")
+                  f"second move of the family; the numbers above are over all {n}.")
     return {"intro": intro, "rows": rows}
 
 
