@@ -410,3 +410,18 @@ def test_the_search_read_back_is_the_search_computed(paper_recommendation, paper
     assert data.pop("from_cache") == again.from_cache
     assert data == json.loads(json.dumps(expected))
 
+
+
+def test_the_report_s_table_quotes_the_design_as_the_advice_does(paper_recommendation):
+    """The advice above the table read '60 x 15.3 x 0.55 mm leaves', the table beneath it
+    '60 mm x 15.31 mm x 0.55 mm' (and the console's 15.3); the spec's column of the drive
+    stiffness, 'net of gravity', held the joint's given 6667 N/m, not its guide's net."""
+    import re
+
+    from fi_design.report.recommend import STIFFNESS_ROW, _design_rows
+
+    rows = {r[0]: r for r in _design_rows(paper_recommendation)}
+    leaves = rows["Leaves L \u00d7 b \u00d7 t"][2].replace("\u00a0", " ")
+    numbers = re.findall(r"[0-9.]+", leaves)
+    assert " x ".join(numbers) + " mm leaves" in paper_recommendation.advice
+    assert STIFFNESS_ROW in rows and "net of gravity" not in STIFFNESS_ROW.split("(")[0]
