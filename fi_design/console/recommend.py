@@ -74,7 +74,8 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
     fx = result.flexure
     t.add_row("Leaves L x b x t", "", guide + ("" if fx is None or fx.guide is None else
                                                f", {fx.leaves} {fx.guide.orientation}"))
-    t.add_row("Drive stiffness (net of gravity)", f"{number(sd['stiffness'])} N/m",
+    t.add_row("Drive stiffness k (recommended: the guide's, net of gravity)",
+              f"{number(sd['stiffness'])} N/m",
               f"{number(d.stiffness)} N/m")
     t.add_row("Lowest parasitic mode", "", "-" if d.lowest_mode is None
               else f"{number(d.lowest_mode)} Hz")

@@ -183,8 +183,13 @@ def step2_crossover(model: Model) -> CrossoverResult:
                                    f"{number(linear.BAND_FACTOR, 6)}x below the "
                                    f"{quantity(fc, 'Hz', 4)} crossover (the integrator against "
                                    "a stiff support)"
+                                   + (f": its phase margin there, "
+                                      f"{number(c.phase_margin_deg, 3)} deg, lies outside the "
+                                      "loop's band and is not judged"
+                                      if math.isfinite(c.phase_margin_deg) else
+                                      ": no phase margin in the loop's band")
                                    if c.crossover is not None else "the loop never crosses "
-                                   "0 dB") + ": no phase margin in the loop's band")
+                                   "0 dB: no phase margin in the loop's band"))
         else:
             msg = f"{where}: phase margin {number(c.phase_margin_deg, 3)} deg{at_f}"
         checks.append(_criterion_check(c, "phase margin", f"phase_margin.{c.name}",

@@ -236,12 +236,16 @@ def _scatter_words(r: RobustnessCheck) -> str:
              "effects[type=mass_error].stage_mass": "m1",
              "effects[type=mass_error].cart_mass": "m2", "isolator.stiffness": "k",
              "controller.delay": "the delay"}
-    spread = sorted(set(r.scatter.values()))
+    # the judged plant's scatter: without an isolator the drive stiffness scatters only on the
+    # comparison's isolator, not on the stage as specified
+    scatter = {k: v for k, v in r.scatter.items()
+               if not (k == "isolator.stiffness" and r.plant == "non_isolated")}
+    spread = sorted(set(scatter.values()))
     if len(spread) == 1 and spread[0] > 0:
-        parts = [f"+-{percent(spread[0], 3)} on " + " and ".join(names.get(k, k)
-                                                                  for k in r.scatter)]
+        parts = [f"\u00b1{percent(spread[0], 3)} on " + " and ".join(names.get(k, k)
+                                                                      for k in scatter)]
     else:
-        parts = [f"+-{percent(v, 3)} on {names.get(k, k)}" for k, v in r.scatter.items()]
+        parts = [f"\u00b1{percent(v, 3)} on {names.get(k, k)}" for k, v in scatter.items()]
     if r.ripple is not None:
         parts.append(f"a {percent(r.ripple['amplitude'], 3)} ripple every "
                      f"{quantity(r.ripple['wavelength'], 'm', 3)} along the rail")
@@ -627,8 +631,9 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
         if rise <= spread:
             reasons.append(Reason(
                 "WARN", "end_stop_clearance",
-                "The cart rests {} from its end stop (joint deflection {} of the {} stroke): "
-                "a friction force ".format(*quantities((clearance, d, d + clearance), "m", 3))
+                "The cart rests {} from its end stop (joint deflection {} of the \u00b1{} "
+                "stroke): a friction force ".format(*quantities(
+                    (clearance, margin.resting_deflection, d + clearance), "m", 3))
                 + f"{percent(rise, 2)} higher would put it on the limiter, within the "
                 f"\u00b1{percent(spread)} scatter of Fc."))
     if not_valid is not None:  # what the simulation shows passing does not hold here

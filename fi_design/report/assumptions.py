@@ -169,16 +169,27 @@ def _robustness(result: Any) -> str:
     ripple = ("" if r.ripple is None else
               f", and a {percent(r.ripple.amplitude, 3)} ripple with a "
               f"{qty(r.ripple.wavelength, 'm')} wavelength along the rail at a random phase")
-    stiff = ("the flexure's stock tolerance, k going with t\u00b3" if r.stiffness is None
-             else percent(r.stiffness, 3))
+    check = getattr(result, "robustness", None)
+    spread = None if check is None else check.scatter.get("isolator.stiffness")
+    fx = result.flexure
+    if spread is None:
+        stiff = ""
+    else:
+        stiff = ("; the drive stiffness ("
+                 + (f"{percent(spread, 3)}, the flexure's stock tolerance, k going with "
+                    "t\u00b3" if r.stiffness is None and fx is not None and fx.feasible
+                    else percent(spread, 3) + ("" if r.stiffness is not None else
+                                               ", the default without a sized flexure"))
+                 + (", of the isolator simulated for comparison only" if check.plant ==
+                    "non_isolated" else "") + ")")
     delay = (f", the loop delay {percent(r.delay, 3)}"
              if result.spec.controller.delay > 0 else "")
     return (f"Robustness: {r.samples} samples ({r.distribution}, seed {r.seed}), each drawing "
             f"Coulomb friction ({percent(r.coulomb, 3)}) and the gap Fs \u2212 Fc "
             f"({percent(r.gap, 3)}) together, so static friction never falls below "
             "Coulomb friction and no sample is lost; the true masses "
-            f"({percent(r.mass, 3)}, the controller keeping its tuning); the drive "
-            f"stiffness ({stiff}){delay}{ripple}. The parasitic modes do not enter the "
+            f"({percent(r.mass, 3)}, the controller keeping its tuning)"
+            f"{stiff}{delay}{ripple}. The parasitic modes do not enter the "
             "nonlinear simulation, and the LuGre dynamics (sigma0, sigma1, vs, sigma2) stay "
             "nominal. The probability of not settling carries a Wilson interval at "
             f"{percent(r.confidence, 3)} confidence.")

@@ -149,7 +149,9 @@ def _bode_caption(result: Any) -> str:
     far = plots.out_of_band_crossovers(result)
     if far:
         text += " Below the band, not drawn: " + "; ".join(
-            f"case {numbers.get(c.name, '?')} also crosses 0 dB at {qty(x, 'Hz', 3)}"
+            f"case {numbers.get(c.name, '?')} "
+            + ("also crosses" if any(y and y >= lo for y in c.crossovers) else "crosses")
+            + f" 0 dB at {qty(x, 'Hz', 3)}"
             for c, x in far) + " (the integrator against a stiff support, outside the loop's band)."
     return text
 
@@ -325,12 +327,13 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
 
 
 def _forces(forces: Any) -> dict | None:
-    """The forces over the move family, a row per move (the largest moves of the family
-    where the table would run long)."""
+    """The forces over the move family, a row per move (the spec's motion and every second
+    move of the family where the table would run long, which the intro says)."""
     if forces is None:
         return None
     moves = list(forces.moves)
-    if len(moves) > 13:  # the spec's own motion and every second move of the family
+    thinned = len(moves) > 13
+    if thinned:  # the spec's own motion and every second move of the family
         moves = moves[:1] + moves[1::2]
     rows = [{"label": "the spec's motion" if m.label == "spec" else "family",
              "distance": abs(m.distance) * 1e3, "impacts": m.impacts,
@@ -351,6 +354,9 @@ def _forces(forces: Any) -> dict | None:
                    f"{qty(forces.peak_actuator_force, 'N')}. Each move is simulated from rest "
                    f"through its settling ({qty(forces.settle, 's')} after its end) with traces "
                    f"at {qty(forces.rate, 'Hz')}.")
+    if thinned:
+        intro += (f" The table lists {len(rows)} of the {n} moves: the spec's motion and every "
+                  f"second move of the family; the numbers above are over all {n}.")
     return {"intro": intro, "rows": rows}
 
 

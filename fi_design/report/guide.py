@@ -32,7 +32,9 @@ _ORIENTATION_WORDS = {
 }
 
 
-def _gravity_words(mech: Any) -> str:
+def _gravity_words(mech: Any, joint: float | None = None) -> str:
+    """The weight's effect on the guide in words; ``joint`` is the drive stiffness the loop and
+    the simulation use [N/m] (``isolator.stiffness`` where given), None or the guide's own."""
     g, grav = mech.guide, mech.gravity
     w = qty(g.weight, "N", 3)
     elastic, net = mech.stiffness.x, mech.net_drive_stiffness
@@ -40,8 +42,10 @@ def _gravity_words(mech: Any) -> str:
         sense = "softens" if grav.geometric_stiffness < 0 else "stiffens"
         text = (f"The stage's weight of {w} {sense} the drive direction by "
                 f"{qty(abs(grav.geometric_stiffness), 'N/m', 3)} (about 1.2 m\u2081g / L), from "
-                f"{qty(elastic, 'N/m')} elastic to {qty(net, 'N/m')} net: the joint the loop "
-                "and the simulation see.")
+                f"{qty(elastic, 'N/m')} elastic to {qty(net, 'N/m')} net"
+                + (": the joint the loop and the simulation see." if joint is None or joint == net
+                   else f"; the loop and the simulation use the joint's {qty(joint, 'N/m')} "
+                        "(isolator.stiffness), which step 3 checks the guide realises."))
         if grav.buckling_factor is not None:
             f = grav.buckling_factor
             text += (f" The leaves would buckle sideways under {qty(grav.buckling_load, 'N', 3)}, "
@@ -88,7 +92,8 @@ def guide_section(result: Any, figures: bool, number: int) -> dict | None:
     mech, g = fx.mechanics, fx.guide
     fe = getattr(result, "flexure_fe", None)
     req = result.spec.requirements
-    need = req.parasitic_separation * result.crossover.desired
+    # the requirement step 2 and the flexure check judge: n_sep x the loop's crossover
+    need = req.parasitic_separation * result.crossover.separation_crossover
     how = ("as the spec draws it" if fx.drawn else
            f"sized from stock for the net drive stiffness {qty(fx.target_stiffness, 'N/m')}")
     intro = (f"The isolator's joint is a parallel leaf-spring guide of {g.leaves} leaves, "
@@ -144,7 +149,9 @@ def guide_section(result: Any, figures: bool, number: int) -> dict | None:
         fe_text = (f"Independent check: the same guide as a finite-element model ({fe.library}, "
                    f"{fe.elements_per_leaf} Timoshenko beam elements per leaf, the stage a rigid "
                    f"body) gives the FE column; closed form and FE agree within {worst}.")
-    return {"intro": intro, "gravity": _gravity_words(mech), "drawing": drawing,
+    joint = getattr(getattr(result, "model", None), "joint", None)
+    return {"intro": intro, "drawing": drawing,
+            "gravity": _gravity_words(mech, None if joint is None else joint.stiffness),
             "stiffness": stiffness, "modes": modes, "fe": fe_text,
             "given": any(m.source == "given" for m in result.crossover.parasitic_modes),
             "required": need}

@@ -10,11 +10,17 @@ from .context import build_context, document_context
 from .filters import num, qty
 from .meta import TITLES
 
-__all__ = ["recommend_context"]
+__all__ = ["recommend_context", "STIFFNESS_ROW"]
+
+#: The drive stiffness's row: the spec's column holds the joint's stiffness the analysis uses
+#: (isolator.stiffness where given, which need not be its guide's net), the recommended one the
+#: sized guide's, net of gravity.
+STIFFNESS_ROW = "Drive stiffness k (recommended: the guide's, net of gravity)"
 
 
 def _mm(x: float | None) -> str:
-    return "" if x is None else qty(x, "m")
+    # 3 digits, as the advice above the table and the console's table give the guide
+    return "" if x is None else qty(x, "m", 3)
 
 
 def _design_rows(result: RecommendResult) -> tuple[tuple[str, str, str], ...]:
@@ -22,23 +28,23 @@ def _design_rows(result: RecommendResult) -> tuple[tuple[str, str, str], ...]:
     req = result.spec.requirements
     fx = result.flexure
     hm = m.get("hunting_margin")
-    rows = [("Stroke", qty(sd["stroke"], "m"), qty(d.stroke, "m")),
+    rows = [("Stroke", qty(sd["stroke"], "m", 3), qty(d.stroke, "m", 3)),
             ("Leaves L \u00d7 b \u00d7 t", "", "" if d.length is None else
              f"{_mm(d.length)} \u00d7 {_mm(d.width)} \u00d7 {_mm(d.thickness)}"),
-            ("Drive stiffness (net of gravity)", qty(sd["stiffness"], "N/m"),
+            (STIFFNESS_ROW, qty(sd["stiffness"], "N/m"),
              qty(d.stiffness, "N/m")),
             ("Lowest parasitic mode", "", qty(d.lowest_mode, "Hz"))]
     if fx is not None and fx.mechanics is not None and \
             fx.mechanics.gravity.buckling_factor is not None:
         rows.append(("Buckling load / weight", "", num(fx.mechanics.gravity.buckling_factor, 3)))
     rows += [("Joint damping", "", "default ratio" if d.damping is None
-              else qty(d.damping, "N*s/m")),
+              else qty(d.damping, "N*s/m", 3)),
              ("Crossover", qty(sd["crossover"], "Hz"), qty(d.crossover, "Hz")),
              ("No move hunts from", "", qty(d.hunting_free_from, "Hz")),
              (f"Hunting margin (required {num(req.hunting_margin, 3)})", "",
               "no cycle found" if hm is not None and hm == float("inf") else num(hm, 3)),
              ("k_max / k", "", num(m.get("stiffness_factor"), 3)),
-             ("End-stop clearance at rest", "", qty(m.get("end_stop_clearance"), "m")),
+             ("End-stop clearance at rest", "", qty(m.get("end_stop_clearance"), "m", 3)),
              ("Not settling under scatter", "",
               "" if d.unsettled_probability is None
               else qty(100 * d.unsettled_probability, "%"))]

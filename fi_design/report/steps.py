@@ -81,16 +81,24 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
     if xo.achievable is not None:
         ok = xo.desired <= xo.achievable * (1 + 1e-9)
         rel = "\\leq" if ok else ">"
-        eqs.append(eq(
-            f"f_c = {tex_qty(xo.desired, 'Hz')}\\ {rel}\\ "
-            f"f_{{c,\\mathrm{{ach}}}} = {tex_qty(xo.achievable, 'Hz')}"))
+        if xo.limit_kind == "scan_limit":  # the search cap: a bound, not the achievable
+            eqs.append(eq(
+                f"f_c = {tex_qty(xo.desired, 'Hz')}\\ {rel}\\ {tex_qty(xo.achievable, 'Hz')}"
+                f"\\ \\leq\\ f_{{c,\\mathrm{{ach}}}}"))
+        else:
+            eqs.append(eq(
+                f"f_c = {tex_qty(xo.desired, 'Hz')}\\ {rel}\\ "
+                f"f_{{c,\\mathrm{{ach}}}} = {tex_qty(xo.achievable, 'Hz')}"))
     eqs.append(eq(f"f_\\mathrm{{par}} \\geq n_\\mathrm{{sep}}\\, f_\\mathrm{{loop}} = "
                   f"{tex_num(sep)} \\times {tex_qty(loop_fc, 'Hz')} = {tex_qty(need, 'Hz')}"))
     pms = [c.phase_margin_deg for c in xo.cases]
     gms = [abs(c.gain_margin_db) for c in xo.cases]
     results = [
         {"quantity": "desired crossover fc", "value": xo.desired, "unit": "Hz"},
-        {"quantity": "achievable crossover", "value": xo.achievable, "unit": "Hz"},
+        # not limited below the search cap: the cap is a bound, as the verdict box says
+        {"quantity": "achievable crossover",
+         "value": (f"\u2265 {qty(xo.achievable, 'Hz')} (a bound: the search cap)"
+                   if xo.limit_kind == "scan_limit" else xo.achievable), "unit": "Hz"},
         {"quantity": "limited by", "value": xo.limited_by, "unit": ""},
         {"quantity": "smallest phase margin at fc (all cases)", "value": min(pms),
          "unit": "deg"},
@@ -187,11 +195,12 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
             {"quantity": "net drive stiffness at \u00b1\u0394t", "value":
              list(fx.stiffness_range), "unit": "N/m"},
             {"quantity": "stress at full stroke", "value": m.stress, "unit": "Pa"},
-            {"quantity": "stress margin allowed / actual", "value": m.stress_margin,
+            # factors to 3 digits, as the flexure checks, the conclusion and the guide quote them
+            {"quantity": "stress margin allowed / actual", "value": num(m.stress_margin, 3),
              "unit": "1"},
             {"quantity": "buckling factor (load / weight)",
              "value": "no compression" if m.gravity.buckling_factor is None
-             else m.gravity.buckling_factor, "unit": "1"},
+             else num(m.gravity.buckling_factor, 3), "unit": "1"},
             {"quantity": f"lowest parasitic mode ({low.name})", "value": low.frequency,
              "unit": "Hz"},
             {"quantity": "required parasitic frequency (step 2: n_sep f_loop)",

@@ -220,7 +220,7 @@ def _force_checks(model: Model, forces) -> list[Check]:
                 + ")")
         text = (f"{forces.moves_on_stop} of {n} moves run the joint onto {stop}, up to "
                 f"{forces.most_impacts} times a move; the largest contact force "
-                f"{quantity(peak, 'N', 3)}"
+                f"{quantity(peak, 'N', 4)}"
                 if forces.moves_on_stop else f"no move of the family reaches {stop}")
         if limit is None:
             out.append(Check("end_stop_force", None, peak, None, "N", text, step))

@@ -411,7 +411,6 @@ def test_the_search_read_back_is_the_search_computed(paper_recommendation, paper
     assert data == json.loads(json.dumps(expected))
 
 
-
 def test_the_search_holds_a_candidates_modes_at_the_loops_crossover(paper_spec):
     """loop_meets held the modes at 3 x the controller's crossover (24 Hz at 8 Hz) while step 2
     and step 3 hold them at 3 x the loop's (12.04 Hz here, the cart stuck and the joint free:
@@ -430,3 +429,18 @@ def test_the_search_holds_a_candidates_modes_at_the_loops_crossover(paper_spec):
     assert 3 * drawn.crossover < lateral.frequency < 3 * top  # 24 < 30.02 < 36.1 Hz
     ok, why = loop_meets(drawn)
     assert not ok and "stage y (lateral)" in why and "loop's crossover" in why
+
+
+def test_the_report_s_table_quotes_the_design_as_the_advice_does(paper_recommendation):
+    """The advice above the table read '60 x 15.3 x 0.55 mm leaves', the table beneath it
+    '60 mm x 15.31 mm x 0.55 mm' (and the console's 15.3); the spec's column of the drive
+    stiffness, 'net of gravity', held the joint's given 6667 N/m, not its guide's net."""
+    import re
+
+    from fi_design.report.recommend import STIFFNESS_ROW, _design_rows
+
+    rows = {r[0]: r for r in _design_rows(paper_recommendation)}
+    leaves = rows["Leaves L \u00d7 b \u00d7 t"][2].replace("\u00a0", " ")
+    numbers = re.findall(r"[0-9.]+", leaves)
+    assert " x ".join(numbers) + " mm leaves" in paper_recommendation.advice
+    assert STIFFNESS_ROW in rows and "net of gravity" not in STIFFNESS_ROW.split("(")[0]

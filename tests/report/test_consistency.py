@@ -1,0 +1,212 @@
+"""The design report says one thing once: a quantity quoted in two sections (the verdict box,
+the checks table, the step sections, the guide, the captions) is the same number in both.
+
+Each test reads the context of the paper setup's report (computed once per session by
+``paper_confirmed_design``, figures off) and compares what two of its parts state.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from fi_design import report
+
+DATE = "2026-01-01"
+
+
+@pytest.fixture(scope="module")
+def ctx(paper_confirmed_design) -> dict:
+    return report.build_context(paper_confirmed_design, date=DATE, figures=False)
+
+
+def _check(ctx: dict, name: str) -> dict:
+    return next(r for g in ctx["verdict"]["groups"] for r in g["rows"] if r["name"] == name)
+
+
+def _step_row(ctx: dict, number: int, start: str) -> dict:
+    step = next(s for s in ctx["steps"] if s["number"] == number)
+    return next(r for r in step["results"] if r["quantity"].startswith(start))
+
+
+def test_one_required_parasitic_frequency(ctx):
+    """Step 2, step 3, the flexure check and the guide's mode table ask the same frequency of
+    a parasitic mode (step 3 quoted the sizing's 46.11 Hz and the guide 3 x 8 = 24 Hz while
+    step 2 and the check ask 3 x 15.43 = 46.28 Hz)."""
+    limit = _check(ctx, "flexure.modes")["limit"]
+    assert _step_row(ctx, 2, "lowest allowed parasitic frequency")["value"] == limit
+    assert _step_row(ctx, 3, "required parasitic frequency")["value"] == limit
+    required = {m["required"] for m in ctx["guide"]["modes"] if m["required"] is not None}
+    assert required == {limit}
+    assert ctx["guide"]["required"] == limit
+
+
+def test_the_guide_names_the_stiffness_the_analysis_uses(ctx, paper_confirmed_design):
+    """The guide section said the guide's net 6627 N/m is 'the joint the loop and the simulation
+    see', the step 3 check that the analysis simulates the joint's given 6667 N/m."""
+    joint = paper_confirmed_design.model.joint.stiffness
+    net = paper_confirmed_design.flexure.mechanics.net_drive_stiffness
+    assert joint != net
+    words = ctx["guide"]["gravity"]
+    assert "the joint the loop and the simulation see" not in words
+    assert f"use the joint's {report.filters.qty(joint, 'N/m')}" in words
+    assert "the joint's 6667 N/m that the analysis simulates" in _check(ctx, "flexure.joint")[
+        "message"]
+
+
+def test_the_bode_caption_says_also_only_beside_a_drawn_crossover(ctx):
+    """Case 4 crosses 0 dB once, at 0.00135 Hz (the linear table: 1 crossing; the verdict's
+    note: 'only at'), but the Bode caption said it 'also crosses 0 dB' there."""
+    case4 = next(c for c in ctx["linear"]["cases"] if c["number"] == 4)
+    assert case4["crossovers"] == 1
+    caption = ctx["linear"]["bode"]["caption"]
+    assert "case 4 crosses 0 dB at 0.00135\u00a0Hz" in caption
+    assert "also" not in caption
+
+
+def test_the_forces_table_says_it_lists_only_some_moves(ctx, paper_confirmed_design):
+    """'17 of 25 moves run the joint onto its end stop' above a table of 13 moves, 9 of them on
+    the stop, without saying the table left moves out."""
+    forces = ctx["nonlinear"]["forces"]
+    n = len(paper_confirmed_design.simulation.forces.moves)
+    assert len(forces["rows"]) < n
+    assert f"The table lists {len(forces['rows'])} of the {n} moves" in forces["intro"]
+
+
+def _robustness_reason(ctx: dict) -> str:
+    return next(r["text"] for r in ctx["verdict"]["reasons"]
+                if r["text"].startswith("Under friction scatter"))
+
+
+def _robustness_assumption(ctx: dict) -> str:
+    return next(t for t in ctx["assumptions"]["model"] if t.startswith("Robustness:"))
+
+
+def test_the_scatter_on_k_is_stated_alike_in_the_verdict_and_the_assumptions(ctx):
+    """The verdict's reason and the assumptions name the same spread of k (6 %, the stock's
+    thickness tolerance on t = 0.5 mm), with the same sign as the other reasons (±)."""
+    assert "\u00b16 % on k" in _robustness_reason(ctx)
+    assert "+-" not in _robustness_reason(ctx)
+    assert "the drive stiffness (6" in _robustness_assumption(ctx)
+    assert "the flexure's stock tolerance" in _robustness_assumption(ctx)
+
+
+def test_without_the_isolator_k_does_not_scatter_on_the_stage_as_specified(
+        paper_confirmed_design):
+    """A stage without isolator was said to scatter '+-5 % on k' (only the comparison's isolator
+    has a k), and the assumptions called that 5 % 'the flexure's stock tolerance' for specs
+    without a flexure."""
+    import dataclasses
+
+    r = paper_confirmed_design.robustness
+    plain = dataclasses.replace(r, plant="non_isolated", scatter={**r.scatter,
+                                                                  "isolator.stiffness": 0.05})
+    result = dataclasses.replace(paper_confirmed_design, robustness=plain, flexure=None)
+    from fi_design.guideline.verdict import _scatter_words
+    from fi_design.report.assumptions import _robustness
+
+    assert " on k" not in _scatter_words(plain)
+    words = _robustness(result)
+    assert "stock tolerance" not in words
+    assert ("the drive stiffness (5 %, the default without a sized flexure, of the isolator "
+            "simulated for comparison only)") in words
+
+
+def test_a_phase_margin_outside_the_band_is_not_denied_beside_its_value(ctx):
+    """The checks table showed case 4's phase margin, 90.12°, in its value column beside a
+    message saying the case has 'no phase margin'; the table of every crossing gives it too
+    (90.1° at 0.00135 Hz, below the band). The message now says it is there but not judged."""
+    row = _check(ctx, "phase_margin.stuck_limited")
+    assert row["status"] == "INFO" and math.isfinite(row["value"])
+    assert "no phase margin" not in row["message"]
+    assert f"its phase margin there, {report.filters.num(row['value'], 3)} deg" in row["message"]
+
+
+def test_the_flexure_factors_read_alike_in_step_3_the_check_and_the_conclusion(ctx):
+    """Step 3 quoted the stress margin 11.75 and the buckling factor 21.83, the flexure checks,
+    the conclusion, the guide and the assumptions 11.8 and 21.8."""
+    margin = _step_row(ctx, 3, "stress margin")["value"]
+    factor = _step_row(ctx, 3, "buckling factor")["value"]
+    assert f"(margin x{margin})" in _check(ctx, "flexure.stress")["message"]
+    assert f"a stress margin of {margin} " in ctx["verdict"]["conclusion"]
+    assert f"factor {factor}," in _check(ctx, "flexure.buckling")["message"]
+    assert f"{factor} times the weight" in ctx["guide"]["gravity"]
+
+
+def test_the_end_stop_force_reads_alike_in_the_check_and_the_forces_section(ctx):
+    """The forces section said 'a contact force of up to 9.612 N', the end-stop check '9.61 N'."""
+    row = _check(ctx, "end_stop_force")
+    words = report.filters.qty(row["value"], "N")
+    assert f"with a contact force of up to {words}" in ctx["nonlinear"]["forces"]["intro"]
+    assert f"the largest contact force {words.replace(chr(0xa0), ' ')}" in row["message"]
+
+
+def test_the_crossover_factor_figure_asks_the_hunting_margin(paper_confirmed_design):
+    """The key figure asked '> 1' of design / lowest hunting-free crossover (green from 1 on)
+    while the checks table judges it against requirements.hunting_margin (1.2): a design at
+    1.1 read PASS in the verdict box beside a FAIL row."""
+    import dataclasses
+
+    from fi_design.report.checks import key_figures
+
+    def figure(factor):
+        m = dataclasses.replace(paper_confirmed_design.margins, crossover_factor=factor)
+        rows = key_figures(dataclasses.replace(paper_confirmed_design, margins=m))
+        return next(r for r in rows if r["label"].startswith("Crossover factor"))
+
+    need = paper_confirmed_design.spec.requirements.hunting_margin
+    assert need == 1.2
+    assert figure(1.1)["requirement"].startswith("\u2265 1.2")
+    assert figure(1.1)["css"] == "fail"
+    assert figure(1.3)["css"] == "pass"
+    assert figure(0.709)["css"] == "warn"
+
+
+def test_the_legend_does_not_call_an_info_row_s_limit_a_requirement(ctx):
+    """Step 1's row reads 'INFO, 3 N, limit < 1 N' (and says: 'a screening rule, not a
+    requirement') under a legend saying 'the limit column states the requirement the value
+    must meet'."""
+    import html
+
+    row = _check(ctx, "friction_gap")
+    assert row["status"] == "INFO" and row["limit"] is not None
+    text = html.unescape(report.render_html(ctx))
+    assert "on an INFO row, the threshold the value is compared with, which it need not meet" \
+        in text
+
+
+def test_the_resting_deflection_keeps_its_sign_in_the_verdict(ctx):
+    """The end-stop reason said 'joint deflection 0.278 mm of the 0.3 mm stroke', the key
+    figure beside it and step 3 '-0.278 mm' (of the ±0.3 mm stroke)."""
+    reason = next(r["text"] for r in ctx["verdict"]["reasons"]
+                  if r["text"].startswith("The cart rests"))
+    note = next(f["note"] for f in ctx["verdict"]["figures"]
+                if f["label"] == "End-stop clearance at rest")
+    assert note.replace("\u00a0", " ") in reason.replace("\u00a0", " ")
+    assert "-0.278" in reason
+
+
+@pytest.fixture(scope="module")
+def no_isolator_steps():
+    """Step 2 of examples/no_isolator.yaml (no isolator, no modes: the achievable crossover
+    is not limited below the search cap), without the simulation."""
+    from conftest import EXAMPLES, shared
+    from fi_design.guideline.evaluate import evaluate
+    from fi_design.report.steps import guideline_steps
+    from fi_design.spec.file import load_spec
+
+    spec = load_spec(EXAMPLES / "no_isolator.yaml")
+    design = shared("design", spec, lambda: evaluate(spec, confirm=False), False)
+    assert design.crossover.limit_kind == "scan_limit"
+    return design, guideline_steps(design, figures=False)
+
+
+def test_a_search_cap_is_no_achievable_crossover(no_isolator_steps):
+    """The verdict box says '≥ 1000 Hz ... a bound, not a result', step 2 said 'achievable
+    crossover 1000 Hz' and f_c ≤ f_c,ach = 1000 Hz."""
+    design, steps = no_isolator_steps
+    step2 = next(s for s in steps if s["number"] == 2)
+    row = next(r for r in step2["results"] if r["quantity"] == "achievable crossover")
+    assert isinstance(row["value"], str) and row["value"].startswith("\u2265 1000")
+    assert not any("f_c,ach = " in e["text"] for e in step2["equations"])
