@@ -217,7 +217,11 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
                         "unit": ""})
     sim = result.simulation
     land = getattr(sim, "landing", None) if sim is not None else None
-    if land is not None:
+    if land is not None and not math.isfinite(land.deflection):  # the run did not complete
+        results.append({"quantity": "simulated deflection at rest d",
+                        "value": "not determined: the isolated simulation of the spec's move "
+                                 "did not complete (see the simulation section)", "unit": ""})
+    elif land is not None:
         eqs.append(eq(
             f"F_\\mathrm{{rest}} = k \\min(|d|, s) = {tex_qty(land.stiffness, 'N/m')} \\times "
             f"{tex_qty(min(abs(land.deflection), land.stroke), 'm')} = {tex_qty(land.force, 'N')}"))
