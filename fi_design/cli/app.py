@@ -285,7 +285,8 @@ def sweep_command(
     """Map hunting over one or two spec values (the paper's Figure 4).
 
     Every point is the spec with the swept values replaced and validated; an
-    invalid point (say Fs < Fc) or a failed simulation is recorded, and the
+    invalid point (say Fs < Fc), one whose drawn guide the stage's weight
+    buckles (not simulated) or a failed simulation is recorded, and the
     sweep goes on. Finished points are cached, so a repeated or interrupted
     sweep only simulates what is missing.
     """
