@@ -285,7 +285,8 @@ def sweep_command(
     """Map hunting over one or two spec values (the paper's Figure 4).
 
     Every point is the spec with the swept values replaced and validated; an
-    invalid point (say Fs < Fc) or a failed simulation is recorded, and the
+    invalid point (say Fs < Fc), one whose drawn guide the stage's weight
+    buckles (not simulated) or a failed simulation is recorded, and the
     sweep goes on. Finished points are cached, so a repeated or interrupted
     sweep only simulates what is missing.
     """
@@ -635,7 +636,7 @@ def identify_command(
     spec_obj = load(spec) if spec is not None else None
 
     from ..console import FractionBar, make_console, print_identification
-    from ..identification import identified_spec_text, identify
+    from ..identification import identified_spec_text, identify, kept_mass_message
     from ..measured import load_measurement
 
     data = load_measurement(measured)
@@ -646,6 +647,9 @@ def identify_command(
     payloads = {} if outs["json"] is None else {"json": json_text(result)}
     if outs["spec"] is not None:
         payloads["spec"] = identified_spec_text(result)
+        kept = kept_mass_message(result)
+        if kept:
+            console.print(f"--write-spec: {kept}", style="yellow", markup=False)
     write_outputs(console, outs, payloads)
     write_report(console, outs["report"], result)
 

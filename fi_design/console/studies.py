@@ -25,7 +25,7 @@ def _axis_values_text(axis) -> str:
 
 
 _CELL = {"settled": ("·", "green"), "stuck": ("s", "yellow"), "undetermined": ("?", "yellow"),
-         "invalid": ("-", "dim"), "failed": ("×", "bold red")}
+         "buckled": ("b", "bold magenta"), "invalid": ("-", "dim"), "failed": ("×", "bold red")}
 
 
 #: Widest map printed on the console [columns]; a wider one is named by its file.
@@ -48,7 +48,8 @@ def sweep_grid_table(result, columns: slice | None = None):
     rich.table.Table
         Rows are y values, columns x values, both in display units; a cell
         holds the cycle count of a hunting point, ``·`` settled, ``s`` stuck,
-        ``?`` undetermined, ``-`` invalid, ``×`` failed.
+        ``?`` undetermined, ``b`` the drawn guide buckled under the stage (not
+        simulated), ``-`` invalid, ``×`` failed.
     """
     from rich import box
     from rich.table import Table
@@ -132,7 +133,10 @@ def grid_caption(result) -> str:
     text = f"{what}; columns: {axis_label(result.x.path, result.x.unit)}"
     if result.y is not None:
         text += f", rows: {axis_label(result.y.path, result.y.unit)}"
-    return text + "; · settled, s stuck, ? undetermined, - invalid, × failed"
+    marks = "; · settled, s stuck, ? undetermined, - invalid, × failed"
+    if "buckled" in result.verdict:
+        marks += "; b the weight has buckled the guide (not simulated)"
+    return text + marks
 
 
 def _print_grid(console: "Console", result, files: tuple = ()) -> None:
@@ -205,6 +209,12 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
         if not math.isnan(above[0]):
             console.print(Text(f"no hunting from {quantity_name(result.x.path).lower()} = "
                                f"{number(above[0] * xf)} {xu} upwards"))
+    buckled = [p for p in result.points if p.verdict == "buckled"]
+    if buckled:
+        console.print(Text(f"buckled: at {len(buckled)} point(s) the stage's weight buckles the "
+                           "drawn guide (net drive stiffness at or below 0, which the design "
+                           "fails in step 3); they are not simulated and count as no design",
+                           style="magenta"))
     failed = [p for p in result.points if p.status == "failed"]
     for p in failed[:3]:
         console.print(Text(f"failed at {dict(zip(result.paths, p.values))}: {p.message}",
@@ -287,8 +297,9 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
         (f"{percent(conf, 2)} Wilson interval",
          lambda p: f"{percent(p.low, 3)} to {percent(p.high, 3)}"),
         ("Hunting / valid samples", lambda p: f"{p.hunting} / {p.valid}"),
-    ] + [(f"  {v}", lambda p, v=v: str(p.counts[v]))
-         for v in ("settled", "stuck", "undetermined", "invalid", "failed")]
+    ] + [(f"  {v}", lambda p, v=v: str(p.counts.get(v, 0)))
+         for v in ("settled", "stuck", "undetermined", "buckled", "invalid", "failed")
+         if v != "buckled" or any(p.counts.get(v, 0) for _, p in plants)]
     for title, cell in rows:
         t.add_row(Text(title), *[cell(p) for _, p in plants])
     t.caption = Text("Probability among the valid samples; the indented rows count every "

@@ -117,9 +117,11 @@ from .preprocess import processing
 from ..results.identification import (DYNAMIC, FORMS, NAMES, UNITS, BranchFit, Dynamic, Excitation,
                                       Fit, ForcePrediction, IdentificationResult, Masses,
                                       Parameter, Processing, Samples, SweepFit)
-from .specwrite import identified_spec, identified_spec_text, spec_values
+from .specwrite import (identified_spec, identified_spec_text, kept_mass_message,
+                        mass_kept, spec_values)
 
 __all__ = ["identify", "IdentificationResult", "Parameter", "Fit", "Processing", "Excitation",
            "Masses", "Samples", "ForcePrediction", "predict_force", "processing", "excitation",
-           "spec_values", "identified_spec", "identified_spec_text", "segment", "NAMES", "UNITS",
+           "spec_values", "identified_spec", "identified_spec_text", "mass_kept",
+           "kept_mass_message", "segment", "NAMES", "UNITS",
            "FORMS", "DYNAMIC", "BranchFit", "SweepFit", "Dynamic"]

@@ -43,6 +43,23 @@ MASS_FACTOR = 1.5
 FIT_LEAK = 0.05
 
 
+def mass_far(total: Parameter, spec) -> bool:
+    """Whether the identified total mass lies beyond :data:`MASS_FACTOR` of the spec's
+    stage plus cart mass (False without a spec or a positive identified mass)."""
+    if spec is None or total.value is None or total.value <= 0.0:
+        return False
+    ratio = total.value / float(spec.total_mass)
+    return not 1.0 / MASS_FACTOR <= ratio <= MASS_FACTOR
+
+
+def mass_leaks(total: Parameter, spec, fit: Fit) -> bool:
+    """Whether the identified mass is not to be written into the spec: far from the spec's
+    (:func:`mass_far`) with a fit that leaves :data:`FIT_LEAK` or more of the force
+    unexplained, so that a force the model lacks leaks into it (:func:`mass_note` says so).
+    """
+    return mass_far(total, spec) and fit.relative_error >= FIT_LEAK
+
+
 def mass_note(total: Parameter, spec, proc: Processing, fit: Fit) -> str:
     """A note when the identified total mass is far from the spec's moving mass, with the cause.
 
@@ -52,16 +69,14 @@ def mass_note(total: Parameter, spec, proc: Processing, fit: Fit) -> str:
     more says the model lacks a force (the mass then depends on the low-pass cut-off, which
     the spec's crossover sets); a close fit says the record is consistent with that mass.
     """
-    if spec is None or total.value is None or total.value <= 0.0:
+    if not mass_far(total, spec):
         return ""
     moving = float(spec.total_mass)
     ratio = total.value / moving
-    if 1.0 / MASS_FACTOR <= ratio <= MASS_FACTOR:
-        return ""
     text = (f"mass = {with_error(total.value, total.std_error, 'kg', 3)} is "
             f"{number(ratio, 3)} times the spec's moving mass (stage + cart = "
             f"{quantity(moving, 'kg', 4)}), beyond a factor of {number(MASS_FACTOR)} either way: ")
-    if fit.relative_error >= FIT_LEAK:
+    if mass_leaks(total, spec, fit):
         return text + (
             f"the fit leaves {percent(fit.relative_error, 2)} of the force unexplained, so a "
             "force the model lacks (force ripple, a cable force, friction varying along the "

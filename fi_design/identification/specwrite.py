@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import math
 
-from ..display import number, plain, quantity
-from .regression import IMPLAUSIBLE
+from ..display import number, percent, plain, quantity
+from .regression import IMPLAUSIBLE, mass_leaks
 from ..results.identification import DYNAMIC, IdentificationResult
 
 
@@ -32,6 +32,11 @@ def spec_values(result: IdentificationResult) -> dict[str, float]:
     the record; the Stribeck velocity and bristle stiffness not identified
     keep the spec's own values.
 
+    Where identify's note says not to write the mass (:func:`mass_kept`: far
+    from the spec's with a fit that leaves a force unexplained, which leaks
+    into it), ``stage.mass`` and ``cart.mass`` are the spec's own; the
+    friction is the identified.
+
     A record that slides in one direction only identifies that direction's
     friction with the force offset included: the spec's offset is kept and
     that direction's Coulomb friction is the identified level less it
@@ -45,10 +50,53 @@ def spec_values(result: IdentificationResult) -> dict[str, float]:
         The identification (with a spec).
     """
     return _values(result.spec, result.parameters, result.masses, result.form,
-                   result.direction)
+                   result.direction, keep_mass=mass_kept(result))
 
 
-def _values(spec, params, masses, form, direction: str = "both") -> dict[str, float]:
+def mass_kept(result: IdentificationResult) -> bool:
+    """Whether ``--write-spec`` keeps the spec's stage and cart masses.
+
+    True where identify's own note says not to write its mass into the spec
+    (:func:`fi_design.identification.regression.mass_leaks`): the total mass
+    lies beyond a factor of 1.5 from the spec's and the fit leaves 5 % or more
+    of the force unexplained, so a force the model lacks leaks into the mass
+    through the filter (it follows the filter's cut-off, not the stage).
+
+    Parameters
+    ----------
+    result : IdentificationResult
+        The identification.
+    """
+    return mass_leaks(result.parameters["mass"], result.spec, result.fit)
+
+
+def kept_mass_message(result: IdentificationResult) -> str:
+    """What ``--write-spec`` did with the masses when :func:`mass_kept`, else ``""``.
+
+    Parameters
+    ----------
+    result : IdentificationResult
+        The identification.
+    """
+    if not mass_kept(result):
+        return ""
+    spec, p = result.spec, result.parameters["mass"]
+    return (f"kept the spec's stage and cart masses ({quantity(spec.stage.mass, 'kg', 4)} and "
+            f"{quantity(spec.cart.mass, 'kg', 4)}): the identified mass "
+            f"{quantity(p.value, 'kg', 4)} is far from them and, by the fit, a force the model "
+            "lacks leaks into it (see the note), so it is not written; the identified friction "
+            "is written")
+
+
+def _values(spec, params, masses, form, direction: str = "both",
+            keep_mass: bool = False) -> dict[str, float]:
+    v = _identified_values(spec, params, masses, form, direction)
+    if keep_mass and spec is not None:
+        v["stage.mass"], v["cart.mass"] = spec.stage.mass, spec.cart.mass
+    return v
+
+
+def _identified_values(spec, params, masses, form, direction: str) -> dict[str, float]:
     if direction != "both":
         return _one_direction_values(spec, params, masses, direction)
     v = {"stage.mass": masses.stage, "cart.mass": masses.cart,
@@ -99,8 +147,12 @@ def _one_direction_values(spec, params, masses, direction: str) -> dict[str, flo
     return v
 
 
-def identified_spec(spec, params, masses, form, direction: str = "both"):
+def identified_spec(spec, params, masses, form, direction: str = "both",
+                    keep_mass: bool = False):
     """The spec with identified values (a :class:`~fi_design.spec.Spec`, no file origin).
+
+    ``keep_mass``: the spec's stage and cart masses instead of the identified
+    ones (see :func:`mass_kept`).
 
     Raises
     ------
@@ -111,7 +163,7 @@ def identified_spec(spec, params, masses, form, direction: str = "both"):
     from ..errors import SpecError
     from ..spec.file import with_values
 
-    values = _values(spec, params, masses, form, direction)
+    values = _values(spec, params, masses, form, direction, keep_mass)
     bad = [k for k in ("stage.mass", "cart.mass", "friction.coulomb",
                        "friction.coulomb_negative", "friction.viscous",
                        "friction.viscous_negative") if k in values and values[k] < 0.0
@@ -143,7 +195,8 @@ def identified_spec_text(result: IdentificationResult) -> str:
     :func:`spec_values` replaces the one written in the file, with a comment
     giving the estimate, its standard error and the value it replaced; a
     missing key is added to its section. A header comment names the record
-    and the form. The text is checked with :func:`fi_design.spec.file.load_spec`
+    and the form. Where :func:`mass_kept`, the masses are the spec's own, and
+    the header and their comments say why. The text is checked with :func:`fi_design.spec.file.load_spec`
     before it is returned.
 
     Parameters
@@ -169,7 +222,7 @@ def identified_spec_text(result: IdentificationResult) -> str:
     if spec is None:
         raise SpecError("identification without a spec: nothing to fill in (give --spec)")
     identified_spec(spec, result.parameters, result.masses, result.form,
-                    result.direction)  # refuses bad values
+                    result.direction, mass_kept(result))  # refuses bad values
     values = spec_values(result)
     org = origin(spec)
     raw = org.raw if org is not None else {}
@@ -177,7 +230,9 @@ def identified_spec_text(result: IdentificationResult) -> str:
     for path in values:
         section, key = path.split(".")
         old = (raw.get(section) or {}).get(key) if isinstance(raw.get(section), dict) else None
-        comments[path] = _value_comment(result, path) + ("" if old is None else f" (was {old})")
+        kept = path in ("stage.mass", "cart.mass") and mass_kept(result)
+        comments[path] = _value_comment(result, path) + ("" if old is None or kept
+                                                         else f" (was {old})")
     return edited_spec_text(spec, {p: spec_quantity(p, v, digits=6) for p, v in values.items()},
                             comments=comments, header=_header(result),
                             source="<identified spec>")
@@ -192,6 +247,9 @@ def _value_comment(result: IdentificationResult, path: str) -> str:
     section, key = path.split(".")
     unit = _SPEC_UNITS[path]
     if section in ("stage", "cart"):
+        if mass_kept(result):
+            return ("the spec's own mass, kept: identify's mass is far from the spec's and a "
+                    "force the model lacks leaks into it (see the header)")
         m = result.masses
         se = m.stage_std_error if section == "stage" else m.cart_std_error
         if se is not None:
@@ -227,6 +285,15 @@ def _header(result: IdentificationResult) -> str:
     lines = [f"# Friction and masses identified by fi-design identify from {src}",
              f"# ({result.form.replace('_', '-')} form, {result.model} model, relative force "
              f"error {number(result.fit.relative_error, 3)}); values marked 'identified' below."]
+    if mass_kept(result):
+        p = result.parameters["mass"]
+        lines += ["# stage.mass and cart.mass are the spec's own, kept: the identified total "
+                  f"mass {_quantity('stage.mass', p.value)}",
+                  f"# is far from them and the fit leaves {percent(result.fit.relative_error, 2)}"
+                  " of the force unexplained, a force the model",
+                  "# lacks that leaks into the mass; identify's note says not to write it into "
+                  "the spec",
+                  "# (fi-design reconcile names the missing force)."]
     for name in DYNAMIC:
         p = result.parameters[name]
         if not p.identifiable:

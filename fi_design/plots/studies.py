@@ -16,6 +16,11 @@ from .labels import axis_label, display_unit, quantity_name
 #: Marks drawn on map cells whose verdict is not a plain count.
 VERDICT_MARKS = {"stuck": "s", "undetermined": "?", "failed": "×"}
 
+#: Fill of the cells whose drawn guide the stage's weight buckles (not simulated), and its
+#: legend entry.
+BUCKLED_COLOUR = "#6a3d9a"
+BUCKLED_LABEL = "guide buckled by the weight (not simulated)"
+
 
 #: A stage map's colour scale turns logarithmic when its cycles span more than this [-].
 LOG_SPAN = 20.0
@@ -36,9 +41,10 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
     A map is a heatmap (paper Figure 4) of the hunting cycles counted on the
     spec's move (``measure "move"``), or of the peak-to-peak amplitude of the
     cycle some move of the family ends in (``measure "stage"``): white where
-    there is none, invalid points hatched grey, stuck points marked ``s``,
-    undetermined ``?``, failed ``×``, the design point a red cross. A line is
-    a step plot of the same over x.
+    there is none, invalid points hatched grey, points whose drawn guide the
+    stage's weight buckles filled purple (in the legend), stuck points marked
+    ``s``, undetermined ``?``, failed ``×``, the design point a red cross. A
+    line is a step plot of the same over x.
 
     Parameters
     ----------
@@ -85,9 +91,16 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
                             va="bottom", fontsize=8, color="0.3")
             elif v == "invalid":
                 ax.axvspan(xi - 0.5 * _step(xs), xi + 0.5 * _step(xs), color="0.85", lw=0)
+        buckled = False
+        for xi, v in zip(xs, verdict):
+            if v == "buckled":
+                ax.axvspan(xi - 0.5 * _step(xs), xi + 0.5 * _step(xs), color=BUCKLED_COLOUR,
+                           alpha=0.35, lw=0, label=None if buckled else BUCKLED_LABEL)
+                buckled = True
         if result.design_point[0] is not None:
             ax.axvline(result.design_point[0] * xf, color="red", lw=1, ls="--",
                        label="design point")
+        if buckled or result.design_point[0] is not None:
             ax.legend(loc="best", fontsize=8, frameon=False)
         ax.set_xlabel(axis_label(x.path, x.unit))
         ax.set_ylabel(label)
@@ -137,6 +150,10 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
     for j, i in zip(*np.nonzero(verdict == "invalid")):
         ax.add_patch(Rectangle((ex[i], ey[j]), ex[i + 1] - ex[i], ey[j + 1] - ey[j], fill=False,
                                hatch="//", edgecolor="0.55", lw=0))
+    buckled = np.nonzero(verdict == "buckled")
+    for j, i in zip(*buckled):
+        ax.add_patch(Rectangle((ex[i], ey[j]), ex[i + 1] - ex[i], ey[j + 1] - ey[j],
+                               facecolor=BUCKLED_COLOUR, alpha=0.6, lw=0))
     if annotate is None:
         annotate = len(xs) * len(ys) <= 225
     for j in range(len(ys)):
@@ -155,6 +172,14 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
     if dx is not None and dy is not None:
         ax.plot([dx * xf], [dy * yf], marker="X", color="red", ms=10, mec="white", mew=1.0,
                 ls="none", label="design point")
+    if len(buckled[0]):
+        from matplotlib.patches import Patch
+
+        handles = [Patch(facecolor=BUCKLED_COLOUR, alpha=0.6, label=BUCKLED_LABEL)]
+        if dx is not None and dy is not None:
+            handles += ax.get_legend_handles_labels()[0]
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14),
+                  fontsize=7, frameon=False, ncol=len(handles))
     if x.log:
         ax.set_xscale("log")
     if y.log:
@@ -254,7 +279,9 @@ def _legend_text(result: Any, verdicts: Any = None) -> str:
     extra = "hatched: invalid spec" if np.any(verdicts == "invalid") else ""
     white = ("white: every move settles (colour: the largest cycle any move ends in)"
              if getattr(result, "measure", "move") == "stage" and result.y is not None else "")
-    parts = [p for p in (white, marks, extra) if p]
+    buckled = "purple: the guide buckles (not simulated)" if np.any(verdicts == "buckled") \
+        else ""
+    parts = [p for p in (white, marks, extra, buckled) if p]
     return ("red cross: design point" if result.y is not None else "dashed: design point") + \
         ("; " + "; ".join(parts) if parts else "")
 

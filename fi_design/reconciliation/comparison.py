@@ -27,7 +27,7 @@ from ..errors import DataError
 from ..measured import Measurement
 from ..model import as_model
 from ..simulation.replay import command_state
-from ..simulation.run import simulate
+from ..simulation.run import record_notes, simulate
 from ..trajectory import from_samples
 from ..results.reconciliation import Lattice, ModelTrace, NoiseLevels, Segment
 
@@ -111,6 +111,9 @@ class Comparison:
         self.fail_level = FAIL_FACTOR
         err = np.abs(measured.position - measured.reference)
         self.runaway = RUNAWAY_FACTOR * (float(np.max(err)) + 10.0 * noise.position)
+        #: The replay's warnings about the record (a closed loop that starts far from its
+        #: reference: :func:`fi_design.simulation.run.record_notes`).
+        self.notes = record_notes(self.model, measured, drive)
         self._segments(settle_window)
 
     # ---- model runs

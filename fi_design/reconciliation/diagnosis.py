@@ -238,6 +238,15 @@ def _band(r: np.ndarray, t: np.ndarray, low: float | None, high: float | None) -
     return out
 
 
+def _offset_text(cmp: Comparison) -> str:
+    """The record's start offset for the initial-state cause, when the replay warns of one."""
+    if not cmp.notes:
+        return ""
+    x0, r0 = float(cmp.meas.position[0]), float(cmp.meas.reference[0])
+    return (f" The record's position_m starts {quantity(x0 - r0, 'm', 4)} from reference_m: "
+            "see the warning (an encoder or homing offset between the columns?).")
+
+
 def _causes(cmp: Comparison, r: np.ndarray, crossover: float, use_force: bool) -> list[Cause]:
     """Shares of the residual's energy (its mean included) that point at each cause."""
     unit = "N" if use_force else "m"
@@ -260,7 +269,7 @@ def _causes(cmp: Comparison, r: np.ndarray, crossover: float, use_force: bool) -
                      f"{percent(frac_ss, 2)} of the residual's energy lies in the first "
                      f"{quantity(window, 's', 3)} ({percent(frac_t, 2)} of the record): check "
                      "the state the replay starts from (position, velocity, the controller's "
-                     "integrator)."))
+                     "integrator)." + _offset_text(cmp)))
     moving = cmp.kind != "hold"
     a, v = cmp.a_ref, cmp.v_ref
     mass, slope = 0.0, 0.0

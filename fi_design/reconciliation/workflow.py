@@ -155,6 +155,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     conclusion = _conclusion(final.steps, first, nominal.chi2, final.chi2, cmp.n_points,
                              ambiguous, diagnosis)
     conclusion = f"{conclusion} {thinning}" if thinning else conclusion
+    conclusion = _warned(cmp, conclusion)
     say("done", 1.0)
     steps = final.steps
     return ReconcileResult(
@@ -500,12 +501,19 @@ def _failed_nominal(cmp: Comparison, nominal: Baseline, started: float,
         lattice=cmp.lattice, signatures=(), segments=cmp.segment_list(), diagnosis=diagnosis,
         isolated=cmp.iso, drive=cmp.drive, threshold=float(threshold), n_points=cmp.n_points,
         initial_command=cmp.initial_command, chi2_nominal=math.inf, chi2_corrected=math.inf,
-        conclusion=diagnosis.message, n_simulations=cmp.n_sims,
+        conclusion=_warned(cmp, diagnosis.message), n_simulations=cmp.n_sims,
         wall_time=_time.perf_counter() - started, measurement=cmp.meas,
         nominal=cmp.model_trace(run), corrected=cmp.model_trace(run), spec=cmp.spec)
 
 
 # --------------------------------------------------------------------------- wording
+
+
+def _warned(cmp: Comparison, conclusion: str) -> str:
+    """The conclusion led by the replay's warnings about the record (a closed loop that
+    starts far from its reference: an offset between position_m and reference_m explains a
+    gap no effect does, and a cause the diagnosis would call only the initial state)."""
+    return " ".join([f"Warning: {n}." for n in cmp.notes] + [conclusion])
 
 
 def _conclusion(steps, candidates, chi2_nom, chi2_cor, n, ambiguous, diagnosis) -> str:

@@ -28,8 +28,9 @@ __all__ = ["POINT_VERDICTS", "Axis", "PointResult", "RunInfo", "SweepResult", "D
            "MapDefinition", "StudyMap", "StudyResult", "Scatter", "PositionFriction",
            "HuntingProbability", "RobustnessResult", "columns", "csv_text"]
 
-#: Verdicts of the hunting metric plus the two outcomes of a point that has no metric.
-POINT_VERDICTS = ("settled", "hunting", "stuck", "undetermined", "invalid", "failed")
+#: Verdicts of the hunting metric plus the outcomes of a point that has no metric: its
+#: drawn guide buckled under the stage's weight (not simulated), refused by the spec, failed.
+POINT_VERDICTS = ("settled", "hunting", "stuck", "undetermined", "buckled", "invalid", "failed")
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,11 +81,13 @@ class PointResult(Result):
     isolated : bool
         Whether the isolated plant was simulated.
     status : str
-        ``"ok"``, ``"invalid"`` (the spec refused the values) or ``"failed"``
-        (the simulation did not complete or raised).
+        ``"ok"``, ``"invalid"`` (the spec refused the values, or the drawn
+        guide buckles under the stage: not simulated) or ``"failed"`` (the
+        simulation did not complete or raised).
     verdict : str
         ``settled``, ``hunting``, ``stuck`` or ``undetermined`` (the metric's
-        verdict), or ``invalid`` / ``failed``.
+        verdict), ``buckled`` (the stage's weight buckles the drawn guide: net
+        drive stiffness at or below 0), or ``invalid`` / ``failed``.
     hunting_cycles : int or None
         Peaks counted in the window (the paper's metric); None without a metric.
     amplitude : float or None
@@ -255,7 +258,7 @@ class SweepResult(Result):
             order = range(len(xs) - 1, -1, -1) if free == "above" else range(len(xs))
             last = None
             for i in order:
-                if row[i] in ("hunting", "invalid", "failed"):
+                if row[i] in ("hunting", "buckled", "invalid", "failed"):
                     break
                 last = i
             if last is not None:

@@ -269,11 +269,26 @@ def _result(model, iso, method, params, out, t_out, wall, *, move_end,
         record=None if record is None else (record.source or "record"),
         window=None if window is None else frozen_array(window, dtype=int),
         replay=None if record is None else replay_fit(
-            record, Y[:, idx["x1"]], out.command, _record_notes(model, record, drive)))
+            record, Y[:, idx["x1"]], out.command, record_notes(model, record, drive)))
 
 
-def _record_notes(model, record, drive: str) -> tuple[str, ...]:
-    """Warnings about a replayed record: a closed loop that starts far from its reference."""
+def record_notes(model, record, drive: str) -> tuple[str, ...]:
+    """Warnings about a replayed record: a closed loop that starts far from its reference.
+
+    Parameters
+    ----------
+    model : Model
+        The model replaying it (its largest move is the scale of a record at rest).
+    record : Measurement
+        The record.
+    drive : {"closed", "force"}
+        The replay's drive: an open loop (``"force"``) has no warning.
+
+    Returns
+    -------
+    tuple of str
+        :func:`~fi_design.simulation.replay.start_note`'s warning, or empty.
+    """
     if drive != "closed":  # open loop the reference drives nothing
         return ()
     note = start_note(record, max(abs(m.distance) for m in model.spec.motion.moves))

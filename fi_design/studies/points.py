@@ -117,6 +117,9 @@ def evaluate_point(model: Model, values: Mapping[str, Any], isolated: bool,
         largest of their cycles' peak to peak (``hunting_cycles`` None); when
         all come to rest, ``settled`` with amplitude 0; a move that sticks or
         cannot be judged makes the point ``stuck`` or ``undetermined``.
+        Either way, an isolated point whose drawn guide the stage's weight
+        buckles (net drive stiffness at or below 0, which step 3 fails) is
+        not simulated: status ``invalid``, verdict ``buckled``.
         ``"stage_first"``: the same, but the moves, the largest first
         (:func:`~fi_design.stage.moves.spread`), stop at the first that
         hunts (``amplitude`` is that move's cycle).
@@ -137,6 +140,8 @@ def evaluate_point(model: Model, values: Mapping[str, Any], isolated: bool,
         point = model.varied(values) if values else model
     except SpecError as exc:
         return _outcome("invalid", "invalid", message=str(exc))
+    if isolated and point.joint is not None and point.joint.stiffness <= 0.0:
+        return _buckled(point.joint.stiffness)
     if measure != "move":
         return _stage_point(point, isolated, first_only=measure == STAGE_FIRST)
     try:
@@ -191,6 +196,19 @@ def _stage_point(point: Model, isolated: bool, first_only: bool = False) -> dict
                             message=f"the {_distance(bad.distance)} move: {bad.reason}")
     return _outcome("ok", "settled", amplitude=0.0, final_error=final,
                     message=f"all {len(moves)} moves come to rest")
+
+
+def _buckled(stiffness: float) -> dict:
+    """The outcome of a point whose drawn guide the stage's weight buckles (not simulated).
+
+    Its net drive stiffness, gravity included, is at or below zero: the design fails it
+    in step 3, and a simulation would only show the stage leaning on its end stop (a
+    cycle of the stroke's size that is no hunting of the isolated stage).
+    """
+    return _outcome("invalid", "buckled",
+                    message=f"the weight has buckled the guide: net drive stiffness "
+                            f"{quantity(stiffness, 'N/m', 4)} (at or below 0; step 3 fails "
+                            "it); not simulated")
 
 
 def _distance(x: float) -> str:

@@ -366,3 +366,39 @@ def test_the_example_record_with_its_force_negated_names_no_effect(tmp_path):
     top = data["candidates"][0]
     assert top["name"] == "position_dependent_friction" and not top["eligible"]
     assert "force_N looks wrong" in top["reasons"][0]
+
+
+def test_a_record_far_off_its_reference_carries_the_replays_warning(tmp_path):
+    """examples/measured_trace.csv with position_m 50 mm off its reference_m (another zero):
+    the replay warns (fi_design.simulation.replay.start_note), but reconcile showed it only as
+    a generic "initial state" cause and blamed force_N's scale. The conclusion and the console
+    now state the offset, and the initial-state cause names it. One candidate: about 2 s."""
+    import io
+
+    from rich.console import Console
+
+    from fi_design import load_measurement, load_spec
+    from fi_design.console import print_reconcile
+    from fi_design.display import quantity
+
+    from conftest import EXAMPLES
+
+    lines = (EXAMPLES / "measured_trace.csv").read_text().splitlines()
+    out = [line if line.startswith(("#", "time_s")) else
+           ",".join(c if i != 2 else repr(float(c) + 0.05) for i, c in
+                    enumerate(line.split(",")))
+           for line in lines]
+    csv = tmp_path / "offset.csv"
+    csv.write_text("\n".join(out) + "\n")
+    rec = load_measurement(csv)
+    result = reconcile(load_spec(EXAMPLES / "measured_stage.yaml"), rec,
+                       candidates=["cable_force"])
+    offset = quantity(float(rec.position[0] - rec.reference[0]), "m", 4)
+    assert result.conclusion.startswith("Warning: the record's first position_m")
+    assert f"lies {offset} from its first reference_m" in result.conclusion
+    assert "subtract the offset" in result.conclusion
+    start = next(c for c in result.diagnosis.causes if c.name == "initial_state")
+    assert f"position_m starts {offset} from reference_m" in start.detail
+    buf = io.StringIO()
+    print_reconcile(Console(file=buf, width=200, color_system=None), result)
+    assert f"lies {offset} from its first reference_m" in buf.getvalue()

@@ -61,6 +61,74 @@ def test_sweep_one_dimensional_with_invalid_points(paper_spec_path, tmp_path):
     assert rows[1]["verdict"] == "hunting"
 
 
+def _drawn_guide_spec(paper_spec_path, tmp_path):
+    """The paper setup with its guide drawn (60 x 15 mm leaves, standing) defining the joint."""
+    import yaml
+
+    d = yaml.safe_load(paper_spec_path.read_text())
+    iso = d["isolator"]
+    for key in ("stiffness", "damping", "parasitic_modes"):
+        iso.pop(key)
+    iso["flexure"].update(length="60 mm", width="15 mm", thickness="0.4 mm")
+    path = tmp_path / "drawn.yaml"
+    path.write_text(yaml.safe_dump(d, sort_keys=False))
+    return path
+
+
+def test_sweep_marks_points_whose_guide_buckles(paper_spec_path, tmp_path):
+    """Leaves of 0.1 mm buckle under the 1.6 kg stage (net drive stiffness about -205 N/m):
+    such a point is `buckled`, not simulated, in the CSV, the console and the map; the
+    0.4 mm leaves (+1463 N/m) are simulated as before."""
+    spec = _drawn_guide_spec(paper_spec_path, tmp_path)
+    out, fig = tmp_path / "line.csv", tmp_path / "line.svg"
+    r = run("sweep", spec, "--x", "isolator.flexure.thickness=0.1 mm,0.4 mm", "--measure",
+            "move", "--csv", out, "--figure", fig, "--jobs", "1", "--no-cache")
+    assert r.exit_code == 0, r.output
+    rows = list(csv.DictReader(out.open()))
+    assert rows[0]["verdict"] == "buckled" and rows[0]["status"] == "invalid"
+    assert "buckled the guide" in rows[0]["message"] and rows[0]["amplitude"] == ""
+    assert rows[1]["verdict"] != "buckled" and rows[1]["status"] == "ok"
+    assert "1 buckled" in r.output and "b the weight has buckled the guide" in r.output
+    assert "guide buckled by the weight" in fig.read_text()
+
+
+def test_buckled_cells_have_their_own_colour_and_legend_entry(repo_root):
+    """A map's buckled cell is filled in its own colour, with a legend entry."""
+    import matplotlib
+    import numpy as np
+
+    from fi_design import plots
+    from fi_design.results.studies import SweepResult
+    from fi_design.spec.file import load_spec
+    from fi_design.studies.axes import make_axis
+    from fi_design.studies.points import grid, point_result, verdict_grid
+
+    spec = load_spec(repo_root / "examples" / "paper_setup.yaml")
+    x = make_axis("controller.crossover", [4.0, 8.0], spec=spec)
+    y = make_axis("isolator.stroke", [1e-4, 3e-4], spec=spec)
+    outs = [dict(status="invalid", verdict="buckled", message="buckled"),
+            dict(status="ok", verdict="hunting", amplitude=1e-3),
+            dict(status="ok", verdict="settled", amplitude=0.0),
+            dict(status="invalid", verdict="invalid", message="no")]
+    pts = [point_result(idx, v, True, o) for idx, v, o in
+           zip([(0, 0), (0, 1), (1, 0), (1, 1)], [(4.0, 1e-4), (8.0, 1e-4), (4.0, 3e-4),
+                                                  (8.0, 3e-4)], outs)]
+    res = SweepResult(spec=spec, x=x, y=y, isolated=True, points=tuple(pts),
+                      hunting_cycles=grid(pts, (2, 2), "hunting_cycles"),
+                      amplitude=grid(pts, (2, 2), "amplitude"),
+                      period=grid(pts, (2, 2), "period"), verdict=verdict_grid(pts, (2, 2)),
+                      design_point=(8.0, 3e-4), run=None, measure="stage")
+    fig = plots.sweep_figure(res)
+    ax = fig.axes[0]
+    legend = ax.get_legend()
+    assert legend is not None
+    labels = [t.get_text() for t in legend.get_texts()]
+    assert plots.studies.BUCKLED_LABEL in labels and "design point" in labels
+    colours = {matplotlib.colors.to_hex(p.get_facecolor()) for p in ax.patches}
+    assert plots.studies.BUCKLED_COLOUR in colours
+    assert res.counts()["buckled"] == 1 and np.isnan(res.boundary("above")[0])
+
+
 @pytest.mark.parametrize("args,words", [
     (["--x", "isolator.strok=1 mm:2 mm:3"], "did you mean 'stroke'"),
     (["--x", "isolator.stroke=1 mm:2 mm"], "START:STOP:N"),
