@@ -202,8 +202,11 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
     status = "ok"
     code = 0
     zero_run = 0
-    while t < t_end - 1e-12:
-        # time events at t
+
+    def time_events(t: float) -> None:
+        """The controller's sample and the delayed outputs due at ``t`` (and a stuck cart's
+        breakaway): before the outputs at ``t``, the end's too, as the fast integrator."""
+        nonlocal k_sample, dx, fa_hold
         if discrete and t >= k_sample * Ts - 1e-12:
             lev = math.floor(y[0] / q + 0.5) if q > 0 else 0
             xm = lev * q if q > 0 else y[0]
@@ -229,6 +232,9 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
             if breakaway(F, p) > 0:
                 modes[MODE_STICK] = 0
                 modes[MODE_SIGN] = 1 if F > 0 else -1
+
+    while t < t_end - 1e-12:
+        time_events(t)
         write_outputs(t, t, None)
         # next time event
         t_next = t_end
@@ -278,6 +284,7 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
             code, status = 4, "solution diverged"
             break
     if code == 0:
+        time_events(t)
         write_outputs(t, t, None)
     return Integration(code=code, status=status, states=out_y, reference=out_r,
                        applied_force=out_fa, command=out_cmd, n_steps=n_steps, n_rejected=n_rej,
