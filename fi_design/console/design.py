@@ -144,8 +144,8 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
         else:
             text = (f"Drive stiffness: k_max = {number(stiff['maximum'])} N/m, chosen k = "
                     f"{number(stiff.get('chosen'))} N/m")
-            if stiff.get("source"):
-                text += f" ({stiff['source']})"
+            if stiff.get("source"):  # it holds parentheses of its own: after a comma
+                text += f", {stiff['source']}"
             if stiff.get("force_at_stroke") is not None:
                 text += f", flexure force at full stroke {number(stiff['force_at_stroke'], 3)} N"
         console.print(Text(text))

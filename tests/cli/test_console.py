@@ -149,3 +149,10 @@ def test_a_map_too_wide_to_print_names_its_file(paper_spec_path, tmp_path, monke
                 "--csv", str(csv), "-j", "1"], 80)
     flat = " ".join(out.split())
     assert f"the map has 70 columns, too many to print here: see {csv}" in flat
+
+
+def test_the_drive_stiffness_line_names_its_source_without_nested_parentheses(design_outputs):
+    """It read 'chosen k = 6667 N/m (given in the spec (isolator.stiffness))'."""
+    text = " ".join(design_outputs["paper_setup", 120].split())
+    assert "chosen k = 6667 N/m, given in the spec (isolator.stiffness), flexure force" in text
+    assert "(given in the spec (isolator.stiffness))" not in text
