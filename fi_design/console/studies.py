@@ -169,7 +169,8 @@ def _print_counts(console: "Console", counts: dict) -> None:
 
 
 def _print_run(console: "Console", run, executor: str) -> None:
-    console.print(f"{run.points} points: {run.computed} simulated, {run.cached} from the cache; "
+    # "evaluated": a point whose guide the weight buckles is judged without a simulation
+    console.print(f"{run.points} points: {run.computed} evaluated now, {run.cached} from the cache; "
                   f"{executor}; {fixed(run.wall_time, 2)} s", markup=False, highlight=False)
 
 

@@ -44,11 +44,11 @@ def test_sweep_default_executor_and_cache(paper_spec_path, tmp_path, monkeypatch
     args = ("sweep", paper_spec_path, "--x", "controller.crossover=2:20:4", "--no-isolator")
     first = run(*args)
     assert first.exit_code == 0, first.output
-    assert "4 simulated, 0 from the cache" in first.output and "worker processes" in first.output
+    assert "4 evaluated now, 0 from the cache" in first.output and "worker processes" in first.output
     second = run(*args)
-    assert "0 simulated, 4 from the cache" in second.output
+    assert "0 evaluated now, 4 from the cache" in second.output
     third = run(*args, "--no-cache", "--jobs", "1")
-    assert "4 simulated" in third.output and "serial" in third.output
+    assert "4 evaluated now" in third.output and "serial" in third.output
 
 
 def test_sweep_one_dimensional_with_invalid_points(paper_spec_path, tmp_path):
