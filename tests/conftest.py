@@ -232,3 +232,15 @@ def variant(spec, **paths):
         else:
             node[last] = value
     return load_spec(raw)
+
+
+def edited_trace(tmp_path, name: str, edit) -> Path:
+    """examples/measured_trace.csv with each data row's cells passed through ``edit`` (a list
+    of strings in, a list out: time_s, reference_m, position_m, force_N, deflection_m),
+    written to ``tmp_path / name``; comments and the header kept."""
+    lines = (EXAMPLES / "measured_trace.csv").read_text().splitlines()
+    out = [line if line.startswith(("#", "time_s")) else ",".join(edit(line.split(",")))
+           for line in lines]
+    path = tmp_path / name
+    path.write_text("\n".join(out) + "\n")
+    return path

@@ -185,14 +185,7 @@ def test_a_mass_far_from_the_specs_is_noted_with_its_likely_cause(mass, ripple, 
     spec is off) and one of a 2 kg stage with a force ripple the model lacks (the fit leaves
     15 % of the force: the mass, 0.7 kg here, follows the filter's cut-off that the spec's
     crossover sets) used to give their mass without a word."""
-    t = np.arange(0.0, 4.0, 1e-3)
-    x = 0.015 * np.sin(2 * np.pi * 0.5 * t)
-    v = np.gradient(x, t)
-    a = np.gradient(v, t)
-    u = mass * a + 1.0 * np.sign(v) + 20.0 * v + ripple * np.sin(2 * np.pi * x / 0.01)
-    u = u + 2e-3 * np.random.default_rng(0).standard_normal(len(t))
-    r = identify(measurement_from_arrays(t, x, x, force_N=u),
-                 load_spec(EXAMPLES / "no_isolator.yaml"))
+    r = identify(_mass_record(mass, ripple), load_spec(EXAMPLES / "no_isolator.yaml"))
     far = [n for n in r.notes if "spec's moving mass" in n]
     if cause is None:
         assert far == [] and "far from" not in r.parameters["mass"].note

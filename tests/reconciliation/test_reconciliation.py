@@ -339,19 +339,13 @@ def test_the_example_record_with_its_force_negated_names_no_effect(tmp_path):
 
     from fi_design.cli.app import app
 
-    from conftest import EXAMPLES
+    from conftest import EXAMPLES, edited_trace
 
-    lines = (EXAMPLES / "measured_trace.csv").read_text().splitlines()
-    out = []
-    for line in lines:
-        if line.startswith(("#", "time_s")):
-            out.append(line)
-            continue
-        cells = line.split(",")
-        cells[3] = cells[3][1:] if cells[3].startswith("-") else "-" + cells[3]
-        out.append(",".join(cells))
-    csv = tmp_path / "flipped.csv"
-    csv.write_text("\n".join(out) + "\n")
+    def flip(cells):  # force_N negated
+        f = cells[3]
+        return [*cells[:3], f[1:] if f.startswith("-") else "-" + f, *cells[4:]]
+
+    csv = edited_trace(tmp_path, "flipped.csv", flip)
     res = CliRunner().invoke(app, ["reconcile", str(EXAMPLES / "measured_stage.yaml"), str(csv),
                                    "--json", str(tmp_path / "gap.json")])
     assert res.exit_code == 0, res.output
@@ -381,15 +375,10 @@ def test_a_record_far_off_its_reference_carries_the_replays_warning(tmp_path):
     from fi_design.console import print_reconcile
     from fi_design.display import quantity
 
-    from conftest import EXAMPLES
+    from conftest import EXAMPLES, edited_trace
 
-    lines = (EXAMPLES / "measured_trace.csv").read_text().splitlines()
-    out = [line if line.startswith(("#", "time_s")) else
-           ",".join(c if i != 2 else repr(float(c) + 0.05) for i, c in
-                    enumerate(line.split(",")))
-           for line in lines]
-    csv = tmp_path / "offset.csv"
-    csv.write_text("\n".join(out) + "\n")
+    csv = edited_trace(tmp_path, "offset.csv", lambda c: [*c[:2], repr(float(c[2]) + 0.05),
+                                                           *c[3:]])
     rec = load_measurement(csv)
     result = reconcile(load_spec(EXAMPLES / "measured_stage.yaml"), rec,
                        candidates=["cable_force"])

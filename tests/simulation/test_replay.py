@@ -259,19 +259,13 @@ def test_cli_simulate_record_with_nan_disturbance_names_the_row(tmp_path, paper_
 
 def _shifted(tmp_path, reference: float, position: float):
     """examples/measured_trace.csv with offsets added to reference_m and position_m [m]."""
-    lines = (EXAMPLES / "measured_trace.csv").read_text().splitlines()
-    out = []
-    for line in lines:
-        if line.startswith(("#", "time_s")):
-            out.append(line)
-            continue
-        cells = line.split(",")
-        cells[1] = repr(float(cells[1]) + reference)
-        cells[2] = repr(float(cells[2]) + position)
-        out.append(",".join(cells))
-    path = tmp_path / f"shifted_{reference}_{position}.csv"
-    path.write_text("\n".join(out) + "\n")
-    return path
+    from conftest import edited_trace
+
+    def shift(cells):
+        return [cells[0], repr(float(cells[1]) + reference), repr(float(cells[2]) + position),
+                *cells[3:]]
+
+    return edited_trace(tmp_path, f"shifted_{reference}_{position}.csv", shift)
 
 
 def test_cli_simulate_warns_when_the_record_starts_far_from_its_reference(tmp_path):
