@@ -68,8 +68,8 @@ import numpy as np
 from ..controller.polynomials import controller_polynomials, pid_polynomials, reference_polynomials
 from ..errors import SpecError
 from ..mechanism.modes import mode_factor, mode_term
-from ..mechanism.plants import (BAND_FACTOR, balanced_scale, rigid_plant, scaled,
-                                two_mass_plant)
+from ..mechanism.plants import (BAND_FACTOR, balanced_scale, case_arguments, rigid_plant,
+                                scaled, two_mass_plant)
 from ..model import Model, require_model
 from ..results import Status, frozen_array
 from ..results.controller import ControlLaw, PidGains
@@ -191,20 +191,9 @@ def limit_cases(model: Model, modes=None) -> tuple[LimitCase, ...]:
         isolator (:data:`RIGID_CASES`).
     """
     model = require_model(model)
-    f = model.friction
-    m1, m2, M = model.m1, model.m2, model.total_mass
-    s0, s1 = f.sigma0, f.sigma1
-    s2 = min(f.viscous(1), f.viscous(-1))
-    if model.joint is None:
-        raw = {"sliding": _rigid(M, s2, 0.0), "stuck": _rigid(M, s1 + s2, s0)}
-    else:
-        k, c = model.joint.stiffness, model.joint.damping
-        raw = {
-            "sliding_free": _two_mass(m1, m2, k, c, 0.0, s2),
-            "stuck_free": _two_mass(m1, m2, k, c, s0, s1 + s2),
-            "sliding_limited": _rigid(M, s2, 0.0),
-            "stuck_limited": _rigid(M, s1 + s2, s0),
-        }
+    m1 = model.m1
+    raw = {name: (_rigid if plant is rigid_plant else _two_mass)(*args)
+           for name, (plant, args) in case_arguments(model).items()}
     modes = model.modes if modes is None else tuple(modes)
     factors = [mode_factor(m) for m in modes if m.source == "given"]
     terms = [mode_term(m, m1) for m in modes if m.source != "given" and m.participation != 0.0]

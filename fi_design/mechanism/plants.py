@@ -20,7 +20,7 @@ import numpy as np
 
 from ..controller.polynomials import controller_polynomials
 
-__all__ = ["BAND_FACTOR", "rigid_plant", "two_mass_plant", "case_plants", "gain_crossings",
+__all__ = ["BAND_FACTOR", "rigid_plant", "two_mass_plant", "case_arguments", "case_plants", "gain_crossings",
            "rigid_loop_crossover", "scaled", "balanced_scale"]
 
 #: A gain crossover more than this factor below the controller's crossover lies outside the
@@ -48,8 +48,9 @@ def two_mass_plant(m1: float, m2: float, k: float, c: float, cart_stiffness: flo
     return num, den
 
 
-def case_plants(model) -> dict[str, tuple[list, list]]:
-    """The rigid limit cases of a model by name, each ``(num, den)`` of x1/u.
+def case_arguments(model) -> dict:
+    """The limit cases of a model by name, each ``(plant, arguments)``: :func:`rigid_plant`
+    or :func:`two_mass_plant` and what it takes.
 
     Four for an isolated stage (the cart sliding or stuck on its bristles, the joint
     free or on its limiter), two without isolator (sliding, stuck).
@@ -64,14 +65,21 @@ def case_plants(model) -> dict[str, tuple[list, list]]:
     s0, s1 = f.sigma0, f.sigma1
     s2 = min(f.viscous(1), f.viscous(-1))
     if model.joint is None:
-        return {"sliding": rigid_plant(M, s2, 0.0), "stuck": rigid_plant(M, s1 + s2, s0)}
+        return {"sliding": (rigid_plant, (M, s2, 0.0)),
+                "stuck": (rigid_plant, (M, s1 + s2, s0))}
     k, c = model.joint.stiffness, model.joint.damping
     return {
-        "sliding_free": two_mass_plant(m1, m2, k, c, 0.0, s2),
-        "stuck_free": two_mass_plant(m1, m2, k, c, s0, s1 + s2),
-        "sliding_limited": rigid_plant(M, s2, 0.0),
-        "stuck_limited": rigid_plant(M, s1 + s2, s0),
+        "sliding_free": (two_mass_plant, (m1, m2, k, c, 0.0, s2)),
+        "stuck_free": (two_mass_plant, (m1, m2, k, c, s0, s1 + s2)),
+        "sliding_limited": (rigid_plant, (M, s2, 0.0)),
+        "stuck_limited": (rigid_plant, (M, s1 + s2, s0)),
     }
+
+
+def case_plants(model) -> dict[str, tuple[list, list]]:
+    """The rigid limit cases of a model by name, each ``(num, den)`` of x1/u
+    (:func:`case_arguments`)."""
+    return {name: plant(*args) for name, (plant, args) in case_arguments(model).items()}
 
 
 def scaled(p, w0: float) -> np.ndarray:
