@@ -282,8 +282,10 @@ def key_figures(result: Any) -> list[dict]:
         rows.append(_figure(
             "Crossover factor: design / lowest hunting-free",
             ("\u2265 " if m.crossover_factor_bound else "") + num(m.crossover_factor, 3), "1",
-            f"\u2265 {num(need, 3)} (requirements.hunting_margin)", f"no move hunts from {qty(m.hunting_free_crossover, 'Hz')} (the fold of "
-                   "the cycle); the ratio of the set crossovers, the loop's frequency scale"
+            f"\u2265 {num(need, 3)}",  # the key's name in the basis: it overran the column
+            "the hunting margin (requirements.hunting_margin); no move hunts from "
+            f"{qty(m.hunting_free_crossover, 'Hz')} (the fold of the cycle); the ratio of the "
+            "set crossovers, the loop's frequency scale"
             + (f"; the loop the cycle slides in ({_CASE_WORDS.get(m.hunting_case, m.hunting_case)})"
                f" crosses 0 dB at {qty(m.hunting_loop_crossover, 'Hz')} and at "
                f"{qty(m.hunting_free_loop_crossover, 'Hz')}: "
