@@ -117,9 +117,27 @@ def json_sha256(data: Any) -> str:
     Returns
     -------
     str
-        Hex digest; equal for equal data whatever its key order.
+        Hex digest; equal for equal data whatever its key order. An integer beyond
+        Python's decimal conversion limit (``sys.get_int_max_str_digits``) enters in
+        hexadecimal, which has no limit, so such data still has a digest (the spec's
+        validation then names the field).
     """
-    return hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
+    try:
+        text = json.dumps(data, sort_keys=True, default=str)
+    except ValueError:  # an integer too long for decimal text
+        text = json.dumps(_hex_huge(data), sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _hex_huge(data: Any) -> Any:
+    """``data`` with every integer longer than decimal text allows written as ``"int:0x..."``."""
+    if isinstance(data, dict):
+        return {k: _hex_huge(v) for k, v in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [_hex_huge(v) for v in data]
+    if isinstance(data, int) and not isinstance(data, bool) and data.bit_length() > 4000:
+        return f"int:{hex(data)}"
+    return data
 
 
 def header(version: str | None = None, source: Source | None = None,

@@ -15,6 +15,7 @@ from typing import Any
 
 from ..display import number
 from . import Spec
+from .units import _digits, huge
 
 
 def clean_loc(loc: tuple, raw: dict) -> tuple:
@@ -219,9 +220,8 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
         return path, f"takes at most {_items(ctx.get('max_length'), loc)}, got {given}"
     if kind in ("finite_number",):
         return path, "must be a finite number"
-    if isinstance(err.get("input"), int) and len(str(abs(err["input"]))) > 300:
-        digits = len(str(abs(err["input"])))
-        return path, f"the number {_shown(err['input'])} ({digits} digits) is too large"
+    if huge(err.get("input")):
+        return path, f"the number {_digits(err['input'])} is too large"
     if kind in ("float_type", "float_parsing"):
         return path, f"expected a number or a string with units, got {_shown(err['input'])}"
     if kind in ("model_type", "model_attributes_type", "dict_type"):
@@ -241,6 +241,8 @@ def _items(count: Any, loc: tuple) -> str:
 
 def _shown(value: Any) -> str:
     """A value read from the spec, for a message: its repr, cut to 40 characters."""
+    if huge(value):
+        return f"the number {_digits(value)}"
     text = repr(value)
     return text if len(text) <= 40 else text[:28] + "..." + text[-8:]
 

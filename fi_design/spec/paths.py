@@ -427,6 +427,10 @@ def _element(ann: Any, index: int) -> Any:
 
 
 def _show(value: Any) -> str:
+    from .units import _digits, huge
+
+    if huge(value):
+        return f"the number {_digits(value)}"
     return number(value, 6) if isinstance(value, float) else repr(value) \
         if isinstance(value, str) else str(value)
 

@@ -30,6 +30,7 @@ import re
 import sys
 import tokenize
 from functools import lru_cache
+from typing import Any
 
 from ..display import quantity
 from ..errors import ArgumentError, UnitError
@@ -182,6 +183,13 @@ def to_si(value, unit: str, path: str | None = None) -> float:
             raise UnitError(f"cannot read {value!r} as a gain in dB (write e.g. '6 dB')", path=path)
         return _finite(float(m.group(1)), path, value)
     return _plausible(_finite(_convert(text, unit, path), path, value), unit, path, value)
+
+
+def huge(value: Any) -> bool:
+    """Whether ``value`` is an integer too long to show whole in a message (over 997 bits,
+    about 300 digits; Python's ``str`` refuses those of more than 4300 digits)."""
+    return isinstance(value, int) and not isinstance(value, bool) and \
+        abs(value).bit_length() > 997
 
 
 def _digits(value: int) -> str:

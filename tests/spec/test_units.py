@@ -137,3 +137,34 @@ def test_a_value_is_one_number_and_its_unit(value, unit, words):
     for w in words:
         assert w in str(err.value), str(err.value)
     assert len(str(err.value)) < 300
+
+
+@pytest.mark.parametrize("path", ["stage.mass", "requirements.parasitic_separation",
+                                  "requirements.hunting_margin", "requirements.robustness.samples"])
+def test_an_integer_beyond_pythons_digit_limit_is_a_spec_error_in_a_mapping(path,
+                                                                          paper_spec_path):
+    """A library mapping (or with_values, Model.varied) holding an integer of 5000 digits was a
+    raw ValueError from the spec's hash or the message's str(): now a SpecError naming the path."""
+    import copy
+
+    import yaml
+
+    from fi_design.errors import SpecError
+    from fi_design.model import resolve
+    from fi_design.spec.file import load_spec
+    from fi_design.spec.paths import with_values
+
+    raw = yaml.safe_load(paper_spec_path.read_text())
+    data = copy.deepcopy(raw)
+    node = data
+    *head, last = path.split(".")
+    for key in head:
+        node = node.setdefault(key, {})
+    node[last] = 10 ** 5000
+    spec = load_spec(raw)
+    for call in (lambda: load_spec(data), lambda: with_values(spec, {path: 10 ** 5000}),
+                 lambda: resolve(spec).varied({path: 10 ** 5000})):
+        with pytest.raises(SpecError) as err:
+            call()
+        assert err.value.path == path
+        assert "more than 4300 digits" in str(err.value), str(err.value)
