@@ -423,9 +423,11 @@ def _columns(header: list[str], source: str) -> dict[str, int]:
                             f"{UNITS[want]} (SI)", column=header[j], source=source)
     for name in REQUIRED:
         if name not in index:
+            hint = ("; this is a YAML file (a spec?), not a measured record, which is CSV"
+                    if Path(source).suffix.lower() in (".yaml", ".yml") else "")
             raise DataError("required column is missing; the header must name "
-                            f"{', '.join(REQUIRED)} (found {', '.join(repr(h) for h in header)})",
-                            column=name, source=source)
+                            f"{', '.join(REQUIRED)} (found {', '.join(repr(h) for h in header)})"
+                            + hint, column=name, source=source)
     return index
 
 

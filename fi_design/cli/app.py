@@ -594,15 +594,17 @@ def reconcile_command(
 # --------------------------------------------------------------------------- identify
 
 
-@app.command("identify")
+@app.command("identify", context_settings={"allow_extra_args": True})
 def identify_command(
+    ctx: typer.Context,
     measured: Annotated[Path, typer.Argument(
         metavar="MEASURED.csv", help="The measured record: time_s, reference_m, position_m, "
                                      "force_N (optional deflection_m, disturbance_N).",
         show_default=False)],
     spec: Optional[Path] = output_option("--spec", "SPEC.yaml",
         "The stage's spec: its loop sets the filter, its isolator gives the flexure force, its "
-        "masses the split; needed for --write-spec and --report."),
+        "masses the split; needed for --write-spec and --report. It may also come first, "
+        "as reconcile takes it: fi-design identify SPEC.yaml MEASURED.csv."),
     json_out: Optional[Path] = output_option("--json", "OUT.json", "Write the identification as JSON."),
     write_spec: Optional[Path] = output_option("--write-spec", "OUT.yaml",
         "Write the spec with the identified friction and masses filled in (never the input)."),
@@ -623,6 +625,13 @@ def identify_command(
     stiffness only where the record holds their excitation (breakaways after
     a stop, a slow velocity sweep through zero, presliding).
     """
+    if ctx.args:  # the order reconcile and simulate take: SPEC.yaml MEASURED.csv
+        if (len(ctx.args) > 1 or spec is not None
+                or measured.suffix.lower() not in (".yaml", ".yml")):
+            raise typer.BadParameter(
+                f"one record only, got {measured}, {', '.join(ctx.args)}; the spec goes first "
+                "(a .yaml file) or with --spec", param_hint="MEASURED.csv")
+        spec, measured = measured, Path(ctx.args[0])
     forms = {"symmetric": "symmetric", "per-direction": "per_direction",
              "per_direction": "per_direction"}
     if form not in forms:

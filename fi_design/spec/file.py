@@ -275,8 +275,11 @@ def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, Any]:
         raise SpecError(f"not valid YAML: {exc}", source=source) from None
     if not isinstance(document, dict):
         kind = "a list" if isinstance(document, list) else f"a {type(document).__name__}"
+        hint = ("; this is a CSV file (a measured record?), not a spec, which is YAML: the spec "
+                "comes first, e.g. fi-design reconcile SPEC.yaml MEASURED.csv"
+                if source is not None and source.lower().endswith(".csv") else "")
         raise SpecError(f"the top level must be a mapping of sections (name, stage, cart, ...), "
-                        f"got {kind}", line=1, source=source)
+                        f"got {kind}{hint}", line=1, source=source)
     return plain(document), document
 
 

@@ -299,6 +299,29 @@ def test_mistyped_command_gets_a_hint(paper_spec_path):
     assert r.exit_code == 2 and "did you mean 'fi-design recommend'" in r.stderr
 
 
+def test_a_spec_and_a_record_in_either_command_order(tmp_path):
+    """identify takes the spec first as reconcile does (it was 'Got unexpected extra
+    argument'); a record where a spec belongs, or a spec where a record belongs, says so."""
+    from conftest import EXAMPLES
+
+    spec, record = str(EXAMPLES / "measured_stage.yaml"), str(EXAMPLES / "measured_trace.csv")
+    out = tmp_path / "id.json"
+    r = runner.invoke(app, ["identify", spec, record, "--json", str(out)])
+    assert r.exit_code == 0, r.output
+    notes = json.loads(out.read_text())["notes"]  # the spec's joint separates the two masses
+    assert any("k = 6667 N/m from the spec" in n for n in notes), notes
+    for args in (["identify", record, record], ["identify", spec, record, record],
+                 ["identify", "--spec", spec, spec, record]):
+        r = runner.invoke(app, args)
+        assert r.exit_code == 2 and "one record only" in r.stderr, r.output
+    r = runner.invoke(app, ["identify", spec])
+    assert r.exit_code == 2
+    assert "this is a YAML file (a spec?), not a measured record" in r.stderr, r.stderr
+    r = runner.invoke(app, ["reconcile", record, spec])
+    assert r.exit_code == 2
+    assert "this is a CSV file (a measured record?), not a spec" in " ".join(r.stderr.split())
+
+
 def test_installed_entry_point(tmp_path, paper_spec_path):
     """The console script in a process of its own, simulation included; the design search
     (--no-recommend here) runs in this file's CliRunner run and in test_console's."""
