@@ -187,7 +187,8 @@ def evaluate(guide: LeafGuide, stroke: float, length, width, thickness) -> GridM
     low = np.minimum(_parasitic_low(guide, K + Kg), _parasitic_low(guide, Ks + Kg))
     low = np.minimum(low, _leaf.bending_frequency(E, rho, L, b, t, force))
     low = np.minimum(low, _leaf.torsion_frequency(G, rho, L, b, t))
-    stress = _leaf.bending_stress(E, t, L, stroke) + abs(force) / (b * t)
+    u = _guide.largest_deflection(guide, stroke, net)
+    stress = _leaf.bending_stress(E, t, L, u) + abs(force) / (b * t)
     if guide.orientation == "flat":
         stress = stress + 3.0 * guide.weight * L / (guide.leaves * t * b * b)
     return GridMechanics(length=L, width=b, thickness=t, net=net, buckling=buckling,
@@ -238,7 +239,7 @@ def reevaluate(fx: FlexureResult, guide: LeafGuide) -> FlexureResult:
 
 def drawn_guide(flexure, body: StageBody, *, stroke: float, maximum_stiffness: float,
                 required_frequency: float, required_buckling: float,
-                cart_mass: float = 0.0) -> FlexureResult:
+                cart_mass: float = 0.0, stop_stiffness: float = math.inf) -> FlexureResult:
     """The guide the spec draws (one value per leaf dimension), evaluated.
 
     Parameters
@@ -257,16 +258,21 @@ def drawn_guide(flexure, body: StageBody, *, stroke: float, maximum_stiffness: f
         Required buckling factor [-], for the checks.
     cart_mass : float, optional
         m2 [kg].
+    stop_stiffness : float, optional
+        The end stop's contact stiffness k_stop [N/m] (a vertical axis's cart may rest on it);
+        default inf (rigid).
     """
     g = leaf_guide(flexure, body, length=flexure.length, width=flexure.width,
-                   thickness=flexure.thickness, cart_mass=cart_mass)
+                   thickness=flexure.thickness, cart_mass=cart_mass,
+                   stop_stiffness=stop_stiffness)
     return _result(g, stroke, drawn=True, flexure=flexure, maximum_stiffness=maximum_stiffness,
                    required_frequency=required_frequency, required_buckling=required_buckling)
 
 
 def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_stiffness: float,
                stroke: float, required_frequency: float, required_buckling: float,
-               cart_mass: float = 0.0, points: int = GRID_POINTS) -> FlexureResult:
+               cart_mass: float = 0.0, stop_stiffness: float = math.inf,
+               points: int = GRID_POINTS) -> FlexureResult:
     """Size a parallel leaf-spring guide for a net drive stiffness.
 
     Parameters
@@ -288,6 +294,9 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
         Lowest allowed buckling factor [-].
     cart_mass : float, optional
         m2 [kg].
+    stop_stiffness : float, optional
+        The end stop's contact stiffness k_stop [N/m] (a vertical axis's cart may rest on it);
+        default inf (rigid).
     points : int, optional
         Grid points of the length. Default :data:`GRID_POINTS`.
 
@@ -308,7 +317,7 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
             f"stock: no multiple of the {_mm(flexure.thickness_step)} thickness step lies "
             f"within the thickness bounds {_mm(t0)} to {_mm(t1)}"), **terms)
     base = leaf_guide(flexure, body, length=L0, width=b0, thickness=stock[0],
-                      cart_mass=cart_mass)
+                      cart_mass=cart_mass, stop_stiffness=stop_stiffness)
     L = (np.geomspace(L0, L1, points) if L1 > L0 else np.array([L0]))[:, None]
     t = stock[None, :]
     n, E = base.leaves, base.youngs_modulus
@@ -343,7 +352,7 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
     i, j = np.unravel_index(np.argmax(np.where(close, margin, -np.inf)), err.shape)
     chosen = leaf_guide(flexure, body, length=float(grid.length[i, j]),
                         width=float(grid.width[i, j]), thickness=float(grid.thickness[i, j]),
-                        cart_mass=cart_mass)
+                        cart_mass=cart_mass, stop_stiffness=stop_stiffness)
     return _result(chosen, stroke, drawn=False, flexure=flexure, target_stiffness=kt,
                    maximum_stiffness=kmax, required_frequency=required_frequency,
                    required_buckling=required_buckling)

@@ -170,7 +170,7 @@ def guide_for(base: Model, stiffness: float, stroke: float, crossover: float, *,
                       required_frequency=req.parasitic_separation
                       * _loop_at(base, stiffness, stroke, crossover).sizing_crossover,
                       required_buckling=req.buckling_factor, cart_mass=base.m2,
-                      points=points)
+                      stop_stiffness=base.limiter.stiffness, points=points)
 
 
 def _loop_at(base: Model, stiffness: float, stroke: float, crossover: float) -> Model:

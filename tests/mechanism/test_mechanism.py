@@ -87,6 +87,35 @@ def test_gravity_softens_a_standing_guide_and_stiffens_a_hanging_one():
         mechanics(flat, 0.3e-3).stiffness.x
 
 
+def test_the_limiter_bounds_a_vertical_axis_leaf_at_the_stroke_however_far_it_sags():
+    """The stress on a vertical drive axis took the deflection as stroke + sag: 0.3 mm + 0.59 mm
+    for the paper's leaves carrying a 0.4 kg cart. The limiter stops the joint at +-s from the
+    unloaded leaves: a sag within the stroke only moves where the joint rests; a sag beyond it
+    presses the joint onto its end stop, k u + k_stop (u - s) = m2 g."""
+    from dataclasses import replace
+
+    E_, t, L = E, 0.45e-3, 50.7e-3
+    within = make_guide(orientation="vertical_axis", m2=0.4)
+    m = mechanics(within, 1.0e-3)
+    k = m.net_drive_stiffness
+    assert 0.0 < m.gravity.sag < 1.0e-3  # 0.59 mm of a 1 mm stroke
+    assert m.stress == pytest.approx(3 * E_ * t * 1.0e-3 / L ** 2, rel=1e-12)
+    # beyond: the cart rests on its stop, which shares the weight with the leaves
+    beyond = replace(within, stop_stiffness=1e5)
+    m = mechanics(beyond, 0.3e-3)
+    assert m.gravity.sag == pytest.approx(0.4 * GRAVITY / k, rel=1e-12)
+    assert m.gravity.sag > 0.3e-3
+    u = (0.4 * GRAVITY + 1e5 * 0.3e-3) / (k + 1e5)
+    assert 0.3e-3 < u < m.gravity.sag
+    assert m.stress == pytest.approx(3 * E_ * t * u / L ** 2, rel=1e-12)
+    # a rigid stop holds it at the stroke exactly
+    assert mechanics(within, 0.3e-3).stress == pytest.approx(3 * E_ * t * 0.3e-3 / L ** 2,
+                                                             rel=1e-12)
+    # the sizing's grid takes the same deflection as the single guide
+    grid = evaluate(beyond, 0.3e-3, np.array([L]), np.array([23.9e-3]), np.array([t]))
+    assert float(grid.stress[0]) == pytest.approx(m.stress, rel=1e-9)
+
+
 def test_buckling_of_a_low_stage_is_the_euler_sway_load():
     # a low, flat stage: its centre of mass 1 mm above the clamp, the sway mode alone
     g = make_guide(L=40e-3, b=10e-3, t=0.2e-3, size=(0.06, 0.06, 0.002), m1=5.0)
