@@ -430,6 +430,35 @@ def _paper_variant(paper_spec, **values):
     return with_values(paper_spec, values)
 
 
+def test_a_stubby_leaf_warns_that_beam_theory_is_doubtful(paper_spec):
+    """No check looked at a leaf's slenderness: 6 mm leaves of 1 mm stock (L/t = 6) were judged
+    on beam theory without a word."""
+    from fi_design import design
+    from fi_design.results import Status
+
+    drawn = {"isolator.stiffness": None, "isolator.damping": None,
+             "isolator.parasitic_modes": []}
+    stubby = design(_paper_variant(paper_spec, **drawn, **{
+        "isolator.flexure.length": "6 mm", "isolator.flexure.width": "20 mm",
+        "isolator.flexure.thickness": "1 mm"}), confirm=False)
+    [c] = [c for c in stubby.checks if c.name == "flexure.slenderness"]
+    assert c.status == Status.WARN and c.passed is None
+    assert c.value == pytest.approx(6.0) and c.limit == 10.0
+    assert c.message == (
+        "the leaves are 6 mm long and 1 mm thick: L/t = 6, below 10, where beam theory is "
+        "doubtful (the model includes shear, but the clamps' compliance and the leaf's end and "
+        "plate effects are left out): its stiffness, stress and modes are estimates; measure "
+        "the guide or model it in FE, or draw longer, thinner leaves")
+    assert any(r.source == "flexure.slenderness" and r.severity == "WARN"
+               for r in stubby.verdict.reasons)
+    # the paper's leaves, 50.7 mm of 0.45 mm (L/t = 113): no warning
+    paper = design(_paper_variant(paper_spec, **drawn, **{
+        "isolator.flexure.length": "50.7 mm", "isolator.flexure.width": "23.9 mm",
+        "isolator.flexure.thickness": "0.45 mm"}), confirm=False)
+    assert paper.flexure.drawn and paper.checks
+    assert not [c for c in paper.checks if c.name == "flexure.slenderness"]
+
+
 def test_a_thin_guide_standing_under_the_stage_fails_with_the_reason(paper_spec):
     from fi_design import design
 
