@@ -9,6 +9,8 @@ the control loop sees. This package computes them from the geometry:
 - :mod:`.guide`: the guide at the stage's centre of mass (six stiffnesses,
   gravity's geometric and load stiffness, buckling, the stage's six modes);
 - :mod:`.sizing`: sizing a guide from stock for a drive stiffness and stroke;
+- :mod:`.bounds`: a sized guide's dimensions on the sizing's bounds, and whether
+  beyond them adds margin;
 - :mod:`.fe`: the same guide as a finite-element model (pyfe3d), the
   independent check of the closed forms.
 

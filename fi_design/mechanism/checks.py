@@ -1,4 +1,4 @@
-"""Step 3's judgement of the leaf-spring guide: stiffness, stress, buckling, modes, sag, slenderness.
+"""Step 3's judgement of the guide: stiffness, stress, buckling, modes, sag, slenderness.
 
 The one place the guide is judged (:func:`flexure_checks`); the design's
 checks, the verdict, the report and the console read these checks.

@@ -40,7 +40,8 @@ from . import mechanics
 from .geometry import StageBody, leaf_guide
 
 __all__ = ["GRID_POINTS", "STIFFNESS_TIE", "GridMechanics", "stock_thicknesses",
-           "stiffness_range", "net_stiffness", "evaluate", "reevaluate", "drawn_guide", "size_guide"]
+           "stiffness_range", "net_stiffness", "evaluate", "reevaluate", "drawn_guide",
+           "size_guide", "MARGIN_WORDS", "SizingMargin", "sizing_margin"]
 
 #: Grid points of a searched continuous dimension (length).
 GRID_POINTS = 161
@@ -195,6 +196,62 @@ def evaluate(guide: LeafGuide, stroke: float, length, width, thickness) -> GridM
                          lowest_mode=low, stress=stress)
 
 
+#: What each of the sizing's margins (:func:`sizing_margin`) compares, in words.
+MARGIN_WORDS = ("the allowed stress over the stress", "the lowest parasitic mode over the "
+                "required", "the buckling factor over the required", "k_max over the drive "
+                "stiffness of the stock's thickest leaves")
+
+
+def _margins(grid: GridMechanics, guide: LeafGuide, kmax: float, f_req: float, b_req: float,
+             dt: float) -> np.ndarray:
+    """The sizing's margins over a grid, stacked along a first axis in the order of
+    :data:`MARGIN_WORDS` (the last one 1 / 0 = inf without a thickness tolerance)."""
+    k_thick = (net_stiffness(guide, grid.length, grid.width, grid.thickness + dt) if dt > 0.0
+               else np.zeros(grid.net.shape))
+    with np.errstate(divide="ignore"):
+        return np.stack([guide.allowed_stress / grid.stress, grid.lowest_mode / f_req,
+                         grid.buckling / b_req,
+                         np.where(dt > 0.0, kmax / np.maximum(k_thick, 1e-300), np.inf)])
+
+
+@dataclass(frozen=True)
+class SizingMargin:
+    """The smallest of a sized guide's margins, the one its sizing's tie-break maximises.
+
+    Attributes
+    ----------
+    value : float
+        The smallest margin [-].
+    limited_by : str
+        What it compares (one of :data:`MARGIN_WORDS`).
+    """
+
+    value: float
+    limited_by: str
+
+
+def sizing_margin(fx: FlexureResult) -> SizingMargin:
+    """The smallest margin of a feasible guide, as its sizing ranks the guides.
+
+    The stress's, the lowest parasitic mode's, the buckling factor's (each over
+    its requirement) and k_max over the drive stiffness of the stock's thickest
+    leaves; :func:`size_guide` keeps, among the guides closest to the target
+    stiffness, the one with the largest.
+
+    Parameters
+    ----------
+    fx : FlexureResult
+        A feasible guide (its sizing's terms: k_max, the required frequency and
+        buckling factor, the thickness tolerance).
+    """
+    g = fx.guide
+    grid = evaluate(g, fx.stroke, g.length, g.width, g.thickness)
+    m = _margins(grid, g, fx.maximum_stiffness, fx.required_frequency, fx.required_buckling,
+                 fx.thickness_tolerance).reshape(len(MARGIN_WORDS))
+    i = int(np.argmin(m))
+    return SizingMargin(value=float(m[i]), limited_by=MARGIN_WORDS[i])
+
+
 def _mm(x: float) -> str:
     """A flexure dimension: always in mm, so that the lengths of one sentence share a unit."""
     return quantity(x, "m", 3, shown=("mm", 1e3))
@@ -272,7 +329,7 @@ def drawn_guide(flexure, body: StageBody, *, stroke: float, maximum_stiffness: f
 def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_stiffness: float,
                stroke: float, required_frequency: float, required_buckling: float,
                cart_mass: float = 0.0, stop_stiffness: float = math.inf,
-               points: int = GRID_POINTS) -> FlexureResult:
+               points: int = GRID_POINTS, bounds: dict | None = None) -> FlexureResult:
     """Size a parallel leaf-spring guide for a net drive stiffness.
 
     Parameters
@@ -299,6 +356,9 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
         default inf (rigid).
     points : int, optional
         Grid points of the length. Default :data:`GRID_POINTS`.
+    bounds : dict, optional
+        ``{"length": (min, max), ...}`` [m] in place of the flexure's bounds of those
+        dimensions (a guide sized just beyond them, :mod:`.bounds`).
 
     Returns
     -------
@@ -310,7 +370,8 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
                  required_frequency=required_frequency, required_buckling=required_buckling,
                  thickness_step=flexure.thickness_step,
                  thickness_tolerance=flexure.thickness_tolerance)
-    (L0, L1), (b0, b1), (t0, t1) = (flexure.bounds(n) for n in ("length", "width", "thickness"))
+    (L0, L1), (b0, b1), (t0, t1) = (tuple((bounds or {}).get(n, flexure.bounds(n)))
+                                     for n in ("length", "width", "thickness"))
     stock = stock_thicknesses((t0, t1), flexure.thickness_step, points)
     if stock.size == 0:
         return FlexureResult(feasible=False, drawn=False, mechanics=None, reason=(
@@ -342,12 +403,8 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
             grid, base, stroke, kmax, required_frequency, required_buckling,
             (ok_shape, ok_stress, ok_stiff, ok_buckle, ok_modes)), **terms)
     err = np.where(ok, np.abs(np.log(np.maximum(grid.net, 1e-300) / kt)), np.inf)
-    margin = np.minimum(np.minimum(base.allowed_stress / grid.stress,
-                                   grid.lowest_mode / required_frequency),
-                        grid.buckling / required_buckling)
-    dt = flexure.thickness_tolerance
-    if dt > 0.0:  # k_max over the stock's thickest leaves: thin stock scatters k the most
-        margin = np.minimum(margin, kmax / np.maximum(net_stiffness(base, L, b, t + dt), 1e-300))
+    margin = np.min(_margins(grid, base, kmax, required_frequency, required_buckling,
+                             flexure.thickness_tolerance), axis=0)
     close = err <= err.min() + STIFFNESS_TIE
     i, j = np.unravel_index(np.argmax(np.where(close, margin, -np.inf)), err.shape)
     chosen = leaf_guide(flexure, body, length=float(grid.length[i, j]),
