@@ -207,6 +207,7 @@ class Model:
 
         req = self.requirements
         common = dict(stroke=self.joint.stroke, cart_mass=self.m2,
+                      stop_stiffness=self.limiter.stiffness,
                       maximum_stiffness=_spec.stiffness_limit(self.spec, self.joint.stroke),
                       required_frequency=req.parasitic_separation * self.sizing_crossover,
                       required_buckling=req.buckling_factor)

@@ -103,6 +103,8 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
             "; ".join(f"{r['name']}: {r['why']}" for r in bad)))
     if result.binding:
         console.print(Text("Binds it: ", style="bold").append("; ".join(result.binding)))
+    for n in result.flexure_bounds:
+        console.print(Text("On a bound: ", style="bold").append(n.text))
     for v in result.violates:
         console.print(Text("Violates: ", style="bold red").append(v))
     lc = result.least_change

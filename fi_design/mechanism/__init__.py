@@ -9,6 +9,8 @@ the control loop sees. This package computes them from the geometry:
 - :mod:`.guide`: the guide at the stage's centre of mass (six stiffnesses,
   gravity's geometric and load stiffness, buckling, the stage's six modes);
 - :mod:`.sizing`: sizing a guide from stock for a drive stiffness and stroke;
+- :mod:`.bounds`: a sized guide's dimensions on the sizing's bounds, and whether
+  beyond them adds margin;
 - :mod:`.fe`: the same guide as a finite-element model (pyfe3d), the
   independent check of the closed forms.
 
@@ -19,7 +21,7 @@ for one guide and stroke. A new flexure type is a new geometry value in
 
 from __future__ import annotations
 
-from ..results.mechanism import Gravity, GuideMechanics, LeafGuide
+from ..results.mechanism import GRAVITY, Gravity, GuideMechanics, LeafGuide
 from . import guide as _guide
 from . import leaf as _leaf
 
@@ -62,13 +64,15 @@ def mechanics(guide: LeafGuide, stroke: float) -> GuideMechanics:
     force = _guide.leaf_force(guide)
     compressed = force < 0.0
     factor = _guide.buckling_factor(guide) if compressed else None
-    sag = guide.cart_mass * 9.80665 / net if guide.orientation == "vertical_axis" else 0.0
+    sag = guide.cart_mass * GRAVITY / net if guide.orientation == "vertical_axis" else 0.0
     gravity = Gravity(orientation=guide.orientation, axial_load=force * guide.leaves,
                       geometric_stiffness=net - elastic,
                       buckling_load=None if factor is None else factor * guide.weight,
                       buckling_factor=factor, sag=sag)
     E, L, b, t = guide.youngs_modulus, guide.length, guide.width, guide.thickness
-    stress = float(_leaf.bending_stress(E, t, L, stroke + sag)) + abs(force) / (b * t)
+    # the limiter bounds the joint at the stroke: a sag within it only moves where it rests
+    u = _guide.largest_deflection(guide, stroke, net)
+    stress = float(_leaf.bending_stress(E, t, L, u)) + abs(force) / (b * t)
     if guide.orientation == "flat":  # the weight as shear along the leaves' width
         stress += 3.0 * guide.weight * L / (guide.leaves * t * b * b)
     stage = _guide.stage_modes(guide, K + Kg)

@@ -1,4 +1,4 @@
-"""Step 3's judgement of the leaf-spring guide: stiffness, stress, buckling, modes, sag.
+"""Step 3's judgement of the guide: stiffness, stress, buckling, modes, sag, slenderness.
 
 The one place the guide is judged (:func:`flexure_checks`); the design's
 checks, the verdict, the report and the console read these checks.
@@ -7,10 +7,10 @@ checks, the verdict, the report and the console read these checks.
 from __future__ import annotations
 
 from ..display import number, quantity
-from ..results import Check
+from ..results import Check, Status
 from ..results.steps import FlexureResult
 
-__all__ = ["flexure_checks"]
+__all__ = ["SLENDERNESS", "flexure_checks"]
 
 
 def _g(x: float) -> str:
@@ -25,10 +25,17 @@ def _mm(x: float) -> str:
 #: stiffness [-] (the sizing solves the width to about 1e-3 of its target).
 STIFFNESS_MATCH = 0.02
 
+#: Leaf length over thickness below which the beam model of a leaf is doubtful [-]: a stubby
+#: leaf bends as a block (the clamps' compliance, plate and end effects) more than as a beam.
+SLENDERNESS = 10.0
+
 
 def flexure_checks(fx: FlexureResult | None, crossover: float,
                    separation: float, joint_stiffness: float | None = None) -> tuple[Check, ...]:
-    """Step 3's checks of the guide: stiffness, stress, buckling, modes, sag.
+    """Step 3's checks of the guide: stiffness, stress, buckling, modes, sag, slenderness.
+
+    A leaf shorter than :data:`SLENDERNESS` times its thickness gets a warning
+    (``flexure.slenderness``, WARN): the closed forms are beam theory.
 
     Parameters
     ----------
@@ -94,6 +101,16 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
             f"on the vertical axis the joint carries the cart's weight: it sags "
             f"{_mm(grav.sag)} of its {_mm(fx.stroke)} stroke"
             + ("" if grav.sag < fx.stroke else ": it rests on its end stop"), step=step))
+    slender = g.length / g.thickness
+    if slender < SLENDERNESS:
+        out.append(Check(
+            "flexure.slenderness", None, slender, SLENDERNESS, "-",
+            f"the leaves are {_mm(g.length)} long and {_mm(g.thickness)} thick: L/t = "
+            f"{number(slender, 3)}, below {number(SLENDERNESS, 3)}, where beam theory is "
+            "doubtful (the model includes shear, but the clamps' compliance and the leaf's "
+            "end and plate effects are left out): its stiffness, stress and modes are "
+            "estimates; measure the guide or model it in FE, or draw longer, thinner leaves",
+            step=step, status=Status.WARN))
     return tuple(out)
 
 

@@ -15,6 +15,7 @@ closed forms read; defaults are filled in here and nowhere else:
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from ..results.mechanism import LeafGuide, box_inertia, steel_cube
@@ -73,7 +74,7 @@ def stage_body(stage) -> StageBody:
 
 
 def leaf_guide(flexure, body: StageBody, *, length: float, width: float, thickness: float,
-               cart_mass: float = 0.0) -> LeafGuide:
+               cart_mass: float = 0.0, stop_stiffness: float = math.inf) -> LeafGuide:
     """A leaf guide of the spec's ``isolator.flexure`` with the given leaf dimensions [m].
 
     Parameters
@@ -86,6 +87,8 @@ def leaf_guide(flexure, body: StageBody, *, length: float, width: float, thickne
         L, b, t [m].
     cart_mass : float, optional
         m2 [kg] (a vertical drive axis: the joint carries the cart).
+    stop_stiffness : float, optional
+        The end stop's contact stiffness k_stop [N/m]; default inf (rigid).
     """
     mat = flexure.material
     # without a size the spec gives both spacings (fi_design.spec.Spec checks it)
@@ -102,4 +105,5 @@ def leaf_guide(flexure, body: StageBody, *, length: float, width: float, thickne
                      orientation=flexure.orientation, stage_mass=body.mass,
                      stage_inertia=body.inertia, com_height=body.com_height,
                      sensor_offset=body.sensor_offset, actuator_offset=body.actuator_offset,
-                     damping_ratio=flexure.damping_ratio, cart_mass=cart_mass)
+                     damping_ratio=flexure.damping_ratio, cart_mass=cart_mass,
+                     stop_stiffness=stop_stiffness)

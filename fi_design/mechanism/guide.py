@@ -40,7 +40,8 @@ from . import leaf
 
 __all__ = ["EFFECTIVE_MASS", "MODE_NAMES", "leaf_force", "weight_vector", "clamp_stiffness",
            "clamp_geometric_stiffness", "at_centre", "mass_matrix", "stiffness6",
-           "drive_stiffness", "net_drive_stiffness", "buckling_factor", "stage_modes", "leaf_modes"]
+           "drive_stiffness", "net_drive_stiffness", "buckling_factor", "largest_deflection",
+           "stage_modes", "leaf_modes"]
 
 #: Effective modal mass of a clamped-clamped beam's first bending mode over its mass [-];
 #: half of it is taken to act on the stage's clamp (the other half on the cart's).
@@ -196,6 +197,54 @@ def net_drive_stiffness(K: np.ndarray, Kg: np.ndarray):
     """
     elastic, net = drive_stiffness(K), drive_stiffness(K + Kg)
     return np.where(np.abs(net - elastic) <= 1e-9 * np.abs(elastic), elastic, net)
+
+
+def largest_deflection(guide: LeafGuide, stroke: float, net):
+    """The leaves' largest drive deflection [m]: the stroke, where the limiter stops the joint.
+
+    The limiter engages at a joint deflection of +-s from the unloaded leaves,
+    whatever rests on the joint. On a vertical drive axis the joint carries the
+    cart's weight m2 g and rests at its sag m2 g / k: within the stroke the sag
+    only moves where the joint rests, and the limiter still stops it at s. A
+    sag beyond the stroke presses the joint onto its end stop, the leaves and
+    the stop sharing the weight: k u + k_stop (u - s) = m2 g, so
+    ``u = (m2 g + k_stop s) / (k + k_stop)``, s plus the stop's compression
+    (exactly s for a rigid stop, ``guide.stop_stiffness`` inf).
+
+    Parameters
+    ----------
+    guide : LeafGuide
+        Its orientation, ``cart_mass`` and ``stop_stiffness``.
+    stroke : float
+        One-sided stroke s [m].
+    net : float or numpy.ndarray
+        The guide's net drive stiffness k [N/m]; arrays broadcast.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Largest deflection [m], of the shape of ``net``.
+
+    Examples
+    --------
+    >>> from fi_design.results.mechanism import LeafGuide
+    >>> g = LeafGuide(leaves=2, length=0.05, width=0.02, thickness=0.4e-3, spacing=0.03,
+    ...               lateral_spacing=0.0, youngs_modulus=200e9, poisson_ratio=0.3,
+    ...               density=7800.0, allowed_stress=300e6, orientation="vertical_axis",
+    ...               stage_mass=1.0, stage_inertia=(1e-4,) * 3, com_height=0.025,
+    ...               cart_mass=0.4, stop_stiffness=1e6)
+    >>> round(largest_deflection(g, 0.3e-3, 2000.0) * 1e3, 4)  # sag 1.96 mm, on its stop
+    0.3033
+    >>> largest_deflection(g, 0.3e-3, 20000.0) * 1e3  # sag 0.196 mm, within the stroke
+    0.3
+    """
+    k = np.asarray(net, float)
+    ks = guide.stop_stiffness
+    if guide.orientation != "vertical_axis" or math.isinf(ks):
+        u = np.full(k.shape, float(stroke))
+    else:
+        u = np.maximum(stroke, (guide.cart_mass * GRAVITY + ks * stroke) / (k + ks))
+    return float(u) if u.ndim == 0 else u
 
 
 def buckling_factor(guide: LeafGuide, *, length=None, width=None, thickness=None,

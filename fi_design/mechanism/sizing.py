@@ -40,7 +40,8 @@ from . import mechanics
 from .geometry import StageBody, leaf_guide
 
 __all__ = ["GRID_POINTS", "STIFFNESS_TIE", "GridMechanics", "stock_thicknesses",
-           "stiffness_range", "net_stiffness", "evaluate", "reevaluate", "drawn_guide", "size_guide"]
+           "stiffness_range", "net_stiffness", "evaluate", "reevaluate", "drawn_guide",
+           "size_guide", "MARGIN_WORDS", "SizingMargin", "sizing_margin"]
 
 #: Grid points of a searched continuous dimension (length).
 GRID_POINTS = 161
@@ -187,11 +188,68 @@ def evaluate(guide: LeafGuide, stroke: float, length, width, thickness) -> GridM
     low = np.minimum(_parasitic_low(guide, K + Kg), _parasitic_low(guide, Ks + Kg))
     low = np.minimum(low, _leaf.bending_frequency(E, rho, L, b, t, force))
     low = np.minimum(low, _leaf.torsion_frequency(G, rho, L, b, t))
-    stress = _leaf.bending_stress(E, t, L, stroke) + abs(force) / (b * t)
+    u = _guide.largest_deflection(guide, stroke, net)
+    stress = _leaf.bending_stress(E, t, L, u) + abs(force) / (b * t)
     if guide.orientation == "flat":
         stress = stress + 3.0 * guide.weight * L / (guide.leaves * t * b * b)
     return GridMechanics(length=L, width=b, thickness=t, net=net, buckling=buckling,
                          lowest_mode=low, stress=stress)
+
+
+#: What each of the sizing's margins (:func:`sizing_margin`) compares, in words.
+MARGIN_WORDS = ("the allowed stress over the stress", "the lowest parasitic mode over the "
+                "required", "the buckling factor over the required", "k_max over the drive "
+                "stiffness of the stock's thickest leaves")
+
+
+def _margins(grid: GridMechanics, guide: LeafGuide, kmax: float, f_req: float, b_req: float,
+             dt: float) -> np.ndarray:
+    """The sizing's margins over a grid, stacked along a first axis in the order of
+    :data:`MARGIN_WORDS` (the last one 1 / 0 = inf without a thickness tolerance)."""
+    k_thick = (net_stiffness(guide, grid.length, grid.width, grid.thickness + dt) if dt > 0.0
+               else np.zeros(grid.net.shape))
+    with np.errstate(divide="ignore"):
+        return np.stack([guide.allowed_stress / grid.stress, grid.lowest_mode / f_req,
+                         grid.buckling / b_req,
+                         np.where(dt > 0.0, kmax / np.maximum(k_thick, 1e-300), np.inf)])
+
+
+@dataclass(frozen=True)
+class SizingMargin:
+    """The smallest of a sized guide's margins, the one its sizing's tie-break maximises.
+
+    Attributes
+    ----------
+    value : float
+        The smallest margin [-].
+    limited_by : str
+        What it compares (one of :data:`MARGIN_WORDS`).
+    """
+
+    value: float
+    limited_by: str
+
+
+def sizing_margin(fx: FlexureResult) -> SizingMargin:
+    """The smallest margin of a feasible guide, as its sizing ranks the guides.
+
+    The stress's, the lowest parasitic mode's, the buckling factor's (each over
+    its requirement) and k_max over the drive stiffness of the stock's thickest
+    leaves; :func:`size_guide` keeps, among the guides closest to the target
+    stiffness, the one with the largest.
+
+    Parameters
+    ----------
+    fx : FlexureResult
+        A feasible guide (its sizing's terms: k_max, the required frequency and
+        buckling factor, the thickness tolerance).
+    """
+    g = fx.guide
+    grid = evaluate(g, fx.stroke, g.length, g.width, g.thickness)
+    m = _margins(grid, g, fx.maximum_stiffness, fx.required_frequency, fx.required_buckling,
+                 fx.thickness_tolerance).reshape(len(MARGIN_WORDS))
+    i = int(np.argmin(m))
+    return SizingMargin(value=float(m[i]), limited_by=MARGIN_WORDS[i])
 
 
 def _mm(x: float) -> str:
@@ -238,7 +296,7 @@ def reevaluate(fx: FlexureResult, guide: LeafGuide) -> FlexureResult:
 
 def drawn_guide(flexure, body: StageBody, *, stroke: float, maximum_stiffness: float,
                 required_frequency: float, required_buckling: float,
-                cart_mass: float = 0.0) -> FlexureResult:
+                cart_mass: float = 0.0, stop_stiffness: float = math.inf) -> FlexureResult:
     """The guide the spec draws (one value per leaf dimension), evaluated.
 
     Parameters
@@ -257,16 +315,21 @@ def drawn_guide(flexure, body: StageBody, *, stroke: float, maximum_stiffness: f
         Required buckling factor [-], for the checks.
     cart_mass : float, optional
         m2 [kg].
+    stop_stiffness : float, optional
+        The end stop's contact stiffness k_stop [N/m] (a vertical axis's cart may rest on it);
+        default inf (rigid).
     """
     g = leaf_guide(flexure, body, length=flexure.length, width=flexure.width,
-                   thickness=flexure.thickness, cart_mass=cart_mass)
+                   thickness=flexure.thickness, cart_mass=cart_mass,
+                   stop_stiffness=stop_stiffness)
     return _result(g, stroke, drawn=True, flexure=flexure, maximum_stiffness=maximum_stiffness,
                    required_frequency=required_frequency, required_buckling=required_buckling)
 
 
 def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_stiffness: float,
                stroke: float, required_frequency: float, required_buckling: float,
-               cart_mass: float = 0.0, points: int = GRID_POINTS) -> FlexureResult:
+               cart_mass: float = 0.0, stop_stiffness: float = math.inf,
+               points: int = GRID_POINTS, bounds: dict | None = None) -> FlexureResult:
     """Size a parallel leaf-spring guide for a net drive stiffness.
 
     Parameters
@@ -288,8 +351,14 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
         Lowest allowed buckling factor [-].
     cart_mass : float, optional
         m2 [kg].
+    stop_stiffness : float, optional
+        The end stop's contact stiffness k_stop [N/m] (a vertical axis's cart may rest on it);
+        default inf (rigid).
     points : int, optional
         Grid points of the length. Default :data:`GRID_POINTS`.
+    bounds : dict, optional
+        ``{"length": (min, max), ...}`` [m] in place of the flexure's bounds of those
+        dimensions (a guide sized just beyond them, :mod:`.bounds`).
 
     Returns
     -------
@@ -301,14 +370,15 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
                  required_frequency=required_frequency, required_buckling=required_buckling,
                  thickness_step=flexure.thickness_step,
                  thickness_tolerance=flexure.thickness_tolerance)
-    (L0, L1), (b0, b1), (t0, t1) = (flexure.bounds(n) for n in ("length", "width", "thickness"))
+    (L0, L1), (b0, b1), (t0, t1) = (tuple((bounds or {}).get(n, flexure.bounds(n)))
+                                     for n in ("length", "width", "thickness"))
     stock = stock_thicknesses((t0, t1), flexure.thickness_step, points)
     if stock.size == 0:
         return FlexureResult(feasible=False, drawn=False, mechanics=None, reason=(
             f"stock: no multiple of the {_mm(flexure.thickness_step)} thickness step lies "
             f"within the thickness bounds {_mm(t0)} to {_mm(t1)}"), **terms)
     base = leaf_guide(flexure, body, length=L0, width=b0, thickness=stock[0],
-                      cart_mass=cart_mass)
+                      cart_mass=cart_mass, stop_stiffness=stop_stiffness)
     L = (np.geomspace(L0, L1, points) if L1 > L0 else np.array([L0]))[:, None]
     t = stock[None, :]
     n, E = base.leaves, base.youngs_modulus
@@ -333,17 +403,13 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
             grid, base, stroke, kmax, required_frequency, required_buckling,
             (ok_shape, ok_stress, ok_stiff, ok_buckle, ok_modes)), **terms)
     err = np.where(ok, np.abs(np.log(np.maximum(grid.net, 1e-300) / kt)), np.inf)
-    margin = np.minimum(np.minimum(base.allowed_stress / grid.stress,
-                                   grid.lowest_mode / required_frequency),
-                        grid.buckling / required_buckling)
-    dt = flexure.thickness_tolerance
-    if dt > 0.0:  # k_max over the stock's thickest leaves: thin stock scatters k the most
-        margin = np.minimum(margin, kmax / np.maximum(net_stiffness(base, L, b, t + dt), 1e-300))
+    margin = np.min(_margins(grid, base, kmax, required_frequency, required_buckling,
+                             flexure.thickness_tolerance), axis=0)
     close = err <= err.min() + STIFFNESS_TIE
     i, j = np.unravel_index(np.argmax(np.where(close, margin, -np.inf)), err.shape)
     chosen = leaf_guide(flexure, body, length=float(grid.length[i, j]),
                         width=float(grid.width[i, j]), thickness=float(grid.thickness[i, j]),
-                        cart_mass=cart_mass)
+                        cart_mass=cart_mass, stop_stiffness=stop_stiffness)
     return _result(chosen, stroke, drawn=False, flexure=flexure, target_stiffness=kt,
                    maximum_stiffness=kmax, required_frequency=required_frequency,
                    required_buckling=required_buckling)

@@ -33,7 +33,8 @@ from ..model import Model
 from ..spec.file import with_values
 
 __all__ = ["SEARCH_POINTS", "reserve_values", "reserve_requirements", "crossover_cap",
-           "notched_model", "notch_entries", "guide_for", "loop_meets", "stage_answer",
+           "notched_model", "notch_entries", "guide_for",
+           "guide_bounds", "loop_meets", "stage_answer",
            "margin_screen", "reserve_corners", "hunting_margin"]
 
 #: Lengths of the guide's sizing grid during the search (the chosen design is sized again at
@@ -170,7 +171,7 @@ def guide_for(base: Model, stiffness: float, stroke: float, crossover: float, *,
                       required_frequency=req.parasitic_separation
                       * _loop_at(base, stiffness, stroke, crossover).sizing_crossover,
                       required_buckling=req.buckling_factor, cart_mass=base.m2,
-                      points=points)
+                      stop_stiffness=base.limiter.stiffness, points=points)
 
 
 def _loop_at(base: Model, stiffness: float, stroke: float, crossover: float) -> Model:
@@ -183,6 +184,27 @@ def _loop_at(base: Model, stiffness: float, stroke: float, crossover: float) -> 
         m1, m2 = base.m1, base.m2
         c = 2.0 * base.joint_damping_ratio * math.sqrt(stiffness * m1 * m2 / (m1 + m2))
     return base.at(stiffness=stiffness, stroke=stroke, crossover=crossover, damping=c)
+
+
+def guide_bounds(base: Model, fx: Any) -> tuple:
+    """The sized guide's leaf dimensions on a bound of the base's flexure, each with its note.
+
+    Parameters
+    ----------
+    base : Model
+        The search's base (its ``isolator.flexure`` bounds, stage, cart and end stop).
+    fx : fi_design.results.steps.FlexureResult
+        The guide :func:`guide_for` sized.
+
+    Returns
+    -------
+    tuple of fi_design.results.steps.BoundNote
+        (:func:`fi_design.mechanism.bounds.bound_notes`.)
+    """
+    from ..mechanism.bounds import bound_notes
+
+    return bound_notes(fx, base.flexure_spec, base.body, cart_mass=base.m2,
+                       stop_stiffness=base.limiter.stiffness)
 
 
 def loop_meets(model: Model) -> tuple[bool, str]:

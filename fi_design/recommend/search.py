@@ -458,6 +458,7 @@ def _searched(model: Model, executor: Any, say: Callable[[str], None],
     fx, corners, report = signed
     if fx is None and chosen.candidate is not None:
         fx = _c.guide_for(srch.base_model, chosen.stiffness, chosen.stroke, srch.fc)
+    bounds = _c.guide_bounds(srch.base_model, fx) if fx is not None else ()
     st = report.simulation.stage["isolated"] if report is not None else None
     rob = report.robustness if report is not None else None
     binding = _o.binding(srch, chosen) if feasible else ()
@@ -486,7 +487,8 @@ def _searched(model: Model, executor: Any, say: Callable[[str], None],
         stiffnesses=tuple(sorted({p.target for p in srch.points})),
         candidates=tuple(p.result() for p in srch.points), spec_design=spec_design,
         crossover_limit=srch.fc_why, assumptions=srch.assumed, rule=srch.rule,
-        evaluations=srch.evaluations, wall_time=_time.perf_counter() - start, notch=srch.notch)
+        evaluations=srch.evaluations, wall_time=_time.perf_counter() - start, notch=srch.notch,
+        flexure_bounds=bounds)
 
 
 def _least_aside(srch: _Search, executor: Any, say: Callable[[str], None]) -> Any:

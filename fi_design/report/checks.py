@@ -58,6 +58,7 @@ SENSE = {
     "gain_margin": "\u2265", "modulus_margin": "\u2265", "parasitic_separation": "\u2265",
     "drive_stiffness": "\u2264", "flexure.stiffness": "\u2264", "flexure.joint": "\u2248", "flexure.stress": "\u2264",
     "flexure.buckling": "\u2265", "flexure.modes": "\u2265", "flexure.sag": "<",
+    "flexure.slenderness": "\u2265",
     "simulation_isolated": "=", "min_crossover_isolated": "\u2264", "landing_force": "<",
     "simulation_non_isolated": "=", "min_crossover_non_isolated": "\u2264", "robustness": "\u2264",
     "end_stop_force": "\u2264", "actuator_force": "<",
@@ -126,7 +127,8 @@ def check_label(name: str, cases: Mapping[str, Any] | None = None) -> str:
             "stress": "Flexure stress at full stroke",
             "buckling": "Flexure buckling load over the stage's weight",
             "modes": "Flexure's lowest parasitic mode above the crossover",
-            "sag": "Joint sag under the cart's weight within the stroke"}
+            "sag": "Joint sag under the cart's weight within the stroke",
+            "slenderness": "Flexure leaves slender enough for beam theory (L/t)"}
     if head == "flexure" and tail in flex:
         return flex[tail]
     if head == "pid" and tail == "tuning_mass":

@@ -80,6 +80,7 @@ def recommend_context(result: RecommendResult, *, date: Any = None, command: str
     paras = [result.advice]
     if result.binding:
         paras.append("What binds it: " + "; ".join(result.binding) + ".")
+    paras += [f"On a bound: {n.text}." for n in result.flexure_bounds]
     if result.violates:
         paras.append("What the nearest design violates: " + " ".join(result.violates))
     paras += [f"Assumed: {a}." for a in result.assumptions]

@@ -15,6 +15,7 @@ guide's axis, ``com_height`` beyond the stage's clamp.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from . import Result
@@ -75,6 +76,11 @@ class LeafGuide(Result):
     cart_mass : float
         Mass of the bearing cart m2 [kg]: on a vertical drive axis the joint
         carries its weight.
+    stop_stiffness : float
+        Contact stiffness k_stop of the joint's end stop [N/m]
+        (``isolator.limiter.stiffness``): on a vertical drive axis a cart whose
+        weight sags the joint beyond the stroke rests on it and compresses it.
+        Default inf (a rigid stop).
     """
 
     leaves: int
@@ -95,6 +101,7 @@ class LeafGuide(Result):
     actuator_offset: tuple[float, float] = (0.0, 0.0)
     damping_ratio: float = 0.01
     cart_mass: float = 0.0
+    stop_stiffness: float = math.inf
 
     @property
     def shear_modulus(self) -> float:
@@ -170,7 +177,8 @@ class Gravity(Result):
     sag : float
         Static deflection of the joint along x under the weight it carries [m]:
         on a vertical drive axis the actuator holds the stage and the joint
-        the cart, m2 g / k; 0 in the other orientations.
+        the cart, m2 g / k (the spring's alone: beyond the stroke the joint
+        rests on its end stop); 0 in the other orientations.
     """
 
     orientation: str
@@ -251,8 +259,11 @@ class GuideMechanics(Result):
     gravity : Gravity
         What the weight does.
     stress : float
-        Peak stress in the leaves at full stroke: bending plus the axial stress
-        of the weight [Pa].
+        Peak stress in the leaves at their largest deflection (the stroke: the
+        limiter bounds the joint; on a vertical drive axis sagging beyond the
+        stroke, the stroke plus the end stop's compression under the cart's
+        weight, :func:`fi_design.mechanism.guide.largest_deflection`): bending
+        plus the axial stress of the weight [Pa].
     stress_margin : float
         Allowed stress over ``stress`` [-].
     modes : tuple of Mode

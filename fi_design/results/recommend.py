@@ -178,6 +178,10 @@ class RecommendResult(Result):
     notch : fi_design.results.controller.Filter or None
         The notch the search added to the drive's chain
         (``requirements.recommend.filters``); None: the chain as the spec has it.
+    flexure_bounds : tuple of fi_design.results.steps.BoundNote
+        The recommended guide's leaf dimensions that sit on a bound of
+        ``isolator.flexure`` (which bound, its key), each saying whether a guide
+        sized past the bound has more margin (:func:`fi_design.mechanism.bounds.bound_notes`).
     from_cache : str or None
         The cache entry this result was read from
         (:mod:`fi_design.recommend.stored`): a search of the same spec by the
@@ -211,6 +215,7 @@ class RecommendResult(Result):
     evaluations: int
     wall_time: float
     notch: Any = None
+    flexure_bounds: tuple = ()
     from_cache: str | None = None
     fi_design_source: Source = field(default_factory=current_source)
 
@@ -228,7 +233,8 @@ class RecommendResult(Result):
     def to_dict(self) -> dict:
         """The contract: ``feasible``, ``isolator``, ``crossover``, ``flexure``, ``binding``,
         ``least_change``, ``stage_hunting``, ``robustness``, ``reserves``, ``forces``,
-        ``margins``, ``pareto``, the ``notch`` the search added (null: none); the nearest
+        ``margins``, ``pareto``, the ``notch`` the search added (null: none), ``flexure_bounds``
+        (the guide's dimensions on a bound of the flexure's, each with its note); the nearest
         design's ``violates``, the ``advice``, every judged ``candidate``, the search's
         ``evaluations`` and ``wall_time`` [s], and ``from_cache`` (the cache entry it was read
         from; null: computed by this run)."""
@@ -247,6 +253,7 @@ class RecommendResult(Result):
             "crossover_limit": self.crossover_limit, "assumptions": list(self.assumptions),
             "rule": self.rule,
             "notch": None if self.notch is None else self.notch.to_dict(),
+            "flexure_bounds": [n.to_dict() for n in self.flexure_bounds],
             "map": {"strokes": list(self.strokes), "stiffnesses": list(self.stiffnesses),
                     "candidates": [c.to_dict() for c in self.candidates]},
             "evaluations": self.evaluations, "wall_time": self.wall_time,

@@ -16,7 +16,7 @@ from .controller import ControlLaw, DiscreteController, DriveGains, Filter, PidG
 from .linear import CaseMargins
 from .mechanism import GuideMechanics
 
-__all__ = ["FrictionGapResult", "ModeSeparation", "NotchSuggestion", "CrossoverResult", "StiffnessResult", "FlexureResult", "DRIVE_FORM", "RULE_FORM", "DRIVE_UNITS", "RULE_UNITS", "DISCRETE_UNITS", "DISCRETE_METHOD", "PidResult", "CaseResponse", "LoopResponses"]
+__all__ = ["FrictionGapResult", "ModeSeparation", "NotchSuggestion", "CrossoverResult", "StiffnessResult", "FlexureResult", "BoundNote", "DRIVE_FORM", "RULE_FORM", "DRIVE_UNITS", "RULE_UNITS", "DISCRETE_UNITS", "DISCRETE_METHOD", "PidResult", "CaseResponse", "LoopResponses"]
 
 
 @dataclass(frozen=True)
@@ -336,6 +336,55 @@ class FlexureResult(Result):
             out.update(self.mechanics.to_dict())
             out["modes_at_stroke"] = [m.to_dict() for m in self.modes_at_stroke]
         return out
+
+
+@dataclass(frozen=True)
+class BoundNote(Result):
+    """A sized guide's leaf dimension on a bound of its sizing, and whether beyond it adds margin.
+
+    The sizing keeps, among the guides closest to the target stiffness, the one
+    with the largest smallest margin; where that grows beyond a bound, the
+    bound and not the physics chose the dimension.
+
+    Attributes
+    ----------
+    dimension : str
+        ``length``, ``width`` or ``thickness``.
+    key : str
+        The spec path of its bounds (``isolator.flexure.length``).
+    side : str
+        ``lower`` or ``upper``.
+    bound : float
+        The bound the dimension sits on [m] (for a stock thickness, the last
+        multiple of the step within it).
+    given : bool
+        Whether the spec sets the bounds (False: the default bounds).
+    margin : float
+        The guide's smallest margin [-] (:func:`fi_design.mechanism.sizing.sizing_margin`).
+    limited_by : str
+        What that margin compares.
+    beyond : float
+        The bound moved out, the guide sized again up to it [m].
+    margin_beyond : float or None
+        The smallest margin of the guide sized so [-]; None where no guide
+        there meets the constraints as close to the target stiffness.
+    adds_margin : bool
+        Whether going beyond the bound adds margin (``margin_beyond`` above ``margin``).
+    text : str
+        The note in words.
+    """
+
+    dimension: str
+    key: str
+    side: str
+    bound: float
+    given: bool
+    margin: float
+    limited_by: str
+    beyond: float
+    margin_beyond: float | None
+    adds_margin: bool
+    text: str
 
 
 #: What ``pid.drive`` is: the one gain set to give a drive.

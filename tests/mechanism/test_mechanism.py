@@ -87,6 +87,35 @@ def test_gravity_softens_a_standing_guide_and_stiffens_a_hanging_one():
         mechanics(flat, 0.3e-3).stiffness.x
 
 
+def test_the_limiter_bounds_a_vertical_axis_leaf_at_the_stroke_however_far_it_sags():
+    """The stress on a vertical drive axis took the deflection as stroke + sag: 0.3 mm + 0.59 mm
+    for the paper's leaves carrying a 0.4 kg cart. The limiter stops the joint at +-s from the
+    unloaded leaves: a sag within the stroke only moves where the joint rests; a sag beyond it
+    presses the joint onto its end stop, k u + k_stop (u - s) = m2 g."""
+    from dataclasses import replace
+
+    E_, t, L = E, 0.45e-3, 50.7e-3
+    within = make_guide(orientation="vertical_axis", m2=0.4)
+    m = mechanics(within, 1.0e-3)
+    k = m.net_drive_stiffness
+    assert 0.0 < m.gravity.sag < 1.0e-3  # 0.59 mm of a 1 mm stroke
+    assert m.stress == pytest.approx(3 * E_ * t * 1.0e-3 / L ** 2, rel=1e-12)
+    # beyond: the cart rests on its stop, which shares the weight with the leaves
+    beyond = replace(within, stop_stiffness=1e5)
+    m = mechanics(beyond, 0.3e-3)
+    assert m.gravity.sag == pytest.approx(0.4 * GRAVITY / k, rel=1e-12)
+    assert m.gravity.sag > 0.3e-3
+    u = (0.4 * GRAVITY + 1e5 * 0.3e-3) / (k + 1e5)
+    assert 0.3e-3 < u < m.gravity.sag
+    assert m.stress == pytest.approx(3 * E_ * t * u / L ** 2, rel=1e-12)
+    # a rigid stop holds it at the stroke exactly
+    assert mechanics(within, 0.3e-3).stress == pytest.approx(3 * E_ * t * 0.3e-3 / L ** 2,
+                                                             rel=1e-12)
+    # the sizing's grid takes the same deflection as the single guide
+    grid = evaluate(beyond, 0.3e-3, np.array([L]), np.array([23.9e-3]), np.array([t]))
+    assert float(grid.stress[0]) == pytest.approx(m.stress, rel=1e-9)
+
+
 def test_buckling_of_a_low_stage_is_the_euler_sway_load():
     # a low, flat stage: its centre of mass 1 mm above the clamp, the sway mode alone
     g = make_guide(L=40e-3, b=10e-3, t=0.2e-3, size=(0.06, 0.06, 0.002), m1=5.0)
@@ -399,6 +428,35 @@ def _paper_variant(paper_spec, **values):
     from fi_design.spec.file import with_values
 
     return with_values(paper_spec, values)
+
+
+def test_a_stubby_leaf_warns_that_beam_theory_is_doubtful(paper_spec):
+    """No check looked at a leaf's slenderness: 6 mm leaves of 1 mm stock (L/t = 6) were judged
+    on beam theory without a word."""
+    from fi_design import design
+    from fi_design.results import Status
+
+    drawn = {"isolator.stiffness": None, "isolator.damping": None,
+             "isolator.parasitic_modes": []}
+    stubby = design(_paper_variant(paper_spec, **drawn, **{
+        "isolator.flexure.length": "6 mm", "isolator.flexure.width": "20 mm",
+        "isolator.flexure.thickness": "1 mm"}), confirm=False)
+    [c] = [c for c in stubby.checks if c.name == "flexure.slenderness"]
+    assert c.status == Status.WARN and c.passed is None
+    assert c.value == pytest.approx(6.0) and c.limit == 10.0
+    assert c.message == (
+        "the leaves are 6 mm long and 1 mm thick: L/t = 6, below 10, where beam theory is "
+        "doubtful (the model includes shear, but the clamps' compliance and the leaf's end and "
+        "plate effects are left out): its stiffness, stress and modes are estimates; measure "
+        "the guide or model it in FE, or draw longer, thinner leaves")
+    assert any(r.source == "flexure.slenderness" and r.severity == "WARN"
+               for r in stubby.verdict.reasons)
+    # the paper's leaves, 50.7 mm of 0.45 mm (L/t = 113): no warning
+    paper = design(_paper_variant(paper_spec, **drawn, **{
+        "isolator.flexure.length": "50.7 mm", "isolator.flexure.width": "23.9 mm",
+        "isolator.flexure.thickness": "0.45 mm"}), confirm=False)
+    assert paper.flexure.drawn and paper.checks
+    assert not [c for c in paper.checks if c.name == "flexure.slenderness"]
 
 
 def test_a_thin_guide_standing_under_the_stage_fails_with_the_reason(paper_spec):

@@ -71,6 +71,38 @@ def test_the_recommendation_is_a_buildable_stiff_joint_bound_by_physics(paper_re
     assert {"least_change", "pareto", "reserves", "binding", "flexure"} <= set(data)
 
 
+def test_the_recommended_guide_on_its_length_bound_says_so_everywhere(paper_recommendation):
+    """The paper setup's guide, 60 x 15.3 x 0.55 mm, has its length on the upper bound of
+    isolator.flexure.length [10, 60] mm, and nothing said so: the sizing's tie-break (the
+    largest smallest margin) grows with length, so the user's range chose it. The console, the
+    JSON and the report now name the bound and its key, and that longer leaves add margin (a
+    guide sized past the bound has more: tests/mechanism/test_bounds.py)."""
+    from datetime import date
+
+    from rich.console import Console
+
+    from fi_design.console.recommend import print_recommendation
+    from fi_design.report import build_context
+
+    r = paper_recommendation
+    [n] = r.flexure_bounds
+    assert r.flexure.length == n.bound == 0.06 and n.key == "isolator.flexure.length"
+    assert n.side == "upper" and n.given and n.adds_margin and n.margin_beyond > n.margin
+    text = n.text
+    assert text.startswith("the leaves' length, 60 mm, sits on the upper bound of its range "
+                           "10 mm to 60 mm (isolator.flexure.length, you set); their smallest "
+                           "margin, ")
+    assert text.endswith(": longer leaves would add margin (widen isolator.flexure.length to "
+                         "let the sizing choose)")
+    data = json.loads(json.dumps(r.to_dict(), allow_nan=False))
+    assert data["flexure_bounds"] == [n.to_dict()] and data["flexure_bounds"][0]["text"] == text
+    ctx = json.dumps(build_context(r, date=date(2024, 5, 1), figures=False), default=str)
+    assert json.dumps(f"On a bound: {text}.") in ctx
+    console = Console(record=True, width=100)
+    print_recommendation(console, r)
+    assert f"On a bound: {text}" in " ".join(console.export_text().split())
+
+
 def test_what_binds_it_agrees_with_the_front_and_k_max(paper_recommendation):
     """'Binds it' read 'a shorter stroke (0.5196 mm) allows a softer joint at most: 3652 N/m'
     beside a front with 7611 N/m at 0.52 mm. Each stroke's sentence gives that stroke's k_max
