@@ -286,6 +286,14 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
         out.append(("requirements.hunting.window_start",
                     f"the last move ends at {quantity(t_end, 's', 4)}, {where} "
                     f"{quantity(h.window_start, 's', 6)}{whose}"))
+    for i, e in enumerate(spec.effects):
+        if e.type == "quantization" and e.resolution > h.settle_band:
+            out.append((f"effects[{i}].resolution",
+                        f"the position quantization step {quantity(e.resolution, 'm', 4)} is "
+                        "coarser than the settle band requirements.hunting.settle_band = "
+                        f"{quantity(h.settle_band, 'm', 4)}: the controller cannot see an error "
+                        "within the band it is judged on (check the unit: a bare number is in "
+                        "metres; an encoder's step is nanometres to micrometres)"))
     ctl = spec.controller
     delayed = any(e.type == "time_delay" for e in spec.effects)
     if ctl.sample_rate is None and ctl.delay == 0 and not delayed:

@@ -206,6 +206,18 @@ def test_an_end_stop_softer_than_the_joint_is_warned_about(paper_spec):
             sp.warnings_for(variant(paper_spec, **{"isolator.limiter": stop})))
 
 
+
+def test_a_quantizer_coarser_than_the_settle_band_is_warned_about(paper_spec):
+    """effects: [{type: quantization, resolution: 1}] (a bare 1, read as 1 m) passed without a
+    word, and the stage 'hunted' over a metre; a step coarser than the settle band (10 um)
+    cannot show the controller an error within the band the stage is judged on."""
+    coarse = variant(paper_spec, effects=[{"type": "quantization", "resolution": 1}])
+    text = dict(sp.warnings_for(coarse))["effects[0].resolution"]
+    assert "1000 mm is coarser than the settle band" in text and "10 µm" in text, text
+    for fine in ("1 um", "10 um"):  # at or within the band: no warning
+        spec = variant(paper_spec, effects=[{"type": "quantization", "resolution": fine}])
+        assert "effects[0].resolution" not in dict(sp.warnings_for(spec))
+
 def test_a_stage_box_no_solid_fills_is_warned_about(paper_spec):
     """1.6 kg in a 1 mm cube (a size written in mm where metres were meant, or the reverse)
     passed without a word, its inertia on the guide, and so its tilt modes, wrong by the
