@@ -686,7 +686,8 @@ def switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state):
     direction : int
         Which way the crossing goes: for ``EV_LIMIT`` out of the free range
         the limiter engaged, +1 (d > s) or -1 (d < -s), ignored when leaving
-        a limiter; for ``EV_LEVEL`` +1 up a level, -1 down; ignored otherwise.
+        a limiter; for ``EV_LEVEL`` the levels crossed, signed (+1 up a level, -1 down; more
+        where the integrator catches up with levels a step crossed); ignored otherwise.
     y : ndarray
         State at the crossing (changed in place: the switch model's stopped
         cart, the filtered controller's jump).
@@ -704,7 +705,7 @@ def switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state):
     -----
     A quantization level change with a filtered continuous controller makes
     its output u jump by the derivative terms' impulse, -wt (kd + kdm) q per
-    level. A sampled controller (``sample_period`` > 0) reads the position at
+    level (so a catch-up over n levels jumps n times that: no impulse is lost). A sampled controller (``sample_period`` > 0) reads the position at
     its samples and holds its output in u: nothing jumps.
     """
     if kind == EV_SIGN:
@@ -727,7 +728,7 @@ def switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state):
         else:
             modes[MODE_LIMIT] = 0
     elif kind == EV_LEVEL:
-        step = 1 if direction > 0 else -1
+        step = direction  # levels crossed, signed (one at a located crossing)
         modes[MODE_LEVEL] += step
         if p[P_TS] == 0.0 and not math.isinf(p[P_WT]):
             y[iu] += -p[P_WT] * (p[P_KD] + p[P_KDM]) * p[P_QUANT] * step

@@ -1129,6 +1129,12 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                     if cont_delay:
                         u_before = controller_output(y, p, modes, r0, rd0, ii, iu)
                     apply_event(kind, y, p, modes, iv2, iu, r0, rd0, fa0, fa_state, ybuf)
+                    if zero_run >= 8 and p[P_QUANT] > 0.0 and p[P_TS] == 0.0:
+                        # natural_modes below sets the level the state is at: its impulses
+                        behind = int(math.floor(y[0] / p[P_QUANT] + 0.5)) - modes[MODE_LEVEL]
+                        if behind != 0:
+                            switch_mode(EV_LEVEL, behind, y, p, modes, iv2, iu, r0, rd0, fa0,
+                                        fa_state)
                     if cont_delay:
                         u_after = controller_output(y, p, modes, r0, rd0, ii, iu)
                         if u_after != u_before:
