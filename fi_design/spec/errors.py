@@ -15,7 +15,7 @@ from typing import Any
 
 from ..display import number
 from . import Spec
-from .units import _digits, huge
+from .units import huge, shown_digits
 
 
 def clean_loc(loc: tuple, raw: dict) -> tuple:
@@ -221,7 +221,7 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
     if kind in ("finite_number",):
         return path, "must be a finite number"
     if huge(err.get("input")):
-        return path, f"the number {_digits(err['input'])} is too large"
+        return path, f"the number {shown_digits(err['input'])} is too large"
     if kind in ("float_type", "float_parsing"):
         return path, f"expected a number or a string with units, got {_shown(err['input'])}"
     if kind in ("model_type", "model_attributes_type", "dict_type"):
@@ -242,7 +242,7 @@ def _items(count: Any, loc: tuple) -> str:
 def _shown(value: Any) -> str:
     """A value read from the spec, for a message: its repr, cut to 40 characters."""
     if huge(value):
-        return f"the number {_digits(value)}"
+        return f"the number {shown_digits(value)}"
     text = repr(value)
     return text if len(text) <= 40 else text[:28] + "..." + text[-8:]
 

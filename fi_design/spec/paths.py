@@ -427,10 +427,10 @@ def _element(ann: Any, index: int) -> Any:
 
 
 def _show(value: Any) -> str:
-    from .units import _digits, huge
+    from .units import huge, shown_digits
 
     if huge(value):
-        return f"the number {_digits(value)}"
+        return f"the number {shown_digits(value)}"
     return number(value, 6) if isinstance(value, float) else repr(value) \
         if isinstance(value, str) else str(value)
 

@@ -161,7 +161,7 @@ def to_si(value, unit: str, path: str | None = None) -> float:
         raise ArgumentError(f"unknown target unit {unit!r}")
     if _is_number(value):
         if isinstance(value, numbers.Integral) and abs(int(value)) > 2 ** 1023:
-            raise UnitError(f"the number {_digits(int(value))} is too large for a physical value",
+            raise UnitError(f"the number {shown_digits(int(value))} is too large for a physical value",
                             path=path)
         if unit == "deg":
             raise UnitError(f"a bare number is ambiguous for an angle; write e.g. '{value} deg'",
@@ -192,7 +192,7 @@ def huge(value: Any) -> bool:
         abs(value).bit_length() > 997
 
 
-def _digits(value: int) -> str:
+def shown_digits(value: int) -> str:
     """A huge integer for a message: its first digits and how many it has."""
     try:
         text = str(abs(value))
