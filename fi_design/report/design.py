@@ -13,6 +13,7 @@ from typing import Any
 
 from ..display import quantity
 from ..results.design import DesignResult
+from ..results.linear import NOT_JUDGED, phase_margin_judged
 from ..results.stage import STATIC_ERROR_FORMULA, length_range
 from ..results.studies import DesignMap
 from .assumptions import assumptions, family_words
@@ -32,21 +33,21 @@ __all__ = ["design_context", "REFERENCES"]
 
 def _cases_table(result: Any) -> list[dict]:
     """Rows of the margins table, with each case's status as the analysis judged it; a case
-    without a crossing in the loop's band (INFO) shows no phase or delay margin: they are
-    not margins to pass."""
+    whose phase margin is not judged (:func:`~fi_design.results.linear.phase_margin_judged`,
+    as in the console) shows no phase or delay margin, and says why."""
     numbers = {c.name: c.number for c in result.loop.cases}
     rows = []
     for c in result.crossover.cases:
         status = c.status.value
-        out_of_band = c.status == "INFO"
+        judged = phase_margin_judged(c.criteria)
         rows.append({
             "number": numbers.get(c.name, ""), "description": c.description,
             "crossover": c.crossover, "crossovers": len(c.crossovers),
-            "phase_margin": None if out_of_band else c.phase_margin_deg,
+            "phase_margin": c.phase_margin_deg if judged else None,
             "gain_margin": c.gain_margin_db, "modulus_margin": c.modulus_margin,
-            "delay_margin": None if out_of_band else c.delay_margin,
+            "delay_margin": c.delay_margin if judged else None,
             "stable": "yes" if c.stable else "no", "status": status, "css": status.lower(),
-            "failed": "outside the band" if out_of_band else ", ".join(c.failed),
+            "failed": ", ".join(c.failed + (() if judged else (NOT_JUDGED,))),
         })
     return rows
 

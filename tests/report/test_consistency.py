@@ -8,6 +8,7 @@ Each test reads the context of the paper setup's report (computed once per sessi
 from __future__ import annotations
 
 import math
+import re
 
 import pytest
 
@@ -210,3 +211,66 @@ def test_a_search_cap_is_no_achievable_crossover(no_isolator_steps):
     row = next(r for r in step2["results"] if r["quantity"] == "achievable crossover")
     assert isinstance(row["value"], str) and row["value"].startswith("\u2265 1000")
     assert not any("f_c,ach = " in e["text"] for e in step2["equations"])
+
+
+def _console_case_rows(design) -> dict:
+    """The console's limit-case table of a design: case number -> its cells, as printed."""
+    from rich.console import Console
+
+    from fi_design import console
+
+    cases = design.to_dict()["crossover"]["cases"]
+    out = Console(width=200, record=True)
+    out.print(console.cases_table(cases, {c.name: c.number for c in design.loop.cases}))
+    rows = {}
+    for line in out.export_text().splitlines():
+        cells = line.split()
+        if cells and cells[0].isdigit() and "cart" in line:
+            rows[int(cells[0])] = line
+    return rows
+
+
+@pytest.mark.parametrize("gain_margin_fails", [False, True])
+def test_one_rule_for_a_margin_outside_the_band(paper_confirmed_design, gain_margin_fails):
+    """Case 4 crosses 0 dB only at 0.00135 Hz: the report's margins table showed – for its phase
+    and delay margins (not judged, outside the band), the console 90.12 deg and 185.8 s. Both
+    show – and say why, also beside a failing gain margin (the report showed the numbers
+    then)."""
+    import dataclasses
+
+    from fi_design.report.design import _cases_table
+    from fi_design.results import Status
+
+    design = paper_confirmed_design
+    stuck = next(c for c in design.crossover.cases if c.name == "stuck_limited")
+    assert not stuck.in_band and stuck.criteria["phase margin"] == Status.INFO
+    assert stuck.phase_margin_deg > 90 and stuck.delay_margin > 185
+    if gain_margin_fails:
+        stuck = dataclasses.replace(
+            stuck, passed=False, failed=("gain margin",), status=Status.FAIL,
+            criteria={**stuck.criteria, "gain margin": Status.FAIL})
+        design = dataclasses.replace(design, crossover=dataclasses.replace(
+            design.crossover, cases=tuple(stuck if c.name == stuck.name else c
+                                          for c in design.crossover.cases)))
+    why = "gain margin, outside the band" if gain_margin_fails else "outside the band"
+    row = next(r for r in _cases_table(design) if r["description"] == stuck.description)
+    assert (row["phase_margin"], row["delay_margin"], row["failed"]) == (None, None, why)
+    assert row["gain_margin"] == stuck.gain_margin_db
+    html = report.render_html(report.build_context(design, date=DATE, figures=False))
+    table = html[html.index('<table class="margins">'):]
+    shown = re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", table[
+        table.index(stuck.description):table.index("</tr>", table.index(stuck.description))]))
+    assert shown.split() == [*stuck.description.split(), report.num(stuck.crossover), "1",
+                             "\u2013", report.num(stuck.gain_margin_db),
+                             report.num(stuck.modulus_margin), "\u2013", "yes",
+                             "FAIL" if gain_margin_fails else "INFO", *why.split()], shown
+    number = next(c.number for c in design.loop.cases if c.name == stuck.name)
+    cells = _console_case_rows(design)[number].split()
+    status = "FAIL" if gain_margin_fails else "INFO"
+    assert cells[-len(why.split()) - 6:] == [
+        report.num(stuck.crossover), "\u2013", report.num(stuck.gain_margin_db),
+        report.num(stuck.modulus_margin), "\u2013", status, *why.split()], cells
+    from fi_design import console
+
+    assert "outside its band, where the phase and delay margins are not judged" in (
+        console.CASE_CAPTION)
