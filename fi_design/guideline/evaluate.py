@@ -26,6 +26,7 @@ from ..mechanism.checks import flexure_checks
 from ..model import Model, as_model
 from ..results import Check, Status
 from ..results.design import DesignResult, FlexureResult, IsolatorAdvice
+from ..results.linear import phase_margin_judged
 from ..results.stage import STATIC_ERROR_FORMULA
 from ..spec import Spec, warnings_for
 from .steps import (controller_words, isolator_advice, notch_words, step1_friction_gap,
@@ -290,7 +291,7 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
                           else "."))
     n = len(xo.cases)
     bad = [c for c in xo.cases if not c.passed]
-    pms = [c.phase_margin_deg for c in xo.cases if c.in_band] or [math.inf]
+    pms = [c.phase_margin_deg for c in xo.cases if phase_margin_judged(c.criteria)] or [math.inf]
     gms = [abs(c.gain_margin_db) for c in xo.cases]
     margins = (f"phase margins of at least {number(min(pms), 3)} deg and gain margins of at least "
                f"{number(min(gms), 3)} dB" if all(math.isfinite(x) for x in gms)

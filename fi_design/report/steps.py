@@ -6,6 +6,7 @@ import itertools
 import math
 from typing import Any
 
+from ..results.linear import phase_margin_judged
 from .equations import equation
 from .filters import num, qty, tex_num, tex_qty
 
@@ -91,7 +92,14 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
                 f"f_{{c,\\mathrm{{ach}}}} = {tex_qty(xo.achievable, 'Hz')}"))
     eqs.append(eq(f"f_\\mathrm{{par}} \\geq n_\\mathrm{{sep}}\\, f_\\mathrm{{loop}} = "
                   f"{tex_num(sep)} \\times {tex_qty(loop_fc, 'Hz')} = {tex_qty(need, 'Hz')}"))
-    pms = [c.phase_margin_deg for c in xo.cases]
+    # the phase margins the margins table judges: a case crossing 0 dB only outside the
+    # loop's band shows none there (results.linear.phase_margin_judged)
+    unjudged = [_case_number(xo, c.name) for c in xo.cases if not phase_margin_judged(c.criteria)]
+    pms = [c.phase_margin_deg for c in xo.cases if phase_margin_judged(c.criteria)]
+    pm_cases = ("all cases" if not unjudged else
+                f"the judged cases; case{'s' if len(unjudged) > 1 else ''} "
+                f"{', '.join(map(str, unjudged))} cross{'' if len(unjudged) > 1 else 'es'} 0 dB "
+                f"only outside the loop's band, not judged")
     gms = [abs(c.gain_margin_db) for c in xo.cases]
     results = [
         {"quantity": "desired crossover fc", "value": xo.desired, "unit": "Hz"},
@@ -100,8 +108,8 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
          "value": (f"\u2265 {qty(xo.achievable, 'Hz')} (a bound: the search cap)"
                    if xo.limit_kind == "scan_limit" else xo.achievable), "unit": "Hz"},
         {"quantity": "limited by", "value": xo.limited_by, "unit": ""},
-        {"quantity": "smallest phase margin at fc (all cases)", "value": min(pms),
-         "unit": "deg"},
+        {"quantity": f"smallest phase margin at fc ({pm_cases})",
+         "value": min(pms) if pms else "none", "unit": "deg" if pms else ""},
         {"quantity": "smallest gain margin at fc (all cases)", "value": min(gms), "unit": "dB"},
         {"quantity": "loop delay in the analysis", "value": xo.delay, "unit": "s"},
         {"quantity": "loop crossover f_loop (the highest 0 dB crossing in the band"

@@ -274,3 +274,27 @@ def test_one_rule_for_a_margin_outside_the_band(paper_confirmed_design, gain_mar
 
     assert "outside its band, where the phase and delay margins are not judged" in (
         console.CASE_CAPTION)
+
+
+def test_step_2_smallest_phase_margin_is_of_the_judged_cases(paper_confirmed_design):
+    """Step 2's 'smallest phase margin at fc (all cases)' took case 4's phase margin too, which
+    the margins table shows as – (its loop crosses 0 dB only outside the band): with that
+    margin at 20 deg the step reported 20 deg that nothing judges. Now it is the smallest of
+    the judged margins, and says so."""
+    import dataclasses
+
+    design = paper_confirmed_design
+    cases = design.crossover.cases
+    assert [c.criteria["phase margin"] for c in cases] == ["PASS", "PASS", "PASS", "INFO"]
+    low = dataclasses.replace(cases[3], phase_margin_deg=20.0)
+    design = dataclasses.replace(design, crossover=dataclasses.replace(
+        design.crossover, cases=cases[:3] + (low,)))
+    ctx = report.build_context(design, date=DATE, figures=False)
+    row = _step_row(ctx, 2, "smallest phase margin")
+    assert row["quantity"] == ("smallest phase margin at fc (the judged cases; case 4 crosses "
+                               "0 dB only outside the loop's band, not judged)")
+    assert row["value"] == min(c.phase_margin_deg for c in cases[:3]) == cases[1].phase_margin_deg
+    table = [r["phase_margin"] for r in ctx["linear"]["cases"]]
+    assert row["value"] == min(p for p in table if p is not None)
+    gain = _step_row(ctx, 2, "smallest gain margin")
+    assert gain["quantity"] == "smallest gain margin at fc (all cases)"
