@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..display import quantity
+from ..display import column, quantity
 from ..results.design import DesignResult
 from ..results.linear import NOT_JUDGED, phase_margin_judged
 from ..results.stage import STATIC_ERROR_FORMULA, length_range
@@ -216,6 +216,26 @@ def _plant_rows(sim: Any) -> list[dict]:
     return rows
 
 
+#: The columns of the nonlinear tables that carry a unit: key -> (header, SI unit, digits).
+_STAGE_COLUMNS = {"amplitude": ("Cycle (p-p)", "m", 3), "period": ("Period", "s", 3),
+                  "free_from": ("No move hunts from", "Hz", 4)}
+_PLANT_COLUMNS = {"amplitude": ("Amplitude (p-p)", "m", 3), "period": ("Period", "s", 3),
+                  "settling_time": ("Settling time", "s", 3),
+                  "final_error": ("Final error", "m", 3)}
+
+
+def _in_columns(rows: list[dict], columns: dict) -> dict:
+    """Each column of a table in one unit, named in its header (:func:`display.column`): the
+    cells' text in ``row["cells"]``; returns the headers."""
+    heads = {}
+    for key, (title, unit, digits) in columns.items():
+        shown, cells = column([r[key] for r in rows], unit, digits)
+        heads[key] = f"{title} [{shown}]" if shown else title
+        for r, cell in zip(rows, cells):
+            r.setdefault("cells", {})[key] = cell
+    return heads
+
+
 def _stage_rows(sim: Any) -> list[dict]:
     """One row per plant of the stage-level answer (every move of its family)."""
     names = _plant_labels(sim)
@@ -269,14 +289,16 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "disagree on is not shown: the moves that end in the cycle show it attracts); the "
             "crossover from which no move hunts is "
             "the cycle's fold, found by bisection."),
-        "stage": _stage_rows(sim),
+        "stage": (stage := _stage_rows(sim)),
+        "stage_heads": _in_columns(stage, _STAGE_COLUMNS),
         "spec_intro": (
             "The spec's own motion alone, as the paper judges it (section 2.3): the peaks of "
             f"the position error x1 - r of at least {qty(h.min_height, 'm')} and standing out "
             f"by as much, at least {qty(h.min_distance, 's')} apart, in the window "
             f"[{num(h.window_start)} s, {num(h.window_start + h.window_length)} s); one peak "
             "is one hunting cycle. This answers for one move only."),
-        "plants": _plant_rows(sim),
+        "plants": (plants := _plant_rows(sim)),
+        "plant_heads": _in_columns(plants, _PLANT_COLUMNS),
         "moves": figure_entry(
             (lambda: plots.moves_figure(sim)) if figures else None, "moves",
             "How the stage ends after each move of its family: the cycle's peak to peak for a "

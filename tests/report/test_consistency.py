@@ -298,3 +298,38 @@ def test_step_2_smallest_phase_margin_is_of_the_judged_cases(paper_confirmed_des
     assert row["value"] == min(p for p in table if p is not None)
     gain = _step_row(ctx, 2, "smallest gain margin")
     assert gain["quantity"] == "smallest gain margin at fc (all cases)"
+
+
+def test_the_nonlinear_tables_have_one_unit_per_column(ctx, paper_confirmed_design):
+    """The spec-motion table read '0.0252 µm' over '1.37 mm' (amplitude) and '< 0.001 µm'
+    over '-0.625 mm' (final error), and the console's rows alike: a column (a row of the
+    console's transposed table) is in one unit, named once in its header."""
+    from rich.console import Console
+
+    from fi_design import console
+
+    section = ctx["nonlinear"]
+    sim = paper_confirmed_design.simulation
+    iso, bare = sim.isolated.metrics, sim.non_isolated.metrics
+    assert 0 < abs(iso.final_error) < 1e-9 and iso.amplitude < 1e-7 < 1e-4 < bare.amplitude
+    heads = section["plant_heads"]
+    assert heads == {"amplitude": "Amplitude (p-p) [mm]", "period": "Period [s]",
+                     "settling_time": "Settling time [s]", "final_error": "Final error [mm]"}
+    cells = [p["cells"] for p in section["plants"]]
+    assert [c["final_error"] for c in cells] == ["< 1\u00a0\u00d7\u00a010\u207b\u2076",
+                                                 report.num(bare.final_error * 1e3, 3)]
+    assert [c["amplitude"] for c in cells] == [report.num(iso.amplitude * 1e3, 3),
+                                               report.num(bare.amplitude * 1e3, 3)]
+    assert section["stage_heads"] == {"amplitude": "Cycle (p-p) [mm]", "period": "Period [s]",
+                                      "free_from": "No move hunts from [Hz]"}
+    html = report.render_html(ctx)
+    for head in (*heads.values(), *section["stage_heads"].values()):
+        assert f'<th scope="col" class="num">{head}</th>' in html
+    data = paper_confirmed_design.to_dict()
+    out = Console(width=120, record=True)
+    out.print(console.simulation_table(data["simulation"], stages=data["stage_hunting"]))
+    text = out.export_text()
+    for title in ("Cycle, peak to peak [mm]", "Amplitude, peak to peak [mm]",
+                  "Final error x1 - r [mm]"):
+        row = next(line for line in text.splitlines() if line.strip().startswith(title))
+        assert "\u00b5m" not in row and " mm" not in row.replace(title, ""), row
