@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..display import number, percent, quantity, with_error
+from ..display import number, percent, quantity, unit_text, with_error
 from ..results.linear import NOT_JUDGED, phase_margin_judged
 from ..results.stage import STATIC_ERROR_FORMULA
 from .common import heading, status_text, table
@@ -208,7 +208,8 @@ def _gains_table(pid: dict) -> Any:
     t = table("PID gains (step 4) a drive takes: kp + ki/s + kd s / (1 + s/(2 pi roll_off)), the "
               "roll-off on the D term only (controller.gains, controller.roll_off)")
     t.add_column("")
-    for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "roll_off [Hz]"):
+    for col in ("kp [N/m]", f"ki [{unit_text('N/(m*s)')}]", f"kd [{unit_text('N*s/m')}]",
+                "roll_off [Hz]"):
         t.add_column(Text(col), justify="right", no_wrap=True)
     for label, g in rows:
         t.add_row(label, number(g["kp"]), number(g["ki"]), number(g["kd"]),

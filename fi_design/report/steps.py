@@ -270,8 +270,8 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
                   f"r\\, \\omega_c = {tex_qty(g.wt, 'rad/s')},\\quad \\omega_i = \\omega_c / r_i = "
                   f"{tex_qty(g.wi, 'rad/s')}"),
         eq(f"k_p = k_s (1 + \\omega_i/\\omega_d) = {tex_qty(g.kp, 'N/m')},\\quad "
-                  f"k_i = k_s \\omega_i = {tex_qty(g.ki, 'N/(m s)')},\\quad "
-                  f"k_d = k_s / \\omega_d = {tex_qty(g.kd, 'N s/m')}"),
+                  f"k_i = k_s \\omega_i = {tex_qty(g.ki, 'N/(m*s)')},\\quad "
+                  f"k_d = k_s / \\omega_d = {tex_qty(g.kd, 'N*s/m')}"),
     ]
     law = result.pid.controller
     hand = law.hand_off()
@@ -280,7 +280,7 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
             eq("C(s) = \\frac{k_p + k_i/s + k_d s}{1 + s/\\omega_t} = k_p' + \\frac{k_i}{s} + "
                "\\frac{k_d' s}{1 + s/\\omega_t}"),
             eq(f"k_p' = k_p - k_i/\\omega_t = {tex_qty(hand['kp'], 'N/m')},\\quad "
-               f"k_d' = k_d - k_p'/\\omega_t = {tex_qty(hand['kd'], 'N s/m')},\\quad "
+               f"k_d' = k_d - k_p'/\\omega_t = {tex_qty(hand['kd'], 'N*s/m')},\\quad "
                f"f_t = \\omega_t / 2\\pi = {tex_qty(hand['roll_off'], 'Hz')}"),
         ]
     sampled = ("continuous" if hand["sample_rate"] is None
@@ -290,9 +290,9 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
         {"quantity": "tuning mass m", "value": g.tuning_mass, "unit": "kg"},
         {"quantity": "drive gain kp (controller.gains.kp)", "value": hand["kp"], "unit": "N/m"},
         {"quantity": "drive gain ki (controller.gains.ki)", "value": hand["ki"],
-         "unit": "N/(m s)"},
+         "unit": "N/(m*s)"},
         {"quantity": "drive gain kd (controller.gains.kd)", "value": hand["kd"],
-         "unit": "N s/m"},
+         "unit": "N*s/m"},
         {"quantity": "controller.roll_off (D term only)",
          "value": "none (an ideal D)" if hand["roll_off"] is None else hand["roll_off"],
          "unit": "Hz"},
