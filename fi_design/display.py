@@ -15,6 +15,8 @@ axes:
 - :func:`scale` and :func:`quantities`: one unit for values read together
   (a table row, the lengths of one sentence), picked by the largest, so that
   ``22 µm`` never stands beside ``0.278 mm``;
+- :func:`column`: the values of one table column (or row) as numbers in one unit,
+  named once in its header: ``Final error [mm]`` over ``-0.625`` and ``< 1 × 10⁻⁶``;
 - :func:`with_error`: a value and its standard error in one unit
   (``5 ± 3.5 × 10⁻⁵ mm``);
 - :func:`percent`, :func:`unit_text` (``N*s/m`` -> ``N·s/m``) and
@@ -33,7 +35,7 @@ from __future__ import annotations
 import math
 from typing import Any, Iterable, Sequence
 
-__all__ = ["number", "quantity", "quantities", "scale", "display_scale", "with_error",
+__all__ = ["number", "quantity", "quantities", "column", "scale", "display_scale", "with_error",
            "percent", "fixed", "plain", "code_point", "unit_text", "axis_unit", "UNIT_TEXT",
            "DISPLAY_SCALES", "AXIS_UNITS", "NBSP", "tick_label"]
 
@@ -299,6 +301,48 @@ def quantities(values: Sequence[Any], unit: str, digits: int = 4, *,
     """
     shown = scale(unit, values)
     return [quantity(v, unit, digits, sep=sep, shown=shown) for v in values]
+
+
+def column(values: Sequence[Any], unit: str, digits: int = 4) -> tuple[str, list[str]]:
+    """The values of one table column in one unit, picked by the largest, named once.
+
+    A column never mixes units (``0.0252 µm`` over ``1.37 mm``): its header
+    carries the unit, its cells the numbers. A length below what a position
+    sensor resolves reads as less than 0.001 µm in the column's unit.
+
+    Parameters
+    ----------
+    values : sequence of float or None
+        SI values; None gives an en dash, as :func:`number` does.
+    unit : str
+        Their SI unit.
+    digits : int, optional
+        Significant digits.
+
+    Returns
+    -------
+    shown : str
+        The column's unit text (``""`` for a plain number).
+    cells : list of str
+        One number per value, in that unit.
+
+    Examples
+    --------
+    >>> column([1e-13, -6.25e-4, None], "m", 3)
+    ('mm', ['< 1\xa0×\xa010⁻⁶', '-0.625', '–'])
+    >>> column([2.52e-11, 3.1e-8], "m", 3)
+    ('µm', ['< 0.001', '0.031'])
+    """
+    shown, factor = scale(unit, values)
+    cells = []
+    for v in values:
+        if unit == "m" and _is_number(v) and 0 < abs(v) < _SUB_NANO:
+            cells.append("< " + number(1e-9 * factor))
+        elif _is_number(v) and math.isfinite(v):
+            cells.append(number(v * factor, digits))
+        else:
+            cells.append(number(v))
+    return shown, cells
 
 
 def with_error(value: Any, error: Any, unit: str = "", digits: int = 4, error_digits: int = 2,

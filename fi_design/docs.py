@@ -22,7 +22,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .display import plain
+from .display import plain, unit_text
 from .errors import ArgumentError
 
 #: Markers around the generated spec reference in docs/spec.md.
@@ -37,8 +37,14 @@ EFFECTS_END = "<!-- effects-table:end -->"
 _UNITS = {"dimensionless": "-", "1": "-", "degree": "deg", "decibel": "dB"}
 
 
+#: Units the docs write as every output does (:func:`fi_design.display.unit_text`).
+_AS_DISPLAYED = ("N*s/m", "N/(m*s)")
+
+
 def _unit(text: str) -> str:
     text = _UNITS.get(text, text)
+    if text in _AS_DISPLAYED:
+        return unit_text(text)
     return text.replace("**", "^").replace("*", " ")
 
 

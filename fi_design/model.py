@@ -46,7 +46,7 @@ from typing import Any
 
 from . import effects as _effects
 from . import spec as _spec
-from .display import quantity
+from .display import quantity, unit_text
 from .errors import ArgumentError, SimulationError, SpecError
 from .controller.pid import at_crossover, control_law
 from .kernel.layout import PlantParameters
@@ -511,9 +511,9 @@ class Model:
             k = _spec.proposed_stiffness(self.spec, s)
         given_c = damping is not None or (j is not None and j.damping_given)
         if damping is not None:
-            c = _finite(damping, "isolator.damping", "N s/m")
+            c = _finite(damping, "isolator.damping", "N*s/m")
             if c < 0.0:
-                raise SpecError(f"must be at least 0 N s/m, got {damping!r}",
+                raise SpecError(f"must be at least {quantity(0.0, 'N*s/m')}, got {damping!r}",
                                 path="isolator.damping")
         elif given_c:
             c = j.damping
@@ -696,9 +696,10 @@ def _finite(value, path: str, unit: str) -> float:
     try:
         x = float(value)
     except (TypeError, ValueError):
-        raise SpecError(f"expected a number [{unit}], got {value!r}", path=path) from None
+        raise SpecError(f"expected a number [{unit_text(unit)}], got {value!r}",
+                        path=path) from None
     if not math.isfinite(x):
-        raise SpecError(f"must be a finite number [{unit}], got {value!r}", path=path)
+        raise SpecError(f"must be a finite number [{unit_text(unit)}], got {value!r}", path=path)
     return x
 
 

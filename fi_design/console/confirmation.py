@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from ..display import number, quantity, scale
+from ..display import column, number, quantity, scale
 from .common import table
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -73,7 +73,7 @@ def simulation_table(sim: dict, window: tuple[float, float] | None = None,
     """Table of the simulated verdicts from the confirmation's JSON form.
 
     One column per plant, one row per quantity, so it reads at any width;
-    lengths carry their unit (``1.37 mm``, ``25.2 µm``).
+    a row of lengths is in one unit, named in its title (``Final error x1 - r [mm]``).
 
     Parameters
     ----------
@@ -152,28 +152,35 @@ def simulation_table(sim: dict, window: tuple[float, float] | None = None,
         st = v.get("settling_time")
         return "never" if st is None else f"{number(st, 3)} s"
 
+    def lengths(title: str, value: Any) -> tuple[str, list[str]]:
+        """A row of lengths in one unit, named in its title (display.column)."""
+        values = [value(key) for key, _ in plants]
+        shown, cells = column(values, "m", 3)
+        return f"{title} [{shown}]", [c if v is not None else "-" for v, c in zip(values, cells)]
+
     rows = [
         ("Stage, after every move", lambda k, v: verdict_text(stage(k).get("outcome", ""))),
         ("Moves ending in a cycle", lambda k, v: hunting_moves(k)),
         ("Moves that enter it", lambda k, v: entered(k)),
-        ("Cycle, peak to peak", lambda k, v: cycle(k, "amplitude", "m")),
+        lengths("Cycle, peak to peak", lambda k: (stage(k).get("cycle") or {}).get("amplitude")),
         ("Cycle period", lambda k, v: cycle(k, "period", "s")),
         ("Floquet multiplier", lambda k, v: cycle(k, "multiplier")),
         ("Joint on its limiter", lambda k, v: cycle(k, "on_limiter")),
         ("No move hunts from", lambda k, v: free_from(k)),
         ("Spec's motion: outcome", lambda k, v: verdict_text(v.get("outcome") or v.get("verdict", ""))),
         (f"Hunting cycles {counted}", lambda k, v: str(v.get("hunting_cycles"))),
-        ("Amplitude, peak to peak", lambda k, v: quantity(v.get("amplitude"), "m", 3)),
+        lengths("Amplitude, peak to peak", lambda k: sim[k].get("amplitude")),
         ("Period", lambda k, v: period(v)),
         ("Settling time after the motion", lambda k, v: settling(v)),
-        ("Final error x1 - r", lambda k, v: quantity(v.get("final_error"), "m", 3)),
+        lengths("Final error x1 - r", lambda k: sim[k].get("final_error")),
     ]
     if other:
         rows.append((f"Cross-check, {_MODEL_NAMES.get(other_model, other_model)} model",
                      lambda k, v: verdict_text((other.get(k) or {}).get("outcome")
                                                or (other.get(k) or {}).get("verdict", ""))))
     for title, cell in rows:
-        t.add_row(Text(title), *[cell(key, sim[key]) for key, _ in plants])
+        t.add_row(Text(title), *(cell if isinstance(cell, list) else
+                                 [cell(key, sim[key]) for key, _ in plants]))
     return t
 
 

@@ -7,7 +7,8 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..display import number, percent, quantity, with_error
+from ..display import number, percent, quantity, unit_text, with_error
+from ..results.linear import NOT_JUDGED, phase_margin_judged
 from ..results.stage import STATIC_ERROR_FORMULA
 from .common import heading, status_text, table
 from .confirmation import moves_strips, simulation_table
@@ -207,7 +208,8 @@ def _gains_table(pid: dict) -> Any:
     t = table("PID gains (step 4) a drive takes: kp + ki/s + kd s / (1 + s/(2 pi roll_off)), the "
               "roll-off on the D term only (controller.gains, controller.roll_off)")
     t.add_column("")
-    for col in ("kp [N/m]", "ki [N/(m s)]", "kd [N s/m]", "roll_off [Hz]"):
+    for col in ("kp [N/m]", f"ki [{unit_text('N/(m*s)')}]", f"kd [{unit_text('N*s/m')}]",
+                "roll_off [Hz]"):
         t.add_column(Text(col), justify="right", no_wrap=True)
     for label, g in rows:
         t.add_row(label, number(g["kp"]), number(g["ki"]), number(g["kd"]),
@@ -393,7 +395,12 @@ CASE_COLUMNS = {
 
 #: What the short headers of the limit-case table mean (the table's caption).
 CASE_CAPTION = ("fc: gain crossover; PM, GM, MM, DM: phase, gain, modulus and delay margin "
-                "(inf: no crossing); an unstable case fails with 'stability'")
+                "(inf: no crossing; \u2013: the loop crosses 0 dB only outside its band, where "
+                "the phase and delay margins are not judged); an unstable case fails with "
+                "'stability'")
+
+#: The columns a case whose phase margin is not judged shows as "–", as the report does.
+_UNJUDGED = ("phase_margin_deg", "delay_margin")
 
 
 _CASE_SKIP = {"name", "description", "passed", "failed", "crossovers", "stable", "in_band",
@@ -419,11 +426,14 @@ def cases_table(cases: list, numbers: dict) -> Any:
     for i, case in enumerate(cases, 1):
         case_no = str(numbers.get(case.get("name"), i))
         label = case.get("description") or case.get("name") or ""
-        cells = [Text("inf" if case.get(k) is None and "margin" in k else number(case.get(k)))
+        judged = phase_margin_judged(case.get("criteria") or {})
+        cells = [Text("\u2013" if k in _UNJUDGED and not judged else
+                      "inf" if case.get(k) is None and "margin" in k else number(case.get(k)))
                  for k in keys]
         status = status_text(case["status"])  # as the analysis judged it
-        if case.get("failed"):
-            status.append(" " + ", ".join(map(str, case["failed"])))
+        why = [*map(str, case.get("failed") or ()), *(() if judged else (NOT_JUDGED,))]
+        if why:
+            status.append(" " + ", ".join(why))
         t.add_row(case_no, Text(str(label)), *cells, status)
     return t
 

@@ -83,7 +83,7 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
             fx.mechanics.gravity.buckling_factor is not None:
         t.add_row("Buckling load / weight", "", number(fx.mechanics.gravity.buckling_factor, 3))
     t.add_row("Joint damping", "", "default ratio" if d.damping is None
-              else f"{number(d.damping, 3)} N s/m")
+              else quantity(d.damping, "N*s/m", 3))
     t.add_row("Crossover", f"{number(sd['crossover'])} Hz", f"{number(d.crossover)} Hz")
     t.add_row("No move hunts from", "", "-" if d.hunting_free_from is None
               else f"{number(d.hunting_free_from)} Hz")

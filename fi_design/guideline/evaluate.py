@@ -26,6 +26,7 @@ from ..mechanism.checks import flexure_checks
 from ..model import Model, as_model
 from ..results import Check, Status
 from ..results.design import DesignResult, FlexureResult, IsolatorAdvice
+from ..results.linear import phase_margin_judged
 from ..results.stage import STATIC_ERROR_FORMULA
 from ..spec import Spec, warnings_for
 from .steps import (controller_words, isolator_advice, notch_words, step1_friction_gap,
@@ -290,7 +291,7 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
                           else "."))
     n = len(xo.cases)
     bad = [c for c in xo.cases if not c.passed]
-    pms = [c.phase_margin_deg for c in xo.cases if c.in_band] or [math.inf]
+    pms = [c.phase_margin_deg for c in xo.cases if phase_margin_judged(c.criteria)] or [math.inf]
     gms = [abs(c.gain_margin_db) for c in xo.cases]
     margins = (f"phase margins of at least {number(min(pms), 3)} deg and gain margins of at least "
                f"{number(min(gms), 3)} dB" if all(math.isfinite(x) for x in gms)
@@ -344,15 +345,17 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
     law = pid.controller
     if law.source == "rule":
         parts.append(f"The PID tuned on {_g(g.tuning_mass)} kg gives the drive (in the form "
-                     f"controller.gains takes) kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
-                     f"N/(m s) and kd = {_g(law.kd)} N s/m ({controller_words(law)}).")
+                     f"controller.gains takes) kp = {_g(law.kp)} N/m, ki = "
+                     f"{quantity(law.ki, 'N/(m*s)')} and kd = {quantity(law.kd, 'N*s/m')} "
+                     f"({controller_words(law)}).")
     else:
         r = law.rule_in_this_form()
-        parts.append(f"The hardware's controller (kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} "
-                     f"N/(m s), kd = {_g(law.kd)} N s/m; {controller_words(law)}) crosses over "
+        parts.append(f"The hardware's controller (kp = {_g(law.kp)} N/m, ki = "
+                     f"{quantity(law.ki, 'N/(m*s)')}, kd = {quantity(law.kd, 'N*s/m')}; "
+                     f"{controller_words(law)}) crosses over "
                      f"at {quantity(law.crossover, 'Hz', 4)} on {_g(law.tuning_mass)} kg; the rule "
-                     f"would tune kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), kd = "
-                     f"{_g(r['kd'])} N s/m with a D roll-off of "
+                     f"would tune kp = {_g(r['kp'])} N/m, ki = {quantity(r['ki'], 'N/(m*s)')}, "
+                     f"kd = {quantity(r['kd'], 'N*s/m')} with a D roll-off of "
                      f"{_g(r['roll_off'] / (2 * math.pi))} Hz there.")
     if pid.static_error is not None:
         parts.append(f"The loop has no integrator, so it cannot hunt by the paper's mechanism; "

@@ -411,16 +411,19 @@ def step4_pid(model: Model) -> PidResult:
     if law.source == "rule":
         msg = (f"tuned at {_g(g.crossover)} Hz on {_g(g.tuning_mass)} kg; the gains a drive "
                f"takes (controller.gains, with controller.roll_off on the D term only): kp = "
-               f"{_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s), kd = {_g(law.kd)} N s/m "
+               f"{_g(law.kp)} N/m, ki = {quantity(law.ki, 'N/(m*s)')}, kd = "
+               f"{quantity(law.kd, 'N*s/m')} "
                f"({controller_words(law)})")
         checks = [Check("pid", None, law.kp, None, "N/m", msg, step=step)]
     else:
         r = law.rule_in_this_form()
-        msg = (f"the hardware's gains kp = {_g(law.kp)} N/m, ki = {_g(law.ki)} N/(m s), "
-               f"kd = {_g(law.kd)} N s/m ({controller_words(law)}) cross over at "
+        msg = (f"the hardware's gains kp = {_g(law.kp)} N/m, ki = "
+               f"{quantity(law.ki, 'N/(m*s)')}, kd = {quantity(law.kd, 'N*s/m')} "
+               f"({controller_words(law)}) cross over at "
                f"{quantity(law.crossover, 'Hz', 4)} on {quantity(law.tuning_mass, 'kg', 4)}; "
-               f"the rule there would give kp = {_g(r['kp'])} N/m, ki = {_g(r['ki'])} N/(m s), "
-               f"kd = {_g(r['kd'])} N s/m with a D roll-off of "
+               f"the rule there would give kp = {_g(r['kp'])} N/m, ki = "
+               f"{quantity(r['ki'], 'N/(m*s)')}, kd = {quantity(r['kd'], 'N*s/m')} with a D "
+               f"roll-off of "
                f"{quantity(r['roll_off'] / (2 * math.pi), 'Hz', 4)}")
         # the rule's gains are a recommendation beside the hardware's, not a limit: they are in
         # the message and the gains table, never in the limit column

@@ -11,8 +11,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..display import quantity
+from ..display import column, quantity
 from ..results.design import DesignResult
+from ..results.linear import NOT_JUDGED, phase_margin_judged
 from ..results.stage import STATIC_ERROR_FORMULA, length_range
 from ..results.studies import DesignMap
 from .assumptions import assumptions, family_words
@@ -32,21 +33,21 @@ __all__ = ["design_context", "REFERENCES"]
 
 def _cases_table(result: Any) -> list[dict]:
     """Rows of the margins table, with each case's status as the analysis judged it; a case
-    without a crossing in the loop's band (INFO) shows no phase or delay margin: they are
-    not margins to pass."""
+    whose phase margin is not judged (:func:`~fi_design.results.linear.phase_margin_judged`,
+    as in the console) shows no phase or delay margin, and says why."""
     numbers = {c.name: c.number for c in result.loop.cases}
     rows = []
     for c in result.crossover.cases:
         status = c.status.value
-        out_of_band = c.status == "INFO"
+        judged = phase_margin_judged(c.criteria)
         rows.append({
             "number": numbers.get(c.name, ""), "description": c.description,
             "crossover": c.crossover, "crossovers": len(c.crossovers),
-            "phase_margin": None if out_of_band else c.phase_margin_deg,
+            "phase_margin": c.phase_margin_deg if judged else None,
             "gain_margin": c.gain_margin_db, "modulus_margin": c.modulus_margin,
-            "delay_margin": None if out_of_band else c.delay_margin,
+            "delay_margin": c.delay_margin if judged else None,
             "stable": "yes" if c.stable else "no", "status": status, "css": status.lower(),
-            "failed": "outside the band" if out_of_band else ", ".join(c.failed),
+            "failed": ", ".join(c.failed + (() if judged else (NOT_JUDGED,))),
         })
     return rows
 
@@ -215,6 +216,26 @@ def _plant_rows(sim: Any) -> list[dict]:
     return rows
 
 
+#: The columns of the nonlinear tables that carry a unit: key -> (header, SI unit, digits).
+_STAGE_COLUMNS = {"amplitude": ("Cycle (p-p)", "m", 3), "period": ("Period", "s", 3),
+                  "free_from": ("No move hunts from", "Hz", 4)}
+_PLANT_COLUMNS = {"amplitude": ("Amplitude (p-p)", "m", 3), "period": ("Period", "s", 3),
+                  "settling_time": ("Settling time", "s", 3),
+                  "final_error": ("Final error", "m", 3)}
+
+
+def _in_columns(rows: list[dict], columns: dict) -> dict:
+    """Each column of a table in one unit, named in its header (:func:`display.column`): the
+    cells' text in ``row["cells"]``; returns the headers."""
+    heads = {}
+    for key, (title, unit, digits) in columns.items():
+        shown, cells = column([r[key] for r in rows], unit, digits)
+        heads[key] = f"{title} [{shown}]" if shown else title
+        for r, cell in zip(rows, cells):
+            r.setdefault("cells", {})[key] = cell
+    return heads
+
+
 def _stage_rows(sim: Any) -> list[dict]:
     """One row per plant of the stage-level answer (every move of its family)."""
     names = _plant_labels(sim)
@@ -268,14 +289,16 @@ def _nonlinear(result: Any, figures: bool, fig_no: _Numbering) -> dict | None:
             "disagree on is not shown: the moves that end in the cycle show it attracts); the "
             "crossover from which no move hunts is "
             "the cycle's fold, found by bisection."),
-        "stage": _stage_rows(sim),
+        "stage": (stage := _stage_rows(sim)),
+        "stage_heads": _in_columns(stage, _STAGE_COLUMNS),
         "spec_intro": (
             "The spec's own motion alone, as the paper judges it (section 2.3): the peaks of "
             f"the position error x1 - r of at least {qty(h.min_height, 'm')} and standing out "
             f"by as much, at least {qty(h.min_distance, 's')} apart, in the window "
             f"[{num(h.window_start)} s, {num(h.window_start + h.window_length)} s); one peak "
             "is one hunting cycle. This answers for one move only."),
-        "plants": _plant_rows(sim),
+        "plants": (plants := _plant_rows(sim)),
+        "plant_heads": _in_columns(plants, _PLANT_COLUMNS),
         "moves": figure_entry(
             (lambda: plots.moves_figure(sim)) if figures else None, "moves",
             "How the stage ends after each move of its family: the cycle's peak to peak for a "

@@ -6,6 +6,7 @@ import itertools
 import math
 from typing import Any
 
+from ..results.linear import phase_margin_judged
 from .equations import equation
 from .filters import num, qty, tex_num, tex_qty
 
@@ -91,7 +92,14 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
                 f"f_{{c,\\mathrm{{ach}}}} = {tex_qty(xo.achievable, 'Hz')}"))
     eqs.append(eq(f"f_\\mathrm{{par}} \\geq n_\\mathrm{{sep}}\\, f_\\mathrm{{loop}} = "
                   f"{tex_num(sep)} \\times {tex_qty(loop_fc, 'Hz')} = {tex_qty(need, 'Hz')}"))
-    pms = [c.phase_margin_deg for c in xo.cases]
+    # the phase margins the margins table judges: a case crossing 0 dB only outside the
+    # loop's band shows none there (results.linear.phase_margin_judged)
+    unjudged = [_case_number(xo, c.name) for c in xo.cases if not phase_margin_judged(c.criteria)]
+    pms = [c.phase_margin_deg for c in xo.cases if phase_margin_judged(c.criteria)]
+    pm_cases = ("all cases" if not unjudged else
+                f"the judged cases; case{'s' if len(unjudged) > 1 else ''} "
+                f"{', '.join(map(str, unjudged))} cross{'' if len(unjudged) > 1 else 'es'} 0 dB "
+                f"only outside the loop's band, not judged")
     gms = [abs(c.gain_margin_db) for c in xo.cases]
     results = [
         {"quantity": "desired crossover fc", "value": xo.desired, "unit": "Hz"},
@@ -100,8 +108,8 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
          "value": (f"\u2265 {qty(xo.achievable, 'Hz')} (a bound: the search cap)"
                    if xo.limit_kind == "scan_limit" else xo.achievable), "unit": "Hz"},
         {"quantity": "limited by", "value": xo.limited_by, "unit": ""},
-        {"quantity": "smallest phase margin at fc (all cases)", "value": min(pms),
-         "unit": "deg"},
+        {"quantity": f"smallest phase margin at fc ({pm_cases})",
+         "value": min(pms) if pms else "none", "unit": "deg" if pms else ""},
         {"quantity": "smallest gain margin at fc (all cases)", "value": min(gms), "unit": "dB"},
         {"quantity": "loop delay in the analysis", "value": xo.delay, "unit": "s"},
         {"quantity": "loop crossover f_loop (the highest 0 dB crossing in the band"
@@ -262,8 +270,8 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
                   f"r\\, \\omega_c = {tex_qty(g.wt, 'rad/s')},\\quad \\omega_i = \\omega_c / r_i = "
                   f"{tex_qty(g.wi, 'rad/s')}"),
         eq(f"k_p = k_s (1 + \\omega_i/\\omega_d) = {tex_qty(g.kp, 'N/m')},\\quad "
-                  f"k_i = k_s \\omega_i = {tex_qty(g.ki, 'N/(m s)')},\\quad "
-                  f"k_d = k_s / \\omega_d = {tex_qty(g.kd, 'N s/m')}"),
+                  f"k_i = k_s \\omega_i = {tex_qty(g.ki, 'N/(m*s)')},\\quad "
+                  f"k_d = k_s / \\omega_d = {tex_qty(g.kd, 'N*s/m')}"),
     ]
     law = result.pid.controller
     hand = law.hand_off()
@@ -272,7 +280,7 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
             eq("C(s) = \\frac{k_p + k_i/s + k_d s}{1 + s/\\omega_t} = k_p' + \\frac{k_i}{s} + "
                "\\frac{k_d' s}{1 + s/\\omega_t}"),
             eq(f"k_p' = k_p - k_i/\\omega_t = {tex_qty(hand['kp'], 'N/m')},\\quad "
-               f"k_d' = k_d - k_p'/\\omega_t = {tex_qty(hand['kd'], 'N s/m')},\\quad "
+               f"k_d' = k_d - k_p'/\\omega_t = {tex_qty(hand['kd'], 'N*s/m')},\\quad "
                f"f_t = \\omega_t / 2\\pi = {tex_qty(hand['roll_off'], 'Hz')}"),
         ]
     sampled = ("continuous" if hand["sample_rate"] is None
@@ -282,9 +290,9 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
         {"quantity": "tuning mass m", "value": g.tuning_mass, "unit": "kg"},
         {"quantity": "drive gain kp (controller.gains.kp)", "value": hand["kp"], "unit": "N/m"},
         {"quantity": "drive gain ki (controller.gains.ki)", "value": hand["ki"],
-         "unit": "N/(m s)"},
+         "unit": "N/(m*s)"},
         {"quantity": "drive gain kd (controller.gains.kd)", "value": hand["kd"],
-         "unit": "N s/m"},
+         "unit": "N*s/m"},
         {"quantity": "controller.roll_off (D term only)",
          "value": "none (an ideal D)" if hand["roll_off"] is None else hand["roll_off"],
          "unit": "Hz"},

@@ -10,16 +10,42 @@ checks, the report and the console read them.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Mapping, Sequence
 
 from . import Result, Status
 from .controller import ControlLaw
 
-__all__ = ["CRITERIA", "loop_crossover", "GainCrossing", "PhaseCrossing", "CaseMargins", "LoopAnalysis",
+__all__ = ["CRITERIA", "NOT_JUDGED", "phase_margin_judged", "loop_crossover", "GainCrossing", "PhaseCrossing", "CaseMargins", "LoopAnalysis",
            "AchievableCrossover"]
 
 #: The requirements a limit case is judged on, in the order they are listed.
 CRITERIA = ("stability", "phase margin", "gain margin", "modulus margin")
+
+#: Why a case's phase and delay margins are shown as "–" in the report's and the console's
+#: tables: its loop crosses 0 dB only outside the loop's band, where they are not judged.
+NOT_JUDGED = "outside the band"
+
+
+def phase_margin_judged(criteria: Mapping[str, str]) -> bool:
+    """Whether a case's phase and delay margins are judged (shown as numbers) or not ("–").
+
+    The one rule the report's and the console's margins tables follow: a case
+    whose phase margin criterion is INFO (:attr:`CaseMargins.criteria`: its
+    loop crosses 0 dB only outside the loop's band, and the phase margin
+    there holds) has no phase or delay margin to pass; one that fails is
+    judged and shown.
+
+    Parameters
+    ----------
+    criteria : mapping of str to Status or str
+        :attr:`CaseMargins.criteria`, or its JSON form (``"INFO"``).
+
+    Examples
+    --------
+    >>> phase_margin_judged({"phase margin": "INFO"}), phase_margin_judged({})
+    (False, True)
+    """
+    return criteria.get("phase margin") != Status.INFO
 
 
 @dataclass(frozen=True)

@@ -216,14 +216,15 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
         if s1 >= bound and not math.isclose(s1, default, rel_tol=5e-3):
             within = 0.9 * bound
             ratio = within / (2.0 * default)  # sigma1 / (2 sqrt(sigma0 m)) of the presliding mode
-            advice = (f"a value below the bound, e.g. {number(within, 3)} N s/m, keeps it "
+            advice = (f"a value below the bound, e.g. {quantity(within, 'N*s/m', 3)}, keeps it "
                       f"dissipative but damps the presliding mode at a ratio of only "
                       f"{number(ratio, 2)}, where the default sqrt(sigma0 (m1 + m2)) = "
-                      f"{number(default)} N s/m damps it at 0.5" if bound > 0 else
+                      f"{quantity(default, 'N*s/m')} damps it at 0.5" if bound > 0 else
                       "only sigma1 = 0 meets it without viscous or Coulomb friction")
             out.append(("friction.bristle_damping",
-                        f"sigma1 = {number(s1)} N s/m (given) is not below sigma2 Fc / (Fs - Fc) "
-                        f"= {number(bound)} N s/m: the LuGre model is not guaranteed dissipative "
+                        f"sigma1 = {quantity(s1, 'N*s/m')} (given) is not below sigma2 Fc / "
+                        f"(Fs - Fc) = {quantity(bound, 'N*s/m')}: the LuGre model is not "
+                        f"guaranteed dissipative "
                         f"(Barabanov and Ortega); {advice}; leave the key out for the default"))
     if spec.isolator is not None:
         presl = f.static / f.bristle_stiffness

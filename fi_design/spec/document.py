@@ -9,7 +9,7 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import Discriminator, Field, PrivateAttr, Tag, create_model, model_validator
 
 from .. import effects as _effects
-from ..display import number, percent, quantity
+from ..display import number, percent, quantity, unit_text
 from ..provenance import json_sha256
 from .defaults import CROSSOVER_AGREEMENT, gains_crossover, tuning_mass
 from .fields import OptQ, Q, StrictModel, Text
@@ -25,12 +25,13 @@ def _effect_model(effect: _effects.Effect):
     fields: dict[str, Any] = {"type": (Literal[effect.name], Field(description=effect.description))}
     for p in effect.parameters:
         kind = p.unit
+        shown = unit_text(kind) or "-"  # as every output writes it: N·s/m
         limits = dict(p.limits)
         if p.required:
-            fields[p.name] = (Q(kind), Field(description=f"{p.description} [{p.unit}].",
+            fields[p.name] = (Q(kind), Field(description=f"{p.description} [{shown}].",
                                              **limits))
         else:
-            fields[p.name] = (OptQ(kind), Field(None, description=f"{p.description} [{p.unit}]. "
+            fields[p.name] = (OptQ(kind), Field(None, description=f"{p.description} [{shown}]. "
                                                                   "Optional.", **limits))
     model = create_model("Effect_" + effect.name, __base__=StrictModel, **fields)
     model.__doc__ = effect.description

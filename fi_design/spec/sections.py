@@ -9,10 +9,14 @@ from typing import Any, Literal, Union
 
 from pydantic import Field, field_validator, model_validator
 
-from ..display import quantity
+from ..display import quantity, unit_text
 from ..trajectory import profile_duration
 from .fields import OptQ, Q, StrictModel, Text
 from .filters import Drive, FilterEntry
+
+#: Units in the field descriptions as every output writes them (fi_design.display).
+_DAMPING = unit_text("N*s/m")
+_INTEGRAL = unit_text("N/(m*s)")
 
 
 # --------------------------------------------------------------------------- sections
@@ -79,18 +83,18 @@ class Friction(StrictModel):
                                               "above 0).")
     stribeck_velocity: Q("m/s") = Field(gt=0, description="Stribeck velocity vs [m/s].")
     viscous: Q("N*s/m") = Field(0.0, ge=0, description="Viscous friction coefficient sigma2 "
-                                                        "[N s/m]. Default 0.")
+                                                        f"[{_DAMPING}]. Default 0.")
     bristle_stiffness: Q("N/m") = Field(1e6, gt=0, description="Bristle (presliding) stiffness "
                                                                "sigma0 [N/m]. Default 1e6 N/m.")
     bristle_damping: OptQ("N*s/m") = Field(
-        None, ge=0, description="Bristle damping sigma1 [N s/m]. Default sqrt(sigma0 (m1 + m2)): "
+        None, ge=0, description=f"Bristle damping sigma1 [{_DAMPING}]. Default sqrt(sigma0 (m1 + m2)): "
                                 "damping ratio 0.5 of the whole moving mass on the bristles.")
     coulomb_negative: OptQ("N") = Field(
         None, gt=0, description="Coulomb friction when the cart slides in the negative direction "
                                 "[N]; static friction that way scales with it (Fs coulomb_negative "
                                 "/ coulomb). Default: coulomb (symmetric friction).")
     viscous_negative: OptQ("N*s/m") = Field(
-        None, ge=0, description="Viscous friction coefficient in the negative direction [N s/m]. "
+        None, ge=0, description=f"Viscous friction coefficient in the negative direction [{_DAMPING}]. "
                                 "Default: viscous.")
     offset: Q("N") = Field(0.0, description="Constant load force on the stage [N] (drive offset, "
                                             "gravity on an inclined axis), with the sign of a "
@@ -114,7 +118,7 @@ class Limiter(StrictModel):
 
     stiffness: Q("N/m") = Field(1e6, gt=0, description="Contact stiffness k_stop [N/m]. "
                                                        "Default 1e6 N/m.")
-    damping: OptQ("N*s/m") = Field(None, ge=0, description="Contact damping c_stop [N s/m]. "
+    damping: OptQ("N*s/m") = Field(None, ge=0, description=f"Contact damping c_stop [{_DAMPING}]. "
                                                            "Default 2 * 0.2 * sqrt(k_stop m1).")
 
 
@@ -244,7 +248,7 @@ class Isolator(StrictModel):
     stiffness: OptQ("N/m") = Field(None, gt=0, description="Drive stiffness k [N/m]. Omit to let "
                                                            "step 3 propose one (k_max / 2).")
     stroke: Q("m") = Field(gt=0, description="One-sided stroke s before the limiter engages [m].")
-    damping: OptQ("N*s/m") = Field(None, ge=0, description="Joint damping c [N s/m]. Default "
+    damping: OptQ("N*s/m") = Field(None, ge=0, description=f"Joint damping c [{_DAMPING}]. Default "
                                                            "damping ratio 0.05 of the joint mode: "
                                                            "2 * 0.05 * sqrt(k m1 m2 / (m1 + m2)).")
     limiter: Limiter = Field(default_factory=Limiter)
@@ -260,16 +264,16 @@ class Gains(StrictModel):
     """The hardware's own controller gains, parallel form: u = kp e + ki integral(e) + kd e'."""
 
     kp: Q("N/m") = Field(gt=0, description="Proportional gain kp [N/m].")
-    ki: Q("N/(m*s)") = Field(0.0, ge=0, description="Integral gain ki [N/(m s)]; 0: a PD loop "
+    ki: Q("N/(m*s)") = Field(0.0, ge=0, description=f"Integral gain ki [{_INTEGRAL}]; 0: a PD loop "
                                                     "(no integrator). Default 0.")
-    kd: Q("N*s/m") = Field(0.0, ge=0, description="Derivative gain kd [N s/m]. Default 0.")
+    kd: Q("N*s/m") = Field(0.0, ge=0, description=f"Derivative gain kd [{_DAMPING}]. Default 0.")
 
 
 class Feedforward(StrictModel):
     """Force from the reference, added to the feedback force: mass r'' + viscous r' + coulomb sign(r')."""
 
     mass: Q("kg") = Field(0.0, ge=0, description="Acceleration feedforward mass [kg]. Default 0.")
-    viscous: Q("N*s/m") = Field(0.0, ge=0, description="Velocity feedforward [N s/m]. Default 0.")
+    viscous: Q("N*s/m") = Field(0.0, ge=0, description=f"Velocity feedforward [{_DAMPING}]. Default 0.")
     coulomb: Q("N") = Field(0.0, ge=0, description="Coulomb feedforward, times the sign of the "
                                                    "reference velocity [N]. Default 0.")
 

@@ -214,7 +214,7 @@ def _force_checks(model: Model, forces) -> list[Check]:
         limit = model.requirements.end_stop_force
         peak = forces.peak_stop_force
         stop = (f"the end stop ({quantity(forces.stop_stiffness, 'N/m', 3)}, "
-                f"{quantity(forces.stop_damping, 'N s/m', 3)}"
+                f"{quantity(forces.stop_damping, 'N*s/m', 3)}"
                 + (", the spec's defaults: an assumption, the contact force goes with "
                    "the square root of the stiffness" if forces.stop_default else "")
                 + ")")

@@ -258,7 +258,7 @@ def held_damping_note(model: Model, axes: Sequence[Axis]) -> str | None:
     -------
     str or None
     """
-    from ..display import number
+    from ..display import number, quantity
 
     iso = require_model(model).spec.isolator
     moving = [a for a in axes if a is not None and a.path in _JOINT_PATHS]
@@ -266,7 +266,7 @@ def held_damping_note(model: Model, axes: Sequence[Axis]) -> str | None:
         return None
     ratios = [model.varied({a.path: v}).joint_damping_ratio for a in moving
               for v in (float(np.min(a.values)), float(np.max(a.values)))]
-    return (f"isolator.damping is given ({number(iso.damping)} N s/m) and held as "
+    return (f"isolator.damping is given ({quantity(iso.damping, 'N*s/m')}) and held as "
             f"{', '.join(a.path for a in moving)} varies: the joint's damping ratio runs "
             f"from {number(min(ratios), 3)} to {number(max(ratios), 3)} over the axes (leave "
             "the key out to keep the ratio of the default instead)")

@@ -75,7 +75,7 @@ def test_hunting_amplitude_in_millimetres(design_outputs):
     for width in (80, 120):
         text = design_outputs["no_isolator", width]
         row = next(ln for ln in text.splitlines() if "Amplitude, peak to peak" in ln)
-        assert re.search(r"1\.37 mm\s*$", row), row   # 1370 um reads as 1.37 mm
+        assert re.search(r"\[mm\]\s.*\s1\.37\s*$", row), row   # 1370 um reads as 1.37 mm
         assert "1.37e+03" not in text
         cycles = next(ln for ln in text.splitlines() if "Hunting cycles in" in ln)
         assert re.search(r"\s0\s+5\s*$", cycles), cycles  # suggested isolator 0, without 5

@@ -8,6 +8,7 @@ Each test reads the context of the paper setup's report (computed once per sessi
 from __future__ import annotations
 
 import math
+import re
 
 import pytest
 
@@ -210,3 +211,125 @@ def test_a_search_cap_is_no_achievable_crossover(no_isolator_steps):
     row = next(r for r in step2["results"] if r["quantity"] == "achievable crossover")
     assert isinstance(row["value"], str) and row["value"].startswith("\u2265 1000")
     assert not any("f_c,ach = " in e["text"] for e in step2["equations"])
+
+
+def _console_case_rows(design) -> dict:
+    """The console's limit-case table of a design: case number -> its cells, as printed."""
+    from rich.console import Console
+
+    from fi_design import console
+
+    cases = design.to_dict()["crossover"]["cases"]
+    out = Console(width=200, record=True)
+    out.print(console.cases_table(cases, {c.name: c.number for c in design.loop.cases}))
+    rows = {}
+    for line in out.export_text().splitlines():
+        cells = line.split()
+        if cells and cells[0].isdigit() and "cart" in line:
+            rows[int(cells[0])] = line
+    return rows
+
+
+@pytest.mark.parametrize("gain_margin_fails", [False, True])
+def test_one_rule_for_a_margin_outside_the_band(paper_confirmed_design, gain_margin_fails):
+    """Case 4 crosses 0 dB only at 0.00135 Hz: the report's margins table showed – for its phase
+    and delay margins (not judged, outside the band), the console 90.12 deg and 185.8 s. Both
+    show – and say why, also beside a failing gain margin (the report showed the numbers
+    then)."""
+    import dataclasses
+
+    from fi_design.report.design import _cases_table
+    from fi_design.results import Status
+
+    design = paper_confirmed_design
+    stuck = next(c for c in design.crossover.cases if c.name == "stuck_limited")
+    assert not stuck.in_band and stuck.criteria["phase margin"] == Status.INFO
+    assert stuck.phase_margin_deg > 90 and stuck.delay_margin > 185
+    if gain_margin_fails:
+        stuck = dataclasses.replace(
+            stuck, passed=False, failed=("gain margin",), status=Status.FAIL,
+            criteria={**stuck.criteria, "gain margin": Status.FAIL})
+        design = dataclasses.replace(design, crossover=dataclasses.replace(
+            design.crossover, cases=tuple(stuck if c.name == stuck.name else c
+                                          for c in design.crossover.cases)))
+    why = "gain margin, outside the band" if gain_margin_fails else "outside the band"
+    row = next(r for r in _cases_table(design) if r["description"] == stuck.description)
+    assert (row["phase_margin"], row["delay_margin"], row["failed"]) == (None, None, why)
+    assert row["gain_margin"] == stuck.gain_margin_db
+    html = report.render_html(report.build_context(design, date=DATE, figures=False))
+    table = html[html.index('<table class="margins">'):]
+    shown = re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", table[
+        table.index(stuck.description):table.index("</tr>", table.index(stuck.description))]))
+    assert shown.split() == [*stuck.description.split(), report.num(stuck.crossover), "1",
+                             "\u2013", report.num(stuck.gain_margin_db),
+                             report.num(stuck.modulus_margin), "\u2013", "yes",
+                             "FAIL" if gain_margin_fails else "INFO", *why.split()], shown
+    number = next(c.number for c in design.loop.cases if c.name == stuck.name)
+    cells = _console_case_rows(design)[number].split()
+    status = "FAIL" if gain_margin_fails else "INFO"
+    assert cells[-len(why.split()) - 6:] == [
+        report.num(stuck.crossover), "\u2013", report.num(stuck.gain_margin_db),
+        report.num(stuck.modulus_margin), "\u2013", status, *why.split()], cells
+    from fi_design import console
+
+    assert "outside its band, where the phase and delay margins are not judged" in (
+        console.CASE_CAPTION)
+
+
+def test_step_2_smallest_phase_margin_is_of_the_judged_cases(paper_confirmed_design):
+    """Step 2's 'smallest phase margin at fc (all cases)' took case 4's phase margin too, which
+    the margins table shows as – (its loop crosses 0 dB only outside the band): with that
+    margin at 20 deg the step reported 20 deg that nothing judges. Now it is the smallest of
+    the judged margins, and says so."""
+    import dataclasses
+
+    design = paper_confirmed_design
+    cases = design.crossover.cases
+    assert [c.criteria["phase margin"] for c in cases] == ["PASS", "PASS", "PASS", "INFO"]
+    low = dataclasses.replace(cases[3], phase_margin_deg=20.0)
+    design = dataclasses.replace(design, crossover=dataclasses.replace(
+        design.crossover, cases=cases[:3] + (low,)))
+    ctx = report.build_context(design, date=DATE, figures=False)
+    row = _step_row(ctx, 2, "smallest phase margin")
+    assert row["quantity"] == ("smallest phase margin at fc (the judged cases; case 4 crosses "
+                               "0 dB only outside the loop's band, not judged)")
+    assert row["value"] == min(c.phase_margin_deg for c in cases[:3]) == cases[1].phase_margin_deg
+    table = [r["phase_margin"] for r in ctx["linear"]["cases"]]
+    assert row["value"] == min(p for p in table if p is not None)
+    gain = _step_row(ctx, 2, "smallest gain margin")
+    assert gain["quantity"] == "smallest gain margin at fc (all cases)"
+
+
+def test_the_nonlinear_tables_have_one_unit_per_column(ctx, paper_confirmed_design):
+    """The spec-motion table read '0.0252 µm' over '1.37 mm' (amplitude) and '< 0.001 µm'
+    over '-0.625 mm' (final error), and the console's rows alike: a column (a row of the
+    console's transposed table) is in one unit, named once in its header."""
+    from rich.console import Console
+
+    from fi_design import console
+
+    section = ctx["nonlinear"]
+    sim = paper_confirmed_design.simulation
+    iso, bare = sim.isolated.metrics, sim.non_isolated.metrics
+    assert 0 < abs(iso.final_error) < 1e-9 and iso.amplitude < 1e-7 < 1e-4 < bare.amplitude
+    heads = section["plant_heads"]
+    assert heads == {"amplitude": "Amplitude (p-p) [mm]", "period": "Period [s]",
+                     "settling_time": "Settling time [s]", "final_error": "Final error [mm]"}
+    cells = [p["cells"] for p in section["plants"]]
+    assert [c["final_error"] for c in cells] == ["< 1\u00a0\u00d7\u00a010\u207b\u2076",
+                                                 report.num(bare.final_error * 1e3, 3)]
+    assert [c["amplitude"] for c in cells] == [report.num(iso.amplitude * 1e3, 3),
+                                               report.num(bare.amplitude * 1e3, 3)]
+    assert section["stage_heads"] == {"amplitude": "Cycle (p-p) [mm]", "period": "Period [s]",
+                                      "free_from": "No move hunts from [Hz]"}
+    html = report.render_html(ctx)
+    for head in (*heads.values(), *section["stage_heads"].values()):
+        assert f'<th scope="col" class="num">{head}</th>' in html
+    data = paper_confirmed_design.to_dict()
+    out = Console(width=120, record=True)
+    out.print(console.simulation_table(data["simulation"], stages=data["stage_hunting"]))
+    text = out.export_text()
+    for title in ("Cycle, peak to peak [mm]", "Amplitude, peak to peak [mm]",
+                  "Final error x1 - r [mm]"):
+        row = next(line for line in text.splitlines() if line.strip().startswith(title))
+        assert "\u00b5m" not in row and " mm" not in row.replace(title, ""), row

@@ -73,7 +73,7 @@ def test_prose_and_tables_print_a_number_alike(paper_spec, capsys):
     result = design(spec, confirm=False)
     ki = result.pid.gains.ki
     assert ki > 1e4
-    assert f"ki = {number(ki)} N/(m s)" in result.conclusion, result.conclusion
+    assert f"ki = {number(ki)} N/(m\u00b7s)" in result.conclusion, result.conclusion
     assert "e+0" not in result.conclusion
     print_design(make_console(), result)
     out = capsys.readouterr().out
@@ -262,3 +262,44 @@ def test_a_run_that_did_not_complete_shows_no_cycles_or_final_error(paper_confir
                for s in (sim, failed))
     assert ok["cycles"] == 0 and ok["final_error"] is not None
     assert bad["cycles"] is None and bad["final_error"] is None and bad["amplitude"] is None
+
+
+# The damping unit and the integral gain's were written 'N s/m' and 'N/(m s)' in the checks,
+# the conclusion, the console's gains table, the docs and errors, and 'N·s/m', 'N/(m·s)'
+# (fi_design.display) in the report's tables: one spelling, display's, wherever it is written.
+_OTHER_SPELLINGS = re.compile(r"N s/m|N/\(m s\)")
+
+
+def test_the_damping_unit_reads_as_display_writes_it_in_report_and_console(
+        paper_confirmed_design):
+    from rich.console import Console
+
+    from fi_design import report
+    from fi_design.console import print_design
+
+    assert display.unit_text("N*s/m") == "N\u00b7s/m"
+    assert display.unit_text("N/(m*s)") == "N/(m\u00b7s)"
+    html = report.render_html(report.build_context(paper_confirmed_design, date="2026-01-01",
+                                                   figures=False))
+    out = Console(width=200, record=True)
+    print_design(out, paper_confirmed_design)
+    console = out.export_text()
+    ki = quantity(paper_confirmed_design.pid.controller.ki, "N/(m*s)")
+    for name, text in (("report", html), ("console", console),
+                       ("conclusion", paper_confirmed_design.conclusion)):
+        assert not _OTHER_SPELLINGS.search(text), (name, _OTHER_SPELLINGS.findall(text))
+        assert f"ki = {ki}" in text.replace(NBSP, " "), name
+    assert "ki [N/(m\u00b7s)]" in console and "kd [N\u00b7s/m]" in console
+
+
+def test_the_damping_unit_reads_as_display_writes_it_in_docs_and_errors(paper_spec):
+    from fi_design.errors import SpecError
+    from fi_design.model import resolve
+
+    root = Path(__file__).resolve().parents[2]
+    for page in [root / "README.md", *sorted((root / "docs").glob("*.md"))]:
+        found = _OTHER_SPELLINGS.findall(page.read_text(encoding="utf-8"))
+        assert not found, (page.name, found)
+    with pytest.raises(SpecError) as info:
+        resolve(paper_spec).at(damping=-1.0)
+    assert "must be at least 0 N\u00b7s/m" in str(info.value)

@@ -481,6 +481,33 @@ def test_pdf_never_ends_a_page_with_a_heading(design_html):
     assert headings > 15
 
 
+@needs_poppler
+@pytest.mark.parametrize("options", [0, 1, 2, 3])
+def test_pdf_keeps_a_heading_with_its_first_lines_after_a_long_command(
+        paper_confirmed_design, tmp_path, options):
+    """A long command line in the title block moves the contents down page 1; whatever it
+    pushes over the page's end, no page of the PDF (pdftotext, page by page) ends with a
+    heading, and "1 Verdict" stands on the page of the verdict's status (with one option
+    more than COMMAND, "1 Verdict" stood alone at the foot of page 1, its box on page 2)."""
+    command = COMMAND + " --sweep-point friction.static=3N" * options
+    html = report.render_html(report.build_context(paper_confirmed_design, date=DATE,
+                                                   command=command, figures=False))
+    headings = {re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", h)).strip()
+                for h in re.findall(r"<h[23][^>]*>(.*?)</h[23]>", html, re.S)}
+    assert "1 Verdict" in headings
+    pdf = report.write_document(html, tmp_path / "long.pdf")
+    text = subprocess.run(["pdftotext", "-layout", str(pdf), "-"], capture_output=True,
+                          text=True, check=True, timeout=120).stdout
+    pages = [[re.sub(r"\s+", " ", line.strip()) for line in page.splitlines() if line.strip()]
+             for page in text.split("\f") if page.strip()]
+    for n, lines in enumerate(pages, 1):
+        body = lines[1:-1]  # without the running head and the footer
+        assert body and body[-1] not in headings, f"page {n} ends with {body[-1:]}"
+    page = next(lines for lines in pages if "1 Verdict" in lines)
+    after = page[page.index("1 Verdict") + 1:]
+    assert after and after[0].split()[:2] == ["FAIL", "HUNTS"], page[-4:]
+
+
 def _pdf_images(pdf: Path) -> list[tuple[str, ...]]:
     """(page, width, height, colour, x-ppi) of every image of a PDF, from poppler's pdfimages."""
     out = subprocess.run(["pdfimages", "-list", str(pdf)], capture_output=True, text=True,

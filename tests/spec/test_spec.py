@@ -110,7 +110,7 @@ def test_warnings_fire_on_the_users_own_values(paper_spec):
     own = variant(hardware, **{"friction.bristle_damping": "500 N*s/m"})
     [(path, message)] = sp.warnings_for(own)
     assert path == "friction.bristle_damping"
-    assert "(given)" in message and "1414 N s/m" in message   # the user's value, and the default
+    assert "(given)" in message and "1414 N\u00b7s/m" in message   # the user's value, and the default
     calm = variant(hardware, **{"friction.bristle_damping": "5 N*s/m",
                                 "isolator.stroke": "3 um", "motion.moves": [
                                     {"distance": "10 mm", "velocity": "1 mm/s",
@@ -153,7 +153,7 @@ def test_the_bristle_damping_warning_recommends_a_value_within_its_bound(paper_s
     assert "friction.bristle_damping" not in dict(sp.warnings_for(paper_spec))
     own = variant(paper_spec, **{"friction.bristle_damping": "500 N*s/m"})
     message = dict(sp.warnings_for(own))["friction.bristle_damping"]
-    suggested = float(re.search(r"e\.g\. ([\d.]+) N s/m", message).group(1))
+    suggested = float(re.search(r"e\.g\. ([\d.]+) N\u00b7s/m", message).group(1))
     assert 0 < suggested < bound, message
     assert "presliding mode at a ratio of only" in message
 
