@@ -20,7 +20,8 @@ import math
 
 from .jit import A1, A2, I1, b1, f8, i8, kernel_function
 from .layout import (
-    EV_LEVEL, EV_LIMIT, EV_SIGN, EV_UNSTICK, MODE_SIGN, MODE_LIMIT, MODE_LEVEL, MODE_STICK,
+    EV_LEVEL, EV_LIMIT, EV_SIGN, EV_UNSTICK, LEVEL_FREE, MODE_SIGN, MODE_LIMIT, MODE_LEVEL,
+    MODE_STICK,
     N_CORE_ISO, N_CORE_RIGID, TWO_PI, P_C, P_CABLE_F0, P_CABLE_K, P_CSTOP, P_FC, P_FC_NEG,
     P_FF_C, P_FF_F, P_FF_M, P_FLIMIT, P_FS, P_ISO, P_K, P_KD, P_KDM, P_KI, P_KP, P_KSTOP, P_M1,
     P_M2, P_OFFSET, P_PDF_A, P_PDF_L, P_PDF_PHI, P_QUANT, P_RIP_A, P_RIP_P, P_RIP_PHI, P_S,
@@ -120,11 +121,19 @@ def lugre(v, x2, z, sgn, p):
 
 @kernel_function((f8, A1, i8))
 def measured_position(x1, p, level):
-    """Position the controller sees [m]: x1, or level * q when quantized."""
+    """Position the controller sees [m]: x1, or level * q when quantized (x1 while the
+    quantizer is passed through, ``level`` = :data:`~fi_design.kernel.layout.LEVEL_FREE`)."""
     q = p[P_QUANT]
-    if q > 0.0:
+    if q > 0.0 and level != LEVEL_FREE:
         return level * q
     return x1
+
+
+@kernel_function((A1, I1))
+def quantized(p, modes):
+    """Whether the controller sees whole levels now (a quantizer, not passed through): its
+    measured position is then constant between levels (x' = 0)."""
+    return p[P_QUANT] > 0.0 and modes[MODE_LEVEL] != LEVEL_FREE
 
 
 @kernel_function((f8, f8, f8, A1))
@@ -355,7 +364,7 @@ def control_law(y, p, modes, r, rd, ii):
     levels), its derivatives with respect to x1 and v1 [N/m, N s/m] (dv/dI = 1),
     and the error e [m].
     """
-    quant = p[P_QUANT] > 0.0
+    quant = quantized(p, modes)
     x1 = y[0]
     xm = measured_position(x1, p, modes[MODE_LEVEL])
     xd = 0.0 if quant else y[1]
@@ -613,7 +622,7 @@ def jacobian(t, y, p, modes, r, rd, fa, fa_state, J):
         J[iz, 1] = dzd_dv
         J[iz, iz] = dzd_dz
     if not discrete:
-        J[ii, 0] = 0.0 if p[P_QUANT] > 0.0 else -p[P_KI]
+        J[ii, 0] = 0.0 if quantized(p, modes) else -p[P_KI]
         if not algebraic:
             wt = p[P_WT]
             J[iu, 0] = wt * dv_dx
@@ -649,7 +658,7 @@ def natural_modes(y, p, modes):
         s = p[P_S]
         modes[MODE_LIMIT] = 1 if d > s else (-1 if d < -s else 0)
     q = p[P_QUANT]
-    if q > 0.0:
+    if q > 0.0 and modes[MODE_LEVEL] != LEVEL_FREE:
         modes[MODE_LEVEL] = int(math.floor(y[0] / q + 0.5))
 
 
@@ -732,3 +741,16 @@ def switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state):
         modes[MODE_LEVEL] += step
         if p[P_TS] == 0.0 and not math.isinf(p[P_WT]):
             y[iu] += -p[P_WT] * (p[P_KD] + p[P_KDM]) * p[P_QUANT] * step
+
+
+@kernel_function((A1, A1, I1, i8, b1))
+def pass_quantizer(y, p, modes, iu, free):
+    """Pass the quantizer through (``free``: the controller sees x1) or quantize again (the
+    level x1 lies in), with the derivative terms' impulse of the jump in the measured
+    position, -wt (kd + kdm) (seen after - seen before), as at a level change."""
+    q = p[P_QUANT]
+    before = measured_position(y[0], p, modes[MODE_LEVEL])
+    modes[MODE_LEVEL] = LEVEL_FREE if free else int(math.floor(y[0] / q + 0.5))
+    after = measured_position(y[0], p, modes[MODE_LEVEL])
+    if p[P_TS] == 0.0 and not math.isinf(p[P_WT]):
+        y[iu] += -p[P_WT] * (p[P_KD] + p[P_KDM]) * (after - before)

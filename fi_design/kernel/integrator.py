@@ -58,13 +58,13 @@ import numpy as np
 
 from .equations import (actuator, breakaway, control_law, controller_output, drive_force,
                         feedforward, filter_output_rate, filter_time_rate, jacobian, limit_mode,
-                        measured_position, natural_modes, rhs, sample_filters, switch_mode)
+                        measured_position, natural_modes, pass_quantizer, quantized, rhs,
+                        sample_filters, switch_mode)
 from .jit import A1, A2, I1, b1, f8, i8, kernel_function
 from .layout import (DIVERGED, EV_LEVEL, EV_LIMIT, EV_NONE, EV_SECTION, EV_SIGN, EV_UNSTICK,
-                     HISTORY_OVERFLOW, MAX_PERIOD, MODE_LEVEL, MODE_LIMIT, MODE_SIGN, MODE_STICK,
-                     N_CORE_ISO, N_CORE_RIGID, N_STATS, NOT_FINITE, OK, P_DA, P_DB, P_DC, P_DELAY,
-                     P_NF,
-                     P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F, P_FF_M, P_ISO, P_KD, P_KDM,
+                     HISTORY_OVERFLOW, LEVEL_FREE, MAX_PERIOD, MODE_LEVEL, MODE_LIMIT, MODE_SIGN,
+                     MODE_STICK, N_CORE_ISO, N_CORE_RIGID, N_STATS, NOT_FINITE, OK, P_DA, P_DB,
+                     P_DC, P_DELAY, P_NF, P_QFREE, P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F, P_FF_M, P_ISO, P_KD, P_KDM,
                      P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT,
                      ST_CROSSINGS, ST_EVENTS, ST_H, ST_LIMIT_EVENTS, ST_OUT, ST_PERIOD,
                      ST_REJECTED, ST_STEPS, ST_STOP, ST_T, ST_ZERO_EVENTS, STEP_UNDERFLOW,
@@ -193,7 +193,7 @@ def law_rate(y, p, modes, r, rd, rdd, f, ii):
     ``f`` is the right-hand side at the state ``y`` (for the acceleration).
     """
     _, _, _, e = control_law(y, p, modes, r, rd, ii)
-    quant = p[P_QUANT] > 0.0
+    quant = quantized(p, modes)
     xd = 0.0 if quant else y[1]
     xdd = 0.0 if quant else f[1]
     return p[P_KI] * e + p[P_KP] * (rd - xd) + p[P_KD] * (rdd - xdd) - p[P_KDM] * xdd
@@ -544,10 +544,15 @@ def find_event(y0, y1, k2, k3, p, modes, iv2, r, rd, fa, fa_state, ybuf, skip):
                 tbest = th
                 best = EV_LIMIT
     q = p[P_QUANT]
-    if q > 0.0 and p[P_TS] == 0.0 and skip != EV_LEVEL:
+    if q > 0.0 and p[P_TS] == 0.0 and skip != EV_LEVEL and modes[MODE_LEVEL] != LEVEL_FREE:
         lev = modes[MODE_LEVEL]
         l1 = int(math.floor(y1[0] / q + 0.5))
-        if l1 != lev:
+        free = p[P_QFREE]
+        if free > 0.0 and (l1 - lev > free or lev - l1 > free):
+            # a fast move: the quantizer is passed through from the step's start
+            tbest = 0.0
+            best = EV_LEVEL
+        elif l1 != lev:
             off = (lev + 0.5) * q if l1 > lev else (lev - 0.5) * q
             g0 = y0[0] - off
             g1 = y1[0] - off
@@ -575,7 +580,14 @@ def apply_event(kind, y, p, modes, iv2, iu, r, rd, fa, fa_state, y_trial):
     if kind == EV_LIMIT:
         direction = limit_mode(y_trial[0] - y_trial[2], p[P_S])
     elif kind == EV_LEVEL:
+        if modes[MODE_LEVEL] == LEVEL_FREE:  # the stage slowed: quantized again
+            pass_quantizer(y, p, modes, iu, False)
+            return
         level = int(math.floor(y_trial[0] / p[P_QUANT] + 0.5))
+        free = p[P_QFREE]
+        if free > 0.0 and (level - modes[MODE_LEVEL] > free or modes[MODE_LEVEL] - level > free):
+            pass_quantizer(y, p, modes, iu, True)
+            return
         direction = 1 if level > modes[MODE_LEVEL] else -1
     switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state)
 
@@ -1129,7 +1141,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                     if cont_delay:
                         u_before = controller_output(y, p, modes, r0, rd0, ii, iu)
                     apply_event(kind, y, p, modes, iv2, iu, r0, rd0, fa0, fa_state, ybuf)
-                    if zero_run >= 8 and p[P_QUANT] > 0.0 and p[P_TS] == 0.0:
+                    if zero_run >= 8 and quantized(p, modes) and p[P_TS] == 0.0:
                         # natural_modes below sets the level the state is at: its impulses
                         behind = int(math.floor(y[0] / p[P_QUANT] + 0.5)) - modes[MODE_LEVEL]
                         if behind != 0:
@@ -1205,6 +1217,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
             if reject:
                 h_new = min(h_new, h)
             reject = False
+            travel = abs(ynew[0] - y[0])
             for j in range(n):
                 y[j] = ynew[j]
             t = t_new
@@ -1269,6 +1282,9 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                         stop = STOP_QUIET
                 else:
                     quiet_t0 = -1.0
+            if (pending == EV_NONE and modes[MODE_LEVEL] == LEVEL_FREE
+                    and 2.0 * travel < p[P_QFREE] * p[P_QUANT]):
+                pending = EV_LEVEL  # the stage slowed: quantize again (apply_event)
             if pending != EV_NONE:
                 # the step ended at a located crossing: switch the mode
                 if pending == EV_LIMIT:

@@ -36,6 +36,9 @@ ff_*           kg, N s/m, N  feedforward m r'' + c r' + F sign(r')
 delay          s         delay between controller output and applied force
 sample_period  s         discrete controller period (0: continuous)
 quantization   m         position quantization the controller sees (0: none)
+quantization_free -      levels one trial step must cross for the quantizer to be passed
+                         through while the stage moves fast (0: never; replays of a record,
+                         whose command the derivative's impulse per level marks)
 force_limit    N         actuator saturation (inf: none)
 pdf_*          -, m, rad position-dependent friction amplitude, wavelength, phase
 ripple_*       N, m, rad force ripple amplitude, pitch, phase
@@ -104,7 +107,8 @@ Modes (int array, frozen during a step so the right-hand side is smooth):
 ``MODE_SIGN`` direction of cart sliding (+1/-1; the LuGre |v|, the friction
 values of a direction and the switch model's friction sign), ``MODE_LIMIT``
 limiter state (-1, 0, +1), ``MODE_LEVEL`` quantization level n (the
-controller sees n q), ``MODE_STICK`` switch model: 1 while the cart sticks.
+controller sees n q; :data:`LEVEL_FREE` while a fast move passes the quantizer
+through), ``MODE_STICK`` switch model: 1 while the cart sticks.
 A mode event (``EV_*``) changes them: both solvers locate the crossing their
 own way and switch with the one compiled
 :func:`fi_design.kernel.equations.switch_mode`.
@@ -155,6 +159,7 @@ class PlantParameters:
     delay: float = 0.0
     sample_period: float = 0.0
     quantization: float = 0.0
+    quantization_free: float = 4.0
     force_limit: float = math.inf
     pdf_amplitude: float = 0.0
     pdf_wavelength: float = 1.0
@@ -350,6 +355,7 @@ FILTER_FIELDS = ("order", "b0", "b1", "b2", "a1", "a2", "z0", "z1", "z2", "p1", 
 FILT_STRIDE = len(FILTER_FIELDS)
 #: Index of the filter chain's count and of its first section's first field.
 P_NF = _P["filter_states"]
+P_QFREE = _P["quantization_free"]
 P_FILT = _P["f0_order"]
 if [_P[f"f{i}_{n}"] for i in range(MAX_FILTER_SECTIONS) for n in FILTER_FIELDS] != list(
         range(P_FILT, P_FILT + MAX_FILTER_SECTIONS * FILT_STRIDE)):
@@ -369,6 +375,12 @@ if (ISOLATED_STATES[-3:] != LEAVES or RIGID_STATES[-3:] != LEAVES
 
 MODE_SIGN, MODE_LIMIT, MODE_LEVEL, MODE_STICK = 0, 1, 2, 3
 N_MODES = 4
+
+#: ``MODE_LEVEL`` while the quantizer is passed through: a step of the integrator crossed
+#: more than ``quantization_free`` levels, and the controller sees x1 itself until the stage
+#: slows (the measured position's sawtooth then lies far above the loop's band); it is
+#: quantized again once an accepted step travels less than half as many.
+LEVEL_FREE = -(2 ** 62)
 
 # Mode events: the cart's velocity reverses (LuGre: the sliding sign flips; switch model: the
 # cart sticks or slides on), the switch model's cart breaks away, the joint enters or leaves a
