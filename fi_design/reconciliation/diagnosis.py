@@ -277,7 +277,8 @@ def drive_check(cmp: Comparison) -> ForceCheck:
               "drives the model with it. ")
     detail += ("Check the sign convention of the logged force (positive pushes the stage "
                "towards positive position_m) and flip force_N." if flipped else
-               "Check force_N's unit (N) and the logger's gain.")
+               "Check force_N's unit (N) and the logger's gain (and the spec's masses, if the "
+               "column is right).")
     return ForceCheck(scale, Cause("force_sign" if flipped else "force_scale",
                                    float(min(max(fit, 0.0), 1.0)), detail))
 
