@@ -27,6 +27,15 @@ factor says that ``force_N``'s sign looks wrong (**force sign**), a factor
 beyond :data:`FORCE_SCALE_LIMIT` either way that its scale does (**force
 scale**: a unit or gain slip). Such a record cannot be explained by any
 effect, and the reconciliation names none.
+
+An open-loop replay has no model force to compare: the measured force drives
+the model. There :func:`drive_check` fits the force to the motion it drives,
+``force = factor * M * a + Fc sign(v) + b v + offset`` with the spec's moving
+mass ``M`` while the stage slides (the identification's inverse dynamics,
+every signal low-passed at the loop's crossover): a negative factor is a
+flipped sign (the force pushes against the acceleration it is said to
+cause), a factor beyond :data:`FORCE_SCALE_LIMIT` either way a unit or gain
+slip. The record alone decides it, so no effect is searched.
 """
 
 from __future__ import annotations
@@ -56,6 +65,16 @@ FORCE_SCALE_LIMIT = 2.0
 FORCE_FIX_SHARE = 0.75
 #: Causes that are faults of the record, not of the model: no effect is named with one.
 RECORD_CAUSES = ("force_sign", "force_scale")
+#: Share of the peak speed above which the open-loop check counts the stage as sliding
+#: (where friction is Coulomb plus viscous, as the identification's default threshold).
+SLIDING_SHARE = 0.1
+#: Share of the sliding force's variance the inverse dynamics must explain for the open-loop
+#: check to judge the factor (the motion must be what the force does).
+DRIVE_FIT_MIN = 0.75
+#: Standard errors by which the open-loop factor must lie beyond zero (sign) or beyond
+#: :data:`FORCE_SCALE_LIMIT` (scale) to be called wrong (samples counted independent at twice
+#: the cut-off).
+DRIVE_FACTOR_SIGMAS = 2.0
 
 
 def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
@@ -91,7 +110,8 @@ def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
     r = np.where(np.isfinite(model), meas - model, 0.0)
     crossover = cmp.model.crossover
     spec = _spectrum(r, cmp.t)
-    check = force_check(cmp, nominal if after is None else after)
+    check = force_check(cmp, nominal if after is None else after) if cmp.has_force else \
+        drive_check(cmp)
     causes = _causes(cmp, r, crossover, use_force)
     if check.cause is not None:
         causes.append(check.cause)
@@ -197,6 +217,98 @@ def force_check(cmp: Comparison, run: ModelRun) -> ForceCheck:
                "Check force_N's unit (N) and the logger's gain.")
     return ForceCheck(float(scale), Cause("force_sign" if flipped else "force_scale",
                                           float(min(max(share, 0.0), 1.0)), detail))
+
+
+def drive_check(cmp: Comparison) -> ForceCheck:
+    """Whether force_N's sign or scale looks wrong against the motion it drives (open loop).
+
+    Position and force are low-passed at the loop's crossover (zero phase),
+    the velocity and acceleration taken from the filtered position, and
+    where the stage slides (speed above :data:`SLIDING_SHARE` of its peak)
+    the force is fitted as ``factor * M * a + Fc * sign(v) + b * v + offset``
+    (``sign(v)`` filtered like the force; ``M`` the spec's moving mass, the
+    cart included). The factor is judged when the fit explains
+    :data:`DRIVE_FIT_MIN` of the force's variance, and only beyond
+    :data:`DRIVE_FACTOR_SIGMAS` standard errors (the samples counted
+    independent at twice the cut-off): below zero, the force pushes against
+    the acceleration it is said to drive (**force sign**); beyond
+    :data:`FORCE_SCALE_LIMIT` either way, a unit or gain slip (**force
+    scale**).
+
+    Parameters
+    ----------
+    cmp : Comparison
+        The comparison of an open-loop replay (``drive="force"``).
+    """
+    meas = cmp.meas
+    if cmp.drive != "force" or meas.force is None:
+        return ForceCheck(None, None)
+    t = cmp.t
+    dt = float(np.median(np.diff(t)))
+    cutoff = min(cmp.model.crossover, 0.4 / dt)
+    x = _band(meas.position, t, None, cutoff)
+    v = np.gradient(x, t)
+    a = np.gradient(v, t)
+    sliding = np.abs(v) > SLIDING_SHARE * float(np.max(np.abs(v)))
+    mass = cmp.model.total_mass
+    X = np.column_stack([mass * a, _band(np.sign(v), t, None, cutoff), v,
+                         np.ones_like(v)])[sliding]
+    f = _band(meas.force, t, None, cutoff)[sliding]
+    n_eff = len(f) * min(1.0, 2.0 * cutoff * dt)
+    if n_eff <= 2 * X.shape[1] or np.ptp(f) <= 0:
+        return ForceCheck(None, None)
+    coef, *_ = np.linalg.lstsq(X, f, rcond=None)
+    r = f - X @ coef
+    fit = 1.0 - float(np.var(r)) / float(np.var(f))
+    cov = np.linalg.pinv(X.T @ X) * float(r @ r) / (len(f) - X.shape[1]) * len(f) / n_eff
+    scale = float(coef[0])
+    error = math.sqrt(max(float(cov[0, 0]), 0.0))
+    low, high = scale - DRIVE_FACTOR_SIGMAS * error, scale + DRIVE_FACTOR_SIGMAS * error
+    flipped = high < 0
+    scaled = low > FORCE_SCALE_LIMIT or 0 < high < 1.0 / FORCE_SCALE_LIMIT
+    if fit < DRIVE_FIT_MIN or not (flipped or scaled):
+        return ForceCheck(scale, None)
+    what = "sign" if flipped else "scale"
+    detail = (f"force_N's {what} looks wrong: fitted to the motion it drives while the stage "
+              f"slides (mass times acceleration plus friction and an offset, below "
+              f"{quantity(cutoff, 'Hz', 3)}), the measured force is {number(scale, 3)} times "
+              f"the force the spec's moving mass ({quantity(mass, 'kg', 3)}) needs (R^2 "
+              f"{fixed(fit, 2)}, standard error {number(error, 2)}), and the open-loop replay "
+              "drives the model with it. ")
+    detail += ("Check the sign convention of the logged force (positive pushes the stage "
+               "towards positive position_m) and flip force_N." if flipped else
+               "Check force_N's unit (N) and the logger's gain (and the spec's masses, if the "
+               "column is right).")
+    return ForceCheck(scale, Cause("force_sign" if flipped else "force_scale",
+                                   float(min(max(fit, 0.0), 1.0)), detail))
+
+
+def record_diagnosis(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
+                     check: ForceCheck) -> Diagnosis:
+    """The diagnosis of an open-loop record whose force is at fault (:func:`drive_check`).
+
+    No effect is searched. The fault is the one cause: the structural causes
+    read the residual of a replay driven by the wrong force (and name a
+    controller the open loop does not have).
+    """
+    ran = nominal.ok and math.isfinite(chi2_nominal)
+    misfit = math.sqrt(chi2_nominal / cmp.n_points) if ran else math.inf
+    if ran:
+        r = np.where(np.isfinite(nominal.position), cmp.meas.position - nominal.position, 0.0)
+        spec = _spectrum(r, cmp.t)
+        text = (f"The nominal model misses the record by {number(misfit, 3)} noise units (RMS)"
+                + (", far above the noise" if misfit >= STRUCTURE_MISFIT else "") + ". ")
+    else:
+        spec = Spectrum(np.zeros(0), np.zeros(0))
+        # the simulator's guess at the cause (its closed loop) does not apply: the force does
+        text = f"The nominal model fails on this record ({nominal.message.split(';')[0]}). "
+    message = (text + check.cause.detail + " No effect is searched or named from such a "
+               "record; correct the column and reconcile again.")
+    return Diagnosis(mismatch=True, misfit=misfit, misfit_limit=STRUCTURE_MISFIT,
+                     best_explained=0.0, channel="position", causes=(check.cause,),
+                     message=message, frequency=_frozen(spec.frequency),
+                     spectrum=_frozen(spec.density), crossover=float(cmp.model.crossover),
+                     misfit_after=misfit, best_fit="", force_scale=check.scale)
 
 
 def _frozen(a):

@@ -26,7 +26,7 @@ from ..model import resolve
 from ..simulation.replay import DRIVES
 from ..spec.file import as_spec
 from .comparison import MAX_POINTS, Comparison, ModelRun
-from .diagnosis import diagnose, record_fault
+from .diagnosis import diagnose, drive_check, record_diagnosis, record_fault
 from .fitting import (Baseline, FitOutcome, JointObjective, fit, fit_baseline, joint_fit,
                       marginal_covariance, polish_jointly)
 from .gaps import gap_metrics
@@ -90,8 +90,9 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
         uncertainty, the ranked candidates with the tests each passed, the
         gaps before and after (per named effect too), the lattice, the
         structure diagnosis and the model traces. A record whose force_N
-        has the wrong sign or scale (:func:`.diagnosis.force_check`) names
-        no effect.
+        has the wrong sign or scale (:func:`.diagnosis.force_check`; open
+        loop :func:`.diagnosis.drive_check`, and then no effect is
+        searched) names no effect.
 
     Raises
     ------
@@ -133,6 +134,12 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     cmp = Comparison(spec, measured, iso, noise, lattice, settle_window, drive)
     say("nominal model", 0.02)
     nominal = _nominal(cmp, list(spec.effects), max_points)
+    check = drive_check(cmp)
+    if check.cause is not None:
+        # open loop, force_N of the wrong sign or scale: the record alone says so, and every
+        # effect fitted to a replay it drives would be bent by it
+        return _unsearched(cmp, nominal, record_diagnosis(cmp, nominal.run, nominal.chi2, check),
+                           started, threshold)
     if not nominal.run.ok:
         return _failed_nominal(cmp, nominal, started, threshold)
     evidence = scan(cmp, nominal.run, lattice, cmp.model.at(effects=nominal.entries).plant(iso))
@@ -487,20 +494,30 @@ def _refine_jointly(cmp: Comparison, chosen: list[Chosen], nominal: Baseline) ->
 def _failed_nominal(cmp: Comparison, nominal: Baseline, started: float,
                     threshold: float) -> ReconcileResult:
     """The result when the nominal model cannot be replayed: what failed, and the traces."""
-    run = nominal.run
     diagnosis = Diagnosis(
         mismatch=True, misfit=math.inf, misfit_limit=0.0, best_explained=0.0,
         channel="position", causes=(),
-        message=f"The nominal model fails on this record: {run.message}. No effect can be "
-                "judged against a model that does not run; check the spec against the "
+        message=f"The nominal model fails on this record: {nominal.run.message}. No effect can "
+                "be judged against a model that does not run; check the spec against the "
                 "record (controller, mass, sample rate).",
         frequency=np.zeros(0), spectrum=np.zeros(0), crossover=0.0)
+    return _unsearched(cmp, nominal, diagnosis, started, threshold)
+
+
+def _unsearched(cmp: Comparison, nominal: Baseline, diagnosis: Diagnosis, started: float,
+                threshold: float) -> ReconcileResult:
+    """The result without a search (a nominal model that fails, a faulty record): the
+    diagnosis, the nominal gap when the model ran, and the traces."""
+    run = nominal.run
+    ran = run.ok and math.isfinite(nominal.chi2)
+    chi2 = nominal.chi2 if ran else math.inf
     return ReconcileResult(
         effect="none", parameters={}, uncertainty={}, effects=(), entries=(), steps=(),
-        candidates=(), rounds=(), ambiguous=(), skipped={}, gaps=(), noise=cmp.noise,
+        candidates=(), rounds=(), ambiguous=(), skipped={},
+        gaps=gap_metrics(cmp, run, run, chi2, chi2) if ran else (), noise=cmp.noise,
         lattice=cmp.lattice, signatures=(), segments=cmp.segment_list(), diagnosis=diagnosis,
         isolated=cmp.iso, drive=cmp.drive, threshold=float(threshold), n_points=cmp.n_points,
-        initial_command=cmp.initial_command, chi2_nominal=math.inf, chi2_corrected=math.inf,
+        initial_command=cmp.initial_command, chi2_nominal=chi2, chi2_corrected=chi2,
         conclusion=_warned(cmp, diagnosis.message), n_simulations=cmp.n_sims,
         wall_time=_time.perf_counter() - started, measurement=cmp.meas,
         nominal=cmp.model_trace(run), corrected=cmp.model_trace(run), spec=cmp.spec)

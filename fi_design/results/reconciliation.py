@@ -361,11 +361,14 @@ class Cause(Result):
     name : str
         ``"controller"``, ``"initial_state"``, ``"mass"`` or ``"disturbance"``
         (the model), or ``"force_sign"`` or ``"force_scale"`` (the record's
-        ``force_N`` column, against the model after the best fit).
+        ``force_N`` column, against the model after the best fit; open loop, against
+        the motion it drives).
     share : float
         Share of the nominal residual's variance that points at it, 0-1
         (``force_sign``, ``force_scale``: the share of the force residual's
-        energy that a factor and an offset on the measured force remove).
+        energy that a factor and an offset on the measured force remove;
+        open loop, the share of the sliding force's variance the inverse
+        dynamics explain).
     detail : str
         What was measured and what to check, one or two sentences.
     """
@@ -416,7 +419,10 @@ class Diagnosis(Result):
         Least-squares factor of the measured force on the force of the model
         after the best fit (with an offset) [-]: about 1 when ``force_N``
         and the model agree in sign and scale, negative when the column's
-        sign is flipped. None without a compared force channel.
+        sign is flipped. Open loop (``drive="force"``): the factor on the
+        spec's moving mass times the acceleration in the fit of the measured
+        force to the motion it drives (about 1 likewise). None without a
+        force column.
     """
 
     mismatch: bool

@@ -391,3 +391,74 @@ def test_a_record_far_off_its_reference_carries_the_replays_warning(tmp_path):
     buf = io.StringIO()
     print_reconcile(Console(file=buf, width=200, color_system=None), result)
     assert f"lies {offset} from its first reference_m" in buf.getvalue()
+
+
+# --------------------------------------------------------------------------- open loop
+
+def _example_with_force(tmp_path, factor: float):
+    """examples/measured_trace.csv with force_N times ``factor`` (the cells rewritten)."""
+    from fi_design import load_measurement
+
+    from conftest import edited_trace
+
+    csv = edited_trace(tmp_path, f"force_x_{factor:g}.csv",
+                       lambda c: [*c[:3], repr(factor * float(c[3])), *c[4:]])
+    return csv, load_measurement(csv)
+
+
+@pytest.mark.parametrize("factor, what", [(-1.0, "sign"), (1000.0, "scale")],
+                         ids=["sign-flipped", "in-millinewtons"])
+def test_an_open_loop_replay_calls_out_a_force_of_the_wrong_sign_or_scale(tmp_path, factor,
+                                                                           what):
+    """examples/measured_trace.csv replayed open loop (``--drive force``) with force_N negated
+    or logged in mN: the closed loop's force check needs a compared force channel, so the
+    flipped record named force_ripple (misfit 9847 -> 5301, "likely causes: initial state;
+    controller") after a 7 min search and the mN record answered "the nominal model fails on
+    this record ... an unstable closed loop". The measured force is now fitted to the motion
+    it drives (mass times acceleration plus friction while sliding): no effect is searched or
+    named, and the console, the JSON and the report name force_N and the fault."""
+    import io
+    import json
+    from html import unescape
+
+    from rich.console import Console
+
+    from fi_design import load_spec
+    from fi_design.console import print_reconcile
+    from fi_design.report import render_gap_report
+
+    from conftest import EXAMPLES
+
+    _, rec = _example_with_force(tmp_path, factor)
+    result = reconcile(load_spec(EXAMPLES / "measured_stage.yaml"), rec, drive="force")
+    d = result.diagnosis
+    assert result.effect == "none" and result.entries == () and result.candidates == ()
+    assert d.mismatch and d.causes[0].name == f"force_{what}"
+    # the fitted factor: the spec's moving mass is about 0.85 of the one the record's force moves
+    assert d.force_scale == pytest.approx(0.85 * factor, rel=0.05)
+    message = f"force_N's {what} looks wrong"
+    assert message in result.conclusion and "No effect is searched or named" in result.conclusion
+    assert ("flip force_N" if factor < 0 else "force_N's unit (N)") in result.conclusion
+    buf = io.StringIO()
+    print_reconcile(Console(file=buf, width=200, color_system=None), result)
+    assert "Effect: none" in buf.getvalue() and message in buf.getvalue()
+    assert message in json.loads(json.dumps(result.to_dict()))["conclusion"]
+    html = render_gap_report(result, tmp_path / "gap.html").read_text()
+    assert message in unescape(html)
+
+
+def test_an_unedited_open_loop_record_gets_no_force_alarm(tmp_path):
+    """The same check on examples/measured_trace.csv as recorded: the record's force moves the
+    stage as the spec's mass and friction say (factor about 0.85), no fault; one candidate."""
+    from fi_design import load_measurement, load_spec
+
+    from conftest import EXAMPLES
+
+    result = reconcile(load_spec(EXAMPLES / "measured_stage.yaml"),
+                       load_measurement(EXAMPLES / "measured_trace.csv"), drive="force",
+                       candidates=["force_offset"])
+    d = result.diagnosis
+    assert not any(c.name.startswith("force_") for c in d.causes)
+    assert d.force_scale == pytest.approx(0.85, rel=0.05)
+    assert "force_N" not in result.conclusion
+    assert [c.name for c in result.candidates] == ["force_offset"]

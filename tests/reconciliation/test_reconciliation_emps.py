@@ -126,3 +126,8 @@ def test_open_loop_replay_of_the_real_record(emps_full, emps_symmetric, emps_per
     offset, sigma = sym.parameters["offset"], sym.uncertainty["offset"]
     assert 0 < sigma < abs(offset) and offset < 0
     assert full.chi2_nominal < sym.chi2_nominal
+    # the real force moves the axis as the identified mass says: no alarm about force_N
+    # (diagnosis.drive_check; a flipped or mN column is called out, see test_reconciliation.py)
+    for r in (full, sym):
+        assert not any(c.name in ("force_sign", "force_scale") for c in r.diagnosis.causes)
+        assert r.diagnosis.force_scale == pytest.approx(1.0, abs=0.15)
