@@ -150,8 +150,9 @@ def binding(search: Any, chosen: Any) -> tuple[str, ...]:
 
 
 def advice(search: Any, chosen: Any, feasible: bool, binding: tuple[str, ...],
-           least: Any) -> str:
-    """One sentence a person acts on."""
+           least: Any, bounds: tuple = ()) -> str:
+    """One sentence a person acts on (and, for a guide on a bound the user set past which the
+    sizing finds more margin, that bound: ``bounds``, :class:`~fi_design.results.steps.BoundNote`)."""
     c = chosen.candidate
     if feasible:
         text = (f"Build {_dimensions(c)} leaves for a {quantity(chosen.stroke, 'm')} stroke (k = "
@@ -161,6 +162,9 @@ def advice(search: Any, chosen: Any, feasible: bool, binding: tuple[str, ...],
                    f"{number(chosen.margin, 3)} x below the crossover" if chosen.free_from else
                    ": no move of the family hunts")
                 + (f"; it is bound by {binding[0]}" if binding else "") + ".")
+        for n in (n for n in bounds if n.adds_margin):
+            text += (f" The leaves' {n.dimension} sits on the {n.side} bound of "
+                     f"{n.key}; past it the guide would have more margin.")
         if least is not None and least.feasible:
             text += f" The least change that passes: {least.text}."
         return text

@@ -472,7 +472,7 @@ def _searched(model: Model, executor: Any, say: Callable[[str], None],
                    "stiffness": _spec.drive_stiffness(srch.base),
                    "crossover": _spec.design_crossover(srch.base),
                    "suggested": spec.isolator is None}
-    advice = _o.advice(srch, chosen, feasible, binding, least)
+    advice = _o.advice(srch, chosen, feasible, binding, least, bounds)
     log.info("recommendation for %r: feasible %s, %d evaluations", spec.name, feasible,
              srch.evaluations)
     return RecommendResult(
