@@ -224,11 +224,7 @@ def test_delay_matches_the_reference_path(paper_spec):
 def test_quantization_makes_the_controller_see_steps(paper_spec):
     q = 20e-6
     quant = _effects({"type": "quantization", "resolution": q})
-    short = variant(paper_spec, **{"motion.duration": 0.6,
-                                     "requirements.hunting.window_start": 0.3,
-                                     "requirements.hunting.window_length": 0.3})
-    r = simulate(short, isolated=True, effects=quant)
-    ref = simulate(short, isolated=True, method="reference", rtol=1e-8, effects=quant)
+    r, ref = _short_quantized(paper_spec, True, quant)
     assert r.success and r.n_events > 10
     assert np.max(np.abs(r.position - ref.position)) < 1e-6
     # the derivative of a staircase: the command jumps by wt kd q at each level
@@ -268,12 +264,8 @@ def test_a_quantizer_passed_through_on_a_fast_move_agrees_with_every_level_locat
     q = 1 um); the kernel passes the quantizer through while steps cross several levels
     (a few hundred events): the positions agree within a hundredth of the step."""
     q = 1e-6
-    quant = _effects({"type": "quantization", "resolution": q})
-    short = variant(paper_spec, **{"motion.duration": 0.6,
-                                     "requirements.hunting.window_start": 0.3,
-                                     "requirements.hunting.window_length": 0.3})
-    fast = simulate(short, isolated=isolated, effects=quant)
-    ref = simulate(short, isolated=isolated, method="reference", rtol=1e-8, effects=quant)
+    fast, ref = _short_quantized(paper_spec, isolated,
+                                 _effects({"type": "quantization", "resolution": q}))
     assert fast.success and ref.success
     assert fast.n_events < ref.n_events / 10  # the quantizer was passed through
     assert np.max(np.abs(fast.position - ref.position)) < 0.01 * q
@@ -443,6 +435,16 @@ def test_a_move_that_outlasts_the_run_is_not_finished(paper_spec):
     m = r.metrics
     assert m.verdict == "undetermined" and not m.settled
     assert "not finished" in m.reason and "100 s" in m.reason
+
+
+def _short_quantized(paper_spec, isolated, quant):
+    """The paper stage's first 0.6 s with a quantizer: the fast kernel's run and the
+    reference solver's (every level located)."""
+    short = variant(paper_spec, **{"motion.duration": 0.6,
+                                     "requirements.hunting.window_start": 0.3,
+                                     "requirements.hunting.window_length": 0.3})
+    return (simulate(short, isolated=isolated, effects=quant),
+            simulate(short, isolated=isolated, method="reference", rtol=1e-8, effects=quant))
 
 
 def _effects(*entries):
