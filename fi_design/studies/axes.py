@@ -15,6 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .. import spec as _spec
+from ..display import quantity
 from ..errors import SpecError
 from ..model import Model, require_model
 from ..results.studies import Axis
@@ -65,6 +66,11 @@ def make_axis(path: str, values: Sequence[float], log: bool = False,
     if array.size > MAX_POINTS:
         raise SpecError(f"{array.size} values; a study holds at most {MAX_POINTS} points",
                         path=path)
+    _, first, counts = np.unique(array, return_index=True, return_counts=True)
+    if np.any(counts > 1):
+        twice = array[first[counts > 1][0]]
+        raise SpecError(f"the value {quantity(float(twice), unit, 6)} is given "
+                        f"{int(counts.max())} times: each point of the study once", path=path)
     return Axis(path=path, values=array, unit=unit, log=log)
 
 
@@ -146,6 +152,9 @@ def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> 
     if n > 1 and start == stop:
         raise SpecError(f"range {rng!r}: START equals STOP; give N = 1 or a wider range",
                         path=path)
+    if n == 1 and start != stop:
+        raise SpecError(f"range {rng!r}: N = 1 sweeps START alone, and STOP would be ignored; "
+                        "give N of 2 or more, or START:START:1 for one value", path=path)
     if log:
         if start <= 0 or stop <= 0:
             raise SpecError(f"range {rng!r}: a logarithmic axis needs START and STOP above "

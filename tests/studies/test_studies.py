@@ -78,6 +78,9 @@ def test_parse_axis_with_units():
     ("isolator.stroke=0.2:1 mm:3", r"'0\.2' is a bare number, read as 0\.2 m .*'0\.2 mm'"),
     ("isolator.stroke=1 mm:0.002:3", "'0.002' is a bare number"),
     ("stage.mass=1,2 kg,4", "'1' is a bare number"),
+    # N = 1 ran START alone and dropped STOP without a word; a value given twice ran twice
+    ("controller.crossover=1 Hz:10 Hz:1", "N = 1 sweeps START alone, and STOP would be ignored"),
+    ("stage.mass=1 kg,2 kg,1000 g", "the value 1 kg is given 2 times"),
 ])
 def test_parse_axis_errors(text, words):
     with pytest.raises(SpecError, match=words):
