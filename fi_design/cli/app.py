@@ -419,7 +419,7 @@ def robustness_command(
     distribution: Annotated[str, typer.Option(
         "--distribution", metavar="normal|uniform", help="Distribution of the scatter.")] =
         "normal",
-    seed: Annotated[int, typer.Option("--seed", metavar="S",
+    seed: Annotated[int, typer.Option("--seed", metavar="S", min=0,
                                       help="Seed of the random generator.")] = 0,
     confidence: Annotated[float, typer.Option(
         "--confidence", min=0.5, max=0.999, metavar="LEVEL",

@@ -265,6 +265,8 @@ def robustness(spec: _spec.Spec | Model, scatter: Sequence[Scatter] = (), sample
                         f"{', '.join(DISTRIBUTIONS)}")
     if not 0 < confidence < 1:
         raise SpecError(f"confidence must lie between 0 and 1, got {confidence}")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+        raise ArgumentError(f"seed must be a whole number of 0 or more, got {seed!r}")
     base = model
     if position_friction is not None:
         entries = [e.model_dump() for e in spec.effects if e.type != _PDF]

@@ -672,3 +672,14 @@ def test_a_given_damping_held_over_a_stiffness_axis_is_said(paper_spec):
     assert r.to_dict()["notes"] == list(r.notes)
     default = variant(paper_spec, **{"isolator.flexure": None, "isolator.damping": None})
     assert sweep(default, ("isolator.stiffness", [2000.0, 8000.0]), measure="move").notes == ()
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, True])
+def test_the_scatter_seed_is_a_whole_number_of_zero_or_more(paper_spec, seed):
+    """robustness(seed=-1) was numpy's ValueError ('expected non-negative integer'), an
+    internal error on the command line."""
+    from fi_design.errors import ArgumentError
+    from fi_design.studies import parse_scatter, robustness
+
+    with pytest.raises(ArgumentError, match="seed must be a whole number of 0 or more"):
+        robustness(paper_spec, [parse_scatter("friction.static=10%")], samples=2, seed=seed)
