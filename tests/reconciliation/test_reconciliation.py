@@ -449,7 +449,9 @@ def test_an_open_loop_replay_calls_out_a_force_of_the_wrong_sign_or_scale(tmp_pa
 
 def test_an_unedited_open_loop_record_gets_no_force_alarm(tmp_path):
     """The same check on examples/measured_trace.csv as recorded: the record's force moves the
-    stage as the spec's mass and friction say (factor about 0.85), no fault; one candidate."""
+    stage as the spec's mass and friction say (factor about 0.85), no fault; one candidate.
+    Its structure diagnosis listed "controller ... check the controller description" (80 %)
+    and "the controller's integrator" although the open loop has none."""
     from fi_design import load_measurement, load_spec
 
     from conftest import EXAMPLES
@@ -462,3 +464,10 @@ def test_an_unedited_open_loop_record_gets_no_force_alarm(tmp_path):
     assert d.force_scale == pytest.approx(0.85, rel=0.05)
     assert "force_N" not in result.conclusion
     assert [c.name for c in result.candidates] == ["force_offset"]
+    # no controller in the replay: the structure's likely causes name none
+    assert d.mismatch and [c.name for c in d.causes][:2] == ["measured_force", "initial_state"]
+    assert not any("controller" in c.name or "controller" in c.detail for c in d.causes)
+    assert d.causes[1].detail.endswith(
+        "check the state of the mechanics the open-loop replay starts from (position and "
+        "velocity from the record, the friction's presliding state, the isolator's deflection).")
+    assert "Likely causes, strongest first: measured force (" in result.conclusion
