@@ -471,3 +471,40 @@ def test_an_unedited_open_loop_record_gets_no_force_alarm(tmp_path):
         "check the state of the mechanics the open-loop replay starts from (position and "
         "velocity from the record, the friction's presliding state, the isolator's deflection).")
     assert "Likely causes, strongest first: measured force (" in result.conclusion
+
+
+def test_a_nominal_model_that_fails_open_loop_points_at_the_force_not_a_controller():
+    """A record whose constant 100 kN force_N throws the open-loop replay off (nothing the
+    inverse dynamics can tell: a constant is an offset) said "an unstable closed loop" and
+    "check the spec against the record (controller, mass, sample rate)"; open loop it now
+    names the force and the mechanics. The closed loop of an unstable spec keeps its text."""
+    from fi_design import load_spec
+    from fi_design.measured import measurement_from_arrays
+
+    from conftest import EXAMPLES, variant
+
+    spec = load_spec(EXAMPLES / "measured_stage.yaml")
+    n = 400
+    t = np.arange(n) * 1e-3
+    rng = np.random.default_rng(1)
+    x = 1e-3 * np.sin(2 * np.pi * 2.0 * t)
+    rec = measurement_from_arrays(t, x, x + 1e-7 * rng.standard_normal(n),
+                                  np.full(n, 1e5) + rng.standard_normal(n))
+    opened = reconcile(spec, rec, drive="force")
+    assert opened.effect == "none" and opened.diagnosis.causes == ()
+    assert opened.conclusion.startswith("The nominal model fails on this record: solution "
+                                        "diverged at t = ")
+    assert opened.conclusion.endswith(
+        "s; likely cause: the recorded force drives the stage beyond any plausible travel (open "
+        "loop, only the spec's friction and stiffness hold it): check force_N's sign and unit "
+        "(N), and the friction or stiffness terms of the spec. No effect can be judged against "
+        "a model that does not run; check the spec against the record (mass, friction, "
+        "force_N's sign and unit).")
+    assert "controller" not in opened.conclusion and "closed loop" not in opened.conclusion
+    unstable = variant(spec, **{"controller.crossover": "60 Hz", "controller.delay": "5 ms"})
+    closed = reconcile(unstable, rec)
+    assert closed.conclusion.endswith(
+        "s; likely cause: an unstable closed loop: check the crossover against the achievable "
+        "one (guideline step 2), the delay and the sample rate. No effect can be judged against "
+        "a model that does not run; check the spec against the record (controller, mass, "
+        "sample rate).")
