@@ -471,6 +471,22 @@ def test_an_unedited_open_loop_record_gets_no_force_alarm(tmp_path):
         "check the state of the mechanics the open-loop replay starts from (position and "
         "velocity from the record, the friction's presliding state, the isolator's deflection).")
     assert "Likely causes, strongest first: measured force (" in result.conclusion
+    from html import unescape
+
+    from fi_design.report import render_gap_report
+
+    html = unescape(render_gap_report(result, tmp_path / "gap.html").read_text())
+    assert "Shares are of the residual's energy (measured force, initial state, disturbance) " \
+           "or its R² (mass)" in html
+    assert "controller" not in html.split("The model's structure misses the record")[1].split(
+        "</table>")[0]
+    # the caption of a closed loop (the same result relabelled) keeps the controller
+    from dataclasses import replace
+
+    closed = unescape(render_gap_report(replace(result, drive="closed"),
+                                        tmp_path / "closed.html").read_text())
+    assert "Shares are of the residual's energy (controller, initial state, disturbance) or " \
+           "its R² (mass)" in closed
 
 
 def test_a_nominal_model_that_fails_open_loop_points_at_the_force_not_a_controller():
