@@ -10,14 +10,18 @@ that points there:
 
 - **controller**: energy at and above a third of the loop's crossover, where
   the controller shapes the response (gains, the derivative's filter and
-  input, sample rate, delay);
+  input, sample rate, delay); an open-loop replay (``drive="force"``) has no
+  controller, and the same energy points at the **measured force** there
+  (force_N's timing, filter or gain, or fast mechanics the spec lacks);
 - **initial state**: residual concentrated at the start of the record (the
-  replay's starting position, velocity or controller state);
+  replay's starting position, velocity or controller state; open loop, the
+  state of the mechanics alone);
 - **mass**: residual that follows the reference acceleration (moving mass,
   feedforward);
 - **disturbance**: slow residual (below a thirtieth of the crossover) left
   after the velocity, direction and acceleration terms are taken out (a
-  force the model lacks: cable, drift, a load).
+  force the model lacks: cable, drift, a load; open loop, an offset of
+  force_N too).
 
 The record itself is checked too (:func:`force_check`): when the force
 channel stays :data:`STRUCTURE_MISFIT` noise units (RMS) or more from the
@@ -300,7 +304,7 @@ def record_diagnosis(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
                 + (", far above the noise" if misfit >= STRUCTURE_MISFIT else "") + ". ")
     else:
         spec = Spectrum(np.zeros(0), np.zeros(0))
-        # the simulator's guess at the cause (its closed loop) does not apply: the force does
+        # the check's finding replaces the simulator's guess at the cause
         text = f"The nominal model fails on this record ({nominal.message.split(';')[0]}). "
     message = (text + check.cause.detail + " No effect is searched or named from such a "
                "record; correct the column and reconcile again.")
@@ -365,23 +369,38 @@ def _causes(cmp: Comparison, r: np.ndarray, crossover: float, use_force: bool) -
     t = cmp.t
     total = float(r @ r) or 1e-300
     out = []
+    open_loop = cmp.drive == "force"
     fast = _band(r, t, crossover / 3.0, None)
     high = float(fast @ fast) / total
-    out.append(Cause("controller", min(high, 1.0),
-                     f"{percent(high, 2)} of the residual's energy lies at or above a third of "
-                     f"the loop's crossover ({quantity(crossover, 'Hz', 3)}), where the "
-                     "controller shapes the response: check the controller description (gains, "
-                     "the derivative's input and filter, sample rate, delay)."))
+    band = (f"{percent(high, 2)} of the residual's energy lies at or above a third of the "
+            f"loop's crossover ({quantity(crossover, 'Hz', 3)}), where ")
+    if open_loop:
+        # no controller in the replay: the recorded force shapes the fast response
+        out.append(Cause("measured_force", min(high, 1.0), band +
+                         "the recorded force alone drives the open-loop replay: check force_N "
+                         "(its timing against position_m, the logger's filter, the drive's "
+                         "gain) and fast dynamics of the mechanics the spec lacks (a "
+                         "resonance, a compliance)."))
+    else:
+        out.append(Cause("controller", min(high, 1.0), band +
+                         "the controller shapes the response: check the controller description "
+                         "(gains, the derivative's input and filter, sample rate, delay)."))
     window = max(START_SHARE * cmp.duration, cmp.settle_window)
     first = t <= t[0] + window
     frac_t = float(np.mean(first))
     frac_ss = float(r[first] @ r[first]) / total
     start = max(0.0, (frac_ss - frac_t) / (1.0 - frac_t)) if frac_t < 1.0 else 0.0
+    if open_loop:
+        state = ("the state of the mechanics the open-loop replay starts from (position and "
+                 "velocity from the record, the friction's presliding state"
+                 + (", the isolator's deflection)." if cmp.iso else ")."))
+    else:
+        state = ("the state the replay starts from (position, velocity, the controller's "
+                 "integrator).")
     out.append(Cause("initial_state", start,
                      f"{percent(frac_ss, 2)} of the residual's energy lies in the first "
                      f"{quantity(window, 's', 3)} ({percent(frac_t, 2)} of the record): check "
-                     "the state the replay starts from (position, velocity, the controller's "
-                     "integrator)." + _offset_text(cmp)))
+                     + state + _offset_text(cmp)))
     moving = cmp.kind != "hold"
     a, v = cmp.a_ref, cmp.v_ref
     mass, slope = 0.0, 0.0
@@ -405,5 +424,6 @@ def _causes(cmp: Comparison, r: np.ndarray, crossover: float, use_force: bool) -
                      f"{percent(slow, 2)} of the residual's energy is slow (below "
                      f"{quantity(crossover / 30.0, 'Hz', 3)}, a constant included) and not a "
                      "velocity, direction or acceleration term: a force the model lacks (a load, a "
-                     "cable, a drift)."))
+                     "cable, a drift" + (", or an offset of force_N" if open_loop else "")
+                     + ")."))
     return out

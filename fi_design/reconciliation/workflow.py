@@ -499,7 +499,8 @@ def _failed_nominal(cmp: Comparison, nominal: Baseline, started: float,
         channel="position", causes=(),
         message=f"The nominal model fails on this record: {nominal.run.message}. No effect can "
                 "be judged against a model that does not run; check the spec against the "
-                "record (controller, mass, sample rate).",
+                "record (" + ("mass, friction, force_N's sign and unit" if cmp.drive == "force"
+                              else "controller, mass, sample rate") + ").",
         frequency=np.zeros(0), spectrum=np.zeros(0), crossover=0.0)
     return _unsearched(cmp, nominal, diagnosis, started, threshold)
 

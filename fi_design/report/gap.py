@@ -90,8 +90,9 @@ def gap_sections(result: Any, figures: bool = True) -> list:
         sections.append(Section(
             "structure", "The model's structure misses the record", paragraphs=(diag.message,),
             tables=(Table(("Likely cause", "Share of the residual", "What was measured"), crows,
-                          caption="Shares are of the residual's energy (controller, initial "
-                                  "state, disturbance) or its R² (mass)",
+                          caption="Shares are of the residual's energy ("
+                                  + ("measured force" if result.drive == "force" else "controller")
+                                  + ", initial state, disturbance) or its R² (mass)",
                           numeric=(False, True, False)),) if crows else (),
             figures=figs))
     meas = result.measurement

@@ -359,7 +359,8 @@ class Cause(Result):
     Attributes
     ----------
     name : str
-        ``"controller"``, ``"initial_state"``, ``"mass"`` or ``"disturbance"``
+        ``"controller"`` (open loop ``"measured_force"``: no controller
+        in the replay), ``"initial_state"``, ``"mass"`` or ``"disturbance"``
         (the model), or ``"force_sign"`` or ``"force_scale"`` (the record's
         ``force_N`` column, against the model after the best fit; open loop, against
         the motion it drives).

@@ -247,7 +247,7 @@ def _result(model, iso, method, params, out, t_out, wall, *, move_end,
             time_offset=0.0, drive="closed", record=None, window=None) -> SimulationResult:
     """The result of an integration; ``record`` (a Measurement) for a replay."""
     success = out.code == 0
-    message = "" if success else _failure_message(out.status, out.t_reached, params, iso)
+    message = "" if success else _failure_message(out.status, out.t_reached, params, iso, drive)
     Y, R = out.states, out.reference
     idx = state_index(iso)
     t = t_out + time_offset if time_offset else t_out
@@ -397,7 +397,10 @@ def _metrics(model, t, err, success, message, move_end) -> HuntingMetrics:
                            failure=message)
 
 
-def _failure_message(status: str, t: float, params: PlantParameters, iso: bool) -> str:
+def _failure_message(status: str, t: float, params: PlantParameters, iso: bool,
+                     drive: str = "closed") -> str:
+    """The failure and its likely cause; an open-loop replay (``drive="force"``) has no loop
+    to be unstable: the recorded force itself drives the stage off."""
     causes = {
         "step budget exhausted": "very fast switching (chattering at a limiter or at standstill) or "
                                  "a budget too small for the run; raise simulation.max_steps",
@@ -409,4 +412,10 @@ def _failure_message(status: str, t: float, params: PlantParameters, iso: bool) 
         "delay history overflow": "a delay much longer than the integration steps",
         "singular iteration matrix": "degenerate parameters (zero mass or stiffness)",
     }
+    if drive == "force":
+        pushed = ("the recorded force drives the stage beyond any plausible travel (open "
+                  "loop, only the spec's friction and stiffness hold it): check force_N's sign "
+                  "and unit (N), and the friction or stiffness terms of the spec")
+        causes.update({"state became NaN or infinite": pushed + ", or unphysical parameters",
+                       "solution diverged": pushed})
     return f"{status} at t = {quantity(t, 's', 6)}; likely cause: {causes.get(status, 'unknown')}"

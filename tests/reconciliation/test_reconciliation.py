@@ -449,7 +449,9 @@ def test_an_open_loop_replay_calls_out_a_force_of_the_wrong_sign_or_scale(tmp_pa
 
 def test_an_unedited_open_loop_record_gets_no_force_alarm(tmp_path):
     """The same check on examples/measured_trace.csv as recorded: the record's force moves the
-    stage as the spec's mass and friction say (factor about 0.85), no fault; one candidate."""
+    stage as the spec's mass and friction say (factor about 0.85), no fault; one candidate.
+    Its structure diagnosis listed "controller ... check the controller description" (80 %)
+    and "the controller's integrator" although the open loop has none."""
     from fi_design import load_measurement, load_spec
 
     from conftest import EXAMPLES
@@ -462,3 +464,63 @@ def test_an_unedited_open_loop_record_gets_no_force_alarm(tmp_path):
     assert d.force_scale == pytest.approx(0.85, rel=0.05)
     assert "force_N" not in result.conclusion
     assert [c.name for c in result.candidates] == ["force_offset"]
+    # no controller in the replay: the structure's likely causes name none
+    assert d.mismatch and [c.name for c in d.causes][:2] == ["measured_force", "initial_state"]
+    assert not any("controller" in c.name or "controller" in c.detail for c in d.causes)
+    assert d.causes[1].detail.endswith(
+        "check the state of the mechanics the open-loop replay starts from (position and "
+        "velocity from the record, the friction's presliding state, the isolator's deflection).")
+    assert "Likely causes, strongest first: measured force (" in result.conclusion
+    from html import unescape
+
+    from fi_design.report import render_gap_report
+
+    html = unescape(render_gap_report(result, tmp_path / "gap.html").read_text())
+    assert "Shares are of the residual's energy (measured force, initial state, disturbance) " \
+           "or its R² (mass)" in html
+    assert "controller" not in html.split("The model's structure misses the record")[1].split(
+        "</table>")[0]
+    # the caption of a closed loop (the same result relabelled) keeps the controller
+    from dataclasses import replace
+
+    closed = unescape(render_gap_report(replace(result, drive="closed"),
+                                        tmp_path / "closed.html").read_text())
+    assert "Shares are of the residual's energy (controller, initial state, disturbance) or " \
+           "its R² (mass)" in closed
+
+
+def test_a_nominal_model_that_fails_open_loop_points_at_the_force_not_a_controller():
+    """A record whose constant 100 kN force_N throws the open-loop replay off (nothing the
+    inverse dynamics can tell: a constant is an offset) said "an unstable closed loop" and
+    "check the spec against the record (controller, mass, sample rate)"; open loop it now
+    names the force and the mechanics. The closed loop of an unstable spec keeps its text."""
+    from fi_design import load_spec
+    from fi_design.measured import measurement_from_arrays
+
+    from conftest import EXAMPLES, variant
+
+    spec = load_spec(EXAMPLES / "measured_stage.yaml")
+    n = 400
+    t = np.arange(n) * 1e-3
+    rng = np.random.default_rng(1)
+    x = 1e-3 * np.sin(2 * np.pi * 2.0 * t)
+    rec = measurement_from_arrays(t, x, x + 1e-7 * rng.standard_normal(n),
+                                  np.full(n, 1e5) + rng.standard_normal(n))
+    opened = reconcile(spec, rec, drive="force")
+    assert opened.effect == "none" and opened.diagnosis.causes == ()
+    assert opened.conclusion.startswith("The nominal model fails on this record: solution "
+                                        "diverged at t = ")
+    assert opened.conclusion.endswith(
+        "s; likely cause: the recorded force drives the stage beyond any plausible travel (open "
+        "loop, only the spec's friction and stiffness hold it): check force_N's sign and unit "
+        "(N), and the friction or stiffness terms of the spec. No effect can be judged against "
+        "a model that does not run; check the spec against the record (mass, friction, "
+        "force_N's sign and unit).")
+    assert "controller" not in opened.conclusion and "closed loop" not in opened.conclusion
+    unstable = variant(spec, **{"controller.crossover": "60 Hz", "controller.delay": "5 ms"})
+    closed = reconcile(unstable, rec)
+    assert closed.conclusion.endswith(
+        "s; likely cause: an unstable closed loop: check the crossover against the achievable "
+        "one (guideline step 2), the delay and the sample rate. No effect can be judged against "
+        "a model that does not run; check the spec against the record (controller, mass, "
+        "sample rate).")

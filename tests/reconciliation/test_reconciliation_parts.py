@@ -168,3 +168,56 @@ def test_the_thinning_and_its_bound():
     at_1khz = measurement_from_arrays(t[::10], np.zeros(n // 10), 1e-3 * np.sin(t[::10]))
     same, note = for_the_model(at_1khz, 8.0)
     assert same is at_1khz and note == ""
+
+
+def test_open_loop_structure_causes_name_no_controller(paper_spec):
+    """An open-loop replay (drive="force") has no controller: the structure diagnosis of the
+    same residual names the measured force where a closed loop names the controller, and
+    the mechanics' state (not the integrator) as the initial state."""
+    from fi_design.measured import measurement_from_arrays
+    from fi_design.reconciliation.comparison import Comparison, ModelRun
+    from fi_design.reconciliation.diagnosis import diagnose
+    from fi_design.reconciliation.noise import noise_levels
+    from fi_design.simulation.run import simulate
+
+    res = simulate(paper_spec, False)
+    n = 2000
+    rng = np.random.default_rng(11)
+    data = measurement_from_arrays(res.time[:n], res.reference[:n],
+                                   res.position[:n] + 1e-7 * rng.standard_normal(n),
+                                   res.force[:n] + 1e-3 * rng.standard_normal(n))
+    lat = find_lattice(data.position, estimate_noise(data.position))
+    text = {}
+    for drive in ("closed", "force"):
+        noise = noise_levels(paper_spec, data, False, lat, force_is_input=drive == "force")
+        cmp = Comparison(paper_spec, data, False, noise, lat, None, drive)
+        # a model whose position rings fast and starts off: far above the noise
+        t = cmp.t - cmp.t[0]
+        x = data.position + 2e-6 * np.sin(2 * np.pi * 40.0 * t) + 5e-6 * np.exp(-t / 0.02)
+        f = res.force[:n] + 0.5 * np.sin(2 * np.pi * 40.0 * t) if drive == "closed" else \
+            np.full(n, np.nan)
+        nominal = ModelRun(x, f, None, ok=True, message="")
+        cmp.finish_setup(nominal, 1000)
+        r = cmp.residuals(nominal)
+        d = diagnose(cmp, nominal, float(r @ r), best_explained=0.0)
+        assert d.mismatch, drive
+        text[drive] = ({c.name: c.detail for c in d.causes}, d.message)
+    closed, _ = text["closed"]
+    causes, message = text["force"]
+    assert "controller" in closed and closed["controller"].endswith(
+        "where the controller shapes the response: check the controller description (gains, "
+        "the derivative's input and filter, sample rate, delay).")
+    assert closed["initial_state"].endswith(
+        "check the state the replay starts from (position, velocity, the controller's "
+        "integrator).")
+    assert set(causes) == {"measured_force", "initial_state", "mass", "disturbance"}
+    assert causes["measured_force"].endswith(
+        "where the recorded force alone drives the open-loop replay: check force_N (its timing "
+        "against position_m, the logger's filter, the drive's gain) and fast dynamics of the "
+        "mechanics the spec lacks (a resonance, a compliance).")
+    assert causes["initial_state"].endswith(
+        "check the state of the mechanics the open-loop replay starts from (position and "
+        "velocity from the record, the friction's presliding state).")
+    assert causes["disturbance"].endswith("(a load, a cable, a drift, or an offset of force_N).")
+    assert "measured force" in message
+    assert not any("controller" in s for s in (message, *causes.values()))

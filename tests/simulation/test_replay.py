@@ -185,6 +185,30 @@ def test_open_loop_replay_needs_the_force(paper_spec):
         simulate(paper_spec, isolated=False, record=rec, drive="torque")
 
 
+def test_a_force_that_throws_the_stage_off_names_the_force_not_a_loop(paper_spec):
+    """Open loop there is no loop to be unstable: 100 kN on the paper stage throws it past the
+    replay's bound within milliseconds, and the likely cause is the force (its sign or unit)
+    or the friction and stiffness against it. A closed loop keeps its own cause."""
+    from conftest import variant
+
+    t = np.arange(50) * 1e-3
+    rec = measurement_from_arrays(t, np.zeros(50), np.zeros(50), np.full(50, 1e5))
+    for iso in (False, True):
+        r = simulate(paper_spec, isolated=iso, record=rec, drive="force")
+        assert not r.success and r.status == "solution diverged"
+        assert r.message.endswith(
+            "s; likely cause: the recorded force drives the stage beyond any plausible travel "
+            "(open loop, only the spec's friction and stiffness hold it): check force_N's sign "
+            "and unit (N), and the friction or stiffness terms of the spec"), r.message
+        assert "closed loop" not in r.message and "crossover" not in r.message
+    unstable = variant(paper_spec, **{"controller.crossover": "60 Hz", "controller.delay": "5 ms"})
+    r = simulate(unstable, isolated=False)
+    assert not r.success and r.status == "solution diverged"
+    assert r.message.endswith(
+        "s; likely cause: an unstable closed loop: check the crossover against the achievable "
+        "one (guideline step 2), the delay and the sample rate"), r.message
+
+
 # --------------------------------------------------------------------------- command line
 
 
