@@ -695,8 +695,7 @@ def switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state):
     direction : int
         Which way the crossing goes: for ``EV_LIMIT`` out of the free range
         the limiter engaged, +1 (d > s) or -1 (d < -s), ignored when leaving
-        a limiter; for ``EV_LEVEL`` the levels crossed, signed (+1 up a level, -1 down; more
-        where the integrator catches up with levels a step crossed); ignored otherwise.
+        a limiter; for ``EV_LEVEL`` +1 up a level, -1 down; ignored otherwise.
     y : ndarray
         State at the crossing (changed in place: the switch model's stopped
         cart, the filtered controller's jump).
@@ -714,8 +713,9 @@ def switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state):
     -----
     A quantization level change with a filtered continuous controller makes
     its output u jump by the derivative terms' impulse, -wt (kd + kdm) q per
-    level (so a catch-up over n levels jumps n times that: no impulse is lost). A sampled controller (``sample_period`` > 0) reads the position at
-    its samples and holds its output in u: nothing jumps.
+    level (:func:`pass_quantizer` jumps by that of the levels it moves over). A sampled
+    controller (``sample_period`` > 0) reads the position at its samples and holds its output
+    in u: nothing jumps.
     """
     if kind == EV_SIGN:
         if p[P_SWITCH] != 0.0:
@@ -737,7 +737,7 @@ def switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state):
         else:
             modes[MODE_LIMIT] = 0
     elif kind == EV_LEVEL:
-        step = direction  # levels crossed, signed (one at a located crossing)
+        step = 1 if direction > 0 else -1
         modes[MODE_LEVEL] += step
         if p[P_TS] == 0.0 and not math.isinf(p[P_WT]):
             y[iu] += -p[P_WT] * (p[P_KD] + p[P_KDM]) * p[P_QUANT] * step
@@ -745,9 +745,10 @@ def switch_mode(kind, direction, y, p, modes, iv2, iu, r, rd, fa, fa_state):
 
 @kernel_function((A1, A1, I1, i8, b1))
 def pass_quantizer(y, p, modes, iu, free):
-    """Pass the quantizer through (``free``: the controller sees x1) or quantize again (the
-    level x1 lies in), with the derivative terms' impulse of the jump in the measured
-    position, -wt (kd + kdm) (seen after - seen before), as at a level change."""
+    """Pass the quantizer through (``free``: the controller sees x1) or quantize at the level
+    x1 lies in (from a pass or from a level left behind), with the derivative terms' impulse
+    of the jump in the measured position, -wt (kd + kdm) (seen after - seen before), as at a
+    level change."""
     q = p[P_QUANT]
     before = measured_position(y[0], p, modes[MODE_LEVEL])
     modes[MODE_LEVEL] = LEVEL_FREE if free else int(math.floor(y[0] / q + 0.5))

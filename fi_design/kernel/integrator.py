@@ -64,7 +64,8 @@ from .jit import A1, A2, I1, b1, f8, i8, kernel_function
 from .layout import (DIVERGED, EV_LEVEL, EV_LIMIT, EV_NONE, EV_SECTION, EV_SIGN, EV_UNSTICK,
                      HISTORY_OVERFLOW, LEVEL_FREE, MAX_PERIOD, MODE_LEVEL, MODE_LIMIT, MODE_SIGN,
                      MODE_STICK, N_CORE_ISO, N_CORE_RIGID, N_STATS, NOT_FINITE, OK, P_DA, P_DB,
-                     P_DC, P_DELAY, P_NF, P_QFREE, P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F, P_FF_M, P_ISO, P_KD, P_KDM,
+                     P_DC, P_DELAY, P_NF, P_QFREE, P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F,
+                     P_FF_M, P_ISO, P_KD, P_KDM,
                      P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT,
                      ST_CROSSINGS, ST_EVENTS, ST_H, ST_LIMIT_EVENTS, ST_OUT, ST_PERIOD,
                      ST_REJECTED, ST_STEPS, ST_STOP, ST_T, ST_ZERO_EVENTS, STEP_UNDERFLOW,
@@ -1142,11 +1143,9 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                         u_before = controller_output(y, p, modes, r0, rd0, ii, iu)
                     apply_event(kind, y, p, modes, iv2, iu, r0, rd0, fa0, fa_state, ybuf)
                     if zero_run >= 8 and quantized(p, modes) and p[P_TS] == 0.0:
-                        # natural_modes below sets the level the state is at: its impulses
-                        behind = int(math.floor(y[0] / p[P_QUANT] + 0.5)) - modes[MODE_LEVEL]
-                        if behind != 0:
-                            switch_mode(EV_LEVEL, behind, y, p, modes, iv2, iu, r0, rd0, fa0,
-                                        fa_state)
+                        # the level the state is at, with the impulses of the levels skipped
+                        # (natural_modes below would set it without them)
+                        pass_quantizer(y, p, modes, iu, False)
                     if cont_delay:
                         u_after = controller_output(y, p, modes, r0, rd0, ii, iu)
                         if u_after != u_before:
