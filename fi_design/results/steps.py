@@ -398,12 +398,13 @@ RULE_FORM = ("the tuning rule (series form): C(s) = ks (1 + wi/s) (1 + s/wd) / (
              "corners given in Hz (integrator_corner = wi / 2 pi, lead_corner = wd / 2 pi, "
              "roll_off = wt / 2 pi, on the whole PID); with the rule, the same loop as drive")
 
-#: Units of the keys of ``pid.drive``.
-DRIVE_UNITS = {"kp": "N/m", "ki": "N/(m s)", "kd": "N s/m", "roll_off": "Hz",
+#: Units of the keys of ``pid.drive``, spelt as a spec writes them (``1234 N*s/m``), so that a
+#: value with its unit goes back into a spec as it is.
+DRIVE_UNITS = {"kp": "N/m", "ki": "N/(m*s)", "kd": "N*s/m", "roll_off": "Hz",
                "sample_rate": "Hz", "delay": "s", "force_limit": "N",
                "filters.frequency": "Hz", "filters.width": "Hz", "filters.depth": "dB",
                "filters.damping": "-", "feedforward.mass": "kg",
-               "feedforward.viscous": "N s/m", "feedforward.coulomb": "N"}
+               "feedforward.viscous": "N*s/m", "feedforward.coulomb": "N"}
 
 #: Units of the keys of ``pid.rule``.
 RULE_UNITS = {"crossover": "Hz", "tuning_mass": "kg", "ks": "N/m", "integrator_corner": "Hz",

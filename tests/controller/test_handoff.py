@@ -161,3 +161,19 @@ def test_write_spec_round_trips_with_filters_and_a_drive(paper_spec, tmp_path):
     assert db["filters"] == da["filters"]
     assert db["discrete"]["num"] == pytest.approx(da["discrete"]["num"], rel=1e-9)
     assert db["in_drive_units"]["kp"] == pytest.approx(da["in_drive_units"]["kp"], rel=1e-12)
+
+
+def test_json_units_read_back_as_a_spec_writes_them():
+    """pid.drive.units gave ki in 'N/(m s)' and kd in 'N s/m', spelt unlike the spec
+    ('N/(m*s)', 'N*s/m'): every unit of pid.drive, pid.rule and the sampled form is one the
+    spec's reader takes, and a gain written with it reads back as the same value in SI."""
+    from fi_design.results.steps import DISCRETE_UNITS, DRIVE_UNITS, RULE_UNITS
+    from fi_design.spec.units import KNOWN_UNITS, to_si
+
+    for table in (DRIVE_UNITS, RULE_UNITS, DISCRETE_UNITS):
+        for key, unit in table.items():
+            if unit in ("-", "dB"):
+                continue
+            assert unit in KNOWN_UNITS, (key, unit)
+            assert to_si(f"1234.5 {unit}", unit) == pytest.approx(1234.5), (key, unit)
+
