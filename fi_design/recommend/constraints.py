@@ -8,7 +8,8 @@ Each function judges one thing and says why in words:
   plus their reserve; never raised where the linear model sets no limit;
 - :func:`guide_for` -- a guide from stock for a net drive stiffness and
   stroke (stress, buckling, every parasitic mode at the separation times the
-  crossover);
+  crossover), its stiffness within k_max over the whole thickness tolerance
+  of its stock;
 - :func:`loop_meets` -- the candidate's four limit cases, its own modes in,
   meet the margins plus their reserve at the crossover;
 - :func:`stage_answer` -- the stage after every move of its family at the
@@ -33,13 +34,16 @@ from ..model import Model
 from ..spec.file import with_values
 
 __all__ = ["SEARCH_POINTS", "reserve_values", "reserve_requirements", "crossover_cap",
-           "notched_model", "notch_entries", "guide_for",
+           "notched_model", "notch_entries", "guide_for", "thickest_stiffness",
            "guide_bounds", "loop_meets", "stage_answer",
            "margin_screen", "reserve_corners", "hunting_margin"]
 
 #: Lengths of the guide's sizing grid during the search (the chosen design is sized again at
 #: full resolution).
 SEARCH_POINTS = 41
+#: Sizings of a guide at most: the first at the target, the others at a target lowered until
+#: the stock's thickest leaves stay within k_max (:func:`guide_for`).
+TOLERANCE_SIZINGS = 4
 
 
 def reserve_values(spec: _spec.Spec) -> dict[str, float]:
@@ -142,6 +146,13 @@ def guide_for(base: Model, stiffness: float, stroke: float, crossover: float, *,
               points: int = SEARCH_POINTS) -> Any:
     """A leaf-spring guide from stock for a net drive stiffness and stroke.
 
+    The stock's thickness tolerance +-dt moves the drive stiffness with t^3:
+    where the thickest leaves the stock may deliver (t + dt) would pass
+    k_max = Fs / stroke, the guide is sized again for a target lowered by that
+    excess (up to :data:`TOLERANCE_SIZINGS` sizings in all), so that every leaf
+    of the order keeps the drive within k_max. The guide's drive stiffness may
+    then lie below ``stiffness``; the search reads it from the result.
+
     Parameters
     ----------
     base : Model
@@ -159,10 +170,27 @@ def guide_for(base: Model, stiffness: float, stroke: float, crossover: float, *,
     Returns
     -------
     fi_design.results.steps.FlexureResult
-        Sized within the base's flexure bounds: k_max, the stress, the
-        buckling factor and every parasitic mode at the separation times the
-        loop's crossover.
+        Sized within the base's flexure bounds: k_max (over the stock's
+        thickness tolerance), the stress, the buckling factor and every
+        parasitic mode at the separation times the loop's crossover.
     """
+    kmax = _spec.stiffness_limit(base.spec, stroke)
+    target = float(stiffness)
+    fx = _sized(base, target, stroke, crossover, points)
+    for _ in range(TOLERANCE_SIZINGS - 1):
+        high = thickest_stiffness(fx)
+        if high is None or high <= kmax * (1.0 + 1e-9):
+            break
+        # k goes with t^3 at a kept shape: lower the target by the excess (a hair more, so
+        # the next sizing's rounding lands within)
+        target *= kmax / high * (1.0 - 1e-6)
+        fx = _sized(base, target, stroke, crossover, points)
+    return fx
+
+
+def _sized(base: Model, stiffness: float, stroke: float, crossover: float,
+           points: int) -> Any:
+    """:func:`~fi_design.mechanism.sizing.size_guide` for the search's base at a target."""
     from ..mechanism.sizing import size_guide
 
     req = base.requirements
@@ -172,6 +200,14 @@ def guide_for(base: Model, stiffness: float, stroke: float, crossover: float, *,
                       * _loop_at(base, stiffness, stroke, crossover).sizing_crossover,
                       required_buckling=req.buckling_factor, cart_mass=base.m2,
                       stop_stiffness=base.limiter.stiffness, points=points)
+
+
+def thickest_stiffness(fx: Any) -> float | None:
+    """The net drive stiffness of a feasible guide with its stock's thickest leaves (t + dt)
+    [N/m]; None for no guide or no tolerance."""
+    if not fx.feasible or not fx.stiffness_range:
+        return None
+    return float(fx.stiffness_range[1])
 
 
 def _loop_at(base: Model, stiffness: float, stroke: float, crossover: float) -> Model:

@@ -126,9 +126,16 @@ def binding(search: Any, chosen: Any) -> tuple[str, ...]:
     from .. import spec as _spec
 
     kmax = _spec.stiffness_limit(search.base, chosen.stroke)
+    high = chosen.thickest
     if chosen.stiffness >= 0.97 * kmax:
         out.append(f"k_max = Fs / stroke = {quantity(kmax, 'N/m', 4)} at "
                    f"{quantity(chosen.stroke, 'm')} stroke")
+    elif high is not None and high >= 0.97 * kmax:
+        dt = search.base_model.flexure_spec.thickness_tolerance
+        thick = quantity(chosen.candidate.thickness + dt, "m", 3, shown=("mm", 1e3))
+        out.append(f"k_max = Fs / stroke = {quantity(kmax, 'N/m', 4)} at "
+                   f"{quantity(chosen.stroke, 'm')} stroke, which leaves of the stock's "
+                   f"thickest ({thick}) reach")
     elif stiffer:
         out.append(f"at {quantity(chosen.stroke, 'm')} stroke a stiffer joint "
                    f"({quantity(stiffer[0].target, 'N/m', 4)}) fails on {_why(stiffer[0])}")

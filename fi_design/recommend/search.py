@@ -73,6 +73,7 @@ class _Point:
     violations: list = field(default_factory=list)
     candidate: Candidate | None = None
     lowest_mode: float | None = None
+    thickest: float | None = None
     free_from: float | None = None
     hunts: bool = False
     margin: float | None = None
@@ -176,6 +177,7 @@ class _Search:
                                 thickness=fx.thickness, stiffness=k, crossover=self.fc,
                                 damping=c)
         p.lowest_mode = fx.lowest_mode.frequency if fx.lowest_mode is not None else None
+        p.thickest = _c.thickest_stiffness(fx)
 
     def candidate_model(self, p: _Point) -> Model:
         """The point's candidate resolved into its model, once: every judgement reads it."""
@@ -321,6 +323,7 @@ class _Search:
                                     crossover=self.fc, damping=p.candidate.damping)
             p.model = None  # the guide at full resolution is another candidate
             p.lowest_mode = fx.lowest_mode.frequency
+            p.thickest = _c.thickest_stiffness(fx)
         else:
             fx = _c.guide_for(self.base_model, p.stiffness, p.stroke, self.fc)
         model = self.candidate_model(p)

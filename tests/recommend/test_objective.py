@@ -19,7 +19,8 @@ MARGIN = "the crossover lies only 1.197 x above the hunting-free 8.858 Hz (the m
 
 def _point(stroke, k, status, margin=None, why=()):
     return SimpleNamespace(stroke=stroke, target=k, stiffness=k, status=status, margin=margin,
-                           violations=list(why), candidate=None if status == "flexure" else k)
+                           violations=list(why), candidate=None if status == "flexure" else k,
+                           thickest=None)
 
 
 def _search(spec, points):

@@ -54,6 +54,8 @@ def test_the_recommendation_is_a_buildable_stiff_joint_bound_by_physics(paper_re
     d, req = r.design, r.spec.requirements
     assert d.hunting_margin >= req.hunting_margin and d.hunting_free_from < d.crossover
     assert d.stiffness <= 4.0 / d.stroke * (1 + 1e-9)                  # k <= k_max
+    # and so does the stock's thickest leaf (t + dt): the drawing's every leaf keeps it
+    assert r.flexure.stiffness_range[1] <= 4.0 / d.stroke * (1 + 1e-9)
     # the stiffest of the designs that keep the margin and that the search judged
     keep = [c for c in r.candidates if c.hunting_margin is not None
             and c.hunting_margin >= req.hunting_margin and c.status != "hunts"]
