@@ -26,6 +26,7 @@ base model) and read by all of them.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 from .. import spec as _spec
@@ -180,11 +181,21 @@ def guide_for(base: Model, stiffness: float, stroke: float, crossover: float, *,
     for _ in range(TOLERANCE_SIZINGS - 1):
         high = thickest_stiffness(fx)
         if high is None or high <= kmax * (1.0 + 1e-9):
-            break
-        # k goes with t^3 at a kept shape: lower the target by the excess (a hair more, so
-        # the next sizing's rounding lands within)
-        target *= kmax / high * (1.0 - 1e-6)
+            return fx
+        # the elastic part goes with t^3, gravity's does not: k(t + dt) = a k + b with
+        # a = (k(t + dt) - kg) / (k - kg) and b = kg (1 - a); the net stiffness whose thick
+        # end is k_max at this thickness, a hair below (the next sizing's rounding)
+        k, kg = fx.mechanics.net_drive_stiffness, fx.mechanics.gravity.geometric_stiffness
+        a = (high - kg) / (k - kg)
+        target *= (kmax - kg * (1.0 - a)) / a / k * (1.0 - 1e-6)
         fx = _sized(base, target, stroke, crossover, points)
+    high = thickest_stiffness(fx)
+    if high is not None and high > kmax * (1.0 + 1e-9):
+        thick = quantity(fx.thickness + fx.thickness_tolerance, "m", 3, shown=("mm", 1e3))
+        return replace(fx, feasible=False, reason=(
+            f"stiffness over the thickness tolerance: after {TOLERANCE_SIZINGS} sizings the "
+            f"stock's thickest leaves ({thick}) still give {quantity(high, 'N/m', 4)}, above "
+            f"k_max = {quantity(kmax, 'N/m', 4)}"))
     return fx
 
 

@@ -45,3 +45,28 @@ def test_soft_target_sized_as_asked(search):
     fx = C.guide_for(search.base_model, 0.3 * kmax, stroke, search.fc)
     assert fx.feasible
     assert fx.mechanics.net_drive_stiffness == pytest.approx(0.3 * kmax, rel=2e-3)
+
+
+@pytest.mark.parametrize("tolerance", [0.05e-3, 0.09e-3])
+def test_a_coarse_tolerance_is_kept_or_the_guide_refused(paper_spec_path, tolerance):
+    """A tolerance of a fifth of the leaf changes k by a factor of about 2 over the stock: the
+    guide of every stroke either keeps the thickest leaves within k_max or is no guide, with the
+    tolerance named; never a guide above k_max."""
+    from fi_design.model import as_model
+    from fi_design.spec.file import as_spec, with_values
+
+    spec = with_values(as_spec(paper_spec_path),
+                       {"isolator.flexure.thickness_tolerance": tolerance})
+    srch = _Search(as_model(spec), None, lambda text: None)
+    kept = 0
+    for stroke in (0.3e-3, 0.9e-3, 2e-3):
+        kmax = _spec.stiffness_limit(srch.base, stroke)
+        fx = C.guide_for(srch.base_model, TOP * kmax, stroke, srch.fc)
+        if fx.feasible:
+            g = fx.guide
+            thick = float(net_stiffness(g, g.length, g.width, g.thickness + tolerance))
+            assert thick <= kmax * (1 + 1e-6), (stroke, thick / kmax)
+            kept += 1
+        else:
+            assert "thickness tolerance" in fx.reason and "k_max" in fx.reason
+    assert kept >= 2
