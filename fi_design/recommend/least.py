@@ -7,7 +7,9 @@ each with the design command's own verdict, until one passes:
 1. the crossover alone (a spec tuned by the rule): the hunting margin above
    the fold of the spec's own isolator, if the loop's cap allows it;
 2. the drive stiffness alone, at the spec's stroke and crossover: the
-   stiffest that keeps the hunting margin (bisection);
+   stiffest that keeps the hunting margin (bisection), at most
+   :func:`top_stiffness` (0.99 k_max, and within k_max for the stock's
+   thickest leaves where the spec sizes its guide);
 3. the stroke and the stiffness, at the spec's crossover: a longer stroke
    (two and four times the spec's), each with its stiffest stiffness.
 
@@ -28,7 +30,8 @@ from ..model import Model
 from ..results.recommend import LeastChange
 from . import constraints as _c
 
-__all__ = ["least_change", "least_change_task", "Scope", "BISECTION_STEPS", "STROKE_FACTORS"]
+__all__ = ["least_change", "least_change_task", "top_stiffness", "Scope", "BISECTION_STEPS",
+           "STROKE_FACTORS"]
 
 #: Bisection steps of the stiffness.
 BISECTION_STEPS = 4
@@ -84,12 +87,13 @@ def _stiffest(model: Model, stroke: float,
     """The stiffest drive stiffness at a stroke that keeps the margin (bisection on log k),
     the model there (resolved once, as screened) and the screens run."""
     kmax = _spec.stiffness_limit(model.spec, stroke)
-    lo, hi = math.log(kmax / 40.0), math.log(kmax)
+    k_top = top_stiffness(model, stroke)
+    lo, hi = math.log(kmax / 40.0), math.log(k_top)
     at = lambda k: model.varied({"isolator.stroke": stroke, "isolator.stiffness": k})
     n = 1
-    top = at(kmax)
+    top = at(k_top)
     if _margin_ok(top, margin)[0]:
-        return kmax, top, n
+        return k_top, top, n
     n += 1
     best = at(math.exp(lo))
     if not _margin_ok(best, margin)[0]:
@@ -103,6 +107,29 @@ def _stiffest(model: Model, stroke: float,
         else:
             hi = mid
     return math.exp(lo), best, n
+
+
+def top_stiffness(model: Model, stroke: float) -> float:
+    """The stiffest joint a change of the spec may ask for at a stroke [N/m].
+
+    The search's top target, :data:`~.search.TOP` x k_max; where the spec's
+    flexure section sizes the guide from stock, lower still, so that the
+    stock's thickest leaves keep k_max (:func:`~.constraints.guide_for`), as
+    the recommended design does; rounded down to the digits the change is
+    written with (:data:`~.write.DIGITS`).
+    """
+    from .search import TOP
+    from .write import DIGITS
+
+    k = TOP * _spec.stiffness_limit(model.spec, stroke)
+    fx = model.flexure if model.flexure_spec is not None else None
+    if fx is not None and not fx.drawn:  # a guide from stock: its tolerance scatters k
+        sized = _c.guide_for(model, k, stroke, _spec.design_crossover(model.spec))
+        if sized.feasible:
+            k = min(k, sized.mechanics.net_drive_stiffness)
+    # rounded down to the digits the change is written with: the spec gets what was judged
+    step = 10.0 ** (math.floor(math.log10(k)) - DIGITS + 1)
+    return math.floor(k / step) * step
 
 
 def _passes(model: Model, executor: Any) -> tuple[bool, str]:
@@ -194,8 +221,11 @@ def least_change(search: Any, *, executor: Any = None,
         if ok:
             words = (f"a drive stiffness of {quantity(k, 'N/m', 4)}" if stroke == s0 else
                      f"a {quantity(stroke, 'm')} stroke at {quantity(k, 'N/m', 4)}")
-            return done(values, words + f", the loop at {quantity(fc0, 'Hz', 4)}",
-                        (f"the hunting margin {number(margin, 6)} at {quantity(fc0, 'Hz', 4)}",))
+            kmax = _spec.stiffness_limit(spec, stroke)
+            bound = (f"k_max = Fs / stroke = {quantity(kmax, 'N/m', 4)} at "
+                     f"{quantity(stroke, 'm')} stroke" if k >= top_stiffness(model, stroke) else
+                     f"the hunting margin {number(margin, 6)} at {quantity(fc0, 'Hz', 4)}")
+            return done(values, words + f", the loop at {quantity(fc0, 'Hz', 4)}", (bound,))
         tried.append(f"{what} at {quantity(stroke, 'm')}, {quantity(k, 'N/m', 4)}: {why}")
     return LeastChange(changes={}, feasible=False, binding=(), text="no edit of one or two "
                        "values passes: build the recommended design", tried=tuple(tried))

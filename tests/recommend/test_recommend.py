@@ -245,6 +245,7 @@ def test_the_written_spec_passes_the_design_command(paper_recommendation, tmp_pa
 
 
 def test_the_least_change_passes(paper_recommendation, paper_spec):
+    from fi_design.display import quantity
     from fi_design.guideline.evaluate import evaluate as design
     from fi_design.spec.file import with_values
 
@@ -253,6 +254,12 @@ def test_the_least_change_passes(paper_recommendation, paper_spec):
     assert lc.tried and "crossover alone" in lc.tried[0]     # the crossover alone was tried first
     r = design(with_values(variant(paper_spec, **FEW), lc.changes))
     assert r.verdict.status != "FAIL", [x.text for x in r.verdict.reasons]
+    # the guide the spec then sizes keeps k_max with the stock's thickest leaves too (it asked
+    # for k_max itself, 3333 N/m at 1.2 mm, whose 0.56 mm leaves gave 3536 N/m)
+    fx, kmax = r.flexure, r.stiffness.maximum
+    assert r.stiffness.chosen <= 0.99 * kmax and fx.stiffness_range[1] <= kmax * (1 + 1e-9)
+    # that stiffness keeps the margin, so k_max binds it (it said the hunting margin)
+    assert lc.binding[0].startswith(f"k_max = Fs / stroke = {quantity(kmax, 'N/m', 4)} at")
 
 
 def test_an_empty_space_says_so_with_the_nearest_design(repo_root, tmp_path):
