@@ -34,7 +34,7 @@ from ..display import number, percent, quantity
 from ..model import Model
 from ..spec.file import with_values
 
-__all__ = ["SEARCH_POINTS", "reserve_values", "reserve_requirements", "crossover_cap",
+__all__ = ["SEARCH_POINTS", "TOP", "reserve_values", "reserve_requirements", "crossover_cap",
            "notched_model", "notch_entries", "guide_for", "thickest_stiffness",
            "guide_bounds", "loop_meets", "stage_answer",
            "margin_screen", "reserve_corners", "hunting_margin"]
@@ -42,6 +42,9 @@ __all__ = ["SEARCH_POINTS", "reserve_values", "reserve_requirements", "crossover
 #: Lengths of the guide's sizing grid during the search (the chosen design is sized again at
 #: full resolution).
 SEARCH_POINTS = 41
+#: The stiffest target of the search and of the least change, a fraction of k_max [-]: a
+#: drawing's rounding stays within k_max.
+TOP = 0.99
 #: Sizings of a guide at most: the first at the target, the others at a target lowered until
 #: the stock's thickest leaves stay within k_max (:func:`guide_for`).
 TOLERANCE_SIZINGS = 4

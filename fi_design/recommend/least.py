@@ -112,16 +112,15 @@ def _stiffest(model: Model, stroke: float,
 def top_stiffness(model: Model, stroke: float) -> float:
     """The stiffest joint a change of the spec may ask for at a stroke [N/m].
 
-    The search's top target, :data:`~.search.TOP` x k_max; where the spec's
+    The search's top target, :data:`~.constraints.TOP` x k_max; where the spec's
     flexure section sizes the guide from stock, lower still, so that the
     stock's thickest leaves keep k_max (:func:`~.constraints.guide_for`), as
     the recommended design does; rounded down to the digits the change is
     written with (:data:`~.write.DIGITS`).
     """
-    from .search import TOP
     from .write import DIGITS
 
-    k = TOP * _spec.stiffness_limit(model.spec, stroke)
+    k = _c.TOP * _spec.stiffness_limit(model.spec, stroke)
     fx = model.flexure if model.flexure_spec is not None else None
     if fx is not None and not fx.drawn:  # a guide from stock: its tolerance scatters k
         sized = _c.guide_for(model, k, stroke, _spec.design_crossover(model.spec))

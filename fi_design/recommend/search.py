@@ -41,6 +41,7 @@ from ..model import Model
 from ..results.recommend import DesignCandidate, RecommendResult
 from . import constraints as _c
 from . import objective as _o
+from .constraints import TOP
 from .space import STROKE_SPAN, Candidate, base_model, damping_ratio, stroke_envelope
 
 log = logging.getLogger(__name__)
@@ -52,8 +53,6 @@ STROKES = 5
 #: Target stiffnesses per stroke, log-spaced from k_max / :data:`STIFFNESS_SPAN` to k_max.
 STIFFNESSES = 6
 STIFFNESS_SPAN = 40.0
-#: The stiffest target, a fraction of k_max [-]: a drawing's rounding stays within k_max.
-TOP = 0.99
 #: Bisection steps of the stiffness at the best stroke.
 REFINE_STEPS = 3
 #: Lengths of the chosen guide's sizing grid (the search's is coarser).
