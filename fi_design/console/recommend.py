@@ -90,6 +90,10 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
     t.add_row(f"Hunting margin (required {number(req.hunting_margin, 3)})", "",
               _margin(m.get("hunting_margin")))
     t.add_row("k_max / k", "", number(m.get("stiffness_factor"), 3))
+    lo, hi = (fx.stiffness_range or (None, None)) if fx is not None else (None, None)
+    if lo is not None and hi > lo:  # the stock's tolerance: k goes with t^3
+        t.add_row(f"k over the leaves' tolerance (\u00b1{_mm(fx.thickness_tolerance)})", "",
+                  f"{number(lo)} to {number(hi)} N/m")
     t.add_row("End-stop clearance at rest", "", "-" if m.get("end_stop_clearance") is None
               else quantity(m["end_stop_clearance"], "m", 3))
     t.add_row("Not settling under scatter", "", "-" if d.unsettled_probability is None

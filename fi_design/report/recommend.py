@@ -7,6 +7,7 @@ from typing import Any
 from ..results.recommend import RecommendResult
 from .blocks import FigureBlock, Section, Table, figure_block
 from .context import build_context, document_context
+from ..display import NBSP, quantity
 from .filters import num, qty
 from .meta import TITLES
 
@@ -43,8 +44,13 @@ def _design_rows(result: RecommendResult) -> tuple[tuple[str, str, str], ...]:
              ("No move hunts from", "", qty(d.hunting_free_from, "Hz")),
              (f"Hunting margin (required {num(req.hunting_margin, 3)})", "",
               "no cycle found" if hm is not None and hm == float("inf") else num(hm, 3)),
-             ("k_max / k", "", num(m.get("stiffness_factor"), 3)),
-             ("End-stop clearance at rest", "", qty(m.get("end_stop_clearance"), "m", 3)),
+             ("k_max / k", "", num(m.get("stiffness_factor"), 3))]
+    lo, hi = (fx.stiffness_range or (None, None)) if fx is not None else (None, None)
+    if lo is not None and hi > lo:  # the stock's tolerance: k goes with t^3
+        dt = quantity(fx.thickness_tolerance, "m", 3, shown=("mm", 1e3), sep=NBSP)
+        rows.append((f"k over the leaves' tolerance (\u00b1{dt})", "",
+                     f"{num(lo)} to {qty(hi, 'N/m')}"))
+    rows += [("End-stop clearance at rest", "", qty(m.get("end_stop_clearance"), "m", 3)),
              ("Not settling under scatter", "",
               "" if d.unsettled_probability is None
               else qty(100 * d.unsettled_probability, "%"))]

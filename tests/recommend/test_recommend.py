@@ -488,3 +488,28 @@ def test_the_report_s_table_quotes_the_design_as_the_advice_does(paper_recommend
     numbers = re.findall(r"[0-9.]+", leaves)
     assert " x ".join(numbers) + " mm leaves" in paper_recommendation.advice
     assert STIFFNESS_ROW in rows and "net of gravity" not in STIFFNESS_ROW.split("(")[0]
+
+
+def test_the_console_and_the_report_show_k_over_the_stock_tolerance(paper_recommendation):
+    """The engineer orders stock of +-0.01 mm: the design's table shows the drive stiffness
+    over that tolerance, its thick end within k_max (it was 4148 to 4662 N/m against k_max
+    4444 N/m, and shown nowhere)."""
+    from datetime import date
+
+    from rich.console import Console
+
+    from fi_design.console.recommend import print_recommendation
+    from fi_design.display import number
+    from fi_design.report import build_context
+
+    r = paper_recommendation
+    lo, hi = r.flexure.stiffness_range
+    kmax = r.design.stiffness * r.margins["stiffness_factor"]
+    assert lo < r.design.stiffness < hi <= kmax * (1 + 1e-9)
+    console = Console(record=True, width=100)
+    print_recommendation(console, r)
+    text = " ".join(console.export_text().split())
+    assert f"k over the leaves' tolerance (\u00b10.01 mm) {number(lo)} to {number(hi)} N/m" in text
+    ctx = json.dumps(build_context(r, date=date(2024, 5, 1), figures=False), default=str,
+                     ensure_ascii=False)
+    assert "k over the leaves' tolerance (\u00b10.01\u00a0mm)" in ctx and f"{number(lo)} to " in ctx
