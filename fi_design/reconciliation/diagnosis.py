@@ -83,7 +83,8 @@ DRIVE_FACTOR_SIGMAS = 2.0
 
 def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
              best_explained: float, after: ModelRun | None = None,
-             chi2_after: float | None = None, best_fit: str = "") -> Diagnosis:
+             chi2_after: float | None = None, best_fit: str = "",
+             drive: ForceCheck | None = None) -> Diagnosis:
     """Whether the model's structure misses the record, and the likely causes.
 
     Parameters
@@ -104,6 +105,9 @@ def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
         (default ``chi2_nominal``).
     best_fit : str
         The effect(s) of that fit, for the message.
+    drive : ForceCheck, optional
+        Open loop: :func:`drive_check` of ``cmp`` where the caller has it already (it
+        reads the record alone); default worked out here.
     """
     misfit = math.sqrt(chi2_nominal / cmp.n_points)
     misfit_after = misfit if chi2_after is None else math.sqrt(chi2_after / cmp.n_points)
@@ -114,8 +118,10 @@ def diagnose(cmp: Comparison, nominal: ModelRun, chi2_nominal: float,
     r = np.where(np.isfinite(model), meas - model, 0.0)
     crossover = cmp.model.crossover
     spec = _spectrum(r, cmp.t)
-    check = force_check(cmp, nominal if after is None else after) if cmp.has_force else \
-        drive_check(cmp)
+    if cmp.has_force:
+        check = force_check(cmp, nominal if after is None else after)
+    else:
+        check = drive_check(cmp) if drive is None else drive
     causes = _causes(cmp, r, crossover, use_force)
     if check.cause is not None:
         causes.append(check.cause)

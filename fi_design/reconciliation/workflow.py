@@ -150,7 +150,7 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     best = max((c.explained for c in first if c.success), default=0.0)
     fitted = _best_fit(first, final, nominal)
     diagnosis = diagnose(cmp, nominal.run, nominal.chi2, best, after=final.run,
-                         chi2_after=fitted.chi2, best_fit=fitted.name)
+                         chi2_after=fitted.chi2, best_fit=fitted.name, drive=check)
     fault = record_fault(diagnosis)
     if fault is not None and search.chosen:
         # a force channel no effect can produce: nothing is named from it

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..display import NBSP, quantity
 from ..results.recommend import RecommendResult
 from .blocks import FigureBlock, Section, Table, figure_block
 from .context import build_context, document_context
-from ..display import NBSP, quantity
 from .filters import num, qty
 from .meta import TITLES
 

@@ -15,8 +15,8 @@ from typing import Mapping, Sequence
 from . import Result, Status
 from .controller import ControlLaw
 
-__all__ = ["CRITERIA", "NOT_JUDGED", "phase_margin_judged", "loop_crossover", "GainCrossing", "PhaseCrossing", "CaseMargins", "LoopAnalysis",
-           "AchievableCrossover"]
+__all__ = ["CRITERIA", "NOT_JUDGED", "phase_margin_judged", "loop_crossover", "GainCrossing",
+           "PhaseCrossing", "CaseMargins", "LoopAnalysis", "AchievableCrossover"]
 
 #: The requirements a limit case is judged on, in the order they are listed.
 CRITERIA = ("stability", "phase margin", "gain margin", "modulus margin")
