@@ -82,12 +82,12 @@ def _margin_ok(model: Model, margin: float) -> tuple[bool, dict]:
     return ans["keeps"], ans
 
 
-def _stiffest(model: Model, stroke: float,
-              margin: float) -> tuple[float | None, Model | None, int]:
-    """The stiffest drive stiffness at a stroke that keeps the margin (bisection on log k),
-    the model there (resolved once, as screened) and the screens run."""
+def _stiffest(model: Model, stroke: float, margin: float,
+              k_top: float) -> tuple[float | None, Model | None, int]:
+    """The stiffest drive stiffness at a stroke that keeps the margin (bisection on log k, up
+    to ``k_top``, :func:`top_stiffness`), the model there (resolved once, as screened) and the
+    screens run."""
     kmax = _spec.stiffness_limit(model.spec, stroke)
-    k_top = top_stiffness(model, stroke)
     lo, hi = math.log(kmax / 40.0), math.log(k_top)
     at = lambda k: model.varied({"isolator.stroke": stroke, "isolator.stiffness": k})
     n = 1
@@ -208,7 +208,8 @@ def least_change(search: Any, *, executor: Any = None,
         if s0 * f <= search.envelope[1]]
     for stroke, what in options:
         say(f"the least change: {what} ({quantity(stroke, 'm')}) ...")
-        k, cand, n = _stiffest(model, stroke, margin)
+        k_top = top_stiffness(model, stroke)
+        k, cand, n = _stiffest(model, stroke, margin, k_top)
         search.evaluations += n
         if k is None:
             tried.append(f"{what} at {quantity(stroke, 'm')}: no stiffness keeps the hunting "
@@ -222,7 +223,7 @@ def least_change(search: Any, *, executor: Any = None,
                      f"a {quantity(stroke, 'm')} stroke at {quantity(k, 'N/m', 4)}")
             kmax = _spec.stiffness_limit(spec, stroke)
             bound = (f"k_max = Fs / stroke = {quantity(kmax, 'N/m', 4)} at "
-                     f"{quantity(stroke, 'm')} stroke" if k >= top_stiffness(model, stroke) else
+                     f"{quantity(stroke, 'm')} stroke" if k >= k_top else
                      f"the hunting margin {number(margin, 6)} at {quantity(fc0, 'Hz', 4)}")
             return done(values, words + f", the loop at {quantity(fc0, 'Hz', 4)}", (bound,))
         tried.append(f"{what} at {quantity(stroke, 'm')}, {quantity(k, 'N/m', 4)}: {why}")
