@@ -34,7 +34,10 @@ def step_response(num, den, t):
     """Exact unit-step response of a strictly proper num/den at times t >= 0.
 
     Controllable canonical form; the constant input is one more state of the matrix
-    exponential (Van Loan), so the state at t is exact, not a numerical integration.
+    exponential (Van Loan), so the state at t is exact, not a numerical integration. On a
+    uniform grid the exponential of the first time is carried on by the exponential of the
+    spacing (exact too, to rounding: 1e-15 of the response against one exponential per time,
+    which cost a second per test).
     """
     num = np.atleast_1d(np.asarray(num, float))
     den = np.atleast_1d(np.asarray(den, float))
@@ -52,10 +55,17 @@ def step_response(num, den, t):
     M = np.zeros((n + 1, n + 1))
     M[:n, :n] = A
     M[:n, n] = B
+    t = np.asarray(t, float)
     out = np.empty(len(t))
-    for i, ti in enumerate(t):
-        x = expm(M * ti)[:n, n]
-        out[i] = C @ x
+    if len(t) < 3 or np.ptp(np.diff(t)) > 1e-9 * (t[-1] - t[0]):  # not uniform: one by one
+        for i, ti in enumerate(t):
+            out[i] = C @ expm(M * ti)[:n, n]
+        return out
+    step = expm(M * ((t[-1] - t[0]) / (len(t) - 1)))
+    z = expm(M * t[0])[:, n]  # the state and the input, the input one
+    for i in range(len(t)):
+        out[i] = C @ z[:n]
+        z = step @ z
     return out
 
 
