@@ -132,10 +132,11 @@ def test_jerk_limited_reference_respects_all_limits(paper_spec):
 def test_dense_output_is_as_accurate_as_the_steps(paper_spec):
     """The 1 kHz outputs lie between steps (a few thousand steps for 20 001 samples);
     the continuous extension keeps them at the tolerance's accuracy, and tighter
-    tolerance makes them better."""
+    tolerance makes them better. The reference at rtol 1e-9 lies within 4e-13 of rtol 1e-10, a
+    thousandth of the smallest difference measured here, at three quarters of its cost."""
     from fi_design.simulation.run import simulate
 
-    exact = simulate(paper_spec, isolated=True, method="reference", rtol=1e-10)
+    exact = simulate(paper_spec, isolated=True, method="reference", rtol=1e-9)
     errs = []
     for rtol in (1e-4, 1e-6):
         r = simulate(paper_spec, isolated=True, rtol=rtol)

@@ -352,7 +352,8 @@ def test_switch_model_matches_its_reference_and_the_paper_trend(paper_spec):
                                "requirements.hunting.window_start": 1.0,
                                "requirements.hunting.window_length": 2.0})
     fast = simulate(short, isolated=False)
-    ref = simulate(short, isolated=False, method="reference", rtol=1e-9)
+    # rtol 1e-8: within 1.3e-11 of rtol 1e-9 at two thirds of its cost
+    ref = simulate(short, isolated=False, method="reference", rtol=1e-8)
     assert np.max(np.abs(fast.position - ref.position)) < 5e-6
     # the cart really sticks: zero velocity over stretches of the trace
     assert np.mean(fast.cart_velocity == 0.0) > 0.2
