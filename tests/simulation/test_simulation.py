@@ -229,13 +229,19 @@ def test_a_delay_lowers_the_phase(paper_spec):
 
 
 def test_delay_matches_the_reference_path(paper_spec):
-    spec = variant(paper_spec, **{"controller.delay": "2 ms", "motion.duration": 3.0,
-                                    "requirements.hunting.window_start": 1.0,
-                                    "requirements.hunting.window_length": 2.0})
+    """The first second: the move, the cart's stick-slip after it (sticks at 0.30, 0.33 and
+    0.37 s; the largest difference at 0.31 s), then the cart rests in presliding while the
+    stage settles on the joint, a slow exponential the 3 s run followed to 3 s at 25 % more
+    CPU (the reference's cost lies in the move and the sticks)."""
+    spec = variant(paper_spec, **{"controller.delay": "2 ms", "motion.duration": 1.0,
+                                    "requirements.hunting.window_start": 0.5,
+                                    "requirements.hunting.window_length": 0.5})
     fast = simulate(spec, isolated=True)
     ref = simulate(spec, isolated=True, method="reference", rtol=1e-8)
     assert fast.success and ref.success
-    assert np.max(np.abs(fast.position - ref.position)) < 2e-6
+    # 0.27 nm (2 um before: a delay 2.5 % off moved the stage by 1 um and passed; 0.1 % off
+    # moves it by 42 nm)
+    assert np.max(np.abs(fast.position - ref.position)) < 2e-8
     # the applied force is the command 2 ms earlier
     i = np.searchsorted(fast.time, 0.5)
     assert fast.applied_force[i + 2] == pytest.approx(fast.force[i], abs=1e-9)
@@ -331,14 +337,20 @@ def test_discrete_controller_approaches_the_continuous_one(paper_spec):
 
 
 def test_discrete_controller_matches_the_reference_path(paper_spec):
+    """The first second: the move, the cart's stick-slip after it (sticks at 0.31, 0.33 and
+    0.38 s; the largest difference at 0.05 s), then the cart rests in presliding while the
+    stage settles on the joint, a slow exponential the 2 s run followed to 2 s at 1.8 times
+    the CPU (the reference restarts at every sample and every delayed update)."""
     spec = variant(paper_spec, **{"controller.sample_rate": "1 kHz", "controller.delay": "0.5 ms",
-                                    "motion.duration": 2.0,
-                                    "requirements.hunting.window_start": 1.0,
-                                    "requirements.hunting.window_length": 1.0})
+                                    "motion.duration": 1.0,
+                                    "requirements.hunting.window_start": 0.5,
+                                    "requirements.hunting.window_length": 0.5})
     fast = simulate(spec, isolated=True)
     ref = simulate(spec, isolated=True, method="reference", rtol=1e-8)
     assert fast.success and ref.success
-    assert np.max(np.abs(fast.position - ref.position)) < 2e-6
+    # 0.03 nm (2 um before: a delay 4 % off moved the stage by 0.4 um and passed; 0.4 % off
+    # moves it by 38 nm)
+    assert np.max(np.abs(fast.position - ref.position)) < 2e-8
 
 
 def test_switch_model_matches_its_reference_and_the_paper_trend(paper_spec):
