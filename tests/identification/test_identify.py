@@ -502,9 +502,35 @@ def test_cli_on_emps_json_spec_and_report(emps_path, tmp_path):
     assert html.count("<svg") >= 2 and "velocity of the bearing side [mm/s]" in html
     again = runner.invoke(app, args)  # outputs exist: refused without --force
     assert again.exit_code == 2 and "--force" in again.output
-    design = runner.invoke(app, [str(spec_out)])  # the design command, simulation included
+    # the design command's four linear steps on the written spec; its nonlinear confirmation
+    # (49 moves on two plants and 100 friction-scatter samples: half a minute of CPU) runs in
+    # test_cli_on_emps_design_with_its_confirmation (slow); here the written spec's own motion
+    # is simulated once, as the confirmation's "spec's motion" does
+    design = runner.invoke(app, [str(spec_out), "--no-simulation"])
     assert design.exit_code == 0, design.output
     assert "crosses over" in design.output
+    spec = load_spec(spec_out)
+    sim = simulate(spec)
+    assert sim.success and sim.metrics.settled and sim.metrics.hunting_cycles == 0
+    # a PD loop without integrator rests where its spring kp e balances the friction and the
+    # offset: |x - r| <= (Fs + |offset|) / kp (17 um; the run ends 3 um off)
+    f, kp = spec.friction, spec.controller.gains.kp
+    assert abs(sim.position[-1] - sim.reference[-1]) <= (f.static + abs(f.offset)) / kp
+
+
+@pytest.mark.slow
+def test_cli_on_emps_design_with_its_confirmation(emps_path, tmp_path):
+    """The written spec through the whole design command, its simulated confirmation included
+    (half a minute of CPU). The default run checks the written spec with the linear steps and
+    one simulation of its motion (test_cli_on_emps_json_spec_and_report) and the simulation of
+    the identified axis against the record (test_emps_closed_loop_replay_with_the_identified_friction)."""
+    spec_out = tmp_path / "emps.yaml"
+    res = runner.invoke(app, ["identify", str(emps_path), "--spec",
+                              str(EXAMPLES / "emps_axis.yaml"), "--write-spec", str(spec_out)])
+    assert res.exit_code == 0, res.output
+    design = runner.invoke(app, [str(spec_out)])  # the design command, simulation included
+    assert design.exit_code == 0, design.output
+    assert "crosses over" in design.output and "Nonlinear confirmation" in design.output
 
 
 def test_the_identification_report_is_registered_like_every_other(symmetric_record):
