@@ -38,27 +38,33 @@ runner = CliRunner()
 
 #: A 100 kg axis under a PD loop like the EMPS drive's (D on the measured velocity, 1 kHz).
 AXIS_CONTROLLER = dict(kp=1.371e6, kd=8557.0, derivative_on="measurement", sample_rate=1000.0)
-#: Moves in both directions at several speeds and accelerations, resting in between.
+#: Moves in both directions at several speeds and accelerations, resting in between: two
+#: forwards, then two backwards, so the record's halves (split at AXIS_SPLIT, in the rest
+#: between them) each slide one way only (the one-direction tests read them).
 AXIS_MOVES = [dict(distance=0.1, velocity=0.1, acceleration=1.0),
-              dict(distance=-0.1, velocity=0.05, acceleration=0.5, start=1.5),
-              dict(distance=0.05, velocity=0.08, acceleration=2.0, start=4.0),
-              dict(distance=-0.05, velocity=0.12, acceleration=1.5, start=5.5)]
+              dict(distance=0.05, velocity=0.08, acceleration=2.0, start=1.5),
+              dict(distance=-0.1, velocity=0.05, acceleration=0.5, start=2.6),
+              dict(distance=-0.05, velocity=0.12, acceleration=1.5, start=5.1)]
+#: Duration of the axis records [s] (the last move ends at 5.6 s) and the instant between the
+#: forward moves (the second ends at 2.17 s) and the backward ones (the first starts at 2.6 s).
+AXIS_T_END = 6.0
+AXIS_SPLIT = 2.4
 #: Sensor noise and an encoder count of the recorded columns.
 AXIS_NOISE = dict(position=2e-8, force=0.2)
 RESOLUTION = 5e-8
 
 
 def axis_run(friction: dict, seed: int = 3, disturbance=None):
-    """A 100 kg axis simulated by the independent simulator (7 s, four moves), as its
+    """A 100 kg axis simulated by the independent simulator (6 s, four moves), as its
     :class:`independent.Record` (the noise-free signals kept)."""
     return independent.generate(100.0, 0.0, friction=friction, controller=AXIS_CONTROLLER,
-                                moves=AXIS_MOVES, t_end=7.0, noise=AXIS_NOISE,
+                                moves=AXIS_MOVES, t_end=AXIS_T_END, noise=AXIS_NOISE,
                                 position_resolution=RESOLUTION, seed=seed,
                                 disturbance=disturbance)
 
 
 def axis_record(friction: dict, seed: int = 3, disturbance=None):
-    """A 100 kg axis recorded by the independent simulator (7 s, four moves)."""
+    """A 100 kg axis recorded by the independent simulator (6 s, four moves)."""
     return axis_run(friction, seed, disturbance).measurement()
 
 
@@ -74,12 +80,16 @@ def assert_recovered(result, truth: dict, within: float = 3.0) -> None:
 # --------------------------------------------------------------------------- known truths
 
 
+#: Symmetric Coulomb friction, viscous friction per direction, an offset, LuGre below.
+SYMMETRIC_FRICTION = dict(Fs=25.0, Fc=20.0, vs=0.002, sigma0=1e6, sigma2=150.0, sigma2_neg=220.0,
+                          offset=-1.5)
+
+
 @pytest.fixture(scope="module")
 def symmetric_run():
-    """Symmetric Coulomb friction, viscous friction per direction, an offset, LuGre below: the
-    independent simulator's record (noise-free signals kept, for :func:`recorded_again`)."""
-    return axis_run(dict(Fs=25.0, Fc=20.0, vs=0.002, sigma0=1e6, sigma2=150.0, sigma2_neg=220.0,
-                         offset=-1.5))
+    """The axis with :data:`SYMMETRIC_FRICTION`: the independent simulator's record (noise-free
+    signals kept, for :func:`recorded_again`)."""
+    return axis_run(SYMMETRIC_FRICTION)
 
 
 @pytest.fixture(scope="module")
@@ -569,22 +579,17 @@ def test_report_escapes_user_text(symmetric_record, tmp_path):
 
 # --------------------------------------------------------------------------- one direction
 
-#: Moves that all slide forwards (or, negated, backwards), at several speeds, resting between.
-ONE_WAY = [dict(distance=0.1, velocity=0.1, acceleration=1.0),
-           dict(distance=0.1, velocity=0.05, acceleration=0.5, start=1.5),
-           dict(distance=0.05, velocity=0.08, acceleration=2.0, start=4.3),
-           dict(distance=0.05, velocity=0.12, acceleration=1.5, start=6.0)]
-ONE_WAY_FRICTION = dict(Fs=25.0, Fc=20.0, vs=0.002, sigma0=1e6, sigma2=150.0, sigma2_neg=220.0,
-                        offset=-1.5)
+ONE_WAY_FRICTION = SYMMETRIC_FRICTION
 
 
 @pytest.fixture(scope="module", params=[1, -1], ids=["forwards", "backwards"])
-def one_way(request):
+def one_way(request, symmetric_record):
+    """A record that slides forwards (or backwards) only, at two speeds and accelerations,
+    resting between: the symmetric record's first (or second) half, its two forward (or
+    backward) moves (the same per-direction content the symmetric record's fit has)."""
     s = request.param
-    moves = [{**m, "distance": s * m["distance"]} for m in ONE_WAY]
-    rec = independent.generate(100.0, 0.0, friction=ONE_WAY_FRICTION, controller=AXIS_CONTROLLER,
-                               moves=moves, t_end=7.0, noise=AXIS_NOISE,
-                               position_resolution=RESOLUTION, seed=4).measurement()
+    rec = (segment(symmetric_record, None, AXIS_SPLIT) if s > 0
+           else segment(symmetric_record, AXIS_SPLIT))
     v = np.gradient(rec.position, rec.time)
     # only the overshoots at the ends of the moves creep back, slower than the velocity
     # threshold of the identification (10 % of the peak speed): it slides one way only
