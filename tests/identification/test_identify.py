@@ -121,10 +121,21 @@ def test_per_direction_form_reads_the_same_fit(symmetric_record):
     assert per.parameters["offset"].value is None and "absorbed" in per.parameters["offset"].note
 
 
-def test_per_direction_truth_recovered_in_both_forms():
-    """Coulomb friction that differs between the directions, with an offset on top."""
-    rec = axis_record(dict(Fs=22.0, Fc=18.0, Fc_neg=23.0, vs=0.002, sigma0=1e6, sigma2=150.0,
-                           offset=0.8), seed=5)
+@pytest.fixture(scope="module")
+def per_direction_record():
+    """Coulomb friction that differs between the directions, an offset on top, and injected
+    force pulses (30 N for 0.1 s every 0.7 s) in force_N and disturbance_N: the record of the
+    per-direction test and of the disturbance test (one simulation for both)."""
+    t = np.arange(0.0, AXIS_T_END, 0.05)
+    pulses = np.where((t % 0.7) < 0.1, 30.0, 0.0)
+    return axis_record(dict(Fs=22.0, Fc=18.0, Fc_neg=23.0, vs=0.002, sigma0=1e6, sigma2=150.0,
+                            offset=0.8), seed=5, disturbance=(t, pulses))
+
+
+def test_per_direction_truth_recovered_in_both_forms(per_direction_record):
+    """Coulomb friction that differs between the directions, with an offset on top (and the
+    force pulses of the disturbance test, in the force that acts)."""
+    rec = per_direction_record
     per = identify(rec, form="per_direction")
     # the constant force per direction: Fc + offset sliding forwards, Fc_neg - offset backwards
     assert_recovered(per, dict(mass=100.0, coulomb=18.8, coulomb_negative=22.2, viscous=150.0,
@@ -133,16 +144,18 @@ def test_per_direction_truth_recovered_in_both_forms():
     assert_recovered(sym, dict(coulomb=(18.8 + 22.2) / 2, offset=(18.8 - 22.2) / 2))
 
 
-def test_disturbance_column_the_force_that_acts_is_used():
-    """Injected pulses: force_N (which includes them) is the force on the stage."""
-    t = np.arange(0.0, 7.0, 0.05)
-    pulses = np.where((t % 0.7) < 0.1, 30.0, 0.0)
-    rec = axis_record(dict(Fs=25.0, Fc=20.0, vs=0.002, sigma0=1e6, sigma2=150.0,
-                           sigma2_neg=150.0, offset=1.0), seed=7, disturbance=(t, pulses))
+def test_disturbance_column_the_force_that_acts_is_used(per_direction_record):
+    """Injected pulses: force_N (which includes them) is the force on the stage.
+
+    The per-direction record carries them. Fitted with force_N - disturbance_N instead, the
+    fit leaves 22 % of the force (its standard errors grow with it, so the truth stays within
+    three of them): the relative error, not the truth alone, tells the right force."""
+    rec = per_direction_record
     assert rec.disturbance is not None and np.ptp(rec.disturbance) == pytest.approx(30.0)
     r = identify(rec)
-    assert_recovered(r, dict(mass=100.0, coulomb=20.0, viscous=150.0, viscous_negative=150.0,
-                             offset=1.0))
+    assert_recovered(r, dict(mass=100.0, coulomb=(18.8 + 22.2) / 2, viscous=150.0,
+                             viscous_negative=150.0, offset=(18.8 - 22.2) / 2))
+    assert r.fit.relative_error < 0.01
     assert any("disturbance_N" in n for n in r.notes)
 
 
