@@ -548,7 +548,8 @@ def test_cli_on_emps_design_with_its_confirmation(emps_path, tmp_path):
     """The written spec through the whole design command, its simulated confirmation included
     (half a minute of CPU). The default run checks the written spec with the linear steps and
     one simulation of its motion (test_cli_on_emps_json_spec_and_report) and the simulation of
-    the identified axis against the record (test_emps_closed_loop_replay_with_the_identified_friction)."""
+    the identified axis against the record
+    (test_emps_closed_loop_replay_with_the_identified_friction)."""
     spec_out = tmp_path / "emps.yaml"
     res = runner.invoke(app, ["identify", str(emps_path), "--spec",
                               str(EXAMPLES / "emps_axis.yaml"), "--write-spec", str(spec_out)])
@@ -594,6 +595,7 @@ def test_report_escapes_user_text(symmetric_record, tmp_path):
 
 # --------------------------------------------------------------------------- one direction
 
+#: The friction of the one-direction records (the symmetric record's halves).
 ONE_WAY_FRICTION = SYMMETRIC_FRICTION
 
 
