@@ -1185,18 +1185,18 @@ def test_chromium_console_check_sees_errors(tmp_path):
 
 @needs_chromium
 def test_html_renders_in_chromium_without_console_errors(design_html, tmp_path):
+    """One headless run takes the screenshot and dumps the DOM it rendered."""
     page = _artifacts() / "report.html"
     shot = _artifacts() / "report-chromium.png"
     shot.unlink(missing_ok=True)
-    p = _headless(page, tmp_path, f"--screenshot={shot}", "--window-size=1000,9000")
+    p = _headless(page, tmp_path, f"--screenshot={shot}", "--window-size=1000,9000",
+                  "--dump-dom")
     assert p.returncode == 0, p.stderr[-2000:]
     assert not CONSOLE.search(p.stderr), [ln for ln in p.stderr.splitlines()
                                           if CONSOLE.search(ln)]
     assert shot.is_file() and shot.stat().st_size > 50_000
-    dom = _headless(page, tmp_path, "--dump-dom")
-    assert dom.returncode == 0 and not CONSOLE.search(dom.stderr)
     for sid in DESIGN_SECTIONS:
-        assert f'id="{sid}"' in dom.stdout
+        assert f'id="{sid}"' in p.stdout
 
 
 # --------------------------------------------------------------------------- CLI
@@ -1254,13 +1254,15 @@ def test_cli_map_needs_a_report(monkeypatch, paper_spec_path):
 
 def test_cli_writes_the_html_report_with_force(tmp_path, paper_spec_path, shared_designs):
     """The command replaces an existing report with --force, atomically, every section in
-    order. Without the design search (--no-recommend: how the command writes the report is
-    checked here, not what the search finds); the README's first command, the search and
-    its report included, runs in tests/test_docs.py::test_readme_run_command_succeeds_on_every_run."""
+    order. How the command writes the report is checked here, not what it computes: the
+    design of the linear steps (--no-simulation, a report of every section, the nonlinear
+    one saying it was not run); the README's first command, the simulation, the design
+    search and their report included, is run twice by
+    tests/test_docs.py::test_readme_run_command_succeeds_on_every_run."""
     out = tmp_path / "report.html"
     out.write_text("old")
     r = runner.invoke(app, [str(paper_spec_path), "--report", str(out), "--force",
-                            "--no-recommend"])
+                            "--no-simulation"])
     assert r.exit_code == 0, r.output
     assert f"wrote {out}" in r.output.replace("\n", "")
     text = out.read_text(encoding="utf-8")
