@@ -680,6 +680,21 @@ def test_pdf_figures_drawn_by_a_pool_of_two_workers(pdf_drawn_by_workers, figure
     assert sorted(n for n, _ in asked) == sorted(figures_drawn_here[1])
 
 
+def test_a_figure_stand_in_is_an_rgb_png_of_its_size_that_names_it():
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    from fi_design.report.render import _STAND_IN_KEY, _rgb_png_rows, _stand_in
+
+    with Image.open(io.BytesIO(_stand_in("bode", 37, 11))) as image:
+        assert image.format == "PNG" and image.mode == "RGB" and image.size == (37, 11)
+        assert image.info[_STAND_IN_KEY] == "bode"
+        assert _rgb_png_rows(image) is not None
+        assert (np.asarray(image) == 255).all()
+
+
 @pytest.mark.skipif(shutil.which("pdfimages") is None, reason="poppler-utils is not installed")
 def test_pdf_laid_out_with_stand_ins_holds_the_figures_drawn_by_the_worker(
         pdf_drawn_by_workers, figures_drawn_here, tmp_path):
