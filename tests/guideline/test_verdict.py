@@ -28,7 +28,7 @@ from fi_design.spec.file import load_spec
 from fi_design.studies import wilson_interval
 from fi_design.model import resolve
 
-from conftest import EXAMPLES, variant
+from conftest import EXAMPLES, sharing_designs, variant
 
 runner = CliRunner()
 
@@ -137,14 +137,17 @@ def test_no_isolator_fails_on_its_own_plant_and_recommends_the_isolator(cases):
     assert not any("isolator" in x.text for x in v.reasons if x.severity == "PASS")
 
 
-def test_the_sign_off_recommends_a_design_it_passes(no_isolator_spec):
+def test_the_sign_off_recommends_a_design_it_passes(no_isolator_20):
     """fi_design.design (the design command): a failing stage gets the design search's answer,
-    and the design command on that design passes."""
+    and the design command on that design passes. The spec's design and search are computed
+    once for the module (:func:`sharing_designs`): the command's exit codes below read the
+    same file."""
     import fi_design
     from fi_design.spec.file import with_values
 
-    spec = variant(no_isolator_spec, **_samples(20))
-    r = fi_design.design(spec)
+    spec = no_isolator_20
+    with sharing_designs():
+        r = fi_design.design(spec)
     rec = r.recommendation
     assert r.verdict.status == "FAIL" and rec.feasible and rec.search is not None
     assert rec.text.startswith("Build ") and set(rec.isolator) == {"stroke", "stiffness",
@@ -420,18 +423,31 @@ def test_json_fields(cases):
 # --------------------------------------------------------------------------- --fail-on
 
 
+#: Scatter samples of the spec files the command line reads here (:func:`quick_specs`).
+QUICK_SAMPLES = {"small_gap": 10, "no_isolator": 20}
+
+
 @pytest.fixture(scope="module")
 def quick_specs(tmp_path_factory):
-    """The small-gap and no-isolator examples with 10 scatter samples, as files."""
+    """The small-gap example with 10 scatter samples and the no-isolator example with 20, as
+    files: the no-isolator file is the sign-off's spec, so that its design and its design
+    search are computed once (:func:`sharing_designs`) for the sign-off and the command's
+    exit codes."""
     out = {}
     folder = tmp_path_factory.mktemp("fail_on")
-    for name in ("small_gap", "no_isolator"):
+    for name, samples in QUICK_SAMPLES.items():
         raw = yaml.safe_load((EXAMPLES / f"{name}.yaml").read_text(encoding="utf-8"))
-        raw.setdefault("requirements", {})["robustness"] = {"samples": 10}
+        raw.setdefault("requirements", {})["robustness"] = {"samples": samples}
         path = folder / f"{name}.yaml"
         path.write_text(yaml.safe_dump(raw), encoding="utf-8")
         out[name] = path
     return out
+
+
+@pytest.fixture(scope="module")
+def no_isolator_20(quick_specs):
+    """examples/no_isolator.yaml with 20 scatter samples, read from its file."""
+    return load_spec(quick_specs["no_isolator"])
 
 
 @pytest.mark.parametrize("name,option,code", [
@@ -443,7 +459,8 @@ def quick_specs(tmp_path_factory):
     ("no_isolator", ["--fail-on", "warn"], 3),
 ])
 def test_fail_on_exit_codes(quick_specs, tmp_path, name, option, code, shared_designs):
-    """Each spec's design computed once (:func:`shared_designs`), its exit code per option."""
+    """Each spec's design computed once (:func:`shared_designs`), its exit code per option;
+    the no-isolator file's design and search are the sign-off's."""
     out = tmp_path / "r.json"
     r = runner.invoke(app, [str(quick_specs[name]), "--json", str(out), *option])
     assert r.exit_code == code, r.output
