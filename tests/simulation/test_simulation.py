@@ -60,14 +60,15 @@ def paper_reference(paper_short):
 def test_fast_path_agrees_with_reference(paper_reference, isolated):
     fast, ref = paper_reference[isolated]
     assert fast.success and ref.success
-    # 0.65 um hunting, 0.5 nm isolated (the 20 s run reached 2.3 um, against 5 um then)
+    # measured 0.65 um hunting, 0.5 nm isolated (the 20 s run reached 2.3 um); the bound is
+    # the one the report's validation section states (fi_design.report.validation)
     err = np.max(np.abs(fast.position - ref.position))
-    assert err < 2e-6, f"max position difference {err * 1e6:.2f} um"
+    assert err < 5e-6, f"max position difference {err * 1e6:.2f} um"
     assert fast.metrics.hunting_cycles == ref.metrics.hunting_cycles
     assert fast.metrics.verdict == ref.metrics.verdict == ("settled" if isolated else "hunting")
     # the commanded force too (it is what a user overlays on measurements): 3.3 mN hunting
-    # (the 20 s run: 12 mN, against 50 mN then)
-    assert np.max(np.abs(fast.force - ref.force)) < 0.02
+    # (the 20 s run: 12 mN), within the 0.05 N the validation section states
+    assert np.max(np.abs(fast.force - ref.force)) < 0.05
 
 
 def test_paper_setup_verdicts(paper_fast):
