@@ -570,10 +570,13 @@ IMPULSE = 0.04
 
 
 def test_undamped_joint_conserves_energy_and_momentum_through_limiter_contacts():
-    """No friction, c = c_stop = 0: after a force pulse, energy and momentum stay constant."""
+    """No friction, c = c_stop = 0: after a force pulse, energy and momentum stay constant.
+
+    0.1 s hold 58 limiter contacts; the energy's spread is the same 2e-7 of it as on 0.15 s
+    (it does not drift), at two thirds of the CPU."""
     m1, m2, k, s = 1.6, 0.4, 6667.0, 2e-5
     iso = dict(k=k, c=0.0, s=s, c_stop=0.0)
-    rec = generate(m1=m1, m2=m2, isolator=iso, drive_force=PULSE, t_end=0.15, rate=20000.0)
+    rec = generate(m1=m1, m2=m2, isolator=iso, drive_force=PULSE, t_end=0.1, rate=20000.0)
     after = rec.time >= 0.002
     E = _oscillation_energy(rec, m1, m2, k, s, 1e6, IMPULSE)[after]
     d = (rec.truth.x1 - rec.truth.x2)[after]
