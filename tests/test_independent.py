@@ -36,8 +36,9 @@ def step_response(num, den, t):
     Controllable canonical form; the constant input is one more state of the matrix
     exponential (Van Loan), so the state at t is exact, not a numerical integration. On a
     uniform grid the exponential of the first time is carried on by the exponential of the
-    spacing (exact too, to rounding: 1e-15 of the response against one exponential per time,
-    which cost a second per test).
+    spacing, exact too: it agrees with one exponential per time to 5e-9 of the response
+    (3e-14 for the second-order loops) and lies closer to the simulator, at a fiftieth of
+    the cost (one exponential per time cost a second per test).
     """
     num = np.atleast_1d(np.asarray(num, float))
     den = np.atleast_1d(np.asarray(den, float))
@@ -62,7 +63,7 @@ def step_response(num, den, t):
             out[i] = C @ expm(M * ti)[:n, n]
         return out
     step = expm(M * ((t[-1] - t[0]) / (len(t) - 1)))
-    z = expm(M * t[0])[:, n]  # the state and the input, the input one
+    z = expm(M * t[0])[:, n]  # (x, 1): the state and the constant input
     for i in range(len(t)):
         out[i] = C @ z[:n]
         z = step @ z
@@ -573,7 +574,7 @@ IMPULSE = 0.04
 def test_undamped_joint_conserves_energy_and_momentum_through_limiter_contacts():
     """No friction, c = c_stop = 0: after a force pulse, energy and momentum stay constant.
 
-    0.1 s hold 58 limiter contacts; the energy's spread is the same 2e-7 of it as on 0.15 s
+    0.1 s holds 58 limiter contacts; the energy's spread is the same 2e-7 of it as on 0.15 s
     (it does not drift), at two thirds of the CPU."""
     m1, m2, k, s = 1.6, 0.4, 6667.0, 2e-5
     iso = dict(k=k, c=0.0, s=s, c_stop=0.0)

@@ -187,8 +187,8 @@ def test_friction_dissipates_energy():
     With sigma1 below the dissipativity bound sigma2 Fc / (Fs - Fc) the LuGre
     model is passive (Barabanov and Ortega), so the stored energy falls
     monotonically until the cart sticks. It sticks at 65 ms; 0.1 s adds four periods of the
-    stuck cart ringing on its bristles (at rtol 1e-10 each costs as much as the slide: the
-    0.3 s run cost four times as much and found the same).
+    stuck cart ringing on its bristles (the 0.3 s run, 20 more periods at rtol 1e-10, cost
+    four times as much and found the same).
     """
     par = _rigid(sigma1=5.0, sigma2=20.0)  # bound: 20 * 1 / 3 = 6.7 N s/m
     m = par.m1 + par.m2
@@ -231,8 +231,8 @@ def test_a_delay_lowers_the_phase(paper_spec):
 def test_delay_matches_the_reference_path(paper_spec):
     """The first second: the move, the cart's stick-slip after it (sticks at 0.30, 0.33 and
     0.37 s; the largest difference at 0.31 s), then the cart rests in presliding while the
-    stage settles on the joint, a slow exponential the 3 s run followed to 3 s at 25 % more
-    CPU (the reference's cost lies in the move and the sticks)."""
+    stage settles on the joint, a slow exponential that the 3 s run followed for two more
+    seconds at 25 % more CPU (the reference's cost lies in the move and the sticks)."""
     spec = variant(paper_spec, **{"controller.delay": "2 ms", "motion.duration": 1.0,
                                     "requirements.hunting.window_start": 0.5,
                                     "requirements.hunting.window_length": 0.5})
@@ -341,8 +341,9 @@ def test_discrete_controller_approaches_the_continuous_one(paper_spec):
 def test_discrete_controller_matches_the_reference_path(paper_spec):
     """The first second: the move, the cart's stick-slip after it (sticks at 0.31, 0.33 and
     0.38 s; the largest difference at 0.05 s), then the cart rests in presliding while the
-    stage settles on the joint, a slow exponential the 2 s run followed to 2 s at 1.8 times
-    the CPU (the reference restarts at every sample and every delayed update)."""
+    stage settles on the joint, a slow exponential that the 2 s run followed for one more
+    second at 1.8 times the CPU (the reference restarts at every sample and every delayed
+    update)."""
     spec = variant(paper_spec, **{"controller.sample_rate": "1 kHz", "controller.delay": "0.5 ms",
                                     "motion.duration": 1.0,
                                     "requirements.hunting.window_start": 0.5,
