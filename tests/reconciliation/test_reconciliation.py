@@ -103,7 +103,7 @@ SLOW = [
 ]
 
 CONTROLS = [
-    Case("noise-only-iso", True, None, {}, duration=4.0, seed=21),
+    Case("noise-only-iso", True, None, {}, duration=3.0, seed=21),  # 4 s until trimmed
     # the stage without isolator hunts (stick-slip cycles with a period of about 2 s)
     Case("noise-only-hunting-rigid", False, None, {}, duration=8.0, seed=22),
 ]
