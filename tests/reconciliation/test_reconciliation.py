@@ -103,7 +103,8 @@ SLOW = [
 ]
 
 CONTROLS = [
-    Case("noise-only-iso", True, None, {}, duration=3.0, seed=21),  # 4 s until trimmed
+    # 3 s (4 s until the test run was trimmed; the 10 mm move ends at 0.25 s)
+    Case("noise-only-iso", True, None, {}, duration=3.0, seed=21),
     # the stage without isolator hunts (stick-slip cycles with a period of about 2 s)
     Case("noise-only-hunting-rigid", False, None, {}, duration=8.0, seed=22),
 ]
