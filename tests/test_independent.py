@@ -36,8 +36,9 @@ def step_response(num, den, t):
     Controllable canonical form; the constant input is one more state of the matrix
     exponential (Van Loan), so the state at t is exact, not a numerical integration. On a
     uniform grid the exponential of the first time is carried on by the exponential of the
-    spacing (exact too, to rounding: 1e-15 of the response against one exponential per time,
-    which cost a second per test).
+    spacing, exact too: it agrees with one exponential per time to 5e-9 of the response
+    (3e-14 for the second-order loops) and lies closer to the simulator, at a fiftieth of
+    the cost (one exponential per time cost a second per test).
     """
     num = np.atleast_1d(np.asarray(num, float))
     den = np.atleast_1d(np.asarray(den, float))
@@ -62,7 +63,7 @@ def step_response(num, den, t):
             out[i] = C @ expm(M * ti)[:n, n]
         return out
     step = expm(M * ((t[-1] - t[0]) / (len(t) - 1)))
-    z = expm(M * t[0])[:, n]  # the state and the input, the input one
+    z = expm(M * t[0])[:, n]  # (x, 1): the state and the constant input
     for i in range(len(t)):
         out[i] = C @ z[:n]
         z = step @ z
@@ -456,10 +457,11 @@ def test_rule_crosses_a_free_mass_over_at_wc():
     m1, m2, fc = 1.6, 0.4, 8.0
     wc = 2 * math.pi * fc
     t_s = np.arange(0.0, 3.0, 5e-4)
+    # 1.5 s: the measured loop gain is that of 2.5 s to three digits (at 60 % of the CPU)
     rec = generate(m1=m1, m2=m2, controller=dict(rule=dict(fc=fc)),
-                   reference=(t_s, 1e-3 * np.sin(wc * t_s)), t_end=2.5, rate=2000.0)
+                   reference=(t_s, 1e-3 * np.sin(wc * t_s)), t_end=1.5, rate=2000.0)
     t = rec.time
-    win = t >= 2.5 - 4 / fc            # four periods, transient gone
+    win = t >= 1.5 - 4 / fc            # four periods, transient gone
     phasor = np.exp(-1j * wc * t[win])
     e = rec.reference - rec.truth.x1
     L = np.sum(rec.truth.x1[win] * phasor) / np.sum(e[win] * phasor)
@@ -570,10 +572,13 @@ IMPULSE = 0.04
 
 
 def test_undamped_joint_conserves_energy_and_momentum_through_limiter_contacts():
-    """No friction, c = c_stop = 0: after a force pulse, energy and momentum stay constant."""
+    """No friction, c = c_stop = 0: after a force pulse, energy and momentum stay constant.
+
+    0.1 s holds 58 limiter contacts; the energy's spread is the same 2e-7 of it as on 0.15 s
+    (it does not drift), at two thirds of the CPU."""
     m1, m2, k, s = 1.6, 0.4, 6667.0, 2e-5
     iso = dict(k=k, c=0.0, s=s, c_stop=0.0)
-    rec = generate(m1=m1, m2=m2, isolator=iso, drive_force=PULSE, t_end=0.15, rate=20000.0)
+    rec = generate(m1=m1, m2=m2, isolator=iso, drive_force=PULSE, t_end=0.1, rate=20000.0)
     after = rec.time >= 0.002
     E = _oscillation_energy(rec, m1, m2, k, s, 1e6, IMPULSE)[after]
     d = (rec.truth.x1 - rec.truth.x2)[after]

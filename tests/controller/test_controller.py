@@ -238,9 +238,9 @@ def test_new_terms_agree_with_the_reference_solver(paper_spec, case):
     0.5 ms). Each move breaks the stage loose from a stick, slips, overshoots and sticks
     again (the first stick at 0.3 s, the last at 0.6 s; the largest differences lie there).
     The 1 s run (0.28 s at rest after each move) cost 1.4 times as much and held the same
-    events, its largest differences 1 to 3 times these. The run ends on a sample: both paths
-    apply it before the last output (the reference applied it after, and its last force
-    differed by a controller update, 7.7e-3 N against 6e-6 N elsewhere)."""
+    kinds of events, its largest differences 1 to 3.5 times these. The run ends on a sample:
+    both paths apply it before the last output (the reference applied it after, and its last
+    force differed by a controller update, 7.7e-3 N against 6e-6 N elsewhere)."""
     from conftest import variant
 
     moves = [{"distance": "2 mm", "velocity": "10 mm/s", "acceleration": "0.5 m/s^2"},

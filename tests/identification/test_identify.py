@@ -308,20 +308,17 @@ def _two_mass_spec(stiffness) -> dict:
             "motion": {"moves": [{"distance": 0.02, "velocity": 0.05, "acceleration": 1.0}]}}
 
 
-def test_fast_breakaways_are_detected_but_not_resolved():
+def test_fast_breakaways_are_detected_but_not_resolved(symmetric_record):
     """Dwell-and-go moves under a stiff PD loop: the force rises to the breakaway within the
     filter's reach, so no loading branch is resolved; the note says so and names the
-    experiment, and no number is given."""
-    moves, t = [], 0.0
-    for d, v in [(0.02, 0.05), (-0.02, 0.04), (0.015, 0.06), (-0.015, 0.05)]:
-        moves.append(dict(distance=d, velocity=v, acceleration=0.5, start=t))
-        t += abs(d) / v + v / 0.5 + 0.6
-    rec = independent.generate(
-        2.0, 0.0, friction=dict(Fs=1.5, Fc=1.0, vs=0.001, sigma0=1e5, sigma1=200.0,
-                                sigma2=20.0, offset=0.1),
-        controller=dict(kp=31600.0, kd=350.0, derivative_on="measurement", sample_rate=1000.0),
-        moves=moves, t_end=t + 0.2, noise=dict(position=5e-8, force=0.005), seed=1).measurement()
-    r = identify(rec)
+    experiment, and no number is given.
+
+    The symmetric record's axis (kp = 1.371e6 N/m: the 25 N breakaway is reached within
+    about 6 ms of a move's start) breaks away three times after a rest. Its sliding friction
+    is checked by test_symmetric_truth_recovered_within_standard_errors; that of a light
+    stage (2 kg, Fc = 1 N, which this test's own record used to check) by
+    test_back_and_forth_move_holds_no_excitation (test_identify_dynamic.py)."""
+    r = identify(symmetric_record)
     assert r.excitation.breakaways >= 3 and r.excitation.breakaway
     events = [b for b in r.dynamic.branches if b.kind == "breakaway"]
     assert len(events) == r.excitation.breakaways
@@ -332,7 +329,6 @@ def test_fast_breakaways_are_detected_but_not_resolved():
         assert "would identify it" in p.note
     assert "breakaway(s) after a stop, none with a resolved loading branch" in \
         r.parameters["static"].note
-    assert_recovered(r, dict(mass=2.0, coulomb=1.0, viscous=20.0, offset=0.1))
 
 
 # --------------------------------------------------------------------------- EMPS (real)

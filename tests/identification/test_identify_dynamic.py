@@ -61,11 +61,14 @@ def reference(breakpoints, t_end, extra=None):
     return t, r + (0.0 if extra is None else extra(t))
 
 
-#: Two 20 mm moves at 0.1 m/s (for the sliding friction), then the velocity swept slowly from
-#: -10 to +10 mm/s and back (5 mm/s^2: 5 Stribeck velocities each way, 8 s).
-SWEEP = [(0.0, 0.0), (0.2, 0.0), (0.3, 0.1), (0.4, 0.1), (0.5, 0.0), (0.8, 0.0), (0.9, -0.1),
-         (1.0, -0.1), (1.1, 0.0), (1.4, 0.0), (1.5, -0.01), (5.5, 0.01), (9.5, -0.01),
-         (9.6, 0.0)]
+#: Two 20 mm moves at 0.1 m/s (for the sliding friction), resting between and after.
+TWO_MOVES = [(0.0, 0.0), (0.2, 0.0), (0.3, 0.1), (0.4, 0.1), (0.5, 0.0), (0.8, 0.0),
+             (0.9, -0.1), (1.0, -0.1), (1.1, 0.0), (1.4, 0.0)]
+#: The two moves, then the velocity swept slowly from -7 to +7 mm/s and back (5 mm/s^2: 3.5
+#: Stribeck velocities each way, 5.6 s; it swept to 10 mm/s, 8 s, until the test run was
+#: trimmed: the estimates and their calibration over seeds hold alike, the record is 2.4 s
+#: shorter).
+SWEEP = TWO_MOVES + [(1.5, -0.007), (4.3, 0.007), (7.1, -0.007), (7.2, 0.0)]
 #: A 40 um, 2 Hz sine of the reference for 2.5 s (about 0.6 Fs of force: presliding), then two
 #: 20 mm moves.
 SINE_MOVES = [(0.0, 0.0), (3.0, 0.0), (3.1, 0.1), (3.2, 0.1), (3.3, 0.0), (3.8, 0.0),
@@ -92,8 +95,8 @@ def hunting():
 
 @pytest.fixture(scope="module")
 def sweep():
-    """Two moves, then a slow velocity sweep through zero and back (9.9 s)."""
-    t, r = reference(SWEEP, 9.9)
+    """Two moves, then a slow velocity sweep through zero and back (7.5 s)."""
+    t, r = reference(SWEEP, 7.5)
     return independent.generate(2.0, 0.0, friction=SMALL, controller=SMALL_PD, reference=(t, r),
                                 t_end=t[-1], noise=NOISE, position_resolution=RESOLUTION,
                                 seed=4, rtol=RTOL)
@@ -172,8 +175,8 @@ def test_slow_velocity_sweep_gives_all_three(sweep_result):
     """A sweep through zero: Fs from its reversals' breakaways, vs from the steady sliding
     around them (the breakaways fitted again with the level on the Stribeck curve), sigma0.
 
-    Measured on this record: static 1.503 +- 0.002 N, Stribeck velocity 1.988 +- 0.010 mm/s,
-    bristle stiffness 100600 +- 570 N/m (truth 1.5 N, 2 mm/s, 1e5 N/m).
+    Measured on this record: static 1.500 +- 0.002 N, Stribeck velocity 1.991 +- 0.009 mm/s,
+    bristle stiffness 100450 +- 660 N/m (truth 1.5 N, 2 mm/s, 1e5 N/m).
     """
     r = sweep_result
     assert_within(r, dict(static=SMALL["Fs"], stribeck_velocity=SMALL["vs"],
@@ -201,11 +204,17 @@ def test_presliding_sine_gives_bristle_stiffness(sine):
 
 
 def test_back_and_forth_move_holds_no_excitation():
-    """Trapezoidal moves back and forth without stopping: nothing near zero velocity to use."""
+    """Trapezoidal moves back and forth without stopping: nothing near zero velocity to use.
+
+    The sliding friction of this light stage (2 kg, Fc = 1 N, 20 N s/m, a 0.1 N offset) is
+    identified within three standard errors (the check test_identify.py's fast-breakaway test
+    made on its own 2 kg record; it now reads the 100 kg axis's)."""
     t, r = reference(BACK_AND_FORTH, 1.4)
     rec = independent.generate(2.0, 0.0, friction=SMALL, controller=SMALL_PD, reference=(t, r),
                                t_end=t[-1], noise=NOISE, position_resolution=RESOLUTION, seed=6)
     res = identify(rec.measurement())
+    assert_within(res, dict(mass=2.0, coulomb=SMALL["Fc"], viscous=SMALL["sigma2"],
+                            offset=SMALL["offset"]))
     assert res.excitation.breakaways == 0 and not res.dynamic.branches
     assert res.dynamic.sweep is None
     for name in DYNAMIC:
@@ -221,7 +230,7 @@ def test_back_and_forth_move_holds_no_excitation():
 
 def test_dynamic_standard_errors_are_calibrated_over_seeds(hunting, sweep):
     """The same motions recorded with new noise: the errors scatter as the standard errors say
-    (RMS z about 1; measured 0.6 to 1.4 per parameter over eight seeds)."""
+    (RMS z about 1; measured 0.6 to 1.3 per parameter over eight seeds)."""
     z = []
     for seed in (11, 12, 13):
         z += list(z_scores(identify(renoised(hunting, seed)),
@@ -336,7 +345,7 @@ def test_isolated_stage_uses_the_carts_own_motion():
     (truth 1.5 N, 1e5 N/m); the Stribeck velocity is not identifiable (one sample sliding
     steadily below 0.7 vs).
     """
-    t, r = reference(SWEEP[:12] + [(5.6, 0.0)], 5.9)
+    t, r = reference(TWO_MOVES + [(1.5, -0.01), (5.5, 0.01), (5.6, 0.0)], 5.9)
     rec = independent.generate(1.6, 0.4, friction=SMALL, isolator=ISOLATOR, controller=SMALL_PD,
                                reference=(t, r), t_end=t[-1], noise=dict(NOISE, deflection=1e-8),
                                position_resolution=RESOLUTION, seed=7)
