@@ -134,11 +134,11 @@ def held() -> Iterator[None]:
         return
     came: list[int] = []
     previous = {}
-    for s in SIGNALS:
-        handler = signal.getsignal(s)
-        if handler not in (signal.SIG_IGN, None):
-            previous[s] = signal.signal(s, lambda signum, frame: came.append(signum))
-    try:
+    try:  # a signal's exception while the handlers are swapped still restores them
+        for s in SIGNALS:
+            handler = signal.getsignal(s)
+            if handler not in (signal.SIG_IGN, None):
+                previous[s] = signal.signal(s, lambda signum, frame: came.append(signum))
         yield
     finally:
         for s, handler in previous.items():

@@ -96,6 +96,42 @@ def emps_record(emps_path):
     return load_measurement(emps_path)
 
 
+# --------------------------------------------------------------------------- signal handling
+
+
+def _signal_state() -> tuple:
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return ()
+    from fi_design.interrupts import SIGNALS
+
+    return (tuple(signal.getsignal(s) for s in SIGNALS),
+            frozenset(signal.pthread_sigmask(signal.SIG_BLOCK, [])))
+
+
+@pytest.fixture(autouse=True)
+def _signal_handling_left_as_found():
+    """A test that leaves a signal handler or the thread's signal mask changed fails at its
+    teardown, with both restored: otherwise a later test of the same process that relies on
+    the default Ctrl-C handler (tests/cli/test_interrupts.py) fails in its place."""
+    import signal
+
+    before = _signal_state()
+    yield
+    after = _signal_state()
+    if after == before:
+        return
+    from fi_design.interrupts import SIGNALS
+
+    for s, handler in zip(SIGNALS, before[0]):
+        signal.signal(s, handler if handler is not None else signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_SETMASK, before[1])
+    pytest.fail(f"the test left the signal handling changed: handlers {before[0]} -> "
+                f"{after[0]}, blocked {sorted(before[1])} -> {sorted(after[1])}")
+
+
 # --------------------------------------------------------------------------- parameter studies
 
 

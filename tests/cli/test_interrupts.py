@@ -181,3 +181,29 @@ def test_an_interrupt_between_two_outputs_names_the_one_written(paper_spec_path,
     assert result.exit_code == 130, result.output
     assert f"interrupted; it had written {csv} and no temporary file is left" in result.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["trace.csv"]
+
+
+def test_a_signal_while_held_swaps_its_handlers_leaves_none_of_them_behind(monkeypatch):
+    """Outside the command line, held() swapped SIGINT's handler for a recording one, then
+    SIGTERM's; an interruption between the two (here: the second swap raises) left the
+    recording handler installed for good, and every later Ctrl-C of the process was
+    recorded into a list nobody reads instead of stopping it."""
+    from fi_design.interrupts import held
+
+    before = signal.getsignal(signal.SIGINT)
+    real = signal.signal
+    raised = []
+
+    def swap(signum, handler):
+        if signum == signal.SIGTERM and not raised:
+            raised.append(signum)
+            raise KeyboardInterrupt  # Ctrl-C's exception at that very bytecode
+        return real(signum, handler)
+
+    monkeypatch.setattr(signal, "signal", swap)
+    with pytest.raises(KeyboardInterrupt):
+        with held():
+            raise AssertionError("the block ran although held() did not start")
+    monkeypatch.undo()
+    assert raised == [signal.SIGTERM]
+    assert signal.getsignal(signal.SIGINT) is before
