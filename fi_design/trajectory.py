@@ -17,6 +17,7 @@ value of the last segment.
 
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass
 
@@ -51,6 +52,7 @@ class Trajectory:
         c.flags.writeable = False
         object.__setattr__(self, "breaks", b)
         object.__setattr__(self, "coeffs", c)
+        object.__setattr__(self, "_lists", (b.tolist(), c.tolist()))  # for at()
 
     def __call__(self, t, derivative: int = 0) -> np.ndarray:
         """Evaluate r (``derivative=0``), dr/dt (1) or d2r/dt2 (2) at times ``t`` [s]."""
@@ -71,6 +73,27 @@ class Trajectory:
             raise ValueError("derivative must be 0, 1 or 2")
         outside = before | (t >= b[-1])
         return np.where(outside, 0.0, out)
+
+    def at(self, t: float, derivative: int = 0) -> float:
+        """r (``derivative=0``), dr/dt (1) or d2r/dt2 (2) at one time ``t`` [s], as a float.
+
+        The same arithmetic as calling the trajectory, bit for bit, without numpy's
+        cost per call: for solvers that evaluate r at every right-hand side.
+        """
+        b, c = self._lists
+        k = min(max(bisect.bisect_right(b, t) - 1, 0), len(c) - 1)
+        before = t < b[0]
+        tau = 0.0 if before else min(max(t - b[k], 0.0), b[k + 1] - b[k])
+        c0, c1, c2, c3 = c[k]
+        if derivative == 0:
+            return c0 + tau * (c1 + tau * (c2 + tau * c3))
+        if derivative not in (1, 2):
+            raise ValueError("derivative must be 0, 1 or 2")
+        if before or t >= b[-1]:
+            return 0.0
+        if derivative == 1:
+            return c1 + tau * (2 * c2 + 3 * tau * c3)
+        return 2 * c2 + 6 * tau * c3
 
     @property
     def final(self) -> float:

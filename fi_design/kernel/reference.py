@@ -110,7 +110,7 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
     breaks = list(ref.breaks) if ref.land else []
 
     def r_of(tt: float) -> tuple[float, float]:
-        return float(ref(tt)), float(ref(tt, 1))
+        return ref.at(tt), ref.at(tt, 1)
 
     def u_of(tt: float, yy, mm) -> float:
         return controller_output(yy, p, mm, *r_of(tt), ii, iu)
@@ -125,7 +125,7 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
         """Feedforward (continuous controller) plus input force at tt [N]."""
         F = input_of(tt)
         if not discrete:
-            F += feedforward(float(ref(tt, 1)), float(ref(tt, 2)), 0.0, p)[0]
+            F += feedforward(ref.at(tt, 1), ref.at(tt, 2), 0.0, p)[0]
         return F
 
     def fa_at(tt: float) -> float:
@@ -191,7 +191,7 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
             tt = t_out[i]
             yy = np.ascontiguousarray(sol(tt) if sol is not None else y, dtype=float)
             out_y[i] = yy
-            out_r[i] = float(ref(tt))
+            out_r[i] = ref.at(tt)
             if discrete:
                 out_cmd[i] = yy[iu] + input_of(tt)
                 out_fa[i] = actuator(fa_at(tt), p)[0]
@@ -210,12 +210,12 @@ def solve_reference(params: PlantParameters, y0, ref: Trajectory, t_end: float, 
         if discrete and t >= k_sample * Ts - 1e-12:
             lev = math.floor(y[0] / q + 0.5) if q > 0 else 0
             xm = lev * q if q > 0 else y[0]
-            e_k = float(ref(t)) - xm
+            e_k = ref.at(t) - xm
             d_k = -xm if params.dmeas else e_k
             u_k = params.dp * e_k + dx[0] + params.dc * e_k + dx[1] + params.db * d_k
             if params.filter_states:  # the drive's biquads, their memories in y after u
                 u_k = sample_filters(u_k, y, p, iu + 1)
-            u_k += feedforward(float(ref(t, 1)), float(ref(t, 2)), 0.0, p)[0]
+            u_k += feedforward(ref.at(t, 1), ref.at(t, 2), 0.0, p)[0]
             dx = [dx[0] + 2.0 * params.dc * e_k,
                   params.da * (dx[1] + params.db * d_k) - params.db * d_k]
             y[iu] = u_k

@@ -105,6 +105,27 @@ def test_reference_lookup_matches_the_vectorised_evaluation(paper_spec, t):
     assert rdd == pytest.approx(float(ref(t, 2)), abs=1e-9)
 
 
+@settings(max_examples=80, deadline=None)
+@given(start=st.floats(-1.0, 3.0).map(lambda s: round(s, 6)), t=st.floats(-2.0, 30.0),
+       on_break=st.integers(-1, 40),
+       derivative=st.integers(0, 2))
+def test_one_time_lookup_is_the_vectorised_evaluation_bit_for_bit(start, t, on_break,
+                                                                  derivative):
+    """Trajectory.at (the reference solver's per-right-hand-side lookup) against the
+    vectorised call, before the first break, on the breaks and after the last, for a
+    jerk-limited move pair and a spline through samples."""
+    from fi_design.spec import Move
+    from fi_design.trajectory import from_samples
+
+    moves = (Move(distance=0.01, velocity=0.05, acceleration=1.0, jerk=50.0, start=max(start, 0)),
+             Move(distance=-0.002, velocity=0.05, acceleration=1.0, start=5.0 + start))
+    samples = np.linspace(start, start + 3.0, 31)
+    for ref in (from_moves(moves, 20.0), from_samples(samples, np.sin(samples) * 1e-3)):
+        times = [t] + ([float(ref.breaks[on_break % len(ref.breaks)])] if on_break >= 0 else [])
+        for tt in times:
+            assert ref.at(tt, derivative) == float(ref(tt, derivative)), (tt, derivative)
+
+
 def test_trapezoid_reference_reaches_the_target(paper_spec):
     mv = paper_spec.motion.moves[0]
     ref = from_moves(paper_spec.motion.moves, 20.0)
