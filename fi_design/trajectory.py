@@ -20,6 +20,7 @@ from __future__ import annotations
 import bisect
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -52,7 +53,6 @@ class Trajectory:
         c.flags.writeable = False
         object.__setattr__(self, "breaks", b)
         object.__setattr__(self, "coeffs", c)
-        object.__setattr__(self, "_lists", (b.tolist(), c.tolist()))  # for at()
 
     def __call__(self, t, derivative: int = 0) -> np.ndarray:
         """Evaluate r (``derivative=0``), dr/dt (1) or d2r/dt2 (2) at times ``t`` [s]."""
@@ -73,6 +73,11 @@ class Trajectory:
             raise ValueError("derivative must be 0, 1 or 2")
         outside = before | (t >= b[-1])
         return np.where(outside, 0.0, out)
+
+    @cached_property
+    def _lists(self) -> tuple[list, list]:
+        """The breaks and coefficients as Python lists, made at the first :meth:`at`."""
+        return self.breaks.tolist(), self.coeffs.tolist()
 
     def at(self, t: float, derivative: int = 0) -> float:
         """r (``derivative=0``), dr/dt (1) or d2r/dt2 (2) at one time ``t`` [s], as a float.
