@@ -117,6 +117,7 @@ own way and switch with the one compiled
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -230,7 +231,7 @@ class PlantParameters:
 
     def to_array(self) -> np.ndarray:
         """The kernel's float64 parameter array (negative-direction friction resolved)."""
-        out = np.array([getattr(self, f.name) for f in fields(self)], dtype=np.float64)
+        out = np.array(_VALUES(self), dtype=np.float64)
         if math.isnan(self.Fc_neg):
             out[P_FC_NEG] = self.Fc
         if math.isnan(self.sigma2_neg):
@@ -332,6 +333,8 @@ class Integration:
 
 #: Kernel parameter index of every :class:`PlantParameters` field, by name.
 PARAMETER_INDEX = {f.name: i for i, f in enumerate(fields(PlantParameters))}
+#: The fields' values in the layout's order, as a tuple (:meth:`PlantParameters.to_array`).
+_VALUES = operator.attrgetter(*PARAMETER_INDEX)
 N_PARAMS = len(PARAMETER_INDEX)
 _P = PARAMETER_INDEX
 (P_M1, P_M2, P_K, P_C, P_S, P_KSTOP, P_CSTOP, P_FS, P_FC, P_VS, P_SIGMA0, P_SIGMA1,

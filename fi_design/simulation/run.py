@@ -219,12 +219,17 @@ def _checked_arguments(spec, crossover, duration, rtol, record, rate=None):
 
 
 def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=None,
-               input_force=None):
-    """One integration with the chosen method; returns the Integration and its wall time [s]."""
+               input_force=None, reference_max=None):
+    """One integration with the chosen method; returns the Integration and its wall time [s].
+
+    ``reference_max``: the largest |r| [m] the divergence bound is set from (default: of
+    ``ref``; a window of a longer reference passes the whole reference's)."""
     settings = model.spec.simulation
     tol = rtol if rtol is not None else settings.tolerance * (
         1.0 if method == "fast" else 1e-4)
-    x_bound = 1.0 + 100.0 * float(np.max(np.abs(ref.coeffs[:, 0])) + abs(y0[0]))
+    if reference_max is None:
+        reference_max = float(np.max(np.abs(ref.coeffs[:, 0])))
+    x_bound = 1.0 + 100.0 * (reference_max + abs(y0[0]))
     start = _time.perf_counter()
     if method == "fast":
         from ..kernel import run
@@ -334,13 +339,19 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
     starts = np.unique(np.append(
         np.searchsorted(t_out, np.arange(0.0, t_out[-1], window), side="left"), len(t_out)))
     pieces, wall = [], 0.0
+    r_max = float(np.max(np.abs(ref.coeffs[:, 0])))
     for a, b in zip(starts[:-1], starts[1:]):
         stop = min(b + 1, len(t_out))  # integrate to the next window's start
         y0, p0 = _anchor(model.law, open_loop, record, a, ref, None)
         tw = t_out[a:stop] - t_out[a]
-        seg = Trajectory(ref.breaks - t_out[a], ref.coeffs, land=False)
+        # the reference's pieces over the window (and one more each side): the same values
+        # as the whole reference there, without copying all of it for every window
+        lo = max(int(np.searchsorted(ref.breaks, t_out[a], side="right")) - 2, 0)
+        hi = min(int(np.searchsorted(ref.breaks, t_out[stop - 1], side="right")) + 1,
+                 len(ref.coeffs))
+        seg = Trajectory(ref.breaks[lo:hi + 1] - t_out[a], ref.coeffs[lo:hi], land=False)
         out, dt = _integrate(model, method, p0, y0, seg, float(tw[-1]), tw, rtol, tw,
-                             record.force[a:stop])
+                             record.force[a:stop], reference_max=r_max)
         wall += dt
         pieces.append((int(a), int(b - a), out))
         if out.code != 0:
