@@ -102,9 +102,13 @@ def signals_to_exceptions(make: Callable[[int], BaseException]) -> Iterator[None
         if _STATE.received:
             raise make(_STATE.received[0])
     finally:
-        for s, handler in previous.items():
-            signal.signal(s, handler if handler is not None else signal.SIG_DFL)
-        _STATE.make, _STATE.received, _STATE.depth, _STATE.pending = saved
+        try:
+            # SIGINT last: its restored handler raises at a Ctrl-C, which must find the
+            # others restored already, and the state below restored all the same
+            for s, handler in reversed(previous.items()):
+                signal.signal(s, handler if handler is not None else signal.SIG_DFL)
+        finally:
+            _STATE.make, _STATE.received, _STATE.depth, _STATE.pending = saved
 
 
 @contextlib.contextmanager
@@ -141,7 +145,7 @@ def held() -> Iterator[None]:
                 previous[s] = signal.signal(s, lambda signum, frame: came.append(signum))
         yield
     finally:
-        for s, handler in previous.items():
+        for s, handler in reversed(previous.items()):  # SIGINT last, as above
             signal.signal(s, handler)
         if came:
             signal.raise_signal(came[0])  # the handler restored above acts on it now

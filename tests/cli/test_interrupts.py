@@ -207,3 +207,29 @@ def test_a_signal_while_held_swaps_its_handlers_leaves_none_of_them_behind(monke
     monkeypatch.undo()
     assert raised == [signal.SIGTERM]
     assert signal.getsignal(signal.SIGINT) is before
+
+
+@pytest.mark.parametrize("command_line", [True, False])
+def test_a_ctrl_c_as_the_handlers_are_restored_leaves_none_of_the_others_swapped(monkeypatch,
+                                                                               command_line):
+    """Both blocks restored SIGINT's handler first: a Ctrl-C right after it raised there, and
+    SIGTERM's and SIGHUP's swapped handlers stayed installed (held()'s recording one took a
+    later SIGTERM into a list nobody reads), and signals_to_exceptions() left its state set:
+    every later held() of the process took itself for the command line's and held nothing."""
+    from fi_design.cli.parts import _signal_exception
+    from fi_design.interrupts import SIGNALS, held, signals_to_exceptions
+
+    before = {s: signal.getsignal(s) for s in SIGNALS}
+    real = signal.signal
+
+    def restore(signum, handler):
+        out = real(signum, handler)
+        if signum == signal.SIGINT and handler is before[signal.SIGINT]:
+            raise KeyboardInterrupt  # Ctrl-C at the first bytecode after the restore
+        return out
+
+    with pytest.raises(KeyboardInterrupt):
+        with signals_to_exceptions(_signal_exception) if command_line else held():
+            monkeypatch.setattr(signal, "signal", restore)
+    monkeypatch.undo()
+    assert {s: signal.getsignal(s) for s in SIGNALS} == before
