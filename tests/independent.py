@@ -122,7 +122,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
-__all__ = ["Truth", "Record", "generate"]
+__all__ = ["Truth", "Record", "generate", "recorded_again"]
 
 #: Two instants closer than this [s] are the same instant (breakpoints, sample look-ups).
 TIME_TOL = 1e-9
@@ -1362,17 +1362,54 @@ def generate(m1, m2=0.0, *, friction=None, isolator=None, controller=None, moves
     RuntimeError
         The integration failed.
     """
-    nz = dict(noise or {})
-    _check_keys(nz, {"position", "deflection", "force"}, "noise")
-    if position_resolution is not None and not float(position_resolution) > 0:
-        raise ValueError("position_resolution must be positive")
+    nz = _checked_noise(noise, position_resolution)
     sim = _Simulation(m1=m1, m2=m2, friction=friction, isolator=isolator,
                       controller=controller, moves=moves, reference=reference, t_end=t_end,
                       rate=rate, effects=effects, disturbance=disturbance,
                       drive_force=drive_force, initial=initial, rtol=rtol, atol=atol)
     t_out, states = sim.run()
     ref, dist, truth = sim.signals(t_out, states)
+    return _recorded(t_out, ref, dist, truth, sim.isolated, sim.info, nz, position_resolution,
+                     seed)
 
+
+def recorded_again(record: Record, *, seed: int, noise=None,
+                   position_resolution=None) -> Record:
+    """A record's noise-free signals recorded again with the noise of ``seed``.
+
+    The seed draws the recording noise only (the controller sees the noise-free position):
+    this is the record :func:`generate` gives for the same motion with this ``noise``,
+    ``position_resolution`` and ``seed``, sample for sample, without simulating again.
+
+    Parameters
+    ----------
+    record : Record
+        A record of :func:`generate` (its ``truth`` is recorded again).
+    seed : int
+        Seed of the recording noise.
+    noise, position_resolution
+        As for :func:`generate`.
+
+    Returns
+    -------
+    Record
+    """
+    nz = _checked_noise(noise, position_resolution)
+    return _recorded(record.time, record.reference, record.disturbance, record.truth,
+                     record.deflection is not None, record.info, nz, position_resolution, seed)
+
+
+def _checked_noise(noise, position_resolution) -> dict:
+    nz = dict(noise or {})
+    _check_keys(nz, {"position", "deflection", "force"}, "noise")
+    if position_resolution is not None and not float(position_resolution) > 0:
+        raise ValueError("position_resolution must be positive")
+    return nz
+
+
+def _recorded(t_out, ref, dist, truth, isolated, info, nz, position_resolution, seed) -> Record:
+    """The noise-free signals recorded: noise drawn from ``seed`` (position, deflection,
+    force, in that order), the position rounded to whole counts."""
     rng = np.random.default_rng(seed)
     n = len(t_out)
     e_pos, e_def, e_force = (rng.standard_normal(n) for _ in range(3))
@@ -1381,7 +1418,7 @@ def generate(m1, m2=0.0, *, friction=None, isolator=None, controller=None, moves
         position = np.round(position / float(position_resolution)) * float(position_resolution)
     force = truth.command + float(nz.get("force", 0.0)) * e_force
     deflection = None
-    if sim.isolated:
+    if isolated:
         deflection = truth.x1 - truth.x2 + float(nz.get("deflection", 0.0)) * e_def
     return Record(time=t_out, reference=ref, position=position, force=force,
-                  deflection=deflection, disturbance=dist, truth=truth, info=sim.info)
+                  deflection=deflection, disturbance=dist, truth=truth, info=info)

@@ -118,6 +118,26 @@ def test_bad_input_is_refused():
             generate(**{**base, **bad})
 
 
+def test_a_record_recorded_again_is_the_record_of_that_seed():
+    """recorded_again: the noise of another seed on the same noise-free signals, sample for
+    sample what generate gives with that seed (rigid and isolated, counts and no counts)."""
+    from independent import recorded_again
+
+    moves = [dict(distance=0.002, velocity=0.02, acceleration=1.0)]
+    noise = dict(position=2e-7, deflection=1e-7, force=0.05)
+    for iso, q in ((None, 5e-8), (dict(k=2000.0, c=5.0, s=3e-4), None)):
+        kw = dict(friction=dict(Fs=1.0, Fc=0.8, vs=0.002, sigma0=1e5, sigma2=5.0), isolator=iso,
+                  controller=dict(kp=2e4, kd=300.0), moves=moves, t_end=0.2, noise=noise,
+                  position_resolution=q)
+        first = generate(1.0, 0.5 if iso else 0.0, seed=3, **kw)
+        want = generate(1.0, 0.5 if iso else 0.0, seed=11, **kw)
+        got = recorded_again(first, seed=11, noise=noise, position_resolution=q)
+        for name in ("time", "reference", "position", "force", "deflection"):
+            a, b = getattr(got, name), getattr(want, name)
+            assert (a is None and b is None) or np.array_equal(a, b), (iso, name)
+        assert not np.array_equal(got.position, first.position)
+
+
 def test_reference_moves_follow_the_trapezoid():
     """Distances add up, the velocity limit holds, a triangle move peaks at sqrt(D a)."""
     moves = [dict(distance=10e-3, velocity=50e-3, acceleration=1.0),

@@ -88,7 +88,7 @@ SYMMETRIC_FRICTION = dict(Fs=25.0, Fc=20.0, vs=0.002, sigma0=1e6, sigma2=150.0, 
 @pytest.fixture(scope="module")
 def symmetric_run():
     """The axis with :data:`SYMMETRIC_FRICTION`: the independent simulator's record (noise-free
-    signals kept, for :func:`recorded_again`)."""
+    signals kept, for :func:`independent.recorded_again`)."""
     return axis_run(SYMMETRIC_FRICTION)
 
 
@@ -159,32 +159,19 @@ def test_disturbance_column_the_force_that_acts_is_used(per_direction_record):
     assert any("disturbance_N" in n for n in r.notes)
 
 
-def recorded_again(record, seed: int):
-    """The independent record's noise-free signals recorded with the noise of ``seed``.
-
-    The seed of :func:`independent.generate` draws the recording noise only (the controller
-    sees the noise-free position), so this is the record ``axis_record(friction, seed=seed)``
-    would give, sample for sample (the same draws in the same order: position, deflection,
-    force; the position rounded to whole counts), without simulating the axis again."""
-    rng = np.random.default_rng(seed)
-    n = len(record.time)
-    e_pos, _, e_force = (rng.standard_normal(n) for _ in range(3))
-    truth = record.truth
-    position = np.round((truth.x1 + AXIS_NOISE["position"] * e_pos) / RESOLUTION) * RESOLUTION
-    return measurement_from_arrays(record.time, record.reference, position,
-                                   force_N=truth.command + AXIS_NOISE["force"] * e_force)
-
-
 def test_standard_errors_are_calibrated_over_seeds(symmetric_run):
     """Across noise seeds the errors scatter like the standard errors say (RMS z about 1).
 
     Three seeds of the symmetric record's axis: its own (seed 3, the module's record) and
     two more (11 and 12), the same motion recorded again with their noise
-    (:func:`recorded_again`: the records generate(seed=11 or 12) gives, bit for bit)."""
+    (:func:`independent.recorded_again`: the records generate(seed=11 or 12) gives, bit for
+    bit)."""
     truth = dict(mass=100.0, coulomb=20.0, viscous=150.0, viscous_negative=220.0, offset=-1.5)
     z = []
     for record in (symmetric_run.measurement(),
-                   *(recorded_again(symmetric_run, s) for s in (11, 12))):
+                   *(independent.recorded_again(symmetric_run, seed=s, noise=AXIS_NOISE,
+                                                position_resolution=RESOLUTION).measurement()
+                     for s in (11, 12))):
         r = identify(record)
         z += [(r.value(k) - v) / r.parameters[k].std_error for k, v in truth.items()]
     rms = math.sqrt(np.mean(np.square(z)))

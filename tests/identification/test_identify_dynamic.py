@@ -123,13 +123,8 @@ def sweep_result(sweep):
 
 def renoised(record, seed):
     """The record's noise-free signals recorded again with new noise (the generator's model)."""
-    rng = np.random.default_rng(seed)
-    n = len(record.time)
-    e_pos, _, e_force = (rng.standard_normal(n) for _ in range(3))
-    tr = record.truth
-    position = np.round((tr.x1 + NOISE["position"] * e_pos) / RESOLUTION) * RESOLUTION
-    return measurement_from_arrays(record.time, record.reference, position,
-                                   force_N=tr.command + NOISE["force"] * e_force)
+    return independent.recorded_again(record, seed=seed, noise=NOISE,
+                                      position_resolution=RESOLUTION).measurement()
 
 
 def z_scores(result, truth: dict) -> dict:
