@@ -62,16 +62,10 @@ class Trajectory:
         tau = np.clip(t - b[k], 0.0, b[k + 1] - b[k])
         before = t < b[0]
         tau = np.where(before, 0.0, tau)
-        c0, c1, c2, c3 = c[k, 0], c[k, 1], c[k, 2], c[k, 3]
+        out = _cubic(c[k, 0], c[k, 1], c[k, 2], c[k, 3], tau, derivative)
         if derivative == 0:
-            return c0 + tau * (c1 + tau * (c2 + tau * c3))
-        if derivative == 1:
-            out = c1 + tau * (2 * c2 + 3 * tau * c3)
-        elif derivative == 2:
-            out = 2 * c2 + 6 * tau * c3
-        else:
-            raise ValueError("derivative must be 0, 1 or 2")
-        outside = before | (t >= b[-1])
+            return out
+        outside = before | (t >= b[-1])  # the derivatives of the holds are zero
         return np.where(outside, 0.0, out)
 
     @cached_property
@@ -89,16 +83,8 @@ class Trajectory:
         k = min(max(bisect.bisect_right(b, t) - 1, 0), len(c) - 1)
         before = t < b[0]
         tau = 0.0 if before else min(max(t - b[k], 0.0), b[k + 1] - b[k])
-        c0, c1, c2, c3 = c[k]
-        if derivative == 0:
-            return c0 + tau * (c1 + tau * (c2 + tau * c3))
-        if derivative not in (1, 2):
-            raise ValueError("derivative must be 0, 1 or 2")
-        if before or t >= b[-1]:
-            return 0.0
-        if derivative == 1:
-            return c1 + tau * (2 * c2 + 3 * tau * c3)
-        return 2 * c2 + 6 * tau * c3
+        out = _cubic(*c[k], tau, derivative)
+        return 0.0 if derivative and (before or t >= b[-1]) else out
 
     @property
     def final(self) -> float:
@@ -106,6 +92,18 @@ class Trajectory:
         c0, c1, c2, c3 = self.coeffs[-1]
         tau = self.breaks[-1] - self.breaks[-2]
         return float(c0 + tau * (c1 + tau * (c2 + tau * c3)))
+
+
+def _cubic(c0, c1, c2, c3, tau, derivative: int):
+    """One segment's r (``derivative=0``), dr/dt (1) or d2r/dt2 (2) at ``tau`` [s] after its
+    start, for floats and arrays alike (one expression for both evaluations of a trajectory)."""
+    if derivative == 0:
+        return c0 + tau * (c1 + tau * (c2 + tau * c3))
+    if derivative == 1:
+        return c1 + tau * (2 * c2 + 3 * tau * c3)
+    if derivative == 2:
+        return 2 * c2 + 6 * tau * c3
+    raise ValueError("derivative must be 0, 1 or 2")
 
 
 def jerk_profile_times(d: float, v: float, a: float, j: float) -> tuple[float, float, float]:
