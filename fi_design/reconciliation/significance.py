@@ -177,7 +177,7 @@ def judge(cmp: Comparison, outcome: FitOutcome, baseline: Baseline, threshold: f
     refs = {p: sp.references.get(p) for p in values}
     distance = {}
     for p, v in values.items():
-        r, s = refs.get(p), sigma.get(p)
+        r, s = sp.inactive_at.get(p, refs.get(p)), sigma.get(p)
         distance[p] = (float((v - r) / s) if r is not None and s is not None and s > 0
                        and v is not None else None)
     verdict = _verdict(outcome, st, score, explained, distance, threshold, null)
@@ -255,6 +255,14 @@ def _verdict(outcome, st, score, explained, distance, threshold, null) -> Verdic
     if explained < EXPLAINED_MIN:
         reasons.append(f"explains {percent(explained, 2)} of the gap above noise, less than "
                        f"{percent(EXPLAINED_MIN, 2)}")
+    sp = outcome.space
+    blind = [p for p, d in distance.items() if d is None and
+             sp.inactive_at.get(p, sp.references.get(p)) is not None]
+    if blind:
+        # no standard error: the fit does not move with the parameter (a flat objective), so
+        # nothing tells its value from the model's own
+        reasons.append(f"no standard error for {', '.join(blind)}: the fit does not change "
+                       "with it, so its value cannot be told from the model's")
     z = [abs(d) for d in distance.values() if d is not None]
     if z and max(z) < Z_MIN:
         reasons.append(f"within {number(max(z), 2)} standard errors of the model's own value "

@@ -123,6 +123,10 @@ class Space:
         that test, not the share of the gap it explains, is the evidence.
     data_error : dict
         Standard error of each value read from the data, SI.
+    inactive_at : dict
+        For a parameter without a model value: the value at which it stops
+        acting (a force limit at the record's peak force, SI), from which its
+        distance in standard errors is measured.
     """
 
     name: str
@@ -135,6 +139,7 @@ class Space:
     fixed: dict = field(default_factory=dict)
     from_data: bool = False
     data_error: dict = field(default_factory=dict)
+    inactive_at: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -258,7 +263,8 @@ def _space(name: str, cmp: Comparison, lattice: Lattice, params) -> Space | None
         if not hi > p.bounds[0]:
             return None
         return Space(name, [Coord("limit", p.bounds[0], hi, log=True, limit_lo=1e-3,
-                                  limit_hi=hi)], _same, references=ref)
+                                  limit_hi=hi)], _same, references=ref,
+                     inactive_at={"limit": peak})
     if name == "friction_asymmetry":
         coords = []
         for p in eff.parameters:
@@ -286,7 +292,8 @@ def _reference(p: _effects.Parameter, params) -> float | None:
 
     Parameters that correct a spec value (``neutral`` None) refer to the
     model's value; additive ones (a delay on top) and amplitudes refer to
-    zero; periods, phases and limits have none.
+    zero; periods, phases and limits have none (a force limit's distance is measured from
+    the peak force, :attr:`Space.inactive_at`).
     """
     if p.periodic or (p.log and p.neutral is not None) or p.neutral == math.inf:
         return None

@@ -6,12 +6,16 @@
   constant-velocity move sampled at a fixed rate;
 - the integrated autocorrelation time is 1 for white residuals and
   (1 + phi) / (1 - phi) for an AR(1) series;
-- a failed run scores far above the nominal misfit (it can never win a fit).
+- a failed run scores far above the nominal misfit (it can never win a fit);
+- a parameter with a reference value but no standard error fails the distance
+  test (nothing tells it from the model's value); one without a reference (a
+  phase) does not.
 """
 
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -221,3 +225,19 @@ def test_open_loop_structure_causes_name_no_controller(paper_spec):
     assert causes["disturbance"].endswith("(a load, a cable, a drift, or an offset of force_N).")
     assert "measured force" in message
     assert not any("controller" in s for s in (message, *causes.values()))
+
+
+@pytest.mark.parametrize("reference, inactive, blind",
+                         [(5.0, None, True), (None, None, False), (None, 17.0, True)])
+def test_a_parameter_without_a_standard_error_is_not_shown_to_differ(reference, inactive, blind):
+    from fi_design.reconciliation.significance import _verdict
+
+    space = SimpleNamespace(from_data=False, references={"limit": reference, "amplitude": 0.0},
+                            inactive_at={} if inactive is None else {"limit": inactive})
+    outcome = SimpleNamespace(run=SimpleNamespace(ok=True, message=""), at_bound=(),
+                              space=space)
+    st = SimpleNamespace(value=60.0, n_effective=500.0)
+    # the amplitude lies 4 standard errors out: without the limit the candidate passes
+    verdict = _verdict(outcome, st, 40.0, 0.9, {"limit": None, "amplitude": 4.0}, 10.0, None)
+    assert any("no standard error for limit" in r for r in verdict.reasons) is blind
+    assert len(verdict.reasons) == int(blind)
