@@ -211,7 +211,10 @@ class Candidate(Result):
         where there is none (a period, a phase).
     distance : dict of str to float or None
         (fitted - reference) / uncertainty per parameter [-]: how far from
-        the model's own value the data put it, in honest standard errors.
+        the model's own value the data put it, in honest standard errors (a
+        force limit, whose reference is None, from the record's peak force,
+        above which it never acts); None without a reference or a standard
+        error.
     score : float
         Evidence against the model without it: the chi-square improvement in
         effective samples minus k ln(n_eff) (higher is better) [-].
