@@ -89,9 +89,7 @@ class Trajectory:
     @property
     def final(self) -> float:
         """The held end position [m]."""
-        c0, c1, c2, c3 = self.coeffs[-1]
-        tau = self.breaks[-1] - self.breaks[-2]
-        return float(c0 + tau * (c1 + tau * (c2 + tau * c3)))
+        return float(_cubic(*self.coeffs[-1], self.breaks[-1] - self.breaks[-2], 0))
 
 
 def _cubic(c0, c1, c2, c3, tau, derivative: int):

@@ -177,7 +177,7 @@ def judge(cmp: Comparison, outcome: FitOutcome, baseline: Baseline, threshold: f
     refs = {p: sp.references.get(p) for p in values}
     distance = {}
     for p, v in values.items():
-        r, s = sp.inactive_at.get(p, refs.get(p)), sigma.get(p)
+        r, s = sp.origin(p), sigma.get(p)
         distance[p] = (float((v - r) / s) if r is not None and s is not None and s > 0
                        and v is not None else None)
     verdict = _verdict(outcome, st, score, explained, distance, threshold, null)
@@ -255,9 +255,8 @@ def _verdict(outcome, st, score, explained, distance, threshold, null) -> Verdic
     if explained < EXPLAINED_MIN:
         reasons.append(f"explains {percent(explained, 2)} of the gap above noise, less than "
                        f"{percent(EXPLAINED_MIN, 2)}")
-    sp = outcome.space
-    blind = [p for p, d in distance.items() if d is None and
-             sp.inactive_at.get(p, sp.references.get(p)) is not None]
+    blind = [p for p, d in distance.items()
+             if d is None and outcome.space.origin(p) is not None]
     if blind:
         # no standard error: the fit does not move with the parameter (a flat objective), so
         # nothing tells its value from the model's own

@@ -141,6 +141,11 @@ class Space:
     data_error: dict = field(default_factory=dict)
     inactive_at: dict = field(default_factory=dict)
 
+    def origin(self, parameter: str) -> float | None:
+        """The value a parameter's distance in standard errors is measured from: where it
+        stops acting (:attr:`inactive_at`), else its reference (None: no distance)."""
+        return self.inactive_at.get(parameter, self.references.get(parameter))
+
 
 @dataclass(frozen=True)
 class Spaces:

@@ -228,7 +228,7 @@ def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=No
     tol = rtol if rtol is not None else settings.tolerance * (
         1.0 if method == "fast" else 1e-4)
     if reference_max is None:
-        reference_max = float(np.max(np.abs(ref.coeffs[:, 0])))
+        reference_max = _largest(ref)
     x_bound = 1.0 + 100.0 * (reference_max + abs(y0[0]))
     start = _time.perf_counter()
     if method == "fast":
@@ -246,6 +246,11 @@ def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=No
         out = solve_reference(params, y0, ref, t_end, t_out, tol, tolerances(params, tol),
                               x_bound, input_time=input_time, input_force=input_force)
     return out, _time.perf_counter() - start
+
+
+def _largest(ref: Trajectory) -> float:
+    """The largest |r| of a reference [m] (its pieces' start values, the end held)."""
+    return float(np.max(np.abs(ref.coeffs[:, 0])))
 
 
 def _result(model, iso, method, params, out, t_out, wall, *, move_end,
@@ -339,7 +344,7 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
     starts = np.unique(np.append(
         np.searchsorted(t_out, np.arange(0.0, t_out[-1], window), side="left"), len(t_out)))
     pieces, wall = [], 0.0
-    r_max = float(np.max(np.abs(ref.coeffs[:, 0])))
+    r_max = _largest(ref)
     for a, b in zip(starts[:-1], starts[1:]):
         stop = min(b + 1, len(t_out))  # integrate to the next window's start
         y0, p0 = _anchor(model.law, open_loop, record, a, ref, None)

@@ -231,9 +231,10 @@ def test_open_loop_structure_causes_name_no_controller(paper_spec):
                          [(5.0, None, True), (None, None, False), (None, 17.0, True)])
 def test_a_parameter_without_a_standard_error_is_not_shown_to_differ(reference, inactive, blind):
     from fi_design.reconciliation.significance import _verdict
+    from fi_design.reconciliation.spaces import Space
 
-    space = SimpleNamespace(from_data=False, references={"limit": reference, "amplitude": 0.0},
-                            inactive_at={} if inactive is None else {"limit": inactive})
+    space = Space("force_saturation", [], dict, references={"limit": reference, "amplitude": 0.0},
+                  inactive_at={} if inactive is None else {"limit": inactive})
     outcome = SimpleNamespace(run=SimpleNamespace(ok=True, message=""), at_bound=(),
                               space=space)
     st = SimpleNamespace(value=60.0, n_effective=500.0)
