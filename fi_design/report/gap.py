@@ -189,9 +189,9 @@ def gap_sections(result: Any, figures: bool = True) -> list:
                     f"only when its simulation ran, its fit is off every bound, its score (the "
                     f"improvement in effective samples less k ln n_eff) exceeds "
                     f"{num(result.threshold)}, it removes at least half the gap above noise, a "
-                    f"parameter lies three standard errors from the model's own value (every "
-                    f"parameter that has one has a standard error; a force limit's is the "
-                    f"peak force, above which it never acts), and a "
+                    f"parameter lies three standard errors from the model's own value (a force "
+                    f"limit from the peak force, above which it never acts; a parameter "
+                    f"without a standard error is not shown to differ), and a "
                     f"refit on a noise-only record improves three times less. Distances are in "
                     f"those standard errors; runs that failed or ran away (an unstable loop) "
                     f"scored ten times the nominal misfit and could never win.",),
