@@ -31,6 +31,7 @@ thickness (keyword ``length``, ``width``, ``thickness``), for the sizing.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -87,12 +88,29 @@ def weight_vector(guide: LeafGuide) -> np.ndarray:
             "flat": np.array([0.0, -w, 0.0])}.get(guide.orientation, np.zeros(3))
 
 
+@functools.lru_cache(maxsize=256)
+def _congruence(points: tuple[tuple[float, float, float], ...]) -> np.ndarray:
+    """The linear map of a 6 x 6 block B to ``sum_i T_i^T B T_i`` (``T_i = _shift(r_i)``) on
+    the row-major flattened matrices: ``vec(K) = vec(B) @ W`` with ``W = sum_i T_i (x) T_i``,
+    since ``(T^T B T)[i, m] = sum_jk B[j, k] T[j, i] T[k, m]``. One product of a stack of
+    blocks with a 36 x 36 matrix instead of two 6 x 6 products per block and point."""
+    W = np.zeros((36, 36))
+    for r in points:
+        T = _shift(r)
+        W += np.kron(T, T)
+    W.setflags(write=False)
+    return W
+
+
+def _congruent(block: np.ndarray, points: tuple[tuple[float, float, float], ...]) -> np.ndarray:
+    """``sum_i T_i^T block T_i`` over the points r_i (``T_i = _shift(r_i)``), for a stack of
+    blocks of shape (..., 6, 6)."""
+    block = np.asarray(block, float)
+    return (block.reshape(block.shape[:-2] + (36,)) @ _congruence(points)).reshape(block.shape)
+
+
 def _sum_leaves(guide: LeafGuide, block: np.ndarray) -> np.ndarray:
-    K = np.zeros(block.shape)
-    for x, y in guide.leaf_positions():
-        T = _shift((x, y, 0.0))
-        K = K + T.T @ block @ T
-    return K
+    return _congruent(block, tuple((x, y, 0.0) for x, y in guide.leaf_positions()))
 
 
 def clamp_stiffness(guide: LeafGuide, *, deflection: float = 0.0, length=None, width=None,
@@ -152,8 +170,7 @@ def clamp_geometric_stiffness(guide: LeafGuide, *, load: float = 1.0, length=Non
 
 def at_centre(K: np.ndarray, com_height: float) -> np.ndarray:
     """A stiffness at the clamp moved to the stage's centre of mass, ``T^T K T``."""
-    T = _shift((0.0, 0.0, -com_height))
-    return T.T @ K @ T
+    return _congruent(K, ((0.0, 0.0, -float(com_height)),))
 
 
 def mass_matrix(guide: LeafGuide) -> np.ndarray:
