@@ -118,7 +118,8 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
             console.print(Text("Least change that passes: ", style="bold").append(
                 f"{lc.text} ({edits})"))
         else:
-            console.print(Text("Least change: ", style="bold").append(lc.text))
+            console.print(Text("Least change: ", style="bold").append(
+                lc.text + ("; build the recommended design" if result.feasible else "")))
     if result.pareto:
         front = [p for p in result.pareto if p["hunting_margin"] is not None][:6]
         if front:

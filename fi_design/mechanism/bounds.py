@@ -115,15 +115,18 @@ def _note(name: str, side: str, value: float, bounds: tuple[float, float], given
     theirs = None if other is None else sizing_margin(other).value
     adds = theirs is not None and theirs > mine.value * (1.0 + GROWTH)
     whose = "you set" if given else "by default"
+    # the two margins with the digits that tell them apart (3 at least, 6 at most)
+    digits = next((d for d in range(3, 7) if theirs is None
+                   or number(mine.value, d) != number(theirs, d)), 6)
     text = (f"the leaves' {name}, {_mm(value)}, sits on the {side} bound of its range "
             f"{_mm(bounds[0])} to {_mm(bounds[1])} ({key}, {whose}); their smallest margin, "
-            f"{mine.limited_by}, is x{number(mine.value, 3)}")
+            f"{mine.limited_by}, is x{number(mine.value, digits)}")
     past = f"with the bound moved to {_mm(limit)}"
     if other is None:
         text += (f"; {past} no guide meets the constraints as close to the target stiffness")
     else:
         got = (f"{past} the sizing keeps {_mm(other.length)} x {_mm(other.width)} x "
-               f"{_mm(other.thickness)} with x{number(theirs, 3)}")
+               f"{_mm(other.thickness)} with x{number(theirs, digits)}")
         text += (f"; {got}: {_WORDS[(name, side)]} leaves would add margin (widen {key} to "
                  "let the sizing choose)" if adds else
                  f"; {got}: {_WORDS[(name, side)]} leaves would add no margin")

@@ -379,6 +379,8 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
             f"within the thickness bounds {_mm(t0)} to {_mm(t1)}"), **terms)
     base = leaf_guide(flexure, body, length=L0, width=b0, thickness=stock[0],
                       cart_mass=cart_mass, stop_stiffness=stop_stiffness)
+    if base.leaves == 4:  # the two leaves of a row side by side: at most as wide as apart
+        b1 = max(b0, min(b1, base.lateral_spacing))
     L = (np.geomspace(L0, L1, points) if L1 > L0 else np.array([L0]))[:, None]
     t = stock[None, :]
     n, E = base.leaves, base.youngs_modulus
@@ -401,7 +403,7 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
     if not ok.any():
         return FlexureResult(feasible=False, drawn=False, mechanics=None, reason=_why(
             grid, base, stroke, kmax, required_frequency, required_buckling,
-            (ok_shape, ok_stress, ok_stiff, ok_buckle, ok_modes)), **terms)
+            (ok_shape, ok_stress, ok_stiff, ok_buckle, ok_modes), b1), **terms)
     err = np.where(ok, np.abs(np.log(np.maximum(grid.net, 1e-300) / kt)), np.inf)
     margin = np.min(_margins(grid, base, kmax, required_frequency, required_buckling,
                              flexure.thickness_tolerance), axis=0)
@@ -416,15 +418,16 @@ def size_guide(flexure, body: StageBody, *, target_stiffness: float, maximum_sti
 
 
 def _why(grid: GridMechanics, guide: LeafGuide, stroke: float, kmax: float, f_req: float,
-         buckling_req: float, oks) -> str:
+         buckling_req: float, oks, widest: float) -> str:
     """Name the binding constraint of an infeasible sizing: the first, in the order shape,
-    stress, stiffness, buckling, modes, that no design meeting the ones before it can meet."""
+    stress, stiffness, buckling, modes, that no design meeting the ones before it can meet
+    (``widest``: the largest width the sizing may take [m])."""
     ok_shape, ok_stress, ok_stiff, ok_buckle, ok_modes = oks
     sa = guide.allowed_stress
     if not ok_shape.any():
         return ("shape: every leaf within the bounds is at least as thick as it is wide "
                 f"(thickness from {_mm(float(grid.thickness.min()))}, width at most "
-                f"{_mm(float(grid.width.max()))}); a leaf must be thinner than wide")
+                f"{_mm(widest)}); a leaf must be thinner than wide")
     if not ok_stress.any():  # ok_stress holds the shape: the least stress of shaped leaves
         least = float(np.min(np.where(ok_shape, grid.stress, np.inf)))
         return ("stress: every leaf within the bounds reaches at least "
@@ -432,8 +435,15 @@ def _why(grid: GridMechanics, guide: LeafGuide, stroke: float, kmax: float, f_re
                 "the allowed "
                 f"{quantity(sa, 'Pa', 4, shown=('MPa', 1e-6))}")
     sel = ok_stress
+    if not (sel & ok_stiff).any() and not (sel & (grid.net > 0.0)).any():
+        least = float(np.max(np.where(sel, grid.net, -np.inf)))
+        return (f"gravity: the stage's {quantity(guide.weight, 'N', 3)} {guide.orientation} "
+                f"outweighs the elastic drive stiffness of every leaf thin and long enough for "
+                f"{_mm(stroke)} stroke within {quantity(sa, 'Pa', 4, shown=('MPa', 1e-6))}: "
+                f"their net drive stiffness is at most {quantity(least, 'N/m', 4)}, the guide "
+                "unstable")
     if not (sel & ok_stiff).any():
-        least = float(np.min(np.where(sel, grid.net, np.inf)))
+        least = float(np.min(np.where(sel & (grid.net > 0.0), grid.net, np.inf)))
         return (f"stiffness with stress: leaves thin and long enough for {_mm(stroke)} stroke "
                 f"within {quantity(sa, 'Pa', 4, shown=('MPa', 1e-6))} are at least "
                 f"{quantity(least, 'N/m', 4)} stiff (net of gravity), above k_max = "

@@ -185,7 +185,11 @@ def least_change(search: Any, *, executor: Any = None,
         fold = ans["free_from"]
         if fold is not None:
             fc = 1.01 * margin * fold
-            if fc <= search.fc:
+            low = spec.requirements.recommend.crossover
+            if low is not None and fc < low[0]:
+                tried.append(f"the crossover alone, {quantity(fc, 'Hz', 4)}: below "
+                             "requirements.recommend.crossover")
+            elif fc <= search.fc:
                 cand = model.varied({"controller.crossover": fc})
                 ok, why = _passes(cand, executor)
                 if ok:
@@ -205,7 +209,8 @@ def least_change(search: Any, *, executor: Any = None,
     # 2. the stiffness alone, 3. the stroke and the stiffness, at the spec's crossover
     options = [(s0, "the stiffness alone")] + [
         (s0 * f, "the stroke and the stiffness") for f in STROKE_FACTORS
-        if s0 * f <= search.envelope[1]]
+        if search.envelope[0] <= s0 * f <= search.envelope[1]]
+    bounds = spec.requirements.recommend
     for stroke, what in options:
         say(f"the least change: {what} ({quantity(stroke, 'm')}) ...")
         k_top = top_stiffness(model, stroke)
@@ -214,6 +219,10 @@ def least_change(search: Any, *, executor: Any = None,
         if k is None:
             tried.append(f"{what} at {quantity(stroke, 'm')}: no stiffness keeps the hunting "
                          f"margin at {quantity(fc0, 'Hz', 4)}")
+            continue
+        if bounds.stiffness is not None and not bounds.stiffness[0] <= k <= bounds.stiffness[1]:
+            tried.append(f"{what} at {quantity(stroke, 'm')}: {quantity(k, 'N/m', 4)}, outside "
+                         "requirements.recommend.stiffness")
             continue
         values = {"isolator.stiffness": k} if stroke == s0 else \
             {"isolator.stroke": stroke, "isolator.stiffness": k}
@@ -228,4 +237,4 @@ def least_change(search: Any, *, executor: Any = None,
             return done(values, words + f", the loop at {quantity(fc0, 'Hz', 4)}", (bound,))
         tried.append(f"{what} at {quantity(stroke, 'm')}, {quantity(k, 'N/m', 4)}: {why}")
     return LeastChange(changes={}, feasible=False, binding=(), text="no edit of one or two "
-                       "values passes: build the recommended design", tried=tuple(tried))
+                       "values passes", tried=tuple(tried))

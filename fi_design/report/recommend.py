@@ -105,7 +105,8 @@ def recommend_context(result: RecommendResult, *, date: Any = None, command: str
             tables.append(Table(("Spec path", "New value"), tuple(lc.changes.items()),
                                 caption="The least change"))
         else:
-            least_paras.append(f"Least change: {lc.text}.")
+            least_paras.append(f"Least change: {lc.text}"
+                               + ("; build the recommended design." if result.feasible else "."))
         least_paras += [f"Tried first: {t}." for t in lc.tried]
     figs: tuple[FigureBlock, ...] = ()
     if figures:

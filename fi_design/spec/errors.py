@@ -141,7 +141,26 @@ def real_errors(errors: list[dict]) -> list[dict]:
                     for o in errors)
         return inner and least is not None and hasattr(given, "__len__") and len(given) >= least
 
-    kept = [e for e in errors if not caused(e)]
+    def field(err: dict) -> tuple:
+        """The location up to a union member's tag ("tuple[...]", "function-before[...]")."""
+        loc = tuple(err["loc"])
+        tag = next((n for n, p in enumerate(loc) if isinstance(p, str) and not p.isidentifier()),
+                   None)
+        return loc if tag is None else loc[:tag]
+
+    def other_branch(err: dict) -> bool:
+        # a value-or-range (a value or [min, max]) tried both: the branch that does not take
+        # the input's shape (the range for a scalar, the value for a list) is no problem of
+        # its own where the other branch has one
+        loc, base = tuple(err["loc"]), field(err)
+        if len(loc) != len(base) + 1 or not any(
+                field(o) == base and tuple(o["loc"]) != loc for o in errors):
+            return False
+        listed = isinstance(err.get("input"), (list, tuple))
+        return (err["type"] == "tuple_type" and not listed) or \
+            (not str(loc[-1]).startswith("tuple[") and listed)
+
+    kept = [e for e in errors if not caused(e) and not other_branch(e)]
     return kept or errors
 
 

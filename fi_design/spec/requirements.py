@@ -3,10 +3,11 @@
 
 from __future__ import annotations
 
-from typing import Literal, Union
+from typing import Any, Literal, Union
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
+from ..display import quantity
 from .fields import OptQ, Q, StrictModel
 
 
@@ -119,13 +120,15 @@ class RecommendBounds(StrictModel):
                            "parasitic mode that limits the spec's loop, where the notch lifts "
                            "the achievable crossover (a spec tuned by the rule).")
 
-    @model_validator(mode="after")
-    def _ordered(self) -> "RecommendBounds":
-        for name in ("stroke", "stiffness", "crossover"):
-            pair = getattr(self, name)
-            if pair is not None and not 0 < pair[0] <= pair[1]:
-                raise ValueError(f"{name} must be [min, max] with 0 < min <= max")
-        return self
+    @field_validator("stroke", "stiffness", "crossover")
+    @classmethod
+    def _ordered(cls, pair: Any, info: Any) -> Any:
+        if pair is not None and not 0 < pair[0] <= pair[1]:
+            unit = {"stroke": "m", "stiffness": "N/m", "crossover": "Hz"}[info.field_name]
+            raise ValueError(f"must be [min, max] with 0 < min <= max, got [{quantity(pair[0], unit)}"
+                             f", {quantity(pair[1], unit)}] (a number without a unit is read in "
+                             f"{unit})")
+        return pair
 
 
 class Reserve(StrictModel):

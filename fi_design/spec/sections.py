@@ -169,6 +169,15 @@ class Material(StrictModel):
                                                                 "Default 0.3.")
 
 
+#: The most stock thicknesses (multiples of ``thickness_step`` within the thickness bounds) the
+#: sizing takes: each is a column of its grid of leaves.
+MAX_STOCK = 200
+
+
+def _mm(x: float) -> str:
+    return quantity(x, "m", 4, shown=("mm", 1e3))
+
+
 Bounds = tuple[Q("m"), Q("m")]
 #: A leaf dimension: one value (the guide as drawn) or [min, max] (bounds step 3 sizes within).
 Dimension = Union[Bounds, Q("m")]
@@ -193,14 +202,13 @@ class Flexure(StrictModel):
     thickness: Dimension = Field((0.05e-3, 2e-3), description="Leaf thickness t [m], or "
                                                               "[min, max] to size. Default "
                                                               "0.05 mm to 2 mm.")
-    spacing: OptQ("m") = Field(None, gt=0, description="Distance between the two rows of leaves "
-                                                       "along the drive direction [m]. Default: "
-                                                       "the stage's x size.")
-    lateral_spacing: OptQ("m") = Field(None, gt=0, description="With 4 leaves: centre distance "
-                                                               "of the two leaves of a row [m]. "
-                                                               "Default: the stage's y size "
-                                                               "less a leaf width, at least one "
-                                                               "leaf width.")
+    spacing: OptQ("m") = Field(None, gt=0, description=(
+        "Distance between the two rows of leaves along the drive direction [m], more than the "
+        "leaves' thickness. Default: the stage's x size."))
+    lateral_spacing: OptQ("m") = Field(None, gt=0, description=(
+        "With 4 leaves only: centre distance of the two leaves of a row [m], at least the "
+        "narrowest leaf's width (the sizing keeps the leaves no wider). Default: the stage's y "
+        "size less a leaf width, at least one leaf width."))
     orientation: Literal["standing", "hanging", "flat", "vertical_axis"] = Field(
         "standing", description="The guide against gravity: 'standing' (leaves vertical, the "
                                 "stage on top, compressed by its weight; default), 'hanging' "
@@ -210,26 +218,80 @@ class Flexure(StrictModel):
     damping_ratio: float = Field(0.01, gt=0, lt=1, description="Modal damping ratio of the "
                                                                "guide's computed modes [-]. "
                                                                "Default 0.01.")
-    thickness_step: OptQ("m") = Field(0.05e-3, gt=0, description="Stock thicknesses: the leaves "
-                                                                 "are sized in multiples of this "
-                                                                 "[m]; null sizes an unrounded "
-                                                                 "thickness. Default 0.05 mm.")
-    thickness_tolerance: Q("m") = Field(0.01e-3, ge=0, description="Thickness tolerance of the "
-                                                                   "stock, +- [m]: the drive "
-                                                                   "stiffness goes with t^3. "
-                                                                   "Default 0.01 mm.")
+    thickness_step: OptQ("m") = Field(0.05e-3, gt=0, validate_default=True, description=(
+        "Stock thicknesses: the leaves are sized in multiples of this [m], at most 200 of them "
+        "within the thickness bounds; null sizes an unrounded thickness. Default 0.05 mm."))
+    thickness_tolerance: Q("m") = Field(0.01e-3, ge=0, validate_default=True, description=(
+        "Thickness tolerance of the stock, +- [m], below the smallest thickness: the drive "
+        "stiffness goes with t^3. Default 0.01 mm."))
 
-    @model_validator(mode="after")
-    def _ordered(self) -> "Flexure":
-        for name in ("length", "width", "thickness"):
-            lo, hi = self.bounds(name)
-            if not 0 < lo <= hi:
-                raise ValueError(f"{name} must be positive, or [min, max] with 0 < min <= max")
-        if self.thickness_tolerance >= self.bounds("thickness")[0]:
-            raise ValueError("thickness_tolerance must be below the smallest thickness")
-        if self.drawn and self.bounds("thickness")[0] >= self.bounds("width")[0]:
-            raise ValueError("a leaf is thinner than it is wide: thickness must be below width")
-        return self
+    @field_validator("length", "width", "thickness")
+    @classmethod
+    def _ordered(cls, value: Any, info: Any) -> Any:
+        lo, hi = (value, value) if isinstance(value, float) else value
+        if isinstance(value, float) and not lo > 0:
+            raise ValueError(f"must be positive, got {_mm(lo)}")
+        if not 0 < lo <= hi:
+            raise ValueError(f"[min, max] with 0 < min <= max, got [{_mm(lo)}, {_mm(hi)}] (a "
+                             "number without a unit is read in m)")
+        width = info.data.get("width")
+        if info.field_name == "thickness" and isinstance(value, float) and \
+                isinstance(width, float) and isinstance(info.data.get("length"), float) and \
+                value >= width:
+            raise ValueError(f"a leaf must be thinner than it is wide: thickness {_mm(value)} "
+                             f"is not below width {_mm(width)}")
+        return value
+
+    @field_validator("spacing")
+    @classmethod
+    def _rows_apart(cls, spacing: Any, info: Any) -> Any:
+        thickness = info.data.get("thickness")
+        top = thickness if isinstance(thickness, float) else (thickness or (0.0, 0.0))[1]
+        if spacing is not None and spacing <= top:
+            raise ValueError(f"the two rows of leaves would touch: {_mm(spacing)} must exceed "
+                             f"the leaves' thickness (up to {_mm(top)})")
+        return spacing
+
+    @field_validator("lateral_spacing")
+    @classmethod
+    def _side_by_side(cls, lateral: Any, info: Any) -> Any:
+        width = info.data.get("width")
+        if lateral is None or width is None:
+            return lateral
+        if info.data.get("leaves") == 2:
+            raise ValueError("places the two leaves of a row side by side: it needs leaves: 4 "
+                             "(with 2 leaves, one per row, leave it out)")
+        least = width if isinstance(width, float) else width[0]
+        if lateral < least:
+            raise ValueError(f"the leaves of a row would overlap: {_mm(lateral)} is below the "
+                             f"smallest leaf width {_mm(least)} (their centre distance must be "
+                             "at least a width)")
+        return lateral
+
+    @field_validator("thickness_step")
+    @classmethod
+    def _few_stocks(cls, step: Any, info: Any) -> Any:
+        thickness = info.data.get("thickness")
+        if step is None or thickness is None or isinstance(thickness, float):
+            return step
+        lo, hi = thickness
+        count = math.floor(hi / step + 1e-9) - math.ceil(lo / step - 1e-9) + 1
+        if count > MAX_STOCK:
+            raise ValueError(f"{quantity(step, 'm', 4)} gives {count} stock thicknesses from "
+                             f"{_mm(lo)} to {_mm(hi)} (isolator.flexure.thickness); the sizing "
+                             f"takes at most {MAX_STOCK}: a coarser step or a narrower "
+                             "thickness range")
+        return step
+
+    @field_validator("thickness_tolerance")
+    @classmethod
+    def _below_stock(cls, tolerance: Any, info: Any) -> Any:
+        thickness = info.data.get("thickness")
+        if thickness is not None:
+            least = thickness if isinstance(thickness, float) else thickness[0]
+            if tolerance >= least:
+                raise ValueError(f"must be below the smallest thickness, {_mm(least)}")
+        return tolerance
 
     def bounds(self, name: str) -> tuple[float, float]:
         """[min, max] of a leaf dimension [m] (a drawn value is both)."""

@@ -302,12 +302,30 @@ def test_sized_guides_meet_their_constraints(k_target, headroom, stroke, f_req, 
      ["shape: every leaf within the bounds is at least as thick as it is wide"]),
     (dict(), dict(width=(1e-3, 3e-3), thickness=(1e-3, 3e-3), length=(50e-3, 200e-3)),
      ["parasitic modes:", "reaches at most 7.7", "below the required"]),
+    # the width bound, not the width the stiffness asked for (it read "at most 5 mm")
+    (dict(), dict(thickness=0.1), ["shape:", "thickness from 100 mm, width at most 30 mm"]),
+    # leaves of 200 Pa: the weight outweighs every leaf's elastic stiffness (it read "at least
+    # -401 N/m stiff, above k_max")
+    (dict(), dict(material={"youngs_modulus": 200.0, "allowed_stress": SIGMA, "density": RHO}),
+     ["gravity: the stage's 15.7 N standing outweighs the elastic drive stiffness",
+      "the guide unstable"]),
 ])
 def test_an_infeasible_sizing_names_the_binding_constraint(kwargs, bounds, words):
     r = size_guide(make_flexure(**bounds), BODY, **{**PAPER, **kwargs})
     assert not r.feasible and r.mechanics is None and r.length is None
     for w in words:
         assert w in r.reason, r.reason
+
+
+def test_four_leaves_are_sized_no_wider_than_they_stand_apart():
+    """The two leaves of a row stand ``lateral_spacing`` apart (centre to centre): a wider
+    leaf would overlap its neighbour. Without the cap the paper's target took 5.5 mm leaves
+    5.2 mm apart."""
+    free = size_guide(make_flexure(leaves=4), BODY, **PAPER)
+    r = size_guide(make_flexure(leaves=4, lateral_spacing=5.2e-3), BODY, **PAPER)
+    assert free.feasible and free.width > 5.2e-3
+    assert r.feasible and r.width <= 5.2e-3 * (1 + 1e-12)
+    assert r.mechanics.net_drive_stiffness <= r.maximum_stiffness
 
 
 def test_the_torsion_constant_of_a_rectangle_takes_its_shorter_side_as_thickness():

@@ -283,6 +283,11 @@ def test_an_empty_space_says_so_with_the_nearest_design(repo_root, tmp_path):
     data = json.loads(js.read_text())
     assert data["feasible"] is False and data["violates"]
     assert all(c["status"] != "feasible" for c in data["map"]["candidates"])
+    # no design to build: the least change never says to build one (it did when it found none)
+    lc = data["least_change"]
+    assert lc is not None
+    assert "build the recommended design" not in r.output + lc["text"], (r.output, lc)
+    assert lc["feasible"] or "no edit of one or two values passes" in r.output
 
 
 @pytest.mark.slow
@@ -513,3 +518,21 @@ def test_the_console_and_the_report_show_k_over_the_stock_tolerance(paper_recomm
     ctx = json.dumps(build_context(r, date=date(2024, 5, 1), figures=False), default=str,
                      ensure_ascii=False)
     assert "k over the leaves' tolerance (\u00b10.01\u00a0mm)" in ctx and f"{number(lo)} to " in ctx
+
+
+@pytest.mark.slow
+def test_the_least_change_keeps_within_the_bounds_the_user_set(repo_root):
+    """requirements.recommend.stroke of 2 to 3 mm (the travel the mechanism allows): the
+    least change of the spec's 0.3 mm stroke never proposes a stroke outside it (it proposed
+    1.2 mm at 3141 N/m, below the bound; about 11 s)."""
+    from fi_design.spec.file import load_spec
+
+    spec = variant(load_spec(repo_root / "examples" / "paper_setup.yaml"),
+                   **{"requirements.robustness.samples": 20,
+                      "requirements.recommend.stroke": ["2 mm", "3 mm"]})
+    r = recommend(spec)
+    assert r.feasible and 2e-3 * (1 - 1e-9) <= r.design.stroke <= 3e-3 * (1 + 1e-9)
+    lc = r.least_change
+    assert lc is not None
+    assert "isolator.stroke" not in lc.changes, lc
+    assert not any("1.2 mm" in t or "0.6 mm" in t for t in lc.tried), lc.tried
