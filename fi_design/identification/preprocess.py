@@ -57,6 +57,11 @@ def check_record(m: Measurement) -> None:
     if float(np.ptp(m.position)) <= 0.0:
         raise DataError("constant: the stage never moves; identification needs a record of "
                         "sliding motion in both directions", column="position_m", source=src)
+    if float(np.ptp(m.force)) <= 0.0:
+        raise DataError(f"constant: the force is {quantity(float(m.force[0]), 'N', 6)} in every "
+                        "row; the friction and the mass are read from how the force changes "
+                        "with the motion (is the column the drive's force command, logged?)",
+                        column="force_N", source=src)
     dt = np.diff(m.time)
     med = float(np.median(dt))
     worst = float(np.max(np.abs(dt - med)))

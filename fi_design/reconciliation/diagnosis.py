@@ -215,6 +215,12 @@ def force_check(cmp: Comparison, run: ModelRun) -> ForceCheck:
     if rms0 < STRUCTURE_MISFIT * cmp.noise.force or share < FORCE_FIX_SHARE or \
             not (flipped or scaled):
         return ForceCheck(float(scale), None)
+    if float(np.ptp(meas)) <= 0.0:  # no correlation to speak of: say what the column holds
+        return ForceCheck(float(scale), Cause("force_scale", float(min(max(share, 0.0), 1.0)), (
+            f"force_N is {quantity(float(meas[0]), 'N', 3)} in every row, where the model's "
+            f"force moves by {quantity(float(np.ptp(model)), 'N', 3)}: the record carries no "
+            "force signal. Check that the logger records the drive's force (command) and "
+            "that the column is the one meant.")))
     corr = float(np.corrcoef(meas, model)[0, 1])
     what = "sign" if flipped else "scale"
     detail = (f"force_N's {what} looks wrong: the measured force is {number(scale, 3)} times "

@@ -468,6 +468,10 @@ def test_bad_records_name_the_column_and_what_is_needed():
     with pytest.raises(DataError) as e:
         identify(measurement_from_arrays(t, x, np.full_like(x, 0.1), force_N=u))
     assert e.value.column == "position_m" and "never moves" in str(e.value)
+    for level in (0.0, 5.0):  # a dead force channel: refused, not a least-squares fit of 0 / 0
+        with pytest.raises(DataError) as e:
+            identify(measurement_from_arrays(t, x, x, force_N=np.full_like(x, level)))
+        assert e.value.column == "force_N" and "in every row" in str(e.value)
     jitter = t + np.where(np.arange(len(t)) % 7 == 3, 4e-4, 0.0)
     with pytest.raises(DataError) as e:
         identify(measurement_from_arrays(jitter, x, x, force_N=u))

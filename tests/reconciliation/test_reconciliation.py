@@ -340,6 +340,22 @@ def test_a_force_column_of_the_wrong_sign_or_scale_is_called_out(isolated, facto
     assert "No effect is named" in result.conclusion
 
 
+def test_a_force_column_that_never_changes_is_called_out_without_numpy_warnings(recwarn):
+    """force_N logged as 0 N in every row (a dead channel): the record is at fault, said in
+    words; before, numpy's "invalid value encountered in divide" of a correlation with a
+    constant reached the user's terminal and the cause read "0 times the model's"."""
+    case = Case("dead-force", False, {"type": "force_offset", "offset": 0.5}, {},
+                duration=1.0, moves=SHORT)
+    spec = base_spec(case)
+    result = reconcile(spec, _with_force(measure(case, spec), 0.0), candidates=["force_offset"])
+    d = result.diagnosis
+    assert result.effect == "none" and d.mismatch and d.causes[0].name == "force_scale"
+    assert "force_N is 0 N in every row" in d.causes[0].detail
+    assert "carries no force signal" in result.conclusion
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)], \
+        [str(w.message) for w in recwarn]
+
+
 @pytest.mark.slow
 def test_the_example_record_with_its_force_negated_names_no_effect(tmp_path):
     """examples/measured_trace.csv with force_N negated (about 12 s): position and deflection
