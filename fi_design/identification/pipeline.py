@@ -17,13 +17,15 @@ from typing import Callable
 import numpy as np
 
 from ..arguments import choice, integer, number
+from ..display import number as number_text
 from ..display import quantity
 from ..errors import ArgumentError, DataError
 from ..measured import Measurement, measurement_from_arrays
 from ..spec.file import as_spec
 from .dynamic import dynamic_parameters
 from .events import excitation
-from .preprocess import JITTER, check_record, joint_model, prepare, processing
+from .preprocess import (CROSSOVER_FACTOR, JITTER, check_record, joint_model, prepare,
+                         processing)
 from .regression import (IMPLAUSIBLE, Solution, check_directions, direction_words, equations,
                          fit_statistics, force_rss, form_note, mass_note, rigid_parameters,
                          split_masses, solve, symmetric_view, threshold_note)
@@ -137,10 +139,27 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
     else:
         shape = form_note(form)
     notes = list(joint.notes) + [shape, threshold_note(proc)]
+    signs = [p.value for k, p in params.items() if k != "offset" and p.value is not None]
+    if signs and all(v < 0.0 for v in signs):
+        notes.append("the mass and every friction term are negative: force_N most likely has "
+                     "the wrong sign (positive force must push the stage towards positive "
+                     "position_m); flip the column and identify again")
     for name, p in list(params.items()):
         if p.value is not None and p.value <= 0.0 and name != "offset":
             params[name] = replace(p, note=p.note + "; " + IMPLAUSIBLE)
             notes.append(f"{name} = {quantity(p.value, p.unit, 4)} is not positive: {IMPLAUSIBLE}")
+    if cutoff is None and spec is not None:
+        from ..model import as_model
+
+        fc = as_model(spec).crossover
+        if proc.cutoff < CROSSOVER_FACTOR * fc * (1.0 - 1e-9):
+            notes.append(f"the record is sampled at {quantity(proc.sample_rate, 'Hz', 4)}, too "
+                         f"slowly for the loop's {quantity(fc, 'Hz', 4)} crossover: the "
+                         f"low-pass is capped at {quantity(proc.cutoff, 'Hz', 4)} instead of "
+                         f"{number_text(CROSSOVER_FACTOR)} x the crossover, so the loop's own "
+                         "dynamics are smeared into the friction and the mass read here; log at "
+                         f"least {quantity(4.0 * CROSSOVER_FACTOR * fc, 'Hz', 3)} (a time_s "
+                         "column in ms reads 1000 x too slow)")
     for name, m in (("stage mass", masses.stage), ("cart mass", masses.cart)):
         if masses.stage_std_error is not None and m <= 0.0:  # both fitted (a two-mass record)
             notes.append(f"the {name} = {quantity(m, 'kg', 4)} is not positive: {IMPLAUSIBLE}; "

@@ -60,6 +60,26 @@ def mass_leaks(total: Parameter, spec, fit: Fit) -> bool:
     return mass_far(total, spec) and fit.relative_error >= FIT_LEAK
 
 
+#: A unit's factor between the identified and the spec's moving mass (within 2 %), and the
+#: slip of a column that gives it: m = F / a, so a force in mN gives 1000 x the mass and a
+#: position in mm a thousandth.
+UNIT_SLIPS = ((1e3, "force_N logged in mN"), (1e-3, "position_m logged in mm"),
+              (1e-6, "position_m logged in µm"), (1e6, "force_N logged in µN"))
+
+
+def unit_slip(mass: float | None, spec) -> str | None:
+    """The column's unit slip an identified total mass [kg] points at, or None.
+
+    The mass lies within 2 % of a unit's factor (:data:`UNIT_SLIPS`) times the spec's
+    moving mass (stage + cart): a designer's estimate is off by tens of percent, never by
+    exactly 1000.
+    """
+    if spec is None or mass is None or not mass > 0.0:
+        return None
+    ratio = mass / float(spec.total_mass)
+    return next((what for k, what in UNIT_SLIPS if abs(ratio / k - 1.0) <= 0.02), None)
+
+
 def mass_note(total: Parameter, spec, proc: Processing, fit: Fit) -> str:
     """A note when the identified total mass is far from the spec's moving mass, with the cause.
 
@@ -84,6 +104,13 @@ def mass_note(total: Parameter, spec, proc: Processing, fit: Fit) -> str:
             f"follows its cut-off ({quantity(proc.cutoff, 'Hz', 3)}: {proc.cutoff_rule}), "
             "so another spec's crossover (or identify's cutoff argument) gives another mass. "
             "fi-design reconcile names such effects; do not write this mass into the spec")
+    slip = unit_slip(total.value, spec)
+    if slip is not None:
+        return text + (
+            f"a unit's factor, and the fit leaves only {percent(fit.relative_error, 2)} of the "
+            f"force unexplained: most likely {slip} (the columns are read in N and m); every "
+            "force identified here carries the same factor: fix the column, do not write these "
+            "values into the spec")
     return text + (
         f"the fit leaves only {percent(fit.relative_error, 2)} of the force unexplained, so "
         "the record is consistent with this mass: most likely the spec's stage and cart masses are off "

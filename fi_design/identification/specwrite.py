@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 from ..display import number, percent, plain, quantity
-from .regression import IMPLAUSIBLE, mass_leaks
+from .regression import IMPLAUSIBLE, mass_leaks, unit_slip
 from ..results.identification import DYNAMIC, IdentificationResult
 
 
@@ -163,14 +163,25 @@ def identified_spec(spec, params, masses, form, direction: str = "both",
     from ..errors import SpecError
     from ..spec.file import with_values
 
+    slip = unit_slip(params["mass"].value, spec)
+    if slip is not None:
+        raise SpecError(f"the identified mass {quantity(params['mass'].value, 'kg', 4)} is a "
+                        f"unit's factor from the spec's {quantity(float(spec.total_mass), 'kg', 4)}:"
+                        f" most likely {slip}, and every identified force carries the same "
+                        "factor; fix the record's column and identify again", path="stage.mass")
     values = _values(spec, params, masses, form, direction, keep_mass)
     bad = [k for k in ("stage.mass", "cart.mass", "friction.coulomb",
                        "friction.coulomb_negative", "friction.viscous",
                        "friction.viscous_negative") if k in values and values[k] < 0.0
            or k in values and values[k] == 0.0 and "viscous" not in k]
     if bad:
+        flipped = all(values[k] < 0.0 for k in ("stage.mass", "friction.coulomb")
+                      if k in values)
         raise SpecError(f"the identified value {quantity(values[bad[0]], _SPEC_UNITS[bad[0]], 4)} "
-                        f"is not positive, which a spec cannot hold: {IMPLAUSIBLE}", path=bad[0])
+                        "is not positive, which a spec cannot hold: " + (
+                            "the mass and the friction are negative together, so force_N most "
+                            "likely has the wrong sign: flip the column and identify again"
+                            if flipped else IMPLAUSIBLE), path=bad[0])
     if values.get("friction.static", math.inf) < values.get("friction.coulomb", 0.0):
         raise SpecError("the identified static friction "
                         f"{quantity(values['friction.static'], 'N', 4)} lies below the Coulomb "

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -686,3 +687,41 @@ def test_epoch_time_stamps_give_the_same_identification():
     assert abs(at_epoch.value("mass") - at_zero.value("mass")) < 3 * se
     assert abs(at_epoch.value("coulomb") - at_zero.value("coulomb")) < \
         3 * at_zero.parameters["coulomb"].std_error
+
+
+AXIS_SPEC = {"name": "axis", "stage": {"mass": 90.0}, "cart": {"mass": 10.0},
+             "friction": {"static": 25.0, "coulomb": 20.0, "stribeck_velocity": 0.002},
+             "controller": {"gains": {"kp": 1.371e6, "kd": 8557.0},
+                            "derivative_on": "measurement", "sample_rate": 1000.0},
+             "motion": {"moves": [{"distance": 0.1, "velocity": 0.1, "acceleration": 1.0}]}}
+
+
+@pytest.mark.parametrize("factor, words", [
+    (1e3, "force_N logged in mN"),       # it read "the spec's masses are off ... or not in N"
+    (-1.0, "force_N most likely has the wrong sign")])   # it read "an unmodelled effect"
+def test_a_column_in_another_unit_or_sign_is_named_and_never_written(symmetric_record, factor,
+                                                                    words):
+    """The independent simulator's axis (100 kg) with force_N in mN or negated: a close fit
+    whose mass is exactly 1000 x (or minus) the spec's says which column slipped, and
+    --write-spec refuses it (it wrote a 90000 kg stage with 1000 x the friction)."""
+    from fi_design.errors import SpecError
+
+    spec = load_spec(AXIS_SPEC)
+    r = identify(replace(symmetric_record, force=factor * symmetric_record.force), spec)
+    assert r.fit.relative_error < 0.01
+    assert any(words in n for n in r.notes), r.notes
+    with pytest.raises(SpecError) as e:
+        identified_spec_text(r)
+    assert (words if factor > 0 else "wrong sign") in str(e.value)
+
+
+def test_a_record_logged_slower_than_the_loop_says_so(symmetric_record):
+    """Every 20th sample of the 1 kHz record (50 Hz, below the 5 x crossover the low-pass
+    needs): the identification says its cut-off was capped (it was silent)."""
+    rec = symmetric_record
+    slow = measurement_from_arrays(rec.time[::20], rec.reference[::20], rec.position[::20],
+                                   force_N=rec.force[::20])
+    r = identify(slow, load_spec(AXIS_SPEC))
+    assert any("too slowly for the loop's" in n and "capped at 12.5 Hz" in n for n in r.notes), \
+        r.notes
+    assert not any("too slowly" in n for n in identify(rec, load_spec(AXIS_SPEC)).notes)
