@@ -34,6 +34,7 @@ matplotlib) and of rich happen inside the command functions, so
 from __future__ import annotations
 
 import difflib
+import math
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -183,8 +184,8 @@ def simulate_command(
         raise typer.BadParameter("only an open-loop replay has windows: give --record "
                                  "MEASURED.csv --drive force, or leave --window out",
                                  param_hint="--window")
-    if not window > 0:
-        raise typer.BadParameter(f"must be a positive time in seconds, got {window!r}",
+    if not 0 < window < math.inf:
+        raise typer.BadParameter(f"must be a positive, finite time in seconds, got {window!r}",
                                  param_hint="--window")
     inputs = (spec,) if record is None else (spec, record)
     outs = check_outputs(inputs, force, csv=(csv_out, (".csv",)), json=(json_out, (".json",)))

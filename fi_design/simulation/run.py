@@ -24,7 +24,7 @@ import numpy as np
 from .. import spec as _spec
 from ..arguments import number
 from ..display import number as number_text, quantity  # number: the argument check
-from ..errors import ArgumentError, SimulationError
+from ..errors import ArgumentError, DataError, SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from ..model import Model, as_model
 from ..kernel.layout import PlantParameters, state_index
@@ -323,8 +323,8 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
         return _result(model, iso, method, p0, out, t_out, wall, move_end=0.0,
                        time_offset=t0, record=record)
     if record.force is None:
-        raise SimulationError("an open-loop replay (drive='force') needs the record's force_N "
-                              "column")
+        raise DataError("missing: an open-loop replay (--drive force) drives the plant with the "
+                        "record's force, a column force_N", column="force_N", source=record.source)
     window = number(window, "window", "s", positive=True)
     least = MIN_WINDOW_SAMPLES * record.sample_period
     if window < least:

@@ -254,16 +254,25 @@ def test_cli_simulate_record(tmp_path, emps_path, emps_identification):
     # --window without an open-loop replay was ignored while --drive force was refused
     (["--window", "0.2"], "only an open-loop replay has windows"),
     (["--record", "RECORD", "--window", "0.2"], "only an open-loop replay has windows"),
+    # inf passed the option's check and was refused by the library without naming --window
+    (["--record", "RECORD", "--drive", "force", "--window=inf"], "Invalid value for --window"),
+    # a record without force_N: the file and the column, not the library's drive='force'
+    (["--record", "NOFORCE", "--drive", "force"], "column 'force_N': missing: an open-loop "
+                                                  "replay (--drive force)"),
 ])
-def test_cli_simulate_bad_replay_options(paper_spec_path, args, words):
+def test_cli_simulate_bad_replay_options(paper_spec_path, tmp_path, args, words):
     from typer.testing import CliRunner
 
     from fi_design.cli.app import app
 
     record = str(EXAMPLES / "measured_trace.csv")
-    res = CliRunner().invoke(app, ["simulate", str(paper_spec_path),
-                                   *(record if a == "RECORD" else a for a in args)])
-    assert res.exit_code == 2 and words in res.output
+    noforce = tmp_path / "noforce.csv"
+    noforce.write_text("time_s,reference_m,position_m\n" + "".join(
+        f"{i * 1e-3},0,0\n" for i in range(100)))
+    res = CliRunner().invoke(app, ["simulate", str(paper_spec_path), *(
+        {"RECORD": record, "NOFORCE": str(noforce)}.get(a, a) for a in args)])
+    assert res.exit_code == 2 and words in " ".join(res.output.split()), res.output
+    assert "NOFORCE" not in args or str(noforce) in res.output
 
 
 def test_cli_simulate_record_with_nan_disturbance_names_the_row(tmp_path, paper_spec_path):
