@@ -179,8 +179,9 @@ def test_record_too_short_for_a_velocity_names_the_column():
 def test_open_loop_replay_needs_the_force(paper_spec):
     t = np.arange(50) * 1e-3
     rec = measurement_from_arrays(t, np.zeros(50), np.zeros(50))
-    with pytest.raises(SimulationError, match="force_N"):
+    with pytest.raises(DataError, match="force_N") as err:  # the record's fault, named so
         simulate(paper_spec, isolated=False, record=rec, drive="force")
+    assert err.value.column == "force_N"
     with pytest.raises(SimulationError, match="drive"):
         simulate(paper_spec, isolated=False, record=rec, drive="torque")
 
