@@ -20,6 +20,7 @@ import numpy as np
 from .. import effects as _effects
 from .. import display
 from ..arguments import integer, number
+from ..display import quantity
 from ..errors import ArgumentError, DataError, SimulationError
 from ..measured import Measurement
 from ..model import resolve
@@ -213,6 +214,13 @@ def _check_arguments(spec, measured, isolated, candidates, max_effects,
     if measured.n < 50:
         raise DataError(f"too short for a reconciliation: {measured.n} samples, at least 50",
                         column="time_s", source=measured.source)
+    moved = float(np.ptp(measured.reference)) if measured.reference is not None else 0.0
+    if float(np.ptp(measured.position)) <= 0.0 < moved:
+        raise DataError(f"constant: position_m holds {quantity(float(measured.position[0]), 'm', 6)}"
+                        f" in every row while the reference moves by {quantity(moved, 'm', 4)}: "
+                        "the stage never moves in the record, so there is no motion to compare "
+                        "with the model (was the encoder logged, the stage free?)",
+                        column="position_m", source=measured.source)
     return CheckedArguments(iso, names)
 
 

@@ -553,3 +553,21 @@ def test_a_nominal_model_that_fails_open_loop_points_at_the_force_not_a_controll
         "one (guideline step 2), the delay and the sample rate. No effect can be judged against "
         "a model that does not run; check the spec against the record (controller, mass, "
         "sample rate).")
+
+
+def test_a_record_whose_stage_never_moves_is_refused_naming_position_m():
+    """position_m frozen at its first value while the reference moves: it was reconciled and
+    the diagnosis said to flip force_N (the force was right; the position column was not)."""
+    from fi_design.errors import DataError
+    from fi_design.measured import measurement_from_arrays
+
+    case = Case("frozen-position", False, {"type": "force_offset", "offset": 0.5}, {},
+                duration=1.0, moves=SHORT)
+    spec = base_spec(case)
+    data = measure(case, spec)
+    frozen = measurement_from_arrays(data.time, data.reference,
+                                     np.full_like(data.position, data.position[0]),
+                                     force_N=data.force, source="frozen.csv")
+    with pytest.raises(DataError) as e:
+        reconcile(spec, frozen)
+    assert e.value.column == "position_m" and "never moves" in str(e.value)
