@@ -332,10 +332,29 @@ def load_measurement(path: str | os.PathLike) -> Measurement:
                 _header(fh, src)
                 arrays = _read_exact(fh, header, index, delimiter, src)
     except UnicodeDecodeError:
-        raise DataError("not a text file (expected UTF-8 CSV)", source=src) from None
+        raise _not_utf8(p, src) from None
     except OSError as exc:
         raise DataError(f"cannot read ({exc.strerror})", source=src) from None
     return _checked(arrays, src)
+
+
+def _not_utf8(path: Path, source: str) -> DataError:
+    """What a file that is not UTF-8 is: binary (a NUL byte in its first 64 kB), else text in
+    another encoding, with the first line that is not UTF-8."""
+    with open(path, "rb") as fh:
+        if b"\x00" in fh.read(65536):
+            return DataError("not a text file (expected UTF-8 CSV)", source=source)
+        fh.seek(0)
+        for n, line in enumerate(fh, start=1):
+            try:
+                line.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                byte = line[exc.start]
+                return DataError(f"line {n}: text in another encoding than UTF-8 (byte "
+                                 f"0x{byte:02x}; Latin-1 or Windows-1252, as some loggers and "
+                                 "spreadsheets write, perhaps): save the file as UTF-8",
+                                 source=source)
+    return DataError("not a text file (expected UTF-8 CSV)", source=source)
 
 
 def _header(fh: IO[str], source: str) -> tuple[list[str], str]:
@@ -348,6 +367,10 @@ def _header(fh: IO[str], source: str) -> tuple[list[str], str]:
     delimiter = ";" if line.count(";") > line.count(",") else ("\t" if "\t" in line
                                                                 and "," not in line else ",")
     header = [h.strip() for h in next(csv.reader([line], delimiter=delimiter))]
+    if len(header) == 1 and len(header[0].split()) > 1:
+        raise DataError(f"the header {header[0]!r} is one field: columns separated by spaces "
+                        "are not read; separate them by commas, ';' or tabs", row=0,
+                        source=source)
     return header, delimiter
 
 
@@ -445,6 +468,10 @@ def _number(cell: str, column: str, row: int, source: str) -> float:
         if re.match(r"^[+-]?[\d.]+([eE][+-]?\d+)?\s*[A-Za-zµ](?:[^\d^]|\^-?\d)*$", text):  # not 0x10
             raise DataError(f"value {text!r} carries a unit: write plain SI numbers "
                             f"({UNITS[column]})", column=column, row=row, source=source)
+        if re.match(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$", text):
+            raise DataError(f"value {text!r} has a decimal comma: write {text.replace(',', '.')!r} "
+                            "(the file's separator may be ';' or a tab, the decimal sign is a "
+                            "point)", column=column, row=row, source=source)
         raise DataError(f"value {text!r} is not a number", column=column, row=row, source=source)
     value = float(text)
     if not math.isfinite(value):

@@ -208,3 +208,20 @@ def test_columns_are_written_a_chunk_at_a_time(monkeypatch):
     out = io.StringIO()
     measured.write_columns_csv(out, cols, comment="c")
     assert out.getvalue() == whole and whole.count("\n") == 12
+
+
+@pytest.mark.parametrize("raw, words", [
+    # a Latin-1 micro sign in a comment: it read "not a text file", no line
+    (b"# x in \xb5m\ntime_s,reference_m,position_m\n0,0,0\n", ["line 1", "0xb5", "UTF-8"]),
+    # spaces between the columns: it read "unit 's reference_m position_m' is not accepted"
+    (b"time_s reference_m position_m\n0 0 0\n", ["one field", "separated by spaces"]),
+    # a decimal comma beside ';': it read "value '0,001' is not a number"
+    (b"time_s;reference_m;position_m\n0,001;0;0\n", ["decimal comma", "'0.001'", "row 1"]),
+], ids=["latin-1", "spaces", "decimal-comma"])
+def test_a_csv_in_a_neighbouring_format_says_what_to_change(tmp_path, raw, words):
+    p = tmp_path / "trace.csv"
+    p.write_bytes(raw)
+    with pytest.raises(DataError) as e:
+        load_measurement(p)
+    for w in words:
+        assert w in str(e.value), str(e.value)
