@@ -351,7 +351,7 @@ def _not_utf8(path: Path, source: str) -> DataError:
             except UnicodeDecodeError as exc:
                 byte = line[exc.start]
                 return DataError(f"line {n}: text in another encoding than UTF-8 (byte "
-                                 f"0x{byte:02x}; Latin-1 or Windows-1252, as some loggers and "
+                                 f"{hex(byte)}; Latin-1 or Windows-1252, as some loggers and "
                                  "spreadsheets write, perhaps): save the file as UTF-8",
                                  source=source)
     return DataError("not a text file (expected UTF-8 CSV)", source=source)

@@ -283,6 +283,12 @@ def _hunting_loop(model: Model, crossover: CrossoverResult, stage, free_from: fl
             "hunting_free_loop_crossover": at_free}
 
 
+def _sag(flexure: FlexureResult | None) -> float:
+    """The guide's static sag under the weight it carries [m] (0 without a guide)."""
+    mech = None if flexure is None or not flexure.feasible else flexure.mechanics
+    return 0.0 if mech is None else float(mech.gravity.sag)
+
+
 def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult,
             flexure: FlexureResult | None, pid: PidResult,
             simulation: Confirmation | None) -> Margins:
@@ -358,7 +364,7 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
         land = simulation.landing
         if model.has_isolator and land is not None and math.isfinite(land.deflection):
             out["resting_deflection"] = land.deflection
-            out["end_stop_clearance"] = land.stroke - abs(land.deflection)
+            out["end_stop_clearance"] = land.clearance(_sag(flexure))
     if model.has_isolator:
         out["stiffness_factor"] = stiffness.maximum / stiffness.chosen
         if flexure is not None and flexure.feasible:
@@ -626,14 +632,17 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
     clearance = margin.end_stop_clearance
     if clearance is not None and margin.resting_deflection and clearance > 0:
         d = abs(margin.resting_deflection)
+        sag = model.joint.stroke - d - clearance  # the weight's share (a vertical drive axis)
         rise = (d + clearance) / d - 1.0
         spread = model.requirements.robustness.coulomb
         if rise <= spread:
             reasons.append(Reason(
                 "WARN", "end_stop_clearance",
                 "The cart rests {} from its end stop (joint deflection {} of the \u00b1{} "
-                "stroke): a friction force ".format(*quantities(
-                    (clearance, margin.resting_deflection, d + clearance), "m", 3))
+                "stroke{}): a friction force ".format(*quantities(
+                    (clearance, margin.resting_deflection, model.joint.stroke), "m", 3),
+                    "" if sag <= 1e-9 * model.joint.stroke else f", with a sag of {quantity(sag, 'm', 3)} under "
+                                          "the cart's weight")
                 + f"{percent(rise, 2)} higher would put it on the limiter, within the "
                 f"\u00b1{percent(spread)} scatter of Fc."))
     if not_valid is not None:  # what the simulation shows passing does not hold here

@@ -348,7 +348,8 @@ class _Search:
         self.evaluations += 0 if rob is None else rob.samples
         land = r.simulation.landing if r.simulation is not None else None
         if land is not None:
-            p.clearance = land.stroke - abs(land.deflection)
+            mech = fx.mechanics if fx is not None and fx.feasible else None
+            p.clearance = land.clearance(0.0 if mech is None else mech.gravity.sag)
         if r.verdict.status == "FAIL":
             fails = [x for x in r.verdict.reasons if x.severity == "FAIL"]
             p.status = "robustness" if fails and fails[0].source == "robustness" else "checks"

@@ -164,6 +164,17 @@ class Landing(Result):
     on_limiter: bool
     rule_force: float
 
+    def clearance(self, sag: float = 0.0) -> float:
+        """The end stop's clearance at rest [m]: the stroke less the landing deflection and the
+        static sag.
+
+        The simulation carries no weight: the sag (``m2 g / k`` on a vertical drive axis, 0
+        otherwise [m]), which the joint's spring adds to whatever deflection the friction
+        leaves, is taken on the side that brings the cart closer to its stop. Negative where
+        the joint rests on its end stop.
+        """
+        return self.stroke - (abs(self.deflection) + sag)
+
 
 @dataclass(frozen=True, eq=False)
 class Confirmation(Result):

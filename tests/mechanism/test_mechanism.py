@@ -564,3 +564,24 @@ def test_the_guide_s_modes_are_judged_on_the_loop_s_crossover_as_step_2_judges_t
     assert check.limit == pytest.approx(separation.required)
     assert not check.passed and not separation.passed
     assert "loop's crossover" in check.message
+
+
+def test_the_end_stop_clearance_of_a_vertical_axis_takes_the_sag(paper_spec):
+    """The simulation carries no weight; on a vertical drive axis the joint also sags
+    m2 g / k. The clearance at rest read stroke - |deflection| alone: 0.38 mm beside a
+    finding that the joint rests on its end stop. Now the sag, m2 g / k by hand with the
+    guide's net stiffness, comes off it too."""
+    from fi_design import design
+    from fi_design.spec.file import with_values
+
+    spec = with_values(paper_spec, {"isolator.flexure.orientation": "vertical_axis",
+                                    "isolator.stroke": "1 mm",
+                                    "requirements.robustness.samples": 0})
+    r = design(spec, recommend=False)
+    k = r.flexure.mechanics.net_drive_stiffness
+    land = r.simulation.landing
+    sag = 0.4 * GRAVITY / k
+    assert 0.2e-3 < sag < 1e-3
+    assert r.margins.end_stop_clearance == pytest.approx(1e-3 - abs(land.deflection) - sag,
+                                                         rel=1e-9)
+    assert land.clearance() == pytest.approx(1e-3 - abs(land.deflection), rel=1e-12)
