@@ -106,7 +106,10 @@ def _congruent(block: np.ndarray, points: tuple[tuple[float, float, float], ...]
     """``sum_i T_i^T block T_i`` over the points r_i (``T_i = _shift(r_i)``), for a stack of
     blocks of shape (..., 6, 6)."""
     block = np.asarray(block, float)
-    return (block.reshape(block.shape[:-2] + (36,)) @ _congruence(points)).reshape(block.shape)
+    # a row vector per block (a stack of products, which numpy does not hand to a threaded
+    # BLAS: one (N, 36) x (36, 36) product woke BLAS threads that spun beside the workers)
+    flat = block.reshape(block.shape[:-2] + (1, 36))
+    return (flat @ _congruence(points)).reshape(block.shape)
 
 
 def _sum_leaves(guide: LeafGuide, block: np.ndarray) -> np.ndarray:
