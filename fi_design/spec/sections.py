@@ -178,6 +178,11 @@ def _mm(x: float) -> str:
     return quantity(x, "m", 4, shown=("mm", 1e3))
 
 
+def _span(value: Any) -> tuple[float, float] | None:
+    """(min, max) of a leaf dimension as validated: a value is both; None where it failed."""
+    return None if value is None else (value, value) if isinstance(value, float) else value
+
+
 Bounds = tuple[Q("m"), Q("m")]
 #: A leaf dimension: one value (the guide as drawn) or [min, max] (bounds step 3 sizes within).
 Dimension = Union[Bounds, Q("m")]
@@ -228,7 +233,7 @@ class Flexure(StrictModel):
     @field_validator("length", "width", "thickness")
     @classmethod
     def _ordered(cls, value: Any, info: Any) -> Any:
-        lo, hi = (value, value) if isinstance(value, float) else value
+        lo, hi = _span(value)
         if isinstance(value, float) and not lo > 0:
             raise ValueError(f"must be positive, got {_mm(lo)}")
         if not 0 < lo <= hi:
@@ -245,8 +250,7 @@ class Flexure(StrictModel):
     @field_validator("spacing")
     @classmethod
     def _rows_apart(cls, spacing: Any, info: Any) -> Any:
-        thickness = info.data.get("thickness")
-        top = thickness if isinstance(thickness, float) else (thickness or (0.0, 0.0))[1]
+        top = (_span(info.data.get("thickness")) or (0.0, 0.0))[1]
         if spacing is not None and spacing <= top:
             raise ValueError(f"the two rows of leaves would touch: {_mm(spacing)} must exceed "
                              f"the leaves' thickness (up to {_mm(top)})")
@@ -255,13 +259,13 @@ class Flexure(StrictModel):
     @field_validator("lateral_spacing")
     @classmethod
     def _side_by_side(cls, lateral: Any, info: Any) -> Any:
-        width = info.data.get("width")
+        width = _span(info.data.get("width"))
         if lateral is None or width is None:
             return lateral
         if info.data.get("leaves") == 2:
             raise ValueError("places the two leaves of a row side by side: it needs leaves: 4 "
                              "(with 2 leaves, one per row, leave it out)")
-        least = width if isinstance(width, float) else width[0]
+        least = width[0]
         if lateral < least:
             raise ValueError(f"the leaves of a row would overlap: {_mm(lateral)} is below the "
                              f"smallest leaf width {_mm(least)} (their centre distance must be "
@@ -286,9 +290,9 @@ class Flexure(StrictModel):
     @field_validator("thickness_tolerance")
     @classmethod
     def _below_stock(cls, tolerance: Any, info: Any) -> Any:
-        thickness = info.data.get("thickness")
+        thickness = _span(info.data.get("thickness"))
         if thickness is not None:
-            least = thickness if isinstance(thickness, float) else thickness[0]
+            least = thickness[0]
             if tolerance >= least:
                 raise ValueError(f"must be below the smallest thickness, {_mm(least)}")
         return tolerance
