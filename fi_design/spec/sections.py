@@ -9,7 +9,7 @@ from typing import Any, Literal, Union
 
 from pydantic import Field, field_validator, model_validator
 
-from ..display import quantity, unit_text
+from ..display import number, quantity, unit_text
 from ..trajectory import profile_duration
 from .fields import OptQ, Q, StrictModel, Text
 from .filters import Drive, FilterEntry
@@ -167,6 +167,33 @@ class Material(StrictModel):
     poisson_ratio: float = Field(0.3, gt=0, lt=0.5, description="Poisson's ratio [-] (the shear "
                                                                 "modulus E / (2 (1 + nu))). "
                                                                 "Default 0.3.")
+
+    @field_validator("youngs_modulus")
+    @classmethod
+    def _a_solid(cls, E: float) -> float:
+        if not 1e7 <= E <= 2e12:
+            raise ValueError(f"{quantity(E, 'Pa', 4)} is not the modulus of a leaf spring's "
+                             "material (10 MPa, a soft polymer, to 2000 GPa; steel 200 GPa): "
+                             "check its unit (GPa; a number without a unit is read in Pa)")
+        return E
+
+    @field_validator("density")
+    @classmethod
+    def _a_solid_density(cls, rho: float) -> float:
+        if not 100.0 <= rho <= 25000.0:
+            raise ValueError(f"{quantity(rho, 'kg/m**3', 4)} is not the density of a solid "
+                             "(100 to 25000 kg/m^3; steel 7800 kg/m^3): check its unit")
+        return rho
+
+    @field_validator("allowed_stress")
+    @classmethod
+    def _below_modulus(cls, stress: float, info: Any) -> float:
+        E = info.data.get("youngs_modulus")
+        if E is not None and stress >= 0.1 * E:
+            raise ValueError(f"{quantity(stress, 'Pa', 4)} is a strain of {number(stress / E, 3)} "
+                             f"at Young's modulus {quantity(E, 'Pa', 4)}, which no leaf spring "
+                             "takes (steel: 300 MPa over 200 GPa, 0.0015): check its unit")
+        return stress
 
 
 #: The most stock thicknesses (multiples of ``thickness_step`` within the thickness bounds) the

@@ -193,6 +193,14 @@ CASES = [
      "lateral_spacing: 1 mm"),
     ("lateral-spacing-with-two-leaves", edit("leaves: 2", "leaves: 2\n    lateral_spacing: 20 mm"),
      ["isolator.flexure.lateral_spacing", "needs leaves: 4"], "lateral_spacing: 20 mm"),
+    # a leaf material no leaf is made of: a unit left out or mistaken
+    ("modulus-without-unit", edit("youngs_modulus: 200 GPa", "youngs_modulus: 200"),
+     ["isolator.flexure.material.youngs_modulus", "not the modulus of a leaf spring",
+      "read in Pa"], "material:"),
+    ("density-in-g-per-cm3", edit("density: 7800 kg/m^3", "density: 7.8 kg/m^3"),
+     ["isolator.flexure.material.density", "not the density of a solid"], "material:"),
+    ("stress-above-modulus", edit("allowed_stress: 300 MPa", "allowed_stress: 500 GPa"),
+     ["isolator.flexure.material.allowed_stress", "a strain of 2.5"], "material:"),
     ("recommend-bounds-reversed", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  recommend: "
                                                           "{stroke: [2 mm, 1 mm]}"),
      ["requirements.recommend.stroke", "[2 mm, 1 mm]"], "recommend: {stroke"),
