@@ -80,6 +80,7 @@ class _Point:
     p: float | None = None
     clearance: float | None = None
     model: Model | None = None
+    guide: Any = None  # the FlexureResult whose leaves the candidate holds
 
     @property
     def stiffness(self) -> float:
@@ -177,6 +178,7 @@ class _Search:
                                 damping=c)
         p.lowest_mode = fx.lowest_mode.frequency if fx.lowest_mode is not None else None
         p.thickest = _c.thickest_stiffness(fx)
+        p.guide = fx
 
     def candidate_model(self, p: _Point) -> Model:
         """The point's candidate resolved into its model, once: every judgement reads it."""
@@ -323,8 +325,9 @@ class _Search:
             p.model = None  # the guide at full resolution is another candidate
             p.lowest_mode = fx.lowest_mode.frequency
             p.thickest = _c.thickest_stiffness(fx)
-        else:
-            fx = _c.guide_for(self.base_model, p.stiffness, p.stroke, self.fc)
+            p.guide = fx
+        else:  # the candidate's own guide (sized again for its stiffness it had other leaves)
+            fx = p.guide
         model = self.candidate_model(p)
         ok, why = _c.loop_meets(model)
         if not ok:
@@ -460,7 +463,7 @@ def _searched(model: Model, executor: Any, say: Callable[[str], None],
             p.status = "not_evaluated"
     fx, corners, report = signed
     if fx is None and chosen.candidate is not None:
-        fx = _c.guide_for(srch.base_model, chosen.stiffness, chosen.stroke, srch.fc)
+        fx = chosen.guide  # the leaves the nearest design holds
     bounds = _c.guide_bounds(srch.base_model, fx) if fx is not None else ()
     st = report.simulation.stage["isolated"] if report is not None else None
     rob = report.robustness if report is not None else None
