@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 from typing import Any, Iterable, Sequence
 
-__all__ = ["number", "quantity", "quantities", "column", "scale", "display_scale", "with_error",
+__all__ = ["number", "quantity", "millimetres", "quantities", "column", "scale", "display_scale", "with_error",
            "percent", "fixed", "plain", "code_point", "unit_text", "axis_unit", "UNIT_TEXT",
            "DISPLAY_SCALES", "AXIS_UNITS", "NBSP", "tick_label"]
 
@@ -272,6 +272,20 @@ def quantity(value: Any, unit: str = "", digits: int = 4, *, sep: str = " ",
         return number(value)
     unit_shown, factor = shown or display_scale(unit, value)
     return _attach(number(value if factor == 1.0 else value * factor, digits), unit_shown, sep)
+
+
+def millimetres(value: float, digits: int = 3) -> str:
+    """A length always in mm (a flexure's dimensions, so that the lengths of one sentence share
+    a unit): ``millimetres(6e-5)`` -> ``0.06 mm``.
+
+    Parameters
+    ----------
+    value : float
+        [m].
+    digits : int, optional
+        Significant digits.
+    """
+    return quantity(value, "m", digits, shown=("mm", 1e3))
 
 
 def quantities(values: Sequence[Any], unit: str, digits: int = 4, *,

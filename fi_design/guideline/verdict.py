@@ -283,12 +283,6 @@ def _hunting_loop(model: Model, crossover: CrossoverResult, stage, free_from: fl
             "hunting_free_loop_crossover": at_free}
 
 
-def _sag(flexure: FlexureResult | None) -> float:
-    """The guide's static sag under the weight it carries [m] (0 without a guide)."""
-    mech = None if flexure is None or not flexure.feasible else flexure.mechanics
-    return 0.0 if mech is None else float(mech.gravity.sag)
-
-
 def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult,
             flexure: FlexureResult | None, pid: PidResult,
             simulation: Confirmation | None) -> Margins:
@@ -364,7 +358,7 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
         land = simulation.landing
         if model.has_isolator and land is not None and math.isfinite(land.deflection):
             out["resting_deflection"] = land.deflection
-            out["end_stop_clearance"] = land.clearance(_sag(flexure))
+            out["end_stop_clearance"] = land.clearance(0.0 if flexure is None else flexure.sag)
     if model.has_isolator:
         out["stiffness_factor"] = stiffness.maximum / stiffness.chosen
         if flexure is not None and flexure.feasible:
@@ -633,6 +627,8 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
     if clearance is not None and margin.resting_deflection and clearance > 0:
         d = abs(margin.resting_deflection)
         sag = model.joint.stroke - d - clearance  # the weight's share (a vertical drive axis)
+        weight = f", with a sag of {quantity(sag, 'm', 3)} under the cart's weight" \
+            if sag > 1e-9 * model.joint.stroke else ""
         rise = (d + clearance) / d - 1.0
         spread = model.requirements.robustness.coulomb
         if rise <= spread:
@@ -640,9 +636,7 @@ def judge(model: Model, checks: Sequence[Check], warnings: Sequence[tuple[str, s
                 "WARN", "end_stop_clearance",
                 "The cart rests {} from its end stop (joint deflection {} of the \u00b1{} "
                 "stroke{}): a friction force ".format(*quantities(
-                    (clearance, margin.resting_deflection, model.joint.stroke), "m", 3),
-                    "" if sag <= 1e-9 * model.joint.stroke else f", with a sag of {quantity(sag, 'm', 3)} under "
-                                          "the cart's weight")
+                    (clearance, margin.resting_deflection, model.joint.stroke), "m", 3), weight)
                 + f"{percent(rise, 2)} higher would put it on the limiter, within the "
                 f"\u00b1{percent(spread)} scatter of Fc."))
     if not_valid is not None:  # what the simulation shows passing does not hold here

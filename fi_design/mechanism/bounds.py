@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 
+from ..display import millimetres as _mm
 from ..display import number, quantity
 from ..results.steps import BoundNote, FlexureResult
 from .geometry import StageBody
@@ -35,10 +36,6 @@ _WORDS = {("length", "upper"): "longer", ("length", "lower"): "shorter",
           ("width", "upper"): "wider", ("width", "lower"): "narrower",
           ("thickness", "upper"): "thicker", ("thickness", "lower"): "thinner"}
 _SIZE = {"length": "long", "width": "wide", "thickness": "thick"}
-
-
-def _mm(x: float) -> str:
-    return quantity(x, "m", 3, shown=("mm", 1e3))
 
 
 def _on_bound(value: float, lo: float, hi: float, step: float | None) -> tuple[str, ...]:

@@ -6,6 +6,7 @@ checks, the verdict, the report and the console read these checks.
 
 from __future__ import annotations
 
+from ..display import millimetres as _mm
 from ..display import number, quantity
 from ..results import Check, Status
 from ..results.steps import FlexureResult
@@ -15,10 +16,6 @@ __all__ = ["SLENDERNESS", "flexure_checks"]
 
 def _g(x: float) -> str:
     return number(x, 4)
-
-
-def _mm(x: float) -> str:
-    return quantity(x, "m", 3, shown=("mm", 1e3))
 
 
 #: Slack beyond the stock's stiffness range within which a guide still realises the joint's

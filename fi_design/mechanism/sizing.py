@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..display import millimetres as _mm
 from ..display import number, plain, quantity
 from ..results.mechanism import LeafGuide
 from ..results.steps import FlexureResult
@@ -252,11 +253,6 @@ def sizing_margin(fx: FlexureResult) -> SizingMargin:
     return SizingMargin(value=float(m[i]), limited_by=MARGIN_WORDS[i])
 
 
-def _mm(x: float) -> str:
-    """A flexure dimension: always in mm, so that the lengths of one sentence share a unit."""
-    return quantity(x, "m", 3, shown=("mm", 1e3))
-
-
 def _modes_at_stroke(guide: LeafGuide, stroke: float) -> tuple:
     h = guide.com_height
     K = _guide.at_centre(_guide.clamp_stiffness(guide, deflection=stroke), h)
@@ -435,7 +431,7 @@ def _why(grid: GridMechanics, guide: LeafGuide, stroke: float, kmax: float, f_re
                 "the allowed "
                 f"{quantity(sa, 'Pa', 4, shown=('MPa', 1e-6))}")
     sel = ok_stress
-    if not (sel & ok_stiff).any() and not (sel & (grid.net > 0.0)).any():
+    if not (sel & (grid.net > 0.0)).any():
         least = float(np.max(np.where(sel, grid.net, -np.inf)))
         return (f"gravity: the stage's {quantity(guide.weight, 'N', 3)} {guide.orientation} "
                 f"outweighs the elastic drive stiffness of every leaf thin and long enough for "

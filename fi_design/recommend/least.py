@@ -170,6 +170,7 @@ def least_change(search: Any, *, executor: Any = None,
     tried: list[str] = []
     fc0 = _spec.design_crossover(spec)
     s0 = spec.isolator.stroke
+    bounds = spec.requirements.recommend  # the user's bounds hold for the least change too
 
     def done(changes: dict, text: str, binding: tuple[str, ...]) -> LeastChange:
         from .write import DIGITS, written
@@ -185,8 +186,7 @@ def least_change(search: Any, *, executor: Any = None,
         fold = ans["free_from"]
         if fold is not None:
             fc = 1.01 * margin * fold
-            low = spec.requirements.recommend.crossover
-            if low is not None and fc < low[0]:
+            if bounds.crossover is not None and fc < bounds.crossover[0]:
                 tried.append(f"the crossover alone, {quantity(fc, 'Hz', 4)}: below "
                              "requirements.recommend.crossover")
             elif fc <= search.fc:
@@ -210,7 +210,6 @@ def least_change(search: Any, *, executor: Any = None,
     options = [(s0, "the stiffness alone")] + [
         (s0 * f, "the stroke and the stiffness") for f in STROKE_FACTORS
         if search.envelope[0] <= s0 * f <= search.envelope[1]]
-    bounds = spec.requirements.recommend
     for stroke, what in options:
         say(f"the least change: {what} ({quantity(stroke, 'm')}) ...")
         k_top = top_stiffness(model, stroke)

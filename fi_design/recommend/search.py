@@ -326,7 +326,7 @@ class _Search:
             p.lowest_mode = fx.lowest_mode.frequency
             p.thickest = _c.thickest_stiffness(fx)
             p.guide = fx
-        else:  # the candidate's own guide (sized again for its stiffness it had other leaves)
+        else:  # the candidate's own guide (one sized again for the stiffness it reached differs)
             fx = p.guide
         model = self.candidate_model(p)
         ok, why = _c.loop_meets(model)
@@ -351,8 +351,7 @@ class _Search:
         self.evaluations += 0 if rob is None else rob.samples
         land = r.simulation.landing if r.simulation is not None else None
         if land is not None:
-            mech = fx.mechanics if fx is not None and fx.feasible else None
-            p.clearance = land.clearance(0.0 if mech is None else mech.gravity.sag)
+            p.clearance = land.clearance(0.0 if fx is None else fx.sag)
         if r.verdict.status == "FAIL":
             fails = [x for x in r.verdict.reasons if x.severity == "FAIL"]
             p.status = "robustness" if fails and fails[0].source == "robustness" else "checks"

@@ -214,7 +214,7 @@ def _check_arguments(spec, measured, isolated, candidates, max_effects,
     if measured.n < 50:
         raise DataError(f"too short for a reconciliation: {measured.n} samples, at least 50",
                         column="time_s", source=measured.source)
-    moved = float(np.ptp(measured.reference)) if measured.reference is not None else 0.0
+    moved = float(np.ptp(measured.reference))
     if float(np.ptp(measured.position)) <= 0.0 < moved:
         raise DataError(f"constant: position_m holds {quantity(float(measured.position[0]), 'm', 6)}"
                         f" in every row while the reference moves by {quantity(moved, 'm', 4)}: "

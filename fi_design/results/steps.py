@@ -299,6 +299,12 @@ class FlexureResult(Result):
         return None if self.mechanics is None else self.mechanics.net_drive_stiffness
 
     @property
+    def sag(self) -> float:
+        """Static sag of the joint under the weight it carries [m] (``m2 g / k`` on a vertical
+        drive axis; 0 in the other orientations and without a guide)."""
+        return 0.0 if self.mechanics is None else float(self.mechanics.gravity.sag)
+
+    @property
     def stress(self) -> float | None:
         """Peak stress at full stroke [Pa], or None."""
         return None if self.mechanics is None else self.mechanics.stress

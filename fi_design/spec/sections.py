@@ -9,6 +9,7 @@ from typing import Any, Literal, Union
 
 from pydantic import Field, field_validator, model_validator
 
+from ..display import millimetres as _mm
 from ..display import number, quantity, unit_text
 from ..trajectory import profile_duration
 from .fields import OptQ, Q, StrictModel, Text
@@ -199,10 +200,6 @@ class Material(StrictModel):
 #: The most stock thicknesses (multiples of ``thickness_step`` within the thickness bounds) the
 #: sizing takes: each is a column of its grid of leaves.
 MAX_STOCK = 200
-
-
-def _mm(x: float) -> str:
-    return quantity(x, "m", 4, shown=("mm", 1e3))
 
 
 def _span(value: Any) -> tuple[float, float] | None:
