@@ -332,6 +332,14 @@ def emps_result(emps_record, emps_spec):
     return identify(emps_record, emps_spec)
 
 
+def test_the_real_record_raises_no_column_alarm(emps_result):
+    """The EMPS record (1 kHz, force in N, position in m, the right sign): none of the notes
+    that name a column's slip, its sign or a too slow logging fires on real data."""
+    words = ("logged in", "wrong sign", "too slowly")
+    assert not [n for n in emps_result.notes if any(w in n for w in words)], emps_result.notes
+    identified_spec_text(emps_result)  # and --write-spec writes it
+
+
 def test_emps_mass_and_friction_in_the_documented_order(emps_result):
     """The moving mass 'of the order of 100 kg' (measured: 94.6 +- 0.2 kg); friction positive."""
     r = emps_result
