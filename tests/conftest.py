@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 import sys
 from pathlib import Path
 
@@ -192,6 +193,21 @@ def shared(kind: str, spec, compute, *extra):
     return _SHARED[key]
 
 
+def design_options(confirm: bool, kwargs: dict) -> tuple:
+    """The options of a design as a key, the defaults filled in: ``evaluate(spec)`` and
+    ``evaluate(spec, fe_check=False)`` are one design (the executor and the progress change
+    where and how visibly it runs, not what it gives)."""
+    import inspect
+
+    from fi_design.guideline.evaluate import evaluate  # a wrapper here follows __wrapped__
+
+    given = dict(kwargs)
+    for name, p in inspect.signature(evaluate).parameters.items():
+        if p.kind is p.KEYWORD_ONLY and name not in ("confirm", "executor", "progress"):
+            given.setdefault(name, p.default)
+    return (confirm, *sorted(given.items()))
+
+
 @contextlib.contextmanager
 def sharing_designs():
     """The guideline's design and the design search computed once per spec and process.
@@ -211,10 +227,11 @@ def sharing_designs():
     search = importlib.import_module("fi_design.recommend")  # the package, not the function
     real_design, real_recommend = guideline.evaluate, search.recommend
 
+    @functools.wraps(real_design)
     def design(spec, *, confirm=True, executor=None, progress=None, **kwargs):
         return shared("design", spec, lambda: real_design(
-            spec, confirm=confirm, executor=executor, progress=progress, **kwargs), confirm,
-            *sorted(kwargs.items()))
+            spec, confirm=confirm, executor=executor, progress=progress, **kwargs),
+            *design_options(confirm, kwargs))
 
     def recommend(spec, *, executor=None, progress=None, cache=None, **kwargs):
         # the cache changes where a search comes from, not what it finds
@@ -243,7 +260,7 @@ def paper_confirmed_design(paper_spec):
     (and shared with the tests that use :func:`shared_designs`)."""
     from fi_design.guideline.evaluate import evaluate as design
 
-    return shared("design", paper_spec, lambda: design(paper_spec), True)
+    return shared("design", paper_spec, lambda: design(paper_spec), *design_options(True, {}))
 
 
 def variant(spec, **paths):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
@@ -85,7 +86,7 @@ def test_the_design_command_and_recommend_share_the_search_in_the_cache(
 
     from fi_design.guideline import evaluate as guideline
 
-    from conftest import shared
+    from conftest import design_options, shared
 
     search = importlib.import_module("fi_design.recommend.search")
     real_search, real_design = search._searched, guideline.evaluate
@@ -95,10 +96,11 @@ def test_the_design_command_and_recommend_share_the_search_in_the_cache(
         runs.append(model.spec.name)
         return shared("recommend", model.spec, lambda: real_search(model, executor, say, start))
 
+    @functools.wraps(real_design)
     def evaluate(spec, *, confirm=True, executor=None, progress=None, **kwargs):
         return shared("design", spec, lambda: real_design(
-            spec, confirm=confirm, executor=executor, progress=progress, **kwargs), confirm,
-            *sorted(kwargs.items()))
+            spec, confirm=confirm, executor=executor, progress=progress, **kwargs),
+            *design_options(confirm, kwargs))
 
     monkeypatch.setattr(search, "_searched", searched)
     monkeypatch.setattr(guideline, "evaluate", evaluate)

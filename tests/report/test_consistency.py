@@ -192,13 +192,14 @@ def test_the_resting_deflection_keeps_its_sign_in_the_verdict(ctx):
 def no_isolator_steps():
     """Step 2 of examples/no_isolator.yaml (no isolator, no modes: the achievable crossover
     is not limited below the search cap), without the simulation."""
-    from conftest import EXAMPLES, shared
+    from conftest import EXAMPLES, design_options, shared
     from fi_design.guideline.evaluate import evaluate
     from fi_design.report.steps import guideline_steps
     from fi_design.spec.file import load_spec
 
     spec = load_spec(EXAMPLES / "no_isolator.yaml")
-    design = shared("design", spec, lambda: evaluate(spec, confirm=False), False)
+    design = shared("design", spec, lambda: evaluate(spec, confirm=False),
+                    *design_options(False, {}))
     assert design.crossover.limit_kind == "scan_limit"
     return design, guideline_steps(design, figures=False)
 
