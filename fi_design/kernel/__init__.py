@@ -9,6 +9,9 @@ One module a job:
   controller and the mode switch (compiled);
 - :mod:`~fi_design.kernel.integrator`: the RODAS4 integrator with events,
   the delay history, the discrete controller and the watch (compiled);
+- :mod:`~fi_design.kernel.metric`: the hunting metric's loops (scipy's peak
+  search, one peak per plateau), compiled with the kernel for
+  :mod:`fi_design.simulation.metrics`;
 - :mod:`~fi_design.kernel.jit`: how numba compiles a kernel function, and
   the signature types;
 - :mod:`~fi_design.kernel.build`: the one seam between the source and

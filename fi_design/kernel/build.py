@@ -51,6 +51,8 @@ FUNCTIONS = {
     "natural_modes": "equations", "drive_force": "equations", "controller_output": "equations", "actuator": "equations",
     "static_friction": "equations", "stribeck": "equations", "feedforward": "equations",
     "breakaway": "equations", "switch_mode": "equations", "sample_filters": "equations",
+    "local_maxima": "metric", "select_peaks": "metric", "one_per_plateau": "metric",
+    "extremes": "metric", "step_range": "metric", "last_outside": "metric",
 }
 
 
@@ -122,9 +124,9 @@ def compiled() -> SimpleNamespace:
 
 def _source_functions() -> dict:
     """The kernel's functions from the source (numba compiles them, or loads its cache)."""
-    from . import equations, integrator
+    from . import equations, integrator, metric
 
-    where = {"integrator": integrator, "equations": equations}
+    where = {"integrator": integrator, "equations": equations, "metric": metric}
     return {n: getattr(where[m], n) for n, m in FUNCTIONS.items()}
 
 
@@ -150,7 +152,9 @@ def _returns() -> dict:
             "drive_force": f8, "controller_output": f8, "actuator": t.UniTuple(f8, 2),
             "static_friction": f8, "stribeck": t.UniTuple(f8, 3),
             "feedforward": t.UniTuple(f8, 2), "breakaway": f8, "switch_mode": t.void,
-            "sample_filters": f8}
+            "sample_filters": f8, "local_maxima": t.int64, "select_peaks": t.int64,
+            "one_per_plateau": t.int64, "extremes": t.UniTuple(f8, 2),
+            "step_range": t.UniTuple(f8, 2), "last_outside": t.int64}
 
 
 def built(output_dir: str | os.PathLike | None = None) -> list[Path]:
@@ -183,7 +187,7 @@ def build(output_dir: str | os.PathLike | None = None) -> list[Path]:
     """
     from .jit import AOT_BUILD_ENV
 
-    if any(f"{__package__}.{m}" in sys.modules for m in ("integrator", "equations")) \
+    if any(f"{__package__}.{m}" in sys.modules for m in ("integrator", "equations", "metric")) \
             and not os.environ.get(AOT_BUILD_ENV):
         raise RuntimeError("build() needs a fresh process: the kernel is already JIT-compiled")
     os.environ[AOT_BUILD_ENV] = "1"

@@ -30,13 +30,16 @@ without a counted peak (it sees part of the window only).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..display import quantity
+from ..kernel.build import compiled
 from ..results import frozen_array
 from ..results.simulation import VERDICTS, HuntingMetrics
 
-__all__ = ["VERDICTS", "HuntingMetrics", "hunting_metrics"]
+__all__ = ["VERDICTS", "HuntingMetrics", "counted_peaks", "find_peaks", "hunting_metrics"]
 
 
 def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_length: float = 10.0,
@@ -72,28 +75,26 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     -------
     HuntingMetrics
     """
-    from scipy.signal import find_peaks
-
-    t = np.asarray(time_s, dtype=float)
-    e = np.asarray(error_m, dtype=float)
+    t = _taken(time_s)
+    e = _taken(error_m)
     w0, w1 = window_start, window_start + window_length
     # the times increase: the window and its last quarter are slices
     a, b = np.searchsorted(t, (w0, w1))
     tw, ew = _finite(t[a:b], e[a:b])
+    finite = len(ew) == b - a  # every sample of the window is
     idx = np.zeros(0, dtype=int)
-    amplitude = float(np.ptp(ew)) if len(ew) else float("nan")
+    lowest, highest = compiled().extremes(ew) if len(ew) else (math.nan, math.nan)
+    amplitude = highest - lowest
     # a peak's prominence is at most the trace's range: below min_height, no side has one
     if len(tw) > 1 and amplitude >= min_height:
-        distance = _peak_distance(np.diff(tw), min_distance)
+        distance = _peak_distance(tw, min_distance)
         # a peak must stand out by min_height from its surroundings (prominence), so a
         # plateau's numerical noise or a secondary bump of one period is no cycle; a cycle
         # below the target shows its negative peaks: count the side that shows more
-        for y in (ew, -ew):
-            if y.max() < min_height:
+        for side, top in ((1.0, highest), (-1.0, -lowest)):
+            if top < min_height:
                 continue  # no sample reaches the least peak height on this side
-            found, _ = find_peaks(y, height=min_height, prominence=min_height,
-                                  distance=distance)
-            found = _one_per_plateau(y, found, min_height)
+            found = counted_peaks(ew if side > 0.0 else -ew, min_height, distance)
             if len(found) > len(idx):
                 idx = found
     peaks_t, peaks_h = tw[idx], ew[idx]
@@ -111,9 +112,7 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     step = float(t[-1] - t[-2]) if len(t) > 1 else 0.0
     short = not moving and w0 < t_last < w1 - 1.5 * step
     c = max(a, int(np.searchsorted(t, w1 - window_length / 4.0)))
-    _, tail = _finite(t[c:b], e[c:b])
-    settled = bool(success and not moving and len(tail)
-                   and np.all(np.abs(tail) <= settle_band))
+    settled = bool(success and not moving and _within(e, c, b, settle_band, finite))
     settling_time = _settling_time(t, e, settle_band, motion_end) if success else None
 
     if not success:
@@ -159,8 +158,32 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
         settle_band=settle_band)
 
 
-def _one_per_plateau(y: np.ndarray, peaks: np.ndarray, min_height: float) -> np.ndarray:
-    """One peak per plateau: peaks no dip of ``min_height`` separates are one.
+def find_peaks(y, height: float, prominence: float, distance: int) -> np.ndarray:
+    """scipy's ``find_peaks(y, height=height, prominence=prominence, distance=distance)[0]``.
+
+    The same indices, by the compiled steps of :mod:`fi_design.kernel.metric`
+    (the order of equal heights from numpy's ``argsort``, as scipy takes it).
+
+    Parameters
+    ----------
+    y : array_like, shape (n,)
+        The trace, finite [m].
+    height, prominence : float
+        The least peak height and prominence [m].
+    distance : int
+        The least distance between peaks [samples], at least 1.
+
+    Returns
+    -------
+    ndarray of int
+        The peaks' indices, increasing.
+    """
+    return _peak_search(_taken(y), height, prominence, distance)
+
+
+def counted_peaks(y, min_height: float, distance: int) -> np.ndarray:
+    """The peaks the metric counts: :func:`find_peaks` with ``min_height`` as the least height
+    and prominence, one peak per plateau.
 
     scipy's prominence looks past a neighbour of *equal* height (it stops at a
     strictly higher one), so the samples of a stick plateau that round to the
@@ -173,58 +196,39 @@ def _one_per_plateau(y: np.ndarray, peaks: np.ndarray, min_height: float) -> np.
 
     Parameters
     ----------
-    y : ndarray, shape (n,)
-        The trace whose peaks were found [m].
-    peaks : ndarray of int
-        Their indices, increasing.
+    y : array_like, shape (n,)
+        The trace, finite [m].
     min_height : float
-        The prominence a peak needs [m].
+        The least peak height and prominence, and the dip that parts two peaks [m].
+    distance : int
+        The least distance between peaks [samples], at least 1.
 
     Returns
     -------
     ndarray of int
         The indices kept, increasing.
     """
-    if len(peaks) == 0:
-        return peaks
-    heights = y[peaks]
-    # the lowest sample between neighbours (both ends included), and whether it parts them
-    dips = np.minimum(np.minimum.reduceat(y, peaks)[:-1], heights[1:])
-    parted = np.minimum(heights[:-1], heights[1:]) - dips >= min_height
-    starts = [0, *(np.flatnonzero(parted) + 1)]
-    keep = []
-    for a, b in zip(starts, [*starts[1:], len(peaks)]):
-        top = int(peaks[a + int(np.argmax(heights[a:b]))])
-        lo, hi = _flat_top(y, top, y[top] - 1e-6 * min_height)
-        keep.append((lo + hi) // 2)
-    return np.asarray(keep, dtype=int)
+    y = _taken(y)
+    found = _peak_search(y, min_height, min_height, distance)
+    return found[:compiled().one_per_plateau(y, found, len(found), float(min_height))]
 
 
-def _flat_top(y: np.ndarray, top: int, level: float) -> tuple[int, int]:
-    """First and last index of the samples around ``top`` that stay at or above ``level``.
+def _peak_search(y: np.ndarray, height: float, prominence: float, distance: int) -> np.ndarray:
+    """:func:`find_peaks` on a float64, C-contiguous, writable ``y`` (a fresh index array)."""
+    k = compiled()
+    found = np.empty(len(y) // 2 + 1, dtype=np.int64)
+    m = k.local_maxima(y, float(height), found)
+    if m == 0:
+        return found[:0]
+    order = np.argsort(y[found[:m]]).astype(np.int64, copy=False)
+    m = k.select_peaks(y, found, m, order, int(distance), float(prominence))
+    return found[:m]
 
-    Searched outwards in growing chunks: a top is short next to the trace, and
-    comparing the whole trace once per peak was much of the metric's time.
-    """
-    if (top == 0 or y[top - 1] < level) and (top == len(y) - 1 or y[top + 1] < level):
-        return top, top  # a sharp top, the common case: no array search
-    lo, step = top, 1024
-    while lo > 0:
-        start = max(0, lo - step)
-        below = np.flatnonzero(y[start:lo] < level)
-        if len(below):
-            lo = start + int(below[-1]) + 1
-            break
-        lo, step = start, 4 * step
-    hi, step = top, 1024
-    while hi < len(y) - 1:
-        stop = min(len(y), hi + 1 + step)
-        below = np.flatnonzero(y[hi + 1:stop] < level)
-        if len(below):
-            hi += int(below[0])
-            break
-        hi, step = stop - 1, 4 * step
-    return lo, hi
+
+def _taken(values) -> np.ndarray:
+    """``values`` as the compiled code takes them: float64, C-contiguous and writable (copied
+    only when they are not; it only reads them)."""
+    return np.require(values, dtype=np.float64, requirements=("C", "W"))
 
 
 def _finite(t: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -233,8 +237,21 @@ def _finite(t: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (t, e) if ok.all() else (t[ok], e[ok])
 
 
-def _peak_distance(steps: np.ndarray, min_distance: float) -> int:
-    """The least distance between peaks in samples: ``min_distance`` over the median step.
+def _within(e: np.ndarray, c: int, b: int, band: float, finite: bool) -> bool:
+    """Whether ``e[c:b]`` holds a finite sample and its finite samples stay within ``band`` [m].
+
+    ``finite``: every sample there is (the search runs from the end and stops at the
+    first sample outside).
+    """
+    if finite:
+        return bool(c < b and compiled().last_outside(e[:b], c, band) < 0)
+    tail = e[c:b][np.isfinite(e[c:b])]
+    return bool(len(tail) and np.all(np.abs(tail) <= band))
+
+
+def _peak_distance(t: np.ndarray, min_distance: float) -> int:
+    """The least distance between peaks in samples: ``min_distance`` over the median step of
+    the times ``t`` [s] (at least two).
 
     The median is taken only when the steps' range leaves a choice (the
     rounded count of the smallest and of the largest step differ): on a
@@ -243,18 +260,18 @@ def _peak_distance(steps: np.ndarray, min_distance: float) -> int:
     def samples(dt: float) -> int:
         return max(1, int(round(min_distance / dt)))
 
-    few, many = samples(float(steps.max())), samples(float(steps.min()))
-    return few if few == many else samples(float(np.median(steps)))
+    shortest, longest = compiled().step_range(t)
+    few, many = samples(longest), samples(shortest)
+    return few if few == many else samples(float(np.median(np.diff(t))))
 
 
 def _settling_time(t: np.ndarray, e: np.ndarray, band: float, start: float) -> float | None:
     after = int(np.searchsorted(t, start))  # the times increase
     if after == len(t):
         return None
-    outside = np.flatnonzero(~(np.abs(e[after:]) <= band))
-    if len(outside) == 0:
+    last = compiled().last_outside(e, after, band)  # searched from the end
+    if last < 0:
         return 0.0
-    last = after + outside[-1]
     if last == len(t) - 1:
         return None
     return float(t[last + 1] - start)
