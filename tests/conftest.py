@@ -183,14 +183,86 @@ def remember(kind: str, spec, result, *extra) -> None:
 
 
 def shared(kind: str, spec, compute, *extra):
-    """``compute()`` once per process for this kind of result of this spec (file and content)."""
+    """``compute()`` once in the run for this kind of result of this spec (file and content):
+    once per process, and across pytest-xdist's processes through :data:`_ACROSS`."""
     key = _spec_key(spec)
     if key is None:
         return compute()
     key = (kind, *key, *extra)
     if key not in _SHARED:
-        _SHARED[key] = compute()
+        _SHARED[key] = compute() if _ACROSS is None else _computed_once(key, compute)
     return _SHARED[key]
+
+
+# --------------------------------------------------------------------------- across processes
+
+#: The folder this run's processes share (pytest-xdist hands the controller's to its
+#: workers), where :func:`shared` keeps what one of them computed for the others; None in a
+#: run of one process, which its own :data:`_SHARED` serves.
+_ACROSS: Path | None = None
+#: How long a process waits for another to compute a shared result before it computes the
+#: result itself [s] (a guard: shared results do not nest, so none waits for itself).
+WAIT_FOR_OTHERS = 900.0
+
+
+def pytest_configure(config):
+    """The controller of a pytest-xdist run makes the folder :func:`shared` keeps results in;
+    each worker reads it from its input."""
+    import tempfile
+
+    global _ACROSS
+    given = getattr(config, "workerinput", {}).get("fi_design_shared")
+    if given is not None:
+        _ACROSS = Path(given)
+    elif getattr(config.option, "numprocesses", None):
+        config._fi_design_shared = tempfile.mkdtemp(prefix="fi_design_shared-")
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    """pytest-xdist's hook on the controller, for each worker it starts."""
+    folder = getattr(node.config, "_fi_design_shared", None)
+    if folder is not None:
+        node.workerinput["fi_design_shared"] = folder
+
+
+def pytest_unconfigure(config):
+    import shutil
+
+    folder = getattr(config, "_fi_design_shared", None)
+    if folder is not None:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _computed_once(key: tuple, compute):
+    """``compute()`` in the first process that asks, kept in :data:`_ACROSS` under a lock the
+    others wait on; they read it back (a design is a function of its spec, so which process
+    computed it does not change what the tests read)."""
+    import fcntl
+    import hashlib
+    import os
+    import pickle
+    import time
+
+    name = hashlib.sha256(repr(key).encode()).hexdigest()[:32]
+    path = _ACROSS / f"{name}.pickle"
+    with open(_ACROSS / f"{name}.lock", "w") as lock:
+        deadline = time.monotonic() + WAIT_FOR_OTHERS
+        while True:
+            try:
+                fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if time.monotonic() > deadline:
+                    return compute()
+                time.sleep(0.05)
+        if path.exists():
+            return pickle.loads(path.read_bytes())
+        result = compute()
+        part = path.with_suffix(".part")
+        part.write_bytes(pickle.dumps(result, protocol=pickle.HIGHEST_PROTOCOL))
+        os.replace(part, path)
+        return result
 
 
 def design_options(confirm: bool, kwargs: dict) -> tuple:
