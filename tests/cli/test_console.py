@@ -44,26 +44,15 @@ def _readable(text: str, width: int) -> None:
 #: built from stock, the stroke, the crossover, what binds it) and the least change.
 SEARCHED = "paper_setup"
 
-#: The robustness requirement of the industrial axis read here: its robustness study is most
-#: of its design (100 samples of 49 moves, with and without the rule's isolator). 20 samples,
-#: all of which settle, within a limit raised to 20 % (the Wilson interval of 0 of 20 reaches
-#: 16.1 %): the summary has every row of the example's, its PASS verdict included, with 20
-#: samples and 20 % for 100 and 5 %.
-INDUSTRIAL_ROBUSTNESS = {"samples": 20, "hunting_probability": 0.2}
 
 
 @pytest.fixture(scope="module")
-def design_outputs(tmp_path_factory):
+def design_outputs(industrial_quick):
     """The design summary of every example with a stage of its own, at 80 and 120 columns
     (the recommendation a failing spec adds is read at the narrow width only, for
-    :data:`SEARCHED`); the industrial axis with :data:`INDUSTRIAL_ROBUSTNESS`, from a copy
-    of the example in a folder of its own (run from there: a short path)."""
-    import yaml
-
-    folder = tmp_path_factory.mktemp("console")
-    raw = yaml.safe_load((EXAMPLES / "industrial_axis.yaml").read_text(encoding="utf-8"))
-    raw.setdefault("requirements", {})["robustness"] = INDUSTRIAL_ROBUSTNESS
-    (folder / "industrial_axis.yaml").write_text(yaml.safe_dump(raw), encoding="utf-8")
+    :data:`SEARCHED`); the industrial axis with conftest's ``INDUSTRIAL_ROBUSTNESS``, from
+    the copy of the example in a folder of its own (run from there: a short path)."""
+    folder = industrial_quick.parent
     specs = {"paper_setup": str(EXAMPLES / "paper_setup.yaml"),
              "no_isolator": str(EXAMPLES / "no_isolator.yaml"),
              "industrial_axis": "industrial_axis.yaml"}

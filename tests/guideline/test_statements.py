@@ -32,7 +32,7 @@ from html.parser import HTMLParser
 
 import pytest
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, sharing_designs
 
 NAMES = sorted(p.stem for p in EXAMPLES.glob("*.yaml"))
 DATE = "2026-11-28"
@@ -57,28 +57,15 @@ needs_poppler = pytest.mark.skipif(shutil.which("pdftotext") is None,
 # --------------------------------------------------------------------------- the documents
 
 
-#: The robustness requirement of an example read with fewer scatter samples than it gives:
-#: industrial_axis's robustness study (100 samples of 49 moves, with and without the rule's
-#: isolator) is most of its design. 20 samples, all of which settle, within a limit raised to
-#: 20 % (the Wilson interval of 0 of 20 reaches 16.1 %): its documents state what the
-#: example's do (PASS, nothing to review, the same rows) with 20 samples and 20 % for 100 and
-#: 5 % (test_console reads it so too).
-ROBUSTNESS = {"industrial_axis": {"samples": 20, "hunting_probability": 0.2}}
-
-
-def _design(name: str, sensitivity: bool, folder):
-    import yaml
-
+def _design(name: str, sensitivity: bool, quick):
+    """An example's sign-off; industrial_axis read from ``quick`` (conftest's
+    ``INDUSTRIAL_ROBUSTNESS``: fewer scatter samples), its design shared with test_console's."""
     from fi_design.signoff import design
     from fi_design.spec.file import load_spec
 
-    path = EXAMPLES / f"{name}.yaml"
-    if name in ROBUSTNESS:  # a copy of the example with fewer samples
-        raw = yaml.safe_load(path.read_text(encoding="utf-8"))
-        raw.setdefault("requirements", {})["robustness"] = ROBUSTNESS[name]
-        path = folder / f"{name}.yaml"
-        path.write_text(yaml.safe_dump(raw), encoding="utf-8")
-    return design(load_spec(path), recommend=False, sensitivity=sensitivity)
+    path = quick if name == "industrial_axis" else EXAMPLES / f"{name}.yaml"
+    with sharing_designs():
+        return design(load_spec(path), recommend=False, sensitivity=sensitivity)
 
 
 def _selected_examples(session) -> list[str]:
@@ -91,14 +78,14 @@ def _selected_examples(session) -> list[str]:
 
 
 @pytest.fixture(scope="session")
-def example_designs(request, tmp_path_factory):
+def example_designs(request, industrial_quick):
     """Every example the selected tests read designed once (its sign-off, no recommendation),
     in this process (a pool's workers cost more CPU than they save: they import the design's
     modules again and send the results back); the flagship with its sensitivity study, which
-    the validation section shows; the examples of :data:`ROBUSTNESS` with fewer scatter
-    samples."""
-    folder = tmp_path_factory.mktemp("examples")
-    return {n: _design(n, n == FLAGSHIP, folder) for n in _selected_examples(request.session)}
+    the validation section shows; industrial_axis with fewer scatter samples (conftest's
+    ``INDUSTRIAL_ROBUSTNESS``)."""
+    return {n: _design(n, n == FLAGSHIP, industrial_quick)
+            for n in _selected_examples(request.session)}
 
 
 class _Text(HTMLParser):
