@@ -31,6 +31,7 @@ without a counted peak (it sees part of the window only).
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -40,6 +41,10 @@ from ..results import frozen_array
 from ..results.simulation import VERDICTS, HuntingMetrics
 
 __all__ = ["VERDICTS", "HuntingMetrics", "counted_peaks", "find_peaks", "hunting_metrics"]
+
+#: :func:`~fi_design.display.quantity` of the settings' values, which every trace judged
+#: under the same settings repeats (a pure function of its arguments, kept by their type).
+_shown = lru_cache(maxsize=64, typed=True)(quantity)
 
 
 def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_length: float = 10.0,
@@ -99,7 +104,9 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
                 idx = found
     peaks_t, peaks_h = tw[idx], ew[idx]
     cycles = int(len(idx))
-    period = float(np.mean(np.diff(peaks_t))) if cycles >= 2 else None
+    # np.mean(np.diff(peaks_t)) without its Python layers: the same sum and division
+    period = float(np.add.reduce(peaks_t[1:] - peaks_t[:-1]) / (cycles - 1)) \
+        if cycles >= 2 else None
     # the last finite error (a failed run ends in NaN)
     end = e[-1:] if len(e) and np.isfinite(e[-1]) else e[np.isfinite(e)][-1:]
     final_error = float(end[0]) if len(end) else float("nan")
@@ -132,8 +139,8 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
         verdict, reason = "undetermined", "the trace does not cover the counting window"
     elif cycles > 0:
         verdict = "hunting"
-        reason = (f"{cycles} peak(s) of at least {quantity(min_height, 'm', 6)} in "
-                  f"[{quantity(w0, 's', 6)}, {quantity(w1, 's', 6)})"
+        reason = (f"{cycles} peak(s) of at least {_shown(min_height, 'm', 6)} in "
+                  f"[{_shown(w0, 's', 6)}, {_shown(w1, 's', 6)})"
                   + (f", period {quantity(period, 's', 3)}" if period else ""))
     elif short:
         verdict = "undetermined"
@@ -142,7 +149,7 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
                   "part only")
     elif settled:
         verdict = "settled"
-        reason = f"|x1 - r| stays within {quantity(settle_band, 'm', 3)} at the end of the window"
+        reason = f"|x1 - r| stays within {_shown(settle_band, 'm', 3)} at the end of the window"
     elif amplitude <= settle_band:
         verdict = "stuck"
         reason = (f"the stage rests {quantity(abs(final_error), 'm', 3)} from its target: no peaks, "
@@ -227,8 +234,16 @@ def _peak_search(y: np.ndarray, height: float, prominence: float, distance: int)
 
 def _taken(values) -> np.ndarray:
     """``values`` as the compiled code takes them: float64, C-contiguous and writable (copied
-    only when they are not; it only reads them)."""
+    only when they are not; it only reads them): ``np.require``, its checks skipped for an
+    array that already is."""
+    if type(values) is np.ndarray and values.dtype == _FLOAT64:
+        flags = values.flags
+        if flags.c_contiguous and flags.writeable:
+            return values
     return np.require(values, dtype=np.float64, requirements=("C", "W"))
+
+
+_FLOAT64 = np.dtype(np.float64)
 
 
 def _finite(t: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
