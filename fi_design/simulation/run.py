@@ -167,9 +167,9 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
     motion = model.spec.motion
     if reference is None:
         t_end = motion.duration if duration is None else duration
-        ref, move_end = _move_reference(motion, t_end, initial_position)
+        ref, move_end, r_max, pieces = _move_reference(motion, t_end, initial_position)
     else:
-        ref, move_end = reference, 0.0
+        ref, move_end, r_max, pieces = reference, 0.0, None, None
         t_end = float(ref.breaks[-1]) if duration is None else duration
     if rate is None:
         rate = model.spec.simulation.output_rate
@@ -178,7 +178,8 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
     idx = _STATE_INDEX[iso]
     y0[idx["x1"]] = initial_position
     y0[idx["x2"]] = initial_position
-    out, wall = _integrate(model, method, params, y0, ref, t_end, t_out, rtol, array=p)
+    out, wall = _integrate(model, method, params, y0, ref, t_end, t_out, rtol,
+                           reference_max=r_max, array=p, pieces=pieces)
     return _result(model, iso, method, params, out, t_out, wall, move_end=move_end,
                    shown_time=t_shown)
 
@@ -191,6 +192,8 @@ _LAST_RESOLVED: tuple | None = None
 
 #: Per model (by identity, while it lives): ``{isolated: (PlantParameters, kernel array)}``.
 _PLANTS: "weakref.WeakKeyDictionary[Model, dict]" = weakref.WeakKeyDictionary()
+
+_FLOAT64 = np.dtype(np.float64)
 
 #: The state index of each plant (without filter states: their names are not read here).
 _STATE_INDEX = {True: state_index(True), False: state_index(False)}
@@ -221,16 +224,35 @@ def _plant(model: Model, iso: bool) -> tuple[PlantParameters, np.ndarray]:
     return hit
 
 
+#: ``{id(params): (params, rtol, tolerances(params, rtol))}`` of the kept plants' parameters.
+_TOLERANCES: dict = {}
+
+
+def _tolerances(params: PlantParameters, rtol: float) -> np.ndarray:
+    """:func:`tolerances` of kept parameters (by identity, the object held), kept (the kernel
+    only reads it)."""
+    kept = _TOLERANCES.get(id(params))
+    if kept is not None and kept[0] is params and kept[1] == rtol:
+        return kept[2]
+    atol = tolerances(params, rtol)
+    if len(_TOLERANCES) >= 16:
+        _TOLERANCES.clear()
+    _TOLERANCES[id(params)] = (params, rtol, atol)
+    return atol
+
+
 @lru_cache(maxsize=32)
-def _move_reference(motion, t_end: float, initial_position: float) -> tuple[Trajectory, float]:
+def _move_reference(motion, t_end: float, initial_position: float):
     """The reference of the spec's moves (``motion``, immutable) until ``t_end``, started at
-    ``initial_position``, and the end of the last move [s]: kept by their values."""
+    ``initial_position``, the end of the last move [s], the largest |r| [m] and the
+    reference's breaks and coefficients as the kernel takes them (writable copies, which it
+    only reads): kept by their values."""
     ref = from_moves(motion.moves, t_end)
     if initial_position:
         c = np.array(ref.coeffs)
         c[:, 0] += initial_position
         ref = Trajectory(ref.breaks, c, land=True)
-    return ref, motion.end_time
+    return ref, motion.end_time, _largest(ref), (np.array(ref.breaks), np.array(ref.coeffs))
 
 
 @lru_cache(maxsize=8)
@@ -278,12 +300,13 @@ def _checked_arguments(spec, crossover, duration, rtol, record, rate=None):
 
 
 def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=None,
-               input_force=None, reference_max=None, array=None):
+               input_force=None, reference_max=None, array=None, pieces=None):
     """One integration with the chosen method; returns the Integration and its wall time [s].
 
     ``reference_max``: the largest |r| [m] the divergence bound is set from (default: of
     ``ref``; a window of a longer reference passes the whole reference's). ``array``:
-    ``params.to_array()`` when the caller has it."""
+    ``params.to_array()``, ``pieces``: ``ref``'s breaks and coefficients as writable
+    arrays, when the caller has them."""
     settings = model.spec.simulation
     tol = rtol if rtol is not None else settings.tolerance * (
         1.0 if method == "fast" else 1e-4)
@@ -294,9 +317,11 @@ def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=No
     if method == "fast":
         compiled()  # loads the built kernel (or compiles it) before the clock starts
         start = _time.perf_counter()
-        out = _kernel_run(params.to_array() if array is None else array, y0, ref.breaks,
-                          ref.coeffs, ref.land, t_end, t_out, tol, tolerances(params, tol), 0.05,
-                          settings.max_steps, x_bound, input_time, input_force)
+        breaks, coeffs = (ref.breaks, ref.coeffs) if pieces is None else pieces
+        out = _kernel_run(params.to_array() if array is None else array, y0, breaks, coeffs,
+                          ref.land, t_end, t_out, tol,
+                          tolerances(params, tol) if array is None else _tolerances(params, tol),
+                          0.05, settings.max_steps, x_bound, input_time, input_force)
     else:
         from ..kernel.reference import solve_reference
 
@@ -323,6 +348,10 @@ def _result(model, iso, method, params, out, t_out, wall, *, move_end,
     metrics = _metrics(model, t, Y[:, idx["x1"]] - R, success, message, move_end)
 
     def trace(values):  # the integration's own arrays, handed over without a copy
+        if type(values) is np.ndarray and values.dtype == _FLOAT64:  # frozen_array's view
+            view = values.view()
+            view.flags.writeable = False
+            return view
         return frozen_array(values, copy=False)
 
     return SimulationResult(
