@@ -63,17 +63,12 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     out_fa = np.empty(m)
     out_cmd = np.empty(m)
     stats = np.zeros(N_STATS)
-    if watch is None:
-        w = np.zeros(N_WATCH)
-        w[W_START] = np.inf
-        w[W_QUIET] = np.inf
-    else:
-        w = np.array(watch, dtype=np.float64)
+    w = _NO_WATCH.copy() if watch is None else np.array(watch, dtype=np.float64)
     k = max(int(crossings), 1)
-    cross_t = np.full(k, np.nan)
-    cross_y = np.full((k, n), np.nan)
-    cross_e = np.full((k, 2), np.nan)
-    y_end = np.full(n, np.nan)
+    cross_t = _nans(k)
+    cross_y = _nans((k, n))
+    cross_e = _nans((k, 2))
+    y_end = _nans(n)
     status = compiled().integrate(
         p, y, _taken(breaks), _taken(coeffs), bool(land), float(t_end), t_out, float(rtol),
         _taken(atol), float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r,
@@ -94,6 +89,18 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
 
 #: No known input force (an empty series; the integrator reads none of it).
 _NO_INPUT = np.zeros(0)
+
+#: The watch array of a run without a watch (copied for each run: the integrator writes it).
+_NO_WATCH = np.zeros(N_WATCH)
+_NO_WATCH[W_START] = np.inf
+_NO_WATCH[W_QUIET] = np.inf
+
+
+def _nans(shape) -> np.ndarray:
+    """``np.full(shape, np.nan)`` without its Python layer."""
+    out = np.empty(shape)
+    out.fill(np.nan)
+    return out
 
 _FLOAT64 = np.dtype(np.float64)
 
