@@ -173,7 +173,11 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
         t_end = float(ref.breaks[-1]) if duration is None else duration
     if rate is None:
         rate = model.spec.simulation.output_rate
-    t_out, t_shown = _output_times(int(math.floor(t_end * rate + 1e-9)) + 1, rate)
+    n_out = int(math.floor(t_end * rate + 1e-9)) + 1
+    if n_out <= _KEPT_OUTPUT_SAMPLES:
+        t_out, t_shown = _output_times(n_out, rate)
+    else:  # a long run's times are not kept (nor worth keeping beside its integration)
+        t_out, t_shown = np.arange(n_out) / rate, None
     y0 = np.zeros(params.n_states)
     idx = _STATE_INDEX[iso]
     y0[idx["x1"]] = initial_position
@@ -255,7 +259,11 @@ def _move_reference(motion, t_end: float, initial_position: float):
     return ref, motion.end_time, _largest(ref), (np.array(ref.breaks), np.array(ref.coeffs))
 
 
-@lru_cache(maxsize=8)
+#: Most output samples whose times are kept (:func:`_output_times`: 16 bytes a sample).
+_KEPT_OUTPUT_SAMPLES = 100_000
+
+
+@lru_cache(maxsize=4)
 def _output_times(n_out: int, rate: float) -> tuple[np.ndarray, np.ndarray]:
     """The output times ``arange(n_out) / rate`` twice: for the kernel and the metric
     (writable, as the compiled code takes them; they only read it), and for the results (on
