@@ -53,8 +53,8 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     p = _taken(params)
     y = _taken(y0)
     t_out = _taken(t_out)
-    in_t = np.zeros(0) if input_time is None else _taken(input_time)
-    in_f = np.zeros(0) if input_force is None else _taken(input_force)
+    in_t = _NO_INPUT if input_time is None else _taken(input_time)
+    in_f = _NO_INPUT if input_force is None else _taken(input_force)
     n = y.shape[0]
     m = t_out.shape[0]
     # the kernel writes every output row up to where it stopped; the rest is NaN (below)
@@ -63,24 +63,20 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     out_fa = np.empty(m)
     out_cmd = np.empty(m)
     stats = np.zeros(N_STATS)
-    if watch is None:
-        w = np.zeros(N_WATCH)
-        w[W_START] = np.inf
-        w[W_QUIET] = np.inf
-    else:
-        w = np.array(watch, dtype=np.float64)
+    w = _NO_WATCH.copy() if watch is None else np.array(watch, dtype=np.float64)
     k = max(int(crossings), 1)
-    cross_t = np.full(k, np.nan)
-    cross_y = np.full((k, n), np.nan)
-    cross_e = np.full((k, 2), np.nan)
-    y_end = np.full(n, np.nan)
+    cross_t = _nans(k)
+    cross_y = _nans((k, n))
+    cross_e = _nans((k, 2))
+    y_end = _nans(n)
     status = compiled().integrate(
         p, y, _taken(breaks), _taken(coeffs), bool(land), float(t_end), t_out, float(rtol),
         _taken(atol), float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r,
         out_fa, out_cmd, stats, w, cross_t, cross_y, cross_e, y_end)
     written = int(stats[ST_OUT])
-    for arr in (out_y, out_r, out_fa, out_cmd):
-        arr[written:] = np.nan
+    if written < m:
+        for arr in (out_y, out_r, out_fa, out_cmd):
+            arr[written:] = np.nan
     c = int(stats[ST_CROSSINGS])
     return Integration(code=int(status), status=STATUS_TEXT[int(status)], states=out_y,
                        reference=out_r, applied_force=out_fa, command=out_cmd,
@@ -91,7 +87,32 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
                        crossing_extremes=cross_e[:c], period_crossings=int(stats[ST_PERIOD]))
 
 
+#: No known input force (an empty series; the integrator reads none of it).
+_NO_INPUT = np.zeros(0)
+
+#: The watch array of a run without a watch (copied for each run: the integrator writes it).
+_NO_WATCH = np.zeros(N_WATCH)
+_NO_WATCH[W_START] = np.inf
+_NO_WATCH[W_QUIET] = np.inf
+
+
+def _nans(shape) -> np.ndarray:
+    """``np.full(shape, np.nan)`` without its Python layer."""
+    out = np.empty(shape)
+    out.fill(np.nan)
+    return out
+
+_FLOAT64 = np.dtype(np.float64)
+
+
 def _taken(values) -> np.ndarray:
     """``values`` as the compiled code takes them: float64, C-contiguous and writable (it
-    types read-only arrays differently); copied only when they are not (it only reads them)."""
+    types read-only arrays differently); copied only when they are not (it only reads them).
+
+    ``np.require(values, np.float64, ("C", "W"))``, with its Python-level checks skipped for
+    an array that already is (the common case)."""
+    if type(values) is np.ndarray and values.dtype == _FLOAT64:
+        flags = values.flags
+        if flags.c_contiguous and flags.writeable:
+            return values
     return np.require(values, dtype=np.float64, requirements=("C", "W"))

@@ -31,6 +31,7 @@ without a counted peak (it sees part of the window only).
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -40,6 +41,11 @@ from ..results import frozen_array
 from ..results.simulation import VERDICTS, HuntingMetrics
 
 __all__ = ["VERDICTS", "HuntingMetrics", "counted_peaks", "find_peaks", "hunting_metrics"]
+
+#: :func:`~fi_design.display.quantity` for the verdict's reason: the settings' values, which
+#: every trace judged under them repeats, and the trace's (a pure function of its
+#: arguments, kept by their type).
+_shown = lru_cache(maxsize=64, typed=True)(quantity)
 
 
 def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_length: float = 10.0,
@@ -79,10 +85,10 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     e = _taken(error_m)
     w0, w1 = window_start, window_start + window_length
     # the times increase: the window and its last quarter are slices
-    a, b = np.searchsorted(t, (w0, w1))
+    a, b = int(t.searchsorted(w0)), int(t.searchsorted(w1))
     tw, ew = _finite(t[a:b], e[a:b])
     finite = len(ew) == b - a  # every sample of the window is
-    idx = np.zeros(0, dtype=int)
+    idx = _NO_PEAKS
     lowest, highest = compiled().extremes(ew) if len(ew) else (math.nan, math.nan)
     amplitude = highest - lowest
     # a peak's prominence is at most the trace's range: below min_height, no side has one
@@ -99,9 +105,11 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
                 idx = found
     peaks_t, peaks_h = tw[idx], ew[idx]
     cycles = int(len(idx))
-    period = float(np.mean(np.diff(peaks_t))) if cycles >= 2 else None
+    # np.mean(np.diff(peaks_t)) without its Python layers: the same sum and division
+    period = float(np.add.reduce(peaks_t[1:] - peaks_t[:-1]) / (cycles - 1)) \
+        if cycles >= 2 else None
     # the last finite error (a failed run ends in NaN)
-    end = e[-1:] if len(e) and np.isfinite(e[-1]) else e[np.isfinite(e)][-1:]
+    end = e[-1:] if len(e) and math.isfinite(e[-1]) else e[np.isfinite(e)][-1:]
     final_error = float(end[0]) if len(end) else float("nan")
 
     t_last = float(t[-1]) if len(t) else 0.0
@@ -111,7 +119,7 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     # the trace ends inside the window (more than a step and a half before its end)
     step = float(t[-1] - t[-2]) if len(t) > 1 else 0.0
     short = not moving and w0 < t_last < w1 - 1.5 * step
-    c = max(a, int(np.searchsorted(t, w1 - window_length / 4.0)))
+    c = max(a, int(t.searchsorted(w1 - window_length / 4.0)))
     settled = bool(success and not moving and _within(e, c, b, settle_band, finite))
     settling_time = _settling_time(t, e, settle_band, motion_end) if success else None
 
@@ -120,36 +128,36 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     elif moving:
         what = "run" if t_last <= w1 else "counting window"
         verdict = "undetermined"
-        reason = (f"not finished: the motion runs until {quantity(motion_end, 's', 4)}, past "
-                  f"the end of the {what} at {quantity(min(w1, t_last), 's', 4)}; the stage is "
+        reason = (f"not finished: the motion runs until {_shown(motion_end, 's', 4)}, past "
+                  f"the end of the {what} at {_shown(min(w1, t_last), 's', 4)}; the stage is "
                   "still moving")
     elif late:
         verdict = "undetermined"
-        reason = (f"the motion ends at {quantity(motion_end, 's', 4)}, after the counting window "
-                  f"opens at {quantity(w0, 's', 4)}: the count would take the move's own "
+        reason = (f"the motion ends at {_shown(motion_end, 's', 4)}, after the counting window "
+                  f"opens at {_shown(w0, 's', 4)}: the count would take the move's own "
                   "overshoot for hunting (start the window after the motion)")
     elif len(ew) < 2:
         verdict, reason = "undetermined", "the trace does not cover the counting window"
     elif cycles > 0:
         verdict = "hunting"
-        reason = (f"{cycles} peak(s) of at least {quantity(min_height, 'm', 6)} in "
-                  f"[{quantity(w0, 's', 6)}, {quantity(w1, 's', 6)})"
-                  + (f", period {quantity(period, 's', 3)}" if period else ""))
+        reason = (f"{cycles} peak(s) of at least {_shown(min_height, 'm', 6)} in "
+                  f"[{_shown(w0, 's', 6)}, {_shown(w1, 's', 6)})"
+                  + (f", period {_shown(period, 's', 3)}" if period else ""))
     elif short:
         verdict = "undetermined"
-        reason = (f"the trace ends at {quantity(t_last, 's', 4)}, inside the counting window "
-                  f"[{quantity(w0, 's', 6)}, {quantity(w1, 's', 6)}): it covers the window in "
+        reason = (f"the trace ends at {_shown(t_last, 's', 4)}, inside the counting window "
+                  f"[{_shown(w0, 's', 6)}, {_shown(w1, 's', 6)}): it covers the window in "
                   "part only")
     elif settled:
         verdict = "settled"
-        reason = f"|x1 - r| stays within {quantity(settle_band, 'm', 3)} at the end of the window"
+        reason = f"|x1 - r| stays within {_shown(settle_band, 'm', 3)} at the end of the window"
     elif amplitude <= settle_band:
         verdict = "stuck"
-        reason = (f"the stage rests {quantity(abs(final_error), 'm', 3)} from its target: no peaks, "
+        reason = (f"the stage rests {_shown(abs(final_error), 'm', 3)} from its target: no peaks, "
                   "but not settled either (the integrator has not broken it loose in the window)")
     else:
         verdict = "undetermined"
-        reason = (f"no peaks counted, but the error still moves by {quantity(amplitude, 'm', 3)} in "
+        reason = (f"no peaks counted, but the error still moves by {_shown(amplitude, 'm', 3)} in "
                   "the window: a cycle or creep too slow to judge in this window")
     return HuntingMetrics(
         hunting_cycles=cycles, peak_times=frozen_array(peaks_t), peak_heights=frozen_array(peaks_h),
@@ -220,19 +228,32 @@ def _peak_search(y: np.ndarray, height: float, prominence: float, distance: int)
     m = k.local_maxima(y, float(height), found)
     if m == 0:
         return found[:0]
-    order = np.argsort(y[found[:m]]).astype(np.int64, copy=False)
+    order = y[found[:m]].argsort().astype(np.int64, copy=False)
     m = k.select_peaks(y, found, m, order, int(distance), float(prominence))
     return found[:m]
 
 
 def _taken(values) -> np.ndarray:
     """``values`` as the compiled code takes them: float64, C-contiguous and writable (copied
-    only when they are not; it only reads them)."""
+    only when they are not; it only reads them): ``np.require``, its checks skipped for an
+    array that already is."""
+    if type(values) is np.ndarray and values.dtype == _FLOAT64:
+        flags = values.flags
+        if flags.c_contiguous and flags.writeable:
+            return values
     return np.require(values, dtype=np.float64, requirements=("C", "W"))
+
+
+_FLOAT64 = np.dtype(np.float64)
+
+#: No peak (the metric's indices before a side has any; never written).
+_NO_PEAKS = np.zeros(0, dtype=int)
 
 
 def _finite(t: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The samples of ``t`` and ``e`` where ``e`` is finite (the arrays themselves if all are)."""
+    if math.isfinite(np.add.reduce(e)):  # NaN and infinity carry into a sum: all are finite
+        return t, e
     ok = np.isfinite(e)
     return (t, e) if ok.all() else (t[ok], e[ok])
 
@@ -266,7 +287,7 @@ def _peak_distance(t: np.ndarray, min_distance: float) -> int:
 
 
 def _settling_time(t: np.ndarray, e: np.ndarray, band: float, start: float) -> float | None:
-    after = int(np.searchsorted(t, start))  # the times increase
+    after = int(t.searchsorted(start))  # the times increase
     if after == len(t):
         return None
     last = compiled().last_outside(e, after, band)  # searched from the end

@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import math
 import time as _time
+import weakref
 from dataclasses import replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -27,6 +29,8 @@ from ..display import number as number_text, quantity  # number: the argument ch
 from ..errors import ArgumentError, DataError, SimulationError
 from .metrics import HuntingMetrics, hunting_metrics
 from ..model import Model, as_model
+from ..kernel import run as _kernel_run
+from ..kernel.build import compiled
 from ..kernel.layout import PlantParameters, state_index
 from .replay import (DRIVES, command_state, initial_state, record_reference, record_state,
                      reference_state, replay_fit, start_note)
@@ -148,39 +152,124 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
     spec, crossover, duration, rtol, rate = _checked_arguments(spec, crossover, duration, rtol,
                                                              record, rate)
     initial_position = number(initial_position, "initial_position", "m")
-    model = as_model(spec)
+    model = _model_of(spec)
     if crossover is not None or effects is not None:
         model = model.at(crossover=crossover, effects=effects)
     iso = model.has_isolator if isolated is None else bool(isolated)
-    params = model.plant(iso)
+    params, p = _plant(model, iso)
     if record is not None:
         return _replay(model, iso, method, params, record, drive, window, rtol, initial_command)
     if drive != "closed":
         raise SimulationError("drive='force' replays a record: give record=")
     if params.x1_initial != initial_position:
         params = replace(params, x1_initial=float(initial_position))
+        p = None
     motion = model.spec.motion
     if reference is None:
         t_end = motion.duration if duration is None else duration
-        ref = from_moves(motion.moves, t_end)
-        if initial_position:
-            c = np.array(ref.coeffs)
-            c[:, 0] += initial_position
-            ref = Trajectory(ref.breaks, c, land=True)
+        ref, move_end, r_max, pieces = _move_reference(motion, t_end, initial_position)
     else:
-        ref = reference
+        ref, move_end, r_max, pieces = reference, 0.0, None, None
         t_end = float(ref.breaks[-1]) if duration is None else duration
     if rate is None:
         rate = model.spec.simulation.output_rate
     n_out = int(math.floor(t_end * rate + 1e-9)) + 1
-    t_out = np.arange(n_out) / rate
+    if n_out <= _KEPT_OUTPUT_SAMPLES:
+        t_out, t_shown = _output_times(n_out, rate)
+    else:  # a long run's times are not kept (nor worth keeping beside its integration)
+        t_out, t_shown = np.arange(n_out) / rate, None
     y0 = np.zeros(params.n_states)
-    idx = state_index(iso)
+    idx = _STATE_INDEX[iso]
     y0[idx["x1"]] = initial_position
     y0[idx["x2"]] = initial_position
-    out, wall = _integrate(model, method, params, y0, ref, t_end, t_out, rtol)
-    return _result(model, iso, method, params, out, t_out, wall,
-                   move_end=motion.end_time if reference is None else 0.0)
+    out, wall = _integrate(model, method, params, y0, ref, t_end, t_out, rtol,
+                           reference_max=r_max, array=p, pieces=pieces)
+    return _result(model, iso, method, params, out, t_out, wall, move_end=move_end,
+                   shown_time=t_shown)
+
+
+# What simulate() works out again and again for the same spec, model or moves: kept, all of
+# it immutable (the kernel only reads the arrays it is given).
+
+#: The last spec resolved here and its model (the spec held, so its identity stays its own).
+_LAST_RESOLVED: tuple | None = None
+
+#: Per model (by identity, while it lives): ``{isolated: (PlantParameters, kernel array)}``.
+_PLANTS: "weakref.WeakKeyDictionary[Model, dict]" = weakref.WeakKeyDictionary()
+
+_FLOAT64 = np.dtype(np.float64)
+
+#: The state index of each plant (without filter states: their names are not read here).
+_STATE_INDEX = {True: state_index(True), False: state_index(False)}
+
+
+def _model_of(spec) -> Model:
+    """``as_model(spec)``; the same spec object again gives the same model (resolved once)."""
+    global _LAST_RESOLVED
+    if isinstance(spec, Model):
+        return spec
+    last = _LAST_RESOLVED
+    if last is not None and last[0] is spec:
+        return last[1]
+    model = as_model(spec)
+    _LAST_RESOLVED = (spec, model)
+    return model
+
+
+def _plant(model: Model, iso: bool) -> tuple[PlantParameters, np.ndarray]:
+    """``model.plant(iso)`` and its kernel array, worked out once per model and plant."""
+    kept = _PLANTS.get(model)
+    if kept is None:
+        kept = _PLANTS[model] = {}
+    hit = kept.get(iso)
+    if hit is None:
+        params = model.plant(iso)
+        hit = kept[iso] = (params, params.to_array())
+    return hit
+
+
+#: ``{id(params): (params, rtol, tolerances(params, rtol))}`` of the kept plants' parameters.
+_TOLERANCES: dict = {}
+
+
+def _tolerances(params: PlantParameters, rtol: float) -> np.ndarray:
+    """:func:`tolerances` of kept parameters (by identity, the object held), kept (the kernel
+    only reads it)."""
+    kept = _TOLERANCES.get(id(params))
+    if kept is not None and kept[0] is params and kept[1] == rtol:
+        return kept[2]
+    atol = tolerances(params, rtol)
+    if len(_TOLERANCES) >= 16:
+        _TOLERANCES.clear()
+    _TOLERANCES[id(params)] = (params, rtol, atol)
+    return atol
+
+
+@lru_cache(maxsize=32)
+def _move_reference(motion, t_end: float, initial_position: float):
+    """The reference of the spec's moves (``motion``, immutable) until ``t_end``, started at
+    ``initial_position``, the end of the last move [s], the largest |r| [m] and the
+    reference's breaks and coefficients as the kernel takes them (writable copies, which it
+    only reads): kept by their values."""
+    ref = from_moves(motion.moves, t_end)
+    if initial_position:
+        c = np.array(ref.coeffs)
+        c[:, 0] += initial_position
+        ref = Trajectory(ref.breaks, c, land=True)
+    return ref, motion.end_time, _largest(ref), (np.array(ref.breaks), np.array(ref.coeffs))
+
+
+#: Most output samples whose times are kept (:func:`_output_times`: 16 bytes a sample).
+_KEPT_OUTPUT_SAMPLES = 100_000
+
+
+@lru_cache(maxsize=4)
+def _output_times(n_out: int, rate: float) -> tuple[np.ndarray, np.ndarray]:
+    """The output times ``arange(n_out) / rate`` twice: for the kernel and the metric
+    (writable, as the compiled code takes them; they only read it), and for the results (on
+    an immutable buffer: no result can make it writable, so none can change another's)."""
+    t = np.arange(n_out) / rate
+    return t, np.frombuffer(t.tobytes(), dtype=np.float64)
 
 
 def _checked_arguments(spec, crossover, duration, rtol, record, rate=None):
@@ -219,11 +308,13 @@ def _checked_arguments(spec, crossover, duration, rtol, record, rate=None):
 
 
 def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=None,
-               input_force=None, reference_max=None):
+               input_force=None, reference_max=None, array=None, pieces=None):
     """One integration with the chosen method; returns the Integration and its wall time [s].
 
     ``reference_max``: the largest |r| [m] the divergence bound is set from (default: of
-    ``ref``; a window of a longer reference passes the whole reference's)."""
+    ``ref``; a window of a longer reference passes the whole reference's). ``array``:
+    ``params.to_array()``, ``pieces``: ``ref``'s breaks and coefficients as writable
+    arrays, when the caller has them."""
     settings = model.spec.simulation
     tol = rtol if rtol is not None else settings.tolerance * (
         1.0 if method == "fast" else 1e-4)
@@ -232,14 +323,13 @@ def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=No
     x_bound = 1.0 + 100.0 * (reference_max + abs(y0[0]))
     start = _time.perf_counter()
     if method == "fast":
-        from ..kernel import run
-        from ..kernel.build import compiled
-
         compiled()  # loads the built kernel (or compiles it) before the clock starts
         start = _time.perf_counter()
-        out = run(params.to_array(), y0, ref.breaks, ref.coeffs, ref.land, t_end, t_out, tol,
-                  tolerances(params, tol), 0.05, settings.max_steps, x_bound,
-                  input_time, input_force)
+        breaks, coeffs = (ref.breaks, ref.coeffs) if pieces is None else pieces
+        out = _kernel_run(params.to_array() if array is None else array, y0, breaks, coeffs,
+                          ref.land, t_end, t_out, tol,
+                          tolerances(params, tol) if array is None else _tolerances(params, tol),
+                          0.05, settings.max_steps, x_bound, input_time, input_force)
     else:
         from ..kernel.reference import solve_reference
 
@@ -254,22 +344,28 @@ def _largest(ref: Trajectory) -> float:
 
 
 def _result(model, iso, method, params, out, t_out, wall, *, move_end,
-            time_offset=0.0, drive="closed", record=None, window=None) -> SimulationResult:
-    """The result of an integration; ``record`` (a Measurement) for a replay."""
+            time_offset=0.0, drive="closed", record=None, window=None,
+            shown_time=None) -> SimulationResult:
+    """The result of an integration; ``record`` (a Measurement) for a replay.
+    ``shown_time``: ``t_out``'s values on a buffer of its own for the result (read-only)."""
     success = out.code == 0
     message = "" if success else _failure_message(out.status, out.t_reached, params, iso, drive)
     Y, R = out.states, out.reference
-    idx = state_index(iso)
+    idx = _STATE_INDEX[iso]
     t = t_out + time_offset if time_offset else t_out
     metrics = _metrics(model, t, Y[:, idx["x1"]] - R, success, message, move_end)
 
     def trace(values):  # the integration's own arrays, handed over without a copy
+        if type(values) is np.ndarray and values.dtype == _FLOAT64:  # frozen_array's view
+            view = values.view()
+            view.flags.writeable = False
+            return view
         return frozen_array(values, copy=False)
 
     return SimulationResult(
         spec=model.spec, isolated=iso, method=method, friction_model=model.friction.model,
         crossover=model.crossover, effects=tuple(e.type for e in model.effects),
-        time=trace(t), reference=trace(R), position=trace(Y[:, idx["x1"]]),
+        time=trace(t if shown_time is None or time_offset else shown_time), reference=trace(R), position=trace(Y[:, idx["x1"]]),
         cart_position=trace(Y[:, idx["x2"]]), velocity=trace(Y[:, idx["v1"]]),
         cart_velocity=trace(Y[:, idx["v2"]]), force=trace(out.command),
         applied_force=trace(out.applied_force), bristle=trace(Y[:, idx["z"]]),

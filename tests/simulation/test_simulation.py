@@ -442,6 +442,31 @@ def test_result_arrays_are_read_only(paper_fast):
     assert d["metrics"]["verdict"] == "settled" and "position" not in d
 
 
+def test_the_set_up_kept_between_runs_changes_nothing(paper_spec):
+    """simulate() keeps what it works out per spec, model and moves (the model, the plant's
+    parameters, the reference, the output times): a run again, from the model, or with
+    another start, length or rate is the same as worked out afresh, and no result can make
+    the shared times writable."""
+    from fi_design.model import resolve
+
+    def traces(r):
+        return [r.time, r.position, r.velocity, r.force, r.applied_force, r.bristle]
+
+    first = simulate(paper_spec, isolated=True, duration=3.0)
+    for again in (simulate(paper_spec, isolated=True, duration=3.0),
+                  simulate(resolve(paper_spec), isolated=True, duration=3.0)):
+        for a, b in zip(traces(first), traces(again)):
+            assert np.array_equal(a, b)
+        assert again.metrics.reason == first.metrics.reason
+    with pytest.raises(ValueError):
+        first.time.flags.writeable = True
+    moved = simulate(paper_spec, isolated=True, duration=3.0, initial_position=1e-3)
+    assert moved.position[0] == 1e-3 and moved.reference[0] == 1e-3
+    assert simulate(paper_spec, isolated=True, duration=3.0).position[0] == 0.0
+    assert len(simulate(paper_spec, isolated=True, duration=2.0).time) == 2001
+    assert simulate(paper_spec, isolated=True, duration=2.0, rate=500.0).time[1] == 0.002
+
+
 def test_to_dict_without_traces_never_converts_them(paper_fast):
     """`simulate --record --json` of a 2e6-row record peaked at 1.09 GB: to_dict turned every
     trace into a list of Python floats, then dropped it. Left out, it costs nothing."""
