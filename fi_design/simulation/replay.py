@@ -182,6 +182,38 @@ class ReplayFit:
 #: move for a sluggish loop), while two zeros (an encoder or homing offset, another unit)
 #: differ by the order of the travel.
 START_OFFSET_SHARE = 0.1
+#: A record sampled below this many times the loop's crossover cannot show the loop's
+#: dynamics (its Nyquist frequency lies below the crossover) [-].
+RATE_FACTOR = 2.0
+
+
+def rate_note(record: Measurement, crossover: float) -> str:
+    """A warning when the record is sampled too slowly to show the loop it is compared with.
+
+    Below :data:`RATE_FACTOR` times the crossover the record's Nyquist
+    frequency lies below the loop's crossover: the comparison reads only the
+    record's slow part. A ``time_s`` column written in ms is the usual cause
+    (it reads 1000 times too slow).
+
+    Parameters
+    ----------
+    record : Measurement
+        The record.
+    crossover : float
+        The loop's crossover [Hz].
+
+    Returns
+    -------
+    str
+        The warning, empty when the record is sampled fast enough.
+    """
+    rate = 1.0 / record.sample_period
+    if rate >= RATE_FACTOR * crossover:
+        return ""
+    return (f"the record is sampled at {quantity(rate, 'Hz', 4)}, below "
+            f"{RATE_FACTOR:g} x the loop's {quantity(crossover, 'Hz', 4)} crossover: it cannot "
+            "show the loop's dynamics, so the comparison reads only its slow part; time_s "
+            "must be in s (a column in ms reads 1000 x too slow)")
 
 
 def start_note(record: Measurement, distance: float) -> str:

@@ -33,7 +33,7 @@ from ..kernel import run as _kernel_run
 from ..kernel.build import compiled
 from ..kernel.layout import PlantParameters, state_index
 from .replay import (DRIVES, command_state, initial_state, record_reference, record_state,
-                     reference_state, replay_fit, start_note)
+                     rate_note, reference_state, replay_fit, start_note)
 from ..results import frozen_array
 from ..results.simulation import SimulationResult
 from ..trajectory import Trajectory, from_moves
@@ -379,7 +379,8 @@ def _result(model, iso, method, params, out, t_out, wall, *, move_end,
 
 
 def record_notes(model, record, drive: str) -> tuple[str, ...]:
-    """Warnings about a replayed record: a closed loop that starts far from its reference.
+    """Warnings about a replayed record: a closed loop that starts far from its reference, a
+    record sampled too slowly for the loop's crossover.
 
     Parameters
     ----------
@@ -388,17 +389,19 @@ def record_notes(model, record, drive: str) -> tuple[str, ...]:
     record : Measurement
         The record.
     drive : {"closed", "force"}
-        The replay's drive: an open loop (``"force"``) has no warning.
+        The replay's drive: an open loop (``"force"``) has no start warning (the
+        reference drives nothing there).
 
     Returns
     -------
     tuple of str
-        :func:`~fi_design.simulation.replay.start_note`'s warning, or empty.
+        :func:`~fi_design.simulation.replay.start_note`'s and
+        :func:`~fi_design.simulation.replay.rate_note`'s warnings, those that apply.
     """
-    if drive != "closed":  # open loop the reference drives nothing
-        return ()
-    note = start_note(record, max(abs(m.distance) for m in model.spec.motion.moves))
-    return (note,) if note else ()
+    notes = [rate_note(record, model.crossover)]
+    if drive == "closed":
+        notes.insert(0, start_note(record, max(abs(m.distance) for m in model.spec.motion.moves)))
+    return tuple(n for n in notes if n)
 
 
 def _replay(model, iso, method, params, record, drive, window, rtol, initial_command=None):

@@ -330,3 +330,34 @@ def test_cli_simulate_warns_when_the_record_starts_far_from_its_reference(tmp_pa
     # open loop the reference drives nothing
     far = load_measurement(rec)
     assert simulate(spec_obj, record=far, drive="force").replay.notes == ()
+
+
+def test_a_record_sampled_below_the_crossover_names_the_time_unit(tmp_path):
+    """examples/measured_trace.csv with time_s written in ms replayed 'ok' without a word (a
+    1 Hz record against the 8 Hz loop: 1.8 million steps over 20,000 s); now the replay (and
+    the reconciliation, which keeps these notes) says the record cannot show the loop and
+    names the time unit, closed loop and open loop. The record as written (1 kHz) has no
+    such note."""
+    from conftest import edited_trace
+
+    from fi_design.measured import load_measurement
+    from fi_design.model import as_model
+    from fi_design.simulation.run import record_notes
+
+    model = as_model(load_spec(EXAMPLES / "measured_stage.yaml"))
+    ms = load_measurement(edited_trace(tmp_path, "ms.csv",
+                                       lambda cells: [repr(float(cells[0]) * 1e3), *cells[1:]]))
+    for drive in ("closed", "force"):
+        (note,) = record_notes(model, ms, drive)
+        assert "sampled at 1 Hz, below 2 x the loop's 8 Hz crossover" in note, note
+        assert "time_s must be in s (a column in ms" in note
+    assert record_notes(model, load_measurement(EXAMPLES / "measured_trace.csv"), "closed") == ()
+
+
+def test_the_real_record_is_sampled_fast_enough_for_its_loop(emps_record, emps_axis):
+    """The EMPS record (1 kHz) against its identified axis's loop: no rate note."""
+    from fi_design.model import as_model
+    from fi_design.simulation.run import record_notes
+
+    assert not any("sampled at" in n for n in record_notes(as_model(emps_axis), emps_record,
+                                                           "closed"))
