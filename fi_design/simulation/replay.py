@@ -22,7 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..display import percent, quantity
+from ..display import number, percent, quantity
 from ..errors import DataError
 from ..kernel.build import compiled
 from ..kernel.layout import P_SIGMA2_NEG, PlantParameters, state_index
@@ -210,10 +210,10 @@ def rate_note(record: Measurement, crossover: float) -> str:
     rate = 1.0 / record.sample_period
     if rate >= RATE_FACTOR * crossover:
         return ""
-    return (f"the record is sampled at {quantity(rate, 'Hz', 4)}, below "
-            f"{RATE_FACTOR:g} x the loop's {quantity(crossover, 'Hz', 4)} crossover: it cannot "
-            "show the loop's dynamics, so the comparison reads only its slow part; time_s "
-            "must be in s (a column in ms reads 1000 x too slow)")
+    return (f"the record is sampled at {quantity(rate, 'Hz', 4)}, below {number(RATE_FACTOR)} "
+            f"x the loop's {quantity(crossover, 'Hz', 4)} crossover: it cannot show the loop's "
+            "dynamics, so the comparison reads only its slow part; time_s must be in s (a "
+            "column in ms reads 1000 x too slow)")
 
 
 def start_note(record: Measurement, distance: float) -> str:
