@@ -31,7 +31,7 @@ from .layout import (N_STATS, N_WATCH, ST_CROSSINGS, ST_EVENTS, ST_OUT, ST_PERIO
                      ST_STEPS, ST_STOP, ST_T, STATUS_TEXT, STOP_TEXT, W_QUIET, W_START,
                      Integration)
 
-__all__ = ["run"]
+__all__ = ["run", "taken"]
 
 
 def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
@@ -50,11 +50,11 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     """
     from .build import compiled  # not at import: `python -m fi_design.kernel.build` runs it
 
-    p = _taken(params)
-    y = _taken(y0)
-    t_out = _taken(t_out)
-    in_t = _NO_INPUT if input_time is None else _taken(input_time)
-    in_f = _NO_INPUT if input_force is None else _taken(input_force)
+    p = taken(params)
+    y = taken(y0)
+    t_out = taken(t_out)
+    in_t = _NO_INPUT if input_time is None else taken(input_time)
+    in_f = _NO_INPUT if input_force is None else taken(input_force)
     n = y.shape[0]
     m = t_out.shape[0]
     # the kernel writes every output row up to where it stopped; the rest is NaN (below)
@@ -70,8 +70,8 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     cross_e = _nans((k, 2))
     y_end = _nans(n)
     status = compiled().integrate(
-        p, y, _taken(breaks), _taken(coeffs), bool(land), float(t_end), t_out, float(rtol),
-        _taken(atol), float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r,
+        p, y, taken(breaks), taken(coeffs), bool(land), float(t_end), t_out, float(rtol),
+        taken(atol), float(h_max), int(max_steps), float(x_bound), in_t, in_f, out_y, out_r,
         out_fa, out_cmd, stats, w, cross_t, cross_y, cross_e, y_end)
     written = int(stats[ST_OUT])
     if written < m:
@@ -102,10 +102,11 @@ def _nans(shape) -> np.ndarray:
     out.fill(np.nan)
     return out
 
+
 _FLOAT64 = np.dtype(np.float64)
 
 
-def _taken(values) -> np.ndarray:
+def taken(values) -> np.ndarray:
     """``values`` as the compiled code takes them: float64, C-contiguous and writable (it
     types read-only arrays differently); copied only when they are not (it only reads them).
 

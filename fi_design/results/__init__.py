@@ -103,7 +103,12 @@ def frozen_array(values, dtype=float, copy: bool = True) -> np.ndarray:
     ``copy=False`` hands over an array nobody else writes to (a trace the kernel
     has just filled): a read-only view of it, copied only to change its dtype.
     """
-    arr = np.array(values, dtype=dtype, copy=True) if copy else np.asarray(values, dtype).view()
+    if copy:
+        arr = np.array(values, dtype=dtype, copy=True)
+    elif type(values) is np.ndarray and values.dtype == dtype:  # asarray's layer skipped
+        arr = values.view()
+    else:
+        arr = np.asarray(values, dtype).view()
     arr.flags.writeable = False
     return arr
 

@@ -36,6 +36,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..display import quantity
+from ..kernel import taken
 from ..kernel.build import compiled
 from ..results import frozen_array
 from ..results.simulation import VERDICTS, HuntingMetrics
@@ -81,8 +82,8 @@ def hunting_metrics(time_s, error_m, *, window_start: float = 10.0, window_lengt
     -------
     HuntingMetrics
     """
-    t = _taken(time_s)
-    e = _taken(error_m)
+    t = taken(time_s)
+    e = taken(error_m)
     w0, w1 = window_start, window_start + window_length
     # the times increase: the window and its last quarter are slices
     a, b = int(t.searchsorted(w0)), int(t.searchsorted(w1))
@@ -186,7 +187,7 @@ def find_peaks(y, height: float, prominence: float, distance: int) -> np.ndarray
     ndarray of int
         The peaks' indices, increasing.
     """
-    return _peak_search(_taken(y), height, prominence, distance)
+    return _peak_search(taken(y), height, prominence, distance)
 
 
 def counted_peaks(y, min_height: float, distance: int) -> np.ndarray:
@@ -216,7 +217,7 @@ def counted_peaks(y, min_height: float, distance: int) -> np.ndarray:
     ndarray of int
         The indices kept, increasing.
     """
-    y = _taken(y)
+    y = taken(y)
     found = _peak_search(y, min_height, min_height, distance)
     return found[:compiled().one_per_plateau(y, found, len(found), float(min_height))]
 
@@ -233,18 +234,6 @@ def _peak_search(y: np.ndarray, height: float, prominence: float, distance: int)
     return found[:m]
 
 
-def _taken(values) -> np.ndarray:
-    """``values`` as the compiled code takes them: float64, C-contiguous and writable (copied
-    only when they are not; it only reads them): ``np.require``, its checks skipped for an
-    array that already is."""
-    if type(values) is np.ndarray and values.dtype == _FLOAT64:
-        flags = values.flags
-        if flags.c_contiguous and flags.writeable:
-            return values
-    return np.require(values, dtype=np.float64, requirements=("C", "W"))
-
-
-_FLOAT64 = np.dtype(np.float64)
 
 #: No peak (the metric's indices before a side has any; never written).
 _NO_PEAKS = np.zeros(0, dtype=int)

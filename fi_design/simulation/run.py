@@ -197,8 +197,6 @@ _LAST_RESOLVED: tuple | None = None
 #: Per model (by identity, while it lives): ``{isolated: (PlantParameters, kernel array)}``.
 _PLANTS: "weakref.WeakKeyDictionary[Model, dict]" = weakref.WeakKeyDictionary()
 
-_FLOAT64 = np.dtype(np.float64)
-
 #: The state index of each plant (without filter states: their names are not read here).
 _STATE_INDEX = {True: state_index(True), False: state_index(False)}
 
@@ -356,16 +354,13 @@ def _result(model, iso, method, params, out, t_out, wall, *, move_end,
     metrics = _metrics(model, t, Y[:, idx["x1"]] - R, success, message, move_end)
 
     def trace(values):  # the integration's own arrays, handed over without a copy
-        if type(values) is np.ndarray and values.dtype == _FLOAT64:  # frozen_array's view
-            view = values.view()
-            view.flags.writeable = False
-            return view
         return frozen_array(values, copy=False)
 
     return SimulationResult(
         spec=model.spec, isolated=iso, method=method, friction_model=model.friction.model,
         crossover=model.crossover, effects=tuple(e.type for e in model.effects),
-        time=trace(t if shown_time is None or time_offset else shown_time), reference=trace(R), position=trace(Y[:, idx["x1"]]),
+        time=trace(t if shown_time is None or time_offset else shown_time), reference=trace(R),
+        position=trace(Y[:, idx["x1"]]),
         cart_position=trace(Y[:, idx["x2"]]), velocity=trace(Y[:, idx["v1"]]),
         cart_velocity=trace(Y[:, idx["v2"]]), force=trace(out.command),
         applied_force=trace(out.applied_force), bristle=trace(Y[:, idx["z"]]),
