@@ -75,7 +75,12 @@ def signals_to_exceptions(make: Callable[[int], BaseException]) -> Iterator[None
     remembered: :func:`raise_received` raises it again where a result
     would be written, and when the block ends without an exception, it
     raises it then (the run was interrupted, whatever swallowed the first
-    exception). Outside the main thread the block runs unchanged.
+    exception). A block that ends by ``SystemExit`` with a success code (0 or
+    None: a command line's normal end) raises it too. A block inside another
+    starts with the signals the outer one has received (one swallowed while
+    the arguments were parsed still stops the command that follows), and hands
+    none back: the inner block ends by its own. Outside the main thread the
+    block runs unchanged.
 
     Parameters
     ----------
@@ -86,19 +91,25 @@ def signals_to_exceptions(make: Callable[[int], BaseException]) -> Iterator[None
     Raises
     ------
     BaseException
-        ``make(signum)`` of a signal received in the block, at its end, when
-        the block itself did not raise.
+        ``make(signum)`` of a signal received in the block (or before it, in
+        an outer one), at its end, when the block itself did not raise or
+        ended by ``SystemExit`` with a success code.
     """
     if not _main_thread():
         yield
         return
     saved = (_STATE.make, _STATE.received, _STATE.depth, _STATE.pending)
     previous = {s: signal.getsignal(s) for s in SIGNALS}
-    _STATE.make, _STATE.received, _STATE.depth, _STATE.pending = make, [], 0, []
+    _STATE.make, _STATE.received, _STATE.depth, _STATE.pending = make, list(saved[1]), 0, []
     try:
         for s in SIGNALS:
             signal.signal(s, _on_signal)
-        yield
+        try:
+            yield
+        except SystemExit as exc:
+            if _STATE.received and exc.code in (0, None):  # a run that ends as if not stopped
+                raise make(_STATE.received[0]) from None
+            raise
         if _STATE.received:
             raise make(_STATE.received[0])
     finally:

@@ -56,6 +56,49 @@ def test_an_interrupt_swallowed_by_a_finalizer_still_stops_the_run(paper_spec_pa
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_an_interrupt_swallowed_while_the_arguments_are_parsed_stops_the_command(
+        paper_spec_path, tmp_path, monkeypatch):
+    """A Ctrl-C 0.2 s into a sweep was raised inside importlib's weakref callback while the
+    command line was built: dropped, and the command's own block began with no signal
+    received, so the sweep ran to its end, wrote map.csv and exited 0."""
+    from fi_design.cli.parts import DefaultCommandGroup
+
+    real = DefaultCommandGroup.parse_args
+
+    def parse_args(self, ctx, args):
+        _Finalizer()  # collected at once: Ctrl-C lands inside its finalizer
+        return real(self, ctx, args)
+
+    monkeypatch.setattr(DefaultCommandGroup, "parse_args", parse_args)
+    out = tmp_path / "out.json"
+    result = runner.invoke(app(), ["simulate", str(paper_spec_path), "--json", str(out)])
+    assert result.exit_code == 130, result.output
+    assert "interrupted; no output was written" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_signal_swallowed_before_a_successful_exit_is_raised():
+    """A block that ends by sys.exit(0) (click's end of a command line) after a swallowed
+    signal ended the run with exit 0."""
+    from fi_design.interrupts import signals_to_exceptions
+
+    with pytest.raises(KeyboardInterrupt):
+        with signals_to_exceptions(lambda signum: KeyboardInterrupt()):
+            try:
+                _sigint_here()
+            except KeyboardInterrupt:
+                pass  # swallowed, as a finalizer or a C callback does
+            raise SystemExit(0)
+    with pytest.raises(SystemExit):  # an exit with its own code is left alone
+        with signals_to_exceptions(lambda signum: KeyboardInterrupt()):
+            try:
+                _sigint_here()
+            except KeyboardInterrupt:
+                pass
+            raise SystemExit(3)
+
+
 def test_an_error_raised_by_an_interruption_is_the_interruption(paper_spec_path, tmp_path,
                                                                monkeypatch):
     """Ctrl-C inside the import of a compiled module is `ImportError: initialization failed`
