@@ -21,6 +21,10 @@ from ..results.identification import UNITS, Fit, Masses, Parameter, Processing, 
 
 #: Fewest used (decimated, sliding) samples per direction of motion.
 MIN_DIRECTION_SAMPLES = 10
+#: A record sampled below this rate is named in the "too little sliding" error [Hz]: a servo
+#: log runs at hundreds of Hz or more, and a time_s column written in ms reads 1000 x too
+#: slow (its speeds 1000 x too low, under the velocity threshold).
+SLOW_RECORD_RATE = 100.0
 #: Largest condition number of the column-scaled regressor: beyond it two columns are the same
 #: within the record's precision (one speed only: Coulomb and viscous friction alike).
 MAX_CONDITION = 1e8
@@ -255,11 +259,19 @@ def check_directions(prep: Prepared, proc: Processing, source: str | None) -> in
             f"too little sliding: {pos} usable samples moving in the positive direction and "
             f"{neg} in the negative one faster than {quantity(proc.velocity_threshold, 'm/s', 3)} "
             f"(at least {MIN_DIRECTION_SAMPLES} in one direction after decimation by "
-            f"{proc.decimation}); identification needs sliding at varied speeds",
-            column="position_m", source=source)
+            f"{proc.decimation}); identification needs sliding at varied speeds"
+            + _slow_record_words(proc), column="position_m", source=source)
     if min(pos, neg) >= MIN_DIRECTION_SAMPLES:
         return 0
     return 1 if pos >= MIN_DIRECTION_SAMPLES else -1
+
+
+def _slow_record_words(proc: Processing) -> str:
+    """The record's rate named when it is below :data:`SLOW_RECORD_RATE`, else empty."""
+    if proc.sample_rate >= SLOW_RECORD_RATE:
+        return ""
+    return (f"; the record is sampled at {quantity(proc.sample_rate, 'Hz', 4)}: time_s must be "
+            "in s (a column in ms reads 1000 x too slow, its speeds 1000 x too low)")
 
 
 def direction_words(direction: int) -> tuple[str, str]:

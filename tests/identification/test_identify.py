@@ -490,6 +490,23 @@ def test_bad_records_name_the_column_and_what_is_needed():
     assert e.value.column == "position_m" and "varied speeds" in str(e.value)
 
 
+def test_too_little_sliding_in_a_record_timed_in_ms_names_the_unit(tmp_path):
+    """examples/measured_trace.csv with time_s written in ms: "too little sliding ... faster
+    than 9 mm/s" without a word on the unit (the speeds read 1000 x too low); now the
+    record's 1 Hz rate and the unit are named. The record as written identifies."""
+    from conftest import edited_trace
+
+    from fi_design.measured import load_measurement
+
+    spec = load_spec(EXAMPLES / "measured_stage.yaml")
+    ms = load_measurement(edited_trace(tmp_path, "ms.csv",
+                                       lambda cells: [repr(float(cells[0]) * 1e3), *cells[1:]]))
+    with pytest.raises(DataError) as e:
+        identify(ms, spec)
+    assert e.value.column == "position_m" and "too little sliding" in str(e.value)
+    assert "sampled at 1 Hz: time_s must be in s (a column in ms" in str(e.value), e.value
+
+
 def test_cli_bad_input_exits_2_without_traceback(tmp_path):
     t, x, _ = _arrays()
     csv = tmp_path / "no_force.csv"
