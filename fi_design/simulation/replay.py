@@ -97,16 +97,23 @@ class LocalFit(NamedTuple):
 def _local_fit(record: Measurement, values: np.ndarray, index: int, span: float) -> LocalFit:
     """Quadratic least-squares fit of ``values`` within ``span`` around sample ``index``.
 
-    One-sided at the ends of the record, at least :data:`MIN_FIT_SAMPLES`
-    samples. Returns the coefficients (value, first and second derivative
-    over 1, 1 and 2 at the sample) and their covariance from the residuals.
+    At an end of the record the stretch is one-sided and as wide as ``span``
+    (not half of it: a derivative taken at the end of its stretch is the
+    noisiest, and a record that starts in motion is read there), at least
+    :data:`MIN_FIT_SAMPLES` samples. Returns the coefficients (value, first
+    and second derivative over 1, 1 and 2 at the sample) and their covariance
+    from the residuals.
     """
     t = record.time
     n = len(t)
     half = max(span / 2.0, 0.5 * (MIN_FIT_SAMPLES - 1) * record.sample_period)
     lo = int(np.searchsorted(t, t[index] - half, side="left"))
     hi = int(np.searchsorted(t, t[index] + half, side="right"))
-    if hi - lo < MIN_FIT_SAMPLES:  # at an end: extend to the other side
+    if lo == 0 and t[index] - half < t[0]:  # at the start: the whole span after it
+        hi = int(np.searchsorted(t, t[0] + 2.0 * half, side="right"))
+    if hi == n and t[index] + half > t[-1]:  # at the end: the whole span before it
+        lo = int(np.searchsorted(t, t[-1] - 2.0 * half, side="left"))
+    if hi - lo < MIN_FIT_SAMPLES:  # a short record: extend to the other side
         lo, hi = max(0, min(lo, n - MIN_FIT_SAMPLES)), min(n, max(hi, MIN_FIT_SAMPLES))
     A = np.vander(t[lo:hi] - t[index], 3, increasing=True)
     coef, ssr, _, _ = np.linalg.lstsq(A, np.asarray(values[lo:hi], dtype=float), rcond=None)
@@ -336,9 +343,24 @@ def command_state(record: Measurement, index: int = 0) -> float | None:
     return float(record.force[index]) - dist
 
 
+def command_rate(record: Measurement, index: int = 0) -> float | None:
+    """Rate of the controller's own output at sample ``index`` [N/s], from the data.
+
+    The local quadratic of :func:`record_state` on ``force_N`` less
+    ``disturbance_N``; None without a ``force_N`` column.
+    """
+    if record.force is None:
+        return None
+    rate = float(_fit_of(record, "force", index, VELOCITY_SPAN).coef[1])
+    if record.disturbance is not None:
+        rate -= float(_fit_of(record, "disturbance", index, VELOCITY_SPAN).coef[1])
+    return rate
+
+
 def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, *,
                   deflection: float | None, command: float | None, reference: tuple[float, ...],
-                  feedforward: float) -> tuple[np.ndarray, PlantParameters]:
+                  feedforward: float,
+                  rate: float | None = None) -> tuple[np.ndarray, PlantParameters]:
     """The kernel's initial state for a record, and the parameters with the controller's state.
 
     Parameters
@@ -362,6 +384,14 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
         Reference position, velocity, acceleration at the sample [m, m/s, m/s^2].
     feedforward : float
         The feedforward force at the sample [N].
+    rate : float or None
+        Rate of ``command`` [N/s] (:func:`command_rate`). A continuous
+        controller's derivative roll-off lags the PID's output, by ``rate``
+        over its corner [rad/s]: with it the integrator takes the PID's
+        output, not the lagging command (a stage caught mid-move, its command
+        changing, otherwise starts with its integrator off by that much); the
+        feedforward is taken as steady. None, or a stage at rest: the roll-off
+        taken at rest.
 
     Returns
     -------
@@ -415,8 +445,13 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
         kf = law.kernel_form()
         v_wo_i = kf["kp"] * e + kf["kd"] * (rd - v1) - kf["kdm"] * v1
         target = v_wo_i if command is None else command - feedforward
+        pid = target  # the PID's output, before the roll-off
+        if command is not None and rate is not None and state.moving \
+                and not math.isinf(kf["wt"]) and not params.filter_states:
+            # u' = wt (pid - u), u the command (at rest the rate is the force's noise)
+            pid = target + rate / kf["wt"]
         if law.integrator:  # the integrator takes what P and D leave of the first sample
-            y0[idx["I"]] = target - v_wo_i
+            y0[idx["I"]] = pid - v_wo_i
         if not math.isinf(kf["wt"]):  # the filter state is the output itself
             y0[idx["u"]] = target
     nf = int(params.filter_states)

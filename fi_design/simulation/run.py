@@ -32,8 +32,8 @@ from ..model import Model, as_model
 from ..kernel import run as _kernel_run
 from ..kernel.build import compiled
 from ..kernel.layout import PlantParameters, state_index
-from .replay import (DRIVES, command_state, initial_state, record_reference, record_state,
-                     rate_note, reference_state, replay_fit, start_note)
+from .replay import (DRIVES, command_rate, command_state, initial_state, record_reference,
+                     record_state, rate_note, reference_state, replay_fit, start_note)
 from ..results import frozen_array
 from ..results.simulation import SimulationResult
 from ..trajectory import Trajectory, from_moves
@@ -469,8 +469,9 @@ def _anchor(law, params, record, index, ref, command):
     ff = compiled().feedforward(rd, rdd, 0.0, params.to_array())[0]
     defl = None if record.deflection is None or not params.isolated else \
         float(record.deflection[index])
+    rate = None if command is None else command_rate(record, index)
     return initial_state(params, law, st, deflection=defl, command=command,
-                         reference=(r, rd, rdd), feedforward=ff)
+                         reference=(r, rd, rdd), feedforward=ff, rate=rate)
 
 
 def _merge(pieces, t_out):
