@@ -79,3 +79,23 @@ def test_a_neighbouring_stroke_with_no_joint_kept_names_its_stiffest(paper_spec)
     assert (f"a shorter stroke (0.3 mm) raises k_max to {kmax}, but no joint there passes: "
             "6325 N/m fails on hunting at the crossover (at 10.6 Hz some move of the family "
             "hunts)") in out
+
+
+def test_the_nearest_infeasible_design_is_the_stiffest_that_kept_the_margin():
+    """The paper setup on a vertical axis (its search's points, tests/recommend's slow test):
+    every design sags past its stroke under the cart, and ranked by hunting margin alone the
+    nearest was the softest, 310 N/m sagging 12.6 mm on a 2.92 mm stroke, beside 4211 N/m
+    sagging 0.93 mm on 0.9 mm. A design that kept the margin and fails a check is nearer the
+    stiffer it is; one short of the margin, the more margin it has."""
+    from fi_design.recommend.objective import nearest
+
+    sags = ["it sags %s of its stroke" % s for s in ("12.6 mm", "3.11 mm", "0.932 mm")]
+    checks = [_point(2.916e-3, 310.3, "checks", 3.11, [sags[0]]),
+              _point(2.916e-3, 1260.6, "checks", 2.51, [sags[1]]),
+              _point(0.9e-3, 4210.7, "checks", 1.41, [sags[2]])]
+    short = [_point(0.52e-3, 3651.5, "margin", 1.197, [MARGIN]),
+             _point(0.52e-3, 7353.6, "margin", 1.099, ["the crossover lies only 1.099 x"]),
+             _point(0.1e-3, 9091.1, "hunts", 0.0, ["some move of the family hunts"])]
+    assert nearest(checks + short) is checks[2]
+    assert nearest(short) is short[0]  # the most margin, not the stiffest
+    assert nearest(short[1:]) is short[1]
