@@ -156,7 +156,7 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
     if crossover is not None or effects is not None:
         model = model.at(crossover=crossover, effects=effects)
     iso = model.has_isolator if isolated is None else bool(isolated)
-    params, p = _plant(model, iso)
+    params, p, atols = _plant(model, iso)
     if record is not None:
         return _replay(model, iso, method, params, record, drive, window, rtol, initial_command)
     if drive != "closed":
@@ -183,7 +183,7 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
     y0[idx["x1"]] = initial_position
     y0[idx["x2"]] = initial_position
     out, wall = _integrate(model, method, params, y0, ref, t_end, t_out, rtol,
-                           reference_max=r_max, array=p, pieces=pieces)
+                           reference_max=r_max, array=p, atols=atols, pieces=pieces)
     return _result(model, iso, method, params, out, t_out, wall, move_end=move_end,
                    shown_time=t_shown)
 
@@ -194,7 +194,8 @@ def simulate(spec: _spec.Spec | Model, isolated: bool | None = None, method: str
 #: The last spec resolved here and its model (the spec held, so its identity stays its own).
 _LAST_RESOLVED: tuple | None = None
 
-#: Per model (by identity, while it lives): ``{isolated: (PlantParameters, kernel array)}``.
+#: Per model (by identity, while it lives): ``{isolated: (PlantParameters, kernel array,
+#: {rtol: absolute tolerances})}``.
 _PLANTS: "weakref.WeakKeyDictionary[Model, dict]" = weakref.WeakKeyDictionary()
 
 #: The state index of each plant (without filter states: their names are not read here).
@@ -214,33 +215,17 @@ def _model_of(spec) -> Model:
     return model
 
 
-def _plant(model: Model, iso: bool) -> tuple[PlantParameters, np.ndarray]:
-    """``model.plant(iso)`` and its kernel array, worked out once per model and plant."""
+def _plant(model: Model, iso: bool) -> tuple[PlantParameters, np.ndarray, dict]:
+    """``model.plant(iso)``, its kernel array and its absolute tolerances per relative
+    tolerance (filled by :func:`_integrate`), worked out once per model and plant."""
     kept = _PLANTS.get(model)
     if kept is None:
         kept = _PLANTS[model] = {}
     hit = kept.get(iso)
     if hit is None:
         params = model.plant(iso)
-        hit = kept[iso] = (params, params.to_array())
+        hit = kept[iso] = (params, params.to_array(), {})
     return hit
-
-
-#: ``{id(params): (params, rtol, tolerances(params, rtol))}`` of the kept plants' parameters.
-_TOLERANCES: dict = {}
-
-
-def _tolerances(params: PlantParameters, rtol: float) -> np.ndarray:
-    """:func:`tolerances` of kept parameters (by identity, the object held), kept (the kernel
-    only reads it)."""
-    kept = _TOLERANCES.get(id(params))
-    if kept is not None and kept[0] is params and kept[1] == rtol:
-        return kept[2]
-    atol = tolerances(params, rtol)
-    if len(_TOLERANCES) >= 16:
-        _TOLERANCES.clear()
-    _TOLERANCES[id(params)] = (params, rtol, atol)
-    return atol
 
 
 @lru_cache(maxsize=32)
@@ -306,13 +291,14 @@ def _checked_arguments(spec, crossover, duration, rtol, record, rate=None):
 
 
 def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=None,
-               input_force=None, reference_max=None, array=None, pieces=None):
+               input_force=None, reference_max=None, array=None, atols=None, pieces=None):
     """One integration with the chosen method; returns the Integration and its wall time [s].
 
     ``reference_max``: the largest |r| [m] the divergence bound is set from (default: of
     ``ref``; a window of a longer reference passes the whole reference's). ``array``:
-    ``params.to_array()``, ``pieces``: ``ref``'s breaks and coefficients as writable
-    arrays, when the caller has them."""
+    ``params.to_array()``, ``atols``: the kept ``{rtol: tolerances(params, rtol)}`` of
+    that array's plant (filled here), ``pieces``: ``ref``'s breaks and coefficients as
+    writable arrays, when the caller has them."""
     settings = model.spec.simulation
     tol = rtol if rtol is not None else settings.tolerance * (
         1.0 if method == "fast" else 1e-4)
@@ -324,10 +310,14 @@ def _integrate(model, method, params, y0, ref, t_end, t_out, rtol, input_time=No
         compiled()  # loads the built kernel (or compiles it) before the clock starts
         start = _time.perf_counter()
         breaks, coeffs = (ref.breaks, ref.coeffs) if pieces is None else pieces
-        out = _kernel_run(params.to_array() if array is None else array, y0, breaks, coeffs,
-                          ref.land, t_end, t_out, tol,
-                          tolerances(params, tol) if array is None else _tolerances(params, tol),
-                          0.05, settings.max_steps, x_bound, input_time, input_force)
+        if array is None or atols is None:
+            array, atol = params.to_array() if array is None else array, tolerances(params, tol)
+        else:  # the kept plant's (the kernel only reads them)
+            atol = atols.get(tol)
+            if atol is None:
+                atol = atols[tol] = tolerances(params, tol)
+        out = _kernel_run(array, y0, breaks, coeffs, ref.land, t_end, t_out, tol, atol, 0.05,
+                          settings.max_steps, x_bound, input_time, input_force)
     else:
         from ..kernel.reference import solve_reference
 
