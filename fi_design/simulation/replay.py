@@ -94,24 +94,27 @@ class LocalFit(NamedTuple):
     dof: int
 
 
-def _local_fit(record: Measurement, values: np.ndarray, index: int, span: float) -> LocalFit:
+def _local_fit(record: Measurement, values: np.ndarray, index: int, span: float,
+               measured: bool = True) -> LocalFit:
     """Quadratic least-squares fit of ``values`` within ``span`` around sample ``index``.
 
-    At an end of the record the stretch is one-sided and as wide as ``span``
-    (not half of it: a derivative taken at the end of its stretch is the
-    noisiest, and a record that starts in motion is read there), at least
-    :data:`MIN_FIT_SAMPLES` samples. Returns the coefficients (value, first
-    and second derivative over 1, 1 and 2 at the sample) and their covariance
-    from the residuals.
+    At an end of the record the stretch is one-sided, at least
+    :data:`MIN_FIT_SAMPLES` samples: for a ``measured`` (noisy) column as
+    wide as ``span`` (a derivative taken at the end of its stretch is the
+    noisiest, and a record that starts in motion is read there), else half
+    of it (a noise-free reference is fitted best where its polynomial
+    pieces are shortest). Returns the coefficients (value, first and second
+    derivative over 1, 1 and 2 at the sample) and their covariance from the
+    residuals.
     """
     t = record.time
     n = len(t)
     half = max(span / 2.0, 0.5 * (MIN_FIT_SAMPLES - 1) * record.sample_period)
     lo = int(np.searchsorted(t, t[index] - half, side="left"))
     hi = int(np.searchsorted(t, t[index] + half, side="right"))
-    if lo == 0 and t[index] - half < t[0]:  # at the start: the whole span after it
+    if measured and lo == 0 and t[index] - half < t[0]:  # at the start: the span after it
         hi = int(np.searchsorted(t, t[0] + 2.0 * half, side="right"))
-    if hi == n and t[index] + half > t[-1]:  # at the end: the whole span before it
+    if measured and hi == n and t[index] + half > t[-1]:  # at the end: the span before it
         lo = int(np.searchsorted(t, t[-1] - 2.0 * half, side="left"))
     if hi - lo < MIN_FIT_SAMPLES:  # a short record: extend to the other side
         lo, hi = max(0, min(lo, n - MIN_FIT_SAMPLES)), min(n, max(hi, MIN_FIT_SAMPLES))
@@ -134,7 +137,8 @@ def _fit_of(record: Measurement, column: str, index: int, span: float) -> LocalF
     key = (column, int(index), float(span))
     fit = kept.get(key)
     if fit is None:
-        fit = kept[key] = _local_fit(record, getattr(record, column), index, span)
+        fit = kept[key] = _local_fit(record, getattr(record, column), index, span,
+                                     column != "reference")
     return fit
 
 
