@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 import weakref
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -361,11 +361,11 @@ def command_rate(record: Measurement, index: int = 0) -> float | None:
     return rate
 
 
-def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, *,
-                  deflection: float | None, command: float | None, reference: tuple[float, ...],
-                  feedforward: float,
-                  rate: float | None = None) -> tuple[np.ndarray, PlantParameters]:
-    """The kernel's initial state for a record, and the parameters with the controller's state.
+def initial_changes(params: PlantParameters, law: ControlLaw, state: RecordState, *,
+                    deflection: float | None, command: float | None,
+                    reference: tuple[float, ...], feedforward: float, rate: float | None = None,
+                    array: np.ndarray | None = None) -> tuple[np.ndarray, dict[str, float]]:
+    """The kernel's initial state for a record, and the parameters' changes for it.
 
     Parameters
     ----------
@@ -397,17 +397,21 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
         feedforward is taken as steady. None, or a stage at rest: the roll-off
         taken at rest.
 
+    array : ndarray, optional
+        ``params.to_array()``, when the caller has it.
+
     Returns
     -------
     y0 : ndarray
         Initial state (layout of :func:`fi_design.kernel.layout.state_index`).
-    params : PlantParameters
-        ``params`` with ``x1_initial``, the discrete controller's states
-        ``dx1``, ``dx2`` and the command held before t = 0 (``u_initial``).
+    changes : dict
+        New values of ``params``' fields ``x1_initial``, the discrete
+        controller's states ``dx1``, ``dx2`` and the command held before
+        t = 0 (``u_initial``).
     """
     iso = bool(params.isolated)
     idx = state_index(iso)
-    p = params.to_array()
+    p = params.to_array() if array is None else array
     x1 = state.position
     v1 = state.velocity if state.moving else 0.0
     sgn = 1.0 if v1 >= 0.0 else -1.0
@@ -463,7 +467,7 @@ def initial_state(params: PlantParameters, law: ControlLaw, state: RecordState, 
         y0[len(y0) - nf:] = params.filter_rest(target)
     if command is not None:
         changes["u_initial"] = command
-    return y0, replace(params, **changes)
+    return y0, changes
 
 
 def _sliding_deflection(params: PlantParameters, friction: float) -> float:

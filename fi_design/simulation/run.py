@@ -31,8 +31,8 @@ from .metrics import HuntingMetrics, hunting_metrics
 from ..model import Model, as_model
 from ..kernel import run as _kernel_run
 from ..kernel.build import compiled
-from ..kernel.layout import PlantParameters, state_index
-from .replay import (DRIVES, command_rate, command_state, initial_state, record_reference,
+from ..kernel.layout import PARAMETER_INDEX, PlantParameters, state_index
+from .replay import (DRIVES, command_rate, command_state, initial_changes, record_reference,
                      record_state, rate_note, reference_state, replay_fit, start_note)
 from ..results import frozen_array
 from ..results.simulation import SimulationResult
@@ -401,7 +401,8 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
     if drive == "closed":
         dist = record.disturbance
         command = command_state(record, 0) if initial_command is None else float(initial_command)
-        y0, p0 = _anchor(model.law, params, record, 0, ref, command)
+        y0, changes = _anchor(model.law, params, record, 0, ref, command)
+        p0 = replace(params, **changes)
         out, wall = _integrate(model, method, p0, y0, ref, float(t_out[-1]), t_out, rtol,
                                None if dist is None else t_out, dist)
         return _result(model, iso, method, p0, out, t_out, wall, move_end=0.0,
@@ -429,9 +430,15 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
         np.searchsorted(t_out, np.arange(0.0, t_out[-1], window), side="left"), len(t_out)))
     pieces, wall = [], 0.0
     r_max = _largest(ref)
+    # every window's plant is open_loop with its own start: its array with those entries
+    # changed (the kernel only reads it), its tolerances the same (they scale with Fs, sigma0)
+    base, atols = open_loop.to_array(), {}
     for a, b in zip(starts[:-1], starts[1:]):
         stop = min(b + 1, len(t_out))  # integrate to the next window's start
-        y0, p0 = _anchor(model.law, open_loop, record, a, ref, None)
+        y0, changes = _anchor(model.law, open_loop, record, a, ref, None, base)
+        array = base.copy()
+        for name, value in changes.items():
+            array[PARAMETER_INDEX[name]] = value
         tw = t_out[a:stop] - t_out[a]
         # the reference's pieces over the window (and one more each side): the same values
         # as the whole reference there, without copying all of it for every window
@@ -439,8 +446,14 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
         hi = min(int(np.searchsorted(ref.breaks, t_out[stop - 1], side="right")) + 1,
                  len(ref.coeffs))
         seg = Trajectory(ref.breaks[lo:hi + 1] - t_out[a], ref.coeffs[lo:hi], land=False)
-        out, dt = _integrate(model, method, p0, y0, seg, float(tw[-1]), tw, rtol, tw,
-                             record.force[a:stop], reference_max=r_max)
+        if method == "fast":
+            out, dt = _integrate(model, method, open_loop, y0, seg, float(tw[-1]), tw, rtol, tw,
+                                 record.force[a:stop], reference_max=r_max, array=array,
+                                 atols=atols)
+        else:
+            out, dt = _integrate(model, method, replace(open_loop, **changes), y0, seg,
+                                 float(tw[-1]), tw, rtol, tw, record.force[a:stop],
+                                 reference_max=r_max)
         wall += dt
         pieces.append((int(a), int(b - a), out))
         if out.code != 0:
@@ -450,18 +463,21 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
                    time_offset=t0, drive="force", record=record, window=labels)
 
 
-def _anchor(law, params, record, index, ref, command):
-    """Initial state and parameters for a replay starting at sample ``index``."""
+def _anchor(law, params, record, index, ref, command, array=None):
+    """Initial state and the parameters' changes for a replay starting at sample ``index``
+    (``array``: ``params.to_array()``, when the caller has it)."""
     from ..kernel.build import compiled
 
     st = record_state(record, index)
     r, rd, rdd = reference_state(record, index)
-    ff = compiled().feedforward(rd, rdd, 0.0, params.to_array())[0]
+    if array is None:
+        array = params.to_array()
+    ff = compiled().feedforward(rd, rdd, 0.0, array)[0]
     defl = None if record.deflection is None or not params.isolated else \
         float(record.deflection[index])
     rate = None if command is None else command_rate(record, index)
-    return initial_state(params, law, st, deflection=defl, command=command,
-                         reference=(r, rd, rdd), feedforward=ff, rate=rate)
+    return initial_changes(params, law, st, deflection=defl, command=command,
+                           reference=(r, rd, rdd), feedforward=ff, rate=rate, array=array)
 
 
 def _merge(pieces, t_out):
