@@ -77,6 +77,29 @@ JACKKNIFE_BLOCKS = 4
 #: Function evaluations of each jackknife refit (it starts at the full fit's optimum).
 JACKKNIFE_NFEV = 10
 
+#: Standard deviations of a noise-only record's misfit within which a model agrees with the
+#: measurement (:func:`within_noise`).
+AGREE_Z = 3.0
+
+
+def within_noise(chi2: float, n: int) -> bool:
+    """Whether a model's weighted squared residual is that of noise alone.
+
+    Its misfit sqrt(chi2 / n) lies within :data:`AGREE_Z` standard deviations
+    sqrt(2 / n) of 1: there is no gap above noise for an effect to explain (a
+    fit that still lowers chi2 there fits the noise, or the phase of a
+    hunting record whose cycle a perturbation of 1e-15 shifts).
+
+    Parameters
+    ----------
+    chi2 : float
+        Weighted squared residual [-].
+    n : int
+        Residual entries.
+    """
+    return math.sqrt(chi2 / n) <= 1.0 + AGREE_Z * math.sqrt(2.0 / n)
+
+
 #: Effects that contain another as a special case: a cable force of zero stiffness is a
 #: force offset (its preload the offset).
 NESTED = {"cable_force": "force_offset"}
@@ -180,7 +203,8 @@ def judge(cmp: Comparison, outcome: FitOutcome, baseline: Baseline, threshold: f
         r, s = sp.origin(p), sigma.get(p)
         distance[p] = (float((v - r) / s) if r is not None and s is not None and s > 0
                        and v is not None else None)
-    verdict = _verdict(outcome, st, score, explained, distance, threshold, null)
+    verdict = _verdict(outcome, st, score, explained, distance, threshold, null,
+                       math.sqrt(baseline.chi2 / n) if within_noise(baseline.chi2, n) else None)
     status, reasons = verdict.status, verdict.reasons
     message = outcome.note if outcome.run.ok else outcome.run.message
     return Candidate(
@@ -235,8 +259,12 @@ class Verdict:
     reasons: list
 
 
-def _verdict(outcome, st, score, explained, distance, threshold, null) -> Verdict:
-    """Status and failed tests; an effect read from the data skips the tests the data replace."""
+def _verdict(outcome, st, score, explained, distance, threshold, null,
+             agreeing: float | None = None) -> Verdict:
+    """Status and failed tests; an effect read from the data skips the tests the data replace.
+
+    ``agreeing``: the misfit of the model the fit starts from when that agrees with the
+    measurement within noise (:func:`within_noise`), else None."""
     reasons: list[str] = []
     status = "ok"
     if not outcome.run.ok:
@@ -252,6 +280,9 @@ def _verdict(outcome, st, score, explained, distance, threshold, null) -> Verdic
                        f"{fixed(st.n_effective, 0)} effective samples)")
     if outcome.space.from_data:
         return Verdict(status, reasons)
+    if agreeing is not None:
+        reasons.append(f"the model it starts from agrees with the measurement within noise "
+                       f"(misfit {number(agreeing, 4)} noise units): no gap to explain")
     if explained < EXPLAINED_MIN:
         reasons.append(f"explains {percent(explained, 2)} of the gap above noise, less than "
                        f"{percent(EXPLAINED_MIN, 2)}")

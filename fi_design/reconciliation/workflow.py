@@ -37,7 +37,8 @@ from ..results.reconciliation import (Candidate, Cause, Diagnosis, EffectStep,
                                       ReconcileResult, SearchRound)
 from .signatures import Evidence, scan
 from .significance import (NESTED, NULL_SEED, THRESHOLD, block_jackknife, judge,
-                           noise_only_refit, numerical_error, passes_primary, prefer_simpler)
+                           noise_only_refit, numerical_error, passes_primary, prefer_simpler,
+                           within_noise)
 from .spaces import Space, candidate_spaces
 from .records import check_excitation, for_the_model
 from .specout import make_entry
@@ -550,7 +551,7 @@ def _conclusion(steps, candidates, chi2_nom, chi2_cor, n, ambiguous, diagnosis) 
             text += " Named nonetheless: " + ", ".join(s.name for s in steps) + "."
         return text
     if not steps:
-        if before <= 1.0 + 3.0 * math.sqrt(2.0 / n):
+        if within_noise(chi2_nom, n):
             return (f"The nominal model agrees with the measurement within noise (misfit "
                     f"{display.number(before, 3)} noise units): no effect is missing.")
         best = next((c for c in candidates if c.success), None)
