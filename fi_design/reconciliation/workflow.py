@@ -281,6 +281,8 @@ def _search(cmp, evidence: Evidence, names, nominal: Baseline, max_effects: int,
         spaces = candidate_spaces(cmp, hints, remaining, cmp.lattice, params)
         if index == 0:
             skipped.update(spaces.skipped)
+        if within_noise(baseline.chi2, cmp.n_points):
+            break  # no gap above noise: no candidate could be named (significance.judge)
         done = _search_round(cmp, spaces.spaces, baseline, [c.outcome for c in chosen],
                              nominal.entries, threshold, max_points, index, max_effects, say)
         n_sims += done.n_simulations
@@ -553,7 +555,8 @@ def _conclusion(steps, candidates, chi2_nom, chi2_cor, n, ambiguous, diagnosis) 
     if not steps:
         if within_noise(chi2_nom, n):
             return (f"The nominal model agrees with the measurement within noise (misfit "
-                    f"{display.number(before, 3)} noise units): no effect is missing.")
+                    f"{display.number(before, 3)} noise units): no effect is missing, and "
+                    "the catalogue was not fitted (there is no gap to explain).")
         best = next((c for c in candidates if c.success), None)
         tail = ""
         if best is not None:
