@@ -86,9 +86,10 @@ def within_noise(chi2: float, n: int) -> bool:
     """Whether a model's weighted squared residual is that of noise alone.
 
     Its misfit sqrt(chi2 / n) lies within :data:`AGREE_Z` standard deviations
-    sqrt(2 / n) of 1: there is no gap above noise for an effect to explain (a
-    fit that still lowers chi2 there fits the noise, or the phase of a
-    hunting record whose cycle a perturbation of 1e-15 shifts).
+    sqrt(2 / n) of 1: there is no gap above noise for an effect to explain, and
+    the search fits none (:func:`fi_design.reconciliation.workflow.reconcile`; a
+    fit that still lowers chi2 there fits the noise, or the phase of a hunting
+    record whose cycle a perturbation of 1e-15 shifts).
 
     Parameters
     ----------
@@ -203,8 +204,7 @@ def judge(cmp: Comparison, outcome: FitOutcome, baseline: Baseline, threshold: f
         r, s = sp.origin(p), sigma.get(p)
         distance[p] = (float((v - r) / s) if r is not None and s is not None and s > 0
                        and v is not None else None)
-    verdict = _verdict(outcome, st, score, explained, distance, threshold, null,
-                       math.sqrt(baseline.chi2 / n) if within_noise(baseline.chi2, n) else None)
+    verdict = _verdict(outcome, st, score, explained, distance, threshold, null)
     status, reasons = verdict.status, verdict.reasons
     message = outcome.note if outcome.run.ok else outcome.run.message
     return Candidate(
@@ -259,12 +259,8 @@ class Verdict:
     reasons: list
 
 
-def _verdict(outcome, st, score, explained, distance, threshold, null,
-             agreeing: float | None = None) -> Verdict:
-    """Status and failed tests; an effect read from the data skips the tests the data replace.
-
-    ``agreeing``: the misfit of the model the fit starts from when that agrees with the
-    measurement within noise (:func:`within_noise`), else None."""
+def _verdict(outcome, st, score, explained, distance, threshold, null) -> Verdict:
+    """Status and failed tests; an effect read from the data skips the tests the data replace."""
     reasons: list[str] = []
     status = "ok"
     if not outcome.run.ok:
@@ -280,9 +276,6 @@ def _verdict(outcome, st, score, explained, distance, threshold, null,
                        f"{fixed(st.n_effective, 0)} effective samples)")
     if outcome.space.from_data:
         return Verdict(status, reasons)
-    if agreeing is not None:
-        reasons.append(f"the model it starts from agrees with the measurement within noise "
-                       f"(misfit {number(agreeing, 4)} noise units): no gap to explain")
     if explained < EXPLAINED_MIN:
         reasons.append(f"explains {percent(explained, 2)} of the gap above noise, less than "
                        f"{percent(EXPLAINED_MIN, 2)}")

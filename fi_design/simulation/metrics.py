@@ -234,7 +234,6 @@ def _peak_search(y: np.ndarray, height: float, prominence: float, distance: int)
     return found[:m]
 
 
-
 #: No peak (the metric's indices before a side has any; never written).
 _NO_PEAKS = np.zeros(0, dtype=int)
 

@@ -396,7 +396,6 @@ def initial_changes(params: PlantParameters, law: ControlLaw, state: RecordState
         changing, otherwise starts with its integrator off by that much); the
         feedforward is taken as steady. None, or a stage at rest: the roll-off
         taken at rest.
-
     array : ndarray, optional
         ``params.to_array()``, when the caller has it.
 

@@ -446,14 +446,11 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
         hi = min(int(np.searchsorted(ref.breaks, t_out[stop - 1], side="right")) + 1,
                  len(ref.coeffs))
         seg = Trajectory(ref.breaks[lo:hi + 1] - t_out[a], ref.coeffs[lo:hi], land=False)
-        if method == "fast":
-            out, dt = _integrate(model, method, open_loop, y0, seg, float(tw[-1]), tw, rtol, tw,
-                                 record.force[a:stop], reference_max=r_max, array=array,
-                                 atols=atols)
-        else:
-            out, dt = _integrate(model, method, replace(open_loop, **changes), y0, seg,
-                                 float(tw[-1]), tw, rtol, tw, record.force[a:stop],
-                                 reference_max=r_max)
+        # the kernel reads the array; the reference solver the parameters themselves
+        p0 = open_loop if method == "fast" else replace(open_loop, **changes)
+        out, dt = _integrate(model, method, p0, y0, seg, float(tw[-1]), tw, rtol, tw,
+                             record.force[a:stop], reference_max=r_max, array=array,
+                             atols=atols)
         wall += dt
         pieces.append((int(a), int(b - a), out))
         if out.code != 0:
@@ -466,8 +463,6 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
 def _anchor(law, params, record, index, ref, command, array=None):
     """Initial state and the parameters' changes for a replay starting at sample ``index``
     (``array``: ``params.to_array()``, when the caller has it)."""
-    from ..kernel.build import compiled
-
     st = record_state(record, index)
     r, rd, rdd = reference_state(record, index)
     if array is None:

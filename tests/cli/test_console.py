@@ -45,7 +45,6 @@ def _readable(text: str, width: int) -> None:
 SEARCHED = "paper_setup"
 
 
-
 @pytest.fixture(scope="module")
 def design_outputs(industrial_quick):
     """The design summary of every example with a stage of its own, at 80 and 120 columns
