@@ -44,17 +44,18 @@ def print_reconcile(console: "Console", result) -> None:
         for st in result.steps:
             s.add_row(Text(st.name), number(st.misfit_before), number(st.misfit_after))
         console.print(s)
-    t = table("Candidates (best first)")
-    longest = max((len(c.name) for c in result.candidates), default=6)
-    for col, just in (("Effect", "left"), ("Score", "right"), ("Explained", "right"),
-                      ("Fitted parameters", "left")):
-        t.add_column(col, justify=just, no_wrap=col != "Fitted parameters",
-                     min_width=longest if col == "Effect" else None,
-                     ratio=1 if col == "Fitted parameters" else None)
-    for c in result.candidates:
-        params = _effects_text(c.name, c.parameters, c.uncertainty)
-        t.add_row(Text(c.name), number(c.score), percent(c.explained, 3), Text(params))
-    console.print(t)
+    if result.candidates:  # none when nothing was fitted (the conclusion says why)
+        t = table("Candidates (best first)")
+        longest = max(len(c.name) for c in result.candidates)
+        for col, just in (("Effect", "left"), ("Score", "right"), ("Explained", "right"),
+                          ("Fitted parameters", "left")):
+            t.add_column(col, justify=just, no_wrap=col != "Fitted parameters",
+                         min_width=longest if col == "Effect" else None,
+                         ratio=1 if col == "Fitted parameters" else None)
+        for c in result.candidates:
+            params = _effects_text(c.name, c.parameters, c.uncertainty)
+            t.add_row(Text(c.name), number(c.score), percent(c.explained, 3), Text(params))
+        console.print(t)
     for c in result.candidates:
         if c.name not in result.effects and c.reasons:
             console.print(Text(f"{c.name} not named: {c.reasons[0]}", style="dim"))

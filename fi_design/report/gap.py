@@ -182,26 +182,35 @@ def gap_sections(result: Any, figures: bool = True) -> list:
                       _params_text(c.name, c.parameters, c.uncertainty), dist or "-",
                       f"{c.n_failed} of {c.n_simulations}" if c.n_failed else
                       str(c.n_simulations), _short(c.reasons)))
-    sections.append(Section(
-        "candidates", "Candidate effects",
-        paragraphs=(f"Every applicable catalogue effect was fitted by bounded least squares "
-                    f"(bounds widened up to twice where a fit ended on one). An effect is named "
-                    f"only when its simulation ran, its fit is off every bound, its score (the "
-                    f"improvement in effective samples less k ln n_eff) exceeds "
-                    f"{num(result.threshold)}, it removes at least half the gap above noise, a "
-                    f"parameter lies three standard errors from the model's own value (a force "
-                    f"limit from the peak force, above which it never acts; a parameter "
-                    f"without a standard error is not shown to differ), and a "
-                    f"refit on a noise-only record improves three times less. Distances are in "
-                    f"those standard errors; runs that failed or ran away (an unstable loop) "
-                    f"scored ten times the nominal misfit and could never win.",),
-        tables=(Table(("#", "Effect", "Status", "Score", "Explained", "Fitted parameters",
-                       "Distance from the model's value", "Simulations (failed)",
-                       "Why not named"), tuple(crows),
-                      numeric=(True, False, False, True, True, False, False, True, False)),),
-        figures=(fig(plots.candidate_scores_figure,
-                     "Candidate scores (signed log scale); named effects in blue.",
-                     "gap-scores"),)))
+    if not result.candidates:  # nothing was fitted: say why, with no empty table or figure
+        sections.append(Section("candidates", "Candidate effects", paragraphs=(
+            "No catalogue effect was fitted: " + (
+                "the nominal model agrees with the measurement within noise, so there is no "
+                "gap for an effect to explain." if not result.diagnosis.mismatch else
+                "the diagnosis above says why the record or the nominal model does not allow "
+                "a fit."),)))
+    else:
+        sections.append(Section(
+            "candidates", "Candidate effects",
+            paragraphs=(f"Every applicable catalogue effect was fitted by bounded least "
+                        f"squares (bounds widened up to twice where a fit ended on one). An "
+                        f"effect is named only when its simulation ran, its fit is off every "
+                        f"bound, its score (the improvement in effective samples less k ln "
+                        f"n_eff) exceeds {num(result.threshold)}, it removes at least half the "
+                        f"gap above noise, a parameter lies three standard errors from the "
+                        f"model's own value (a force limit from the peak force, above which it "
+                        f"never acts; a parameter without a standard error is not shown to "
+                        f"differ), and a refit on a noise-only record improves three times "
+                        f"less. Distances are in those standard errors; runs that failed or ran "
+                        f"away (an unstable loop) scored ten times the nominal misfit and could "
+                        f"never win.",),
+            tables=(Table(("#", "Effect", "Status", "Score", "Explained", "Fitted parameters",
+                           "Distance from the model's value", "Simulations (failed)",
+                           "Why not named"), tuple(crows),
+                          numeric=(True, False, False, True, True, False, False, True, False)),),
+            figures=(fig(plots.candidate_scores_figure,
+                         "Candidate scores (signed log scale); named effects in blue.",
+                         "gap-scores"),)))
     srows = tuple((s.name, ", ".join(s.effects), fixed(s.strength, 2),
                    "-" if s.value is None else qty(s.value, s.unit, 4), s.detail)
                   for s in result.signatures)

@@ -597,6 +597,21 @@ def test_the_specs_own_simulation_agrees_within_noise(tmp_path):
     assert result.diagnosis.misfit < 1.0, result.diagnosis.misfit
     assert result.conclusion.startswith("The nominal model agrees with the measurement within "
                                         "noise"), result.conclusion
+    # nothing was fitted: the console and the report say so, with no empty candidate table
+    import io
+
+    from rich.console import Console
+
+    from fi_design import report
+    from fi_design.console import print_reconcile
+
+    assert result.candidates == ()
+    buf = io.StringIO()
+    print_reconcile(Console(file=buf, width=120, color_system=None), result)
+    assert "Candidates (best first)" not in buf.getvalue()
+    html = report.render_html(report.build_context(result, date="2026-01-01", figures=False))
+    assert "No catalogue effect was fitted: the nominal model agrees" in html
+    assert "Every applicable catalogue effect was fitted" not in html
 
 
 @pytest.mark.slow  # 9 s; test_replay.py's mid-move record guards the replay by default
