@@ -19,7 +19,8 @@ from ..errors import SpecError
 from . import Spec
 from .errors import describe, real_errors
 
-__all__ = ["with_values", "value_at", "path_unit", "path_description", "parse_path", "path_text"]
+__all__ = ["with_values", "value_at", "path_unit", "path_description", "parse_path", "path_text",
+           "split_assignment"]
 
 
 # --------------------------------------------------------------------------- dotted-path values
@@ -331,6 +332,40 @@ def parse_path(path: str) -> list[tuple[str, list]]:
                                 "[type=NAME])", path=text)
         out.append((m.group(1), selectors))
     return out
+
+
+def split_assignment(text: str) -> tuple[str, str] | None:
+    """``PATH=VALUE`` split at its first ``=`` outside a list selector.
+
+    The ``=`` of ``[type=NAME]`` belongs to the path: ``effects[type=time_delay].delay=1 ms``
+    is the path ``effects[type=time_delay].delay`` and the value ``1 ms``.
+
+    Parameters
+    ----------
+    text : str
+        The text as written (``--x``, ``--scatter``).
+
+    Returns
+    -------
+    (str, str) or None
+        The path and the value, each stripped; None when no ``=`` lies outside brackets.
+
+    Examples
+    --------
+    >>> split_assignment("effects[type=time_delay].delay=10%")
+    ('effects[type=time_delay].delay', '10%')
+    >>> split_assignment("friction.static") is None
+    True
+    """
+    depth = 0
+    for i, char in enumerate(text):
+        if char == "[":
+            depth += 1
+        elif char == "]":
+            depth = max(depth - 1, 0)
+        elif char == "=" and depth == 0:
+            return text[:i].strip(), text[i + 1:].strip()
+    return None
 
 
 def path_text(tokens: list) -> str:

@@ -20,6 +20,7 @@ from ..errors import SpecError
 from ..model import Model, require_model
 from ..results.studies import Axis
 from ..spec.file import path_unit, value_at
+from ..spec.paths import split_assignment
 
 __all__ = ["make_axis", "parse_axis", "design_value", "is_number", "held_damping_note",
            "crossover_note"]
@@ -107,10 +108,11 @@ def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> 
     """
     from ..spec.units import to_si
 
-    if "=" not in text:
+    parts = split_assignment(text)
+    if parts is None:
         raise SpecError(f"axis {text!r}: expected PATH=START:STOP:N, e.g. "
                         "'controller.crossover=2 Hz:30 Hz:15'")
-    path, rng = (part.strip() for part in text.split("=", 1))
+    path, rng = parts
     if not path:
         raise SpecError(f"axis {text!r}: the path before '=' is empty")
     unit = path_unit(path, spec)

@@ -30,6 +30,7 @@ from ..results import frozen_array
 from ..results.studies import (POINT_VERDICTS, HuntingProbability, PointResult, PositionFriction,
                                RobustnessResult, Scatter)
 from ..spec.file import path_unit
+from ..spec.paths import split_assignment
 from .axes import design_value, is_number
 from .cache import PointCache
 from .points import (MAX_POINTS, STAGE_FIRST, ProgressCallback, evaluate, point_result,
@@ -65,9 +66,10 @@ def parse_scatter(text: str, spec: _spec.Spec | None = None) -> Scatter:
     """
     from ..spec.units import to_si
 
-    if "=" not in text:
+    parts = split_assignment(text)
+    if parts is None:
         raise SpecError(f"scatter {text!r}: expected PATH=SPREAD, e.g. 'friction.static=10%'")
-    path, word = (part.strip() for part in text.split("=", 1))
+    path, word = parts
     unit = path_unit(path, spec)
     if unit == "":
         raise SpecError("is not a numeric value; only numbers can scatter", path=path)

@@ -87,6 +87,16 @@ def test_parse_axis_errors(text, words):
         sw.parse_axis(text)
 
 
+def test_a_type_selector_in_the_path_is_not_the_axis_equals_sign():
+    # PATH=...: the '=' of a documented [type=NAME] selector was taken for the axis's, so
+    # 'effects[type=time_delay].delay=1 ms:2 ms:2' was refused as a malformed path
+    ax = sw.parse_axis("effects[type=time_delay].delay=1 ms:2 ms:2")
+    assert ax.path == "effects[type=time_delay].delay" and ax.unit == "s"
+    np.testing.assert_allclose(ax.values, [1e-3, 2e-3])
+    assert sw.parse_scatter("effects[type=time_delay].delay=10%") == \
+        sw.Scatter("effects[type=time_delay].delay", 0.1, True)
+
+
 def test_log_axis_needs_positive_values():
     with pytest.raises(SpecError, match="above zero"):
         sw.parse_axis("motion.moves[0].distance=-1 mm:1 mm:3", log=True)
