@@ -29,8 +29,11 @@ def clean_loc(loc: tuple, raw: dict) -> tuple:
     node: Any = raw
     tagged = False
     for part in loc:
-        if isinstance(part, str) and not part.isidentifier():
-            continue  # a union member's tag: "tuple[...]", "function-before[parse(), float]"
+        if isinstance(part, str) and not part.isidentifier() \
+                and not (isinstance(node, dict) and part in node):
+            # a union member's tag: "tuple[...]", "function-before[parse(), float]"; a key
+            # the user wrote ("stribeck-velocity", "static friction") is no tag
+            continue
         if isinstance(node, dict) and isinstance(part, str) and not tagged and len(out) >= 2 \
                 and isinstance(out[-1], int) and out[-2] in ("effects", "filters") \
                 and node.get("type") == part:

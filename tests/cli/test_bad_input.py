@@ -84,6 +84,15 @@ CASES = [
      ["friction.statc", "unknown key", "did you mean 'static'"], "statc:"),
     ("unknown-section", edit("controller:", "controler:"),
      ["controler", "unknown key", "did you mean 'controller'"], "controler:"),
+    # a key no identifier (a hyphen, a space) was taken for a union tag and dropped: the
+    # message named the section as its own unknown key ("friction: unknown key 'friction'")
+    ("unknown-key-hyphen", edit("stribeck_velocity: 3 mm/s", "stribeck-velocity: 3 mm/s"),
+     ["friction.stribeck-velocity", "unknown key 'stribeck-velocity'",
+      "did you mean 'stribeck_velocity'"], "stribeck-velocity:"),
+    ("unknown-key-space", edit("  static: 4 N", "  static friction: 4 N"),
+     ["friction.static friction", "unknown key 'static friction'"], "static friction:"),
+    ("unknown-top-level-key-space", BASE + "my notes: checked\n",
+     ["unknown key 'my notes'"], "my notes:"),
     ("unknown-effect", BASE + "effects:\n  - {type: time_dleay, delay: 1 ms}\n",
      ["effects[0].type", "unknown effect 'time_dleay'", "did you mean 'time_delay'"],
      "type: time_dleay"),
