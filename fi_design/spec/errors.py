@@ -245,7 +245,10 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
     if huge(err.get("input")):
         return path, f"the number {shown_digits(err['input'])} is too large"
     if kind in ("float_type", "float_parsing"):
-        return path, f"expected a number or a string with units, got {_shown(err['input'])}"
+        given = err["input"]
+        if isinstance(given, str) and _unit_at(loc, raw) == "":
+            return path, f"is a plain number [-], written without a unit; got {_plain(given)}"
+        return path, f"expected a number or a string with units, got {_shown(given)}"
     if kind in ("model_type", "model_attributes_type", "dict_type"):
         model = _model_at(loc + ("x",), raw)
         keys = ", ".join(model.model_fields) if model is not None else ""
@@ -267,6 +270,20 @@ def _shown(value: Any) -> str:
         return f"the number {shown_digits(value)}"
     text = repr(value)
     return text if len(text) <= 40 else text[:28] + "..." + text[-8:]
+
+
+def _plain(given: str) -> str:
+    """A string given to a plain-number field, with the number it means where it is a
+    percentage (``'20 %'``: write 0.2; a decibel is no plain ratio of one meaning)."""
+    from .units import to_si
+
+    try:
+        meant = to_si(given, "1") if given.rstrip().endswith("%") else None
+    except Exception:  # not one number and its percent sign: nothing to suggest
+        meant = None
+    if meant is None:
+        return _shown(given)
+    return f"{_shown(given)}: write {number(meant, 6)}"
 
 
 def _not_an_effect_entry(given: Any) -> str:

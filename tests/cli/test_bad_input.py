@@ -164,6 +164,14 @@ CASES = [
     ("five-filters", edit("  integrator_ratio: 10", "  integrator_ratio: 10\n  filters: ["
                           + ", ".join(["{type: low_pass, frequency: 300 Hz}"] * 5) + "]"),
      ["controller.filters", "takes at most 4 filters, got 5"], "filters:"),
+    # a plain-number field (a ratio, a fraction) given a unit: the message said it expected
+    # "a number or a string with units" of a string with units, and named no way out
+    ("ratio-with-a-unit", edit("derivative_ratio: 3", "derivative_ratio: 3 Hz"),
+     ["controller.derivative_ratio", "a plain number [-], written without a unit",
+      "got '3 Hz'"], "derivative_ratio: 3 Hz"),
+    ("fraction-in-percent", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  reserve: "
+                                                      "{mass: 20 %}"),
+     ["requirements.reserve.mass", "a plain number [-]", "got '20 %': write 0.2"], "reserve:"),
     ("hunting-margin-below-1", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting_margin: 0.5"),
      ["requirements.hunting_margin", "must be at least 1, got 0.5"], "hunting_margin:"),
     # checks across sections name the field the user gave, and its line
