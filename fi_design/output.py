@@ -107,11 +107,11 @@ def check_output(path: str | os.PathLike, *, force: bool = False,
         if _same_file(out, Path(other)):
             raise OutputError(f"{out}: refusing to overwrite the input file {other} "
                               "(not even with --force); choose another output name")
+    if out.is_dir():
+        raise OutputError(f"{out}: is a directory; give a file name")
     if exts and out.suffix.lower() not in exts:
         want = " or ".join(exts)
         raise OutputError(f"{out}: output file name must end with {want}")
-    if out.is_dir():
-        raise OutputError(f"{out}: is a directory; give a file name")
     parent = out.parent if str(out.parent) else Path(".")
     if not parent.exists():
         raise OutputError(f"{out}: directory {parent} does not exist")

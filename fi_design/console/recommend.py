@@ -62,7 +62,7 @@ def print_recommendation(console: "Console", result, spec_path: Optional[Path] =
     d, sd, m = result.design, result.spec_design, result.margins
     req = result.spec.requirements
     head = "the stiffest buildable joint that keeps the hunting margin" if result.feasible \
-        else "no design passes; the nearest"
+        else "no design that passes; the nearest"
     t = table(f"The search found {head}")
     t.add_column("")
     t.add_column(Text("as specified" + (" (suggested)" if sd.get("suggested") else "")),

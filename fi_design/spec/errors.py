@@ -232,7 +232,9 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
         words = {"greater_than": "greater than", "greater_than_equal": "at least",
                  "less_than": "less than", "less_than_equal": "at most"}[kind]
         shown = f" {unit}" if unit not in ("", "1") else ""
-        return path, f"must be {words} {number(bound, 6)}{shown}, got {_shown(err['input'])}"
+        written = _value_at(loc, raw)  # as the user wrote it ('-0.3 mm'), not in SI
+        given = written if isinstance(written, str) else err["input"]
+        return path, f"must be {words} {number(bound, 6)}{shown}, got {_shown(given)}"
     if kind in ("too_short", "too_long"):
         ctx = err.get("ctx") or {}
         given = ctx.get("actual_length")
@@ -249,6 +251,10 @@ def describe(err: dict, raw: dict) -> tuple[str, str]:
         if isinstance(given, str) and _unit_at(loc, raw) == "":
             return path, f"is a plain number [-], written without a unit; got {_plain(given)}"
         return path, f"expected a number or a string with units, got {_shown(given)}"
+    if kind == "string_type" and isinstance(err["input"], (int, float)) \
+            and not isinstance(err["input"], bool):
+        return path, (f"is text; YAML read {_shown(err['input'])} as a number: write it in "
+                      f"quotes as you mean it, e.g. '{_shown(err['input'])}'")
     if kind in ("model_type", "model_attributes_type", "dict_type"):
         model = _model_at(loc + ("x",), raw)
         keys = ", ".join(model.model_fields) if model is not None else ""

@@ -6,9 +6,11 @@ Every physical field accepts an SI number or a string with units
 
 from __future__ import annotations
 
+import typing
 from typing import Annotated, Any, Union
 
-from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, WithJsonSchema
+from pydantic import (AfterValidator, BaseModel, BeforeValidator, ConfigDict, ValidationInfo,
+                      WithJsonSchema, field_validator)
 
 from ..display import code_point
 from .units import to_si
@@ -57,8 +59,31 @@ def _plain_text(value: str) -> str:
 Text = Annotated[str, AfterValidator(_plain_text)]
 
 
+def _numeric(annotation: Any) -> bool:
+    """Whether a field's type takes numbers and no yes/no value (``int``, ``float``, a
+    quantity, optional or not)."""
+    origin = typing.get_origin(annotation)
+    if origin is Annotated:
+        return _numeric(typing.get_args(annotation)[0])
+    if origin is Union:
+        arms = [arm for arm in typing.get_args(annotation) if arm is not type(None)]
+        return bool(arms) and all(_numeric(arm) for arm in arms)
+    return annotation in (int, float)
+
+
 class StrictModel(BaseModel):
     """Base of every spec section: unknown keys are errors, values immutable and finite."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False,
                               str_strip_whitespace=True)
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _no_yes_no_for_a_number(cls, value: Any, info: ValidationInfo) -> Any:
+        """A yes/no value (YAML's true or false) given to a number is refused, not read as
+        1 or 0 (``samples: true`` would run one sample)."""
+        if isinstance(value, bool) and info.field_name is not None \
+                and _numeric(cls.model_fields[info.field_name].annotation):
+            raise ValueError(f"expected a number, got {str(value).lower()} (a yes/no value in "
+                             "YAML)")
+        return value

@@ -656,7 +656,7 @@ class ReportInfo(StrictModel):
             last = data["revisions"][-1]
             label = last.get("revision") if isinstance(last, dict) else \
                 getattr(last, "revision", None)
-            if label is not None:
+            if isinstance(label, str):  # a label that is no text is the entry's own error
                 data = {**data, "revision": label}
         return data
 

@@ -172,6 +172,21 @@ CASES = [
     ("fraction-in-percent", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  reserve: "
                                                       "{mass: 20 %}"),
      ["requirements.reserve.mass", "a plain number [-]", "got '20 %': write 0.2"], "reserve:"),
+    # a yes/no value given to a number was read as 1 (samples: true ran one sample)
+    ("true-for-a-count", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  robustness:\n"
+                                                   "    samples: true"),
+     ["requirements.robustness.samples", "expected a number, got true (a yes/no value"],
+     "samples: true"),
+    ("false-for-a-ratio", edit("derivative_ratio: 3", "derivative_ratio: false"),
+     ["controller.derivative_ratio", "expected a number, got false"], "derivative_ratio: false"),
+    # a bound's message shows the value as written, not its SI number without a unit
+    ("negative-stroke-as-written", edit("stroke: 0.3 mm", "stroke: -0.3 mm"),
+     ["isolator.stroke", "must be greater than 0 m, got '-0.3 mm'"], "stroke: -0.3 mm"),
+    ("negative-margin-as-written", edit("gain_margin: 6 dB", "gain_margin: -6 dB"),
+     ["requirements.gain_margin", "at least 0 dB, got '-6 dB'"], "gain_margin: -6 dB"),
+    # a label YAML reads as a number: one message, on the label, saying to quote it
+    ("numeric-revision", edit("revision: A,", "revision: 2,"),
+     ["report.revisions[0].revision", "YAML read 2 as a number", "'2'"], "revision: 2,"),
     ("hunting-margin-below-1", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting_margin: 0.5"),
      ["requirements.hunting_margin", "must be at least 1, got 0.5"], "hunting_margin:"),
     # checks across sections name the field the user gave, and its line
@@ -233,7 +248,7 @@ CASES = [
      ["effects", "listed twice"], "effects:"),
     # effects with impossible parameters
     ("effect-negative-delay", BASE + "effects:\n  - {type: time_delay, delay: -1 ms}\n",
-     ["effects[0].delay", "at least 0 s", "-0.001"], "type: time_delay"),
+     ["effects[0].delay", "at least 0 s", "got '-1 ms'"], "type: time_delay"),
     ("effect-negative-resolution",
      BASE + "effects:\n  - {type: quantization, resolution: -1 um}\n",
      ["effects[0].resolution", "at least 0 m"], "type: quantization"),

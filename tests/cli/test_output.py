@@ -45,6 +45,9 @@ def test_extension_directory_parent(tmp_path):
     (tmp_path / "d.json").mkdir()
     with pytest.raises(OutputError, match="is a directory"):
         check_output(tmp_path / "d.json", force=True)
+    (tmp_path / "outdir").mkdir()  # a folder without the suffix: told it is a folder
+    with pytest.raises(OutputError, match="outdir: is a directory"):
+        check_output(tmp_path / "outdir", extensions=(".html", ".pdf"))
     (tmp_path / "file").write_text("")
     with pytest.raises(OutputError, match="not a directory"):
         check_output(tmp_path / "file" / "r.json")
