@@ -147,15 +147,15 @@ class Reserve(StrictModel):
     phase_margin: Q("deg") = Field(5.0, ge=0, lt=90, description="Phase margin beyond "
                                                                  "requirements.phase_margin "
                                                                  "[deg]. Default 5 deg.")
-    crossover: float = Field(0.95, gt=0, le=1, description="The crossover at most this times "
+    crossover: Q("1") = Field(0.95, gt=0, le=1, description="The crossover at most this times "
                                                           "the achievable one [-]. Default "
                                                           "0.95.")
-    mass: float = Field(0.15, ge=0, lt=0.5, description="The design passes with the masses "
+    mass: Q("1") = Field(0.15, ge=0, lt=0.5, description="The design passes with the masses "
                                                         "this fraction off, either way [-]. "
                                                         "Default 15 %.")
-    modes: float = Field(0.10, ge=0, lt=0.5, description="... and with the computed modes this "
+    modes: Q("1") = Field(0.10, ge=0, lt=0.5, description="... and with the computed modes this "
                                                          "fraction lower [-]. Default 10 %.")
-    delay: float = Field(0.5, ge=0, description="... and with the loop delay this fraction "
+    delay: Q("1") = Field(0.5, ge=0, description="... and with the loop delay this fraction "
                                                 "longer [-]. Default 50 %.")
 
 

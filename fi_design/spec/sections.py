@@ -142,7 +142,7 @@ class ParasiticMode(StrictModel):
                           "guide's computed modes and kept for any guide. Default none: with "
                           "a flexure guide, the given modes replace all computed ones.")
     frequency: Q("Hz") = Field(gt=0, description="Resonance frequency [Hz].")
-    damping_ratio: float = Field(0.01, ge=0, lt=1, description="Modal damping ratio [-]. "
+    damping_ratio: Q("1") = Field(0.01, ge=0, lt=1, description="Modal damping ratio [-]. "
                                                                "Default 0.01.")
     collocated: bool = Field(False, description="True: an antiresonance precedes the resonance "
                                                 "(phase returns); false: the resonance adds a "
@@ -244,7 +244,7 @@ class Flexure(StrictModel):
                                 "(the stage below, in tension), 'flat' (leaves horizontal, the "
                                 "weight across their width), 'vertical_axis' (the drive axis "
                                 "vertical: the joint carries the cart's weight).")
-    damping_ratio: float = Field(0.01, gt=0, lt=1, description="Modal damping ratio of the "
+    damping_ratio: Q("1") = Field(0.01, gt=0, lt=1, description="Modal damping ratio of the "
                                                                "guide's computed modes [-]. "
                                                                "Default 0.01.")
     thickness_step: OptQ("m") = Field(0.05e-3, gt=0, validate_default=True, description=(

@@ -169,9 +169,10 @@ CASES = [
     ("ratio-with-a-unit", edit("derivative_ratio: 3", "derivative_ratio: 3 Hz"),
      ["controller.derivative_ratio", "a plain number [-], written without a unit",
       "got '3 Hz'"], "derivative_ratio: 3 Hz"),
-    ("fraction-in-percent", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  reserve: "
-                                                      "{mass: 20 %}"),
-     ["requirements.reserve.mass", "a plain number [-]", "got '20 %': write 0.2"], "reserve:"),
+    ("ratio-in-percent", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  hunting_margin: "
+                                                   "120 %"),
+     ["requirements.hunting_margin", "a plain number [-]", "got '120 %': write 1.2"],
+     "hunting_margin:"),
     # a yes/no value given to a number was read as 1 (samples: true ran one sample)
     ("true-for-a-count", edit("gain_margin: 6 dB", "gain_margin: 6 dB\n  robustness:\n"
                                                    "    samples: true"),

@@ -30,6 +30,20 @@ def test_values_are_si(paper_spec):
     assert s.has_isolator
 
 
+def test_fractions_read_in_percent(paper_spec):
+    """The reserves and damping ratios are fractions, described with their defaults in
+    percent ("Default 15 %"): written so, they read as fractions; a unit that is no fraction
+    is refused."""
+    s = variant(paper_spec, **{"requirements.reserve": {"mass": "15 %", "crossover": "90 %",
+                                                        "modes": "0.1", "delay": "50 %"},
+                               "isolator.flexure.damping_ratio": "2 %"})
+    r = s.requirements.reserve
+    assert (r.mass, r.crossover, r.modes, r.delay) == pytest.approx((0.15, 0.9, 0.1, 0.5))
+    assert s.isolator.flexure.damping_ratio == pytest.approx(0.02)
+    with pytest.raises(SpecError, match="requirements.reserve.mass"):
+        variant(paper_spec, **{"requirements.reserve": {"mass": "15 Hz"}})
+
+
 def test_spec_is_immutable(paper_spec):
     with pytest.raises(ValidationError):
         paper_spec.friction.static = 5.0
