@@ -122,7 +122,7 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
         p = replace(proc, force_hold=hold)
         prep = prepare(measured, p, joint)
         direction = check_directions(prep, p, measured.source)
-        sol = solve(equations(prep, form, joint, direction), prep.used)
+        sol = solve(equations(prep, form, joint, direction), prep.used, measured.source)
         fits.append((force_rss(prep, sol, joint), p, prep, sol, direction))
     _, proc, prep, sol, direction = min(fits, key=lambda f: f[0])
     samples, fit = fit_statistics(prep, sol, joint)

@@ -167,8 +167,12 @@ class Solution:
     n_eff: float
 
 
-def solve(equations: list, used: np.ndarray) -> Solution:
-    """Weighted least squares over the equations, with the autocorrelation-corrected covariance."""
+def solve(equations: list, used: np.ndarray, source: str | None = None) -> Solution:
+    """Weighted least squares over the equations, with the autocorrelation-corrected covariance.
+
+    ``source``: the record's file, named in the error of a record that does not excite every
+    parameter.
+    """
     from scipy.linalg import lstsq, svdvals
 
     names: list[str] = []
@@ -194,7 +198,7 @@ def solve(equations: list, used: np.ndarray) -> Solution:
         raise DataError("the record does not excite every parameter (the regressor is rank "
                         f"deficient: rank {rank} of {len(names)} for {', '.join(names)}); it "
                         "needs acceleration and sliding at varied speeds in both directions",
-                        column="position_m")
+                        column="position_m", source=source)
     Aw = np.vstack([w * A for w, (A, _) in zip(weights, blocks)])
     rw = np.concatenate([w * r for w, r in zip(weights, res)])
     n, k = Aw.shape
@@ -211,7 +215,7 @@ def solve(equations: list, used: np.ndarray) -> Solution:
                         f"number is {number(cond, 3)}, above {number(MAX_CONDITION, 1)}, for "
                         f"{', '.join(names)}): it needs acceleration and sliding at varied "
                         "speeds (at one speed Coulomb and viscous friction are alike)",
-                        column="position_m")
+                        column="position_m", source=source)
     return Solution(names=names, theta=theta, cov=cov * inflation, cond=cond,
                     n_used=int(used.sum()), n_eff=n / inflation)
 

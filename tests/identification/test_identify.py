@@ -486,8 +486,11 @@ def test_bad_records_name_the_column_and_what_is_needed():
         identify(measurement_from_arrays(jitter, x, x, force_N=u))
     assert e.value.column == "time_s" and "resample" in str(e.value)
     with pytest.raises(DataError) as e:  # one direction at one speed: not enough to tell
-        identify(measurement_from_arrays(t, 0.02 * t, 0.02 * t, force_N=u))
+        identify(measurement_from_arrays(t, 0.02 * t, 0.02 * t, force_N=u, source="axis.csv"))
     assert e.value.column == "position_m" and "varied speeds" in str(e.value)
+    # the regression's refusal named no file ("error: column 'position_m': the record does
+    # not excite every parameter ..."), unlike every other refusal of a record
+    assert e.value.source == "axis.csv" and str(e.value).startswith("axis.csv: ")
 
 
 def test_too_little_sliding_in_a_record_timed_in_ms_names_the_unit(tmp_path):
