@@ -12,7 +12,8 @@ can be compared at is refused, naming the limit.
 
 A record in which neither the stage nor its reference moves holds no
 evidence: there is nothing a model could disagree with, and "agrees within
-noise" would be an answer without a test. It is refused.
+noise" would be an answer without a test. It is refused, and so is a record
+shorter than one period of the loop's crossover (:func:`check_duration`).
 """
 
 from __future__ import annotations
@@ -67,6 +68,40 @@ def check_excitation(measured: Measurement, position_noise: float) -> None:
             f"within {number(EXCITATION)} noise levels ({band_text}); a record in which nothing "
             "moves cannot show where the model is wrong: record a move (or a hold that hunts)",
             column="position_m", source=measured.source)
+
+
+def check_duration(measured: Measurement, crossover: float) -> None:
+    """Refuse a record shorter than one period of the loop's crossover.
+
+    Such a record cannot show the loop's dynamics: a replay started from its
+    first samples (the controller's state read from the first force sample)
+    has not left them, and the residual is the start's, not the stage's. A
+    60 ms slice of ``examples/measured_trace.csv`` (an 8 Hz loop) named
+    mass_error "nonetheless", 30 ms at 100 kHz called force_N's sign wrong,
+    1 ms at 1 MHz named a force offset of 3 N that the stage does not have
+    (or, thinned to one sample, was refused as "the trace has no duration").
+
+    Parameters
+    ----------
+    measured : Measurement
+        The record.
+    crossover : float
+        The loop's crossover [Hz].
+
+    Raises
+    ------
+    DataError
+        The record spans less than ``1 / crossover``.
+    """
+    period = 1.0 / crossover
+    if measured.duration < period:
+        raise DataError(
+            f"too short for a reconciliation: the record spans "
+            f"{quantity(measured.duration, 's', 3)}, less than one period of the loop's "
+            f"{quantity(crossover, 'Hz', 3)} crossover ({quantity(period, 's', 3)}): it cannot "
+            "show the loop's dynamics (a replay started from its first samples has not left "
+            f"them); record at least {quantity(period, 's', 3)}, a move and its settling",
+            column="time_s", source=measured.source)
 
 
 def for_the_model(measured: Measurement, crossover: float) -> tuple[Measurement, str]:

@@ -40,7 +40,7 @@ from .significance import (NESTED, NULL_SEED, THRESHOLD, block_jackknife, judge,
                            noise_only_refit, numerical_error, passes_primary, prefer_simpler,
                            within_noise)
 from .spaces import Space, candidate_spaces
-from .records import check_excitation, for_the_model
+from .records import check_duration, check_excitation, for_the_model
 from .specout import make_entry
 
 ProgressCallback = Callable[[str, float], None]
@@ -99,7 +99,8 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     Raises
     ------
     DataError
-        The trace is too short for the comparison, holds no excitation
+        The trace is too short for the comparison (fewer than 50 samples, or
+        shorter than one period of the loop's crossover), holds no excitation
         (neither the stage nor its reference moves), or is too long even
         thinned to the lowest rate the model allows (:mod:`.records`; a
         record logged faster than the model needs is thinned, and the
@@ -132,7 +133,9 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     lattice = find_lattice(measured.position, estimate_noise(measured.position))
     noise = noise_levels(spec, measured, iso, lattice, force_is_input=drive == "force")
     check_excitation(measured, noise.position)
-    measured, thinning = for_the_model(measured, resolve(spec).crossover)
+    crossover = resolve(spec).crossover
+    check_duration(measured, crossover)
+    measured, thinning = for_the_model(measured, crossover)
     cmp = Comparison(spec, measured, iso, noise, lattice, settle_window, drive)
     say("nominal model", 0.02)
     nominal = _nominal(cmp, list(spec.effects), max_points)

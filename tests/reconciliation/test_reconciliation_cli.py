@@ -126,3 +126,36 @@ def test_gap_table_unit_column_matches_its_values(run):
         assert unit != "m", (name, unit)  # lengths are read in µm or mm
         for v in values:  # a number alone: the unit column names its unit
             assert re.fullmatch(r"-|–|n/a|-?[\d.]+(\s×\s10[⁻⁰¹²³⁴⁵⁶⁷⁸⁹]+)?", v), (name, v)
+
+
+def test_a_record_shorter_than_the_loop_period_is_refused(tmp_path):
+    """60 ms of examples/measured_trace.csv (its stage's loop crosses over at 8 Hz: 125 ms)
+    named mass_error "nonetheless" from a replay that had not left its start; a 10 ms capture
+    at 100 kHz called force_N's sign wrong or, thinned to its model rate, was refused as
+    "noise-only refit: ... too short: 5 sample(s)". Now both are refused before any
+    simulation, naming the file, the record's span and the loop's period."""
+    from conftest import EXAMPLES
+
+    import numpy as np
+
+    from fi_design.errors import DataError
+    from fi_design.measured import load_measurement, measurement_from_arrays
+    from fi_design.reconciliation import reconcile
+
+    lines = (EXAMPLES / "measured_trace.csv").read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    short = tmp_path / "slice.csv"
+    short.write_text("\n".join([lines[header], *lines[header + 201:header + 261]]) + "\n")
+    r = runner.invoke(app, ["reconcile", str(EXAMPLES / "measured_stage.yaml"), str(short)])
+    assert r.exit_code == 2, r.output
+    assert f"{short}: column 'time_s': too short for a reconciliation: the record spans " \
+           "0.059 s, less than one period of the loop's 8 Hz crossover (0.125 s)" \
+        in " ".join(r.output.split()), r.output
+    full = load_measurement(EXAMPLES / "measured_trace.csv")
+    fast = np.arange(1000) * 1e-5 + 0.3  # 10 ms at 100 kHz, in the move
+    columns = [np.interp(fast, full.time, getattr(full, c))
+               for c in ("reference", "position", "force", "deflection")]
+    with pytest.raises(DataError, match="less than one period") as err:
+        reconcile(load_spec(EXAMPLES / "measured_stage.yaml"),
+                  measurement_from_arrays(fast - fast[0], *columns, source="fast.csv"))
+    assert err.value.column == "time_s" and err.value.source == "fast.csv"
