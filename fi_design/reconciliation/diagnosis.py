@@ -161,9 +161,10 @@ def _message(misfit: float, misfit_after: float, best_explained: float, best_fit
                    "the model's structure does not match the record, and no catalogue effect "
                    "closes the gap")
     if check.cause is not None:
+        what = "column" if check.cause.name == "force_sign" else "column (or the spec)"
         return (text + (f": {verdict}" if verdict.startswith("no catalogue") else "")
                 + f". {check.cause.detail} No effect is named from such a record; correct the "
-                "column and reconcile again.")
+                f"{what} and reconcile again.")
     top = [c for c in causes if c.share >= 0.1] or causes[:1]
     return (text + f": {verdict}. Likely causes, strongest first: "
             + "; ".join(f"{c.name.replace('_', ' ')} ({percent(c.share, 2)})" for c in top)
@@ -230,7 +231,9 @@ def force_check(cmp: Comparison, run: ModelRun) -> ForceCheck:
               f"{quantity(cmp.noise.force, 'N', 3)}). ")
     detail += ("Check the sign convention of the logged force (positive pushes the stage "
                "towards positive position_m) and flip force_N." if flipped else
-               "Check force_N's unit (N) and the logger's gain.")
+               "Check force_N's unit (N) and the logger's gain, and the spec's masses and "
+               "friction: the model's force follows them, so a spec of another stage, or "
+               "masses that far off, give the same factor.")
     return ForceCheck(float(scale), Cause("force_sign" if flipped else "force_scale",
                                           float(min(max(share, 0.0), 1.0)), detail))
 

@@ -174,6 +174,27 @@ def test_the_thinning_and_its_bound():
     assert same is at_1khz and note == ""
 
 
+def test_a_closed_loop_force_scale_names_the_specs_masses_beside_the_column():
+    """examples/measured_trace.csv (a 2 kg stage) reconciled against examples/emps_axis.yaml
+    (a 100 kg axis) read "the measured force is 0.0392 times the model's ... Check force_N's
+    unit (N) and the logger's gain ... correct the column and reconcile again": a right
+    column blamed for a wrong spec. The model's force follows the spec's masses, so the
+    factor says as much about them; the message now names both."""
+    from fi_design.reconciliation.diagnosis import _message, force_check
+
+    t = np.linspace(0.0, 2.0, 400)
+    model = 50.0 * np.sin(2 * np.pi * t)
+    measured = 0.04 * model + 0.01 * np.random.default_rng(0).standard_normal(len(t))
+    cmp = SimpleNamespace(has_force=True, meas=SimpleNamespace(force=measured),
+                          noise=SimpleNamespace(force=0.01))
+    check = force_check(cmp, SimpleNamespace(ok=True, force=model))
+    assert check.cause.name == "force_scale" and check.scale == pytest.approx(0.04, rel=0.01)
+    assert "force_N's unit (N)" in check.cause.detail
+    assert "the spec's masses" in check.cause.detail
+    text = _message(4460.0, 4460.0, 0.19, "", [check.cause], check)
+    assert text.endswith("correct the column (or the spec) and reconcile again.")
+
+
 def test_open_loop_structure_causes_name_no_controller(paper_spec):
     """An open-loop replay (drive="force") has no controller: the structure diagnosis of the
     same residual names the measured force where a closed loop names the controller, and
