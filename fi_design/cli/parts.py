@@ -263,6 +263,8 @@ def run_app(application: typer.Typer) -> None:
 
     global _PROCESS_ENDS_WITH_COMMAND
     _PROCESS_ENDS_WITH_COMMAND = True
+    if sys.stdout is not None:
+        sys.stdout = _ReaderMayLeave(sys.stdout)
     try:
         try:
             with signals_to_exceptions(_signal_exception):
@@ -277,6 +279,45 @@ def run_app(application: typer.Typer) -> None:
         raise
     finally:
         _spare_the_last_collection()
+
+
+class _ReaderMayLeave:
+    """Standard output whose reader may stop reading (``fi-design SPEC --json r.json | head``).
+
+    A closed pipe raised BrokenPipeError from the console's next print, in the middle of
+    the command: the run ended with exit 1 and without the files it was asked for. The
+    console is a summary of those files; once its reader has gone, the rest of it goes to
+    the null device, and the run writes its files and ends as it would have.
+    """
+
+    def __init__(self, stream: Any) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._to_null()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._to_null()
+
+    def _to_null(self) -> None:
+        """Point the stream's file descriptor at the null device; what it holds goes there."""
+        null = os.open(os.devnull, os.O_WRONLY)
+        try:
+            os.dup2(null, self._stream.fileno())
+        finally:
+            os.close(null)
+        with contextlib.suppress(OSError):
+            self._stream.flush()
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
 
 
 #: The exit codes of an interrupted run: 128 + SIGHUP, SIGINT or SIGTERM.

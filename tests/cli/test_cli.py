@@ -341,6 +341,23 @@ def test_installed_entry_point(tmp_path, paper_spec_path):
     assert "no such file" in p.stderr and "Traceback" not in p.stderr
 
 
+def test_a_reader_that_stops_reading_leaves_the_files_whole(tmp_path, paper_spec_path):
+    """``fi-design SPEC --json r.json | head -1``: the closed pipe raised BrokenPipeError at
+    the console's next print, the run ended with exit 1 and wrote no r.json. The console is
+    a summary; the run writes its files and ends as it would have."""
+    out = tmp_path / "r.json"
+    with subprocess.Popen([str(BIN / "fi-design"), str(paper_spec_path), "--no-simulation",
+                           "--no-recommend", "--json", str(out)], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, cwd=tmp_path) as p:
+        assert p.stdout.readline()  # the heading; then the reader leaves
+        p.stdout.close()
+        code = p.wait(timeout=300)
+        err = p.stderr.read().decode()
+    assert code == 0, err
+    assert "Traceback" not in err and "error" not in err, err
+    assert json.loads(out.read_text())["spec_sha256"]
+
+
 _FROZEN_AT_EXIT = """\
 import atexit, gc, sys
 atexit.register(lambda: print("frozen", gc.get_freeze_count(), flush=True))
