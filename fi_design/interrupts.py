@@ -57,12 +57,41 @@ def _main_thread() -> bool:
     return threading.current_thread() is threading.main_thread()
 
 
+#: Delay after which a signal that came inside the import machinery is delivered again [s].
+REDELIVERY_DELAY = 0.01
+
+
 def _on_signal(signum: int, frame: Any) -> None:
     _STATE.received.append(signum)
     if _STATE.depth:
         _STATE.pending.append(signum)
         return
+    if _in_import_machinery(frame):
+        _deliver_again(signum)
+        return
     raise _STATE.make(signum)  # type: ignore[misc]
+
+
+def _in_import_machinery(frame: Any) -> bool:
+    """Whether the main thread runs importlib's own bootstrap code (not a module's code).
+
+    An exception raised there can leave the interpreter's import lock held: the weakref
+    callback that drops a module's lock takes the global import lock, and a signal's
+    exception raised as that call returns, before its ``try``, never releases it. Every
+    other thread's import then waits for ever (a design run with an HTML report hung after a
+    Ctrl-C printed "Exception ignored in: <function _get_module_lock.<locals>.cb>").
+    """
+    code = getattr(frame, "f_code", None)
+    return code is not None and code.co_filename.startswith("<frozen importlib")
+
+
+def _deliver_again(signum: int) -> None:
+    """Send ``signum`` to the main thread again shortly, when it has left the import
+    machinery (or not: then again, until it has)."""
+    main = threading.main_thread().ident
+    timer = threading.Timer(REDELIVERY_DELAY, signal.pthread_kill, (main, signum))
+    timer.daemon = True
+    timer.start()
 
 
 @contextlib.contextmanager

@@ -107,10 +107,15 @@ def _signal_state() -> tuple:
 
     if threading.current_thread() is not threading.main_thread():
         return ()
+    import sys
+
     from fi_design.interrupts import SIGNALS
 
+    module = sys.modules["fi_design.interrupts"]
+    state = module._STATE
     return (tuple(signal.getsignal(s) for s in SIGNALS),
-            frozenset(signal.pthread_sigmask(signal.SIG_BLOCK, [])))
+            frozenset(signal.pthread_sigmask(signal.SIG_BLOCK, [])),
+            (id(module), state.make, state.depth, tuple(state.pending), tuple(state.received)))
 
 
 @pytest.fixture(autouse=True)

@@ -20,6 +20,21 @@ pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PO
 runner = CliRunner()
 
 
+@pytest.fixture(autouse=True)
+def _found_as_a_process_starts():
+    """These tests take the process's signal handling as a process starts with it (the
+    default Ctrl-C handler, no block of fi_design.interrupts open); one that finds it
+    otherwise says what an earlier test or fixture of this process left behind, rather than
+    failing as if the code under test had (twice in one loaded run: DID NOT RAISE)."""
+    from fi_design.interrupts import _STATE
+
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler, \
+        f"SIGINT's handler found as {signal.getsignal(signal.SIGINT)!r}"
+    assert (_STATE.make, _STATE.depth, _STATE.pending, _STATE.received) == (None, 0, [], []), \
+        f"fi_design.interrupts found with a block open: {vars(_STATE)!r}"
+    yield
+
+
 def _sigint_here() -> None:
     """Ctrl-C to this process; its handler runs at the next bytecode of the main thread."""
     os.kill(os.getpid(), signal.SIGINT)
@@ -277,3 +292,31 @@ def test_a_ctrl_c_as_the_handlers_are_restored_leaves_none_of_the_others_swapped
             monkeypatch.setattr(signal, "signal", restore)
     monkeypatch.undo()
     assert {s: signal.getsignal(s) for s in SIGNALS} == before
+
+
+def test_a_signal_inside_the_import_machinery_comes_again_outside_it():
+    """A Ctrl-C whose exception was raised as importlib's weakref callback returned from
+    taking the global import lock (before its ``try``) left the lock held: every other
+    thread's import then waited for ever, and a design run with an HTML report hung. A signal
+    that comes while importlib's own code runs is delivered again once the main thread has
+    left it, and raises there."""
+    from types import SimpleNamespace
+
+    from fi_design.interrupts import _on_signal, received, signals_to_exceptions
+
+    in_bootstrap = SimpleNamespace(f_code=SimpleNamespace(
+        co_filename="<frozen importlib._bootstrap>"))
+    raised_inside = []
+    with pytest.raises(KeyboardInterrupt):
+        with signals_to_exceptions(lambda signum: KeyboardInterrupt()):
+            try:
+                _on_signal(signal.SIGINT, in_bootstrap)  # held back: no exception here
+            except KeyboardInterrupt:
+                raised_inside.append(True)
+                raise
+            assert received() == (signal.SIGINT,)
+            deadline = time.monotonic() + 5.0
+            while time.monotonic() < deadline:  # delivered again; raises at a bytecode here
+                time.sleep(0.001)
+            pytest.fail("the signal held back in the import machinery never came again")
+    assert not raised_inside, "raised inside importlib's code"
