@@ -20,7 +20,8 @@ disturbance_N``. A record may start in motion: replays start from the state
 in the first samples (:mod:`fi_design.simulation.run`).
 
 Lines starting with ``#`` before the header are comments (e.g. how the trace
-was recorded); blank lines are skipped; other columns are ignored. Every value must be a plain number
+was recorded; one after the header is refused as such); blank lines are
+skipped; other columns are ignored. Every value must be a plain number
 in the unit of its header: a header with another unit (``position_mm``,
 ``time_ms``), a cell with a unit (``1.2 mm``), an empty cell, NaN or infinity,
 a duplicate header, a time that does not increase, fewer than
@@ -409,6 +410,10 @@ def _read_exact(fh: IO[str], header: list[str], index: dict[str, int], delimiter
         if not any(c.strip() for c in row):
             continue  # blank lines are skipped, as by the fast reader
         n += 1
+        if row[0].lstrip().startswith("#"):
+            raise DataError("a comment line after the header: '#' lines are comments only before "
+                            "the header row; move it above the header or delete it", row=n,
+                            source=source)
         if len(row) != len(header):
             raise DataError(f"has {len(row)} field(s), the header has {len(header)}", row=n,
                             source=source)
@@ -434,16 +439,8 @@ def _columns(header: list[str], source: str) -> dict[str, int]:
                             source=source)
         seen[key] = j
     index = {name: seen[name.lower()] for name in REQUIRED + OPTIONAL if name.lower() in seen}
-    for key, j in seen.items():
-        base, _, unit = key.partition("_")
-        want = _BASES.get(base)
-        if want is not None and want not in index and key != want.lower():
-            if unit:
-                raise DataError(f"unit '{header[j].partition('_')[2]}' is not accepted: give the "
-                                f"column as '{want}' in {UNITS[want]} (SI)", column=header[j],
-                                source=source)
-            raise DataError(f"no unit in the header: give the column as '{want}' in "
-                            f"{UNITS[want]} (SI)", column=header[j], source=source)
+    for j in seen.values():
+        _neighbour(header[j], index, source)
     for name in REQUIRED:
         if name not in index:
             hint = ("; this is a YAML file (a spec?), not a measured record, which is CSV"
@@ -452,6 +449,41 @@ def _columns(header: list[str], source: str) -> dict[str, int]:
                             f"{', '.join(REQUIRED)} (found {', '.join(repr(h) for h in header)})"
                             + hint, column=name, source=source)
     return index
+
+
+#: A header with its unit in brackets or parentheses: ``time [s]``, ``position_m (m)``.
+_BRACKETED = re.compile(r"^(.*?)\s*[\[(]\s*([^\])]*?)\s*[\])]$")
+
+
+def _neighbour(text: str, index: dict[str, int], source: str) -> None:
+    """Refuse a header that names a column of the layout in another form (``position_mm``,
+    ``pos_m``, ``time [s]``), saying the name to give; other headers are other columns."""
+    bracket = _BRACKETED.match(text)
+    name, shown = (bracket.group(1), bracket.group(2)) if bracket else (text, None)
+    key = name.lower()
+    base, _, unit = key.partition("_")
+    want = _BASES.get(base) or next((c for c in UNITS if c.lower() == key), None)
+    if want is None or want in index:
+        return
+    si = UNITS[want]
+    if shown is not None:  # the unit in brackets: the layout has it in the name
+        if shown.lower() in (si.lower(), unit) or not shown:
+            raise DataError(f"the unit goes into the name, after an underscore: give the column "
+                            f"as '{want}' (in {si}, SI) without '{text[len(name):].strip()}'",
+                            column=text, source=source)
+        raise DataError(f"unit '{shown}' is not accepted: give the column as '{want}' in {si} "
+                        f"(SI)", column=text, source=source)
+    if key == want.lower():
+        return
+    if unit == si.lower():  # the unit is right, the name is not the layout's
+        raise DataError(f"not a column name of the layout: give the column as '{want}' (the "
+                        f"layout's names: {', '.join(REQUIRED + OPTIONAL)})", column=text,
+                        source=source)
+    if unit:
+        raise DataError(f"unit '{text.partition('_')[2]}' is not accepted: give the column as "
+                        f"'{want}' in {si} (SI)", column=text, source=source)
+    raise DataError(f"no unit in the header: give the column as '{want}' in {si} (SI)",
+                    column=text, source=source)
 
 
 _NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")

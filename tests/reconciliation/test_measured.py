@@ -225,3 +225,37 @@ def test_a_csv_in_a_neighbouring_format_says_what_to_change(tmp_path, raw, words
         load_measurement(p)
     for w in words:
         assert w in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("header, words", [
+    # it read "required column is missing" with no word on time_s
+    ("time [s],reference [m],position [m]",
+     ["column 'time [s]'", "give the column as 'time_s'", "without '[s]'"]),
+    ("time_s [s],reference_m,position_m", ["give the column as 'time_s'", "without '[s]'"]),
+    ("Time (s),reference_m,position_m", ["give the column as 'time_s'", "without '(s)'"]),
+    ("time_s,reference_m,position [mm]", ["unit 'mm' is not accepted", "'position_m' in m"]),
+    # it read "unit 'm' is not accepted": the unit is right, the name is not the layout's
+    ("time_s,reference_m,pos_m", ["column 'pos_m'", "not a column name of the layout",
+                                  "give the column as 'position_m'"]),
+], ids=["time-brackets", "name-and-brackets", "parentheses", "unit-in-brackets", "pos_m"])
+def test_a_header_in_a_neighbouring_layout_names_the_column_to_give(tmp_path, header, words):
+    rows = [f"{i * 1e-3:.3f},0,0" for i in range(30)]
+    with pytest.raises(DataError) as e:
+        load_measurement(_write(tmp_path, "\n".join([header, *rows]) + "\n"))
+    for w in words:
+        assert w in str(e.value), str(e.value)
+    assert "is not accepted" not in str(e.value) or "mm" in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("comment", ["# paused here", "# paused, here, at 0.01 s, 3"])
+def test_a_comment_after_the_header_says_comments_come_before_it(tmp_path, comment):
+    """A '#' line among the data read "row 11: has 1 field(s), the header has 5" (or, with
+    as many commas as the header, "value '# paused' is not a number")."""
+    rows = _rows()
+    text = "\n".join([HEADER, *rows[:10], comment, *rows[10:]]) + "\n"
+    with pytest.raises(DataError) as e:
+        load_measurement(_write(tmp_path, text))
+    assert e.value.row == 11
+    assert "comment line after the header" in str(e.value)
+    assert "only before the header row" in str(e.value)
+
