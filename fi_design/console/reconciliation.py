@@ -59,15 +59,21 @@ def print_reconcile(console: "Console", result) -> None:
     for c in result.candidates:
         if c.name not in result.effects and c.reasons:
             console.print(Text(f"{c.name} not named: {c.reasons[0]}", style="dim"))
-    g = table("Gap before and after")
-    for col in ("Metric", "Unit", "Before", "After", "Noise"):
-        g.add_column(col, justify="left" if col in ("Metric", "Unit") else "right",
-                     no_wrap=True)
-    for m in result.gaps:
-        unit, factor = scale(m.unit, (m.before, m.after, m.noise))
-        g.add_row(Text(m.name), Text(unit or "-"), *[number(None if v is None else v * factor)
-                                                     for v in (m.before, m.after, m.noise)])
-    console.print(g)
+    if result.gaps:  # none when the nominal model did not run (the conclusion says why)
+        g = table("Gap before and after")
+        for col in ("Metric", "Unit", "Before", "After", "Noise"):
+            g.add_column(col, justify="left" if col in ("Metric", "Unit") else "right",
+                         no_wrap=True)
+        for m in result.gaps:
+            unit, factor = scale(m.unit, (m.before, m.after, m.noise))
+            g.add_row(Text(m.name), Text(unit or "-"),
+                      *[number(None if v is None else v * factor)
+                        for v in (m.before, m.after, m.noise)])
+        console.print(g)
+    else:
+        console.print(Text("No gap table: the nominal model did not run through the record, so "
+                           "there is no gap to measure (the conclusion above says what "
+                           "failed).", style="dim"))
     nz = result.noise
     parts = [f"position {quantity(nz.position, 'm', 3)} ({nz.source.get('position')})"]
     if nz.force is not None:

@@ -169,10 +169,12 @@ def gap_sections(result: Any, figures: bool = True) -> list:
                     "and hold segments; the features (hunting cycles, amplitude, period, "
                     "settling time, final error, error spread) stay meaningful when stick-slip "
                     "drifts out of phase. 'Beyond noise' says whether the corrected model still "
-                    "misses by more than noise explains.",),
+                    "misses by more than noise explains." if grows else
+                    "No gap table: the nominal model did not run through the record, so there "
+                    "is no gap to measure (the finding above says what failed).",),
         tables=(Table(("Metric", "Unit", "Measured", "Nominal", "Corrected", "Gap before",
                        "Gap after", "Noise", "Beyond noise"), tuple(grows),
-                      numeric=(False, False) + (True,) * 6 + (False,)),)))
+                      numeric=(False, False) + (True,) * 6 + (False,)),) if grows else ()))
     crows = []
     for i, c in enumerate(result.candidates, 1):
         dist = ", ".join(f"{k} {'+' if v >= 0 else ''}{num(v, 3)}"  # signed: which side

@@ -159,3 +159,24 @@ def test_a_record_shorter_than_the_loop_period_is_refused(tmp_path):
         reconcile(load_spec(EXAMPLES / "measured_stage.yaml"),
                   measurement_from_arrays(fast - fast[0], *columns, source="fast.csv"))
     assert err.value.column == "time_s" and err.value.source == "fast.csv"
+
+
+def test_a_nominal_model_that_runs_away_prints_no_empty_gap_table(emps_path, tmp_path):
+    """examples/measured_stage.yaml against the EMPS record (another stage: the nominal model
+    runs away) printed the "Gap before and after" table's headers with no rows; now no table,
+    and why (as for the empty candidate table), on the console and in the report."""
+    from conftest import EXAMPLES
+
+    from fi_design.measured import load_measurement
+    from fi_design.reconciliation import reconcile
+    from fi_design.report.gap import gap_sections
+
+    r = runner.invoke(app, ["reconcile", str(EXAMPLES / "measured_stage.yaml"), str(emps_path)])
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert "The nominal model fails on this record: runaway" in text
+    assert "Gap before and after" not in text and "Metric" not in text, r.output
+    assert "No gap table: the nominal model did not run through the record" in text
+    result = reconcile(load_spec(EXAMPLES / "measured_stage.yaml"), load_measurement(emps_path))
+    (gap,) = [s for s in gap_sections(result, figures=False) if s.id == "gap"]
+    assert not gap.tables and "No gap table" in gap.paragraphs[0]
