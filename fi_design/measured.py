@@ -49,7 +49,7 @@ from typing import IO, Mapping
 
 import numpy as np
 
-from .display import number, quantity
+from .display import number, percent, plain, quantity
 from .errors import DataError
 from .results import dataclass_dict, frozen_array
 
@@ -67,6 +67,16 @@ MIN_SAMPLES = 20
 UNIFORM_JITTER = 0.01
 #: Largest file accepted [bytes] (about 3 million rows of five columns).
 MAX_BYTES = 300_000_000
+#: A time step this many times the median step or more is a gap in the record (samples
+#: missing), not jitter or a change of the logging rate (see :func:`check_time_steps`).
+GAP_FACTOR = 5.0
+#: A position step whose speed is this many times the fastest the record moves otherwise (at
+#: the samples around it, and overall) is a jump, not motion (see :func:`check_position_steps`).
+JUMP_FACTOR = 10.0
+#: Samples on either side of a step that show how fast the record moves around it.
+JUMP_WINDOW = 10
+#: Share of the record's position steps slower than its typical fast motion (a quantile).
+JUMP_QUANTILE = 0.99
 #: Magnitudes above these are taken as a wrong unit (e.g. mm written into a _m column).
 PLAUSIBLE = {"reference_m": 10.0, "position_m": 10.0, "deflection_m": 0.1, "force_N": 1e6,
              "disturbance_N": 1e6}
@@ -243,6 +253,126 @@ def thinned(measurement: Measurement, step: int) -> Measurement:
                                              ("deflection_m", "deflection"),
                                              ("disturbance_N", "disturbance"))},
                        source=measurement.source)
+
+
+def check_time_steps(measured: Measurement, *, longest: float = 0.0, longest_is: str = "",
+                     jitter: float | None = None, needs: str, parts: str) -> None:
+    """Refuse a record with a gap in its time, or (with ``jitter``) one not sampled uniformly.
+
+    One check for every command that reads a record: a replay (``fi-design simulate
+    --record``, ``fi-design reconcile``) takes any sampling but not a gap, the
+    identification needs uniform samples. A *gap* is a step of ``time_s`` of
+    :data:`GAP_FACTOR` times the median step or more and longer than ``longest``:
+    samples are missing there, and nothing is known of the stage in it.
+
+    Parameters
+    ----------
+    measured : Measurement
+        The record.
+    longest : float
+        A gap shorter than this [s] is accepted (0: every gap is refused).
+    longest_is : str, optional
+        What ``longest`` is, for the message (default its value).
+    jitter : float, optional
+        Refuse also a step that departs from the median step by more than this
+        fraction of it (uniform sampling needed); None: any sampling but a gap.
+    needs : str
+        Why the caller cannot take the step, said in the message (a clause).
+    parts : str
+        What to do with each part either side of a gap (e.g. "replay each part on its
+        own").
+
+    Raises
+    ------
+    DataError
+        The step, the rows either side of it, their times and the median step.
+    """
+    t = np.asarray(measured.time, dtype=float)
+    dt = np.diff(t)
+    med = float(np.median(dt))
+    i = int(np.argmax(np.abs(dt - med)))
+    step = float(dt[i])
+    src = measured.source
+    if step >= GAP_FACTOR * med and step > longest:
+        beyond = (f" and longer than {longest_is or quantity(longest, 's', 3)}"
+                  if longest > 0.0 else "")
+        raise DataError(
+            f"a gap in the record: no sample for {quantity(step, 's', 4)} between row {i + 1} "
+            f"({quantity(t[i], 's', 9)}) and row {i + 2} ({quantity(t[i + 1], 's', 9)}), "
+            f"{number(step / med, 3)} x the median step ({quantity(med, 's', 4)}){beyond}; "
+            f"{needs}: do not interpolate across the gap; split the record at row {i + 2} "
+            f"and {parts}", column="time_s", row=i + 2, source=src)
+    if jitter is not None and abs(step - med) > jitter * med:
+        raise DataError(
+            f"non-uniform sampling: the step between rows {i + 1} and {i + 2} is "
+            f"{quantity(step, 's', 6)}, the median step {quantity(med, 's', 6)} (at most "
+            f"{percent(jitter, 2)} jitter is taken as uniform); {needs}: resample every "
+            f"column onto a uniform grid first (e.g. numpy.interp onto t0 + k * "
+            f"{plain(med, 6)} s, or scipy.signal.resample_poly for a rational rate change)",
+            column="time_s", row=i + 2, source=src)
+
+
+def check_position_steps(measured: Measurement) -> None:
+    """Refuse a record whose position jumps: a step no motion of the record explains.
+
+    An encoder that wraps, a counter re-zeroed in the record or a glitch moves
+    ``position_m`` by a step in one sample that the stage did not make. A
+    step counts as a jump when its speed (the step over its time step) is
+    :data:`JUMP_FACTOR` times the fastest the record moves otherwise: the
+    position's steps within :data:`JUMP_WINDOW` samples around it (the two
+    steps beside it left out: a glitch of one sample steps back at once), the
+    reference's steps there and anywhere in the record (the commanded motion:
+    a stage that follows a step of its reference steps too), and the
+    :data:`JUMP_QUANTILE` quantile of the position's speed over the whole
+    record (its typical fast motion) and the median of its speeds that are not
+    zero (a quantized record at rest steps by one count now and then). A motion
+    that lasts three samples or more is never a jump, however fast: the record
+    shows it.
+
+    Parameters
+    ----------
+    measured : Measurement
+        The record.
+
+    Raises
+    ------
+    DataError
+        The first jump: its rows and times, the step and the speed it would take
+        beside the fastest the record moves otherwise.
+    """
+    from scipy.ndimage import maximum_filter1d
+
+    t = np.asarray(measured.time, dtype=float)
+    dt = np.diff(t)
+    step = np.diff(np.asarray(measured.position, dtype=float))
+    speed = np.abs(step) / dt
+    ref = np.abs(np.diff(np.asarray(measured.reference, dtype=float))) / dt
+    n, w = len(speed), JUMP_WINDOW
+    side = w - 1  # the steps i - w .. i - 2 and i + 2 .. i + w
+    before, after = np.zeros(n), np.zeros(n)
+    if n > 2:
+        ahead = maximum_filter1d(speed, side, mode="constant", cval=0.0, origin=(side - 1) // 2)
+        before[2:] = ahead[:-2]  # ahead[j]: the largest of speed[j - side + 1 .. j]
+        behind = maximum_filter1d(speed, side, mode="constant", cval=0.0, origin=-(side // 2))
+        after[:-2] = behind[2:]  # behind[j]: the largest of speed[j .. j + side - 1]
+    moving = speed[speed > 0.0]
+    overall = max(float(np.max(ref)), float(np.quantile(speed, JUMP_QUANTILE)),
+                  float(np.median(moving)) if len(moving) else 0.0)
+    fastest = np.maximum.reduce([before, after, np.full(n, overall),
+                                 maximum_filter1d(ref, 2 * w + 1, mode="constant", cval=0.0)])
+    jumps = np.nonzero(speed > JUMP_FACTOR * fastest)[0]
+    if len(jumps):
+        i = int(jumps[0])
+        raise DataError(
+            f"a jump of the position: position_m steps by {quantity(step[i], 'm', 4)} between "
+            f"row {i + 1} ({quantity(t[i], 's', 9)}) and row {i + 2} "
+            f"({quantity(t[i + 1], 's', 9)}), a speed of {quantity(speed[i], 'm/s', 3)}, "
+            f"{number(speed[i] / fastest[i], 3)} x the fastest the record moves otherwise "
+            f"({quantity(fastest[i], 'm/s', 3)}): the stage did not make that step. An encoder "
+            "that wraps, a counter re-zeroed during the record or a glitch gives such a step; "
+            "remove it from position_m (unwrap the counter, or subtract the step from the rows "
+            "after it) or use the record up to it", column="position_m", row=i + 2, source=
+            measured.source)
 
 
 def _checked(arrays: dict, source: str | None) -> Measurement:

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..display import number, percent, plain, quantity
+from ..display import number, quantity
 from ..errors import DataError
-from ..measured import Measurement
+from ..measured import Measurement, check_position_steps, check_time_steps
 from ..results.identification import Processing
 
 #: Fewest samples a record must have.
@@ -62,19 +62,10 @@ def check_record(m: Measurement) -> None:
                         "row; the friction and the mass are read from how the force changes "
                         "with the motion (is the column the drive's force command, logged?)",
                         column="force_N", source=src)
-    dt = np.diff(m.time)
-    med = float(np.median(dt))
-    worst = float(np.max(np.abs(dt - med)))
-    if worst > JITTER * med:
-        i = int(np.argmax(np.abs(dt - med)))
-        raise DataError(
-            f"non-uniform sampling: the step between rows {i + 1} and {i + 2} is "
-            f"{quantity(dt[i], 's', 6)}, the median step {quantity(med, 's', 6)} (at most "
-            f"{percent(JITTER, 2)} jitter is taken as uniform); the zero-phase filter needs "
-            "uniform samples: resample every column onto a uniform grid first (e.g. "
-            f"numpy.interp onto t0 + k * {plain(med, 6)} s, or "
-            "scipy.signal.resample_poly for a rational rate change)",
-            column="time_s", row=i + 2, source=src)
+    check_time_steps(m, jitter=JITTER, needs="the zero-phase filter needs uniform samples",
+                     parts="identify each part on its own (fi_design.identification.segment "
+                           "cuts a record)")
+    check_position_steps(m)
 
 
 def processing(measured: Measurement, spec=None, *, cutoff: float | None = None,

@@ -27,6 +27,7 @@ from ..errors import DataError
 from ..measured import Measurement
 from ..model import as_model
 from ..simulation.replay import command_state
+from ..simulation.replay import vouch
 from ..simulation.run import record_notes, simulate
 from ..trajectory import from_samples
 from ..results.reconciliation import Lattice, ModelTrace, NoiseLevels, Segment
@@ -114,6 +115,9 @@ class Comparison:
         #: The replay's warnings about the record (a closed loop that starts far from its
         #: reference: :func:`fi_design.simulation.run.record_notes`).
         self.notes = record_notes(self.model, measured, drive)
+        # its record is reconcile()'s, checked there before the thinning
+        # (fi_design.simulation.replay.check_record), or a trace of the model itself
+        vouch(measured)
         self._segments(settle_window)
 
     # ---- model runs

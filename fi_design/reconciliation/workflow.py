@@ -24,7 +24,7 @@ from ..display import quantity
 from ..errors import ArgumentError, DataError, SimulationError
 from ..measured import Measurement
 from ..model import resolve
-from ..simulation.replay import DRIVES
+from ..simulation.replay import DRIVES, check_record
 from ..spec.file import as_spec
 from .comparison import MAX_POINTS, Comparison, ModelRun
 from .diagnosis import diagnose, drive_check, record_diagnosis, record_fault
@@ -130,10 +130,11 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     args = _check_arguments(spec, measured, isolated, candidates, max_effects, drive)
     iso = args.isolated
     say("reading the record", 0.0)
+    crossover = resolve(spec).crossover
+    check_record(measured, crossover, "reconcile")
     lattice = find_lattice(measured.position, estimate_noise(measured.position))
     noise = noise_levels(spec, measured, iso, lattice, force_is_input=drive == "force")
     check_excitation(measured, noise.position)
-    crossover = resolve(spec).crossover
     check_duration(measured, crossover)
     measured, thinning = for_the_model(measured, crossover)
     cmp = Comparison(spec, measured, iso, noise, lattice, settle_window, drive)

@@ -26,7 +26,7 @@ from ..display import number, percent, quantity
 from ..errors import DataError
 from ..kernel.build import compiled
 from ..kernel.layout import P_SIGMA2_NEG, PlantParameters, state_index
-from ..measured import Measurement
+from ..measured import Measurement, check_position_steps, check_time_steps
 from ..trajectory import Trajectory, from_samples
 from ..controller.pid import ControlLaw
 
@@ -196,6 +196,61 @@ START_OFFSET_SHARE = 0.1
 #: A record sampled below this many times the loop's crossover cannot show the loop's
 #: dynamics (its Nyquist frequency lies below the crossover) [-].
 RATE_FACTOR = 2.0
+
+
+def check_record(record: Measurement, crossover: float, use: str = "replay") -> None:
+    """Refuse a record a replay cannot follow: a gap in its time, a jump of its position.
+
+    A replay drives the model through every instant of the record, by a spline
+    through its reference (or, open loop, its force) between samples. Across a
+    gap, a step of ``time_s`` :data:`~fi_design.measured.GAP_FACTOR` times the
+    median step or more and longer than half a period of the loop's crossover
+    (below :data:`RATE_FACTOR` samples per period: over it the record cannot
+    show the loop), nothing is known of the stage: the spline invents the
+    reference there, the model moves on it, and the comparison after the gap
+    measures the invention (2 s added to ``examples/measured_trace.csv``'s time
+    after row 4000 read as a missing "disturbance (90 %)"). A record that
+    does not hold the stage's motion cannot be replayed either: a jump of the
+    position (:func:`~fi_design.measured.check_position_steps`). Shorter
+    gaps pass: a logger that changes its rate, or drops a few samples, is
+    bridged as any step is. A record that passed is not checked again.
+
+    Parameters
+    ----------
+    record : Measurement
+        The record.
+    crossover : float
+        The loop's crossover [Hz].
+    use : str
+        What the record is used for, in the message: ``"replay"`` or
+        ``"reconcile"``.
+
+    Raises
+    ------
+    DataError
+        The gap or the jump, with its rows and times and what to do.
+    """
+    kept = _KEPT.setdefault(record, {})
+    checked = kept.get("checked")
+    if checked is True or checked == crossover:
+        return
+    longest = 1.0 / (RATE_FACTOR * crossover)
+    check_time_steps(
+        record, longest=longest,
+        longest_is=(f"half a period of the loop's {quantity(crossover, 'Hz', 4)} crossover "
+                    f"({quantity(longest, 's', 3)})"),
+        needs=("nothing is known of the stage in it, and a replay would drive the model "
+               "across it on a spline through the reference and compare what it invented "
+               "with the samples after it"),
+        parts=f"{use} each part on its own")
+    check_position_steps(record)
+    kept["checked"] = crossover
+
+
+def vouch(record: Measurement) -> None:
+    """Mark a record as one :func:`check_record` need not check: a record it passed, thinned,
+    or a trace of the model itself (its position continuous by construction)."""
+    _KEPT.setdefault(record, {})["checked"] = True
 
 
 def rate_note(record: Measurement, crossover: float) -> str:

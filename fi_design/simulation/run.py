@@ -33,7 +33,8 @@ from ..kernel import run as _kernel_run
 from ..kernel.build import compiled
 from ..kernel.layout import PARAMETER_INDEX, PlantParameters, state_index
 from .replay import (DRIVES, command_rate, command_state, initial_changes, record_reference,
-                     record_state, rate_note, reference_state, replay_fit, start_note)
+                     record_state, rate_note, reference_state, replay_fit, start_note,
+                     check_record)
 from ..results import frozen_array
 from ..results.simulation import SimulationResult
 from ..trajectory import Trajectory, from_moves
@@ -394,6 +395,7 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
 
     A quantizer is never passed through on a fast move here: the record's command carries
     the derivative terms' impulse at every level, which the replay is compared with."""
+    check_record(record, model.crossover)
     params = replace(params, quantization_free=0.0)
     t0 = float(record.time[0])
     t_out = np.asarray(record.time, dtype=float) - t0

@@ -753,3 +753,22 @@ def test_a_record_logged_slower_than_the_loop_says_so(symmetric_record):
     assert any("too slowly for the loop's" in n and "capped at 12.5 Hz" in n for n in r.notes), \
         r.notes
     assert not any("too slowly" in n for n in identify(rec, load_spec(AXIS_SPEC)).notes)
+
+
+def test_a_record_with_a_gap_or_a_position_jump_is_refused_for_what_it_is():
+    """A gap was refused as "non-uniform sampling" with the advice to resample across it (2 s
+    of interpolation), and a position jump (an encoder wrap) was identified: the EMPS record
+    with 50 mm added after row 12421 read 0.43 kg, relative error 0.61, "a force the model
+    lacks". Now the gap is named a gap, to be split at its row, and the jump is refused."""
+    t, x, u = _arrays(2000)
+    gap = np.where(np.arange(len(t)) >= 1000, t + 1.0, t)
+    with pytest.raises(DataError) as e:
+        identify(measurement_from_arrays(gap, x, x, force_N=u, source="gap.csv"))
+    text = str(e.value)
+    assert e.value.row == 1001 and "a gap in the record" in text and "resample" not in text
+    assert "split the record at row 1001 and identify each part on its own" in text, text
+    wrapped = x + np.where(np.arange(len(t)) > 1200, 0.05, 0.0)
+    with pytest.raises(DataError) as e:
+        identify(measurement_from_arrays(t, x, wrapped, force_N=u, source="wrap.csv"))
+    assert (e.value.column, e.value.row) == ("position_m", 1202)
+    assert "a jump of the position: position_m steps by 49.9 mm" in str(e.value), str(e.value)
