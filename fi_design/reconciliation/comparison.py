@@ -114,7 +114,7 @@ class Comparison:
         self.runaway = RUNAWAY_FACTOR * (float(np.max(err)) + 10.0 * noise.position)
         #: The replay's warnings about the record (a closed loop that starts far from its
         #: reference: :func:`fi_design.simulation.run.record_notes`).
-        self.notes = record_notes(self.model, measured, drive)
+        self.notes = record_notes(self.model, measured, drive, isolated)
         # its record is reconcile()'s, checked there before the thinning
         # (fi_design.simulation.replay.check_record), or a trace of the model itself
         vouch(measured)

@@ -253,6 +253,58 @@ def vouch(record: Measurement) -> None:
     _KEPT.setdefault(record, {})["checked"] = True
 
 
+def deflection_note(record: Measurement, isolated: bool, has_isolator: bool) -> str:
+    """A note when the record's ``deflection_m`` is not compared: the spec has no isolator.
+
+    Parameters
+    ----------
+    record : Measurement
+        The record.
+    isolated : bool
+        Whether the replay models the isolator.
+    has_isolator : bool
+        Whether the spec describes one.
+
+    Returns
+    -------
+    str
+        The note, empty when the column is compared, absent, or left out by choice (a spec
+        with an isolator replayed without it).
+    """
+    if record.deflection is None or isolated or has_isolator:
+        return ""
+    largest = float(np.max(np.abs(record.deflection)))
+    return (f"the record has a deflection_m column (up to {quantity(largest, 'm', 3)}), but the "
+            "spec has no isolator: the model is one rigid mass on the bearing, so the column "
+            "is not compared; if the stage has a joint between stage and cart, describe it in "
+            "the spec's isolator section")
+
+
+def window_note(record: Measurement, window: float) -> str:
+    """A note when an open-loop replay's window spans the whole record: one run, never
+    re-anchored.
+
+    Parameters
+    ----------
+    record : Measurement
+        The record.
+    window : float
+        The window [s].
+
+    Returns
+    -------
+    str
+        The note, empty when the record holds more than one window.
+    """
+    if window < record.duration:
+        return ""
+    return (f"the window ({quantity(window, 's', 4)}) is not shorter than the record "
+            f"({quantity(record.duration, 's', 4)}): the replay is one open-loop run from the "
+            "first sample, never re-anchored to the measurement, and its rigid-body drift "
+            "grows over the whole record; give a shorter --window (default 0.1 s) for "
+            "multiple shooting")
+
+
 def rate_note(record: Measurement, crossover: float) -> str:
     """A warning when the record is sampled too slowly to show the loop it is compared with.
 

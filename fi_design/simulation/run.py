@@ -34,7 +34,7 @@ from ..kernel.build import compiled
 from ..kernel.layout import PARAMETER_INDEX, PlantParameters, state_index
 from .replay import (DRIVES, command_rate, command_state, initial_changes, record_reference,
                      record_state, rate_note, reference_state, replay_fit, start_note,
-                     check_record)
+                     check_record, deflection_note, window_note)
 from ..results import frozen_array
 from ..results.simulation import SimulationResult
 from ..trajectory import Trajectory, from_moves
@@ -333,9 +333,10 @@ def _largest(ref: Trajectory) -> float:
 
 
 def _result(model, iso, method, params, out, t_out, wall, *, move_end,
-            time_offset=0.0, drive="closed", record=None, window=None,
+            time_offset=0.0, drive="closed", record=None, window=None, window_span=None,
             shown_time=None) -> SimulationResult:
-    """The result of an integration; ``record`` (a Measurement) for a replay.
+    """The result of an integration; ``record`` (a Measurement) for a replay, ``window`` the
+    open-loop replay's window number of every sample and ``window_span`` its window [s].
     ``shown_time``: ``t_out``'s values on a buffer of its own for the result (read-only)."""
     success = out.code == 0
     message = "" if success else _failure_message(out.status, out.t_reached, params, iso, drive)
@@ -361,12 +362,15 @@ def _result(model, iso, method, params, out, t_out, wall, *, move_end,
         record=None if record is None else (record.source or "record"),
         window=None if window is None else frozen_array(window, dtype=int),
         replay=None if record is None else replay_fit(
-            record, Y[:, idx["x1"]], out.command, record_notes(model, record, drive)))
+            record, Y[:, idx["x1"]], out.command,
+            record_notes(model, record, drive, iso, None if window is None else window_span)))
 
 
-def record_notes(model, record, drive: str) -> tuple[str, ...]:
+def record_notes(model, record, drive: str, isolated: bool | None = None,
+                 window: float | None = None) -> tuple[str, ...]:
     """Warnings about a replayed record: a closed loop that starts far from its reference, a
-    record sampled too slowly for the loop's crossover.
+    record sampled too slowly for the loop's crossover, a deflection_m column that a spec
+    without isolator does not compare, an open-loop window as long as the record.
 
     Parameters
     ----------
@@ -377,16 +381,26 @@ def record_notes(model, record, drive: str) -> tuple[str, ...]:
     drive : {"closed", "force"}
         The replay's drive: an open loop (``"force"``) has no start warning (the
         reference drives nothing there).
+    isolated : bool, optional
+        Whether the replay models the isolator (default: when the spec has one).
+    window : float, optional
+        The open-loop replay's window [s], when there is one.
 
     Returns
     -------
     tuple of str
         :func:`~fi_design.simulation.replay.start_note`'s and
-        :func:`~fi_design.simulation.replay.rate_note`'s warnings, those that apply.
+        :func:`~fi_design.simulation.replay.rate_note`'s,
+        :func:`~fi_design.simulation.replay.deflection_note`'s and
+        :func:`~fi_design.simulation.replay.window_note`'s warnings, those that apply.
     """
-    notes = [rate_note(record, model.crossover)]
+    notes = [rate_note(record, model.crossover),
+             deflection_note(record, model.has_isolator if isolated is None else bool(isolated),
+                             model.has_isolator)]
     if drive == "closed":
         notes.insert(0, start_note(record, max(abs(m.distance) for m in model.spec.motion.moves)))
+    elif window is not None:
+        notes.append(window_note(record, window))
     return tuple(n for n in notes if n)
 
 
@@ -459,7 +473,8 @@ def _replay(model, iso, method, params, record, drive, window, rtol, initial_com
             break
     merged, labels = _merge(pieces, t_out)
     return _result(model, iso, method, open_loop, merged, t_out, wall, move_end=0.0,
-                   time_offset=t0, drive="force", record=record, window=labels)
+                   time_offset=t0, drive="force", record=record, window=labels,
+                   window_span=window)
 
 
 def _anchor(law, params, record, index, ref, command, array=None):
