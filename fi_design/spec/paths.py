@@ -91,8 +91,9 @@ def path_unit(path: str, spec: Spec | None = None) -> str:
     path : str
         Dotted path, as for :func:`with_values`.
     spec : Spec, optional
-        Needed only to resolve a list index into ``effects`` (``effects[0]``);
-        ``effects[type=NAME]`` works without it.
+        Needed only to resolve a list index into a list of typed entries
+        (``effects[0]``, ``controller.filters[0]``); ``[type=NAME]``
+        (``controller.filters[type=notch].frequency``) works without it.
 
     Returns
     -------
@@ -151,20 +152,31 @@ def _leaf(path: str, spec: Spec | None = None) -> tuple[Any, Any]:
         instance = getattr(instance, name, None) if instance is not None else None
         for sel in selectors:
             if isinstance(sel, tuple):  # [type=NAME]
-                from . import EFFECT_MODELS
-
-                if name != "effects" or sel[1] not in EFFECT_MODELS:
-                    raise SpecError(f"no list entry of type '{sel[1]}' here", path=done)
-                model, ann, info = EFFECT_MODELS[sel[1]], EFFECT_MODELS[sel[1]], None
-                instance = None
+                kinds = _entry_types(ann)
+                if not kinds:
+                    raise SpecError(f"'{name}' is not a list of typed entries, so [type=...] "
+                                    "cannot select in it" + ("; select an entry by its index "
+                                                             f"('{name}[0]')"
+                                                             if _is_sequence_of_models(ann)
+                                                             else ""), path=done)
+                if sel[1] not in kinds:
+                    close = difflib.get_close_matches(sel[1], list(kinds), n=1)
+                    raise SpecError(f"no list entry of type '{sel[1]}' here"
+                                    + (f"; did you mean '{close[0]}'?" if close else "")
+                                    + f" (the types: {', '.join(kinds)})", path=done)
+                model = ann = kinds[sel[1]]
+                info = None
+                hits = [e for e in instance if getattr(e, "type", None) == sel[1]] \
+                    if isinstance(instance, tuple) else []
+                instance = hits[0] if hits else None
             else:
                 inner = _element(ann, sel)
-                if inner is None and instance is not None and sel < len(instance):
-                    inner = type(instance[sel])
-                if inner is None:
-                    raise SpecError("cannot resolve this list entry without a spec", path=done)
                 if isinstance(instance, tuple) and sel < len(instance):
+                    inner = inner or type(instance[sel])
                     instance = instance[sel]
+                elif inner is None:
+                    raise SpecError(_unresolved_entry(name, sel, ann, instance, spec),
+                                    path=done)
                 else:
                     instance = None
                 ann = inner
@@ -182,6 +194,45 @@ def _leaf(path: str, spec: Spec | None = None) -> tuple[Any, Any]:
             raise SpecError(f"'{name}' holds a value, not a section", path=done)
         model = sub
     raise SpecError("empty path", path=path)  # pragma: no cover - parse_path refuses it
+
+
+def _entry_types(ann: Any) -> dict[str, Any]:
+    """The entry models of a list of typed entries by their ``type`` (``{}`` for other fields).
+
+    ``effects`` and ``controller.filters`` are such lists: each entry's model follows
+    its ``type``, so ``[type=NAME]`` names the model without a spec.
+    """
+    import typing
+
+    out: dict[str, Any] = {}
+
+    def walk(a: Any, in_list: bool) -> None:
+        if typing.get_origin(a) in (tuple, list):
+            in_list = True
+        if in_list and isinstance(a, type) and "type" in getattr(a, "model_fields", {}):
+            for kind in typing.get_args(a.model_fields["type"].annotation):
+                out[kind] = a
+        for arg in typing.get_args(a):
+            if isinstance(arg, type) or typing.get_args(arg):
+                walk(arg, in_list)
+
+    walk(ann, False)
+    return out
+
+
+def _unresolved_entry(name: str, index: int, ann: Any, instance: Any, spec: Any) -> str:
+    """Why entry ``index`` of a list of typed entries has no model to resolve a path in."""
+    kinds = list(_entry_types(ann))
+    by_type = f"'{name}[type={kinds[0]}]'" if kinds else "its type"
+    if isinstance(instance, tuple) and not instance:
+        return f"the spec has no entry {index}: its '{name}' list is empty; add the entry first"
+    if isinstance(instance, tuple):
+        return (f"index {index} is out of range: the spec's '{name}' list has {len(instance)} "
+                f"entr{'y' if len(instance) == 1 else 'ies'}")
+    if spec is not None:
+        return f"is not set in this spec; add '{name}' to the spec first"
+    return (f"the type of entry {index} depends on the spec: pass the spec, or name the "
+            f"entry by its type ({by_type})")
 
 
 class _Open:

@@ -39,7 +39,7 @@ def make_axis(path: str, values: Sequence[float], log: bool = False,
     log : bool, optional
         Logarithmic spacing (for plots). Default False.
     spec : Spec, optional
-        Resolves list indices into ``effects``.
+        Resolves list indices into ``effects`` and ``controller.filters``.
 
     Returns
     -------
@@ -94,7 +94,7 @@ def parse_axis(text: str, log: bool = False, spec: _spec.Spec | None = None) -> 
     log : bool, optional
         Space the N values logarithmically (START and STOP above zero).
     spec : Spec, optional
-        Resolves list indices into ``effects``.
+        Resolves list indices into ``effects`` and ``controller.filters``.
 
     Returns
     -------

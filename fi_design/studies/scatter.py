@@ -53,7 +53,7 @@ def parse_scatter(text: str, spec: _spec.Spec | None = None) -> Scatter:
         (a bare number below 1 is relative too: 10 %) or
         ``"friction.static=0.3 N"`` (absolute, with units).
     spec : Spec, optional
-        Resolves list indices into ``effects``.
+        Resolves list indices into ``effects`` and ``controller.filters``.
 
     Returns
     -------

@@ -84,3 +84,26 @@ def test_value_at(paper_spec):
     assert value_at(paper_spec, "isolator.stroke") == pytest.approx(3e-4)
     assert value_at(paper_spec, "controller.sample_rate") is None
     assert value_at(paper_spec, "motion.moves[0].velocity") == pytest.approx(0.05)
+
+
+def test_type_selectors_name_any_list_of_typed_entries(paper_spec):
+    # [type=NAME] worked for effects only: 'controller.filters[type=notch].frequency' (as
+    # docs/spec.md writes the filter keys) said "no list entry of type 'notch' here"
+    notch = with_values(paper_spec, {"controller.filters": [
+        {"type": "notch", "frequency": "150 Hz", "width": "20 Hz"}]})
+    path = "controller.filters[type=notch].frequency"
+    assert path_unit(path) == "Hz" and path_unit(path, notch) == "Hz"
+    assert value_at(with_values(notch, {path: "140 Hz"}), path) == 140.0
+    assert path_unit("controller.filters[0].frequency", notch) == "Hz"
+    with pytest.raises(SpecError, match="did you mean 'notch'.*notch, low_pass"):
+        path_unit("controller.filters[type=notsh].frequency")
+    with pytest.raises(SpecError, match="not a list of typed entries.*'parasitic_modes\\[0\\]'"):
+        path_unit("isolator.parasitic_modes[type=x].frequency")
+
+
+def test_an_index_beyond_the_specs_list_says_so(paper_spec):
+    # effects[0] of a spec without effects said "cannot resolve this list entry without a spec"
+    with pytest.raises(SpecError, match="the spec has no entry 0: its 'effects' list is empty"):
+        path_unit("effects[0].delay", paper_spec)
+    with pytest.raises(SpecError, match="pass the spec, or name the entry by its type"):
+        path_unit("effects[0].delay")
