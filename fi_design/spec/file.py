@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -127,7 +128,17 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
         Not valid YAML, not a mapping, or a value is missing or wrong; the
         message names the field path and line.
     ArgumentError
-        ``source`` is neither a path nor a mapping (None, a number, a list, bytes).
+        ``source`` is neither a path nor a mapping (None, a number, a list,
+        bytes), or is the YAML text itself rather than a path to it.
+
+    Examples
+    --------
+    YAML text is loaded as the mapping :func:`parse_yaml` reads from it (the
+    checks of the file reader; the messages name no line):
+
+    >>> text = open("examples/paper_setup.yaml", encoding="utf-8").read()
+    >>> load_spec(parse_yaml(text.encode("utf-8"))[0]).stage.mass
+    1.6
     """
     from ..errors import ArgumentError
 
@@ -136,6 +147,13 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
             if isinstance(source, (bytes, bytearray)) else ""
         raise ArgumentError(f"source must be a path to a YAML spec or a mapping, got "
                             f"{type(source).__name__}{hint}")
+    if isinstance(source, str) and _is_yaml_text(source):
+        first = source.strip().splitlines()[0] if source.strip() else source
+        shown = first if len(first) <= 40 else first[:37] + "..."
+        raise ArgumentError(f"source looks like YAML text ({shown!r}), not a path: load_spec "
+                            "takes the path of a YAML spec file or a mapping; for text, pass "
+                            "the mapping fi_design.spec.file.parse_yaml(text.encode('utf-8'))[0]"
+                            ", or write the text to a file")
     if isinstance(source, Mapping):
         raw = plain(source)
         return _validate(raw, SpecOrigin(None, json_sha256(raw), raw))
@@ -186,9 +204,26 @@ def origin(spec: Spec) -> SpecOrigin | None:
     return spec._origin
 
 
+def _is_yaml_text(source: str) -> bool:
+    """Whether a path argument is clearly YAML text: a newline, or a ``key:`` mapping (or
+    ``{``) at its start that names no existing file."""
+    if "\n" in source or "\r" in source:
+        return True
+    if not re.match(r"\s*(\{|[A-Za-z_][\w.-]*\s*:(\s|$))", source):
+        return False
+    try:
+        return not Path(source).exists()
+    except OSError:  # a name too long for the file system
+        return True
+
+
 def read_bytes(path: Path) -> bytes:
     """Read a spec file's bytes with clear errors for missing files and directories."""
-    if not path.exists():
+    try:
+        exists = path.exists()
+    except OSError as exc:  # a name too long for the file system
+        raise SpecFileError(f"{path}: cannot read ({exc.strerror})") from None
+    if not exists:
         raise SpecFileError(f"{path}: no such file")
     if path.is_dir():
         raise SpecFileError(f"{path}: is a directory, expected a YAML spec file")

@@ -85,6 +85,13 @@ def _calls():
         ("load-spec-list", lambda s, m: fi_design.load_spec([1, 2]), ArgumentError, ["got list"]),
         ("load-spec-bytes", lambda s, m: fi_design.load_spec(b"name: x"),
          ArgumentError, ["got bytes", "write the YAML to a file"]),
+        # YAML text where a path belongs was read as a file name: 'TEXT...: no such file', or
+        # an OSError (File name too long) from the file system
+        ("load-spec-yaml-text", lambda s, m: fi_design.load_spec(
+            (EXAMPLES / "paper_setup.yaml").read_text(encoding="utf-8") * 100),
+         ArgumentError, ["looks like YAML text", "not a path", "parse_yaml(text.encode"]),
+        ("load-spec-yaml-mapping-line", lambda s, m: fi_design.load_spec("stage: {mass: 1 kg}"),
+         ArgumentError, ["looks like YAML text ('stage: {mass: 1 kg}')"]),
         ("replay-window-picoseconds", lambda s, m: fi_design.simulate(
             s, record=m, drive="force", window=1e-12),
          ArgumentError, ["window = 1\u00a0×\u00a010⁻¹² s", "fewer than 10 samples"]),
