@@ -279,8 +279,8 @@ def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, Any]:
 
     try:
         text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise SpecError("not a text file (not UTF-8)", source=source) from None
+    except UnicodeDecodeError as exc:
+        raise _not_utf8(data, exc.start, source) from None
     if not text.strip() or all(ln.strip().startswith("#") or not ln.strip()
                                for ln in text.splitlines()):
         raise SpecError("the spec file is empty", source=source)
@@ -316,6 +316,21 @@ def parse_yaml(data: bytes, source: str = "<spec>") -> tuple[dict, Any]:
         raise SpecError(f"the top level must be a mapping of sections (name, stage, cart, ...), "
                         f"got {kind}{hint}", line=1, source=source)
     return plain(document), document
+
+
+def _not_utf8(data: bytes, start: int, source: str) -> SpecError:
+    """Where a spec stops being UTF-8: the line, column and byte offset of the first bad byte,
+    and what the file is (binary, with a NUL byte; else text in another encoding)."""
+    line_start = data.rfind(b"\n", 0, start) + 1
+    column = len(data[line_start:start].decode("utf-8")) + 1  # valid up to the bad byte
+    where = (f"byte {hex(data[start])} at column {column} (byte offset {start} of the file) "
+             "is not UTF-8")
+    if b"\x00" in data[:65536]:
+        text = f"not a text file: {where}"
+    else:
+        text = (f"{where}: the text is in another encoding (Latin-1 or Windows-1252, as some "
+                "editors write, perhaps); save the file as UTF-8")
+    return SpecError(text, line=data.count(b"\n", 0, start) + 1, source=source)
 
 
 def _count_nodes(node, source: str) -> None:

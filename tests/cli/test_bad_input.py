@@ -402,6 +402,16 @@ def test_binary_file(tmp_path):
     _assert_refused(result, out, tmp_path, ["not a text file"])
 
 
+def test_a_spec_in_another_encoding_names_the_line_and_column(tmp_path):
+    # a Latin-1 byte said 'not a text file (not UTF-8)', with no line or position
+    spec = tmp_path / "latin.yaml"
+    spec.write_bytes(b'name: "\xc3\xa9t\xc3\xa9"\nstage: {mass: 1 kg}   # r\xe9f\n')
+    result, out = _run(str(spec), tmp_path)
+    _assert_refused(result, out, tmp_path, [
+        "latin.yaml:2: byte 0xe9 at column 26 (byte offset 39 of the file) is not UTF-8",
+        "save the file as UTF-8"])
+
+
 @pytest.mark.parametrize("char", ["\x00", "\x07", "\x1b"])
 def test_control_character_in_the_spec(tmp_path, char):
     """A NUL (or other control character) is bad input naming file and line, not a bug."""
