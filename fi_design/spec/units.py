@@ -32,7 +32,7 @@ import tokenize
 from functools import lru_cache
 from typing import Any
 
-from ..display import quantity
+from ..display import quantity, unit_text
 from ..errors import ArgumentError, UnitError
 
 #: Target units understood by :func:`to_si`, with the dimension users see in messages.
@@ -125,8 +125,12 @@ def _plausible(x: float, unit: str, path: str | None, text) -> float:
     least, most = PLAUSIBLE.get(unit, (0.0, math.inf))
     if x != 0 and not least <= abs(x) <= most:
         shown = _cut(text) if isinstance(text, str) else repr(float(text))
-        span = (f"lies within {quantity(least, unit)} to {quantity(most, unit)}" if least > 0
-                else f"is at most {quantity(most, unit)}")
+        si = (unit_text(unit), 1.0)  # the bounds in the SI unit, as docs/spec.md gives them
+        written = _QUANTITY.match(text.strip()) if isinstance(text, str) else None
+        if written and written.group(2).strip() and float(written.group(1)) != x:
+            shown += f" ({quantity(x, unit, shown=si)})"  # a prefix's slip shows in SI
+        span = (f"lies within {quantity((least, most), unit, joiner=' to ', shown=si)}"
+                if least > 0 else f"is at most {quantity(most, unit, shown=si)}")
         raise UnitError(f"{shown} is not a plausible {KNOWN_UNITS[unit]}: a nonzero one {span}; "
                         "check its unit and exponent", path=path)
     return x

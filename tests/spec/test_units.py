@@ -168,3 +168,14 @@ def test_an_integer_beyond_pythons_digit_limit_is_a_spec_error_in_a_mapping(path
             call()
         assert err.value.path == path
         assert "more than 4300 digits" in str(err.value), str(err.value)
+
+
+def test_the_plausible_range_reads_in_one_unit():
+    # '0.3 Mm' said a length lies 'within < 0.001 µm to 1 × 10⁶ mm': the bounds each in the
+    # unit its size picked (the lower one below what quantity shows), not the value in SI
+    with pytest.raises(UnitError) as err:
+        to_si("0.3 Mm", "m", path="isolator.stroke")
+    assert "'0.3 Mm' (300000 m) is not a plausible length: a nonzero one lies within " \
+           "1\u00a0×\u00a010⁻¹⁵ to 1000 m;" in str(err.value), str(err.value)
+    with pytest.raises(UnitError, match="is at most 1\u00a0×\u00a010¹⁵ N;"):
+        to_si("5e15 N", "N")
