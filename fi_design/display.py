@@ -37,7 +37,7 @@ from typing import Any, Iterable, Sequence
 
 __all__ = ["number", "quantity", "millimetres", "quantities", "column", "scale", "display_scale", "with_error",
            "percent", "fixed", "plain", "code_point", "unit_text", "axis_unit", "UNIT_TEXT",
-           "DISPLAY_SCALES", "AXIS_UNITS", "NBSP", "tick_label"]
+           "DISPLAY_SCALES", "AXIS_UNITS", "AXIS_SCALES", "NBSP", "tick_label"]
 
 #: No-break space: between a number and its unit in reports.
 NBSP = "\u00a0"
@@ -69,6 +69,13 @@ AXIS_UNITS: dict[str, tuple[str, float]] = {
     "N*s/m": ("N\u00b7s/m", 1.0),
     "kg/m**3": ("kg/m\u00b3", 1.0),
     "1": ("-", 1.0),
+}
+
+#: SI unit -> (threshold, unit, factor) of an axis whose unit follows the size of its values
+#: (a sweep of a delay from 1 ms to 2 ms reads in ms, of a duration in s); the first threshold
+#: at or below the axis's largest |value| wins.
+AXIS_SCALES: dict[str, list[tuple[float, str, float]]] = {
+    "s": [(1.0, "s", 1.0), (1e-3, "ms", 1e3), (0.0, "\u00b5s", 1e6)],
 }
 
 #: Below this a length is not resolved by any position sensor: shown as ``< 0.001 µm``.
@@ -525,16 +532,20 @@ def tick_label(value: float, _pos: Any = None) -> str:
     return f"{value:.0e}".replace("e+0", "e").replace("e-0", "e-")
 
 
-def axis_unit(unit: str) -> tuple[str, float]:
+def axis_unit(unit: str, values: Iterable[Any] | None = None) -> tuple[str, float]:
     """The unit of a figure axis or a map's header for an SI unit, and the factor from SI.
 
-    One unit per axis whatever its values (:data:`AXIS_UNITS`: lengths in mm,
-    stiffness in N/mm, ...); other units are shown as stored.
+    One unit per axis (:data:`AXIS_UNITS`: lengths in mm, stiffness in N/mm,
+    ...); times follow the axis's largest value (:data:`AXIS_SCALES`: a delay
+    of milliseconds in ms) when its ``values`` are given; other units are shown
+    as stored.
 
     Parameters
     ----------
     unit : str
         SI unit as stored in the spec (``"m"``, ``"N/m"``, ``"Hz"``, ...).
+    values : iterable of float, optional
+        The axis's values (SI), for a unit of :data:`AXIS_SCALES`.
 
     Returns
     -------
@@ -542,5 +553,16 @@ def axis_unit(unit: str) -> tuple[str, float]:
         Unit text (``"mm"`` for metres).
     factor : float
         Multiply SI values by this to get the shown unit.
+
+    Examples
+    --------
+    >>> axis_unit("m"), axis_unit("s", [1e-3, 2e-3]), axis_unit("s", [5.0, 20.0])
+    (('mm', 1000.0), ('ms', 1000.0), ('s', 1.0))
     """
+    scales = AXIS_SCALES.get(unit)
+    if scales is not None and values is not None:
+        finite = [abs(float(v)) for v in values if _is_number(v) and math.isfinite(v) and v != 0]
+        if finite:
+            top = max(finite)
+            return next((shown, f) for threshold, shown, f in scales if top >= threshold)
     return AXIS_UNITS.get(unit, (unit, 1.0))

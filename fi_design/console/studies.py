@@ -17,11 +17,13 @@ if TYPE_CHECKING:  # pragma: no cover
 def _axis_values_text(axis) -> str:
     from ..plots import quantity_name
 
-    unit, f = axis_unit(axis.unit)
+    unit, f = axis_unit(axis.unit, axis.values)
     v = axis.values
     scale = "log" if axis.log else "linear"
-    return (f"{quantity_name(axis.path)} ({axis.path}): {len(v)} values {number(v[0] * f)} to "
-            f"{number(v[-1] * f)} {unit} ({scale})")
+    name = quantity_name(axis.path)
+    named = name if name == axis.path else f"{name} ({axis.path})"  # the path once
+    return (f"{named}: {len(v)} values {number(v[0] * f)} to {number(v[-1] * f)} {unit} "
+            f"({scale})")
 
 
 _CELL = {"settled": ("·", "green"), "stuck": ("s", "yellow"), "undetermined": ("?", "yellow"),
@@ -57,9 +59,9 @@ def sweep_grid_table(result, columns: slice | None = None):
 
     x, y = result.x, result.y
     cols = range(len(x.values))[columns or slice(None)]
-    xu, xf = axis_unit(x.unit)
+    xu, xf = axis_unit(x.unit, x.values)
     if y is not None:
-        yu, yf = axis_unit(y.unit)
+        yu, yf = axis_unit(y.unit, y.values)
     t = Table(box=box.SIMPLE_HEAD, pad_edge=False)
     t.add_column(Text("" if y is None else f"[{yu}]"), justify="right", no_wrap=True)
     for j in cols:
@@ -130,9 +132,9 @@ def grid_caption(result) -> str:
     what = ("peak to peak of the cycle some move ends in [mm]"
             if getattr(result, "measure", "move") == "stage"
             else "hunting cycles of the spec's move in the window")
-    text = f"{what}; columns: {axis_label(result.x.path, result.x.unit)}"
+    text = f"{what}; columns: {axis_label(result.x.path, result.x.unit, result.x.values)}"
     if result.y is not None:
-        text += f", rows: {axis_label(result.y.path, result.y.unit)}"
+        text += f", rows: {axis_label(result.y.path, result.y.unit, result.y.values)}"
     marks = "; · settled, s stuck, ? undetermined, - invalid, × failed"
     if "buckled" in result.verdict:
         marks += "; b the weight has buckled the guide (not simulated)"
@@ -204,7 +206,7 @@ def print_sweep(console: "Console", result, spec_path: Optional[Path] = None,
     _print_counts(console, result.counts())
     for note in result.notes:
         console.print(Text(f"note: {note}", style="yellow"))
-    xu, xf = axis_unit(result.x.unit)
+    xu, xf = axis_unit(result.x.unit, result.x.values)
     above = result.boundary("above")
     if result.y is None:
         if not math.isnan(above[0]):

@@ -71,7 +71,7 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
     from matplotlib.patches import Rectangle
 
     x = result.x
-    xu, xf = display_unit(x.unit)
+    xu, xf = display_unit(x.unit, x.values)
     xs = np.asarray(x.values) * xf
     plant = "with isolator" if result.isolated else "without isolator"
     stage = getattr(result, "measure", "move") == "stage"
@@ -102,7 +102,7 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
                        label="design point")
         if buckled or result.design_point[0] is not None:
             ax.legend(loc="best", fontsize=8, frameon=False)
-        ax.set_xlabel(axis_label(x.path, x.unit))
+        ax.set_xlabel(axis_label(x.path, x.unit, x.values))
         ax.set_ylabel(label)
         if x.log:
             ax.set_xscale("log")
@@ -114,7 +114,7 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
                      fontsize=10)
         return artist
     y = result.y
-    yu, yf = display_unit(y.unit)
+    yu, yf = display_unit(y.unit, y.values)
     ys = np.asarray(y.values) * yf
     log_scale = False
     if stage:
@@ -186,8 +186,8 @@ def draw_sweep(ax: Any, result: Any, *, title: str | None = None, colorbar: bool
         ax.set_yscale("log")
     ax.set_xlim(ex[0], ex[-1])
     ax.set_ylim(ey[0], ey[-1])
-    ax.set_xlabel(axis_label(x.path, x.unit))
-    ax.set_ylabel(axis_label(y.path, y.unit))
+    ax.set_xlabel(axis_label(x.path, x.unit, x.values))
+    ax.set_ylabel(axis_label(y.path, y.unit, y.values))
     ax.set_title(f"{quantity_name(y.path)} vs {quantity_name(x.path).lower()} ({plant})"
                  if title is None else title, fontsize=10)
     if colorbar:
@@ -263,7 +263,7 @@ def design_map_figure(result: Any) -> Any:
         draw_sweep(ax, result, title="")
         for axis, swept in ((ax.xaxis, result.x), (ax.yaxis, result.y)):
             if swept is not None and swept.log:
-                _, factor = display_unit(swept.unit)
+                _, factor = display_unit(swept.unit, swept.values)
                 axis.set_major_formatter(FuncFormatter(plain_tick))
                 axis.set_minor_formatter(NullFormatter())
                 lo, hi = min(swept.values) * factor, max(swept.values) * factor

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..display import percent
+from ..display import AXIS_SCALES, NBSP, axis_unit, percent, quantity
 from ..results.studies import RobustnessResult, StudyResult, SweepResult
 from .blocks import FigureBlock, Section, Table, figure_block
 from .context import build_context, document_context
@@ -14,12 +14,20 @@ from .meta import TITLES
 __all__ = ["sweep_context", "study_context", "robustness_context", "sweep_section"]
 
 
+def _axis_qty(value: Any, axis: Any) -> str:
+    """A value of an axis in the axis's unit where that follows its values (a delay of 1 to
+    2 ms, its design point 1 ms, not 0.001 s), else as :func:`qty` shows it."""
+    if axis.unit not in AXIS_SCALES or value is None:
+        return qty(value, axis.unit)
+    return quantity(value, axis.unit, sep=NBSP, shown=axis_unit(axis.unit, axis.values))
+
+
 def _axis_text(axis: Any) -> str:
     from ..plots import quantity_name
 
     vals = list(axis.values)
     return (f"{quantity_name(axis.path).lower()} ({axis.path}): {len(vals)} values from "
-            f"{qty(vals[0], axis.unit)} to {qty(vals[-1], axis.unit)}"
+            f"{_axis_qty(vals[0], axis)} to {_axis_qty(vals[-1], axis)}"
             f"{' (log)' if axis.log else ''}")
 
 
@@ -51,7 +59,7 @@ def sweep_section(result: SweepResult, sid: str, title: str, lead: str = "",
     paras = [p for p in (lead,) if p]
     axes = [_axis_text(result.x)] + ([_axis_text(result.y)] if result.y is not None else [])
     paras.append(f"Simulated {plant}; " + "; ".join(axes) + ". Design point: "
-                 + ", ".join(qty(v, a.unit) if v is not None else "n/a"
+                 + ", ".join(_axis_qty(v, a) if v is not None else "n/a"
                              for v, a in zip(result.design_point,
                                              [result.x] + ([result.y] if result.y else [])))
                  + ".")
@@ -64,7 +72,8 @@ def sweep_section(result: SweepResult, sid: str, title: str, lead: str = "",
 
         with matplotlib.rc_context(plots.REPORT_RC):
             fig = plots.sweep_figure(result, title="")
-        names = [plots.axis_label(a.path, a.unit) for a in (result.y, result.x) if a is not None]
+        names = [plots.axis_label(a.path, a.unit, a.values) for a in (result.y, result.x)
+                 if a is not None]
         figs = (figure_block(fig, f"Hunting cycles ({plant}) over {' and '.join(names)}.",
                              name=sid),)
     return Section(sid, title, paragraphs=tuple(paras), tables=(table,), figures=figs)

@@ -20,7 +20,7 @@ from . import Spec
 from .errors import describe, real_errors
 
 __all__ = ["with_values", "value_at", "path_unit", "path_description", "parse_path", "path_text",
-           "split_assignment"]
+           "split_assignment", "typed_readings"]
 
 
 # --------------------------------------------------------------------------- dotted-path values
@@ -137,8 +137,48 @@ def path_description(path: str, spec: Spec | None = None) -> str:
     return (getattr(info, "description", None) or "") if info is not None else ""
 
 
-def _leaf(path: str, spec: Spec | None = None) -> tuple[Any, Any]:
-    """The field info (None inside a list entry) and annotation of the value at ``path``."""
+def typed_readings(path: str) -> list[str]:
+    """A path whose index into a list of typed entries only a spec resolves, read by its type.
+
+    ``effects[0].delay`` names a value only once the spec says what entry 0 is;
+    read as each entry type, the rest of the path leaves the types that have it.
+
+    Parameters
+    ----------
+    path : str
+        Dotted path, as for :func:`with_values`.
+
+    Returns
+    -------
+    list of str
+        The path with that index as ``[type=NAME]``, one for each type that has
+        the rest of the path; empty when the path needs no spec or none fits.
+
+    Examples
+    --------
+    >>> typed_readings("effects[0].delay")
+    ['effects[type=time_delay].delay']
+    """
+    found: list[str] = []
+    try:
+        _leaf(path, None, found)
+    except SpecError:
+        pass
+    out = []
+    for reading in found:
+        try:
+            _leaf(reading)
+        except SpecError:
+            continue
+        out.append(reading)
+    return out
+
+
+def _leaf(path: str, spec: Spec | None = None,
+          readings: list[str] | None = None) -> tuple[Any, Any]:
+    """The field info (None inside a list entry) and annotation of the value at ``path``;
+    ``readings`` collects the path read by each entry type where only a spec resolves an index
+    (:func:`typed_readings`)."""
     model: Any = Spec
     instance: Any = spec
     tokens = parse_path(path)
@@ -175,6 +215,11 @@ def _leaf(path: str, spec: Spec | None = None) -> tuple[Any, Any]:
                     inner = inner or type(instance[sel])
                     instance = instance[sel]
                 elif inner is None:
+                    if readings is not None and spec is None:
+                        k = selectors.index(sel)
+                        readings += [path_text(tokens[:n] + [(name, selectors[:k] + [("type", t)]
+                                                              + selectors[k + 1:])]
+                                               + tokens[n + 1:]) for t in _entry_types(ann)]
                     raise SpecError(_unresolved_entry(name, sel, ann, instance, spec),
                                     path=done)
                 else:

@@ -112,6 +112,22 @@ def test_display_units_and_labels():
     assert plots.plain_tick(0.001) == "0.001" and plots.plain_tick(1000.0) == "1000"
 
 
+def test_a_swept_delay_reads_in_ms_and_names_its_path_once():
+    # 'sweep --x "effects[0].delay=1 ms,2 ms"' printed 'effects[0].delay (effects[0].delay): 2
+    # values 0.001 to 0.002 s': no name without the spec's entry type, and the values in SI
+    from fi_design.console.studies import _axis_values_text
+    from fi_design.report.study import _axis_text
+    from fi_design.results.studies import Axis
+
+    delay = Axis(path="effects[0].delay", values=[1e-3, 2e-3], unit="s")
+    assert _axis_values_text(delay) == \
+        "Extra loop delay (effects[0].delay): 2 values 1 to 2 ms (linear)"
+    assert _axis_text(delay).endswith("values from 1\u00a0ms to 2\u00a0ms")
+    assert plots.axis_label(delay.path, delay.unit, delay.values) == "Extra loop delay [ms]"
+    assert plots.display_unit("s", [5.0, 20.0]) == ("s", 1.0)
+    assert plots.quantity_name("effects[0].amplitude") == "Amplitude"  # two types' amplitudes
+
+
 def test_plots_never_use_pyplot():
     """The module imports no pyplot, and drawing a figure does not load it.
 
