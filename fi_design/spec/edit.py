@@ -230,6 +230,8 @@ def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
     buf = io.StringIO()
     yaml.dump(document, buf)
     out = buf.getvalue()
+    if org is not None and org.text is not None:
+        out = _alias_comments(org.text, out)
     if lines:
         import textwrap
 
@@ -242,6 +244,26 @@ def edited_spec_text(spec: Spec, values: Mapping[str, Any] | None = None, *,
         load_spec(data)
     except SpecError as exc:
         raise SpecError(f"the spec to write does not load: {exc.message}", path=exc.path) from None
+    return out
+
+
+#: A line whose value is an alias, with a comment after it: ``cart: *s   # same as the stage``.
+_ALIAS_LINE = re.compile(r"^(?P<head>[^#\n]*\*[^\s,\]}#]+)[ \t]+(?P<comment>#[^\n]*)$", re.M)
+
+
+def _alias_comments(text: str, out: str) -> str:
+    """The comments after aliases put back on their lines.
+
+    ruamel.yaml (0.19) keeps the comment after an alias (``cart: *s   # ...``)
+    as a comment before the next key, and writes it on a line of its own under
+    the alias; each such line that was written unchanged is restored as the
+    file had it.
+    """
+    for m in _ALIAS_LINE.finditer(text):
+        head, comment = m.group("head"), m.group("comment")
+        moved = re.compile(r"^" + re.escape(head) + r"\n[ \t]*" + re.escape(comment.rstrip())
+                           + r"[ \t]*$", re.M)
+        out = moved.sub(lambda _, line=m.group(0): line, out, count=1)
     return out
 
 

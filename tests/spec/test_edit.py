@@ -155,3 +155,14 @@ def test_a_recommended_isolator_and_crossover_written_into_a_spec_without_one():
         if "crossover:" not in line:
             assert line in text, line  # every other line of the input, comments included
     assert "\n\nisolator:\n  stroke: 0.0003 m" in text  # a new section after a blank line
+
+
+def test_a_comment_after_an_alias_stays_on_its_line(tmp_path):
+    # ruamel.yaml writes the comment after 'cart: *s' on a line of its own under it
+    text = (EXAMPLES / "paper_setup.yaml").read_text(encoding="utf-8")
+    text = text.replace("stage: {mass: 1.6 kg}", "stage: &s {mass: 1.6 kg}").replace(
+        "cart: {mass: 0.4 kg}             # m2", "cart: *s   # m2 = m1")
+    spec = tmp_path / "alias.yaml"
+    spec.write_text(text, encoding="utf-8")
+    out = edited_spec_text(load_spec(spec), {"controller.crossover": "9 Hz"})
+    assert "\ncart: *s   # m2 = m1: the bearing cart, friction acts here\n\n" in out, out[:600]
