@@ -90,7 +90,7 @@ def pareto(points: list) -> tuple[dict, ...]:
 
 def _why(p: Any) -> str:
     word = STATUS_WORDS.get(p.status, p.status)
-    return word + (f" ({p.violations[0]})" if p.violations else "")
+    return word + (f" ({p.violations[0].rstrip('.')})" if p.violations else "")
 
 
 #: Statuses of a point nothing is known against: signed off, or kept the margin and not

@@ -99,3 +99,16 @@ def test_the_nearest_infeasible_design_is_the_stiffest_that_kept_the_margin():
     assert nearest(checks + short) is checks[2]
     assert nearest(short) is short[0]  # the most margin, not the stiffest
     assert nearest(short[1:]) is short[1]
+
+
+def test_a_reason_ending_its_sentence_is_not_ended_twice():
+    """The nearest design's advice read "... it rests on its end stop.)." with the reason's
+    own period inside the parenthesis."""
+    from types import SimpleNamespace
+
+    from fi_design.recommend.objective import _why
+
+    point = SimpleNamespace(status="violates", violations=[
+        "step 3 flexure: it sags 0.932 mm of its 0.9 mm stroke: it rests on its end stop."])
+    text = _why(point)
+    assert text.endswith("it rests on its end stop)") and ".)" not in text, text
