@@ -166,7 +166,9 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
                   + flexure_checks(fx, xo.desired if xo.loop_crossover is None
                                    else xo.loop_crossover,
                                    model.requirements.parasitic_separation,
-                                   model.joint.stiffness if model.joint else None)
+                                   model.joint.stiffness if model.joint else None,
+                                   st.maximum if fx is not None and fx.stroke == st.stroke
+                                   else None)
                   + pid.checks)
         result = DesignResult(
             spec=spec, friction_gap=gap, crossover=xo, stiffness=st, flexure=fx, pid=pid,

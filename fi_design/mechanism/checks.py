@@ -7,8 +7,9 @@ checks, the verdict, the report and the console read these checks.
 from __future__ import annotations
 
 from ..display import millimetres as _mm
-from ..display import number, quantity
+from ..display import number, percent, quantity
 from ..results import Check, Status
+from ..results.mechanism import GRAVITY
 from ..results.steps import FlexureResult
 
 __all__ = ["SLENDERNESS", "flexure_checks"]
@@ -28,7 +29,8 @@ SLENDERNESS = 10.0
 
 
 def flexure_checks(fx: FlexureResult | None, crossover: float,
-                   separation: float, joint_stiffness: float | None = None) -> tuple[Check, ...]:
+                   separation: float, joint_stiffness: float | None = None,
+                   k_max: float | None = None) -> tuple[Check, ...]:
     """Step 3's checks of the guide: stiffness, stress, buckling, modes, sag, slenderness.
 
     A leaf shorter than :data:`SLENDERNESS` times its thickness gets a warning
@@ -49,6 +51,11 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
         one step 3 chose). When it is not the guide's own, a check that the guide realises
         it: within the guide's range over the stock's thickness tolerance, widened by
         :data:`STIFFNESS_MATCH`.
+    k_max : float, optional
+        Step 3's largest drive stiffness for the guide's stroke [N/m]. On a vertical drive
+        axis a joint that sags onto its stop is told the window of stiffness that would
+        hold the cart off it within k_max (none when the cart's weight is not below k_max
+        times the stroke, about static friction).
     """
     if fx is None:
         return ()
@@ -97,7 +104,8 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
             "flexure.sag", grav.sag < fx.stroke, grav.sag, fx.stroke, "m",
             f"on the vertical axis the joint carries the cart's weight: it sags "
             f"{_mm(grav.sag)} of its {_mm(fx.stroke)} stroke"
-            + ("" if grav.sag < fx.stroke else ": it rests on its end stop"), step=step))
+            + ("" if grav.sag < fx.stroke else ": it rests on its end stop"
+               + _sag_window(g.cart_mass * GRAVITY, fx.stroke, k_max)), step=step))
     slender = g.length / g.thickness
     if slender < SLENDERNESS:
         out.append(Check(
@@ -109,6 +117,25 @@ def flexure_checks(fx: FlexureResult | None, crossover: float,
             "estimates; measure the guide or model it in FE, or draw longer, thinner leaves",
             step=step, status=Status.WARN))
     return tuple(out)
+
+
+def _sag_window(weight: float, stroke: float, k_max: float | None) -> str:
+    """Where a vertical axis's joint holds the cart off its stop within step 3's limit.
+
+    The sag ``m2 g / k`` stays within the stroke for ``k > m2 g / stroke``; step 3 allows
+    ``k <= k_max`` (about ``Fs / stroke``): a window only while the cart's weight is below
+    ``k_max`` times the stroke, whatever the leaves.
+    """
+    if k_max is None:
+        return ""
+    least = weight / stroke
+    text = (f"; off its stop needs k above m2 g / stroke = {number(least, 4)} N/m (the cart's "
+            f"weight {quantity(weight, 'N', 3)}), and step 3 allows at most k_max = "
+            f"{number(k_max, 4)} N/m")
+    if least >= k_max:
+        return text + (": no joint does both at this stroke; carry the cart's weight "
+                       "otherwise (a counterweight or a preload spring)")
+    return text + f": a window of {percent(k_max / least - 1.0, 2)} above the lower bound"
 
 
 def _realises(fx: FlexureResult, k: float, joint: float, step: str) -> Check:

@@ -595,3 +595,26 @@ def test_the_end_stop_clearance_of_a_vertical_axis_takes_the_sag(paper_spec):
     assert r.margins.end_stop_clearance == pytest.approx(1e-3 - abs(land.deflection) - sag,
                                                          rel=1e-9)
     assert land.clearance() == pytest.approx(1e-3 - abs(land.deflection), rel=1e-12)
+
+
+@pytest.mark.parametrize("cart,window", [("0.4 kg", True), ("0.5 kg", False)])
+def test_a_vertical_axis_that_sags_onto_its_stop_is_told_the_window_of_stiffness(
+        paper_spec, cart, window):
+    """On a vertical drive axis the joint holds the cart off its stop for k > m2 g / stroke;
+    step 3 allows k <= k_max = Fs / stroke: whatever the leaves, a window only while the
+    cart's weight is below static friction. The sag check said only that the joint rests on
+    its stop, and the search then offered the nearest of designs none of which could pass."""
+    from fi_design import design
+    from fi_design.spec.file import with_values
+
+    spec = with_values(paper_spec, {"isolator.flexure.orientation": "vertical_axis",
+                                    "cart.mass": cart})
+    r = design(spec, confirm=False, recommend=False)
+    (sag,) = [c for c in r.checks if c.name == "flexure.sag"]
+    assert not sag.passed
+    m2 = float(cart.split()[0])
+    least = m2 * GRAVITY / 0.3e-3  # N/m: m2 g over the spec's 0.3 mm stroke
+    assert f"{least:.0f} N/m" in sag.message.replace(",", ""), sag.message
+    assert r.stiffness.maximum == pytest.approx(4.0 / 0.3e-3, rel=1e-9)  # Fs / stroke
+    assert ("a window of" in sag.message) == window, sag.message
+    assert ("no joint does both" in sag.message) == (not window), sag.message
