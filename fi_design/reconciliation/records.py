@@ -75,11 +75,9 @@ def check_duration(measured: Measurement, crossover: float) -> None:
 
     Such a record cannot show the loop's dynamics: a replay started from its
     first samples (the controller's state read from the first force sample)
-    has not left them, and the residual is the start's, not the stage's. A
-    60 ms slice of ``examples/measured_trace.csv`` (an 8 Hz loop) named
-    mass_error "nonetheless", 30 ms at 100 kHz called force_N's sign wrong,
-    1 ms at 1 MHz named a force offset of 3 N that the stage does not have
-    (or, thinned to one sample, was refused as "the trace has no duration").
+    has not left them, and the residual is the start's, not the stage's: any
+    effect fitted to it (a mass error, a force offset, a flipped force) would
+    be named for the start alone.
 
     Parameters
     ----------

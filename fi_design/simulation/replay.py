@@ -208,8 +208,7 @@ def check_record(record: Measurement, crossover: float, use: str = "replay") -> 
     (below :data:`RATE_FACTOR` samples per period: over it the record cannot
     show the loop), nothing is known of the stage: the spline invents the
     reference there, the model moves on it, and the comparison after the gap
-    measures the invention (2 s added to ``examples/measured_trace.csv``'s time
-    after row 4000 read as a missing "disturbance (90 %)"). A record that
+    measures the invention (read as a missing disturbance). A record that
     does not hold the stage's motion cannot be replayed either: a jump of the
     position (:func:`~fi_design.measured.check_position_steps`). Shorter
     gaps pass: a logger that changes its rate, or drops a few samples, is
