@@ -46,7 +46,7 @@ except PackageNotFoundError:  # running from a source tree without install
 
 _API = {
     "load_spec": "fi_design.spec.file",
-    "with_values": "fi_design.spec.paths",
+    "with_values": "fi_design.spec.file",
     "Spec": "fi_design.spec",
     "design": "fi_design.signoff",
     "recommend": "fi_design.recommend",

@@ -27,7 +27,8 @@ from ..provenance import json_sha256
 from . import Spec
 from .errors import clean_loc, describe, dotted, real_errors
 # the values at dotted paths live in fi_design.spec.paths; named here as well
-from .paths import path_description, path_unit, value_at, with_values
+from .paths import path_description, path_unit, value_at
+from .paths import with_values as spec_with_values
 
 __all__ = ["SpecOrigin", "load_spec", "as_spec", "origin", "parse_yaml", "yaml_loader",
            "read_bytes", "document_line", "with_values", "value_at", "path_unit",
@@ -197,6 +198,48 @@ def as_spec(spec: Any, name: str = "spec") -> Spec:
         return load_spec(spec)
     raise ArgumentError(f"{name} must be a Spec, a path to a YAML spec or a mapping, got "
                         f"{type(spec).__name__}")
+
+
+def with_values(spec: Spec | str | os.PathLike | Mapping[str, Any],
+                values: Mapping[str, Any]) -> Spec:
+    """Return a copy of a spec with values replaced at dotted paths, re-validated.
+
+    :func:`fi_design.spec.paths.with_values` for what :func:`fi_design.design`
+    takes as its spec (:func:`as_spec`): a script can pass the same mapping or
+    path to each.
+
+    Parameters
+    ----------
+    spec : Spec, str, pathlib.Path or mapping
+        The spec to start from (not changed), or what :func:`load_spec` reads.
+    values : mapping of str to value
+        Dotted path (``"isolator.stroke"``, ``"motion.moves[0].distance"``,
+        ``"effects[type=time_delay].delay"``) to the new value: an SI number or
+        a string with units (``"0.3 mm"``), as the YAML file takes it; None
+        clears an optional value.
+
+    Returns
+    -------
+    Spec
+        A new validated spec, with no file origin.
+
+    Raises
+    ------
+    SpecError
+        An unknown path or a refused value, naming the path and the value.
+    ArgumentError
+        ``spec`` is no spec, path or mapping, or ``values`` is no mapping.
+    SpecFileError
+        ``spec`` names a file that cannot be read.
+
+    Examples
+    --------
+    >>> from fi_design.spec.file import load_spec, with_values
+    >>> spec = load_spec("examples/paper_setup.yaml")
+    >>> with_values(spec, {"isolator.stroke": "0.5 mm"}).isolator.stroke
+    0.0005
+    """
+    return spec_with_values(as_spec(spec), values)
 
 
 def origin(spec: Spec) -> SpecOrigin | None:

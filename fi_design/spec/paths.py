@@ -59,6 +59,10 @@ def with_values(spec: Spec, values: Mapping[str, Any]) -> Spec:
         section the spec does not have (``isolator.stroke`` of a stage without
         isolator), or a value the spec refuses (``friction.static`` below
         ``friction.coulomb``); the message names the path and the value.
+    ArgumentError
+        ``spec`` is no :class:`Spec` (:func:`fi_design.with_values`, which is
+        :func:`fi_design.spec.file.with_values`, also reads a path or a
+        mapping), or ``values`` is no mapping.
 
     Examples
     --------
@@ -69,6 +73,14 @@ def with_values(spec: Spec, values: Mapping[str, Any]) -> Spec:
     """
     from pydantic import ValidationError
 
+    from ..errors import ArgumentError
+
+    if not isinstance(spec, Spec):
+        raise ArgumentError("spec must be a Spec (read a path or a mapping with "
+                            "fi_design.load_spec), got " + type(spec).__name__)
+    if not isinstance(values, Mapping):
+        raise ArgumentError("values must be a mapping of dotted path to value, such as "
+                            "{'isolator.stroke': '0.5 mm'}, got " + type(values).__name__)
     root = _Open(spec)
     for path, value in values.items():
         _assign(root, str(path), _plain_value(value))

@@ -119,6 +119,12 @@ def _calls():
          ArgumentError, ["cache must be a folder", f"{TRACE} is a file"]),
         ("design-cache-file", lambda s, m: fi_design.design(s, cache=TRACE, executor=_NoWork()),
          ArgumentError, ["cache must be a folder"]),
+        # AttributeErrors: type object 'float' has no attribute 'model_fields', 'list' object
+        # has no attribute 'items'
+        ("with-values-number", lambda s, m: fi_design.with_values(5.0, {"stage.mass": 1.0}),
+         ArgumentError, ["spec must be a Spec, a path to a YAML spec or a mapping", "float"]),
+        ("with-values-pairs", lambda s, m: fi_design.with_values(s, [("stage.mass", 1.0)]),
+         ArgumentError, ["values must be a mapping of dotted path to value", "got list"]),
     ]
 
 
@@ -159,3 +165,19 @@ def test_identify_takes_the_spec_mapping_design_takes():
     from_spec = fi_design.identify(measured, fi_design.load_spec(raw))
     assert from_mapping.value("mass") == from_spec.value("mass")
     assert from_mapping.spec == from_spec.spec
+
+
+def test_with_values_takes_the_spec_mapping_and_path_design_takes():
+    """with_values(mapping or path, values) reads the spec as design(mapping) does (it was an
+    AttributeError: type object 'dict' has no attribute 'model_fields')."""
+    import yaml
+
+    import fi_design
+
+    from conftest import EXAMPLES
+
+    path = EXAMPLES / "measured_stage.yaml"
+    raw = yaml.safe_load(path.read_text())
+    for given in (raw, path, str(path)):
+        assert fi_design.with_values(given, {"friction.static": "3 N"}).friction.static == 3.0
+    assert raw["friction"]["static"] != "3 N"  # the mapping is not changed
