@@ -138,12 +138,13 @@ def main(argv: list[str] | None = None) -> int:
         layout_t = phase(layout, args.rounds)
         pdf = tmp / "phases.pdf"
         write_t = phase(write, args.rounds)
-        here_t = phase(lambda: report.render_report(result, pdf, date="2026-01-01"),
+        here_t = phase(lambda: report.render_report(result, pdf, date="2026-01-01", force=True),
                        args.rounds)
 
         def apart():
             with report_pool(pdf) as workers:
-                report.render_report(result, pdf, date="2026-01-01", executor=workers)
+                report.render_report(result, pdf, date="2026-01-01", executor=workers,
+                                     force=True)
 
         apart_t = phase(apart, args.rounds)
         pages = _pages(pdf)

@@ -71,7 +71,7 @@ _WRITTEN: contextvars.ContextVar[tuple] = contextvars.ContextVar("fi_design_outp
 
 def check_output(path: str | os.PathLike, *, force: bool = False,
                  protect: Iterable[str | os.PathLike | None] = (),
-                 extensions: Iterable[str] = ()) -> Path:
+                 extensions: Iterable[str] = (), force_flag: str = "--force") -> Path:
     """Refuse an output path before the work starts.
 
     Parameters
@@ -88,6 +88,9 @@ def check_output(path: str | os.PathLike, *, force: bool = False,
     extensions : iterable of str, optional
         Allowed suffixes, e.g. ``(".json",)`` or ``(".html", ".pdf")``;
         compared case-insensitively. Empty: any suffix.
+    force_flag : str, optional
+        How the caller allows overwriting, for the messages: ``"--force"`` (the
+        command line), ``"force=True"`` (a library function).
 
     Returns
     -------
@@ -106,7 +109,7 @@ def check_output(path: str | os.PathLike, *, force: bool = False,
             continue
         if _same_file(out, Path(other)):
             raise OutputError(f"{out}: refusing to overwrite the input file {other} "
-                              "(not even with --force); choose another output name")
+                              f"(not even with {force_flag}); choose another output name")
     if out.is_dir():
         raise OutputError(f"{out}: is a directory; give a file name")
     if exts and out.suffix.lower() not in exts:
@@ -121,11 +124,30 @@ def check_output(path: str | os.PathLike, *, force: bool = False,
         raise OutputError(f"{out}: directory {parent} is not writable")
     if out.exists() or out.is_symlink():
         if not force:
-            raise OutputError(f"{out}: file exists; use --force to overwrite it")
+            raise OutputError(f"{out}: file exists; use {force_flag} to overwrite it")
         if out.exists() and not out.is_file():
             raise OutputError(f"{out}: exists and is not a regular file")
     _claim(out, force)
     return out
+
+
+def claimed(path: str | os.PathLike) -> bool:
+    """Whether the current run has checked ``path`` (:func:`check_output`) and so owns it.
+
+    A library function that writes a file checks it itself unless its caller
+    (the command line) did, with the user's ``--force``; the claim then
+    decides at the move what may be replaced.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file.
+
+    Returns
+    -------
+    bool
+    """
+    return os.path.realpath(path) in (_CLAIMS.get() or {})
 
 
 def _claim(out: Path, force: bool) -> None:

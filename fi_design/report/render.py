@@ -393,10 +393,30 @@ def _self_contained(figures: Any = None, *, stand_ins: bool = True) -> Any:
     return Fetcher(allowed_protocols={"data"}, fail_on_errors=True)
 
 
+def _checked_output(out: Path, force: bool, write: Callable[[], Path]) -> Path:
+    """``write()`` a report at ``out`` that the current run has not checked (a library call):
+    :func:`~fi_design.output.check_output` first (an existing file refused without
+    ``force``, a directory or a missing folder at once), in a context of its own, so that
+    the claim is this call's and the next call to the same path checks again. A path the
+    run checked (the command line, with its ``--force``) is written as its claim allows."""
+    import contextvars
+
+    from ..output import check_output, claimed
+
+    if claimed(out):
+        return write()
+
+    def checked() -> Path:
+        check_output(out, force=force, extensions=tuple(FORMATS), force_flag="force=True")
+        return write()
+
+    return contextvars.copy_context().run(checked)
+
+
 def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
                   command: str | None = None, design_map: Any = None,
                   progress: Callable[[str], None] | None = None,
-                  executor: Any = None) -> Path:
+                  executor: Any = None, force: bool = False) -> Path:
     """Write the report of a result as HTML or PDF (chosen by the extension).
 
     Presentation only: every number comes from ``result`` (and
@@ -410,8 +430,9 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
         object with ``report_sections()`` and ``report_title`` is rendered as
         a generic document.
     path : str or os.PathLike
-        Output file, ``.html`` or ``.pdf``; an existing file is replaced
-        (atomically). Any other extension raises before any work.
+        Output file, ``.html`` or ``.pdf``, written atomically. Any other
+        extension, an existing file without ``force``, a directory or a missing
+        folder raises before any work.
     date : str or datetime.date, optional
         Report date; default today (or ``SOURCE_DATE_EPOCH``).
     command : str, optional
@@ -428,6 +449,9 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
         for a figure only when it reaches it. None draws them here as the
         layout reaches them. An HTML report's figures are drawn there from the
         first and here from the last at once (the same SVG).
+    force : bool, optional
+        Replace an existing file. Default False: an existing file is refused
+        (``OutputError``), as the command line refuses it without ``--force``.
 
     Returns
     -------
@@ -437,12 +461,19 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     Raises
     ------
     fi_design.errors.OutputError
-        The extension is not .html or .pdf, or the file cannot be written.
+        The extension is not .html or .pdf, the file exists and ``force`` is
+        False, or the file cannot be written.
     fi_design.errors.ReportError
         ``result`` is of a kind there is no report for (a ``TypeError`` too).
     """
     out = Path(path)
     fmt = output_format(out)
+    from ..output import claimed
+
+    if not claimed(out):  # checked first, then this call again as the path's owner
+        return _checked_output(out, force, lambda: render_report(
+            result, out, date=date, command=command, design_map=design_map,
+            progress=progress, executor=executor, force=force))
     if progress is not None:
         progress("drawing the report's figures ...")
     options = {} if design_map is None else {"design_map": design_map}
@@ -648,7 +679,7 @@ class _Figures:
 
 def render_document(path: str | os.PathLike, *, title: str, spec: Any, sections: Any,
                     date: Any = None, command: str | None = None, kind: str = "report",
-                    conclusion: str = "") -> Path:
+                    conclusion: str = "", force: bool = False) -> Path:
     """Write a generic report (HTML or PDF) from :class:`~fi_design.report.blocks.Section` values.
 
     The other commands' reports use this: the same title block, page layout,
@@ -658,7 +689,8 @@ def render_document(path: str | os.PathLike, *, title: str, spec: Any, sections:
     Parameters
     ----------
     path : str or os.PathLike
-        ``.html`` or ``.pdf``.
+        ``.html`` or ``.pdf``, written atomically; an existing file is refused
+        without ``force``.
     title : str
         Report title.
     spec : fi_design.spec.Spec
@@ -673,6 +705,8 @@ def render_document(path: str | os.PathLike, *, title: str, spec: Any, sections:
         Short kind of report.
     conclusion : str, optional
         A summary paragraph shown first.
+    force : bool, optional
+        Replace an existing file (default False: refused with ``OutputError``).
 
     Returns
     -------
@@ -682,12 +716,17 @@ def render_document(path: str | os.PathLike, *, title: str, spec: Any, sections:
     Raises
     ------
     fi_design.errors.OutputError
-        Wrong extension or the file cannot be written.
+        Wrong extension, the file exists and ``force`` is False, or the file
+        cannot be written.
     """
     from .context import document_context
 
     out = Path(path)
     output_format(out)
-    ctx = document_context(title, spec, sections, date=date, command=command, kind=kind,
-                           conclusion=conclusion)
-    return write_document(render_html(ctx), out)
+
+    def write() -> Path:
+        ctx = document_context(title, spec, sections, date=date, command=command, kind=kind,
+                               conclusion=conclusion)
+        return write_document(render_html(ctx), out)
+
+    return _checked_output(out, force, write)

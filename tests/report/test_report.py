@@ -454,7 +454,8 @@ def design_pdf_written(paper_confirmed_design):
         patch.setattr(weasyprint.Document, "write_pdf", write_pdf)
         patch.setattr(render, "write_document", write_document)
         patch.setattr(render._Figures, "png", png)
-        report.render_report(paper_confirmed_design, out, date=DATE, command=COMMAND)
+        report.render_report(paper_confirmed_design, out, date=DATE, command=COMMAND,
+                             force=True)  # the artifact of an earlier run replaced
     assert written and len(pages) == 1, "no PDF was written"
     assert sorted(drawn) == sorted(placed), "a figure placed but not drawn, or drawn twice"
     return out, written[-1], pages[0], {name: drawn[name] for name in placed}
@@ -1340,6 +1341,28 @@ def test_render_report_refuses_other_extensions_and_kinds(tmp_path, paper_confir
     with pytest.raises(ReportError, match="no report for a object"):
         report.render_report(object(), tmp_path / "r.html")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_report_from_the_library_keeps_an_existing_file_without_force(tmp_path, paper_spec):
+    """render_report and render_document replaced any existing file (a user's notes, an
+    earlier report) without a word; they refuse it now, before any work, as the command line
+    does without --force, and replace it with force=True. Each call checks again."""
+    out = tmp_path / "notes.html"
+    out.write_text("my notes", encoding="utf-8")
+    with pytest.raises(OutputError, match="file exists; use force=True to overwrite it"):
+        report.render_report(object(), out)  # refused before the result is looked at
+    with pytest.raises(OutputError, match="file exists"):
+        report.render_document(out, title="x", spec=paper_spec, sections=[])
+    assert out.read_text(encoding="utf-8") == "my notes"
+    folder = tmp_path / "folder.html"
+    folder.mkdir()
+    with pytest.raises(OutputError, match="is a directory"):
+        report.render_report(object(), folder, force=True)
+    assert report.render_document(out, title="x", spec=paper_spec, sections=[], date=DATE,
+                                  force=True) == out
+    assert "<html" in out.read_text(encoding="utf-8")
+    with pytest.raises(OutputError, match="file exists"):  # its own file too, without force
+        report.render_document(out, title="x", spec=paper_spec, sections=[])
 
 
 def test_public_api_exports_render_report():
