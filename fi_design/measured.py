@@ -50,7 +50,7 @@ from typing import IO, Mapping
 import numpy as np
 
 from .display import number, percent, plain, quantity
-from .errors import DataError
+from .errors import ArgumentError, DataError
 from .results import dataclass_dict, frozen_array
 
 #: Required columns, in the order of the layout.
@@ -436,6 +436,9 @@ def load_measurement(path: str | os.PathLike) -> Measurement:
         (missing or duplicate column, a header with another unit, a cell that is
         not a plain number, NaN, a time that does not increase, too few rows);
         the message names the file, column and 1-based data row.
+    ArgumentError
+        ``path`` is no path (None, a number, bytes, a table), or is the CSV
+        text itself rather than a path to it.
 
     Examples
     --------
@@ -444,9 +447,22 @@ def load_measurement(path: str | os.PathLike) -> Measurement:
     >>> m.columns
     ('time_s', 'reference_m', 'position_m', 'force_N', 'deflection_m')
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise ArgumentError("path must be the path of a CSV file (a str or os.PathLike), got "
+                            + type(path).__name__ + _FROM_ARRAYS)
+    if isinstance(path, str) and ("\n" in path or "\r" in path):
+        first = path.strip().splitlines()[0] if path.strip() else ""
+        shown = first if len(first) <= 40 else first[:37] + "..."
+        raise ArgumentError(f"path looks like CSV text ({shown!r}), not a path: load_measurement "
+                            "takes the path of a CSV file; write the text to a file"
+                            + _FROM_ARRAYS)
     p = Path(path)
     src = str(p)
-    if not p.exists():
+    try:
+        exists = p.exists()
+    except OSError as exc:  # a name too long for the file system
+        raise DataError(f"cannot read ({exc.strerror})", source=src) from None
+    if not exists:
         raise DataError("no such file", source=src)
     if p.is_dir():
         raise DataError("is a directory, expected a CSV file", source=src)
@@ -467,6 +483,11 @@ def load_measurement(path: str | os.PathLike) -> Measurement:
     except OSError as exc:
         raise DataError(f"cannot read ({exc.strerror})", source=src) from None
     return _checked(arrays, src)
+
+
+#: How a record held in arrays becomes a Measurement, for the messages of load_measurement.
+_FROM_ARRAYS = (" (a record held in arrays: fi_design.measured.measurement_from_arrays(time_s, "
+                "reference_m, position_m, ...))")
 
 
 def _not_utf8(path: Path, source: str) -> DataError:

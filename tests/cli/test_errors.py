@@ -121,6 +121,13 @@ def _calls():
          ArgumentError, ["cache must be a folder"]),
         # AttributeErrors: type object 'float' has no attribute 'model_fields', 'list' object
         # has no attribute 'items'
+        # TypeErrors ('expected str, bytes or os.PathLike object, not float'), and an
+        # OSError 'File name too long' for the CSV text itself
+        ("load-measurement-number", lambda s, m: fi_design.load_measurement(5.0),
+         ArgumentError, ["path must be the path of a CSV file", "got float",
+                         "measurement_from_arrays"]),
+        ("load-measurement-csv-text", lambda s, m: fi_design.load_measurement(
+            TRACE_TEXT * 2), ArgumentError, ["looks like CSV text", "not a path"]),
         ("with-values-number", lambda s, m: fi_design.with_values(5.0, {"stage.mass": 1.0}),
          ArgumentError, ["spec must be a Spec, a path to a YAML spec or a mapping", "float"]),
         ("with-values-pairs", lambda s, m: fi_design.with_values(s, [("stage.mass", 1.0)]),
@@ -130,6 +137,8 @@ def _calls():
 
 #: A file, not a folder, given as a cache.
 TRACE = str(EXAMPLES / "measured_trace.csv")
+#: The start of its text (a path's length runs out at 4096 bytes).
+TRACE_TEXT = (EXAMPLES / "measured_trace.csv").read_text(encoding="utf-8")[:3000]
 
 
 @pytest.mark.parametrize("case", range(len(_calls())), ids=[c[0] for c in _calls()])
