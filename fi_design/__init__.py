@@ -64,7 +64,14 @@ _API = {
     "render_report": "fi_design.report",
     "FiDesignError": "fi_design.errors",
     "SpecError": "fi_design.errors",
+    "UnitError": "fi_design.errors",
+    "SpecFileError": "fi_design.errors",
     "DataError": "fi_design.errors",
+    "ArgumentError": "fi_design.errors",
+    "ReportError": "fi_design.errors",
+    "OutputError": "fi_design.errors",
+    "CacheError": "fi_design.errors",
+    "SimulationError": "fi_design.errors",
 }
 
 __all__ = sorted(_API) + ["__version__"]

@@ -378,3 +378,17 @@ def test_the_studies_points_take_a_model():
                  lambda: with_isolator(spec, 3e-4, 5000.0)):
         with pytest.raises(ArgumentError, match="expected a Model, got Spec"):
             call()
+
+
+def test_every_library_error_is_a_public_name():
+    """docs/library.md names ArgumentError and OutputError as the errors a script catches;
+    `fi_design.ArgumentError` raised AttributeError (only fi_design.errors had it)."""
+    import inspect
+
+    import fi_design
+    from fi_design import errors
+
+    kinds = {name for name, obj in vars(errors).items()
+             if inspect.isclass(obj) and issubclass(obj, errors.FiDesignError)}
+    assert kinds <= set(fi_design.__all__), kinds - set(fi_design.__all__)
+    assert all(getattr(fi_design, name) is getattr(errors, name) for name in kinds)
