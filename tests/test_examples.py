@@ -36,3 +36,14 @@ def test_example_script_runs(script, tmp_path):
                        timeout=600, cwd=tmp_path)
     assert p.returncode == 0, p.stdout + p.stderr
     assert p.stdout.strip(), "an example should print what it computed"
+
+
+def test_the_trace_script_keeps_an_existing_file(tmp_path):
+    """examples/make_measured_trace.py OUT replaced OUT (a spec, a user's record) without a
+    word; it now keeps it unless --force is given."""
+    out = tmp_path / "mine.csv"
+    out.write_text("a user's record\n")
+    p = subprocess.run([sys.executable, str(EXAMPLES / "make_measured_trace.py"), str(out)],
+                       capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert p.returncode != 0 and "file exists; give --force" in p.stderr, p.stderr
+    assert out.read_text() == "a user's record\n"
