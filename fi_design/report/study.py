@@ -176,8 +176,66 @@ def robustness_context(result: RobustnessResult, *, date: Any = None,
         figs = (figure_block(fig, "Probability of hunting with its confidence interval.",
                              name="robustness", width="half"),)
     sections = [Section("robustness", "Probability of hunting",
-                        paragraphs=(f"{result.samples} samples of the spec with its values "
-                                    "drawn around the nominal ones.",),
-                        tables=(table,), figures=figs)]
+                        paragraphs=(_robustness_lead(result),),
+                        tables=(_scatter_table(result), table, _verdict_table(result)),
+                        figures=figs)]
     return document_context(TITLES["robustness"], result.spec, sections, date=date,
                             command=command, kind="robustness", source=result.fi_design_source)
+
+
+#: What one sample's verdict judges, by the study's measure.
+_MEASURES = {"stage": "after every move of its family (it hunts when some move ends in a "
+                      "hunting cycle)",
+             "move": "after the spec's own move, by the paper's metric"}
+
+
+def _robustness_lead(result: RobustnessResult) -> str:
+    """What a robustness study drew and how it judged: the paragraph above its tables."""
+    samples = result.samples
+    ripple = ""
+    if result.position_friction is not None:
+        pf = result.position_friction
+        ripple = (f"; friction varies along the rail by {percent(pf.amplitude, 3)} with a "
+                  f"{qty(pf.wavelength, 'm')} wavelength, at a phase each sample draws")
+    conf = result.not_isolated.confidence
+    plants = ("with and without the isolator" if result.isolated is not None
+              else "without isolator (the spec has none)")
+    return (f"{num(samples)} sample{'s' if samples != 1 else ''} of the spec, each value "
+            f"below drawn from a {result.distribution} distribution around its nominal value "
+            f"(seed {result.seed}){ripple}; each sample simulated {plants} and judged "
+            f"{_MEASURES.get(result.measure, result.measure)}. The "
+            f"probability is among the valid samples, with its {percent(conf, 2)} Wilson "
+            "interval.")
+
+
+def _scatter_table(result: RobustnessResult) -> Table:
+    """The scattered spec values with their spreads, as the console prints them."""
+    from ..spec.file import path_unit
+
+    rows = []
+    for sc in result.scatter:
+        if sc.relative:
+            spread = f"{percent(sc.spread, 3)} of nominal"
+        else:
+            try:
+                unit = path_unit(sc.path, result.spec)
+            except Exception:  # noqa: BLE001 -- a spread we cannot name a unit for, bare
+                unit = ""
+            spread = qty(sc.spread, unit)
+        rows.append((sc.path + (f" ({sc.meaning})" if sc.meaning else ""), spread))
+    width = "half-width" if result.distribution == "uniform" else "standard deviation"
+    return Table(("Spec value", f"Spread ({width})"), tuple(rows),
+                 caption="Scattered spec values")
+
+
+def _verdict_table(result: RobustnessResult) -> Table:
+    """Every sample counted by its verdict, per plant."""
+    plants = [(label, p) for label, p in (("with isolator", result.isolated),
+                                          ("without isolator", result.not_isolated))
+              if p is not None]
+    verdicts = [v for v in ("settled", "hunting", "stuck", "undetermined", "buckled",
+                            "invalid", "failed")
+                if v != "buckled" or any(p.counts.get(v, 0) for _, p in plants)]
+    rows = tuple((v, *(num(p.counts.get(v, 0)) for _, p in plants)) for v in verdicts)
+    return Table(("Verdict", *(label for label, _ in plants)), rows,
+                 caption="Samples per verdict")

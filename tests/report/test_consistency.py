@@ -334,3 +334,39 @@ def test_the_nonlinear_tables_have_one_unit_per_column(ctx, paper_confirmed_desi
                   "Final error x1 - r [mm]"):
         row = next(line for line in text.splitlines() if line.strip().startswith(title))
         assert "\u00b5m" not in row and " mm" not in row.replace(title, ""), row
+
+
+@pytest.fixture(scope="module")
+def robustness_ctx(paper_spec) -> dict:
+    """The report context of a one-sample robustness study of the paper setup (about a
+    second: one sample, with and without the isolator), with an absolute spread beside a
+    relative one and a uniform distribution."""
+    from fi_design.studies import Scatter, robustness
+
+    result = robustness(paper_spec, [Scatter("friction.static", 0.1),
+                                     Scatter("stage.mass", 0.05, relative=False)],
+                        samples=1, seed=3, distribution="uniform", confidence=0.9)
+    return report.build_context(result, date=DATE, figures=False)
+
+
+def _cells(table: dict) -> list[list[str]]:
+    return [[cell["text"] for cell in row] for row in table["rows"]]
+
+
+def test_the_robustness_report_states_what_scattered(robustness_ctx):
+    """The robustness report said only '1 samples of the spec with its values drawn around the
+    nominal ones': not which values, by how much, in which distribution, with which seed, nor
+    the confidence of its interval or the samples per verdict, all of which the console
+    prints; a checker could not tell what the probability is of."""
+    section = robustness_ctx["robustness"]
+    text = " ".join(section["paragraphs"])
+    assert "1 samples" not in text
+    assert "uniform" in text and "seed 3" in text and "90 % Wilson interval" in text
+    scatter = next(t for t in section["tables"] if t["caption"].startswith("Scattered"))
+    assert [c["text"] for c in scatter["columns"]] == ["Spec value", "Spread (half-width)"]
+    assert _cells(scatter) == [["friction.static", "10 % of nominal"],
+                               ["stage.mass", "0.05\u00a0kg"]]
+    verdicts = next(t for t in section["tables"] if t["caption"].startswith("Samples per"))
+    rows = dict((r[0], r[1:]) for r in _cells(verdicts))
+    assert set(rows) >= {"settled", "hunting", "stuck", "undetermined", "invalid", "failed"}
+    assert sum(int(v[0]) for v in rows.values()) == 1
