@@ -489,6 +489,25 @@ def test_pdf_opens_with_page_numbers_and_key_numbers(design_pdf):
                         str(_artifacts() / "report-page")], check=True, timeout=120)
 
 
+@needs_poppler
+def test_pdf_contents_give_each_section_s_page(design_pdf):
+    """The PDF's contents listed the twelve sections without a page number (26 pages, no
+    reader of the paper can follow a link): each entry now ends with the page its section's
+    heading stands on."""
+    text = subprocess.run(["pdftotext", "-layout", str(design_pdf), "-"], capture_output=True,
+                          text=True, check=True, timeout=120).stdout
+    pages = [[re.sub(r"\s+", " ", line.strip()) for line in page.splitlines() if line.strip()]
+             for page in text.replace(NNBSP, " ").replace(NBSP, " ").split("\f")]
+    entries = [re.fullmatch(r"(\d+)\. (.+?)[ .]*?\s(\d+)", line)
+               for line in pages[0][pages[0].index("Contents") + 1:]]
+    listed = [(m.group(1), m.group(2).rstrip(" ."), int(m.group(3))) for m in entries if m]
+    assert len(listed) >= 10, pages[0]
+    for number, title, page in listed:
+        heading = f"{number} {title}"
+        assert heading in pages[page - 1], (heading, page)
+        assert not any(heading in lines for lines in pages[:page - 1]), (heading, page)
+
+
 def _page_leaves(box, in_heading=False):
     """(box, inside a heading) for every leaf box of a laid-out page, in document order."""
     tag = getattr(box, "element_tag", None)
