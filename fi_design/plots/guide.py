@@ -90,7 +90,8 @@ def guide_figure(mech: Any, body_size: tuple[float, float, float] | None = None)
     side.add_patch(Rectangle((-0.5 * sx, stage_z), sx, sz, fc=_STAGE, ec="0.3", lw=0.8))
     zc = sgn * (L + h)
     side.plot([0.0], [zc], marker="o", ms=5, mfc="white", mec="k", mew=1.0)
-    side.text(-0.03 * span, zc, "centre of mass", fontsize=7.0, va="center", ha="right")
+    # above its marker: to its left the label ran across the actuator's arrow and its word
+    side.text(0.0, zc + 0.04 * span, "centre of mass", fontsize=7.0, va="bottom", ha="center")
     ys, zs = (_mm(v) for v in g.sensor_offset)
     ya, za = (_mm(v) for v in g.actuator_offset)
     side.plot([0.5 * sx], [zc + sgn * zs], marker="<", ms=6, color="k")
@@ -107,8 +108,8 @@ def guide_figure(mech: Any, body_size: tuple[float, float, float] | None = None)
         side.text(0.03 * span, zc - 0.15 * span, weight, color=_GRAVITY, fontsize=7.5)
     elif g.orientation == "vertical_axis":
         side.annotate("", xy=(-0.3 * span, zc), xytext=(0.0, zc), arrowprops=arrow)
-        side.text(-0.3 * span, zc + 0.04 * span, weight + " (x vertical)", color=_GRAVITY,
-                  fontsize=7.5)
+        side.text(-0.3 * span, zc - 0.1 * span, weight + " (x vertical)", color=_GRAVITY,
+                  fontsize=7.5, va="top")
     else:
         side.plot([0.0], [zc - 0.15 * span], marker="X", ms=7, color=_GRAVITY)
         side.text(0.03 * span, zc - 0.15 * span, weight + ", into the page (along \u2212y)",

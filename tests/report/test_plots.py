@@ -290,3 +290,27 @@ def test_captions_say_only_what_is_drawn(reconciliation, paper_confirmed_design)
     assert "dotted" not in caption
     full = _error_caption(paper_confirmed_design.simulation, paper_confirmed_design.spec)
     assert "circles, the peaks the metric counts" in full and "dotted" in full
+
+
+@pytest.mark.parametrize("orientation", ["standing", "hanging", "vertical_axis", "flat"])
+def test_the_guide_s_labels_do_not_overlap(paper_confirmed_design, orientation):
+    """The side view wrote 'centre of mass' to the left of its marker, across the actuator's
+    arrow and over the word 'actuator' (the paper setup: sensor, actuator and centre of mass
+    at one height); no two texts of the drawing overlap now, whichever way gravity acts."""
+    import dataclasses
+
+    mech = paper_confirmed_design.flexure.mechanics
+    mech = dataclasses.replace(mech, guide=dataclasses.replace(mech.guide,
+                                                               orientation=orientation))
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = plots.guide_figure(mech)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    for ax in fig.axes:
+        boxes = [(t.get_text(), t.get_window_extent(renderer)) for t in ax.texts
+                 if t.get_text().strip()]
+        for i, (a, box_a) in enumerate(boxes):
+            for b, box_b in boxes[i + 1:]:
+                assert not box_a.overlaps(box_b), (a, b)
