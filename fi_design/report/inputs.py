@@ -19,7 +19,20 @@ _DERIVED: dict[str, tuple[str, Callable[[Any], float]]] = {
                          lambda m: m.joint.damping),
     "isolator.limiter.damping": ("2 \u00b7 0.2 \u00b7 sqrt(k_stop m1)",
                                  lambda m: m.limiter.damping),
+    "requirements.robustness.stiffness": ("the flexure's stock thickness tolerance, k going "
+                                          "with t\u00b3 (5 % without a sized flexure)",
+                                          lambda m: _stiffness_spread(m)),
 }
+
+
+def _stiffness_spread(model: Any) -> float:
+    """The drive stiffness's scatter the robustness study draws [-] (AttributeError without
+    an isolator: none scatters, the row reads "not given" as the other joint rules')."""
+    from ..guideline.verdict import stiffness_spread
+
+    if model.joint is None:
+        raise AttributeError("no isolator")
+    return stiffness_spread(model)
 
 
 _MISSING = object()

@@ -1483,6 +1483,21 @@ def test_the_inputs_table_lists_values_with_commas_and_ranges_with_a_dash(paper_
     assert rows["isolator.flexure.length"] == "10 \u2013 60\u00a0mm"
 
 
+def test_the_inputs_give_the_stiffness_scatter_the_study_drew(paper_confirmed_design):
+    """Analysis settings read requirements.robustness.stiffness as '- / not given' while the
+    verdict and the assumptions said the study scattered k by 6 % (the flexure's stock
+    tolerance): the report contradicted itself. The row now gives the derived default."""
+    from fi_design.model import resolve
+    from fi_design.report.inputs import spec_inputs
+
+    r = paper_confirmed_design
+    drawn = r.robustness.scatter["isolator.stiffness"]
+    rows = {row["path"]: row for g in spec_inputs(r.spec, resolve(r.spec)) for row in g["rows"]}
+    row = rows["requirements.robustness.stiffness"]
+    assert row["value"] == pytest.approx(drawn, rel=1e-12) and drawn == pytest.approx(0.06)
+    assert row["source"].startswith("derived default: the flexure's stock thickness tolerance")
+
+
 def test_step3_says_the_resting_deflection_was_not_determined_when_the_run_failed(
         paper_confirmed_design):
     """A run that did not complete (diverged: its traces end in nan) showed 'n/a' for the
