@@ -277,11 +277,12 @@ def held_damping_note(model: Model, axes: Sequence[Axis]) -> str | None:
         return None
     ratios = [model.varied({a.path: v}).joint_damping_ratio for a in moving
               for v in (float(np.min(a.values)), float(np.max(a.values)))]
+    if max(ratios) - min(ratios) <= 1e-6 * max(ratios):
+        return None  # the joint's stiffness and masses stay (a stroke with a given stiffness)
     return (f"isolator.damping is given ({quantity(iso.damping, 'N*s/m')}) and held as "
             f"{', '.join(a.path for a in moving)} varies: the joint's damping ratio runs "
             f"from {number(min(ratios), 3)} to {number(max(ratios), 3)} over the axes (leave "
             "the key out to keep the ratio of the default instead)")
-
 
 
 def crossover_note(axes: Sequence[Axis]) -> str | None:

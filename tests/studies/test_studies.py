@@ -693,3 +693,19 @@ def test_the_scatter_seed_is_a_whole_number_of_zero_or_more(paper_spec, seed):
 
     with pytest.raises(ArgumentError, match="seed must be a whole number of 0 or more"):
         robustness(paper_spec, [parse_scatter("friction.static=10%")], samples=2, seed=seed)
+
+
+def test_the_held_damping_note_speaks_only_when_the_ratio_moves(paper_spec):
+    """With isolator.stiffness and isolator.damping given, a stroke axis leaves the joint as
+    it is, yet the map said 'the joint's damping ratio runs from 0.05 to 0.05 over the
+    axes'; a stiffness axis moves the ratio, and the note stays."""
+    from fi_design.model import resolve
+    from fi_design.studies.axes import held_damping_note, make_axis
+
+    model = resolve(paper_spec)
+    assert paper_spec.isolator.stiffness and paper_spec.isolator.damping
+    stroke = make_axis("isolator.stroke", [0.1e-3, 0.9e-3], spec=paper_spec)
+    assert held_damping_note(model, [stroke, None]) is None
+    stiffness = make_axis("isolator.stiffness", [2000.0, 8000.0], spec=paper_spec)
+    note = held_damping_note(model, [stroke, stiffness])
+    assert note is not None and "isolator.stiffness" in note and "runs from" in note
