@@ -359,11 +359,12 @@ def verdict(result: Any) -> dict:
     cases = {c.name: c for c in result.loop.cases}
     rows = [check_row(c, cases) for c in result.checks]
     counts = {s.value: sum(1 for r in rows if r["status"] == s.value) for s in Status}
-    groups: list[dict] = []
+    by_step: dict[str, dict] = {}  # one group per step, in the order steps first appear
     for row, check in zip(rows, result.checks):
-        if not groups or groups[-1]["step"] != check.step:
-            groups.append({"step": check.step, "title": _step_title(check.step), "rows": []})
-        groups[-1]["rows"].append(row)
+        group = by_step.setdefault(check.step, {"step": check.step,
+                                                "title": _step_title(check.step), "rows": []})
+        group["rows"].append(row)
+    groups = list(by_step.values())
     css = {"PASS": "pass", "PASS_WITH_WARNINGS": "warn", "NOT_CONFIRMED": "warn",
            "FAIL": "fail"}[v.status]
     behaviour_css, stamp = BEHAVIOUR[v.behaviour]

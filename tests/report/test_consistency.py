@@ -370,3 +370,14 @@ def test_the_robustness_report_states_what_scattered(robustness_ctx):
     rows = dict((r[0], r[1:]) for r in _cells(verdicts))
     assert set(rows) >= {"settled", "hunting", "stuck", "undetermined", "invalid", "failed"}
     assert sum(int(v[0]) for v in rows.values()) == 1
+
+
+def test_the_checks_table_has_one_group_per_step(paper_confirmed_design):
+    """The checks table headed 'Nonlinear confirmation (simulated hunting)' twice, split by
+    the step 3 refinement's group: its groups followed the checks' order, not their steps."""
+    from fi_design.report.checks import verdict
+
+    groups = verdict(paper_confirmed_design)["groups"]
+    steps = [g["step"] for g in groups]
+    assert len(steps) == len(set(steps)), steps
+    assert sum(len(g["rows"]) for g in groups) == len(paper_confirmed_design.checks)
