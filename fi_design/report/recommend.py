@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..display import NBSP, quantity
+from ..display import NBSP, quantities, quantity
 from ..results.recommend import RecommendResult
 from .blocks import FigureBlock, Section, Table, figure_block
 from .context import build_context, document_context
@@ -83,7 +83,7 @@ def recommend_context(result: RecommendResult, *, date: Any = None, command: str
     head = "Recommended design" if result.feasible else "Nearest design (none passes)"
     table = Table(("Quantity", "As specified", "Recommended" if result.feasible else "Nearest"),
                   _design_rows(result), caption=head)
-    paras = [result.advice]
+    paras = []  # the advice itself is the document's summary (its conclusion), not repeated
     if result.binding:
         paras.append("What binds it: " + "; ".join(result.binding) + ".")
     paras += [f"On a bound: {n.text}." for n in result.flexure_bounds]
@@ -127,7 +127,8 @@ def recommend_context(result: RecommendResult, *, date: Any = None, command: str
     space = Table(("Status", "Points"), tuple((plots.CANDIDATE_LOOK.get(k, (None, k))[1], num(v))
                                               for k, v in counts.items()),
                   caption="Points of the design space")
-    method = (f"Strokes from {qty(result.strokes[0], 'm')} to {qty(result.strokes[-1], 'm')} "
+    shortest, longest = quantities([result.strokes[0], result.strokes[-1]], "m", sep=NBSP)
+    method = (f"Strokes from {shortest} to {longest} "
               "(log-spaced, widened towards the envelope while the best design lay on the "
               "range's edge), at each up to k_max = Fs / stroke; each point a guide sized from "
               "stock (stress, buckling, every parasitic mode at the separation times the "

@@ -520,6 +520,23 @@ def test_the_console_and_the_report_show_k_over_the_stock_tolerance(paper_recomm
     assert "k over the leaves' tolerance (\u00b10.01\u00a0mm)" in ctx and f"{number(lo)} to " in ctx
 
 
+def test_the_report_says_the_advice_once_and_the_strokes_in_one_unit(paper_recommendation):
+    """The recommend report printed its advice as the summary and again as the first paragraph
+    of 'Recommended design', and its method read 'Strokes from 100 µm to 2.916 mm'."""
+    from datetime import date
+
+    from fi_design.display import quantities
+    from fi_design.report import build_context
+
+    r = paper_recommendation
+    ctx = json.dumps(build_context(r, date=date(2024, 5, 1), figures=False), default=str,
+                     ensure_ascii=False)
+    assert ctx.count(json.dumps(r.advice, ensure_ascii=False)[1:-1]) == 1
+    shortest, longest = quantities([r.strokes[0], r.strokes[-1]], "m", sep="\u00a0")
+    assert f"Strokes from {shortest} to {longest} " in ctx
+    assert shortest.split("\u00a0")[1] == longest.split("\u00a0")[1]
+
+
 @pytest.mark.slow
 def test_the_least_change_keeps_within_the_bounds_the_user_set(repo_root):
     """requirements.recommend.stroke of 2 to 3 mm (the travel the mechanism allows): the
