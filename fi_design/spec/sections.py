@@ -619,7 +619,7 @@ class DocumentIds(StrictModel):
     identify: Text | None = Field(None, min_length=1, description="Document id of an "
                                                                  "identification report. Default "
                                                                  "DOCUMENT_ID-IDENTIFY.")
-    recommend: str | None = Field(None, min_length=1, description="Document id of a "
+    recommend: Text | None = Field(None, min_length=1, description="Document id of a "
                                                                   "recommendation report "
                                                                   "(fi-design recommend). "
                                                                   "Default DOCUMENT_ID-RECOMMEND.")

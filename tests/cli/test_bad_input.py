@@ -320,6 +320,10 @@ CASES = [
      ["report.approved_by", "U+0000"], "approved_by:"),
     ("escape-in-name", edit("name: Paper setup with friction isolator", 'name: "Paper\\x1b[31m"'),
      ["name", "U+001B"], "name:"),
+    # the recommend report's id alone was a plain str: a control character passed
+    ("escape-in-recommend-id", edit("  status: draft", '  status: draft\n  document_ids: '
+                                                       '{recommend: "R\\x1b[31m"}'),
+     ["report.document_ids.recommend", "U+001B"], "document_ids:"),
 ]
 
 
