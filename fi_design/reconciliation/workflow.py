@@ -570,8 +570,10 @@ def _conclusion(steps, candidates, chi2_nom, chi2_cor, n, ambiguous, diagnosis) 
                 "but no catalogue "
                 f"effect explains the gap beyond what noise and the fit's freedom give: the "
                 f"answer is none.{tail}")
-    lines = [f"{s.name} ({_effects.values_text(s.name, s.parameters, s.uncertainty)}; misfit "
-             f"{display.number(s.misfit_before, 3)} -> {display.number(s.misfit_after, 3)})"
+    lines = [f"{s.name} ({_effects.values_text(s.name, s.parameters, s.uncertainty)}"
+             + ("" if len(steps) == 1 else  # one step: the next sentence gives its misfit
+                f"; misfit {display.number(s.misfit_before, 3)} \u2192 "
+                f"{display.number(s.misfit_after, 3)}") + ")"
              for s in steps]
     text = (f"The measurement shows {', then '.join(lines)}. With "
             f"{'them' if len(steps) > 1 else 'it'} the misfit drops from "

@@ -97,9 +97,11 @@ def gap_sections(result: Any, figures: bool = True) -> list:
             figures=figs))
     meas = result.measurement
     finding = [result.conclusion]
-    if result.effect != "none":
-        finding.append(f"Fitted parameters (one standard deviation): "
-                       f"{_params_text(result.effect, result.parameters, result.uncertainty)}.")
+    if result.effect != "none":  # the conclusion gives the values: say what their ± is
+        finding.append("The uncertainties (\u00b1) are one standard deviation: the fit's "
+                       "covariance in effective samples (or the block jackknife's error where "
+                       "larger), with the same fit's error on a noise-only record and the "
+                       "numerical error added in quadrature.")
     finding.append(
         f"Measured trace: {meas.source or 'in memory'}, {meas.n} samples over "
         f"{num(meas.duration)} s ({', '.join(meas.columns)}). Model: "

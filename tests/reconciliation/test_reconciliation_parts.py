@@ -263,3 +263,27 @@ def test_a_parameter_without_a_standard_error_is_not_shown_to_differ(reference, 
     verdict = _verdict(outcome, st, 40.0, 0.9, {"limit": None, "amplitude": 4.0}, 10.0, None)
     assert any("no standard error for limit" in r for r in verdict.reasons) is blind
     assert len(verdict.reasons) == int(blind)
+
+
+def test_a_single_finding_states_its_misfit_once():
+    """'The measurement shows X (...; misfit 2052 -> 0.98). With it the misfit drops from 2052
+    to 0.98 noise units.': one effect's misfit was said twice (and with an ASCII arrow); two
+    effects keep each step's misfit, the arrow a real one."""
+    from types import SimpleNamespace
+
+    from fi_design.reconciliation.workflow import _conclusion
+
+    def step(name, value, before, after):
+        return SimpleNamespace(name=name, parameters={"offset": value},
+                               uncertainty={"offset": 0.01}, misfit_before=before,
+                               misfit_after=after)
+
+    clean = SimpleNamespace(mismatch=False)
+    n = 1000
+    one = _conclusion([step("force_offset", 0.5, 40.0, 1.0)], [], 1600.0 * n, 1.0 * n, n, [],
+                      clean)
+    assert one.count("40") == 1 and "->" not in one, one
+    two = _conclusion([step("force_offset", 0.5, 40.0, 5.0), step("force_offset", 0.2, 5.0,
+                                                                  1.0)],
+                      [], 1600.0 * n, 1.0 * n, n, [], clean)
+    assert "misfit 40 \u2192 5)" in two and "misfit 5 \u2192 1)" in two, two
