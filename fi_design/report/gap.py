@@ -149,7 +149,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
             srows.append((str(i), st.name, _params_text(st.name, st.parameters, st.uncertainty),
                           f"{num(st.misfit_before)} → {num(st.misfit_after)}",
                           f"{qty(st.position_rms_before, 'm')} → {qty(st.position_rms_after, 'm')}",
-                          "-" if st.force_rms_before is None else
+                          "\u2013" if st.force_rms_before is None else
                           f"{qty(st.force_rms_before, 'N')} → {qty(st.force_rms_after, 'N')}"))
         sections.append(Section(
             "effects", "Effects found, in order",
@@ -164,7 +164,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
         values = (g.measured, g.nominal, g.corrected, g.before, g.after, g.noise)
         shown, factor = scale(g.unit, values)  # one unit per row, named in the unit column
         grows.append((g.name, shown or "\u2013",
-                      *("-" if v is None else num(v * factor) for v in values), flag))
+                      *("\u2013" if v is None else num(v * factor) for v in values), flag))
     sections.append(Section(
         "gap", "Gap before and after",
         paragraphs=("Sample-wise measures compare the traces point by point in the move, settle "
@@ -183,7 +183,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
                          for k, v in c.distance.items() if v is not None)
         crows.append((str(i), c.name, "named" if c.name in result.effects else c.status,
                       num(c.score), percent(c.explained, 3),
-                      _params_text(c.name, c.parameters, c.uncertainty), dist or "-",
+                      _params_text(c.name, c.parameters, c.uncertainty), dist or "\u2013",
                       f"{c.n_failed} of {c.n_simulations}" if c.n_failed else
                       str(c.n_simulations), _short(c.reasons)))
     if not result.candidates:  # nothing was fitted: say why, with no empty table or figure
@@ -216,7 +216,7 @@ def gap_sections(result: Any, figures: bool = True) -> list:
                          "Candidate scores (signed log scale); named effects in blue.",
                          "gap-scores"),)))
     srows = tuple((s.name, ", ".join(s.effects), fixed(s.strength, 2),
-                   "-" if s.value is None else qty(s.value, s.unit, 4), s.detail)
+                   "\u2013" if s.value is None else qty(s.value, s.unit, 4), s.detail)
                   for s in result.signatures)
     sections.append(Section(
         "signatures", "Signatures in the nominal residual",

@@ -55,14 +55,14 @@ def identification_sections(result: Any, figures: bool = True) -> list:
         return figure_block(make(result), caption, name)
 
     meas = result.measurement
-    rows = tuple((name, _value_text(p), "-" if p.std_error is None else num(p.std_error, 2),
+    rows = tuple((name, _value_text(p), "\u2013" if p.std_error is None else num(p.std_error, 2),
                   p.unit, "yes" if p.identifiable else "no", p.note)
                  for name, p in result.parameters.items())
     m = result.masses
     mass_rows = (("stage (m1)", qty(m.stage, "kg"),
-                  "-" if m.stage_std_error is None else qty(m.stage_std_error, "kg", 2), m.source),
+                  "\u2013" if m.stage_std_error is None else qty(m.stage_std_error, "kg", 2), m.source),
                  ("cart (m2)", qty(m.cart, "kg"),
-                  "-" if m.cart_std_error is None else qty(m.cart_std_error, "kg", 2), m.source))
+                  "\u2013" if m.cart_std_error is None else qty(m.cart_std_error, "kg", 2), m.source))
     s1 = Section(
         "parameters", "Identified parameters",
         paragraphs=(f"Record: {meas.source or 'in memory'}, {meas.n} samples over "
