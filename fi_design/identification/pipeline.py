@@ -164,7 +164,9 @@ def identify(measured: Measurement, spec=None, *, form: str = "symmetric",
         if masses.stage_std_error is not None and m <= 0.0:  # both fitted (a two-mass record)
             notes.append(f"the {name} = {quantity(m, 'kg', 4)} is not positive: {IMPLAUSIBLE}; "
                          "a negative mass also follows from force_N of the wrong sign")
-    far = mass_note(params["mass"], spec, proc, fit)
+    impossible = tuple(name for name, p in params.items() if name not in ("mass", "offset")
+                       and p.value is not None and p.value <= 0.0)
+    far = mass_note(params["mass"], spec, proc, fit, impossible)
     if far:
         params["mass"] = replace(params["mass"], note=params["mass"].note + "; far from the "
                                  "spec's moving mass (see the notes)")

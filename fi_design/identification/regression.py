@@ -84,14 +84,17 @@ def unit_slip(mass: float | None, spec) -> str | None:
     return next((what for k, what in UNIT_SLIPS if abs(ratio / k - 1.0) <= 0.02), None)
 
 
-def mass_note(total: Parameter, spec, proc: Processing, fit: Fit) -> str:
+def mass_note(total: Parameter, spec, proc: Processing, fit: Fit,
+              impossible: tuple[str, ...] = ()) -> str:
     """A note when the identified total mass is far from the spec's moving mass, with the cause.
 
     Empty without a spec, without a positive identified mass (a mass that is not positive
     has a note of its own), or within :data:`MASS_FACTOR` of the spec's stage plus cart mass.
     The likely cause is read from the fit: a relative force residual of :data:`FIT_LEAK` or
     more says the model lacks a force (the mass then depends on the low-pass cut-off, which
-    the spec's crossover sets); a close fit says the record is consistent with that mass.
+    the spec's crossover sets); so does a friction term that came out not positive
+    (``impossible``, their names: the model does not describe the record, however close the
+    fit); a close fit of plausible terms says the record is consistent with that mass.
     """
     if not mass_far(total, spec):
         return ""
@@ -108,6 +111,14 @@ def mass_note(total: Parameter, spec, proc: Processing, fit: Fit) -> str:
             f"follows its cut-off ({quantity(proc.cutoff, 'Hz', 3)}: {proc.cutoff_rule}), "
             "so another spec's crossover (or identify's cutoff argument) gives another mass. "
             "fi-design reconcile names such effects; do not write this mass into the spec")
+    if impossible:
+        return text + (
+            f"{' and '.join(impossible)} came out not positive (see "
+            f"{'their notes' if len(impossible) > 1 else 'its note'}), "
+            "so the model does not describe this record and the mass is no evidence that "
+            "the spec's masses are off: a force the model lacks (friction varying along the "
+            "rail, a cable force, force ripple) most likely leaks into it. fi-design "
+            "reconcile names such effects; do not write this mass into the spec")
     slip = unit_slip(total.value, spec)
     if slip is not None:
         return text + (
@@ -117,8 +128,8 @@ def mass_note(total: Parameter, spec, proc: Processing, fit: Fit) -> str:
             "values into the spec")
     return text + (
         f"the fit leaves only {percent(fit.relative_error, 2)} of the force unexplained, so "
-        "the record is consistent with this mass: most likely the spec's stage and cart masses are off "
-        "(the payload, a screw's or rotor's inertia referred to the axis), or force_N is "
+        "the record is consistent with this mass: most likely the spec's stage and cart "
+        "masses are off (the payload, a screw's or rotor's inertia referred to the axis), or force_N is "
         "not in N (a unit slip or the drive's gain)")
 
 

@@ -772,3 +772,24 @@ def test_a_record_with_a_gap_or_a_position_jump_is_refused_for_what_it_is():
         identify(measurement_from_arrays(t, x, wrapped, force_N=u, source="wrap.csv"))
     assert (e.value.column, e.value.row) == ("position_m", 1202)
     assert "a jump of the position: position_m steps by 49.9 mm" in str(e.value), str(e.value)
+
+
+def test_a_far_mass_beside_an_impossible_friction_is_not_blamed_on_the_spec(paper_spec):
+    """examples/measured_trace.csv (friction varying along the rail, not in the model): the
+    mass came out 1.7 x the spec's with negative viscous friction in both directions, and the
+    notes said both 'the model does not describe this record' (of the friction) and 'the
+    record is consistent with this mass: most likely the spec's masses are off'."""
+    from types import SimpleNamespace
+
+    from fi_design.identification.regression import mass_note
+    from fi_design.results.identification import Parameter
+
+    total = Parameter(value=3.39, std_error=0.23, unit="kg", identifiable=True, note="")
+    proc, fit = SimpleNamespace(cutoff=80.0, cutoff_rule="10 x the crossover"), \
+        SimpleNamespace(relative_error=0.048)
+    plausible = mass_note(total, paper_spec, proc, fit)
+    assert "consistent with this mass" in plausible
+    note = mass_note(total, paper_spec, proc, fit, ("viscous", "viscous_negative"))
+    assert "consistent with this mass" not in note and "no evidence" in note, note
+    assert "viscous and viscous_negative came out not positive" in note
+    assert "do not write this mass into the spec" in note
