@@ -166,7 +166,9 @@ def deflection_figure(confirmation: Any, spec: Any) -> Any:
                    label="stroke (limiter engages)" if sign > 0 else None)
     if confirmation.landing is not None:
         land = confirmation.landing
+        # at the last instant, on the frame: drawn whole over it, not clipped in half
         ax.plot([res.time[-1]], [land.deflection * 1e6], "o", color="black", ms=4,
+                clip_on=False, zorder=3,
                 label=f"at rest: {quantity(land.deflection, 'm', 3, shown=('µm', 1e6))}")
     ax.set_ylim(-1.35 * stroke * 1e6, 1.35 * stroke * 1e6)
     ax.set_xlim(0, float(res.time[-1]))

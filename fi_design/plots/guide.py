@@ -69,8 +69,8 @@ def guide_figure(mech: Any, body_size: tuple[float, float, float] | None = None)
                   else (d + 2 * b / 4, b * 1.5 if g.leaves == 2 else _mm(g.lateral_spacing) + b,
                         2 * h))
     fig = report_figure(3.1, left=0.3, right=0.15, top=0.3, bottom=0.35)
-    side = fig.add_axes([0.05, 0.12, 0.48, 0.76])
-    top = fig.add_axes([0.58, 0.12, 0.38, 0.76])
+    side = fig.add_axes([0.05, 0.13, 0.48, 0.75])  # the x label's descent within the figure
+    top = fig.add_axes([0.58, 0.13, 0.38, 0.75])
     hanging = g.orientation == "hanging"
     sgn = -1.0 if hanging else 1.0  # the drawing's z up, or down for a hanging stage
     span = max(L + sz, d + t, sx)

@@ -314,3 +314,62 @@ def test_the_guide_s_labels_do_not_overlap(paper_confirmed_design, orientation):
         for i, (a, box_a) in enumerate(boxes):
             for b, box_b in boxes[i + 1:]:
                 assert not box_a.overlaps(box_b), (a, b)
+
+
+def _drawn(fig):
+    """Draw ``fig`` on an Agg canvas; its renderer (the extents of what it drew)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return canvas.get_renderer()
+
+
+def _cut_markers(ax):
+    """Markers of ``ax`` inside its view but clipped by its frame: (label, x, y) in pixels."""
+    import numpy as np
+
+    frame = ax.bbox
+    for line in ax.lines:
+        if line.get_marker() in (None, "None", "", " ") or not line.get_clip_on():
+            continue
+        radius = line.get_markersize() * ax.figure.dpi / 72.0 / 2.0
+        xy = np.column_stack([line.get_xdata(), line.get_ydata()]).astype(float)
+        for x, y in ax.transData.transform(xy):
+            inside = frame.x0 <= x <= frame.x1 and frame.y0 <= y <= frame.y1
+            whole = frame.x0 <= x - radius and x + radius <= frame.x1 and \
+                frame.y0 <= y - radius and y + radius <= frame.y1
+            if inside and not whole:
+                yield line.get_label(), x, y
+
+
+_DESIGN_FIGURES = {
+    "bode": lambda d: plots.bode_figure(d),
+    "nyquist": lambda d: plots.nyquist_figure(d),
+    "sensitivity": lambda d: plots.sensitivity_figure(d),
+    "error": lambda d: plots.error_figure(d.simulation, d.spec),
+    "deflection": lambda d: plots.deflection_figure(d.simulation, d.spec),
+    "moves": lambda d: plots.moves_figure(d.simulation),
+    "cycle": lambda d: plots.cycle_figure(d.simulation, d.spec),
+    "boundary": lambda d: plots.boundary_figure(d.simulation),
+    "guide": lambda d: plots.guide_figure(d.flexure.mechanics),
+}
+
+
+@pytest.mark.parametrize("name", list(_DESIGN_FIGURES))
+def test_design_figures_draw_nothing_beyond_their_edges(paper_confirmed_design, name):
+    """The sensitivity plot (Figure 4 of the paper setup's report) cut its '1000' tick label
+    at the right edge, and the deflection plot drew the 'at rest' marker at the last instant,
+    on the frame, half of it clipped. Everything a design figure draws (tick labels, axis
+    labels, legends, texts) lies within the figure, and no marker within the view is clipped
+    by its axes' frame."""
+    fig = _DESIGN_FIGURES[name](paper_confirmed_design)
+    renderer = _drawn(fig)
+    edge = fig.bbox.padded(0.5)  # half a pixel for rounding
+    for artist in [*fig.axes, *fig.legends, *fig.texts]:
+        box = artist.get_tightbbox(renderer)
+        if box is not None:
+            assert edge.containsx(box.x0) and edge.containsx(box.x1) and \
+                edge.containsy(box.y0) and edge.containsy(box.y1), (artist, box, fig.bbox)
+    for ax in fig.axes:
+        assert not list(_cut_markers(ax)), name
