@@ -373,3 +373,71 @@ def test_design_figures_draw_nothing_beyond_their_edges(paper_confirmed_design, 
                 edge.containsy(box.y0) and edge.containsy(box.y1), (artist, box, fig.bbox)
     for ax in fig.axes:
         assert not list(_cut_markers(ax)), name
+
+
+def _ink(artist, renderer):
+    """What an error bar's ``artist`` covers [px]: its cap (a '_' marker, whose window extent
+    is the marker's square) its horizontal stroke only, its bar (a LineCollection, which has
+    no window extent of its own) its segments with their width."""
+    import numpy as np
+    from matplotlib.collections import LineCollection
+    from matplotlib.lines import Line2D
+    from matplotlib.transforms import Bbox
+
+    scale = artist.figure.dpi / 72.0
+    if isinstance(artist, LineCollection):
+        xy = artist.get_transform().transform(np.concatenate(artist.get_segments()))
+        pad = max(artist.get_linewidths()) * scale / 2
+        return Bbox([xy.min(axis=0) - pad, xy.max(axis=0) + pad])
+    if not (isinstance(artist, Line2D) and artist.get_marker() == "_"):
+        return artist.get_window_extent(renderer)
+    half_w, half_h = artist.get_markersize() * scale / 2, artist.get_markeredgewidth() * scale / 2
+    (x, y), = artist.get_transform().transform([(artist.get_xdata()[0],
+                                                  artist.get_ydata()[0])])
+    return Bbox([[x - half_w, y - half_h], [x + half_w, y + half_h]])
+
+
+def _all_hunt(p):
+    """The plant's probability as if every valid sample hunted (a '30/30' bar at 100 %)."""
+    import dataclasses
+
+    from fi_design.studies.scatter import wilson_interval
+
+    low, high = wilson_interval(p.valid, p.valid, p.confidence)
+    return dataclasses.replace(p, hunting=p.valid, probability=1.0, low=low, high=high)
+
+
+@pytest.mark.parametrize("rc", ["report", "default"])
+@pytest.mark.parametrize("counts", ["as computed", "all hunt"])
+def test_robustness_counts_stand_clear_of_the_error_bars(paper_confirmed_design, rc, counts):
+    """The robustness bar chart wrote each bar's count ('30/30') with its baseline 2 % of the
+    axis above the interval's top: its descent (the slash) sat on the error bar's cap, 1.6 pt
+    from it for the paper setup's 96/100. The counts now stand at least 3 pt clear of every
+    error bar and inside the axes, in the report's style and matplotlib's default (the study's
+    own figure file)."""
+    import contextlib
+    import dataclasses
+
+    import matplotlib
+
+    study = paper_confirmed_design.robustness.study
+    if counts == "all hunt":
+        study = dataclasses.replace(study, isolated=_all_hunt(study.isolated),
+                                    not_isolated=_all_hunt(study.not_isolated))
+    style = matplotlib.rc_context(plots.REPORT_RC) if rc == "report" else \
+        contextlib.nullcontext()
+    with style:
+        fig = plots.robustness_figure(study, title="" if rc == "report" else None)
+    renderer = _drawn(fig)
+    ax = fig.axes[0]
+    labels = [t for t in ax.texts if "/" in t.get_text()]
+    assert len(labels) == 2
+    bars = [_ink(a, renderer) for c in ax.containers if hasattr(c, "has_xerr")
+            for a in (*c.lines[1], *c.lines[2])]  # caps and bars (a bar has no marker)
+    assert bars
+    clear = 3.0 * fig.dpi / 72.0  # 3 pt of white between a count and any error bar
+    for label in labels:
+        box = label.get_window_extent(renderer)
+        assert ax.bbox.containsy(box.y1), label.get_text()
+        for bar in bars:
+            assert not box.padded(clear).overlaps(bar), (label.get_text(), box, bar)
