@@ -577,6 +577,112 @@ def test_pdf_keeps_a_heading_with_its_first_lines_after_a_long_command(
     assert after and after[0].split()[:2] == ["FAIL", "HUNTS"], page[-4:]
 
 
+
+def _laid_out(document):
+    """(page index, box) of every box of WeasyPrint's layout, page by page."""
+    for n, page in enumerate(document.pages):
+        stack = [page._page_box]
+        while stack:
+            box = stack.pop()
+            yield n, box
+            stack.extend(getattr(box, "children", None) or ())
+
+
+def _classes(element) -> list[str]:
+    return (element.get("class") or "").split()
+
+
+#: The page-end cases: the section, where the page is made to end (half-way down a row of
+#: a table), and the HTML a spacer goes before to move that row there.
+_PAGE_ENDS = {"key figures": ("verdict", "figures", -1, "<h3>Key figures</h3>"),
+              "inputs": ("inputs", "inputs", 0, '<section id="inputs"')}
+
+
+@pytest.mark.parametrize("case", list(_PAGE_ENDS))
+def test_pdf_keeps_small_tables_whole_and_headings_with_their_first_rows(
+        paper_confirmed_design, case):
+    """The reviewer's PDF of the paper setup left the key-figures table's last row and its
+    footnote alone on page 3, and the heading, intro and table header of "2 Inputs" at the
+    foot of page 5 with the table's rows on page 6. Where a page ends depends on fonts and
+    on everything above; here the page is made to end there: the section alone is laid out
+    (WeasyPrint, no figures) with a spacer above it, sized from a first layout so that the
+    page ends half-way down the key figures' last row, or the inputs' first row. The key
+    figures then stand on one page with their heading and notes, and "Inputs" with its intro
+    on the page of its table's first row."""
+    weasyprint = _import_weasyprint()
+    section, table_class, index, before = _PAGE_ENDS[case]
+    context = report.build_context(paper_confirmed_design, date=DATE, command=COMMAND,
+                                   figures=False)
+    context["sections"] = [s for s in context["sections"] if s["id"] == section]
+    html = report.render_html(context)
+    assert html.count(before) == 1
+
+    def laid_out(spacer):
+        page = html.replace(before, f'<div style="height: {spacer:.3f}px"></div>{before}')
+        document = weasyprint.HTML(string=page).render()
+        boxes = list(_laid_out(document))
+        table = next(b.element for _, b in boxes if b.element_tag == "table" and
+                     table_class in _classes(b.element))
+        rows = {id(r) for r in table.iter("tr") if r.find("td") is not None}
+        on = {}  # element -> the pages it has a box on
+        for n, b in boxes:
+            if getattr(b, "element", None) is not None:
+                on.setdefault(id(b.element), set()).add(n)
+        placed = sorted(((n, b) for n, b in boxes if b.element_tag == "tr" and
+                         id(b.element) in rows), key=lambda nb: (nb[0], nb[1].position_y))
+        return document, boxes, placed, on
+
+    document, _, placed, _ = laid_out(1)
+    n, row = placed[index]
+    page = document.pages[n]._page_box
+    end = page.content_box_y() + page.height
+    _, boxes, placed, on = laid_out(1 + end - row.position_y - row.height / 2)
+
+    def pages(tag, pick=lambda e: True):
+        found = [id(b.element) for _, b in boxes if b.element_tag == tag and pick(b.element)]
+        assert found, tag
+        return set().union(*(on[e] for e in found))
+
+    rows = {n for n, _ in placed}
+    if case == "key figures":
+        assert len(rows) == 1, f"the key figures run over pages {sorted(rows)}"
+        assert pages("h3", lambda e: "".join(e.itertext()) == "Key figures") == rows
+        assert pages("ul", lambda e: "margin-notes" in _classes(e)) == rows
+    else:
+        first = placed[0][0]
+        intro = context["inputs"]["intro"]
+        assert pages("h2", lambda e: "".join(e.itertext()).endswith("Inputs")) == {first}, \
+            "the Inputs heading stands apart from its table's first row"
+        assert pages("p", lambda e: "".join(e.itertext()) == intro) == {first}
+
+
+@needs_poppler
+def test_pdf_key_figures_and_inputs_start_on_the_page_of_their_heading(
+        paper_confirmed_design, design_pdf):
+    """The report's own PDF (:func:`design_pdf`), page by page (pdftotext): the key figures,
+    their last row and notes on the page of their heading, the Inputs heading on the page
+    of its table's first row."""
+    text = subprocess.run(["pdftotext", "-layout", str(design_pdf), "-"], capture_output=True,
+                          text=True, check=True, timeout=120).stdout
+    pages = [re.sub(r"\s+", " ", page.replace(NNBSP, " ").replace(NBSP, " "))
+             for page in text.split("\f")]
+    verdict = report.build_context(paper_confirmed_design, date=DATE, command=COMMAND,
+                                   figures=False)["verdict"]
+
+    def page_of(words):
+        found = [n for n, page in enumerate(pages) if words in page]
+        assert found, words
+        return found[0]
+
+    heading = page_of(" Key figures ")
+    for words in ("Figure Value Unit Requirement Basis",
+                  " ".join(verdict["figures"][-1]["label"].split()[:3]),
+                  " ".join(verdict["notes"][-1].split()[:4])):
+        assert page_of(words) == heading, words
+    assert page_of(" 2 Inputs ") == page_of("Key Value As written Source") == \
+        page_of("Project or stage name")
+
+
 def _pdf_images(pdf: Path) -> list[tuple[str, ...]]:
     """(page, width, height, colour, x-ppi) of every image of a PDF, from poppler's pdfimages."""
     out = subprocess.run(["pdfimages", "-list", str(pdf)], capture_output=True, text=True,
