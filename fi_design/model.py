@@ -216,6 +216,19 @@ class Model:
         return size_guide(flex, self.body, target_stiffness=self.joint.stiffness, **common)
 
     @property
+    def stiffness_scatter(self) -> float:
+        """The drive stiffness's scatter the robustness study draws [-]:
+        ``requirements.robustness.stiffness``, else the flexure's stock thickness tolerance
+        (k goes with t^3), else 5 %."""
+        given = self.requirements.robustness.stiffness
+        if given is not None:
+            return given
+        fx = self.flexure if self.joint is not None else None
+        if fx is not None and fx.mechanics is not None and fx.thickness:
+            return 3.0 * fx.thickness_tolerance / fx.thickness
+        return 0.05
+
+    @property
     def sizing_crossover(self) -> float:
         """The loop's crossover a guide is sized against [Hz]: the highest 0 dB crossing of the
         rigid limit cases in the loop's band (with the cart stuck and the joint free it lies

@@ -47,7 +47,7 @@ from ..results.design import (Confirmation, CrossoverResult, FlexureResult, Fric
                               Reason, Recommendation, RobustnessCheck, StiffnessResult, Verdict,
                               VerdictStatus)
 
-__all__ = ["recommend_command", "stiffness_spread", "friction_gap_judged", "simulated_isolator_advice",
+__all__ = ["recommend_command", "friction_gap_judged", "simulated_isolator_advice",
            "simulation_sentence",
            "run_robustness", "robustness_check", "robustness_as_check", "margins",
            "recommendation", "judge"]
@@ -124,7 +124,7 @@ def run_robustness(model: Model, suggestion: tuple[float, float] | None = None,
         values["effects"] = entries
         scatter += [Scatter("effects[type=mass_error].stage_mass", cfg.mass),
                     Scatter("effects[type=mass_error].cart_mass", cfg.mass)]
-    k_spread = stiffness_spread(model, cfg)
+    k_spread = model.stiffness_scatter
     if k_spread > 0 and target.isolator is not None:
         if target.isolator.stiffness is None:  # a drawn guide: its net stiffness, as measured
             values["isolator.stiffness"] = model.joint.stiffness if model.joint else None
@@ -141,20 +141,6 @@ def run_robustness(model: Model, suggestion: tuple[float, float] | None = None,
                       distribution=cfg.distribution, position_friction=ripple,
                       confidence=cfg.confidence, executor=executor, progress=progress,
                       cache=None, friction_gap=gap)
-
-
-def stiffness_spread(model: Model, cfg: Any = None) -> float:
-    """The drive stiffness's scatter: the spec's, else the flexure's stock thickness tolerance
-    (k goes with t^3), else 5 % [-]. ``cfg``: the robustness settings (default the model's,
-    ``requirements.robustness``)."""
-    if cfg is None:
-        cfg = model.requirements.robustness
-    if cfg.stiffness is not None:
-        return cfg.stiffness
-    fx = model.flexure if model.joint is not None else None
-    if fx is not None and fx.mechanics is not None and fx.thickness:
-        return 3.0 * fx.thickness_tolerance / fx.thickness
-    return 0.05
 
 
 def robustness_check(model: Model, study: Any) -> RobustnessCheck:

@@ -499,8 +499,8 @@ def _appendix(result: Any) -> dict:
         {"quantity": "output rate", "value": sim.output_rate, "unit": "Hz"},
         {"quantity": "step budget per simulation", "value": sim.max_steps, "unit": "1"},
         {"quantity": "simulated time", "value": spec.motion.duration, "unit": "s"},
-        {"quantity": "crossover scan", "value": [scan.start, scan.stop], "unit": "Hz"},
-        {"quantity": "crossover scan step", "value": scan.step, "unit": "Hz"},
+        {"quantity": "hunting-free crossover searched within", "value": [scan.start, scan.stop],
+         "unit": "Hz"},
         {"quantity": "friction model", "value": spec.friction.model, "unit": ""},
         {"quantity": "loop delay (linear analysis, Pad\u00e9 order "
                      f"{spec.controller.pade_order})", "value": result.crossover.delay,

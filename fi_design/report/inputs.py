@@ -21,21 +21,22 @@ _DERIVED: dict[str, tuple[str, Callable[[Any], float]]] = {
                                  lambda m: m.limiter.damping),
     "requirements.robustness.stiffness": ("the flexure's stock thickness tolerance, k going "
                                           "with t\u00b3 (5 % without a sized flexure)",
-                                          lambda m: _stiffness_spread(m)),
+                                          lambda m: _stiffness_scatter(m)),
 }
 
 
-def _stiffness_spread(model: Any) -> float:
+def _stiffness_scatter(model: Any) -> float:
     """The drive stiffness's scatter the robustness study draws [-] (AttributeError without
     an isolator: none scatters, the row reads "not given" as the other joint rules')."""
-    from ..guideline.verdict import stiffness_spread
-
     if model.joint is None:
         raise AttributeError("no isolator")
-    return stiffness_spread(model)
+    return model.stiffness_scatter
 
 
 _MISSING = object()
+
+#: Spec keys read so that specs giving them still load, used by nothing (a warning says so).
+UNUSED = ("simulation.crossover_scan.step",)
 
 #: Spec paths that set how the tool analyses, not the hardware or what it must meet: the
 #: hunting metric and solver, the scatter, the search, the move family and the document.
@@ -170,6 +171,8 @@ def spec_inputs(spec: Any, model: Any) -> list[dict]:
                 rows.append({"path": path, "description": _first_sentence(info.description or ""),
                              "value": "none", "unit": "", "written": "",
                              "source": "not given (section omitted)"})
+            elif path in UNUSED and written is _MISSING:
+                continue  # read for old specs, used by nothing: listed only where given
             else:
                 rows.append(leaf(path, value, written, info, model))
 

@@ -35,23 +35,22 @@ from .fields import OptQ, Q, StrictModel, Text
 from .filters import BUTTERWORTH, FILTER_TYPES, Drive, FilterEntry, LowPass, Notch
 from .requirements import (Hunting, Positioning, RecommendBounds, Requirements, Reserve, Ripple,
                            Robustness)
-from .sections import (MAX_OUTPUT_SAMPLES, MAX_SCAN_POINTS, MAX_STEPS, REPORT_KINDS, Body, Bounds,
+from .sections import (MAX_OUTPUT_SAMPLES, MAX_STEPS, REPORT_KINDS, Body, Bounds,
                        Controller, CrossoverScan, DocumentIds, Family, Feedforward, Flexure,
                        Friction, Gains, Isolator, Limiter, Material, Measurement, Motion, Move,
-                       ParasiticMode, ReportInfo, Revision, Simulation, Stage, move_duration,
-                       scan_points)
+                       ParasiticMode, ReportInfo, Revision, Simulation, Stage, move_duration)
 
 __all__ = [
     "BUTTERWORTH", "Drive", "FILTER_TYPES", "FilterEntry", "LowPass", "Notch",
     "Body", "Bounds", "CROSSOVER_AGREEMENT", "Controller", "CrossoverScan", "DocumentIds",
     "EFFECT_MODELS", "EffectEntry", "Family", "Feedforward", "Flexure", "Friction", "Gains",
     "Hunting", "Isolator", "JOINT_DAMPING_RATIO", "Limiter", "MAX_OUTPUT_SAMPLES",
-    "MAX_SCAN_POINTS", "MAX_STEPS", "Material", "Measurement", "Motion", "Move", "OptQ",
+    "MAX_STEPS", "Material", "Measurement", "Motion", "Move", "OptQ",
     "ParasiticMode", "Positioning", "Q", "REPORT_KINDS", "RecommendBounds", "ReportInfo",
     "Requirements", "Reserve",
     "Revision", "Ripple", "Robustness", "Simulation", "Spec", "Stage", "StrictModel", "Text",
     "antiresonance", "bristle_damping", "default_joint_damping", "default_limiter_damping",
     "design_crossover", "drive_stiffness", "gains_crossover", "joint_damping",
-    "limiter_damping", "move_duration", "proposed_stiffness", "scan_points", "stiffness_limit",
+    "limiter_damping", "move_duration", "proposed_stiffness", "stiffness_limit",
     "tuning_mass", "warnings_for",
 ]

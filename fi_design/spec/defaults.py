@@ -202,11 +202,17 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     outlasts the run, a hunting window that starts before the last move ends, an end stop
     the user made less than :data:`LIMITER_STIFFER` times stiffer than the joint, a stage
     box whose mean density lies outside :data:`STAGE_DENSITY`,
-    and a loop without the hardware's sampling and delay (a
+    a loop without the hardware's sampling and delay (a
     continuous controller without delay: the margins and the hunting depend
-    on both).
+    on both), and a ``simulation.crossover_scan.step`` (read, not used).
     """
     out: list[tuple[str, str]] = []
+    if spec.simulation.crossover_scan.step is not None:
+        out.append(("simulation.crossover_scan.step",
+                    "has no effect: the lowest hunting-free crossover is the fold of the "
+                    "hunting cycle, bisected to 0.01 Hz or 0.1 % of the crossover, whichever is "
+                    "larger, between simulation.crossover_scan.start and stop; leave the key "
+                    "out"))
     f = spec.friction
     gap = f.static - f.coulomb
     if f.model == "lugre" and gap > 0 and f.bristle_damping is not None:

@@ -298,8 +298,6 @@ CASES = [
      ["simulation.output_rate", "10⁹ Hz", "output samples", "at most"], "output_rate"),
     ("duration-without-bound", edit("duration: 20 s", "duration: 1e9 s"),
      ["motion.duration", "output samples", "at most"], "duration:"),
-    ("crossover-scan-micro-step", BASE + "simulation: {crossover_scan: {step: 1e-6 Hz}}\n",
-     ["simulation.crossover_scan", "29000001 points", "at most 1000"], "crossover_scan"),
     ("step-budget-without-bound", BASE + "simulation: {max_steps: 100000000000}\n",
      ["simulation.max_steps", "at most"], "max_steps"),
     # parse-level crashes

@@ -109,6 +109,18 @@ def test_file_and_mapping_give_the_same_spec(paper_spec, paper_spec_path):
     assert origin(again).path is None and origin(again).raw == org.raw
 
 
+def test_the_crossover_scan_step_is_read_and_warned_as_unused(paper_spec):
+    """The hunting-free crossover is the fold of the cycle, bisected: simulation.crossover_scan
+    .step (a grid's resolution, once) changed nothing, yet it was validated ('at most 1000
+    crossovers') and shown in the report's solver settings. A spec that gives it still
+    loads, with a warning that it has no effect."""
+    assert paper_spec.simulation.crossover_scan.step is None
+    given = variant(paper_spec, **{"simulation.crossover_scan": {"step": "1e-6 Hz"}})
+    warned = dict(sp.warnings_for(given))
+    assert "has no effect" in warned["simulation.crossover_scan.step"]
+    assert "simulation.crossover_scan.step" not in dict(sp.warnings_for(paper_spec))
+
+
 def test_warnings_fire_on_the_users_own_values(paper_spec):
     # sigma1 = 1414 N s/m is written in the file, but it is the default's value (the default
     # breaks the bound on purpose, and the report's assumptions say so): no warning on it;
