@@ -154,8 +154,8 @@ def binding(search: Any, chosen: Any) -> tuple[str, ...]:
                    f"{quantity(chosen.stroke, 'm')} stroke, which leaves of the stock's "
                    f"thickest ({thick}) reach")
     elif stiffer:
-        out.append(f"at {quantity(chosen.stroke, 'm')} stroke a stiffer joint "
-                   f"({quantity(stiffer[0].target, 'N/m', 4)}) fails on {_why(stiffer[0])}")
+        out.append(f"what fails a stiffer joint ({quantity(stiffer[0].target, 'N/m', 4)}) at "
+                   f"{quantity(chosen.stroke, 'm')} stroke: {_why(stiffer[0])}")
     strokes = sorted({p.stroke for p in search.points})
     i = strokes.index(chosen.stroke)
     for j, side in ((i - 1, "shorter"), (i + 1, "longer")):
@@ -185,7 +185,7 @@ def advice(search: Any, chosen: Any, feasible: bool, binding: tuple[str, ...],
                 + (f": no move hunts from {quantity(chosen.free_from, 'Hz', 4)}, "
                    f"{number(chosen.margin, 3)} x below the crossover" if chosen.free_from else
                    ": no move of the family hunts")
-                + (f"; it is bound by {binding[0]}" if binding else "") + ".")
+                + (f"; what binds it: {binding[0]}" if binding else "") + ".")
         for n in (n for n in bounds if n.adds_margin):
             text += (f" The leaves' {n.dimension} sits on the {n.side} bound of "
                      f"{n.key}; past it the guide would have more margin.")

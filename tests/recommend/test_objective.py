@@ -112,3 +112,14 @@ def test_a_reason_ending_its_sentence_is_not_ended_twice():
         "step 3 flexure: it sags 0.932 mm of its 0.9 mm stroke: it rests on its end stop."])
     text = _why(point)
     assert text.endswith("it rests on its end stop)") and ".)" not in text, text
+
+
+def test_a_stiffer_joint_that_fails_at_the_chosen_stroke_binds_it_as_a_noun_phrase(paper_spec):
+    """Where a stiffer joint fails at the chosen stroke (below k_max), the advice read 'it is
+    bound by at 100 µm stroke a stiffer joint (39600 N/m) fails on ...': a clause where the
+    sentence wants what binds it."""
+    chosen = _point(1e-4, 20000.0, "feasible", 1.95)
+    stiffer = _point(1e-4, 39600.0, "margin", 1.1, [MARGIN])
+    out = binding(_search(paper_spec, [chosen, stiffer]), chosen)
+    assert out[0] == (f"what fails a stiffer joint (39600 N/m) at 0.1 mm stroke: the hunting "
+                      f"margin ({MARGIN})"), out[0]

@@ -104,7 +104,7 @@ def test_the_recommended_guide_on_its_length_bound_says_so_everywhere(paper_reco
     print_recommendation(console, r)
     assert f"On a bound: {text}" in " ".join(console.export_text().split())
     # the one sentence a person acts on (the design command's recommendation box) says it too
-    assert ("it is bound by" in r.advice and "The leaves' length sits on the upper bound of "
+    assert ("what binds it: k_max" in r.advice and "The leaves' length sits on the upper bound of "
             "isolator.flexure.length; past it the guide would have more margin." in r.advice)
 
 
