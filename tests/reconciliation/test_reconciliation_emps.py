@@ -109,12 +109,13 @@ def test_symmetric_description_misses_an_offset_or_the_asymmetry(symmetric_resul
 def test_open_loop_replay_of_the_real_record(emps_full, emps_symmetric, emps_period):
     """``--drive force``: the plant driven by the measured force, the controller out of it.
 
-    The same two descriptions as above, open loop (candidates restricted to the ones the
-    record can tell apart, to keep the run short): the identified axis answers ``none``;
-    the symmetric one without offset misses a force offset, which closes part of the gap
-    and agrees in sign and size with the closed-loop finding.
+    The same two descriptions as above, open loop (candidates restricted to the two the
+    record must tell apart, an offset and an asymmetry of Coulomb friction, to keep the run
+    short): the identified axis answers ``none``; the symmetric one without offset misses a
+    force offset, which closes part of the gap and agrees in sign and size with the
+    closed-loop finding.
     """
-    names = ["force_offset", "friction_asymmetry", "viscous_friction"]
+    names = ["force_offset", "friction_asymmetry"]
     full = reconcile(emps_full, emps_period, drive="force", candidates=names)
     assert full.drive == "force" and full.effect == "none", [
         (c.name, round(c.score, 1), c.reasons[:1]) for c in full.candidates]
