@@ -186,7 +186,10 @@ class SimulationResult(Result):
         """Columns in the measured-data layout (docs/interfaces.md).
 
         ``time_s``, ``reference_m``, ``position_m``, ``force_N`` and, for the
-        isolated plant, ``deflection_m``.
+        isolated plant, ``deflection_m``. A simulation that did not complete
+        gives the samples it reached: the rows end before the first sample it
+        holds no value for (the result's arrays are NaN there), so that a
+        spreadsheet, pandas and the measured-data reader never meet a ``nan``.
         """
         cols = {"time_s": self.time, "reference_m": self.reference, "position_m": self.position,
                 "force_N": self.force}
@@ -194,6 +197,10 @@ class SimulationResult(Result):
             cols["deflection_m"] = self.deflection
         if self.window is not None:
             cols["window"] = self.window
+        finite = np.all([np.isfinite(np.asarray(v, dtype=float)) for v in cols.values()], axis=0)
+        if not finite.all():
+            end = int(np.argmin(finite))
+            cols = {name: v[:end] for name, v in cols.items()}
         return cols
 
     def to_dict(self, traces: bool = False) -> dict:

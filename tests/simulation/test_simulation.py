@@ -423,6 +423,26 @@ def test_step_budget_is_reported(paper_spec):
     assert 0 < r.t_reached < paper_spec.motion.duration
 
 
+def test_the_trace_of_a_run_that_stopped_ends_where_it_stopped(paper_spec):
+    """`simulate --csv` of a run that did not complete wrote every row of the output grid, the
+    ones past the stop as `nan,nan,nan,nan`: text to a spreadsheet, and a file the measured-data
+    reader (--record, reconcile) refuses. The trace holds the samples the run reached."""
+    import io
+
+    from fi_design.measured import write_columns_csv
+
+    spec = variant(paper_spec, **{"simulation.max_steps": 1000})
+    r = simulate(spec, isolated=False)
+    assert not r.success and np.isnan(r.position[-1])
+    cols = r.traces()
+    assert 0 < len(cols["time_s"]) < len(r.time)
+    assert all(np.isfinite(v).all() and len(v) == len(cols["time_s"]) for v in cols.values())
+    assert cols["time_s"][-1] <= r.t_reached
+    buf = io.StringIO()
+    write_columns_csv(buf, cols)
+    assert "nan" not in buf.getvalue().lower()
+
+
 def test_isolated_plant_needs_an_isolator(paper_spec):
     spec = variant(paper_spec, isolator=None)
     with pytest.raises(SimulationError, match="no isolator"):
