@@ -31,6 +31,11 @@ def _axis_text(axis: Any) -> str:
             f"{' (log)' if axis.log else ''}")
 
 
+#: What a map's colour shows, by the study's measure (the figure's colour bar says the same).
+_FIGURE_MEASURES = {"stage": "Peak to peak of the cycle some move of the family ends in",
+                    "move": "Hunting cycles of the spec's own move in the counting window"}
+
+
 def sweep_section(result: SweepResult, sid: str, title: str, lead: str = "",
                   figures: bool = True) -> Section:
     """One map of hunting cycles as a report section: axes, design point, counts, figure.
@@ -74,8 +79,8 @@ def sweep_section(result: SweepResult, sid: str, title: str, lead: str = "",
             fig = plots.sweep_figure(result, title="")
         names = [plots.axis_label(a.path, a.unit, a.values) for a in (result.y, result.x)
                  if a is not None]
-        figs = (figure_block(fig, f"Hunting cycles ({plant}) over {' and '.join(names)}.",
-                             name=sid),)
+        figs = (figure_block(fig, f"{_FIGURE_MEASURES.get(result.measure, 'Hunting cycles')} "
+                                  f"({plant}) over {' and '.join(names)}.", name=sid),)
     return Section(sid, title, paragraphs=tuple(paras), tables=(table,), figures=figs)
 
 

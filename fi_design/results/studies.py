@@ -293,6 +293,7 @@ class SweepResult(Result):
             **header(self.fi_design_version, self.fi_design_source, self.spec),
             "spec_name": self.spec.name,
             "isolated": self.isolated,
+            "measure": self.measure,
             "x": self.x.to_dict(),
             "y": self.y.to_dict() if self.y is not None else None,
             "design_point": to_jsonable(list(self.design_point)),
@@ -633,6 +634,7 @@ class RobustnessResult(Result):
             "samples": self.samples,
             "seed": self.seed,
             "distribution": self.distribution,
+            "measure": self.measure,
             "scatter": [s.to_dict() for s in self.scatter],
             "position_friction": self.position_friction.to_dict()
             if self.position_friction else None,

@@ -709,3 +709,23 @@ def test_the_held_damping_note_speaks_only_when_the_ratio_moves(paper_spec):
     stiffness = make_axis("isolator.stiffness", [2000.0, 8000.0], spec=paper_spec)
     note = held_damping_note(model, [stroke, stiffness])
     assert note is not None and "isolator.stiffness" in note and "runs from" in note
+
+
+def test_the_json_and_the_report_say_what_a_point_measures(paper_spec, kernel):
+    """A sweep's JSON and a robustness study's did not say their measure, so a reader could not
+    tell why `hunting_cycles` is null; and the sweep report's figure was captioned "Hunting
+    cycles" while its colour (measure "stage", the default) is the cycle's peak to peak."""
+    from fi_design.report.study import sweep_section
+
+    line = sw.sweep(paper_spec, ("controller.crossover", [4.0, 8.0]), isolated=False,
+                    measure="stage")
+    d = line.to_dict()
+    assert d["measure"] == "stage" and d["hunting_cycles"] == [None, None]
+    caption = sweep_section(line, "s", "Map").figures[0].caption
+    assert caption.startswith("Peak to peak of the cycle") and "Hunting cycles" not in caption
+    move = sw.sweep(paper_spec, ("controller.crossover", [4.0, 8.0]), isolated=False,
+                    measure="move")
+    assert move.to_dict()["measure"] == "move"
+    assert sweep_section(move, "s", "Map").figures[0].caption.startswith("Hunting cycles")
+    rob = sw.robustness(paper_spec, [sw.parse_scatter("friction.static=10%")], samples=1)
+    assert rob.to_dict()["measure"] == rob.measure == "stage"
