@@ -247,15 +247,18 @@ class SweepResult(Result):
         ndarray, shape (ny,) or (1,)
             The x value [x.unit] per row; NaN when the row's last (first) point
             hunts or is not a valid, complete simulation. Points that are
-            ``stuck`` or ``undetermined`` do not count as hunting.
+            ``stuck`` or ``undetermined`` do not count as hunting. The values
+            are taken in increasing order, however the axis lists them (a
+            range from START down to STOP, a list ``PATH=V1,V2,...``).
         """
         if free not in ("above", "below"):
             raise ArgumentError("free must be 'above' or 'below'")
         verdicts = self.verdict.reshape(-1, len(self.x.values))
         xs = self.x.values
+        ascending = [int(i) for i in np.argsort(xs, kind="stable")]
         out = np.full(verdicts.shape[0], np.nan)
         for r, row in enumerate(verdicts):
-            order = range(len(xs) - 1, -1, -1) if free == "above" else range(len(xs))
+            order = ascending[::-1] if free == "above" else ascending
             last = None
             for i in order:
                 if row[i] in ("hunting", "buckled", "invalid", "failed"):

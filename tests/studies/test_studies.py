@@ -729,3 +729,15 @@ def test_the_json_and_the_report_say_what_a_point_measures(paper_spec, kernel):
     assert sweep_section(move, "s", "Map").figures[0].caption.startswith("Hunting cycles")
     rob = sw.robustness(paper_spec, [sw.parse_scatter("friction.static=10%")], samples=1)
     assert rob.to_dict()["measure"] == rob.measure == "stage"
+
+
+def test_the_boundary_reads_the_axis_in_increasing_order(paper_spec, kernel):
+    """`sweep --x "controller.crossover=20 Hz,4 Hz,12 Hz,8 Hz" --measure move` printed "no
+    hunting from 12 Hz upwards" though 8 Hz settles and only 4 Hz hunts, and a range from
+    20 Hz down to 2 Hz printed no boundary at all: the boundary walked the axis as listed."""
+    res = sw.sweep(paper_spec, ("controller.crossover", [20.0, 4.0, 12.0, 8.0, 2.0]),
+                   measure="move")
+    hunts = {float(x): v == "hunting" for x, v in zip(res.x.values, res.verdict)}
+    assert hunts == {20.0: False, 4.0: True, 12.0: False, 8.0: False, 2.0: True}
+    assert res.boundary("above")[0] == 8.0
+    assert math.isnan(res.boundary("below")[0])  # the lowest crossover hunts
