@@ -231,7 +231,8 @@ def print_simulation(console: "Console", result) -> None:
             ("amplitude (peak to peak)", quantity(m.amplitude, "m")),
             ("period [s]", number(m.period, 4)),
             ("settling time [s]", number(m.settling_time, 4)),
-            ("final error", quantity(m.final_error, "m")),
+            ("final error", quantity(m.final_error, "m") if result.success else
+             f"\u2013 (the run stopped at {quantity(result.t_reached, 's', 4)})"),
         ]
     rows += [
         ("integration", "ok" if result.success else result.message),

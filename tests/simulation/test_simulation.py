@@ -423,6 +423,22 @@ def test_step_budget_is_reported(paper_spec):
     assert 0 < r.t_reached < paper_spec.motion.duration
 
 
+def test_a_run_that_stopped_prints_no_final_error(paper_spec):
+    """`fi-design simulate` of a run whose step budget ran out at 0.86 s of 20 s printed
+    'final error 0.2051 mm', the error where the run stopped, as if the motion had ended."""
+    from rich.console import Console
+
+    from fi_design.console.confirmation import print_simulation
+    from fi_design.display import quantity
+
+    r = simulate(variant(paper_spec, **{"simulation.max_steps": 1000}), isolated=False)
+    console = Console(record=True, width=200)
+    print_simulation(console, r)
+    line = next(ln for ln in console.export_text().splitlines() if "final error" in ln)
+    assert f"(the run stopped at {quantity(r.t_reached, 's', 4)})" in line, line
+    assert " mm" not in line, line
+
+
 def test_the_trace_of_a_run_that_stopped_ends_where_it_stopped(paper_spec):
     """`simulate --csv` of a run that did not complete wrote every row of the output grid, the
     ones past the stop as `nan,nan,nan,nan`: text to a spreadsheet, and a file the measured-data
