@@ -344,6 +344,21 @@ def _checks(model, iso, non, stage, mins, land, agree, other_iso, other_non,
                     f"k min(|d|, s) = {quantity(land.force, 'N', 3)} against Fs = "
                     f"{quantity(land.static_friction, 'N', 3)} (the rule's bound k s = "
                     f"{quantity(land.rule_force, 'N', 3)})")
+            # the simulation carries no weight: on a vertical drive axis the joint sags too
+            fx = None if suggested else model.flexure
+            sag = 0.0 if fx is None else fx.sag
+            if sag > 0.0 and land.clearance(sag) < 0.0:
+                ok = False
+                text += (f"; but on the vertical axis the joint sags a further "
+                         f"{quantity(sag, 'm', 3)} under the cart's weight, which the "
+                         f"simulation does not carry: |d| + sag = "
+                         f"{quantity(abs(land.deflection) + sag, 'm', 3)} is beyond the "
+                         f"{quantity(land.stroke, 'm', 3)} stroke, so the cart rests on its "
+                         "end stop, not on the flexure")
+            elif sag > 0.0:
+                text += (f"; on the vertical axis with a further sag of "
+                         f"{quantity(sag, 'm', 3)} under the cart's weight, "
+                         f"{quantity(land.clearance(sag), 'm', 3)} from the end stop")
         out.append(Check("landing_force", None if suggested else ok, land.force,
                          land.static_friction, "N", text, "step 3 refinement: landing"))
     if not agree:

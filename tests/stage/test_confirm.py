@@ -237,3 +237,20 @@ def test_cli_simulate_refuses_existing_output_and_bad_extension(paper_spec_path,
     res = runner.invoke(app, ["simulate", str(paper_spec_path), "--csv", str(paper_spec_path),
                               "--force"])
     assert res.exit_code == 2
+
+
+def test_landing_on_a_vertical_axis_counts_the_sag(paper_spec, paper_confirmation):
+    """The simulation carries no weight: on a vertical drive axis whose joint sags past its
+    stroke (the paper's 0.4 kg cart sags 0.59 mm on 6667 N/m) the landing check does not pass
+    a cart 'inside the stroke' while the sag check says it rests on its end stop."""
+    from fi_design.stage.confirm import _checks
+
+    c = paper_confirmation
+    model = resolve(paper_spec).varied({"isolator.flexure.orientation": "vertical_axis"})
+    assert model.flexure.sag > model.joint.stroke
+    checks = {ch.name: ch for ch in _checks(
+        model, c.isolated, c.non_isolated, c.stage, c.min_hunting_free_crossover, c.landing,
+        True, c.isolated, c.non_isolated, False)}
+    land = checks["landing_force"]
+    assert land.status.value == "FAIL"
+    assert "rests on its end stop" in land.message and "sags a further" in land.message
