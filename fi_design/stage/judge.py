@@ -15,7 +15,7 @@ from ..errors import ArgumentError
 from ..kernel.layout import PlantParameters
 from ..model import Model, as_model
 from ..results.stage import Cycle, StageHunting
-from .boundary import hunting_free_boundary
+from .boundary import _run_cycle, hunting_free_boundary
 from .moves import ORDERS, stage_hunts
 from .orbit import converge_cycle
 from .runs import MoveRun
@@ -83,7 +83,13 @@ def stage_hunting(model: Model | _spec.Spec, isolated: bool | None = None, *,
             cycle, others = cycles[0], cycles[1:]
     bound = None
     if boundary and integrates(p):
-        bound = hunting_free_boundary(model, iso, cycle, family=family, progress=say)
+        start = cycle
+        if start is None and hunting:
+            # moves hunt here but no cycle converged (a sampled loop's cycle is no exact
+            # orbit of the section): follow the one a move repeated up from the design
+            # crossover, never search below it as if no move hunted
+            start = _run_cycle(hunting[0], fc)
+        bound = hunting_free_boundary(model, iso, start, family=family, progress=say)
     return StageHunting(plant=plant, crossover=float(fc), moves=outcomes, cycle=cycle,
                         other_cycles=tuple(others),
                         hunting_free_from=None if bound is None else bound.hunting_free_from,

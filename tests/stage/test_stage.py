@@ -427,3 +427,32 @@ def test_the_presliding_shift_balances_the_bristles_and_the_joint(z, d0, k, k_st
     got = presliding_shift(p, z, d0)
     assert got == pytest.approx(ref, rel=1e-9, abs=1e-16)
     assert abs(gap(got)) <= 1e-9 * (sigma0 * (abs(z) + span) + 1e-12)
+
+
+def test_hunting_moves_without_a_converged_cycle_start_the_fold_at_the_design(paper_spec,
+                                                                             monkeypatch):
+    """A sampled loop: moves hunt at the design crossover but no cycle converges as an orbit.
+    The fold search must start from the cycle a move repeated there, not look below the design
+    crossover as if no move hunted (it reported 'no move hunts from 6.425 Hz up' for a stage
+    hunting 6 of 25 moves at 8 Hz)."""
+    from types import SimpleNamespace
+
+    from fi_design.results.stage import Boundary
+    from fi_design.stage import judge
+
+    out = SimpleNamespace(hunts=True, amplitude=1.8e-3, period=3.0)
+    run = SimpleNamespace(outcome=out, section_state=np.zeros(4), crossings=2, level=0.0)
+    seen = {}
+
+    def boundary(model, iso, cycle, **kw):
+        seen["cycle"] = cycle
+        return Boundary(hunting_free_from=None, bracket=(8.0, 8.0), kind="bound",
+                        resolution=0.0, tests=0, branch=(), note="")
+
+    monkeypatch.setattr(judge, "stage_hunts", lambda *a, **k: ((out,), [run]))
+    monkeypatch.setattr(judge, "_distinct_cycles", lambda *a, **k: [])
+    monkeypatch.setattr(judge, "hunting_free_boundary", boundary)
+    model = resolve(paper_spec)
+    judge.stage_hunting(model, True)
+    assert seen["cycle"] is not None
+    assert seen["cycle"].crossover == model.crossover and seen["cycle"].amplitude == 1.8e-3
