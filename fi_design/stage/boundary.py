@@ -139,7 +139,8 @@ def hunting_free_boundary(model: Model, isolated: bool, cycle: Cycle | None = No
     Boundary
         A fold (no move of the family hunts just above it), or a bound: the
         bottom of the search when no move hunts from there up, or None when
-        the cycle persists up to the top.
+        the cycle persists up to the top, or when moves still hunt just above
+        the last of the folds followed (the note says so).
     """
     say = progress or (lambda text: None)
     scan = model.spec.simulation.crossover_scan
@@ -182,5 +183,10 @@ def hunting_free_boundary(model: Model, isolated: bool, cycle: Cycle | None = No
             return replace(fold, tests=tests, branch=tuple(sorted(branch)),
                            note="the fold of the cycle, confirmed by the move family above it")
         cycle = _run_cycle(h[0], hi)
-    return replace(fold, tests=tests, branch=tuple(sorted(branch)),
-                   note="several cycles; the last fold found")
+    # moves still hunt just above the last fold: that fold ends no hunting, so no crossover
+    # from which no move hunts was found (a cycle the continuation cannot follow, such as a
+    # sampled loop's, leaves a fold a bisection step above every crossover it starts from)
+    return Boundary(hunting_free_from=None, bracket=(fold.bracket[0], top), kind="bound",
+                    resolution=0.0, tests=tests, branch=tuple(sorted(branch)),
+                    note=f"not found: moves still hunt at {quantity(hi, 'Hz', 4)}, above "
+                         "the last of several folds the cycles' continuation found")

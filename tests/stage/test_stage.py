@@ -456,3 +456,28 @@ def test_hunting_moves_without_a_converged_cycle_start_the_fold_at_the_design(pa
     judge.stage_hunting(model, True)
     assert seen["cycle"] is not None
     assert seen["cycle"].crossover == model.crossover and seen["cycle"].amplitude == 1.8e-3
+
+
+def test_moves_hunting_above_every_fold_found_leave_the_boundary_not_found(paper_spec,
+                                                                          monkeypatch):
+    """Moves that still hunt just above the last fold the continuation found: no crossover from
+    which no move hunts is known. It reported that last fold ('no move of the family hunts from
+    8.031 Hz up') for a sampled paper setup that still hunts 5 of 25 moves at 10 Hz."""
+    from types import SimpleNamespace
+
+    from fi_design.results.stage import Boundary
+    from fi_design.stage import boundary as bd
+
+    def fold(model, isolated, cycle, *, top=None, progress=None):
+        lo = cycle.crossover
+        return Boundary(hunting_free_from=lo + 0.01, bracket=(lo, lo + 0.01), kind="fold",
+                        resolution=0.01, tests=3, branch=(), note="the fold of the cycle")
+
+    out = SimpleNamespace(hunts=True, amplitude=1.8e-3, period=3.0)
+    run = SimpleNamespace(outcome=out, section_state=np.zeros(4), crossings=2, level=0.0)
+    monkeypatch.setattr(bd, "cycle_fold", fold)
+    monkeypatch.setattr(bd, "stage_hunts", lambda *a, **k: ((out,), [run]))
+    model = resolve(paper_spec)
+    b = bd.hunting_free_boundary(model, True, bd._run_cycle(run, model.crossover))
+    assert b.hunting_free_from is None and b.kind == "bound"
+    assert b.note.startswith("not found: moves still hunt at 8.04 Hz")
