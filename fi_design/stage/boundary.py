@@ -28,7 +28,7 @@ from .orbit import cycle_exists
 from .runs import MoveRun
 from .settings import FOLD_RELATIVE, FOLD_RESOLUTION, FOLD_STEP, watch_settings
 
-__all__ = ["cycle_fold", "hunting_free_boundary"]
+__all__ = ["cycle_fold", "cycle_of_run", "hunting_free_boundary"]
 
 
 def cycle_fold(model: Model, isolated: bool, cycle: Cycle, *, top: float | None = None,
@@ -104,9 +104,22 @@ def cycle_fold(model: Model, isolated: bool, cycle: Cycle, *, top: float | None 
                             note="the fold of the cycle")
 
 
-def _run_cycle(run: MoveRun, crossover: float) -> Cycle:
+def cycle_of_run(run: MoveRun, crossover: float) -> Cycle:
     """The cycle a hunting move repeated, as its run left it (no Newton): enough to start the
-    fold's continuation from, which converges on the cycle at every step anyway."""
+    fold's continuation from, which converges on the cycle at every step anyway.
+
+    Parameters
+    ----------
+    run : MoveRun
+        A run whose move ends in a hunting cycle.
+    crossover : float
+        The crossover it ran at [Hz].
+
+    Returns
+    -------
+    Cycle
+        ``method "simulation"``, no Floquet multiplier.
+    """
     m = run.outcome
     return Cycle(crossover=float(crossover), amplitude=float(m.amplitude or 0.0),
                  period=float(m.period or 0.0), stable=True, multiplier=None,
@@ -159,7 +172,7 @@ def hunting_free_boundary(model: Model, isolated: bool, cycle: Cycle | None = No
             tests += 1
             h = [r for r in runs if r.outcome.hunts]
             if h:
-                found = _run_cycle(h[0], f)
+                found = cycle_of_run(h[0], f)
                 break
         if found is None:
             return Boundary(hunting_free_from=scan.start, bracket=(scan.start, scan.start),
@@ -182,7 +195,7 @@ def hunting_free_boundary(model: Model, isolated: bool, cycle: Cycle | None = No
         if not h:
             return replace(fold, tests=tests, branch=tuple(sorted(branch)),
                            note="the fold of the cycle, confirmed by the move family above it")
-        cycle = _run_cycle(h[0], hi)
+        cycle = cycle_of_run(h[0], hi)
     # moves still hunt just above the last fold: that fold ends no hunting, so no crossover
     # from which no move hunts was found (a cycle the continuation cannot follow, such as a
     # sampled loop's, leaves a fold a bisection step above every crossover it starts from)

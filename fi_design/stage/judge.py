@@ -15,7 +15,7 @@ from ..errors import ArgumentError
 from ..kernel.layout import PlantParameters
 from ..model import Model, as_model
 from ..results.stage import Cycle, StageHunting
-from .boundary import _run_cycle, hunting_free_boundary
+from .boundary import cycle_of_run, hunting_free_boundary
 from .moves import ORDERS, stage_hunts
 from .orbit import converge_cycle
 from .runs import MoveRun
@@ -88,7 +88,7 @@ def stage_hunting(model: Model | _spec.Spec, isolated: bool | None = None, *,
             # moves hunt here but no cycle converged (a sampled loop's cycle is no exact
             # orbit of the section): follow the one a move repeated up from the design
             # crossover, never search below it as if no move hunted
-            start = _run_cycle(hunting[0], fc)
+            start = cycle_of_run(hunting[0], fc)
         bound = hunting_free_boundary(model, iso, start, family=family, progress=say)
     return StageHunting(plant=plant, crossover=float(fc), moves=outcomes, cycle=cycle,
                         other_cycles=tuple(others),

@@ -478,6 +478,6 @@ def test_moves_hunting_above_every_fold_found_leave_the_boundary_not_found(paper
     monkeypatch.setattr(bd, "cycle_fold", fold)
     monkeypatch.setattr(bd, "stage_hunts", lambda *a, **k: ((out,), [run]))
     model = resolve(paper_spec)
-    b = bd.hunting_free_boundary(model, True, bd._run_cycle(run, model.crossover))
+    b = bd.hunting_free_boundary(model, True, bd.cycle_of_run(run, model.crossover))
     assert b.hunting_free_from is None and b.kind == "bound"
     assert b.note.startswith("not found: moves still hunt at 8.04 Hz")
