@@ -284,6 +284,8 @@ def cycle_exists(params: PlantParameters, level: float, guess: np.ndarray, w: Wa
             if not restartable(params):
                 return FoundCycle(None, 0, None, None)  # cannot continue exactly: not at rest yet
             offset += out.t_reached
+            if offset >= horizon:  # quiet to the end of the horizon: no cycle repeated in it
+                return None
             y0 = out.final_state.copy()
             ref = hold(level, horizon - offset)
             continue

@@ -481,3 +481,20 @@ def test_moves_hunting_above_every_fold_found_leave_the_boundary_not_found(paper
     b = bd.hunting_free_boundary(model, True, bd.cycle_of_run(run, model.crossover))
     assert b.hunting_free_from is None and b.kind == "bound"
     assert b.note.startswith("not found: moves still hunt at 8.04 Hz")
+
+
+def test_a_cycle_test_quiet_to_the_end_of_its_horizon_finds_no_cycle(monkeypatch):
+    """friction.model: switch crashed the design ('breaks must be increasing ...'): a cycle
+    test whose restarts after quiet stretches used up its horizon asked for a hold reference of
+    no duration. Quiet to the end of the horizon, no cycle repeated: None, as a run that ends."""
+    from types import SimpleNamespace
+
+    from fi_design.stage import orbit
+
+    quiet = SimpleNamespace(code=0, stop="quiet", final_state=np.zeros(4), t_reached=0.5)
+    monkeypatch.setattr(orbit, "kernel_run", lambda *a, **k: quiet)
+    monkeypatch.setattr(orbit, "watch_array", lambda *a, **k: None)
+    monkeypatch.setattr(orbit, "rest_ends_run", lambda *a, **k: False)
+    monkeypatch.setattr(orbit, "restartable", lambda *a, **k: True)
+    w = SimpleNamespace(horizon=1.0, tolerance=1e-6, max_steps=10, band=1e-5)
+    assert orbit.cycle_exists(None, 0.0, np.zeros(4), w) is None
