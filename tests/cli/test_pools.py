@@ -182,8 +182,9 @@ _SWEEP = ["sweep", str(EXAMPLES / "paper_setup.yaml"), "--x", "controller.crosso
           "--y", "isolator.stroke=0.1 mm:0.9 mm:2", "--jobs", "2", "--no-cache",
           "--csv", "map.csv"]
 #: The design run: the confirmation and the robustness study's chunks on two workers while
-#: this process scans the loop; its JSON output named map.csv so that the check below reads it.
-_DESIGN = ["design", str(EXAMPLES / "paper_setup.yaml"), "--no-recommend", "--json", "map.csv"]
+#: this process scans the loop. Its JSON output is map.json (named map.csv, as it was, the
+#: run was refused at its outputs' check, exit 2, and never designed anything).
+_DESIGN = ["design", str(EXAMPLES / "paper_setup.yaml"), "--no-recommend", "--json", "map.json"]
 
 
 def _interrupt(tmp_path, prefix: str, command: list[str], delay: float,
@@ -235,7 +236,8 @@ def _check_interrupted(run: dict) -> None:
     assert run["code"] in (130, -signal.SIGINT), run
     assert "interrupted" in run["err"], run
     assert "internal error" not in run["err"] and "Traceback" not in run["err"], run
-    assert "map.csv" not in run["files"] or "it had written" in run["err"], run
+    assert not {"map.csv", "map.json"} & set(run["files"]) or "it had written" in run["err"], run
+    assert "output file name must end with" not in run["err"], run  # the command ran
 
 
 def _sweep_at(tmp_path, delays, at_once: int = 2, command: list[str] = _SWEEP) -> None:
