@@ -270,7 +270,8 @@ def sweep_command(
     no_isolator: Annotated[bool, typer.Option(
         "--no-isolator", help="Simulate the stage without its isolator.")] = False,
     csv_out: Optional[Path] = output_option("--csv", "OUT.csv",
-        "Write one row per point (SI values)."),
+        "Write one row per point (SI values; each column named with its unit, "
+        "controller.crossover_Hz, amplitude_m, period_s)."),
     json_out: JsonOut = None,
     figure_out: Optional[Path] = output_option("--figure", "OUT.svg|OUT.png",
         "Write the heatmap (or line plot)."),
@@ -330,9 +331,9 @@ def study_command(
                                          show_default=False)],
     spec: SpecArg,
     out: Annotated[Path, typer.Option(
-        "--out", "-o", metavar="DIR", help="Directory for figure4.svg, figure4.png, "
-                                            "map_A.csv ... map_D.csv and study.json (created "
-                                            "if missing).")] = Path("paper_study"),
+        "--out", "-o", metavar="DIR",
+        help="Directory for figure4.svg, figure4.png, map_A.csv ... map_D.csv and study.json "
+             "(created if missing).")] = Path("paper_study"),
     resolution: Annotated[int, typer.Option(
         "--resolution", "-n", min=2, metavar="N",
         callback=at_most(150, "points per axis (four maps of 150 x 150 are 90 000 simulations)"),
@@ -426,7 +427,8 @@ def robustness_command(
         "--confidence", min=0.5, max=0.999, metavar="LEVEL",
         help="Level of the Wilson confidence interval.")] = 0.95,
     csv_out: Optional[Path] = output_option("--csv", "OUT.csv",
-        "Write one row per sample."),
+        "Write one row per sample: the drawn values and, per plant, the outcome (each "
+        "column named with its unit, friction.static_N, isolated_verdict)."),
     json_out: JsonOut = None,
     figure_out: Optional[Path] = output_option("--figure", "OUT.svg|OUT.png",
         "Write a bar chart of the probabilities."),

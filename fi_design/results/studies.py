@@ -26,7 +26,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["POINT_VERDICTS", "Axis", "PointResult", "RunInfo", "SweepResult", "DesignMap",
            "MapDefinition", "StudyMap", "StudyResult", "Scatter", "PositionFriction",
-           "HuntingProbability", "RobustnessResult", "columns", "csv_text"]
+           "HuntingProbability", "RobustnessResult", "column_name", "columns",
+           "outcome_columns", "csv_text"]
 
 #: Verdicts of the hunting metric plus the outcomes of a point that has no metric: its
 #: drawn guide buckled under the stage's weight (not simulated), refused by the spec, failed.
@@ -274,12 +275,15 @@ class SweepResult(Result):
         Returns
         -------
         dict of str to list
-            Columns (in order) named by each swept dotted path, then
-            ``hunting_cycles``, ``amplitude`` [m], ``period`` [s], ``verdict``,
-            ``status`` and ``message``. ``None`` where a point has no value.
+            Columns (in order) named by each swept dotted path with its unit
+            (:func:`column_name`: ``controller.crossover_Hz``,
+            ``isolator.stroke_m``), then ``hunting_cycles`` (a count),
+            ``amplitude_m``, ``period_s``, ``verdict``, ``status`` and
+            ``message``. ``None`` where a point has no value.
             ``pandas.DataFrame(result.table())`` gives a data frame.
         """
-        return columns(self.paths, self.points)
+        axes = (self.x,) if self.y is None else (self.x, self.y)
+        return columns([(a.path, a.unit) for a in axes], self.points)
 
     def to_csv(self) -> str:
         """The :meth:`table` as CSV text (one row per point; empty cells for no value).
@@ -574,6 +578,10 @@ class RobustnessResult(Result):
     measure : str
         ``"stage"`` (a sample hunts when any move of its family ends in a
         cycle) or ``"move"`` (the paper's metric on the spec's move).
+    units : tuple of str
+        Unit of each scattered value, in the order of ``scatter`` (the
+        columns of ``draws``): the spec's SI unit (``"N"``, ``"Hz"``; ``"1"``
+        for a plain number); empty when not known.
     """
 
     spec: Spec
@@ -590,6 +598,7 @@ class RobustnessResult(Result):
     fi_design_version: str = ""
     fi_design_source: Source = field(default_factory=current_source)
     measure: str = "move"
+    units: tuple[str, ...] = ()
 
     @property
     def samples(self) -> int:
@@ -602,16 +611,18 @@ class RobustnessResult(Result):
         Returns
         -------
         dict of str to list
-            Columns ``sample``, each scattered path, ``phase`` (with
-            position-dependent friction), then ``isolated_hunting_cycles``,
-            ``isolated_verdict`` (with an isolator) and
+            Columns ``sample`` (a count from 0), each scattered path with its
+            unit (:func:`column_name`: ``friction.static_N``), ``phase_rad``
+            (with position-dependent friction), then ``isolated_hunting_cycles``
+            (a count), ``isolated_verdict`` (with an isolator) and
             ``not_isolated_hunting_cycles``, ``not_isolated_verdict``.
         """
         cols: dict[str, list] = {"sample": list(range(self.samples))}
-        for k, sc in enumerate(self.scatter):
-            cols[sc.path] = [float(v) for v in self.draws[:, k]]
+        units = self.units or ("",) * len(self.scatter)
+        for k, (sc, unit) in enumerate(zip(self.scatter, units)):
+            cols[column_name(sc.path, unit)] = [float(v) for v in self.draws[:, k]]
         if self.position_friction is not None:
-            cols["phase"] = [float(v) for v in self.phases]
+            cols[column_name("phase", "rad")] = [float(v) for v in self.phases]
         for name, prob in (("isolated", self.isolated), ("not_isolated", self.not_isolated)):
             if prob is None:
                 continue
@@ -650,13 +661,61 @@ class RobustnessResult(Result):
         }
 
 
-def columns(paths: Sequence[str], points: Sequence[PointResult], prefix: str = "") \
+#: A point's outcome in a table: field, unit.
+_OUTCOME_COLUMNS = (("hunting_cycles", "1"), ("amplitude", "m"), ("period", "s"),
+                    ("verdict", ""), ("status", ""), ("message", ""))
+
+
+def column_name(name: str, unit: str) -> str:
+    """The name of a table's (a CSV file's) column: the quantity and its unit.
+
+    The unit follows the name after an underscore, as in the measured-data
+    layout (``time_s``, ``position_m``): ``amplitude_m``,
+    ``controller.crossover_Hz``, ``isolator.damping_N*s/m``. A plain number
+    (unit ``"1"``: a count, a ratio) and text (no unit) keep the bare name.
+
+    Parameters
+    ----------
+    name : str
+        The quantity: a field or a dotted spec path.
+    unit : str
+        Its unit as the spec stores it (``"m"``, ``"N/m"``, ``"Hz"``; ``"1"``).
+
+    Returns
+    -------
+    str
+    """
+    return name if unit in ("", "1") else f"{name}_{unit}"
+
+
+def columns(axes: Sequence[tuple[str, str]], points: Sequence[PointResult]) \
         -> dict[str, list]:
-    """The points as columns: one per varied path [SI], then the outcome fields."""
-    cols: dict[str, list] = {p: [pt.values[i] for pt in points] for i, p in enumerate(paths)}
-    for name in ("hunting_cycles", "amplitude", "period", "verdict", "status", "message"):
-        cols[prefix + name] = [getattr(pt, name) for pt in points]
+    """The points as columns: one per varied value [SI], then the outcome fields.
+
+    Parameters
+    ----------
+    axes : sequence of (str, str)
+        The varied values' dotted paths and units, in the order of a point's values.
+    points : sequence of PointResult
+        The rows.
+
+    Returns
+    -------
+    dict of str to list
+        Columns named by :func:`column_name`, then :func:`outcome_columns`.
+    """
+    cols: dict[str, list] = {column_name(p, unit): [pt.values[i] for pt in points]
+                             for i, (p, unit) in enumerate(axes)}
+    cols.update(outcome_columns(points))
     return cols
+
+
+def outcome_columns(points: Sequence[PointResult], prefix: str = "") -> dict[str, list]:
+    """The outcome of every point as columns: ``hunting_cycles`` (a count),
+    ``amplitude_m``, ``period_s``, ``verdict``, ``status``, ``message``, each
+    name after ``prefix``."""
+    return {prefix + column_name(name, unit): [getattr(pt, name) for pt in points]
+            for name, unit in _OUTCOME_COLUMNS}
 
 
 def csv_text(columns: Mapping[str, list]) -> str:

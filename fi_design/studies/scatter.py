@@ -336,7 +336,8 @@ def robustness(spec: _spec.Spec | Model, scatter: Sequence[Scatter] = (), sample
         spec=spec, scatter=items, position_friction=position_friction, distribution=distribution,
         seed=int(seed), draws=frozen_array(draws), phases=frozen_array(phases),
         isolated=probs.get(True), not_isolated=probs[False], points=points, run=info,
-        fi_design_version=__version__, measure=measure)
+        fi_design_version=__version__, measure=measure,
+        units=tuple(path_unit(s.path, base.spec) for s in items))
 
 
 def _probability(points: Sequence[PointResult], iso: bool, confidence: float,

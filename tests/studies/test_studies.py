@@ -119,8 +119,8 @@ def test_invalid_and_failed_points_are_recorded(paper_spec, kernel):
     assert math.isnan(res.hunting_cycles[0, 0]) and math.isnan(res.hunting_cycles[0, 1])
     assert res.counts()["invalid"] == 2 and res.counts()["failed"] == 1
     rows = res.to_csv().splitlines()
-    assert rows[0] == ("friction.static,simulation.max_steps,hunting_cycles,amplitude,period,"
-                       "verdict,status,message")
+    assert rows[0] == ("friction.static_N,simulation.max_steps,hunting_cycles,amplitude_m,"
+                       "period_s,verdict,status,message")
     assert rows[1].startswith("0.5,1000.0,,,,invalid,invalid,")
 
 
@@ -573,7 +573,7 @@ def test_robustness_is_reproducible(paper_spec, pool):
     assert a.not_isolated.hunting >= 4 and a.isolated.hunting <= 1
     assert 0 <= a.isolated.low <= a.isolated.high <= 1
     cols = a.table()
-    assert list(cols)[:4] == ["sample", "friction.static", "friction.coulomb", "phase"]
+    assert list(cols)[:4] == ["sample", "friction.static_N", "friction.coulomb_N", "phase_rad"]
 
 
 def test_robustness_invalid_draws_and_errors(paper_spec, kernel):

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import csv
 import json
+import re
+from types import SimpleNamespace
 
 import pytest
 from typer.testing import CliRunner
@@ -17,13 +19,105 @@ def run(*args: str):
     return runner.invoke(app, [str(a) for a in args], catch_exceptions=False)
 
 
-def test_sweep_writes_csv_json_and_figure(paper_spec_path, tmp_path):
-    out_csv, out_json, fig = tmp_path / "m.csv", tmp_path / "m.json", tmp_path / "m.svg"
+# ----------------------------------------------------------------- runs the tests read (once)
+
+
+@pytest.fixture(scope="module")
+def sweep_run(paper_spec_path, tmp_path_factory):
+    """`sweep` of crossover x stroke (3 x 2 points) with its CSV, JSON and figure."""
+    d = tmp_path_factory.mktemp("sweep")
+    out = SimpleNamespace(csv=d / "m.csv", json=d / "m.json", figure=d / "m.svg")
     r = run("sweep", paper_spec_path, "--x", "controller.crossover=3 Hz:9 Hz:3",
-            "--y", "isolator.stroke=0.1 mm:0.3 mm:2", "--csv", out_csv, "--json", out_json,
-            "--figure", fig, "--jobs", "1")
+            "--y", "isolator.stroke=0.1 mm:0.3 mm:2", "--csv", out.csv, "--json", out.json,
+            "--figure", out.figure, "--jobs", "1")
     assert r.exit_code == 0, r.output
-    assert "points:" in r.output and "peak to peak of the cycle some move ends in" in r.output
+    out.output = r.output
+    return out
+
+
+@pytest.fixture(scope="module")
+def study_dir(paper_spec_path, tmp_path_factory):
+    """`study paper` at 2 points per axis, all four maps: the directory and the console."""
+    out = tmp_path_factory.mktemp("study") / "study"
+    r = run("study", "paper", paper_spec_path, "--out", out, "--resolution", "2", "--jobs", "1")
+    assert r.exit_code == 0, r.output
+    return SimpleNamespace(path=out, output=r.output)
+
+
+#: The robustness run the tests read: 4 samples, friction and its variation along the rail.
+ROBUSTNESS_ARGS = ("--samples", "4", "--scatter", "friction.static=10%", "--scatter",
+                   "friction.coulomb=0.1 N", "--seed", "7", "--position-friction", "10%:20 mm",
+                   "--jobs", "1")
+
+
+@pytest.fixture(scope="module")
+def robustness_run(paper_spec_path, tmp_path_factory):
+    """`robustness` (default measure: the stage) with its CSV and JSON."""
+    d = tmp_path_factory.mktemp("robustness")
+    out = SimpleNamespace(csv=d / "r.csv", json=d / "r.json")
+    r = run("robustness", paper_spec_path, *ROBUSTNESS_ARGS, "--csv", out.csv,
+            "--json", out.json)
+    assert r.exit_code == 0, r.output
+    out.output = r.output
+    return out
+
+
+#: Columns without a unit: counts and text (in a robustness CSV after the plant's prefix).
+UNITLESS = {"sample", "hunting_cycles", "verdict", "status", "message"}
+
+
+def column_units(path) -> dict:
+    """The unit each column of a CSV file names after its last underscore (``time_s``,
+    ``controller.crossover_Hz``); None for the columns that have none."""
+    from fi_design.spec.units import KNOWN_UNITS
+
+    header = next(csv.reader(path.open()))
+    units = {}
+    for name in header:
+        if re.sub(r"^(not_)?isolated_", "", name) in UNITLESS:
+            units[name] = None
+            continue
+        head, _, unit = name.rpartition("_")
+        assert head and unit in KNOWN_UNITS and unit != "1", \
+            f"{path.name}: column {name!r} names no unit"
+        units[name] = unit
+    return units
+
+
+def test_every_csv_column_names_its_unit(sweep_run, study_dir, robustness_run):
+    """The studies' CSV files named their columns by the bare quantity (`amplitude`,
+    `controller.crossover`, `phase`): a reader could not tell metres from millimetres, hertz
+    from rad/s. Every column now carries its unit as the measured-data layout does
+    (`amplitude_m`), the swept and scattered values theirs from the spec (the JSON's axis
+    units), or is a count or text."""
+    units = column_units(sweep_run.csv)
+    axes = json.loads(sweep_run.json.read_text())
+    assert units == {f"controller.crossover_{axes['x']['unit']}": "Hz",
+                     f"isolator.stroke_{axes['y']['unit']}": "m", "hunting_cycles": None,
+                     "amplitude_m": "m", "period_s": "s", "verdict": None, "status": None,
+                     "message": None}
+    study = json.loads((study_dir.path / "study.json").read_text())
+    for m in study["maps"]:
+        units = column_units(study_dir.path / f"map_{m['definition']['key']}.csv")
+        x, y = m["result"]["x"], m["result"]["y"]
+        assert list(units)[:2] == [f"{x['path']}_{x['unit']}", f"{y['path']}_{y['unit']}"]
+        assert list(units)[2:] == ["hunting_cycles", "amplitude_m", "period_s", "verdict",
+                                   "status", "message"]
+    units = column_units(robustness_run.csv)
+    assert list(units)[:4] == ["sample", "friction.static_N", "friction.coulomb_N", "phase_rad"]
+    # the values are in the unit the header names (SI)
+    row = next(csv.DictReader(sweep_run.csv.open()))
+    assert float(row["isolator.stroke_m"]) == pytest.approx(1e-4)
+    assert float(row["controller.crossover_Hz"]) == pytest.approx(3.0)
+
+
+# --------------------------------------------------------------------------- sweep
+
+
+def test_sweep_writes_csv_json_and_figure(paper_spec_path, sweep_run):
+    out_csv, out_json, fig, output = sweep_run.csv, sweep_run.json, sweep_run.figure, \
+        sweep_run.output
+    assert "points:" in output and "peak to peak of the cycle some move ends in" in output
     one = run("sweep", paper_spec_path, "--x", "controller.crossover=3 Hz:9 Hz:3",
               "--measure", "move", "--jobs", "1")
     assert one.exit_code == 0 and "hunting cycles of the spec's move in the window" in one.output
@@ -31,9 +125,9 @@ def test_sweep_writes_csv_json_and_figure(paper_spec_path, tmp_path):
                               "--measure", "moves"])
     assert bad.exit_code == 2 and "--measure" in bad.output
     rows = list(csv.DictReader(out_csv.open()))
-    assert list(rows[0])[:6] == ["controller.crossover", "isolator.stroke", "hunting_cycles",
-                                 "amplitude", "period", "verdict"]
-    assert len(rows) == 6 and float(rows[0]["isolator.stroke"]) == pytest.approx(1e-4)
+    assert list(rows[0])[:6] == ["controller.crossover_Hz", "isolator.stroke_m",
+                                 "hunting_cycles", "amplitude_m", "period_s", "verdict"]
+    assert len(rows) == 6 and float(rows[0]["isolator.stroke_m"]) == pytest.approx(1e-4)
     data = json.loads(out_json.read_text())
     assert data["x"]["unit"] == "Hz" and data["y"]["values"][1] == pytest.approx(3e-4)
     assert fig.read_bytes().startswith(b"<?xml")
@@ -86,7 +180,7 @@ def test_sweep_marks_points_whose_guide_buckles(paper_spec_path, tmp_path):
     assert r.exit_code == 0, r.output
     rows = list(csv.DictReader(out.open()))
     assert rows[0]["verdict"] == "buckled" and rows[0]["status"] == "invalid"
-    assert "buckled the guide" in rows[0]["message"] and rows[0]["amplitude"] == ""
+    assert "buckled the guide" in rows[0]["message"] and rows[0]["amplitude_m"] == ""
     assert rows[1]["verdict"] != "buckled" and rows[1]["status"] == "ok"
     said = " ".join(r.output.split())  # the console folds lines at its width
     assert "1 buckled" in said and "b the weight has buckled the guide" in said
@@ -159,19 +253,17 @@ def test_existing_output_refused_before_any_work(paper_spec_path, tmp_path):
     assert csv_out.read_text() == "keep me" and not json_out.exists()
     r = run("sweep", paper_spec_path, "--x", "controller.crossover=3:9:2", "--csv", csv_out,
             "--force", "--jobs", "1")
-    assert r.exit_code == 0 and csv_out.read_text().startswith("controller.crossover,")
+    assert r.exit_code == 0 and csv_out.read_text().startswith("controller.crossover_Hz,")
 
 
-def test_study_paper(paper_spec_path, tmp_path):
-    out = tmp_path / "study"
-    r = run("study", "paper", paper_spec_path, "--out", out, "--resolution", "2", "--jobs", "1")
-    assert r.exit_code == 0, r.output
+def test_study_paper(paper_spec_path, study_dir):
+    out = study_dir.path
     for name in ("figure4.svg", "figure4.png", "study.json", "map_A.csv", "map_B.csv",
                  "map_C.csv", "map_D.csv"):
         assert (out / name).is_file(), name
     data = json.loads((out / "study.json").read_text())
     assert [m["definition"]["key"] for m in data["maps"]] == ["A", "B", "C", "D"]
-    assert "D) crossover vs stroke, with isolator" in r.output
+    assert "D) crossover vs stroke, with isolator" in study_dir.output
     again = runner.invoke(app, ["study", "paper", str(paper_spec_path), "--out", str(out),
                                 "--resolution", "2", "--jobs", "1"])
     assert again.exit_code == 2 and "file exists" in again.output
@@ -185,18 +277,13 @@ def test_study_errors(paper_spec_path, repo_root, tmp_path):
     assert r.exit_code == 2 and "isolator" in r.output and not (tmp_path / "s").exists()
 
 
-def test_robustness_reproducible_with_seed(paper_spec_path, tmp_path):
-    outs = []
-    for k in range(2):
-        out = tmp_path / f"r{k}.json"
-        r = run("robustness", paper_spec_path, "--samples", "4", "--scatter",
-                "friction.static=10%", "--scatter", "friction.coulomb=0.1 N", "--seed", "7",
-                "--position-friction", "10%:20 mm", "--json", out, "--jobs", "1",
-                *(["--no-cache"] if k else []))
-        assert r.exit_code == 0, r.output
-        assert "Probability of hunting" in r.output
-        outs.append(json.loads(out.read_text()))
-    a, b = outs
+def test_robustness_reproducible_with_seed(paper_spec_path, robustness_run, tmp_path):
+    out = tmp_path / "r1.json"
+    r = run("robustness", paper_spec_path, *ROBUSTNESS_ARGS, "--json", out, "--no-cache")
+    assert r.exit_code == 0, r.output
+    assert "Probability of hunting" in r.output and "Probability of hunting" in \
+        robustness_run.output
+    a, b = json.loads(robustness_run.json.read_text()), json.loads(out.read_text())
     assert a["draws"] == b["draws"] and a["points"] == b["points"]
     assert a["isolated"]["probability"] == b["isolated"]["probability"]
     assert a["scatter"][1] == {"path": "friction.coulomb", "spread": 0.1, "relative": False,
