@@ -428,7 +428,7 @@ def robustness_command(
         help="Level of the Wilson confidence interval.")] = 0.95,
     csv_out: Optional[Path] = output_option("--csv", "OUT.csv",
         "Write one row per sample: the drawn values and, per plant, the outcome (each "
-        "column named with its unit, friction.static_N, isolated_verdict)."),
+        "column named with its unit, friction.static_N, isolated_amplitude_m)."),
     json_out: JsonOut = None,
     figure_out: Optional[Path] = output_option("--figure", "OUT.svg|OUT.png",
         "Write a bar chart of the probabilities."),

@@ -613,9 +613,14 @@ class RobustnessResult(Result):
         dict of str to list
             Columns ``sample`` (a count from 0), each scattered path with its
             unit (:func:`column_name`: ``friction.static_N``), ``phase_rad``
-            (with position-dependent friction), then ``isolated_hunting_cycles``
-            (a count), ``isolated_verdict`` (with an isolator) and
-            ``not_isolated_hunting_cycles``, ``not_isolated_verdict``.
+            (with position-dependent friction), then per plant, ``isolated_``
+            (with an isolator) and ``not_isolated_``: ``hunting_cycles`` (a
+            count; empty under the ``stage`` measure), ``amplitude_m`` (under
+            ``stage`` the peak to peak of the cycle the first move found
+            hunting ends in, the largest move tried first; 0 when none hunts),
+            ``period_s``, ``verdict``, ``status`` and ``message`` (which move
+            hunts). The sample's outcome as :attr:`points` (and the JSON) hold
+            it. ``None`` where a sample has no value.
         """
         cols: dict[str, list] = {"sample": list(range(self.samples))}
         units = self.units or ("",) * len(self.scatter)
@@ -623,12 +628,10 @@ class RobustnessResult(Result):
             cols[column_name(sc.path, unit)] = [float(v) for v in self.draws[:, k]]
         if self.position_friction is not None:
             cols[column_name("phase", "rad")] = [float(v) for v in self.phases]
-        for name, prob in (("isolated", self.isolated), ("not_isolated", self.not_isolated)):
-            if prob is None:
-                continue
-            cols[f"{name}_hunting_cycles"] = [None if math.isnan(c) else int(c)
-                                              for c in prob.hunting_cycles]
-            cols[f"{name}_verdict"] = prob.verdict.tolist()
+        for name, iso in (("isolated", True), ("not_isolated", False)):
+            pts = sorted((p for p in self.points if p.isolated == iso), key=lambda p: p.index)
+            if pts:
+                cols.update(outcome_columns(pts, prefix=f"{name}_"))
         return cols
 
     def to_csv(self) -> str:

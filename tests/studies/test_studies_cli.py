@@ -105,10 +105,45 @@ def test_every_csv_column_names_its_unit(sweep_run, study_dir, robustness_run):
                                    "status", "message"]
     units = column_units(robustness_run.csv)
     assert list(units)[:4] == ["sample", "friction.static_N", "friction.coulomb_N", "phase_rad"]
+    for plant in ("isolated", "not_isolated"):
+        assert units[f"{plant}_amplitude_m"] == "m" and units[f"{plant}_period_s"] == "s"
     # the values are in the unit the header names (SI)
     row = next(csv.DictReader(sweep_run.csv.open()))
     assert float(row["isolator.stroke_m"]) == pytest.approx(1e-4)
     assert float(row["controller.crossover_Hz"]) == pytest.approx(3.0)
+
+
+def test_robustness_csv_carries_what_the_stage_measure_gives(robustness_run):
+    """Under the default measure (the stage over its moves) a sample's cycles are not
+    counted, and the CSV's only outcome column per plant besides the verdict,
+    hunting_cycles, was empty: no amplitude at all. It now carries what the JSON's points
+    hold: the peak to peak of the cycle the hunting move ends in [m], its period [s], and the
+    message naming that move."""
+    data = json.loads(robustness_run.json.read_text())
+    assert data["measure"] == "stage"
+    points = {(p["isolated"], p["index"][0]): p for p in data["points"]}
+    rows = list(csv.DictReader(robustness_run.csv.open()))
+    assert len(rows) == data["samples"] == 4
+    hunted = 0
+    for plant, iso in (("isolated", True), ("not_isolated", False)):
+        for n, row in enumerate(rows):
+            p = points[(iso, n)]
+            assert row[f"{plant}_verdict"] == p["verdict"] and row[f"{plant}_hunting_cycles"] == ""
+            assert row[f"{plant}_message"] == p["message"]
+            if p["verdict"] != "hunting":
+                assert row[f"{plant}_amplitude_m"] in ("", "0.0")
+                continue
+            hunted += 1
+            amp, period = float(row[f"{plant}_amplitude_m"]), float(row[f"{plant}_period_s"])
+            assert amp == pytest.approx(p["amplitude"]) and period == pytest.approx(p["period"])
+            # the message names the move that hunts and its cycle, to 3 digits
+            said = re.search(r"move hunts.*: ([\d.]+) (mm|µm) peak to peak, period ([\d.]+) s",
+                             row[f"{plant}_message"])
+            assert said, row[f"{plant}_message"]
+            scale = {"mm": 1e-3, "µm": 1e-6}[said.group(2)]
+            assert amp == pytest.approx(float(said.group(1)) * scale, rel=6e-3)
+            assert period == pytest.approx(float(said.group(3)), rel=6e-3)
+    assert hunted  # the scattered stage hunts in some samples: the columns are exercised
 
 
 # --------------------------------------------------------------------------- sweep
