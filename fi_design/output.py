@@ -210,7 +210,8 @@ def check_outputs(inputs: Iterable[str | os.PathLike], *, force: bool = False,
 
 def check_output_dir(directory: str | os.PathLike, names: Iterable[str], *,
                      force: bool = False,
-                     protect: Iterable[str | os.PathLike | None] = ()) -> dict:
+                     protect: Iterable[str | os.PathLike | None] = (),
+                     stale: Iterable[str] = ()) -> dict:
     """Refuse a directory of outputs before the work starts (it may not exist yet).
 
     Parameters
@@ -224,11 +225,17 @@ def check_output_dir(directory: str | os.PathLike, names: Iterable[str], *,
         Allow overwriting existing files.
     protect : iterable of path, optional
         Files never overwritten.
+    stale : iterable of str, optional
+        Names of files the command writes there in other runs but not in this
+        one (a study's maps left out): one found there would lie beside
+        outputs it does not belong to, so it is refused without ``force``
+        and, with ``force``, claimed for :func:`remove_output` once the new
+        files are written.
 
     Returns
     -------
     dict
-        File name to its :class:`~pathlib.Path` in ``directory``.
+        File name to its :class:`~pathlib.Path` in ``directory`` (``names`` only).
 
     Raises
     ------
@@ -248,7 +255,51 @@ def check_output_dir(directory: str | os.PathLike, names: Iterable[str], *,
         else:
             _claim(out / name, force)
         targets[name] = out / name
+    for name in stale:
+        old = out / name
+        if name in targets or not (old.exists() or old.is_symlink()):
+            continue
+        if not force:
+            raise OutputError(f"{old}: file exists, an output of an earlier run that this one "
+                              "does not write; use --force to remove it, or choose another "
+                              "directory")
+        check_output(old, force=True, protect=protect)
     return targets
+
+
+def remove_output(path: str | os.PathLike) -> bool:
+    """Remove a stale output that the run checked with ``force`` (:func:`check_output_dir`).
+
+    Only the file found at the check goes: one written there since (by
+    another run) is kept, and so is a path the run did not check with
+    ``force``. An interrupted run removes nothing.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    bool
+        Whether it was removed.
+    """
+    out = Path(path)
+    key = os.path.realpath(out)
+    claim = (_CLAIMS.get() or {}).get(key)
+    if claim is None or not claim.force or claim.found is None:
+        return False
+    interrupts.raise_received()
+    parent = out.parent if str(out.parent) else Path(".")
+    with _directory_lock(parent):
+        if _identity(out) != claim.found:
+            return False
+        try:
+            os.unlink(out)
+        except OSError as exc:
+            raise OutputError(f"{out}: cannot remove ({exc.strerror or exc})") from None
+    _set_claim(key, Claim(force=True, found=None))
+    return True
 
 
 def _same_file(a: Path, b: Path) -> bool:

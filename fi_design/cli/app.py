@@ -333,7 +333,8 @@ def study_command(
     out: Annotated[Path, typer.Option(
         "--out", "-o", metavar="DIR",
         help="Directory for figure4.svg, figure4.png, map_A.csv ... map_D.csv and study.json "
-             "(created if missing).")] = Path("paper_study"),
+             "(created if missing). A map file there of a map this run leaves out (--maps) is "
+             "refused; --force removes it (and no other file).")] = Path("paper_study"),
     resolution: Annotated[int, typer.Option(
         "--resolution", "-n", min=2, metavar="N",
         callback=at_most(150, "points per axis (four maps of 150 x 150 are 90 000 simulations)"),
@@ -356,7 +357,9 @@ def study_command(
 
     fi-design study paper SPEC.yaml evaluates the paper's four maps (Figure
     4) with the spec as the design point and writes the figure, one CSV per
-    map and the JSON of the whole study into --out.
+    map and the JSON of the whole study into --out. With --force, the files
+    of an earlier study there are replaced, and its map CSVs of maps this run
+    leaves out (--maps) removed, so that the directory holds this study only.
     """
     if study not in STUDIES:
         close = difflib.get_close_matches(study, STUDIES, n=1)
@@ -366,8 +369,10 @@ def study_command(
     letters = [k for k in maps.upper() if not k.isspace()]
     names = ["figure4.svg", "figure4.png", "study.json"] + [f"map_{k}.csv" for k in letters]
     from ..output import check_output_dir
+    from ..studies import PAPER_MAPS
 
-    targets = check_output_dir(out, names, force=force, protect=(spec,))
+    stale = [f"map_{d.key}.csv" for d in PAPER_MAPS if d.key not in letters]
+    targets = check_output_dir(out, names, force=force, protect=(spec,), stale=stale)
     report_path = check_outputs((spec,), force, report=(report_out, (".html", ".pdf")))["report"]
     if report_path is not None and report_path.resolve() in {p.resolve() for p in
                                                              targets.values()}:
@@ -391,11 +396,14 @@ def study_command(
                 "study.json": json_text(result)}
     payloads.update({f"map_{m.definition.key}.csv": m.result.to_csv() for m in result.maps})
     out.mkdir(exist_ok=True)
-    from ..output import write_atomic
+    from ..output import remove_output, write_atomic
 
     for name, data in payloads.items():
         write_atomic(targets[name], data)
-    console.print(f"wrote {', '.join(payloads)} to {out}", markup=False)
+    removed = [name for name in stale if remove_output(out / name)]
+    console.print(f"wrote {', '.join(payloads)} to {out}"
+                  + (f"; removed {', '.join(removed)} (maps of an earlier study that this one "
+                     "leaves out)" if removed else ""), markup=False)
     write_report(console, report_path, result)
     print_study(console, result, spec_path=spec, executor=pool.describe(), out=out)
 

@@ -186,6 +186,30 @@ def test_concurrent_writers_of_one_path_one_wins_and_the_other_says_so(tmp_path)
     assert [p.name for p in tmp_path.iterdir()] == ["out.json"]
 
 
+def test_a_stale_output_is_removed_only_as_the_check_found_it(tmp_path):
+    """A directory's stale output (a study's map left out this time): refused without force;
+    with it, removed after the run, unless another run wrote it since the check, or the run
+    did not check it."""
+    from fi_design.output import check_output_dir, remove_output
+
+    (tmp_path / "map_C.csv").write_text("earlier study")
+    (tmp_path / "map_D.csv").write_text("earlier study")
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(OutputError, match="map_C.csv: .*earlier run.*--force"):
+        _run(check_output_dir, tmp_path, ["map_A.csv"], stale=["map_B.csv", "map_C.csv"])
+
+    def run():
+        check_output_dir(tmp_path, ["map_A.csv"], force=True, stale=["map_B.csv", "map_C.csv",
+                                                                     "map_D.csv"])
+        (tmp_path / "map_D.csv").write_text("another run's study")  # written since the check
+        return [remove_output(tmp_path / n) for n in ("map_B.csv", "map_C.csv", "map_D.csv",
+                                                      "notes.txt")]
+
+    assert _run(run) == [False, True, False, False]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["map_D.csv", "notes.txt"]
+    assert (tmp_path / "map_D.csv").read_text() == "another run's study"
+
+
 def test_without_a_check_a_library_write_replaces(tmp_path):
     """write_atomic alone (a script) keeps its documented meaning: it replaces."""
     out = tmp_path / "out.json"

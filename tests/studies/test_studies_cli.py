@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import json
 import re
+import shutil
 from types import SimpleNamespace
 
 import pytest
@@ -302,6 +303,40 @@ def test_study_paper(paper_spec_path, study_dir):
     again = runner.invoke(app, ["study", "paper", str(paper_spec_path), "--out", str(out),
                                 "--resolution", "2", "--jobs", "1"])
     assert again.exit_code == 2 and "file exists" in again.output
+
+
+def test_study_force_leaves_no_map_of_an_earlier_study(paper_spec_path, study_dir, tmp_path,
+                                                       monkeypatch):
+    """`study paper --maps A --force` into the directory of an earlier study of all four
+    maps left map_B.csv ... map_D.csv beside a study.json of map A only. Without --force
+    such a file is refused before any work; with it the stale maps go, and no other file.
+    (The map's points come from the cache of the earlier study; the figure, which this test
+    does not read, is not drawn.)"""
+    from fi_design import plots
+
+    monkeypatch.setattr(plots, "study_figure", lambda result: None)
+    monkeypatch.setattr(plots, "figure_bytes", lambda fig, fmt: b"figure")
+    out = tmp_path / "study"
+    shutil.copytree(study_dir.path, out)
+    (out / "notes.txt").write_text("mine")
+    (out / "map_E.csv").write_text("mine too")  # not a map of the study
+    for name in ("figure4.svg", "figure4.png", "study.json", "map_A.csv"):
+        (out / name).unlink()  # nothing this run writes is there: only the other maps
+    refused = runner.invoke(app, ["study", "paper", str(paper_spec_path), "--out", str(out),
+                                  "--maps", "A", "--resolution", "2", "--jobs", "1"])
+    assert refused.exit_code == 2 and "map_B.csv" in refused.output \
+        and "--force" in refused.output, refused.output
+    assert not (out / "study.json").exists() and (out / "map_B.csv").is_file()
+    shutil.copy(study_dir.path / "study.json", out / "study.json")
+    r = run("study", "paper", paper_spec_path, "--out", out, "--maps", "A", "--resolution", "2",
+            "--jobs", "1", "--force")
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in out.iterdir()) == ["figure4.png", "figure4.svg", "map_A.csv",
+                                                     "map_E.csv", "notes.txt", "study.json"]
+    assert "removed map_B.csv, map_C.csv, map_D.csv" in " ".join(r.output.split())
+    data = json.loads((out / "study.json").read_text())
+    assert [m["definition"]["key"] for m in data["maps"]] == ["A"]
+    assert (out / "notes.txt").read_text() == "mine"
 
 
 def test_study_errors(paper_spec_path, repo_root, tmp_path):
