@@ -468,12 +468,16 @@ def render_report(result: Any, path: str | os.PathLike, *, date: Any = None,
     """
     out = Path(path)
     fmt = output_format(out)
-    from ..output import claimed
+    return _checked_output(out, force, lambda: _write_report(
+        result, out, fmt, date=date, command=command, design_map=design_map,
+        progress=progress, executor=executor))
 
-    if not claimed(out):  # checked first, then this call again as the path's owner
-        return _checked_output(out, force, lambda: render_report(
-            result, out, date=date, command=command, design_map=design_map,
-            progress=progress, executor=executor, force=force))
+
+def _write_report(result: Any, out: Path, fmt: str, *, date: Any, command: str | None,
+                  design_map: Any, progress: Callable[[str], None] | None,
+                  executor: Any) -> Path:
+    """Write the report of :func:`render_report` at ``out`` (checked: its claim is this
+    run's) in ``fmt`` (``"html"`` or ``"pdf"``); the parameters are render_report's."""
     if progress is not None:
         progress("drawing the report's figures ...")
     options = {} if design_map is None else {"design_map": design_map}
