@@ -310,6 +310,93 @@ def test_real_and_example_records_have_no_position_jump(emps_record):
     check_position_steps(measurement_from_arrays(t, step, step))
 
 
+#: Encoder count of the hunting record [m].
+COUNT = 1e-6
+
+
+@pytest.fixture(scope="module")
+def hunting_record():
+    """A stick-slip limit cycle recorded by a 1 um encoder at 1 kHz, simulated apart from the
+    package: the paper's stage without its isolator (2 kg, LuGre) under its rule PID at 8 Hz
+    (tests/independent.py, solve_ivp), a 1 mm move, then 2 s of hunting: long stops that
+    creep by one count now and then, and breakaways into slips of about 100 samples. The
+    controller sees the true position (its reading the encoder, a solve_ivp start at every
+    count or sample, costs seconds: the slow test below). At rtol 1e-5 every count is the
+    one of generate's 1e-8 (the position within 5 nm), in 0.3 s of CPU instead of 1.5 s."""
+    return _hunting(dict(rule=dict(fc=8.0)))
+
+
+def _hunting(controller, **options):
+    from independent import generate
+
+    friction = dict(Fs=4.0, Fc=1.0, vs=3e-3, sigma0=1e6, sigma1=1414.0, sigma2=20.0)
+    return generate(2.0, 0.0, friction=friction, controller=controller,
+                    moves=[dict(distance=1e-3, velocity=0.05, acceleration=1.0)], t_end=2.0,
+                    rate=1000.0, position_resolution=COUNT, rtol=1e-5, **options)
+
+
+def _runs(moving):
+    """(start, length) of each run of True in ``moving``."""
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], moving.astype(int), [0]))))
+    return [(int(a), int(b - a)) for a, b in zip(edges[::2], edges[1::2])]
+
+
+def test_a_quantized_hunting_record_of_an_independent_solver_has_no_position_jump(
+        hunting_record):
+    """No false alarm on a record the package did not make: a stage at rest on whole counts
+    (a speed of zero, then one count in one sample) that breaks away into a slip, the
+    jump detector's hardest case, passes the check and the replay's."""
+    from fi_design.measured import check_position_steps
+    from fi_design.simulation.replay import check_record
+
+    rec = hunting_record
+    counts = np.round(rec.position / COUNT)
+    assert np.allclose(rec.position / COUNT, counts, rtol=0.0, atol=1e-6)  # whole counts
+    steps = np.abs(np.diff(counts))
+    slips = [(a, n) for a, n in _runs(steps > 0) if n >= 20 and rec.time[a] > 0.5]
+    assert len(slips) >= 2, slips  # it hunts: breakaways after the move
+    assert np.count_nonzero(steps == 0) > 0.7 * len(steps)  # and sticks most of the time
+    assert np.count_nonzero(steps == 1) > 20  # creeping by one count at rest
+    m = rec.measurement()
+    check_position_steps(m)
+    check_record(m, crossover=8.0)
+
+
+@pytest.mark.slow
+def test_a_hunting_record_of_a_sampled_loop_reading_the_encoder_has_no_position_jump():
+    """The hunting record's loop sampled at 1 kHz and reading the 1 um encoder (the
+    quantization effect) hunts alike and passes alike (about 3 s: 2000 solve_ivp starts)."""
+    from fi_design.measured import check_position_steps
+    from fi_design.simulation.replay import check_record
+
+    rec = _hunting(dict(rule=dict(fc=8.0), sample_rate=1000.0),
+                   effects={"quantization": {"resolution": COUNT}})
+    steps = np.abs(np.diff(np.round(rec.position / COUNT)))
+    assert len([a for a, n in _runs(steps > 0) if n >= 20 and rec.time[a] > 0.5]) >= 2
+    m = rec.measurement()
+    check_position_steps(m)
+    check_record(m, crossover=8.0)
+
+
+def test_a_wrap_in_a_quantized_hunting_record_is_refused(hunting_record):
+    """The same record with a 16-bit counter's wrap (2^16 counts) in the middle of its last
+    slip, where the stage moves fastest, is refused at that row, by the replay's check too."""
+    from fi_design.measured import check_position_steps
+    from fi_design.simulation.replay import check_record
+
+    rec = hunting_record
+    steps = np.abs(np.diff(rec.position))
+    slip = np.flatnonzero(rec.time[1:] > 1.5)
+    j = int(slip[np.argmax(steps[slip])]) + 1  # the sample after the slip's largest step
+    assert steps[j - 1] > 10 * COUNT  # moving fast there
+    wrapped = rec.position + np.where(np.arange(rec.time.size) >= j, 2 ** 16 * COUNT, 0.0)
+    for check in (check_position_steps, lambda m: check_record(m, crossover=8.0)):
+        m = measurement_from_arrays(rec.time, rec.reference, wrapped, force_N=rec.force)
+        with pytest.raises(DataError, match="a jump of the position") as e:
+            check(m)
+        assert (e.value.column, e.value.row) == ("position_m", j + 1)
+
+
 def test_a_gap_in_the_time_is_told_from_jitter():
     """The check identify refuses non-uniform sampling with is the one replays refuse a gap
     with: a step of 5 median steps or more, longer than what the caller accepts."""
