@@ -42,6 +42,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from functools import cached_property
+from pathlib import Path
 from typing import Any
 
 from . import effects as _effects
@@ -591,13 +592,14 @@ class Model:
 # --------------------------------------------------------------------------- resolving
 
 
-def resolve(spec: _spec.Spec) -> Model:
+def resolve(spec: _spec.Spec | str | Path | Mapping[str, Any]) -> Model:
     """Resolve a spec into its :class:`Model`, every default and derived value worked out once.
 
     Parameters
     ----------
-    spec : fi_design.spec.Spec
-        A validated spec.
+    spec : fi_design.spec.Spec, path or mapping
+        A validated spec, or a YAML path or mapping for
+        :func:`fi_design.spec.file.load_spec` (what :func:`fi_design.design` takes).
 
     Returns
     -------
@@ -606,7 +608,9 @@ def resolve(spec: _spec.Spec) -> Model:
     Raises
     ------
     ArgumentError
-        ``spec`` is not a :class:`~fi_design.spec.Spec`.
+        ``spec`` is none of these (None, a number, a list, a :class:`Model`).
+    fi_design.errors.SpecFileError, fi_design.errors.SpecError
+        As :func:`~fi_design.spec.file.load_spec`, for a path or mapping.
 
     Examples
     --------
@@ -616,9 +620,12 @@ def resolve(spec: _spec.Spec) -> Model:
     (8.0, 6667.0, 4.62)
     >>> round(model.at(crossover=10.0).law.kp, 1)
     3333.7
+    >>> resolve("examples/paper_setup.yaml").crossover  # a path (or a mapping) is loaded
+    8.0
     """
-    if not isinstance(spec, _spec.Spec):
-        raise ArgumentError(f"expected a Spec (or a Model), got {type(spec).__name__}")
+    from .spec.file import as_spec
+
+    spec = as_spec(spec)
     f = spec.friction
     friction = FrictionLaw(model=f.model, Fs=f.static, Fc=f.coulomb, vs=f.stribeck_velocity,
                            sigma0=f.bristle_stiffness, sigma1=_spec.bristle_damping(spec),

@@ -78,7 +78,26 @@ def test_a_model_passes_where_a_spec_does(paper_spec):
 
     m = resolve(paper_spec)
     assert as_model(m) is m and isinstance(as_model(paper_spec), Model)
-    with pytest.raises(Exception, match="expected a Spec"):
+
+
+def test_resolve_takes_the_path_and_mapping_design_and_simulate_take(paper_spec,
+                                                                     paper_spec_path):
+    """resolve(path or mapping) loads the spec as design() and simulate() do (resolve took a
+    Spec only: "expected a Spec (or a Model), got PosixPath"); anything else is refused
+    naming what it is, and a mapping that is no spec names the missing field."""
+    from fi_design.errors import ArgumentError
+    from fi_design.spec.file import origin
+
+    want = resolve(paper_spec)
+    for given in (paper_spec_path, str(paper_spec_path), origin(paper_spec).raw):
+        m = resolve(given)
+        assert m.spec.model_dump() == paper_spec.model_dump()
+        assert m.plant(True) == want.plant(True) and m.law == want.law
+    for bad, name in ((5, "int"), (None, "NoneType"), ([paper_spec], "list"), (want, "Model")):
+        with pytest.raises(ArgumentError, match="spec must be a Spec, a path to a YAML spec or "
+                           f"a mapping, got {name}$"):
+            resolve(bad)
+    with pytest.raises(SpecError, match="stage"):
         resolve({"name": "a mapping"})
 
 

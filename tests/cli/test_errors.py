@@ -79,6 +79,8 @@ def _calls():
          ArgumentError, ["duration", "output samples", "at most 4000000"]),
         ("simulate-spec-none", lambda s, m: fi_design.simulate(None),
          ArgumentError, ["spec must be a Spec", "NoneType"]),
+        ("resolve-number", lambda s, m: fi_design.resolve(5.0),
+         ArgumentError, ["spec must be a Spec, a path to a YAML spec or a mapping", "float"]),
         ("load-spec-none", lambda s, m: fi_design.load_spec(None),
          ArgumentError, ["source must be a path to a YAML spec or a mapping", "NoneType"]),
         ("load-spec-number", lambda s, m: fi_design.load_spec(5), ArgumentError, ["got int"]),
