@@ -54,7 +54,7 @@ from .kernel.layout import PlantParameters
 from .mechanism.geometry import StageBody, stage_body
 from .results.controller import ControlLaw, Filter
 from .results.friction import FrictionLaw
-from .results.mechanism import Mode
+from .results.mechanism import GRAVITY, Mode
 from .results.steps import FlexureResult
 
 __all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "require_model",
@@ -270,6 +270,17 @@ class Model:
     def total_mass(self) -> float:
         """m1 + m2 [kg]."""
         return self.m1 + self.m2
+
+    @property
+    def held_weight(self) -> float:
+        """The weight the actuator holds on a vertical drive axis [N], which the simulation
+        does not carry: (m1 + m2) g where ``isolator.flexure.orientation`` is
+        ``vertical_axis`` (the stage's weight directly, the cart's through the joint), else 0."""
+        iso = self.spec.isolator
+        flexure = None if iso is None else iso.flexure
+        if flexure is None or flexure.orientation != "vertical_axis":
+            return 0.0
+        return self.total_mass * GRAVITY
 
     @property
     def departures(self) -> tuple[str, ...]:

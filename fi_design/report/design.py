@@ -377,6 +377,11 @@ def _forces(forces: Any) -> dict | None:
                    f"{qty(forces.peak_actuator_force, 'N')}. Each move is simulated from rest "
                    f"through its settling ({qty(forces.settle, 's')} after its end) with traces "
                    f"at {qty(forces.rate, 'Hz')}.")
+    if forces.held_weight:
+        intro += (f" On the vertical drive axis the actuator also holds the weight (m\u2081 + "
+                  f"m\u2082) g = {qty(forces.held_weight, 'N')}, which the simulation does not "
+                  "carry: every actuator force here adds it to the simulated force's largest "
+                  "magnitude.")
     if thinned:
         intro += (f" The table lists {len(rows)} of the {n} moves: the spec's motion and every "
                   f"second move of the family; the numbers above are over all {n}.")

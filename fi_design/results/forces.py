@@ -28,11 +28,13 @@ class MoveForces(Result):
         Largest contact force of the end stop [N] (0 without contact).
     peak_actuator_force : float
         Largest force the actuator applies [N] (after the delay and the
-        saturation of ``controller.force_limit``).
+        saturation of ``controller.force_limit``), the weight it holds on a
+        vertical drive axis included (:attr:`StageForces.held_weight`).
     contact_time : float
         Time the joint spends on its end stop [s].
     peak_command : float
-        Largest force the controller commands [N] (before the saturation).
+        Largest force the controller commands [N] (before the saturation), the
+        weight it holds on a vertical drive axis included.
     """
 
     distance: float
@@ -64,6 +66,10 @@ class StageForces(Result):
         Time simulated after each move's end [s].
     rate : float
         Output rate the peaks were taken at [Hz].
+    held_weight : float
+        The weight the actuator holds on a vertical drive axis, (m1 + m2) g
+        [N]; 0 otherwise. The simulation carries no weight: every actuator
+        and command peak adds it to the simulated force's largest magnitude.
     """
 
     plant: str
@@ -73,6 +79,7 @@ class StageForces(Result):
     stop_default: bool = True
     settle: float = 0.0
     rate: float = 0.0
+    held_weight: float = 0.0
 
     @property
     def moves_on_stop(self) -> int:
@@ -101,7 +108,7 @@ class StageForces(Result):
 
     def to_dict(self) -> dict:
         """JSON: the summary (``moves_on_stop``, ``peak_stop_force`` N, ``peak_actuator_force``
-        N, ``most_impacts``), the end stop's values and every move."""
+        N, ``most_impacts``), the end stop's values, ``held_weight`` N and every move."""
         return {"plant": self.plant, "moves_on_stop": self.moves_on_stop,
                 "moves_tried": len(self.moves), "most_impacts": self.most_impacts,
                 "peak_stop_force": self.peak_stop_force,
@@ -109,4 +116,5 @@ class StageForces(Result):
                 "peak_command": self.peak_command,
                 "stop_stiffness": self.stop_stiffness, "stop_damping": self.stop_damping,
                 "stop_default": self.stop_default, "settle": self.settle, "rate": self.rate,
+                "held_weight": self.held_weight,
                 "moves": [m.to_dict() for m in self.moves]}

@@ -231,17 +231,28 @@ def _force_checks(model: Model, forces) -> list[Check]:
                 f", above requirements.end_stop_force = {quantity(limit, 'N', 3)}"), step))
     peak = forces.peak_actuator_force
     flim = model.law.force_limit
-    text = f"the largest actuator force over the {n} moves is {quantity(peak, 'N', 3)}"
+    weight = forces.held_weight
+    text = f"the largest actuator force over the {n} moves is {quantity(peak, 'N', 3)}" + (
+        f", the weight (m1 + m2) g = {quantity(weight, 'N', 3)} it holds on the "
+        "vertical drive axis included (the simulation carries no weight)" if weight else "")
     if flim is None or not math.isfinite(flim):
         out.append(Check("actuator_force", None, peak, None, "N", text, step))
+    elif weight >= flim:
+        out.append(Check("actuator_force", False, peak, flim, "N", text + (
+            f": the actuator cannot hold the stage, its controller.force_limit = "
+            f"{quantity(flim, 'N', 3)} is not above the weight"), step))
     else:
+        # saturating, the simulated stage is the hardware's (a warning) unless it leaves out a
+        # weight: then the actuator has that much less for the moves than was simulated
         cmd = forces.peak_command
         ok = cmd < flim
         out.append(Check("actuator_force", ok, peak, flim, "N", text + (
             f", below controller.force_limit = {quantity(flim, 'N', 3)}" if ok else
             f": the actuator saturates at controller.force_limit = {quantity(flim, 'N', 3)} "
-            f"(the loop commands up to {quantity(cmd, 'N', 3)})"), step,
-            status=None if ok else Status.WARN))
+            f"(the loop commands up to {quantity(cmd, 'N', 3)})" + (
+                "; the simulated moves, with the whole limit left for them, are not the "
+                "hardware's" if weight else "")), step,
+            status=None if ok or weight else Status.WARN))
     return out
 
 

@@ -6,6 +6,10 @@ seconds after it, with traces at ``rate``: the end stop's contact force
 ``k_stop (|d| - s) sign(d) + c_stop (v1 - v2)`` while the joint deflection
 ``|d|`` exceeds the stroke s (the kernel's own contact law), the number of
 contacts, the time in contact, and the largest force the controller commands.
+On a vertical drive axis the actuator also holds the weight (m1 + m2) g, which
+the simulation does not carry (:attr:`fi_design.model.Model.held_weight`): it is
+added to the largest force either way (the spec does not say which way is up),
+the force applied capped at the saturation ``force_limit``.
 The contact lasts milliseconds (a 1e6 N/m stop under a 1.6 kg stage rings at
 about 125 Hz), so the traces are sampled at 5 kHz by default; a family of long
 moves (slow scans of hundreds of seconds) at a lower rate, so that no run holds
@@ -35,7 +39,7 @@ MAX_SAMPLES = 1_000_000
 
 
 def _one(model: Model, isolated: bool, moves, end: float, settle: float, rate: float,
-         distance: float, label: str) -> MoveForces:
+         distance: float, label: str, weight: float, limit: float) -> MoveForces:
     from ..simulation.run import simulate
 
     duration = end + settle
@@ -45,7 +49,10 @@ def _one(model: Model, isolated: bool, moves, end: float, settle: float, rate: f
         a = np.abs(x[np.isfinite(x)])
         return float(a.max()) if a.size else 0.0
 
-    peak_u, peak_cmd = peak(res.applied_force), peak(res.force)
+    # the weight the loop holds and the simulation leaves out: on top of the largest force
+    # either way, the force applied no more than the saturation
+    peak_u = min(peak(res.applied_force) + weight, limit)
+    peak_cmd = peak(res.force) + weight
     if not isolated:
         return MoveForces(distance=distance, label=label, impacts=0, peak_stop_force=0.0,
                           peak_actuator_force=peak_u, contact_time=0.0, peak_command=peak_cmd)
@@ -93,7 +100,8 @@ def move_forces(model: Model, isolated: bool | None = None, *,
     iso = model.has_isolator if isolated is None else bool(isolated)
     spec = model.spec
     motion = spec.motion
-    dists = family_distances(model, iso, model.plant(iso)) if family is None else family
+    params = model.plant(iso)
+    dists = family_distances(model, iso, params) if family is None else family
     big = max(motion.moves, key=lambda m: abs(m.distance))
     runs = [(motion.moves, motion.end_time, float(sum(m.distance for m in motion.moves)),
              "spec")]
@@ -104,7 +112,8 @@ def move_forces(model: Model, isolated: bool | None = None, *,
         runs.append(((mv,), end, float(d), "family"))
     longest = max(end for _, end, _, _ in runs) + settle
     rate = min(float(rate), MAX_SAMPLES / longest)
-    out = [_one(model, iso, moves, end, settle, rate, d, label)
+    weight = model.held_weight
+    out = [_one(model, iso, moves, end, settle, rate, d, label, weight, params.force_limit)
            for moves, end, d, label in runs]
     lim = model.limiter if iso else None
     given = spec.isolator.limiter.model_fields_set if iso and spec.isolator is not None \
@@ -113,4 +122,4 @@ def move_forces(model: Model, isolated: bool | None = None, *,
                        stop_stiffness=None if lim is None else lim.stiffness,
                        stop_damping=None if lim is None else lim.damping,
                        stop_default=not {"stiffness", "damping"} <= set(given),
-                       settle=settle, rate=rate)
+                       settle=settle, rate=rate, held_weight=weight)

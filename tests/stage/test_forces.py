@@ -39,3 +39,60 @@ def test_the_sample_bound_counts_the_rate_asked_for(paper_spec):
         simulate(paper_spec, duration=5.0, rate=1e6)
     with pytest.raises(ArgumentError, match="rate"):
         simulate(paper_spec, duration=1.0, rate=-5.0)
+
+
+def _vertical(paper_spec, **values):
+    from fi_design.spec.file import with_values
+
+    return resolve(with_values(paper_spec, {"isolator.flexure.orientation": "vertical_axis",
+                                            **values}))
+
+
+def test_the_actuator_on_a_vertical_axis_also_holds_the_weight(paper_spec):
+    """On a vertical drive axis the actuator holds the stage and, through the joint, the cart:
+    (m1 + m2) g = 2 kg x 9.80665 m/s^2 = 19.6 N at rest, which the simulation (no weight)
+    leaves out. The actuator's peak over the moves was the simulated 4 N the paper move
+    needs; now it is that plus the weight. The paper spec gives the joint's stiffness, so the
+    simulated stage is the same standing and vertical: the peaks differ by the weight."""
+    weight = (1.6 + 0.4) * 9.80665  # N: (m1 + m2) g by hand
+    standing = forces.move_forces(resolve(paper_spec), family=[0.4e-3, -10e-3])
+    vertical = forces.move_forces(_vertical(paper_spec), family=[0.4e-3, -10e-3])
+    assert standing.held_weight == 0.0
+    assert vertical.held_weight == pytest.approx(weight, rel=1e-12)
+    assert 3.0 < standing.peak_actuator_force < 5.0  # N: m a + Fc + sigma2 v = 2 + 1 + 1
+    for up, flat in zip(vertical.moves, standing.moves):
+        assert up.peak_actuator_force == pytest.approx(flat.peak_actuator_force + weight,
+                                                       rel=1e-12)
+        assert up.peak_command == pytest.approx(flat.peak_command + weight, rel=1e-12)
+    assert vertical.to_dict()["held_weight"] == vertical.held_weight
+
+
+@pytest.mark.parametrize("limit,status,says", [
+    ("10 N", "FAIL", "cannot hold the stage"), ("22 N", "FAIL", "saturates"),
+    ("30 N", "PASS", "below controller.force_limit")])
+def test_a_force_limit_below_the_weight_and_the_move_fails_on_a_vertical_axis(
+        paper_spec, limit, status, says):
+    """A 10 N limit is above the 4 N the paper move needs and passed the actuator check, yet
+    below the 19.6 N the actuator holds on a vertical axis: it cannot hold the stage. 22 N
+    holds it, not it and the move (23.7 N): the actuator saturates where the simulation, with
+    the whole limit for the move, does not. 30 N holds both."""
+    from fi_design.stage.confirm import _force_checks
+
+    model = _vertical(paper_spec, **{"controller.force_limit": limit})
+    stage = forces.move_forces(model, family=[0.4e-3])
+    (check,) = [c for c in _force_checks(model, stage) if c.name == "actuator_force"]
+    assert check.status.name == status, check.message
+    assert check.value == pytest.approx(min(stage.peak_command, check.limit))
+    assert "19.6 N" in check.message and "vertical drive axis" in check.message
+    assert says in check.message, check.message
+
+
+def test_the_report_says_the_actuator_force_holds_the_weight(paper_spec):
+    """The report's forces table gives the actuator's peak per move: on a vertical axis the
+    intro says the weight is in it, which the simulation alone does not carry."""
+    from fi_design.report.design import _forces
+
+    vertical = _forces(forces.move_forces(_vertical(paper_spec), family=[0.4e-3]))
+    standing = _forces(forces.move_forces(resolve(paper_spec), family=[0.4e-3]))
+    assert "weight" in vertical["intro"] and "19.61" in vertical["intro"], vertical["intro"]
+    assert "weight" not in standing["intro"]
