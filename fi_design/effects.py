@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Mapping
 
-from .display import with_error
+from .display import quantity, with_error
 
 
 @dataclass(frozen=True)
@@ -235,3 +235,76 @@ def values_text(name: str, values: Mapping[str, float | None],
     units = {p.name: p.unit for p in CATALOGUE[name].parameters} if name in CATALOGUE else {}
     return ", ".join(f"{k} = {with_error(v, (errors or {}).get(k), units.get(k, ''), sep=sep)}"
                      for k, v in values.items() if v is not None)
+
+
+
+def entries_text(entries, *, sep: str = " ") -> str:
+    """A spec's effect entries for a reader: each name and its values.
+
+    Parameters
+    ----------
+    entries : sequence
+        Effect entries (the spec's ``effects`` items: a ``type`` naming a
+        catalogue entry, its parameters as attributes, SI).
+    sep : str, optional
+        Between number and unit (a no-break space in reports).
+
+    Returns
+    -------
+    str
+        ``time_delay (delay = 0.002 s), quantization (resolution = 1 µm)``;
+        empty without entries.
+    """
+    out = []
+    for e in entries:
+        values = {p.name: getattr(e, p.name, None) for p in get(e.type).parameters}
+        out.append(f"{e.type} ({values_text(e.type, values, sep=sep)})")
+    return ", ".join(out)
+
+
+def simulated_only(entries, *, sep: str = " ") -> str:
+    """Which effects the simulation carries and the linear analysis does not, as a clause.
+
+    Effects only set parameters of the simulation: the linear steps (the
+    rule's gains, the limit cases' margins, the achievable crossover) analyse
+    the loop without them, ``controller.delay`` the only delay they model.
+
+    Parameters
+    ----------
+    entries : sequence
+        The spec's effect entries (:func:`entries_text`).
+    sep : str, optional
+        Between number and unit.
+
+    Returns
+    -------
+    str
+        ``the simulation carries the spec's effect time_delay (delay = 0.002 s);
+        the linear analysis (the gains, the margins, the crossover) leaves it
+        out``; empty without entries.
+    """
+    if not entries:
+        return ""
+    one = len(entries) == 1
+    return (f"the simulation carries the spec's effect{'' if one else 's'} "
+            f"{entries_text(entries, sep=sep)}; the linear analysis (the gains, the margins, "
+            f"the crossover) leaves {'it' if one else 'them'} out")
+
+
+def delay_words(delay: float, entries=(), *, sep: str = " ") -> str:
+    """The controller's delay in words: ``no delay``, or ``no controller delay`` where an
+    effect of ``entries`` delays the simulated loop (``time_delay``), or ``delay 0.001 s``.
+
+    Parameters
+    ----------
+    delay : float
+        ``controller.delay`` [s].
+    entries : sequence, optional
+        The spec's effect entries.
+    sep : str, optional
+        Between number and unit.
+    """
+    if delay:
+        return f"delay {quantity(delay, 's', sep=sep)}"
+    return ("no controller delay" if any(e.type == "time_delay" for e in entries)
+            else "no delay")

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..display import number, percent, quantity, unit_text, with_error
+from ..effects import delay_words, simulated_only
 from ..results.linear import NOT_JUDGED, phase_margin_judged
 from ..results.stage import STATIC_ERROR_FORMULA
 from .common import heading, status_text, table
@@ -102,9 +103,10 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     console.print(checks_table(result.checks,
                                cases={c.name: c for c in getattr(loop, "cases", ())}))
 
+    effects = tuple(result.spec.effects)
     pid = data.get("pid") or {}
     if pid:
-        console.print(_gains_table(pid))
+        console.print(_gains_table(pid, effects))
         sampled = discrete_table(pid)
         if sampled is not None:
             console.print(sampled)
@@ -128,7 +130,7 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
         cases = xo.get("cases") or []
         numbers = {c.name: c.number for c in result.loop.cases}
         if cases:
-            console.print(cases_table(cases, numbers))
+            console.print(cases_table(cases, numbers, effects))
             console.print(crossings_table(cases, numbers))
         if xo.get("loop_crossover") is not None:
             console.print(Text(
@@ -190,7 +192,7 @@ def _print_terms(console: "Console", result, data: dict) -> None:
             console.print(Text(f"  {g['term']}: {g['definition']}", style="dim"))
 
 
-def _gains_table(pid: dict) -> Any:
+def _gains_table(pid: dict, effects: tuple = ()) -> Any:
     """Step 4's gains, the one set a drive takes (``pid.drive``), named so.
 
     ``kp + ki/s + kd s / (1 + s/(2 pi roll_off))`` with the roll-off on the D
@@ -198,6 +200,8 @@ def _gains_table(pid: dict) -> Any:
     on the output; with the hardware's own gains, the rule's at the same
     crossover in the same form beside them (``pid.rule.in_drive_form``); with
     ``controller.drive`` the same gains in counts and the drive's current unit.
+    The caption names the spec's ``effects``, which the simulation carries and
+    the gains and margins leave out.
     """
     from rich.text import Text
 
@@ -221,14 +225,15 @@ def _gains_table(pid: dict) -> Any:
                   f"{number(units['ki'])} {u['ki']}", f"{number(units['kd'])} {u['kd']}", "")
     sampled = ("continuous" if drive["sample_rate"] is None
                else f"sampled at {quantity(drive['sample_rate'], 'Hz')}")
-    delay = "no delay" if not drive["delay"] else f"delay {quantity(drive['delay'], 's')}"
+    delay = delay_words(drive["delay"] or 0.0, effects)
+    simulated = simulated_only(effects)
     filters = "; ".join(_filter_words(f) for f in drive.get("filters") or ())
     rule = pid["rule"]
     t.caption = Text(f"D on the {drive['derivative_on']}, {sampled}, {delay}"
                      + (f"; filters on the output: {filters}" if filters else "; no filters")
                      + f"; the rule tunes on {quantity(rule['tuning_mass'], 'kg')} (controller."
                      "derivative_on, sample_rate, delay, filters); --write-spec writes them "
-                     "into a spec", style="dim")
+                     "into a spec" + (f"; {simulated}" if simulated else ""), style="dim")
     t.caption_justify = "left"
     return t
 
@@ -407,8 +412,9 @@ _CASE_SKIP = {"name", "description", "passed", "failed", "crossovers", "stable",
               "status", "modulus_frequency"}
 
 
-def cases_table(cases: list, numbers: dict) -> Any:
-    """Table of the linear limit cases (paper Figure 2) from their JSON form and numbers."""
+def cases_table(cases: list, numbers: dict, effects: tuple = ()) -> Any:
+    """Table of the linear limit cases (paper Figure 2) from their JSON form and numbers; the
+    caption names the spec's ``effects``, which the margins leave out."""
     from rich.text import Text
 
     keys = [k for k in CASE_COLUMNS if any(k in c for c in cases)]
@@ -416,7 +422,9 @@ def cases_table(cases: list, numbers: dict) -> Any:
         keys += [k for k, v in case.items() if k not in keys and k not in _CASE_SKIP
                  and not isinstance(v, (dict, list))]
     t = table("Linear limit cases at the desired crossover (paper Figure 2)")
-    t.caption = Text(CASE_CAPTION, style="dim")
+    simulated = simulated_only(effects)
+    t.caption = Text(CASE_CAPTION + (f". {simulated[0].upper()}{simulated[1:]}" if simulated
+                                     else ""), style="dim")
     t.caption_justify = "left"
     t.add_column("#", justify="right", no_wrap=True)
     t.add_column("Limit case", ratio=1, min_width=12)

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 from ..display import number, quantity
+from ..effects import simulated_only
 from ..errors import ArgumentError
 from ..execution import Background, check_executor
 from ..mechanism.checks import flexure_checks
@@ -349,16 +350,19 @@ def _conclusion(model: Model, gap: FrictionGapResult, xo: CrossoverResult, st: S
         parts.append(f"The PID tuned on {_g(g.tuning_mass)} kg gives the drive (in the form "
                      f"controller.gains takes) kp = {_g(law.kp)} N/m, ki = "
                      f"{quantity(law.ki, 'N/(m*s)')} and kd = {quantity(law.kd, 'N*s/m')} "
-                     f"({controller_words(law)}).")
+                     f"({controller_words(law, model.effects)}).")
     else:
         r = law.rule_in_this_form()
         parts.append(f"The hardware's controller (kp = {_g(law.kp)} N/m, ki = "
                      f"{quantity(law.ki, 'N/(m*s)')}, kd = {quantity(law.kd, 'N*s/m')}; "
-                     f"{controller_words(law)}) crosses over "
+                     f"{controller_words(law, model.effects)}) crosses over "
                      f"at {quantity(law.crossover, 'Hz', 4)} on {_g(law.tuning_mass)} kg; the rule "
                      f"would tune kp = {_g(r['kp'])} N/m, ki = {quantity(r['ki'], 'N/(m*s)')}, "
                      f"kd = {quantity(r['kd'], 'N*s/m')} with a D roll-off of "
                      f"{_g(r['roll_off'] / (2 * math.pi))} Hz there.")
+    simulated = simulated_only(model.effects)
+    if simulated:
+        parts.append(simulated[0].upper() + simulated[1:] + ".")
     if pid.static_error is not None:
         parts.append(f"The loop has no integrator, so it cannot hunt by the paper's mechanism; "
                      f"it leaves a static error of up to {STATIC_ERROR_FORMULA} = "

@@ -27,10 +27,12 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Sequence
 
 
 from ..controller import discrete_controller, drive_gains
 from ..display import number, quantity
+from ..effects import delay_words, simulated_only
 from ..model import Model, require_model
 from ..results import Check, Status
 from ..results.controller import ControlLaw
@@ -370,14 +372,16 @@ def step3_flexure(model: Model,
 # --------------------------------------------------------------------------- step 4
 
 
-def controller_words(c: ControlLaw) -> str:
-    """The structure of a controller in words (D input, roll-off, sampling)."""
+def controller_words(c: ControlLaw, effects: Sequence = ()) -> str:
+    """The structure of a controller in words (D input, roll-off, sampling, delay, filters);
+    ``effects``, the spec's effect entries, say whether its missing delay is the loop's
+    (:func:`fi_design.effects.delay_words`)."""
     parts = [f"D on the {c.derivative_on}",
              "ideal D" if math.isinf(c.roll_off) else
              f"D roll-off {_g(c.roll_off / (2 * math.pi))} Hz"]
     parts.append("continuous" if c.sample_period == 0 else
                  f"sampled at {quantity(1.0 / c.sample_period, 'Hz')}")
-    parts.append("no delay" if c.delay == 0 else f"delay {quantity(c.delay, 's')}")
+    parts.append(delay_words(c.delay, effects))
     parts += [f.describe() for f in c.filters]
     return ", ".join(parts)
 
@@ -408,18 +412,20 @@ def step4_pid(model: Model) -> PidResult:
     law = model.law
     g = law.rule
     step = "step 4 PID"
+    simulated = simulated_only(model.effects)
+    simulated = f"; {simulated}" if simulated else ""
     if law.source == "rule":
         msg = (f"tuned at {_g(g.crossover)} Hz on {_g(g.tuning_mass)} kg; the gains a drive "
                f"takes (controller.gains, with controller.roll_off on the D term only): kp = "
                f"{_g(law.kp)} N/m, ki = {quantity(law.ki, 'N/(m*s)')}, kd = "
                f"{quantity(law.kd, 'N*s/m')} "
-               f"({controller_words(law)})")
-        checks = [Check("pid", None, law.kp, None, "N/m", msg, step=step)]
+               f"({controller_words(law, model.effects)})")
+        checks = [Check("pid", None, law.kp, None, "N/m", msg + simulated, step=step)]
     else:
         r = law.rule_in_this_form()
         msg = (f"the hardware's gains kp = {_g(law.kp)} N/m, ki = "
                f"{quantity(law.ki, 'N/(m*s)')}, kd = {quantity(law.kd, 'N*s/m')} "
-               f"({controller_words(law)}) cross over at "
+               f"({controller_words(law, model.effects)}) cross over at "
                f"{quantity(law.crossover, 'Hz', 4)} on {quantity(law.tuning_mass, 'kg', 4)}; "
                f"the rule there would give kp = {_g(r['kp'])} N/m, ki = "
                f"{quantity(r['ki'], 'N/(m*s)')}, kd = {quantity(r['kd'], 'N*s/m')} with a D "
@@ -427,7 +433,7 @@ def step4_pid(model: Model) -> PidResult:
                f"{quantity(r['roll_off'] / (2 * math.pi), 'Hz', 4)}")
         # the rule's gains are a recommendation beside the hardware's, not a limit: they are in
         # the message and the gains table, never in the limit column
-        checks = [Check("pid", None, law.kp, None, "N/m", msg, step=step)]
+        checks = [Check("pid", None, law.kp, None, "N/m", msg + simulated, step=step)]
     static = model.static_error_bound
     if static is not None:
         checks.append(Check(

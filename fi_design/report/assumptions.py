@@ -13,7 +13,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ..display import percent
+from ..display import NBSP, percent
+from ..effects import simulated_only
 from ..results.stage import STATIC_ERROR_FORMULA
 from .filters import num, qty
 
@@ -138,26 +139,29 @@ def _friction(result: Any) -> list[str]:
 def _loop(result: Any) -> list[str]:
     law = result.pid.controller
     spec = result.spec
-    sampled = ("a continuous-time controller without delay" if law.sample_period == 0
-               and law.delay == 0 else
+    effects = [e.type for e in spec.effects]
+    delayed = "time_delay" in effects
+    sampled = (("a continuous-time controller without delay" if not delayed else
+                "a continuous-time controller without a delay of its own")
+               if law.sample_period == 0 and law.delay == 0 else
                ("continuous-time" if law.sample_period == 0 else
                 f"sampled at {qty(1.0 / law.sample_period, 'Hz')} with a zero-order hold")
                + ("" if law.delay == 0 else f", delay {qty(law.delay, 's')}"))
-    effects = [e.type for e in spec.effects]
     sensor = [e for e in effects if e == "quantization"]
+    simulated = simulated_only(spec.effects, sep=NBSP)
     out = [f"The loop is {sampled}"
            + (" (the hardware samples and computes with a delay: give controller.sample_rate "
               "and controller.delay to judge the loop it has)" if law.sample_period == 0
-              and law.delay == 0 else "") + "."]
+              and law.delay == 0 and not delayed else "") + "."]
     limit = law.force_limit
     out.append(
         "The actuator is an ideal force source: no actuator dynamics (current loop, motor "
         "inductance, amplifier bandwidth)"
         + (f", saturating at \u00b1{qty(limit, 'N')}" if math.isfinite(limit)
-           else ", no saturation")
+           else "" if "force_saturation" in effects else ", no saturation")
         + ". The sensor is ideal: no sensor noise"
         + ("" if sensor else ", no quantization") + ", no latency beyond the loop's delay."
-        + (f" The spec adds the effects {', '.join(effects)}." if effects else ""))
+        + (f" {simulated[0].upper()}{simulated[1:]}." if simulated else ""))
     return out
 
 

@@ -6,6 +6,8 @@ import itertools
 import math
 from typing import Any
 
+from ..display import NBSP
+from ..effects import delay_words, simulated_only
 from ..results.linear import phase_margin_judged
 from .equations import equation
 from .filters import num, qty, tex_num, tex_qty
@@ -285,7 +287,8 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
         ]
     sampled = ("continuous" if hand["sample_rate"] is None
                else f"sampled at {qty(hand['sample_rate'], 'Hz')}")
-    delay = "no delay" if not hand["delay"] else f"delay {qty(hand['delay'], 's')}"
+    delay = delay_words(hand["delay"] or 0.0, spec.effects, sep=NBSP)
+    simulated = simulated_only(spec.effects, sep=NBSP)
     results = [
         {"quantity": "tuning mass m", "value": g.tuning_mass, "unit": "kg"},
         {"quantity": "drive gain kp (controller.gains.kp)", "value": hand["kp"], "unit": "N/m"},
@@ -333,6 +336,7 @@ def guideline_steps(result: Any, figures: bool = True) -> list[dict]:
             "kp, ki, kd above have the roll-off on the whole PID and are other numbers for the "
             f"same controller); D on the {hand['derivative_on']}, {sampled}, {delay} "
             "(controller.sample_rate and controller.delay: the hardware's, where given). "
-            "fi-design SPEC.yaml --write-spec OUT.yaml writes them into a copy of the spec."),
+            + (f"{simulated[0].upper()}{simulated[1:]}. " if simulated else "")
+            + "fi-design SPEC.yaml --write-spec OUT.yaml writes them into a copy of the spec."),
     })
     return steps

@@ -381,3 +381,67 @@ def test_the_checks_table_has_one_group_per_step(paper_confirmed_design):
     steps = [g["step"] for g in groups]
     assert len(steps) == len(set(steps)), steps
     assert sum(len(g["rows"]) for g in groups) == len(paper_confirmed_design.checks)
+
+
+@pytest.fixture(scope="module")
+def delayed_design():
+    """examples/no_isolator.yaml with a 2 ms time_delay effect, without the simulation: the
+    linear steps analyse the loop without it, the simulation carries it."""
+    from conftest import EXAMPLES
+    from fi_design.guideline.evaluate import evaluate
+    from fi_design.spec.file import load_spec, with_values
+
+    spec = with_values(load_spec(EXAMPLES / "no_isolator.yaml"),
+                       {"effects": [{"type": "time_delay", "delay": "2 ms"}]})
+    return evaluate(spec, confirm=False)
+
+
+def _plain(text: str) -> str:
+    return re.sub(r"\s+", " ", text.replace("\u00a0", " "))
+
+
+def test_the_console_names_the_effects_the_simulation_carries(delayed_design):
+    """A spec with a 2 ms time_delay effect: the console's PID line, its gains' caption and
+    the conclusion said 'continuous, no delay' and the limit cases' margins (of the loop
+    without it) said nothing of it. Now each names the effect and says the linear analysis
+    leaves it out."""
+    from rich.console import Console
+
+    from fi_design.console import print_design
+
+    out = Console(width=120, record=True)
+    print_design(out, delayed_design)
+    text = _plain(out.export_text())
+    assert "no delay" not in text
+    assert text.count("continuous, no controller delay") == 3, text  # check, caption, conclusion
+    said = ("the spec's effect time_delay (delay = 0.002 s); the linear analysis (the gains, "
+            "the margins, the crossover) leaves it out")
+    # the PID check and the gains' caption, the cases' caption, the conclusion
+    assert text.lower().count(said.lower()) == 4, text
+
+
+def test_the_report_names_the_effects_the_simulation_carries(delayed_design):
+    """The report's step 4 said 'continuous, no delay', its assumptions 'a continuous-time
+    controller without delay (the hardware samples and computes with a delay: give
+    controller.delay ...)' and 'The spec adds the effects time_delay', and the linear section
+    nothing of the effect its margins leave out."""
+    ctx = report.build_context(delayed_design, date=DATE, figures=False)
+    said = "effect time_delay (delay = 0.002 s); the linear analysis"
+    step4 = _plain(next(s for s in ctx["steps"] if s["number"] == 4)["explanation"])
+    assert "no controller delay" in step4 and said in step4, step4
+    assert said in _plain(ctx["linear"]["intro"]), ctx["linear"]["intro"]
+    text = " ".join(_plain(t) for t in _strings(ctx))
+    assert "no delay" not in text and "without delay" not in text
+    assert "a continuous-time controller without a delay of its own." in text
+
+
+def _strings(node):
+    """Every string in a report context."""
+    if isinstance(node, str):
+        yield node
+    elif isinstance(node, dict):
+        for v in node.values():
+            yield from _strings(v)
+    elif isinstance(node, (list, tuple)):
+        for v in node:
+            yield from _strings(v)
