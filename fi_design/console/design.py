@@ -348,8 +348,9 @@ def print_verdict(console: "Console", result) -> None:
                          f"{number(mar.crossover_factor, 3)}x the hunting-free "
                          f"{number(mar.hunting_free_crossover, 4)} Hz"
                          + (f" (the sliding loop crosses 0 dB at "
-                            f"{number(mar.hunting_loop_crossover, 4)} Hz and "
-                            f"{number(mar.hunting_free_loop_crossover, 4)} Hz)"
+                            f"{number(mar.hunting_loop_crossover, 4)} Hz with the design's "
+                            f"PID, at {number(mar.hunting_free_loop_crossover, 4)} Hz with "
+                            "the PID at the hunting-free crossover)"
                             if mar.hunting_loop_crossover and mar.hunting_free_loop_crossover
                             else ""))
         if mar.end_stop_clearance is not None:

@@ -289,8 +289,9 @@ def key_figures(result: Any) -> list[dict]:
             f"{qty(m.hunting_free_crossover, 'Hz')} (the fold of the cycle); the ratio of the "
             "set crossovers, the loop's frequency scale"
             + (f"; the loop the cycle slides in ({_CASE_WORDS.get(m.hunting_case, m.hunting_case)})"
-               f" crosses 0 dB at {qty(m.hunting_loop_crossover, 'Hz')} and at "
-               f"{qty(m.hunting_free_loop_crossover, 'Hz')}: "
+               f" crosses 0 dB at {qty(m.hunting_loop_crossover, 'Hz')} with the design's PID "
+               f"and at {qty(m.hunting_free_loop_crossover, 'Hz')} with the PID at the "
+               "hunting-free crossover, a ratio of "
                f"{num(m.hunting_loop_crossover / m.hunting_free_loop_crossover, 3)}"
                if m.hunting_loop_crossover and m.hunting_free_loop_crossover else ""), css))
     if m.achievable_factor is not None:

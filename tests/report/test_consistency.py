@@ -445,3 +445,25 @@ def _strings(node):
     elif isinstance(node, (list, tuple)):
         for v in node:
             yield from _strings(v)
+
+
+def test_each_crossing_of_the_sliding_loop_names_its_pid(ctx, paper_confirmed_design):
+    """The hunting margin's two crossings read 'the sliding loop crosses 0 dB at 7.921 Hz and
+    11.29 Hz', as if one loop crossed twice: they are the loop with the design's PID and
+    with the PID at the hunting-free crossover. Console and report say which is which."""
+    from rich.console import Console
+
+    from fi_design.console import print_verdict
+
+    mar = paper_confirmed_design.margins
+    design, free = (report.num(f) for f in (mar.hunting_loop_crossover,
+                                            mar.hunting_free_loop_crossover))
+    note = _plain(next(f["note"] for f in ctx["verdict"]["figures"]
+                       if f["label"].startswith("Crossover factor")))
+    assert (f"crosses 0 dB at {design} Hz with the design's PID and at {free} Hz with the PID "
+            "at the hunting-free crossover") in note, note
+    out = Console(width=120, record=True)
+    print_verdict(out, paper_confirmed_design)
+    box = re.sub(r"[\s\u2500-\u257f]+", " ", out.export_text())  # the frame's lines
+    assert (f"crosses 0 dB at {design} Hz with the design's PID, at {free} Hz with the PID at "
+            "the hunting-free crossover") in box, box
