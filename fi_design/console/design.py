@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..display import number, percent, quantity, unit_text, with_error
 from ..effects import delay_words, simulated_only
+from ..results.controller import filter_label
 from ..results.linear import NOT_JUDGED, phase_margin_judged
 from ..results.stage import STATIC_ERROR_FORMULA
 from .common import heading, status_text, table
@@ -242,11 +243,14 @@ def _filter_words(f: dict) -> str:
     """One filter of ``pid.drive.filters`` in words."""
     if f["type"] == "notch":
         depth = "full" if f["depth"] is None else f"{number(f['depth'], 3)} dB"
-        return (f"notch '{f['name']}' {number(f['frequency'])} Hz, {number(f['width'], 3)} Hz "
+        return (f"notch{filter_label(f['type'], f['name'])} {number(f['frequency'])} Hz, "
+                f"{number(f['width'], 3)} Hz "
                 f"wide, depth {depth}")
     if f["order"] == 1:
-        return f"low-pass '{f['name']}' {number(f['frequency'])} Hz, first order"
-    return (f"low-pass '{f['name']}' {number(f['frequency'])} Hz, second order, damping "
+        return (f"low-pass{filter_label(f['type'], f['name'])} {number(f['frequency'])} Hz, "
+                "first order")
+    return (f"low-pass{filter_label(f['type'], f['name'])} {number(f['frequency'])} Hz, "
+            "second order, damping "
             f"{number(f['damping'], 3)}")
 
 

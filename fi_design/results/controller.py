@@ -17,7 +17,16 @@ from ..display import number, plain, quantity
 from . import dataclass_dict
 
 __all__ = ["PidGains", "Filter", "DriveUnits", "ControlLaw", "SampledFilter",
-           "DiscreteController", "DriveGains"]
+           "DiscreteController", "DriveGains", "DEFAULT_FILTER_NAMES", "filter_label"]
+
+#: The name of a ``controller.filters`` entry the spec leaves unnamed, by type.
+DEFAULT_FILTER_NAMES = {"notch": "notch", "low_pass": "low-pass"}
+
+
+def filter_label(kind: str, name: str) -> str:
+    """A filter's name as its description quotes it, after its type: `` 'tilt'``; empty
+    where the name is its type's default (``notch 'notch'`` reads as a stutter)."""
+    return "" if name == DEFAULT_FILTER_NAMES.get(kind) else f" '{name}'"
 
 
 @dataclass(frozen=True)
@@ -131,11 +140,14 @@ class Filter:
         if self.kind == "notch":
             d = self.depth
             depth = "full depth" if math.isinf(d) else f"{quantity(d, 'dB', 3)} deep"
-            return (f"notch '{self.name}' at {quantity(self.frequency, 'Hz', 4)}, "
+            return (f"notch{filter_label(self.kind, self.name)} at "
+                    f"{quantity(self.frequency, 'Hz', 4)}, "
                     f"{quantity(self.width, 'Hz', 3)} wide ({depth})")
         if self.order == 1:
-            return f"first-order low-pass '{self.name}' at {quantity(self.frequency, 'Hz', 4)}"
-        return (f"second-order low-pass '{self.name}' at {quantity(self.frequency, 'Hz', 4)}, "
+            return (f"first-order low-pass{filter_label(self.kind, self.name)} at "
+                    f"{quantity(self.frequency, 'Hz', 4)}")
+        return (f"second-order low-pass{filter_label(self.kind, self.name)} at "
+                f"{quantity(self.frequency, 'Hz', 4)}, "
                 f"damping {number(self.zeta_pole, 3)}")
 
     def to_dict(self) -> dict:

@@ -21,6 +21,7 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import Discriminator, Field, Tag, model_validator
 
 from ..display import number, quantity
+from ..results.controller import DEFAULT_FILTER_NAMES
 from .fields import OptQ, Q, StrictModel, Text
 
 __all__ = ["Notch", "LowPass", "FilterEntry", "Drive", "FILTER_TYPES", "BUTTERWORTH"]
@@ -33,7 +34,7 @@ class Notch(StrictModel):
     """A notch filter: ``(s^2 + 2 zeta_z w s + w^2) / (s^2 + 2 zeta_p w s + w^2)``."""
 
     type: Literal["notch"] = Field(description="notch")
-    name: Text = Field("notch", description="Label used in reports.")
+    name: Text = Field(DEFAULT_FILTER_NAMES["notch"], description="Label used in reports.")
     frequency: Q("Hz") = Field(gt=0, description="Centre frequency [Hz].")
     width: OptQ("Hz") = Field(None, gt=0, description="-3 dB bandwidth of the full notch [Hz]: "
                                                        "pole damping width / (2 frequency). "
@@ -81,7 +82,7 @@ class LowPass(StrictModel):
     """A low-pass filter: ``w / (s + w)`` or ``w^2 / (s^2 + 2 damping w s + w^2)``."""
 
     type: Literal["low_pass"] = Field(description="low_pass")
-    name: Text = Field("low-pass", description="Label used in reports.")
+    name: Text = Field(DEFAULT_FILTER_NAMES["low_pass"], description="Label used in reports.")
     frequency: Q("Hz") = Field(gt=0, description="Corner frequency [Hz].")
     order: Literal[1, 2] = Field(2, description="1 or 2. Default 2.")
     damping: float | None = Field(None, gt=0, le=2, description="Damping ratio of a "

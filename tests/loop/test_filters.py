@@ -8,6 +8,7 @@ their textbook forms, crossings found on a dense grid, the drawn figure's data.
 from __future__ import annotations
 
 import math
+import re
 
 import control
 import numpy as np
@@ -84,6 +85,25 @@ def test_filters_and_drive_read_from_the_spec(paper_spec):
     assert (d.motor_constant, d.encoder_resolution, d.current_scaling) == (20.0, 1e-6, 0.01)
     # the filters keep their frequencies when the loop shifts
     assert resolve(spec).at(crossover=15.0).law.filters == law.filters
+
+
+def test_a_filter_left_unnamed_is_not_quoted_by_its_default_name(paper_spec):
+    """An unnamed notch read "notch 'notch' at 150 Hz" in the checks and the report, and
+    "notch 'notch' 150 Hz" in the console's gains caption; an unnamed low-pass
+    "low-pass 'low-pass'". The default name is left out; a given one is quoted."""
+    from fi_design.console.design import _filter_words
+
+    spec = variant(paper_spec, **{"controller.filters": [
+        {"type": "notch", "frequency": "150 Hz", "width": "75 Hz"}, NOTCH,
+        {"type": "low_pass", "frequency": "1 kHz", "order": 1},
+        {"type": "low_pass", "name": "anti-alias", "frequency": "2 kHz"}]})
+    words = [(f.describe(), _filter_words(f.to_dict())) for f in resolve(spec).law.filters]
+    before_number = [(re.match(r"(.*?)( at)? \d", d).group(1),
+                      re.match(r"(.*?) \d", c).group(1)) for d, c in words]
+    assert before_number == [
+        ("notch", "notch"), ("notch 'tilt notch'", "notch 'tilt notch'"),
+        ("first-order low-pass", "low-pass"),
+        ("second-order low-pass 'anti-alias'", "low-pass 'anti-alias'")], words
 
 
 @pytest.mark.parametrize("entry, words", [
