@@ -115,7 +115,8 @@ def simulation_table(sim: dict, window: tuple[float, float] | None = None,
         m = mins.get(key)
         b = stage(key).get("boundary") or {}
         if m is None:
-            return "above the search" if b.get("kind") == "bound" else "-"
+            return {"bound": "above the search", "not_found": "not found"}.get(
+                b.get("kind"), "-")
         return f"{number(m, 4)} Hz" + ("" if b.get("kind") == "fold" else " (bound)")
 
     def hunting_moves(key: str) -> str:

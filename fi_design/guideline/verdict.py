@@ -327,6 +327,9 @@ def margins(model: Model, crossover: CrossoverResult, stiffness: StiffnessResult
         if not pid.controller.integrator:
             notes.append("the loop has no integrator: it cannot hunt by the paper's mechanism, "
                          "so there is no hunting-free crossover to keep a distance from")
+        elif m is None and st.boundary is not None and st.boundary.kind == "not_found":
+            notes.append(f"no crossover from which no move of the stage as specified hunts "
+                         f"was found ({st.boundary.note}): no crossover factor")
         elif m is None:
             top = simulation.min_hunting_free_crossover["search"][1]
             notes.append(f"the stage as specified hunts for some move up to the top of the "

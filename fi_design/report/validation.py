@@ -123,20 +123,33 @@ def _sensitivity(result: Any) -> dict | None:
                "friction.bristle_damping": result.model.friction.sigma1,
                "friction.stribeck_velocity": result.model.friction.vs}
 
-    def hz(x):
-        return "above the search" if x is None else qty(x, "Hz")
+    def hz(x, kinds=("bound",)):
+        """A crossover, or why there is none: the cycle persists above the search (a bound
+        without crossover), or none was found (``not_found``), or it was not searched."""
+        if x is not None:
+            return qty(x, "Hz")
+        if "not_found" in kinds:
+            return "not found"
+        return "above the search" if "bound" in kinds else "not computed"
 
     rows = []
     for path, sym in symbols.items():
         pts = s.of(path)
         rows.append({"parameter": f"{sym} ({path})", "nominal": qty(nominal[path], units[path]),
                      "cells": [{"value": qty(p.value, units[path]),
-                                "crossover": hz(p.hunting_free_from)} for p in pts]})
+                                "crossover": hz(p.hunting_free_from, (p.kind,))}
+                               for p in pts]})
     lo, hi = s.span()
+    own = result.simulation.stage.get(s.plant) if result.simulation is not None else None
+    nominal_kind = own.boundary.kind if own is not None and own.boundary is not None else "none"
+    # the kinds of the points (and the nominal) that found no crossover: what None stands for
+    missing = [p.kind for p in s.points if p.hunting_free_from is None] + (
+        [nominal_kind] if s.nominal is None else [])
     factor = max(s.factors)
     span = ("" if lo is None else
             f" Over these values the crossover from which no move hunts lies between "
-            f"{hz(lo)} and {hz(hi)}, against {hz(s.nominal)} with the values the design used.")
+            f"{hz(lo)} and {hz(hi, missing)}, against {hz(s.nominal, (nominal_kind,))} with "
+            "the values the design used.")
     plant = "the isolated stage" if s.plant == "isolated" else "the stage without isolator"
     return {
         "intro": (f"The dynamic LuGre parameters sigma0, sigma1 and vs are seldom identified "

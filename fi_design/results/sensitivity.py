@@ -35,10 +35,12 @@ class SensitivityPoint(Result):
         The value used, SI (N/m, N s/m, m/s).
     hunting_free_from : float or None
         Lowest crossover from which no move of the family hunts [Hz]; None
-        when the cycle persists to the top of the search.
+        when the cycle persists to the top of the search, or none was found.
     kind : str
         How it was found: ``"fold"``, ``"bound"`` (no move hunts from the
-        bottom of the search up) or ``"none"`` (not found).
+        bottom of the search up, or the cycle persists to its top),
+        ``"not_found"`` (moves still hunt above the last fold the search
+        followed) or ``"none"`` (no search).
     """
 
     path: str

@@ -189,9 +189,10 @@ class Cycle(Result):
 
 
 #: How a boundary was found: ``"fold"`` (the crossover where the cycle ceases to exist,
-#: bisected) or ``"bound"`` (the cycle persists up to the top of the search, or no move
-#: hunts from its bottom up).
-BOUNDARY_KINDS = ("fold", "bound")
+#: bisected), ``"bound"`` (the cycle persists up to the top of the search, or no move
+#: hunts from its bottom up) or ``"not_found"`` (moves still hunt just above the last of
+#: the folds the search followed: no crossover from which no move hunts was found).
+BOUNDARY_KINDS = ("fold", "bound", "not_found")
 
 
 @dataclass(frozen=True, eq=False)
@@ -209,7 +210,8 @@ class Boundary(Result):
         The crossover from which no move of the family hunts [Hz]: the upper
         end of the bracket of a fold, the bottom of the search when no move
         hunts from there up; None when the cycle persists up to the top of
-        the search.
+        the search (``kind`` ``"bound"``) or when none was found
+        (``"not_found"``).
     bracket : tuple of float
         The last bracket [lo, hi] of the search [Hz]: the cycle exists at lo
         and not at hi (a fold), or the range searched (a bound).

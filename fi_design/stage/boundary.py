@@ -199,7 +199,7 @@ def hunting_free_boundary(model: Model, isolated: bool, cycle: Cycle | None = No
     # moves still hunt just above the last fold: that fold ends no hunting, so no crossover
     # from which no move hunts was found (a cycle the continuation cannot follow, such as a
     # sampled loop's, leaves a fold a bisection step above every crossover it starts from)
-    return Boundary(hunting_free_from=None, bracket=(fold.bracket[0], top), kind="bound",
+    return Boundary(hunting_free_from=None, bracket=(fold.bracket[0], top), kind="not_found",
                     resolution=0.0, tests=tests, branch=tuple(sorted(branch)),
                     note=f"not found: moves still hunt at {quantity(hi, 'Hz', 4)}, above "
                          "the last of several folds the cycles' continuation found")

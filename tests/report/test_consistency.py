@@ -467,3 +467,53 @@ def test_each_crossing_of_the_sliding_loop_names_its_pid(ctx, paper_confirmed_de
     box = re.sub(r"[\s\u2500-\u257f]+", " ", out.export_text())  # the frame's lines
     assert (f"crosses 0 dB at {design} Hz with the design's PID, at {free} Hz with the PID at "
             "the hunting-free crossover") in box, box
+
+
+def test_a_hunting_free_crossover_not_found_reads_not_found(paper_confirmed_design):
+    """Where moves still hunt above the last fold the search followed, no hunting-free
+    crossover was found; the boundary said kind 'bound' as for a cycle persisting to the top
+    of the search, and the console's table said 'above the search', the verdict's margins
+    'hunts for some move up to the top of the search', the report's sensitivity 'above the
+    search'. Now the boundary's kind is 'not_found' and each says not found. (The paper
+    design doctored: its isolated plant's boundary made one not found.)"""
+    import dataclasses
+
+    from rich.console import Console
+
+    from fi_design.console import simulation_table
+    from fi_design.guideline.verdict import margins
+    from fi_design.report.validation import validation_section
+    from fi_design.results.sensitivity import CrossoverSensitivity, SensitivityPoint
+
+    d = paper_confirmed_design
+    sim = d.simulation
+    st = sim.stage["isolated"]
+    lost = dataclasses.replace(st.boundary, hunting_free_from=None, kind="not_found",
+                               note="not found: moves still hunt at 30 Hz, above the last of "
+                                    "several folds the cycles' continuation found")
+    st = dataclasses.replace(st, boundary=lost, hunting_free_from=None)
+    sim = dataclasses.replace(sim, stage={**sim.stage, "isolated": st},
+                              min_hunting_free_crossover={**sim.min_hunting_free_crossover,
+                                                          "isolated": None})
+    data = d.to_dict()
+    data["simulation"]["min_hunting_free_crossover"]["isolated"] = None
+    data["stage_hunting"]["isolated"] = st.to_dict()
+    out = Console(width=200, record=True)
+    out.print(simulation_table(data["simulation"], None, data["stage_hunting"]))
+    row = next(ln for ln in out.export_text().splitlines() if "No move hunts from" in ln)
+    assert "not found" in row and "above the search" not in row, row
+
+    m = margins(d.model, d.crossover, d.stiffness, d.flexure, d.pid, sim)
+    note = " ".join(m.notes)
+    assert m.crossover_factor is None and "was found" in note and "top of the search" not in note
+
+    points = tuple(SensitivityPoint(path=p, factor=f, value=1.0, hunting_free_from=x, kind=k)
+                   for p in ("friction.bristle_stiffness", "friction.bristle_damping",
+                             "friction.stribeck_velocity")
+                   for f, x, k in ((1 / 3, 11.0, "fold"), (3.0, None, "not_found")))
+    doctored = dataclasses.replace(d, simulation=sim, sensitivity=CrossoverSensitivity(
+        plant="isolated", nominal=None, factors=(1 / 3, 1.0, 3.0), points=points))
+    s = validation_section(doctored)["sensitivity"]
+    cells = [c["crossover"] for r in s["rows"] for c in r["cells"]]
+    assert cells.count("not found") == 3, cells
+    assert "above the search" not in s["intro"] and "not found" in s["intro"], s["intro"]
