@@ -104,7 +104,8 @@ def print_design(console: "Console", result, spec_path: Path | None = None) -> N
     console.print(checks_table(result.checks,
                                cases={c.name: c for c in getattr(loop, "cases", ())}))
 
-    effects = tuple(result.spec.effects)
+    spec = getattr(result, "spec", None)
+    effects = tuple(spec.effects) if spec is not None else ()
     pid = data.get("pid") or {}
     if pid:
         console.print(_gains_table(pid, effects))
