@@ -27,9 +27,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .layout import (N_STATS, N_WATCH, ST_CROSSINGS, ST_EVENTS, ST_OUT, ST_PERIOD, ST_REJECTED,
-                     ST_STEPS, ST_STOP, ST_T, STATUS_TEXT, STOP_TEXT, W_QUIET, W_START,
-                     Integration)
+from .layout import (N_STATS, N_WATCH, ST_CROSSINGS, ST_DX1, ST_DX2, ST_EVENTS, ST_HOLD, ST_OUT,
+                     ST_PENDING, ST_PERIOD, ST_REJECTED, ST_STEPS, ST_STOP, ST_T, STATUS_TEXT,
+                     STOP_TEXT, W_QUIET, W_START, Integration)
 
 __all__ = ["run", "taken"]
 
@@ -67,7 +67,7 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
     k = max(int(crossings), 1)
     cross_t = _nans(k)
     cross_y = _nans((k, n))
-    cross_e = _nans((k, 2))
+    cross_e = _nans((k, 4))
     y_end = _nans(n)
     status = compiled().integrate(
         p, y, taken(breaks), taken(coeffs), bool(land), float(t_end), t_out, float(rtol),
@@ -84,7 +84,10 @@ def run(params, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max=0.1,
                        n_events=int(stats[ST_EVENTS]), t_reached=float(stats[ST_T]),
                        final_state=y_end, stop=STOP_TEXT[int(stats[ST_STOP])],
                        crossing_times=cross_t[:c], crossing_states=cross_y[:c],
-                       crossing_extremes=cross_e[:c], period_crossings=int(stats[ST_PERIOD]))
+                       crossing_extremes=cross_e[:c, :2], crossing_controller=cross_e[:c, 2:],
+                       period_crossings=int(stats[ST_PERIOD]),
+                       controller=(float(stats[ST_DX1]), float(stats[ST_DX2]),
+                                   float(stats[ST_HOLD]), int(stats[ST_PENDING])))
 
 
 #: No known input force (an empty series; the integrator reads none of it).

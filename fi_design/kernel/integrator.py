@@ -67,8 +67,9 @@ from .layout import (DIVERGED, EV_LEVEL, EV_LIMIT, EV_NONE, EV_SECTION, EV_SIGN,
                      P_DC, P_DELAY, P_NF, P_QFREE, P_DMEAS, P_DP, P_DX1, P_DX2, P_FF_C, P_FF_F,
                      P_FF_M, P_ISO, P_KD, P_KDM,
                      P_KI, P_KP, P_M1, P_M2, P_QUANT, P_S, P_SWITCH, P_TS, P_U0, P_WT,
-                     ST_CROSSINGS, ST_EVENTS, ST_H, ST_LIMIT_EVENTS, ST_OUT, ST_PERIOD,
-                     ST_REJECTED, ST_STEPS, ST_STOP, ST_T, ST_ZERO_EVENTS, STEP_UNDERFLOW,
+                     ST_CROSSINGS, ST_DX1, ST_DX2, ST_EVENTS, ST_H, ST_HOLD, ST_LIMIT_EVENTS,
+                     ST_OUT, ST_PENDING, ST_PERIOD, ST_REJECTED, ST_STEPS, ST_STOP, ST_T,
+                     ST_ZERO_EVENTS, STEP_UNDERFLOW,
                      STOP_CROSSINGS, STOP_END, STOP_MATCH, STOP_QUIET, STOP_REPEAT,
                      TOO_MANY_STEPS, W_ARM, W_BAND, W_LEVEL, W_MATCH, W_MAX_CROSSINGS, W_QUIET,
                      W_REPEAT, W_REST_ANYWHERE, W_START, N_WATCH)
@@ -736,9 +737,10 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
         Output: times of the crossings [s] (the first ``stats[ST_CROSSINGS]``).
     cross_y : ndarray, shape (K, n)
         Output: states at the crossings.
-    cross_e : ndarray, shape (K, 2)
+    cross_e : ndarray, shape (K, 4)
         Output: smallest and largest x1 - r at the step ends since the
-        crossing before (since the watch's start for the first) [m].
+        crossing before (since the watch's start for the first) [m], and a
+        discrete controller's ``dx2`` and held output at the crossing [N].
     y_end : ndarray, shape (n,)
         Output: the state where the run ended.
 
@@ -839,6 +841,7 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     armed = False
     quiet_t0 = -1.0
     quiet_x = 0.0
+    quiet_due = False  # a sampled loop's quiet stop, due at its next sample instant
     e_lo = math.inf
     e_hi = -math.inf
     stop = STOP_END
@@ -866,7 +869,11 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
 
     while True:
         # ---------------------------------------------------- time events at t
-        if discrete and t >= t_sample - 1e-12 * max(1.0, t):
+        if discrete and quiet_due and t >= t_sample - 1e-12 * max(1.0, t):
+            # the quiet stop, before this sample is taken (the outputs due now are applied
+            # first): the run continues exactly from here (ST_DX1 ... in the stats)
+            stop = STOP_QUIET
+        elif discrete and t >= t_sample - 1e-12 * max(1.0, t):
             r_s, rd_s, rdd_s, r3_s, kref = reference_at(t, breaks, coeffs, kref)
             lev = int(math.floor(y[0] / p[P_QUANT] + 0.5)) if p[P_QUANT] > 0.0 else 0
             xm = measured_position(y[0], p, lev)
@@ -1217,6 +1224,15 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                 h_new = min(h_new, h)
             reject = False
             travel = abs(ynew[0] - y[0])
+            jitter = 0.0
+            if discrete and pending == EV_SECTION:
+                # how far the state moves in one sample period here, in the physical scales:
+                # a sampled loop's section states scatter by about that much (where its
+                # samples fall), so its repeat rule holds to that rather than to less
+                for j in range(nc):
+                    dj = abs(ynew[j] - y[j]) * (Ts / (t_new - t)) * rtol / atol[j]
+                    if dj > jitter:
+                        jitter = dj
             for j in range(n):
                 y[j] = ynew[j]
             t = t_new
@@ -1229,6 +1245,8 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                         cross_y[n_cross, j] = y[j]
                     cross_e[n_cross, 0] = e_lo
                     cross_e[n_cross, 1] = e_hi
+                    cross_e[n_cross, 2] = dx2
+                    cross_e[n_cross, 3] = fa_hold
                     n_cross += 1
                 armed = False
                 e_lo = math.inf
@@ -1255,13 +1273,14 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                     stop = STOP_CROSSINGS
                 elif repeat > 0.0:
                     c = n_cross - 1
+                    rep = repeat if jitter <= repeat else jitter
                     for q in range(1, min(MAX_PERIOD, c) + 1):
                         worst = 0.0
                         for j in range(n):
                             dj = abs(cross_y[c, j] - cross_y[c - q, j]) * rtol / atol[j]
                             if dj > worst:
                                 worst = dj
-                        if worst <= repeat:
+                        if worst <= rep:
                             stop = STOP_REPEAT
                             period = q
                             break
@@ -1277,10 +1296,15 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
                     if quiet_t0 < 0.0 or abs(y[0] - quiet_x) > band:
                         quiet_t0 = t
                         quiet_x = y[0]
+                        quiet_due = False
                     elif t - quiet_t0 >= quiet:
-                        stop = STOP_QUIET
+                        if discrete:
+                            quiet_due = True  # stop at the next sample instant
+                        else:
+                            stop = STOP_QUIET
                 else:
                     quiet_t0 = -1.0
+                    quiet_due = False
             if (pending == EV_NONE and modes[MODE_LEVEL] == LEVEL_FREE
                     and 2.0 * travel < p[P_QFREE] * p[P_QUANT]):
                 pending = EV_LEVEL  # the stage slowed: quantize again (apply_event)
@@ -1329,6 +1353,10 @@ def integrate(p, y0, breaks, coeffs, land, t_end, t_out, rtol, atol, h_max, max_
     stats[ST_CROSSINGS] = n_cross
     stats[ST_STOP] = stop
     stats[ST_PERIOD] = period
+    stats[ST_DX1] = dx1
+    stats[ST_DX2] = dx2
+    stats[ST_HOLD] = fa_hold
+    stats[ST_PENDING] = f_count
     for j in range(n):
         y_end[j] = y[j]
     return status

@@ -307,10 +307,19 @@ class Integration:
     crossing_extremes : ndarray, shape (c, 2), optional
         Smallest and largest x1 - r at the step ends since the crossing before
         [m] (since the watch's start for the first).
+    crossing_controller : ndarray, shape (c, 2), optional
+        A discrete controller's ``dx2`` and held output at those crossings [N]
+        (``dx1`` is the state's ``I``).
     period_crossings : int
         With ``stop == "repeat"``: crossings per period of the repeating
         motion; with ``stop == "match"``: the index of the known section
         state matched (0 otherwise).
+    controller : (float, float, float, int)
+        A discrete controller's ``dx1``, ``dx2`` and held output [N] where the
+        run ended, and its delayed outputs still pending: a quiet stop of a
+        sampled loop comes on a sample instant before the sample, so that a
+        run from ``final_state`` with ``dx1``, ``dx2`` and ``u_initial`` set
+        to these continues it exactly when none is pending.
     """
 
     code: int
@@ -328,7 +337,9 @@ class Integration:
     crossing_times: np.ndarray | None = None
     crossing_states: np.ndarray | None = None
     crossing_extremes: np.ndarray | None = None
+    crossing_controller: np.ndarray | None = None
     period_crossings: int = 0
+    controller: tuple[float, float, float, int] = (0.0, 0.0, 0.0, 0)
 
 
 #: Kernel parameter index of every :class:`PlantParameters` field, by name.
@@ -430,9 +441,14 @@ STATUS_TEXT = {
 }
 
 # Layout of the kernel's statistics array.
+# ST_DX1, ST_DX2, ST_HOLD, ST_PENDING: a discrete controller's states where the run ended
+# (dx1, dx2 [N], the held output [N], the delayed outputs still pending): a quiet stop of a
+# sampled loop comes on a sample instant, before that sample is taken, so that a run from the
+# end state with these as ``dx1``, ``dx2`` and ``u_initial`` continues it exactly when no
+# output is pending.
 (ST_STEPS, ST_REJECTED, ST_EVENTS, ST_T, ST_H, ST_OUT, ST_ZERO_EVENTS, ST_LIMIT_EVENTS,
- ST_CROSSINGS, ST_STOP, ST_PERIOD) = range(11)
-N_STATS = 11
+ ST_CROSSINGS, ST_STOP, ST_PERIOD, ST_DX1, ST_DX2, ST_HOLD, ST_PENDING) = range(15)
+N_STATS = 15
 
 # --------------------------------------------------------------------------- the watch
 
@@ -444,7 +460,8 @@ N_STATS = 11
 # W_REST_ANYWHERE is 1, within W_BAND of r) for this long (inf: never);
 # W_REPEAT: stop once the state at a section crossing repeats the one 1 to
 # MAX_PERIOD crossings before within this fraction of the physical scales atol / rtol (0:
-# never); W_MAX_CROSSINGS: stop after this many crossings (at most the rows of the crossing
+# never; a sampled loop's, within at least how far its mechanical states move in one sample
+# period at the crossing: where its samples fall scatters its section states by about that); W_MAX_CROSSINGS: stop after this many crossings (at most the rows of the crossing
 # outputs); W_ARM: x1 - r must fall below -W_ARM between two counted crossings;
 # W_MATCH: stop once the state at a section crossing comes within this fraction of the
 # physical scales of a known section state (0: never). The known states follow the N_WATCH

@@ -197,8 +197,8 @@ def hunting_free_boundary(model: Model, isolated: bool, cycle: Cycle | None = No
                            note="the fold of the cycle, confirmed by the move family above it")
         cycle = cycle_of_run(h[0], hi)
     # moves still hunt just above the last fold: that fold ends no hunting, so no crossover
-    # from which no move hunts was found (a cycle the continuation cannot follow, such as a
-    # sampled loop's, leaves a fold a bisection step above every crossover it starts from)
+    # from which no move hunts was found (a cycle the continuation cannot follow leaves a
+    # fold a bisection step above every crossover it starts from)
     return Boundary(hunting_free_from=None, bracket=(fold.bracket[0], top), kind="not_found",
                     resolution=0.0, tests=tests, branch=tuple(sorted(branch)),
                     note=f"not found: moves still hunt at {quantity(hi, 'Hz', 4)}, above "

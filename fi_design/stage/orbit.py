@@ -21,22 +21,29 @@ from ..results.stage import Cycle, CycleTrace
 from ..simulation.run import tolerances
 from .family import hold
 from .rest import rest_ends_run
-from .runs import guess_period, kernel_run, watch_array
+from .runs import guess_period, kernel_run, resumes_sampled, watch_array
 from .settings import MULTIPLIER_AGREEMENT, ORBIT_RTOL, PERTURBATION, REPEAT, Watch, restartable
 
 __all__ = ["converge_cycle", "FoundCycle", "cycle_exists"]
 
+#: Periods a sampled or delayed loop's cycle is run before its repeat is looked for.
+SETTLE_PERIODS = 5
 
-def _return_map(params, level, state, crossings, tol, max_steps, horizon, t_out=None):
-    """Run from a section state to the ``crossings``-th crossing; None if it comes to rest."""
+
+def _return_map(params, level, state, crossings, tol, max_steps, horizon, t_out=None,
+                repeat=0.0):
+    """Run from a section state to the ``crossings``-th crossing; None if it comes to rest.
+
+    With ``repeat`` > 0 the run may stop earlier, once its section state repeats
+    (the kernel's repeat rule)."""
     w = Watch(band=0.0, quiet=math.inf, horizon=horizon, rest_anywhere=False, tolerance=tol,
               max_steps=max_steps)
     arm = max(1e-9, 1e-6 * max(abs(level), 1e-3))
-    arr = watch_array(w, 0.0, level, repeat=0.0, quiet=False, max_crossings=crossings)
+    arr = watch_array(w, 0.0, level, repeat=repeat, quiet=False, max_crossings=crossings)
     arr[W_ARM] = arm
     out = kernel_run(params, state, hold(level, horizon), horizon, arr, tol, max_steps,
                      crossings=crossings, t_out=t_out, h_max=math.inf)
-    if out.code != 0 or len(out.crossing_times) < crossings:
+    if out.code != 0 or (len(out.crossing_times) < crossings and out.stop != "repeat"):
         return None
     return out
 
@@ -169,12 +176,24 @@ def _map_jacobian(params, level, s, crossings, tol, max_steps, horizon, scale, f
 
 
 def _simulated_cycle(params, level, s, crossings, crossover, horizon, max_steps, trace):
-    """The cycle a long run settles on (sampled or delayed controllers: no shooting)."""
+    """The cycle a long run settles on (sampled or delayed controllers: no shooting).
+
+    The run goes on until its section state repeats (within :data:`REPEAT`, or a
+    sampled loop's scatter of where its samples fall) after at least
+    :data:`SETTLE_PERIODS` periods, at most 40."""
     tol = 1e-7
-    out = _return_map(params, level, s, crossings * 40, tol, max_steps, horizon * 40)
-    if out is None:
+    start = _return_map(params, level, s, crossings * SETTLE_PERIODS, tol, max_steps,
+                        horizon * SETTLE_PERIODS)
+    if start is None:
         return None
+    out = _return_map(params, level, start.crossing_states[-1], crossings * 40, tol, max_steps,
+                      horizon * 40, repeat=REPEAT)
+    if out is None or len(out.crossing_times) < 2:
+        return None
+    if out.stop == "repeat":
+        crossings = out.period_crossings
     states = out.crossing_states
+    crossings = min(crossings, len(states) - 1)
     last, before = states[-1], states[-1 - crossings]
     scale = _scales(params, tol)
     free = _free_coordinates(params)
@@ -192,7 +211,7 @@ def _finish_cycle(params, level, s, crossings, crossover, period, mult, mult_che
     t_out = np.linspace(0.0, period, 2001)
     out = _return_map(params, level, s, crossings, tol, max_steps, 3.0 * period + 1.0,
                       t_out=t_out)
-    Y = out.states if out is not None else np.full((len(t_out), len(s)), np.nan)
+    Y = out.states if out is not None else np.full((len(t_out), params.n_states), np.nan)
     ok = np.all(np.isfinite(Y), axis=1)
     idx = state_index(bool(params.isolated))
     err = Y[ok, idx["x1"]] - level
@@ -281,12 +300,15 @@ def cycle_exists(params: PlantParameters, level: float, guess: np.ndarray, w: Wa
         if out.stop == "quiet":
             if rest_ends_run(params, out.final_state, level, w.band):
                 return None
-            if not restartable(params):
+            sampled = not restartable(params) and resumes_sampled(params, out)
+            if not (restartable(params) or sampled):
                 return FoundCycle(None, 0, None, None)  # cannot continue exactly: not at rest yet
             offset += out.t_reached
             if offset >= horizon:  # quiet to the end of the horizon: no cycle repeated in it
                 return None
             y0 = out.final_state.copy()
+            if sampled:  # stopped on a sample instant: the controller's states carry over
+                y0 = np.concatenate([y0, out.controller[1:3]])
             ref = hold(level, horizon - offset)
             continue
         n = len(out.crossing_times)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -59,7 +59,7 @@ class MoveRun:
 
 def _relative(params: PlantParameters, states: np.ndarray, level: float) -> np.ndarray:
     """Section states with the positions (x1, and x2 of the isolated plant) less ``level``."""
-    out = np.array(states, dtype=float, ndmin=2)
+    out = np.array(states, dtype=float, ndmin=2)[:, :params.n_states]
     idx = state_index(bool(params.isolated))
     out[:, idx["x1"]] -= level
     if params.isolated:
@@ -151,10 +151,71 @@ def kernel_run(params: PlantParameters, y0: np.ndarray, ref: Trajectory, t_end: 
         What :func:`fi_design.kernel.run` returns (stop reason, final state,
         section crossings, sampled states).
     """
+    n = params.n_states
+    if len(y0) > n:  # a sampled loop's section state: its controller's states follow
+        params = resumed(params, y0)
+        y0 = np.asarray(y0[:n], dtype=float)
     p, atol = kernel_arrays(params, tol)
-    return run(p, y0, ref.breaks, ref.coeffs, ref.land, t_end,
-               np.zeros(0) if t_out is None else t_out, tol, atol, h_max,
-               max_steps, _x_bound(ref, y0), watch=watch, crossings=crossings)
+    out = run(p, y0, ref.breaks, ref.coeffs, ref.land, t_end,
+              np.zeros(0) if t_out is None else t_out, tol, atol, h_max,
+              max_steps, _x_bound(ref, y0), watch=watch, crossings=crossings)
+    if params.sample_period > 0.0:
+        out = replace(out, crossing_states=np.hstack([out.crossing_states,
+                                                      out.crossing_controller]))
+    return out
+
+
+def resumed(params: PlantParameters, state: np.ndarray) -> PlantParameters:
+    """A sampled loop's plant, its discrete controller set to a section state's.
+
+    A section state of a sampled loop (:func:`kernel_run`'s crossing states)
+    holds the plant's states followed by the controller's ``dx2`` and held
+    output [N] (its ``dx1`` is the state ``I``). A run from it takes its first
+    sample at once: the motion goes on from the crossing with the controller's
+    memory intact, its sample instants shifted by less than a sample period
+    (and a delayed output still pending at the crossing skipped): the cycle of a
+    sampled loop is continued from the section to within that shift.
+
+    Parameters
+    ----------
+    params : PlantParameters
+        The plant (a discrete controller).
+    state : ndarray, shape (n + 2,)
+        The section state.
+
+    Returns
+    -------
+    PlantParameters
+        ``params`` with ``dx1``, ``dx2`` and ``u_initial`` from ``state``.
+    """
+    n = params.n_states
+    ii = state_index(bool(params.isolated))["I"]
+    return replace(params, dx1=float(state[ii]), dx2=float(state[n]),
+                   u_initial=float(state[n + 1]))
+
+
+def resumes_sampled(params: PlantParameters, out) -> bool:
+    """Whether a sampled loop's run can be continued exactly from where it stopped.
+
+    A quiet stop of a discrete controller comes on a sample instant, before the
+    sample is taken (:class:`~fi_design.kernel.layout.Integration`
+    ``controller``): a run from its end state, with the controller's states and
+    held output as the new run's ``dx1``, ``dx2`` and ``u_initial``, takes that
+    sample at its t = 0 and continues the motion exactly, as long as no
+    delayed output is still pending (a loop delay shorter than the sample period).
+
+    Parameters
+    ----------
+    params : PlantParameters
+        The plant.
+    out : fi_design.kernel.layout.Integration
+        The run that stopped.
+
+    Returns
+    -------
+    bool
+    """
+    return params.sample_period > 0.0 and out.stop == "quiet" and out.controller[3] == 0
 
 
 def match_tolerance(params: PlantParameters, known: Sequence[MoveRun]) -> float:
@@ -249,11 +310,15 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
             rested_at = offset + out.t_reached if abs(y[0] - level) <= w.band else None
             if offset + out.t_reached >= t_end * (1 - 1e-12):
                 break
-            if restart:
+            sampled = resumes_sampled(params, out)
+            if restart or sampled:
                 offset += out.t_reached
                 cur_y0, cur_ref = y.copy(), hold(level, t_end - offset)
                 cur_end, start = t_end - offset, 0.0
-            else:
+                if sampled:  # on a sample instant: the controller's states carry over
+                    dx1, dx2, held, _ = out.controller
+                    params = replace(params, dx1=dx1, dx2=dx2, u_initial=held)
+            else:  # run again from the start, watching from later on
                 start = out.t_reached + 1e-9
             continue
         break
