@@ -276,9 +276,8 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
     from rich.text import Text
 
     heading(console, f"Robustness of {result.spec.name}", spec_path)
-    for sc in result.scatter:
-        unit, f = axis_unit("") if sc.relative else axis_unit(
-            _path_unit(sc.path, result.spec))
+    for sc, path_unit in zip(result.scatter, result.units or ("",) * len(result.scatter)):
+        unit, f = axis_unit("" if sc.relative else path_unit)
         spread = (f"{number(sc.spread, 3)} of nominal ({percent(sc.spread, 3)})" if sc.relative
                   else f"{number(sc.spread * f)} {unit}")
         console.print(Text(f"scatter {sc.path}: {result.distribution}, spread {spread}"))
@@ -310,12 +309,3 @@ def print_robustness(console: "Console", result, spec_path: Optional[Path] = Non
     t.caption_justify = "left"
     console.print(t)
     _print_run(console, result.run, executor)
-
-
-def _path_unit(path: str, spec) -> str:
-    from ..spec.file import path_unit
-
-    try:
-        return path_unit(path, spec)
-    except Exception:  # noqa: BLE001 -- a label only
-        return ""

@@ -215,18 +215,9 @@ def _robustness_lead(result: RobustnessResult) -> str:
 
 def _scatter_table(result: RobustnessResult) -> Table:
     """The scattered spec values with their spreads, as the console prints them."""
-    from ..spec.file import path_unit
-
     rows = []
-    for sc in result.scatter:
-        if sc.relative:
-            spread = f"{percent(sc.spread, 3)} of nominal"
-        else:
-            try:
-                unit = path_unit(sc.path, result.spec)
-            except Exception:  # noqa: BLE001 -- a spread we cannot name a unit for, bare
-                unit = ""
-            spread = qty(sc.spread, unit)
+    for sc, unit in zip(result.scatter, result.units or ("",) * len(result.scatter)):
+        spread = f"{percent(sc.spread, 3)} of nominal" if sc.relative else qty(sc.spread, unit)
         rows.append((sc.path + (f" ({sc.meaning})" if sc.meaning else ""), spread))
     width = "half-width" if result.distribution == "uniform" else "standard deviation"
     return Table(("Spec value", f"Spread ({width})"), tuple(rows),

@@ -644,7 +644,18 @@ class RobustnessResult(Result):
         return csv_text(self.table())
 
     def to_dict(self) -> dict:
-        """Plain JSON data."""
+        """Plain JSON data.
+
+        Each ``scatter`` entry carries, beside the :class:`Scatter`'s fields,
+        ``unit`` (of the scattered value: its column of ``draws``, as in
+        :attr:`units`) and ``spread_unit`` (``"1"`` for a relative spread, a
+        fraction of the nominal value; else ``unit``).
+
+        Returns
+        -------
+        dict
+        """
+        units = self.units or ("",) * len(self.scatter)
         return {
             **header(self.fi_design_version, self.fi_design_source, self.spec),
             "spec_name": self.spec.name,
@@ -652,7 +663,8 @@ class RobustnessResult(Result):
             "seed": self.seed,
             "distribution": self.distribution,
             "measure": self.measure,
-            "scatter": [s.to_dict() for s in self.scatter],
+            "scatter": [{**s.to_dict(), "unit": unit, "spread_unit": "1" if s.relative else unit}
+                        for s, unit in zip(self.scatter, units)],
             "position_friction": self.position_friction.to_dict()
             if self.position_friction else None,
             "isolated": self.isolated.to_dict() if self.isolated else None,

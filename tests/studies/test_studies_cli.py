@@ -356,8 +356,28 @@ def test_robustness_reproducible_with_seed(paper_spec_path, robustness_run, tmp_
     a, b = json.loads(robustness_run.json.read_text()), json.loads(out.read_text())
     assert a["draws"] == b["draws"] and a["points"] == b["points"]
     assert a["isolated"]["probability"] == b["isolated"]["probability"]
-    assert a["scatter"][1] == {"path": "friction.coulomb", "spread": 0.1, "relative": False,
-                               "meaning": ""}
+    assert a["scatter"] == b["scatter"]
+
+
+def test_robustness_json_names_the_unit_of_every_scatter(robustness_run):
+    """The robustness JSON's `scatter` entries gave an absolute spread (`friction.coulomb=0.1
+    N`: `"spread": 0.1`) without a unit, and nothing in the JSON named the unit of the drawn
+    values its `draws` hold, which the CSV names (`friction.static_N`). Each entry now names
+    the unit of its value, its column's in the CSV, and the unit of its spread (1 for a
+    fraction of the nominal value); the console prints each spread with its unit."""
+    data = json.loads(robustness_run.json.read_text())
+    scatter = {s["path"]: s for s in data["scatter"]}
+    assert scatter["friction.coulomb"] == {"path": "friction.coulomb", "spread": 0.1,
+                                           "relative": False, "meaning": "", "unit": "N",
+                                           "spread_unit": "N"}
+    assert scatter["friction.static"]["spread_unit"] == "1"
+    assert scatter["friction.static"]["spread"] == pytest.approx(0.1)
+    # the value's unit is the one the CSV's column names
+    columns = list(column_units(robustness_run.csv))[1:1 + len(data["scatter"])]
+    assert columns == [f"{s['path']}_{s['unit']}" for s in data["scatter"]]
+    lines = [ln.strip() for ln in robustness_run.output.splitlines()]
+    assert "scatter friction.coulomb: normal, spread 0.1 N" in lines
+    assert "scatter friction.static: normal, spread 0.1 of nominal (10 %)" in lines
 
 
 @pytest.mark.parametrize("args,words", [
