@@ -211,7 +211,7 @@ def check_outputs(inputs: Iterable[str | os.PathLike], *, force: bool = False,
 def check_output_dir(directory: str | os.PathLike, names: Iterable[str], *,
                      force: bool = False,
                      protect: Iterable[str | os.PathLike | None] = (),
-                     stale: Iterable[str] = ()) -> dict:
+                     stale: Iterable[str] = (), force_flag: str = "--force") -> dict:
     """Refuse a directory of outputs before the work starts (it may not exist yet).
 
     Parameters
@@ -231,6 +231,10 @@ def check_output_dir(directory: str | os.PathLike, names: Iterable[str], *,
         outputs it does not belong to, so it is refused without ``force``
         and, with ``force``, claimed for :func:`remove_output` once the new
         files are written.
+    force_flag : str, optional
+        How the caller allows overwriting, for the messages: ``"--force"`` (the
+        command line), ``"force=True"`` (a library function); as for
+        :func:`check_output`.
 
     Returns
     -------
@@ -251,7 +255,7 @@ def check_output_dir(directory: str | os.PathLike, names: Iterable[str], *,
     targets = {}
     for name in names:
         if out.is_dir():
-            check_output(out / name, force=force, protect=protect)
+            check_output(out / name, force=force, protect=protect, force_flag=force_flag)
         else:
             _claim(out / name, force)
         targets[name] = out / name
@@ -261,9 +265,9 @@ def check_output_dir(directory: str | os.PathLike, names: Iterable[str], *,
             continue
         if not force:
             raise OutputError(f"{old}: file exists, an output of an earlier run that this one "
-                              "does not write; use --force to remove it, or choose another "
-                              "directory")
-        check_output(old, force=True, protect=protect)
+                              f"does not write; use {force_flag} to remove it, or choose "
+                              "another directory")
+        check_output(old, force=True, protect=protect, force_flag=force_flag)
     return targets
 
 

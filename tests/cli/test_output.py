@@ -210,6 +210,25 @@ def test_a_stale_output_is_removed_only_as_the_check_found_it(tmp_path):
     assert (tmp_path / "map_D.csv").read_text() == "another run's study"
 
 
+@pytest.mark.parametrize("kwargs,flag", [({}, "--force"),
+                                         ({"force_flag": "force=True"}, "force=True")])
+def test_a_refused_output_dir_names_the_callers_way_to_force(tmp_path, kwargs, flag):
+    """check_output_dir refused a stale file with 'use --force to remove it' even to a library
+    caller, who has no such option; check_output words it as its caller passes (force_flag),
+    and so does check_output_dir now, for a stale file and for an existing output."""
+    from fi_design.output import check_output_dir
+
+    (tmp_path / "map_C.csv").write_text("earlier study")
+    with pytest.raises(OutputError) as stale:
+        _run(check_output_dir, tmp_path, ["map_A.csv"], stale=["map_C.csv"], **kwargs)
+    (tmp_path / "map_A.csv").write_text("earlier study")
+    with pytest.raises(OutputError) as exists:
+        _run(check_output_dir, tmp_path, ["map_A.csv"], **kwargs)
+    for err, words in ((stale, "earlier run"), (exists, "file exists")):
+        assert words in str(err.value) and f"use {flag} to" in str(err.value)
+        assert flag == "--force" or "--force" not in str(err.value)
+
+
 def test_without_a_check_a_library_write_replaces(tmp_path):
     """write_atomic alone (a script) keeps its documented meaning: it replaces."""
     out = tmp_path / "out.json"
