@@ -72,7 +72,7 @@ def stock_thicknesses(bounds: tuple[float, float], step: float | None,
 
     Examples
     --------
-    >>> [round(t * 1e3, 2) for t in stock_thicknesses((0.12e-3, 0.3e-3), 0.05e-3)]
+    >>> [round(float(t) * 1e3, 2) for t in stock_thicknesses((0.12e-3, 0.3e-3), 0.05e-3)]
     [0.15, 0.2, 0.25, 0.3]
     """
     t0, t1 = bounds

@@ -117,8 +117,11 @@ def reconcile(spec, measured: Measurement, *, isolated: bool | None = None,
     >>> import fi_design
     >>> spec = fi_design.load_spec("examples/measured_stage.yaml")
     >>> data = fi_design.load_measurement("examples/measured_trace.csv")
-    >>> result = fi_design.reconcile(spec, data)    # doctest: +SKIP
-    >>> result.effect, result.parameters            # doctest: +SKIP
+    >>> result = fi_design.reconcile(spec, data)  # about 15 s  # doctest: +SKIP
+    >>> result.effect  # doctest: +SKIP
+    'position_dependent_friction'
+    >>> round(result.parameters["wavelength"] * 1e3, 2)  # [mm]  # doctest: +SKIP
+    5.0
     """
     started = _time.perf_counter()
     say = progress or _silent
