@@ -682,9 +682,30 @@ def given_mode(mode: _spec.ParasiticMode) -> Mode:
                 antiresonance=_spec.antiresonance(mode) if mode.collocated else None)
 
 
-def as_model(spec_or_model) -> Model:
-    """A model as given, or the spec resolved (:func:`resolve`)."""
-    return spec_or_model if isinstance(spec_or_model, Model) else resolve(spec_or_model)
+def as_model(spec_or_model, name: str = "spec") -> Model:
+    """A model as given, or the spec resolved (:func:`resolve`).
+
+    Parameters
+    ----------
+    spec_or_model : Model, Spec, path or mapping
+        The model, or the spec to resolve.
+    name : str, optional
+        The argument's name, for the message.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    ArgumentError
+        ``spec_or_model`` is none of these (None, a number, a list).
+    """
+    from .spec.file import as_spec
+
+    if isinstance(spec_or_model, Model):
+        return spec_or_model
+    return resolve(as_spec(spec_or_model, name, model=True))
 
 
 def require_model(value: Any) -> Model:

@@ -30,8 +30,8 @@ def design(spec: Spec | str | Path | Mapping[str, Any], *, confirm: bool = True,
 
     Parameters
     ----------
-    spec : Spec, path or mapping
-        A validated spec, or a YAML path or mapping.
+    spec : Spec, Model, path or mapping
+        A validated spec, its resolved model, or a YAML path or mapping.
     confirm : bool, optional
         Simulate (see :func:`fi_design.guideline.evaluate.evaluate`). Default True; a
         design that was not simulated is never recommended on.

@@ -101,6 +101,45 @@ def test_resolve_takes_the_path_and_mapping_design_and_simulate_take(paper_spec,
         resolve({"name": "a mapping"})
 
 
+def _entry_points():
+    """(name, call on a bad argument, the argument's name, whether it takes a Model)."""
+    import fi_design
+    from fi_design.model import as_model
+    from fi_design.stage import stage_hunting, stage_hunts
+    from fi_design.studies import paper_study
+
+    return [
+        ("design", lambda x: fi_design.design(x), "spec", True),
+        ("simulate", lambda x: fi_design.simulate(x), "spec", True),
+        ("recommend", lambda x: fi_design.recommend(x), "spec", True),
+        ("sweep", lambda x: fi_design.sweep(x, ("controller.crossover", [8.0])), "spec", True),
+        ("robustness", lambda x: fi_design.robustness(x, []), "spec", True),
+        ("paper_study", lambda x: paper_study(x), "spec", True),
+        ("stage_hunting", lambda x: stage_hunting(x), "model", True),
+        ("stage_hunts", lambda x: stage_hunts(x, True), "model", True),
+        ("as_model", lambda x: as_model(x), "spec", True),
+        ("resolve", lambda x: fi_design.resolve(x), "spec", False),
+        ("with_values", lambda x: fi_design.with_values(x, {}), "spec", False),
+        ("reconcile", lambda x: fi_design.reconcile(x, None), "spec", False),
+    ]
+
+
+@pytest.mark.parametrize("case", range(len(_entry_points())),
+                         ids=[c[0] for c in _entry_points()])
+def test_a_bad_spec_is_refused_naming_what_the_call_takes(case):
+    """simulate(42) said 'spec must be a Spec, a path to a YAML spec or a mapping, got int',
+    though simulate takes a Model as well, and stage_hunts(42, True) named its argument
+    `model` 'spec'. Each entry point names its argument and what it takes: a Model where it
+    takes one, and not where it does not (resolve, with_values, reconcile)."""
+    from fi_design.errors import ArgumentError
+
+    _, call, name, takes_model = _entry_points()[case]
+    model = "a Model, " if takes_model else ""
+    with pytest.raises(ArgumentError, match=f"^{name} must be a Spec, {model}a path to a YAML "
+                       "spec or a mapping, got int$"):
+        call(42)
+
+
 # --------------------------------------------------------------------------- variants
 
 

@@ -127,7 +127,7 @@ def evaluate(spec: Spec | Model | str | Path | Mapping[str, Any], *, confirm: bo
     if not isinstance(spec, Model):
         from ..spec.file import as_spec
 
-        spec = as_spec(spec)
+        spec = as_spec(spec, model=True)
     model = as_model(spec)
     spec = model.spec
     suggestion = suggested_isolator(model) if not model.has_isolator else None

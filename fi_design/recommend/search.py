@@ -415,7 +415,7 @@ def recommend(spec: _spec.Spec | Model | str | Any, *, executor: Any = None,
     start = _time.perf_counter()
     check_executor(executor)
     store = open_store(cache)
-    model = as_model(spec if isinstance(spec, Model) else as_spec(spec))  # the edge: once
+    model = as_model(spec if isinstance(spec, Model) else as_spec(spec, model=True))  # once
     if model.departures:
         from ..errors import ArgumentError
 

@@ -263,7 +263,7 @@ def _checked_arguments(spec, crossover, duration, rtol, record, rate=None):
     from ..spec.file import as_spec
 
     if not isinstance(spec, Model):
-        spec = as_spec(spec)
+        spec = as_spec(spec, model=True)
     settings = (spec.spec if isinstance(spec, Model) else spec).simulation
     if crossover is not None:
         crossover = number(crossover, "crossover", "Hz", positive=True)

@@ -166,7 +166,7 @@ def load_spec(source: str | Path | Mapping[str, Any]) -> Spec:
                                      data.decode("utf-8")))
 
 
-def as_spec(spec: Any, name: str = "spec") -> Spec:
+def as_spec(spec: Any, name: str = "spec", *, model: bool = False) -> Spec:
     """The spec a library function was given: a :class:`Spec`, or a path or mapping to load.
 
     Every public workflow takes what :func:`fi_design.design` takes, so a
@@ -178,6 +178,9 @@ def as_spec(spec: Any, name: str = "spec") -> Spec:
         The spec, or what :func:`load_spec` reads.
     name : str, optional
         The argument's name, for the message.
+    model : bool, optional
+        Whether the caller also takes a resolved :class:`fi_design.model.Model`
+        (and has taken it before asking here), for the message. Default False.
 
     Returns
     -------
@@ -196,8 +199,8 @@ def as_spec(spec: Any, name: str = "spec") -> Spec:
         return spec
     if isinstance(spec, (str, Path, Mapping)):
         return load_spec(spec)
-    raise ArgumentError(f"{name} must be a Spec, a path to a YAML spec or a mapping, got "
-                        f"{type(spec).__name__}")
+    raise ArgumentError(f"{name} must be a Spec, {'a Model, ' if model else ''}a path to a YAML "
+                        f"spec or a mapping, got {type(spec).__name__}")
 
 
 def with_values(spec: Spec | str | os.PathLike | Mapping[str, Any],

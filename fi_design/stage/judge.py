@@ -60,7 +60,7 @@ def stage_hunting(model: Model | _spec.Spec, isolated: bool | None = None, *,
     -------
     StageHunting
     """
-    model = as_model(model)
+    model = as_model(model, "model")
     if crossover is not None:
         model = model.at(crossover=crossover)
     iso = model.has_isolator if isolated is None else bool(isolated)

@@ -110,7 +110,7 @@ def stage_hunts(model: Model | _spec.Spec, isolated: bool, *, crossover: float |
     """
     if order not in ORDERS:
         raise ArgumentError(f"order must be one of {', '.join(ORDERS)}, got {order!r}")
-    model = as_model(model)
+    model = as_model(model, "model")
     if crossover is not None:
         model = model.at(crossover=crossover)
     p = model.plant(isolated)

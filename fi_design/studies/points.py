@@ -86,7 +86,7 @@ def study_model(spec: _spec.Spec | Model, name: str = "spec") -> Model:
     from ..spec.file import as_spec
 
     if not isinstance(spec, Model):
-        return resolve(as_spec(spec, name))
+        return resolve(as_spec(spec, name, model=True))
     if spec.departures:
         raise ArgumentError(f"{name}: this model differs from its spec at "
                             f"{', '.join(spec.departures)} (Model.at), "
