@@ -683,24 +683,8 @@ def given_mode(mode: _spec.ParasiticMode) -> Mode:
 
 
 def as_model(spec_or_model, name: str = "spec") -> Model:
-    """A model as given, or the spec resolved (:func:`resolve`).
-
-    Parameters
-    ----------
-    spec_or_model : Model, Spec, path or mapping
-        The model, or the spec to resolve.
-    name : str, optional
-        The argument's name, for the message.
-
-    Returns
-    -------
-    Model
-
-    Raises
-    ------
-    ArgumentError
-        ``spec_or_model`` is none of these (None, a number, a list).
-    """
+    """A model as given, or the spec resolved (:func:`resolve`); anything else is refused
+    naming the argument ``name`` and a Model among what it takes."""
     from .spec.file import as_spec
 
     if isinstance(spec_or_model, Model):
