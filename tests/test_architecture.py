@@ -321,7 +321,7 @@ def test_an_analysis_refuses_a_spec_with_a_clear_message(paper_spec):
             call()
 
 
-#: The modules outside spec/ and model.py that write values into a spec by dotted path
+#: The modules outside spec/ and model/ that write values into a spec by dotted path
 #: (fi_design.spec.paths.with_values), and why: a spec as an output, never a design varied for an
 #: analysis (that is Model.varied, or its fast form Model.at).
 SPEC_EDITS = {
@@ -340,12 +340,12 @@ def _calls(tree: ast.AST, name: str) -> list[int]:
 def test_a_design_is_varied_by_the_model_only():
     """A study axis, a robustness draw, a sensitivity step, an added isolator: each is
     Model.varied (or Model.at) of a model resolved once; the spec is written by dotted path only
-    in spec/, model.py and the spec outputs of SPEC_EDITS (issue 32)."""
+    in spec/, model/ and the spec outputs of SPEC_EDITS (issue 32)."""
     package = ROOT / "fi_design"
     found = {}
     for path in sorted(package.rglob("*.py")):
         rel = path.relative_to(package).as_posix()
-        if rel.startswith("spec/") or rel == "model.py":
+        if rel.startswith(("spec/", "model/")):
             continue
         lines = _calls(ast.parse(path.read_text(encoding="utf-8")), "with_values")
         if lines:

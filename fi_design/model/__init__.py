@@ -45,17 +45,19 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any
 
-from . import effects as _effects
-from . import spec as _spec
-from .display import quantity, unit_text
-from .errors import ArgumentError, SimulationError, SpecError
-from .controller.pid import at_crossover, control_law
-from .kernel.layout import PlantParameters
-from .mechanism.geometry import StageBody, stage_body
-from .results.controller import ControlLaw, Filter
-from .results.friction import FrictionLaw
-from .results.mechanism import GRAVITY, Mode
-from .results.steps import FlexureResult
+from .. import effects as _effects
+from .. import spec as _spec
+from ..display import quantity
+from ..errors import ArgumentError, SimulationError, SpecError
+from ..controller.pid import at_crossover, control_law
+from ..kernel.layout import PlantParameters
+from ..mechanism.geometry import StageBody, stage_body
+from ..results.controller import ControlLaw, Filter
+from ..results.friction import FrictionLaw
+from ..results.mechanism import GRAVITY, Mode
+from ..results.steps import FlexureResult
+from .checks import (checked_effects, checked_filters, filter_fields, finite,
+                     positive)
 
 __all__ = ["FrictionLaw", "Joint", "Limiter", "Model", "resolve", "as_model", "require_model",
            "apply_effects", "given_mode"]
@@ -204,7 +206,7 @@ class Model:
         flex = self.flexure_spec
         if flex is None:
             return None
-        from .mechanism.sizing import drawn_guide, size_guide
+        from ..mechanism.sizing import drawn_guide, size_guide
 
         req = self.requirements
         common = dict(stroke=self.joint.stroke, cart_mass=self.m2,
@@ -236,7 +238,7 @@ class Model:
         well above the crossover the PID is tuned for: the joint's resonance lifts |L|), else
         the controller's crossover (:func:`fi_design.mechanism.plants.rigid_loop_crossover`).
         """
-        from .mechanism.plants import rigid_loop_crossover
+        from ..mechanism.plants import rigid_loop_crossover
 
         top = rigid_loop_crossover(self)
         return self.crossover if top is None else top
@@ -389,7 +391,7 @@ class Model:
                                 f"{', '.join(self.departures)} (Model.at): "
                                 "vary the model resolved from the spec, with every value "
                                 "in Model.varied")
-        from .spec.paths import with_values
+        from ..spec.paths import with_values
 
         return resolve(with_values(self.spec, values))
 
@@ -465,22 +467,22 @@ class Model:
             ("cart.mass", None if masses is None else masses[1])) if value is not None]
         law, friction = model.law, model.friction
         if crossover is not None:
-            law = at_crossover(law, _positive(crossover, "controller.crossover", "Hz"))
+            law = at_crossover(law, positive(crossover, "controller.crossover", "Hz"))
         if filters is not None:
-            law = replace(law, filters=_checked_filters(filters, law.sample_period))
+            law = replace(law, filters=checked_filters(filters, law.sample_period))
         if friction_model is not None:
             if friction_model not in FRICTION_MODELS:
                 raise SpecError(f"must be one of {', '.join(FRICTION_MODELS)}, got "
                                 f"{friction_model!r}", path="friction.model")
             friction = replace(friction, model=friction_model)
-        entries = model.effects if effects is None else _checked_effects(effects, model.joint)
+        entries = model.effects if effects is None else checked_effects(effects, model.joint)
         changed = self.changed + tuple(p for p in paths if p not in self.changed)
         if delay is not None:
-            d = _finite(delay, "controller.delay", "s")
+            d = finite(delay, "controller.delay", "s")
             if d < 0.0:
                 raise SpecError(f"must be at least 0 s, got {delay!r}", path="controller.delay")
             law = replace(law, delay=d)
-        scale = model.mode_scale if mode_scale is None else _positive(mode_scale, "mode_scale",
+        scale = model.mode_scale if mode_scale is None else positive(mode_scale, "mode_scale",
                                                                      "-")
         out = replace(model, law=law, friction=friction, effects=entries, changed=changed,
                       mode_scale=scale)
@@ -494,15 +496,15 @@ class Model:
 
     def _with_masses(self, m1: float, m2: float) -> "Model":
         """The model with the true masses changed: the guide as built carries the new stage."""
-        m1 = _positive(m1, "stage.mass", "kg")
-        m2 = _positive(m2, "cart.mass", "kg")
+        m1 = positive(m1, "stage.mass", "kg")
+        m2 = positive(m2, "cart.mass", "kg")
         b = self.body
         f = m1 / b.mass
         body = replace(b, mass=m1, inertia=tuple(i * f for i in b.inertia))
         out = replace(self, m1=m1, m2=m2, body=body)
         fx = self.flexure
         if fx is not None and fx.mechanics is not None:
-            from .mechanism.sizing import reevaluate
+            from ..mechanism.sizing import reevaluate
 
             g = replace(fx.guide, stage_mass=m1, stage_inertia=body.inertia, cart_mass=m2)
             moved = reevaluate(fx, g)
@@ -526,17 +528,17 @@ class Model:
         if j is None and stroke is None:
             raise SpecError("the model has no isolator: give its stroke to add one",
                             path="isolator.stroke")
-        s = j.stroke if stroke is None else _positive(stroke, "isolator.stroke", "m")
+        s = j.stroke if stroke is None else positive(stroke, "isolator.stroke", "m")
         given_k = stiffness is not None or (j is not None and j.stiffness_given)
         if stiffness is not None:
-            k = _positive(stiffness, "isolator.stiffness", "N/m")
+            k = positive(stiffness, "isolator.stiffness", "N/m")
         elif given_k:
             k = j.stiffness
         else:
             k = _spec.proposed_stiffness(self.spec, s)
         given_c = damping is not None or (j is not None and j.damping_given)
         if damping is not None:
-            c = _finite(damping, "isolator.damping", "N*s/m")
+            c = finite(damping, "isolator.damping", "N*s/m")
             if c < 0.0:
                 raise SpecError(f"must be at least {quantity(0.0, 'N*s/m')}, got {damping!r}",
                                 path="isolator.damping")
@@ -634,7 +636,7 @@ def resolve(spec: _spec.Spec | str | Path | Mapping[str, Any]) -> Model:
     >>> resolve("examples/paper_setup.yaml").crossover  # a path (or a mapping) is loaded
     8.0
     """
-    from .spec.file import as_spec
+    from ..spec.file import as_spec
 
     spec = as_spec(spec)
     f = spec.friction
@@ -663,8 +665,8 @@ def resolve(spec: _spec.Spec | str | Path | Mapping[str, Any]) -> Model:
 
 def _drawn_stiffness(flexure, body: StageBody, spec: _spec.Spec) -> float:
     """The net drive stiffness of a guide the spec draws, gravity included [N/m]."""
-    from .mechanism.geometry import leaf_guide
-    from .mechanism.sizing import net_stiffness
+    from ..mechanism.geometry import leaf_guide
+    from ..mechanism.sizing import net_stiffness
 
     g = leaf_guide(flexure, body, length=flexure.length, width=flexure.width,
                    thickness=flexure.thickness, cart_mass=spec.cart.mass)
@@ -685,7 +687,7 @@ def given_mode(mode: _spec.ParasiticMode) -> Mode:
 def as_model(spec_or_model, name: str = "spec") -> Model:
     """A model as given, or the spec resolved (:func:`resolve`); anything else is refused
     naming the argument ``name`` and a Model among what it takes."""
-    from .spec.file import as_spec
+    from ..spec.file import as_spec
 
     if isinstance(spec_or_model, Model):
         return spec_or_model
@@ -723,85 +725,3 @@ def apply_effects(params: PlantParameters, entries) -> PlantParameters:
                 value = getattr(params, par.kernel_field) + value
             changes[par.kernel_field] = float(value)
     return replace(params, **changes) if changes else params
-
-
-# --------------------------------------------------------------------------- checks
-
-
-def _finite(value, path: str, unit: str) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise SpecError(f"expected a number [{unit_text(unit)}], got {value!r}",
-                        path=path) from None
-    if not math.isfinite(x):
-        raise SpecError(f"must be a finite number [{unit_text(unit)}], got {value!r}", path=path)
-    return x
-
-
-def _positive(value, path: str, unit: str) -> float:
-    x = _finite(value, path, unit)
-    if not x > 0.0:
-        raise SpecError(f"must be greater than 0 {unit}, got {value!r}", path=path)
-    return x
-
-
-def filter_fields(filters, period: float) -> dict[str, float]:
-    """The kernel's fields of the drive's filter chain (:class:`~fi_design.kernel.layout.PlantParameters`).
-
-    Each filter a section: its polynomials in s, ``(b0 s^2 + b1 s + b2) / (s^2 + a1 s + a2)``
-    or ``(b0 s + b1) / (s + a1)``, and, for a sampled controller (``period`` [s] > 0), the
-    biquad the drive computes (:func:`fi_design.controller.tustin_biquad`).
-    """
-    from .controller import filter_polynomials, tustin_biquad
-    from .kernel.layout import MAX_FILTER_SECTIONS
-
-    if len(filters) > MAX_FILTER_SECTIONS:
-        raise SpecError(f"at most {MAX_FILTER_SECTIONS} filters, got {len(filters)}",
-                        path="controller.filters")
-    out: dict[str, float] = {"filter_states": float(sum(f.order for f in filters))}
-    for i, f in enumerate(filters):
-        num, den = filter_polynomials(f)
-        num = [0.0] * (len(den) - len(num)) + [float(x) for x in num]
-        if f.order == 2:
-            b0, b1, b2 = num
-            a1, a2 = float(den[1]), float(den[2])
-        else:
-            (b0, b1), b2, a1, a2 = num, 0.0, float(den[1]), 0.0
-        out.update({f"f{i}_order": float(f.order), f"f{i}_b0": b0, f"f{i}_b1": b1,
-                    f"f{i}_b2": b2, f"f{i}_a1": a1, f"f{i}_a2": a2})
-        if period > 0.0:
-            b, a = tustin_biquad(f, period)
-            b = list(b) + [0.0] * (3 - len(b))
-            a = list(a) + [0.0] * (3 - len(a))
-            out.update({f"f{i}_z0": float(b[0]), f"f{i}_z1": float(b[1]), f"f{i}_z2": float(b[2]),
-                        f"f{i}_p1": float(a[1]), f"f{i}_p2": float(a[2])})
-    return out
-
-
-def _checked_filters(filters, period: float) -> tuple:
-    out = tuple(filters)
-    for i, f in enumerate(out):
-        if not isinstance(f, Filter):
-            raise SpecError(f"expected a Filter, got {type(f).__name__}",
-                            path=f"controller.filters[{i}]")
-        if not (f.frequency > 0.0 and math.isfinite(f.frequency)):
-            raise SpecError(f"frequency must be a positive number [Hz], got {f.frequency!r}",
-                            path=f"controller.filters[{i}].frequency")
-        if period > 0.0 and f.frequency >= 0.5 / period:
-            raise SpecError(f"{quantity(f.frequency, 'Hz', 6)} lies at or above the Nyquist "
-                            f"frequency {quantity(0.5 / period, 'Hz', 6)}",
-                            path=f"controller.filters[{i}].frequency")
-    return out
-
-
-def _checked_effects(entries, joint: Joint | None) -> tuple:
-    out = tuple(entries)
-    known = tuple(_spec.EFFECT_MODELS.values())
-    for i, e in enumerate(out):
-        if not isinstance(e, known):
-            raise SpecError(f"expected a validated effect entry, got {type(e).__name__}",
-                            path=f"effects[{i}]")
-    if any(e.type == "joint_damping" for e in out) and joint is None:
-        raise SpecError("effect joint_damping needs an isolator", path="effects")
-    return out
