@@ -219,8 +219,19 @@ def build(output_dir: str | os.PathLike | None = None) -> list[Path]:
 
 def main() -> None:
     """``python -m fi_design.kernel.build [DIR]``: build the extension (into the package by
-    default) and print the path of every file written, one a line."""
-    for path in build(sys.argv[1] if len(sys.argv) > 1 else None):
+    default) and print the path of every file written, one a line. ``-h`` or ``--help``
+    prints the usage; any other option, or more than one DIR, is refused (exit code 2)."""
+    args = sys.argv[1:]
+    usage = ("usage: python -m fi_design.kernel.build [DIR]\n"
+             "Build the compiled simulation kernel into DIR (default: the installed package).")
+    if args and args[0] in ("-h", "--help"):
+        print(usage)
+        return
+    if len(args) > 1 or (args and args[0].startswith("-")):
+        print(f"{usage}\nerror: unexpected argument {args[-1] if len(args) > 1 else args[0]!r}",
+              file=sys.stderr)
+        raise SystemExit(2)
+    for path in build(args[0] if args else None):
         print(path)
 
 

@@ -224,3 +224,24 @@ def test_the_jit_build_of_the_same_source_agrees(paper_spec, tmp_path):
     here = [simulate(paper_spec, isolated=i).position for i in (True, False)]
     assert np.max(np.abs(jit[0] - here[0])) < 1e-9
     assert np.max(np.abs(jit[1] - here[1])) < 1e-6
+
+
+@pytest.mark.parametrize("argv, code", [(["--help"], 0), (["-h"], 0), (["--force"], 2),
+                                        (["a", "b"], 2)])
+def test_the_build_command_reads_its_options_without_building(argv, code, monkeypatch, capsys,
+                                                              tmp_path):
+    """``python -m fi_design.kernel.build --help`` built the kernel into a folder named
+    '--help'; an option is now read as one (usage, or refused with exit code 2)."""
+    from fi_design.kernel import build as kb
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(kb, "build", lambda *a, **k: pytest.fail("built the kernel"))
+    monkeypatch.setattr("sys.argv", ["build", *argv])
+    if code:
+        with pytest.raises(SystemExit) as exc:
+            kb.main()
+        assert exc.value.code == code and "unexpected argument" in capsys.readouterr().err
+    else:
+        kb.main()
+        assert "usage: python -m fi_design.kernel.build [DIR]" in capsys.readouterr().out
+    assert not any(tmp_path.iterdir())
