@@ -17,7 +17,7 @@ A spec lists applied effects under ``effects:`` as ``{type: NAME, PARAM: value,
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Mapping
 
 from .display import quantity, with_error
@@ -212,6 +212,44 @@ def get(name: str) -> Effect:
         raise KeyError(f"unknown effect {name!r}; known: {', '.join(EFFECT_NAMES)}") from None
 
 
+def apply_effects(params, entries):
+    """The kernel's parameters with effect entries set (neutral values change nothing).
+
+    Parameters
+    ----------
+    params : fi_design.kernel.layout.PlantParameters
+        The nominal plant's parameters.
+    entries : sequence
+        Effect entries (a spec's ``effects`` items), applied in order (:func:`effect_value`).
+
+    Returns
+    -------
+    fi_design.kernel.layout.PlantParameters
+    """
+    fields = dict.fromkeys(par.kernel_field for entry in entries
+                           for par in get(entry.type).parameters
+                           if getattr(entry, par.name) is not None)
+    changes = {f: effect_value(entries, f, getattr(params, f)) for f in fields}
+    return replace(params, **changes) if changes else params
+
+
+def effect_value(entries, kernel_field: str, nominal: float) -> float:
+    """The value of one kernel parameter once effect entries set it (SI).
+
+    An entry setting it replaces the value, or, for an additive parameter
+    (``combine="add"``: a ``time_delay`` on ``controller.delay``), adds to
+    ``nominal``; of several entries setting it the last counts.
+    """
+    value = float(nominal)
+    for entry in entries:
+        for par in get(entry.type).parameters:
+            given = getattr(entry, par.name)
+            if par.kernel_field != kernel_field or given is None:
+                continue
+            value = float(nominal + given if par.combine == "add" else given)
+    return value
+
+
 def values_text(name: str, values: Mapping[str, float | None],
                 errors: Mapping[str, float | None] | None = None, *, sep: str = " ") -> str:
     """The values of an effect for a reader, each with its standard error in one unit.
@@ -262,12 +300,19 @@ def entries_text(entries, *, sep: str = " ") -> str:
     return ", ".join(out)
 
 
+#: Effects the linear analysis models as well: a ``time_delay`` delays the actuator force like
+#: ``controller.delay`` does (the simulation adds the two), so the limit cases' margins and the
+#: achievable crossover include it (:attr:`fi_design.model.Model.loop_delay`).
+LINEAR_EFFECTS: tuple[str, ...] = ("time_delay",)
+
+
 def simulated_only(entries, *, sep: str = " ") -> str:
     """Which effects the simulation carries and the linear analysis does not, as a clause.
 
-    Effects only set parameters of the simulation: the linear steps (the
-    rule's gains, the limit cases' margins, the achievable crossover) analyse
-    the loop without them, ``controller.delay`` the only delay they model.
+    Effects only set parameters of the simulation; of them the linear steps
+    (the rule's gains, the limit cases' margins, the achievable crossover)
+    model the loop delay a ``time_delay`` adds (:data:`LINEAR_EFFECTS`), and
+    analyse the loop without the others.
 
     Parameters
     ----------
@@ -279,21 +324,23 @@ def simulated_only(entries, *, sep: str = " ") -> str:
     Returns
     -------
     str
-        ``the simulation carries the spec's effect time_delay (delay = 0.002 s);
+        ``the simulation carries the spec's effect quantization (resolution = 1 µm);
         the linear analysis (the gains, the margins, the crossover) leaves it
-        out``; empty without entries.
+        out``; empty when the linear analysis models every entry (or there is none).
     """
-    if not entries:
+    left = [e for e in entries if e.type not in LINEAR_EFFECTS]
+    if not left:
         return ""
-    one = len(entries) == 1
+    one = len(left) == 1
     return (f"the simulation carries the spec's effect{'' if one else 's'} "
-            f"{entries_text(entries, sep=sep)}; the linear analysis (the gains, the margins, "
+            f"{entries_text(left, sep=sep)}; the linear analysis (the gains, the margins, "
             f"the crossover) leaves {'it' if one else 'them'} out")
 
 
 def delay_words(delay: float, entries=(), *, sep: str = " ") -> str:
-    """The controller's delay in words: ``no delay``, or ``no controller delay`` where an
-    effect of ``entries`` delays the simulated loop (``time_delay``), or ``delay 0.001 s``.
+    """The loop's delay in words: ``no delay``, ``delay 0.001 s`` (``controller.delay``), or
+    with a ``time_delay`` effect of ``entries``, which delays the loop as well (in the
+    simulation and the linear analysis), ``delay 0.001 s + 0.002 s of the effect time_delay``.
 
     Parameters
     ----------
@@ -304,7 +351,7 @@ def delay_words(delay: float, entries=(), *, sep: str = " ") -> str:
     sep : str, optional
         Between number and unit.
     """
-    if delay:
-        return f"delay {quantity(delay, 's', sep=sep)}"
-    return ("no controller delay" if any(e.type == "time_delay" for e in entries)
-            else "no delay")
+    parts = [quantity(delay, "s", sep=sep)] if delay else []
+    parts += [f"{quantity(e.delay, 's', sep=sep)} of the effect time_delay"
+              for e in entries if e.type == "time_delay"]
+    return "delay " + " + ".join(parts) if parts else "no delay"

@@ -202,7 +202,8 @@ def _gains_table(pid: dict, effects: tuple = ()) -> Any:
     on the output; with the hardware's own gains, the rule's at the same
     crossover in the same form beside them (``pid.rule.in_drive_form``); with
     ``controller.drive`` the same gains in counts and the drive's current unit.
-    The caption names the spec's ``effects``, which the simulation carries and
+    The caption names the loop's delay (``controller.delay`` and a ``time_delay``
+    effect's) and the spec's other ``effects``, which the simulation carries and
     the gains and margins leave out.
     """
     from rich.text import Text
@@ -420,7 +421,7 @@ _CASE_SKIP = {"name", "description", "passed", "failed", "crossovers", "stable",
 
 def cases_table(cases: list, numbers: dict, effects: tuple = ()) -> Any:
     """Table of the linear limit cases (paper Figure 2) from their JSON form and numbers; the
-    caption names the spec's ``effects``, which the margins leave out."""
+    caption names the spec's ``effects`` the margins leave out (all but a ``time_delay``)."""
     from rich.text import Text
 
     keys = [k for k in CASE_COLUMNS if any(k in c for c in cases)]

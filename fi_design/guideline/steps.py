@@ -374,8 +374,8 @@ def step3_flexure(model: Model,
 
 def controller_words(c: ControlLaw, effects: Sequence = ()) -> str:
     """The structure of a controller in words (D input, roll-off, sampling, delay, filters);
-    ``effects``, the spec's effect entries, say whether its missing delay is the loop's
-    (:func:`fi_design.effects.delay_words`)."""
+    ``effects``, the spec's effect entries, add a ``time_delay`` effect's delay to the
+    loop's (:func:`fi_design.effects.delay_words`)."""
     parts = [f"D on the {c.derivative_on}",
              "ideal D" if math.isinf(c.roll_off) else
              f"D roll-off {_g(c.roll_off / (2 * math.pi))} Hz"]

@@ -36,11 +36,13 @@ the same description the simulation uses. A sampled controller is analysed
 in continuous time with its filters as given (the drive's prewarped Tustin
 biquads match them at their own frequencies). The margins do not depend on where the D term acts (error or measurement: the
 loop broken at the plant input is the same); the closed loop from the
-reference does (:func:`complementary_sensitivity`). The computational delay
-``controller.delay``, plus half a sample period for the zero-order hold when
-``controller.sample_rate`` is set, enters as a Pade approximation of order
-``controller.pade_order``; otherwise the controller is analysed in continuous
-time.
+reference does (:func:`complementary_sensitivity`). The loop's delay
+(``controller.delay`` and a ``time_delay`` effect's, which the simulation adds
+to it: :attr:`fi_design.model.Model.loop_delay`), plus half a sample period for
+the zero-order hold when ``controller.sample_rate`` is set, enters as a Pade
+approximation of order ``controller.pade_order``; otherwise the controller is
+analysed in continuous time. The other effects of the spec the simulation
+carries only.
 
 Margins (:class:`CaseMargins`) come from :func:`control.stability_margins`
 with ``returnall=True``; closed-loop stability from the roots of
@@ -239,11 +241,13 @@ def delay_time(model: Model) -> float:
     Returns
     -------
     float
-        The controller's computational delay plus half a sample period
-        (zero-order hold) when it samples [s].
+        The loop's delay (:attr:`fi_design.model.Model.loop_delay`: the controller's
+        computational delay and a ``time_delay`` effect's, which the simulation adds to it)
+        plus half a sample period (zero-order hold) when it samples [s].
     """
-    law = require_model(model).law
-    t = law.delay
+    model = require_model(model)
+    law = model.law
+    t = model.loop_delay
     if law.sample_period > 0.0:
         t += 0.5 * law.sample_period
     return t

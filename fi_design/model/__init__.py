@@ -48,6 +48,7 @@ from typing import Any
 from .. import effects as _effects
 from .. import spec as _spec
 from ..display import quantity
+from ..effects import apply_effects
 from ..errors import ArgumentError, SimulationError, SpecError
 from ..controller.pid import at_crossover, control_law
 from ..kernel.layout import PlantParameters
@@ -334,8 +335,15 @@ class Model:
 
     @property
     def delay(self) -> float:
-        """Computational delay of the controller [s]."""
+        """Computational delay of the controller [s] (``controller.delay``)."""
         return self.law.delay
+
+    @property
+    def loop_delay(self) -> float:
+        """The loop's delay [s]: ``controller.delay`` with the model's effects on it (a
+        ``time_delay`` adds its delay), the delay :meth:`plant` gives the simulation and the
+        linear analysis models (:func:`fi_design.loop.linear.delay_time`)."""
+        return _effects.effect_value(self.effects, "delay", self.law.delay)
 
     @property
     def requirements(self) -> _spec.Requirements:
@@ -710,18 +718,3 @@ def require_model(value: Any) -> Model:
         raise ArgumentError(f"expected a Model, got {type(value).__name__}: resolve a spec "
                             "once with fi_design.resolve(spec) and pass the model")
     return value
-
-
-def apply_effects(params: PlantParameters, entries) -> PlantParameters:
-    """Set the kernel parameters of effect entries (neutral values change nothing)."""
-    changes: dict[str, float] = {}
-    for entry in entries:
-        eff = _effects.get(entry.type)
-        for par in eff.parameters:
-            value = getattr(entry, par.name)
-            if value is None:
-                continue
-            if par.combine == "add":
-                value = getattr(params, par.kernel_field) + value
-            changes[par.kernel_field] = float(value)
-    return replace(params, **changes) if changes else params

@@ -36,7 +36,7 @@ from ..spec.file import with_values
 
 __all__ = ["SEARCH_POINTS", "TOP", "reserve_values", "reserve_requirements", "crossover_cap",
            "notched_model", "notch_entries", "guide_for", "thickest_stiffness",
-           "guide_bounds", "loop_meets", "stage_answer",
+           "guide_bounds", "loop_meets", "stage_answer", "longer_delay",
            "margin_screen", "reserve_corners", "hunting_margin"]
 
 #: Lengths of the guide's sizing grid during the search (the chosen design is sized again at
@@ -354,14 +354,23 @@ def _settles(model: Model) -> bool:
                          trace=False, order="spread").acceptable
 
 
+def longer_delay(model: Model, fraction: float) -> Model:
+    """The model with its loop's delay longer by ``fraction`` [-]: the delay the linear
+    analysis models (:func:`fi_design.loop.linear.delay_time`: ``controller.delay``, a
+    ``time_delay`` effect's and half the sample period), its controller's delay lengthened."""
+    hold = 0.5 * model.law.sample_period
+    effect = model.loop_delay - model.law.delay
+    return model.at(delay=(model.loop_delay + hold) * (1.0 + fraction) - hold - effect)
+
+
 def reserve_corners(model: Model) -> tuple[dict, ...]:
     """The candidate with the reserve's deviations: does it still pass?
 
     Each corner: the masses ``+-reserve.mass`` (the controller keeps its
     tuning, the guide as built carries the stage), the drive stiffness at the
     stock's thickness tolerance, the computed modes ``-reserve.modes``, the
-    loop delay ``+reserve.delay`` (of the delay and half the sample period;
-    none without either). A corner passes when the four limit cases meet the
+    loop delay ``+reserve.delay`` (:func:`longer_delay`; none without a delay or
+    sampling). A corner passes when the four limit cases meet the
     margins (the requirements, not the reserve) and no move of the family
     hunts.
 
@@ -387,10 +396,8 @@ def reserve_corners(model: Model) -> tuple[dict, ...]:
     if any(m.source == "computed" for m in model.modes):
         corners.append((f"computed modes -{percent(r.modes, 3)}",
                         model.at(mode_scale=1.0 - r.modes)))
-    if model.law.delay > 0.0 or model.law.sample_period > 0.0:
-        corners.append((f"delay +{percent(r.delay, 3)}",
-                        model.at(delay=(model.law.delay + 0.5 * model.law.sample_period)
-                                 * (1 + r.delay) - 0.5 * model.law.sample_period)))
+    if model.loop_delay > 0.0 or model.law.sample_period > 0.0:
+        corners.append((f"delay +{percent(r.delay, 3)}", longer_delay(model, r.delay)))
     out = []
     for name, m in corners:
         res = linear.analyse(m)

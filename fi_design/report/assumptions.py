@@ -140,19 +140,22 @@ def _loop(result: Any) -> list[str]:
     law = result.pid.controller
     spec = result.spec
     effects = [e.type for e in spec.effects]
-    delayed = "time_delay" in effects
-    sampled = (("a continuous-time controller without delay" if not delayed else
+    delays = [e.delay for e in spec.effects if e.type == "time_delay"]
+    sensor = [e for e in effects if e == "quantization"]
+    sampled = (("a continuous-time controller without delay" if not delays else
                 "a continuous-time controller without a delay of its own")
                if law.sample_period == 0 and law.delay == 0 else
                ("continuous-time" if law.sample_period == 0 else
                 f"sampled at {qty(1.0 / law.sample_period, 'Hz')} with a zero-order hold")
                + ("" if law.delay == 0 else f", delay {qty(law.delay, 's')}"))
-    sensor = [e for e in effects if e == "quantization"]
     simulated = simulated_only(spec.effects, sep=NBSP)
     out = [f"The loop is {sampled}"
            + (" (the hardware samples and computes with a delay: give controller.sample_rate "
               "and controller.delay to judge the loop it has)" if law.sample_period == 0
-              and law.delay == 0 and not delayed else "") + "."]
+              and law.delay == 0 and not delays else "")
+           + "".join(f"; the spec's effect time_delay adds {qty(d, 's')} to the loop's delay, "
+                     "in the simulation and in the linear analysis (its margins and crossover)"
+                     for d in delays) + "."]
     limit = law.force_limit
     out.append(
         "The actuator is an ideal force source: no actuator dynamics (current loop, motor "

@@ -90,14 +90,16 @@ def _linear(result: Any, figures: bool, fig_no: _Numbering) -> dict:
     n = len(xo.cases)
     m = req.modulus_margin if req.modulus_margin is not None else 0.5
     simulated = simulated_only(result.spec.effects, sep=NBSP)
+    delayed = any(e.type == "time_delay" for e in result.spec.effects)
     return {
         "intro": (
             f"The loop L = C D P of each of the {n} linear limit cases (paper Figure 2) with the "
             f"PID of step 4 at the desired crossover of {qty(xo.desired, 'Hz')}"
             + (f" and a Pad\u00e9 model of the {qty(xo.delay, 's')} loop delay"
+               + (", the spec's effect time_delay included" if delayed else "")
                if xo.delay > 0 else "")
-            + (f" (the margins of the loop without the spec's effects: {simulated})"
-               if simulated else "")
+            + (f" (the margins of the loop without the spec's {'other ' if delayed else ''}"
+               f"effects: {simulated})" if simulated else "")
             + ". Margins come from python-control's stability_margins; closed-loop stability "
             "from the roots of the characteristic polynomial. A case can cross 0 dB more than "
             "once; the first table gives the crossing with the smallest phase margin and the "

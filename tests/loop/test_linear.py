@@ -151,6 +151,17 @@ def test_delay_is_a_pade_of_delay_plus_half_a_sample(paper_spec):
     assert linear.delay_time(resolve(paper_spec)) == 0.0
 
 
+def test_the_linear_delay_is_the_simulated_loops(paper_spec):
+    """The simulation applies the actuator force controller.delay plus a time_delay effect's
+    delay later (the kernel's delay); the linear analysis modelled controller.delay alone."""
+    model = resolve(variant(paper_spec, **{"controller.delay": "0.2 ms",
+                                           "controller.sample_rate": "5 kHz"},
+                            effects=[{"type": "time_delay", "delay": "1 ms"}]))
+    assert model.plant(True).delay == pytest.approx(1.2e-3, rel=1e-12)
+    assert linear.delay_time(model) == pytest.approx(model.plant(True).delay + 0.5 / 5000,
+                                                     rel=1e-12)
+
+
 # --------------------------------------------------------------------------- margins
 
 
@@ -362,3 +373,46 @@ def test_nothing_feasible_is_said(paper_spec):
     ach = achievable_crossover(resolve(spec))
     assert ach.frequency is None and ach.kind == "infeasible"
     assert ach.limited_by.startswith("no crossover from")
+
+
+# --------------------------------------------------------------------------- effects
+
+
+def _rigid_delayed(paper_spec, **paths):
+    """The paper stage without isolator (two rigid cases, one 0 dB crossing each) with
+    ``paths`` set, resolved."""
+    return resolve(variant(paper_spec, isolator=None, **paths))
+
+
+def test_a_time_delay_effect_delays_the_loop_the_margins_judge(paper_spec):
+    """The simulation adds a time_delay effect's delay to controller.delay (the actuator
+    applies the force that much later), so it is a delay of the loop: the margins must lose
+    its phase. They were those of the loop without it: the same margins as no delay at all.
+
+    Analytic check: an extra delay T moves no gain crossing (|e^{-j w T}| = 1) and takes
+    360 f_c T degrees of phase at each crossing f_c; and the loop is the spec's with
+    controller.delay = T."""
+    T = 1e-3
+    plain = linear.analyse(_rigid_delayed(paper_spec))
+    model = _rigid_delayed(paper_spec, effects=[{"type": "time_delay", "delay": "1 ms"}])
+    delayed = linear.analyse(model)
+    own = linear.analyse(_rigid_delayed(paper_spec, **{"controller.delay": "1 ms"}))
+    assert linear.delay_time(model) == delayed.delay == T
+    for p, d, o in zip(plain.cases, delayed.cases, own.cases):
+        assert p.stable and d.stable and len(p.gain_crossings) == len(d.gain_crossings) == 1
+        f = p.crossover
+        assert d.crossover == pytest.approx(f, rel=1e-9)
+        assert d.phase_margin_deg == pytest.approx(p.phase_margin_deg - 360.0 * f * T,
+                                                   abs=1e-3)
+        assert d.phase_margin_deg == pytest.approx(o.phase_margin_deg, rel=1e-12)
+        assert d.delay_margin == pytest.approx(p.delay_margin - T, rel=1e-6)
+
+
+def test_the_achievable_crossover_counts_a_time_delay_effect(paper_spec):
+    """The achievable crossover of a spec whose loop delay is a 2 ms time_delay effect is that
+    of the same spec with controller.delay = 2 ms (it was that of the loop without delay)."""
+    effect = achievable_crossover(_rigid_delayed(
+        paper_spec, effects=[{"type": "time_delay", "delay": "2 ms"}]))
+    own = achievable_crossover(_rigid_delayed(paper_spec, **{"controller.delay": "2 ms"}))
+    assert effect.kind == own.kind == "margin"
+    assert effect.frequency == pytest.approx(own.frequency, rel=1e-9)

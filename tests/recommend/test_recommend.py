@@ -578,3 +578,29 @@ def test_the_nearest_design_of_a_vertical_axis_holds_its_own_guide(repo_root):
     # on 2.92 mm, when the nearest was ranked by hunting margin alone)
     assert sag < 1.1 * d.stroke, (sag, d.stroke)
     assert d.end_stop_clearance is not None and d.end_stop_clearance < 0.0
+
+
+@pytest.mark.parametrize("paths", [{}, {"controller.sample_rate": "1 kHz"}])
+def test_the_delay_reserve_lengthens_the_loop_delay_of_a_time_delay_effect(paper_spec,
+                                                                           monkeypatch, paths):
+    """The reserve's corner 'delay +50 %' lengthened controller.delay (and half the sample
+    period) alone: a loop whose delay is a time_delay effect had no such corner, or one with
+    the effect's delay not lengthened. Now the corner's loop delay, as the linear analysis
+    models it, is the nominal one times 1 + reserve.delay."""
+    from fi_design.loop import linear
+    from fi_design.model import resolve
+    from fi_design.recommend import constraints
+
+    model = resolve(variant(paper_spec, isolator=None,
+                            effects=[{"type": "time_delay", "delay": "2 ms"}], **paths))
+    analysed = {}
+    real = linear.analyse
+    monkeypatch.setattr(linear, "analyse", lambda m: analysed.setdefault(id(m), (m, real(m)))[1])
+    monkeypatch.setattr(constraints, "_settles", lambda m: True)  # the simulation: not here
+    corners = constraints.reserve_corners(model)
+    r = model.requirements.reserve.delay
+    assert [c["name"].split()[0] for c in corners].count("delay") == 1
+    late = [m for m, _ in analysed.values() if m.changed == ("controller.delay",)]
+    assert len(late) == 1
+    assert linear.delay_time(late[0]) == pytest.approx((1 + r) * linear.delay_time(model),
+                                                       rel=1e-12)

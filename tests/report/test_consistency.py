@@ -384,15 +384,17 @@ def test_the_checks_table_has_one_group_per_step(paper_confirmed_design):
 
 
 @pytest.fixture(scope="module")
-def delayed_design():
-    """examples/no_isolator.yaml with a 2 ms time_delay effect, without the simulation: the
-    linear steps analyse the loop without it, the simulation carries it."""
+def effects_design():
+    """examples/no_isolator.yaml with a 2 ms time_delay effect and a 1 um quantization effect,
+    without the simulation: the linear steps analyse the loop with the delay (a delay of the
+    loop) and without the quantization, the simulation carries both."""
     from conftest import EXAMPLES
     from fi_design.guideline.evaluate import evaluate
     from fi_design.spec.file import load_spec, with_values
 
     spec = with_values(load_spec(EXAMPLES / "no_isolator.yaml"),
-                       {"effects": [{"type": "time_delay", "delay": "2 ms"}]})
+                       {"effects": [{"type": "time_delay", "delay": "2 ms"},
+                                    {"type": "quantization", "resolution": "1 um"}]})
     return evaluate(spec, confirm=False)
 
 
@@ -400,39 +402,51 @@ def _plain(text: str) -> str:
     return re.sub(r"\s+", " ", text.replace("\u00a0", " "))
 
 
-def test_the_console_names_the_effects_the_simulation_carries(delayed_design):
+#: What the console and the report say of the effect the linear analysis leaves out.
+QUANTIZATION_LEFT_OUT = ("the spec's effect quantization (resolution = 1 µm); the linear "
+                         "analysis (the gains, the margins, the crossover) leaves it out")
+
+
+def test_the_console_names_the_effects_the_simulation_carries(effects_design):
     """A spec with a 2 ms time_delay effect: the console's PID line, its gains' caption and
-    the conclusion said 'continuous, no delay' and the limit cases' margins (of the loop
-    without it) said nothing of it. Now each names the effect and says the linear analysis
-    leaves it out."""
+    the conclusion said 'continuous, no controller delay', and that the linear analysis
+    leaves the effect out, while the simulation adds it to controller.delay: a delay of the
+    loop, which the margins now include. Each names the delay, and only the quantization as
+    left out of the linear analysis."""
     from rich.console import Console
 
     from fi_design.console import print_design
 
     out = Console(width=120, record=True)
-    print_design(out, delayed_design)
+    print_design(out, effects_design)
     text = _plain(out.export_text())
-    assert "no delay" not in text
-    assert text.count("continuous, no controller delay") == 3, text  # check, caption, conclusion
-    said = ("the spec's effect time_delay (delay = 0.002 s); the linear analysis (the gains, "
-            "the margins, the crossover) leaves it out")
+    assert "no delay" not in text and "no controller delay" not in text
+    # check, caption, conclusion
+    assert text.count("continuous, delay 0.002 s of the effect time_delay") == 3, text
+    assert "time_delay (delay = 0.002 s)" not in text
     # the PID check and the gains' caption, the cases' caption, the conclusion
-    assert text.lower().count(said.lower()) == 4, text
+    assert text.lower().count(QUANTIZATION_LEFT_OUT.lower()) == 4, text
+    assert text.count("leaves it out") == 4
 
 
-def test_the_report_names_the_effects_the_simulation_carries(delayed_design):
-    """The report's step 4 said 'continuous, no delay', its assumptions 'a continuous-time
-    controller without delay (the hardware samples and computes with a delay: give
-    controller.delay ...)' and 'The spec adds the effects time_delay', and the linear section
-    nothing of the effect its margins leave out."""
-    ctx = report.build_context(delayed_design, date=DATE, figures=False)
-    said = "effect time_delay (delay = 0.002 s); the linear analysis"
+def test_the_report_names_the_effects_the_simulation_carries(effects_design):
+    """The report's step 4 said 'continuous, no controller delay', and step 4, the linear
+    section and the assumptions that the linear analysis leaves the time_delay effect out,
+    which its margins now include."""
+    ctx = report.build_context(effects_design, date=DATE, figures=False)
     step4 = _plain(next(s for s in ctx["steps"] if s["number"] == 4)["explanation"])
-    assert "no controller delay" in step4 and said in step4, step4
-    assert said in _plain(ctx["linear"]["intro"]), ctx["linear"]["intro"]
+    assert "continuous, delay 0.002 s of the effect time_delay" in step4, step4
+    assert QUANTIZATION_LEFT_OUT in step4, step4
+    intro = _plain(ctx["linear"]["intro"])
+    assert ("a Padé model of the 0.002 s loop delay, the spec's effect time_delay included "
+            "(the margins of the loop without the spec's other effects: the simulation carries "
+            + QUANTIZATION_LEFT_OUT + ")") in intro, intro
     text = " ".join(_plain(t) for t in _strings(ctx))
     assert "no delay" not in text and "without delay" not in text
-    assert "a continuous-time controller without a delay of its own." in text
+    assert "time_delay (delay = 0.002 s)" not in text
+    assert ("a continuous-time controller without a delay of its own; the spec's effect "
+            "time_delay adds 0.002 s to the loop's delay, in the simulation and in the linear "
+            "analysis") in text
 
 
 def _strings(node):
