@@ -141,7 +141,7 @@ def _loop(result: Any) -> list[str]:
     spec = result.spec
     effects = [e.type for e in spec.effects]
     delays = [e.delay for e in spec.effects if e.type == "time_delay"]
-    sensor = [e for e in effects if e == "quantization"]
+    steps = [e.resolution for e in spec.effects if e.type == "quantization"]
     sampled = (("a continuous-time controller without delay" if not delays else
                 "a continuous-time controller without a delay of its own")
                if law.sample_period == 0 and law.delay == 0 else
@@ -157,13 +157,17 @@ def _loop(result: Any) -> list[str]:
                      "in the simulation and in the linear analysis (its margins and crossover)"
                      for d in delays) + "."]
     limit = law.force_limit
+    sensor = ("The sensor is ideal: no sensor noise, no quantization, no latency beyond the "
+              "loop's delay" if not steps else
+              "The sensor has no noise and no latency beyond the loop's delay, and resolves the "
+              "position in steps of " + " and ".join(qty(q, "m") for q in steps)
+              + " (the spec's effect quantization)")
     out.append(
         "The actuator is an ideal force source: no actuator dynamics (current loop, motor "
         "inductance, amplifier bandwidth)"
         + (f", saturating at \u00b1{qty(limit, 'N')}" if math.isfinite(limit)
            else "" if "force_saturation" in effects else ", no saturation")
-        + ". The sensor is ideal: no sensor noise"
-        + ("" if sensor else ", no quantization") + ", no latency beyond the loop's delay."
+        + f". {sensor}."
         + (f" {simulated[0].upper()}{simulated[1:]}." if simulated else ""))
     return out
 

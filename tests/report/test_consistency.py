@@ -449,6 +449,16 @@ def test_the_report_names_the_effects_the_simulation_carries(effects_design):
             "analysis") in text
 
 
+def test_the_report_does_not_call_a_quantized_sensor_ideal(effects_design):
+    """The assumptions said 'The sensor is ideal' beside a quantization effect, which the
+    simulation carries: the controller sees the position in whole steps."""
+    ctx = report.build_context(effects_design, date=DATE, figures=False)
+    text = " ".join(_plain(t) for t in _strings(ctx))
+    assert "sensor is ideal" not in text
+    assert ("The sensor has no noise and no latency beyond the loop's delay, and resolves the "
+            "position in steps of 1 µm (the spec's effect quantization).") in text
+
+
 def _strings(node):
     """Every string in a report context."""
     if isinstance(node, str):
