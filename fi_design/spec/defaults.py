@@ -13,6 +13,7 @@ import sys
 from typing import TYPE_CHECKING
 
 from ..display import number, quantity
+from ..results.mechanism import GRAVITY
 from .sections import Limiter, ParasiticMode
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -187,6 +188,29 @@ LIMITER_STIFFER = 10.0
 STAGE_DENSITY = (10.0, 22600.0)
 
 
+def _weight_twice(spec: Spec) -> list[tuple[str, str]]:
+    """The warning on a load offset beside a vertical drive axis, whose weight the design
+    adds to the simulated actuator force (:attr:`fi_design.model.Model.held_weight`): an
+    offset that stands for the weight counts it twice."""
+    iso = spec.isolator
+    flexure = None if iso is None else iso.flexure
+    if flexure is None or flexure.orientation != "vertical_axis":
+        return []
+    path, offset = "friction.offset", spec.friction.offset
+    for i, e in enumerate(spec.effects):
+        if e.type == "force_offset":  # the effect sets the simulated load in its place
+            path, offset = f"effects[{i}].offset", e.offset
+    if not offset:
+        return []
+    weight = spec.total_mass * GRAVITY
+    return [(path, f"a load offset of {quantity(offset, 'N', 4)} on a vertical drive axis "
+                   "(isolator.flexure.orientation: vertical_axis), whose weight (m1 + m2) g = "
+                   f"{quantity(weight, 'N', 4)} the design already adds to the actuator's "
+                   "simulated force (the simulation carries no weight): an offset that stands "
+                   "for the weight counts it twice; give only the drive's own offset here "
+                   "(0 without)")]
+
+
 def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     """Suspicious but legal input, as ``(path, message)`` pairs.
 
@@ -202,6 +226,8 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
     outlasts the run, a hunting window that starts before the last move ends, an end stop
     the user made less than :data:`LIMITER_STIFFER` times stiffer than the joint, a stage
     box whose mean density lies outside :data:`STAGE_DENSITY`,
+    a load offset (``friction.offset`` or a ``force_offset`` effect) on a vertical drive
+    axis, whose weight the actuator's forces already add,
     a loop without the hardware's sampling and delay (a
     continuous controller without delay: the margins and the hunting depend
     on both), and a ``simulation.crossover_scan.step`` (read, not used).
@@ -250,6 +276,7 @@ def warnings_for(spec: Spec) -> list[tuple[str, str]]:
                         f"{number(LIMITER_STIFFER)} times {whose}, {quantity(k, 'N/m')}: it "
                         "hardly limits the stroke, while the limit cases with the limiter "
                         "engaged (3 and 4) take the joint on its end stop as rigid"))
+    out += _weight_twice(spec)
     size = spec.stage.size
     if size is not None:
         rho = spec.stage.mass / (size[0] * size[1] * size[2])

@@ -150,6 +150,29 @@ def test_warnings_fire_on_the_users_own_values(paper_spec):
     assert "default" not in dict(sp.warnings_for(given))["requirements.hunting.window_start"]
 
 
+def test_a_load_offset_on_a_vertical_axis_is_warned_as_a_weight_counted_twice(paper_spec):
+    """On a vertical drive axis the actuator's forces add the weight (m1 + m2) g, which the
+    simulation does not carry (Model.held_weight); friction.offset is a load the simulation
+    carries, so an offset given for gravity (as its description suggests: gravity on an
+    inclined axis) put the weight into the actuator's peak force twice, without a word. Now
+    the spec is warned about, with the weight by hand; neither alone is."""
+    from fi_design.model import resolve
+
+    weight = (1.6 + 0.4) * 9.80665  # N, (m1 + m2) g of the paper stage
+    vertical = {"isolator.flexure.orientation": "vertical_axis"}
+    both = variant(paper_spec, **vertical, **{"friction.offset": "19.6 N"})
+    assert resolve(both).held_weight == pytest.approx(weight) and resolve(both).offset == 19.6
+    message = dict(sp.warnings_for(both))["friction.offset"]
+    assert "19.6 N on a vertical drive axis" in message and "19.61 N" in message
+    assert "counts it twice" in message
+    effect = variant(paper_spec, **vertical, effects=[{"type": "force_offset", "offset": "-5 N"}])
+    assert "-5 N on a vertical drive axis" in dict(sp.warnings_for(effect))["effects[0].offset"]
+    for alone in (variant(paper_spec, **vertical),
+                  variant(paper_spec, **{"friction.offset": "19.6 N"})):
+        found = dict(sp.warnings_for(alone))
+        assert "friction.offset" not in found and "effects[0].offset" not in found
+
+
 def test_a_move_thousands_of_strokes_long_and_a_run_it_outlasts_are_warned(paper_spec):
     """A bare `distance: 5` is 5 m: 16667 times the 0.3 mm stroke, a 100 s move in a 20 s run."""
     spec = variant(paper_spec, **{"motion.moves": [
