@@ -189,13 +189,20 @@ def remember(kind: str, spec, result, *extra) -> None:
 
 def shared(kind: str, spec, compute, *extra):
     """``compute()`` once in the run for this kind of result of this spec (file and content):
-    once per process, and across pytest-xdist's processes through :data:`_ACROSS`."""
+    once per process, and across pytest-xdist's processes through :data:`_ACROSS`.
+
+    Computed in the repository's root, whichever test asks first: a result names its spec's
+    path relative to the working directory (the next step's command), so one first asked for
+    by a test working in a temporary folder named it absolute for every test after it."""
+    import contextlib
+
     key = _spec_key(spec)
     if key is None:
         return compute()
     key = (kind, *key, *extra)
     if key not in _SHARED:
-        _SHARED[key] = compute() if _ACROSS is None else _computed_once(key, compute)
+        with contextlib.chdir(ROOT):
+            _SHARED[key] = compute() if _ACROSS is None else _computed_once(key, compute)
     return _SHARED[key]
 
 
