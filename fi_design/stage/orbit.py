@@ -21,7 +21,7 @@ from ..results.stage import Cycle, CycleTrace
 from ..simulation.run import tolerances
 from .family import hold
 from .rest import rest_ends_run
-from .runs import guess_period, kernel_run, resumes_sampled, watch_array
+from .runs import continued_state, guess_period, kernel_run, watch_array
 from .settings import MULTIPLIER_AGREEMENT, ORBIT_RTOL, PERTURBATION, REPEAT, Watch, restartable
 
 __all__ = ["converge_cycle", "FoundCycle", "cycle_exists"]
@@ -300,15 +300,13 @@ def cycle_exists(params: PlantParameters, level: float, guess: np.ndarray, w: Wa
         if out.stop == "quiet":
             if rest_ends_run(params, out.final_state, level, w.band):
                 return None
-            sampled = not restartable(params) and resumes_sampled(params, out)
-            if not (restartable(params) or sampled):
+            go_on = continued_state(params, out)
+            if go_on is None:
                 return FoundCycle(None, 0, None, None)  # cannot continue exactly: not at rest yet
             offset += out.t_reached
             if offset >= horizon:  # quiet to the end of the horizon: no cycle repeated in it
                 return None
-            y0 = out.final_state.copy()
-            if sampled:  # stopped on a sample instant: the controller's states carry over
-                y0 = np.concatenate([y0, out.controller[1:3]])
+            y0 = go_on
             ref = hold(level, horizon - offset)
             continue
         n = len(out.crossing_times)

@@ -218,6 +218,32 @@ def resumes_sampled(params: PlantParameters, out) -> bool:
     return params.sample_period > 0.0 and out.stop == "quiet" and out.controller[3] == 0
 
 
+def continued_state(params: PlantParameters, out) -> np.ndarray | None:
+    """The state a run that stopped goes on from exactly, for :func:`kernel_run`; None if none.
+
+    Its final state where that is the whole state (:func:`~.settings.restartable`); a
+    sampled loop's, stopped on a sample instant with nothing pending
+    (:func:`resumes_sampled`), followed by its controller's ``dx2`` and held output (a
+    section state, :func:`resumed`); otherwise None (a run has to start over).
+
+    Parameters
+    ----------
+    params : PlantParameters
+        The plant.
+    out : fi_design.kernel.layout.Integration
+        The run that stopped.
+
+    Returns
+    -------
+    ndarray or None
+    """
+    if restartable(params):
+        return out.final_state.copy()
+    if resumes_sampled(params, out):
+        return np.concatenate([out.final_state, out.controller[1:3]])
+    return None
+
+
 def match_tolerance(params: PlantParameters, known: Sequence[MoveRun]) -> float:
     """How close to a known cycle a move's section state must come to have entered it [-].
 
@@ -310,14 +336,11 @@ def move_outcome(params: PlantParameters, ref: Trajectory, move_end: float, w: W
             rested_at = offset + out.t_reached if abs(y[0] - level) <= w.band else None
             if offset + out.t_reached >= t_end * (1 - 1e-12):
                 break
-            sampled = resumes_sampled(params, out)
-            if restart or sampled:
+            go_on = continued_state(params, out)
+            if go_on is not None:
                 offset += out.t_reached
-                cur_y0, cur_ref = y.copy(), hold(level, t_end - offset)
+                cur_y0, cur_ref = go_on, hold(level, t_end - offset)
                 cur_end, start = t_end - offset, 0.0
-                if sampled:  # on a sample instant: the controller's states carry over
-                    dx1, dx2, held, _ = out.controller
-                    params = replace(params, dx1=dx1, dx2=dx2, u_initial=held)
             else:  # run again from the start, watching from later on
                 start = out.t_reached + 1e-9
             continue

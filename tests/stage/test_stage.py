@@ -497,7 +497,7 @@ def test_a_cycle_test_quiet_to_the_end_of_its_horizon_finds_no_cycle(monkeypatch
     monkeypatch.setattr(orbit, "kernel_run", lambda *a, **k: quiet)
     monkeypatch.setattr(orbit, "watch_array", lambda *a, **k: None)
     monkeypatch.setattr(orbit, "rest_ends_run", lambda *a, **k: False)
-    monkeypatch.setattr(orbit, "restartable", lambda *a, **k: True)
+    monkeypatch.setattr(orbit, "continued_state", lambda p, out: out.final_state.copy())
     w = SimpleNamespace(horizon=1.0, tolerance=1e-6, max_steps=10, band=1e-5)
     assert orbit.cycle_exists(None, 0.0, np.zeros(4), w) is None
 
